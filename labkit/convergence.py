@@ -1,0 +1,169 @@
+"""The lab's convergence experiments: error tables and observed orders.
+
+``convergence_table`` interpolates a function from equally spaced data of
+growing size and reports the relative maximum error, the ratios between
+successive errors and the order they imply. The tables the lab asks for are
+printed in ``notebooks/02_convergence.ipynb``.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .functions import runge
+from .monotone import pchip_slopes
+from .piecewise import _hermite_eval, eval_plin
+from .splines import ccspline, nakspline, ncspline
+
+METHOD_TITLES = {
+    "plin": "Piecewise Linear",
+    "pherm": "Piecewise Hermite Cubic",
+    "complete": "Complete Cubic Spline",
+    "natural": "Natural Cubic Spline",
+    "notaknot": "Not-A-Knot Cubic Spline",
+    "pchip": "Monotone Cubic Interpolation",
+}
+NEEDS_DERIVATIVE = {"pherm", "complete"}
+DEFAULT_NDATA = (5, 11, 21, 41, 81, 161, 321, 641)
+
+
+@dataclass(frozen=True)
+class ConvergenceTable:
+    """Errors of one interpolation method for growing data sizes.
+
+    Attributes
+    ----------
+    title : str
+        First line of the printed table, e.g. ``"Runge function, Natural Cubic Spline"``.
+    ndata : ndarray of int
+        Number of data points of each row.
+    errors : ndarray
+        ``max|f - p| / max|f|`` over the test points, one per row.
+    ratios : ndarray
+        ``errors[i] / errors[i+1]`` (one fewer than rows).
+    rates : ndarray
+        Observed order of each ratio: ``log(ratio) / log(h_i / h_{i+1})``.
+    order : int
+        The estimated order: the nearest integer to the mean of the
+        observed rates of the three finest ratios.
+    """
+
+    title: str
+    ndata: np.ndarray
+    errors: np.ndarray
+
+    @property
+    def ratios(self):
+        return self.errors[:-1] / self.errors[1:]
+
+    @property
+    def rates(self):
+        spacing_ratio = (self.ndata[1:] - 1) / (self.ndata[:-1] - 1)
+        return np.log(self.ratios) / np.log(spacing_ratio)
+
+    @property
+    def order(self):
+        return int(np.rint(np.mean(self.rates[-3:])))
+
+    def __str__(self):
+        lines = [self.title]
+        for i, (n, err) in enumerate(zip(self.ndata, self.errors)):
+            row = f"ndata ={n:3d}  Err({n:3d}) = {err:10.3e}"
+            if i:
+                prev = self.ndata[i - 1]
+                row += f"  Err({prev:3d})/Err({n:3d}) = {self.ratios[i - 1]:8.3f}"
+            lines.append(row)
+        lines.append(f"Estimated order of convergence: {self.order}")
+        return "\n".join(lines)
+
+
+def convergence_table(method, ndata=DEFAULT_NDATA, f=runge, interval=(0.0, 5.0), ntest=4001):
+    """Interpolation errors of `method` on equally spaced data, as in the lab.
+
+    Parameters
+    ----------
+    method : {'plin', 'pherm', 'complete', 'natural', 'notaknot', 'pchip'}
+        Piecewise linear, piecewise Hermite, and the complete, natural and
+        not-a-knot cubic splines, or monotone cubic (pchip) interpolation.
+    ndata : sequence of int
+        Data sizes, each at least 2 (4 for 'notaknot' to be a true spline).
+    f : callable
+        ``f(x)`` returning values, or ``(values, derivatives)`` as
+        :func:`labkit.runge` does; 'pherm' and 'complete' need derivatives
+        ('complete' uses them at the two ends only).
+    interval : (float, float)
+        Where the data and test points lie.
+    ntest : int
+        Number of equally spaced test points.
+
+    Returns
+    -------
+    ConvergenceTable
+        ``str()`` of it is the table in the lab's layout.
+
+    Examples
+    --------
+    >>> from labkit import convergence_table
+    >>> table = convergence_table("pherm")
+    >>> table.order
+    4
+    >>> print(str(table).splitlines()[2])
+    ndata = 11  Err( 11) =  1.252e-03  Err(  5)/Err( 11) =   28.446
+    """
+    if method not in METHOD_TITLES:
+        raise ValueError(
+            f"unknown method {method!r}; choose one of {', '.join(map(repr, METHOD_TITLES))}."
+        )
+    sizes = np.asarray(ndata)
+    if sizes.ndim != 1 or sizes.size < 2 or not np.issubdtype(sizes.dtype, np.integer):
+        raise ValueError("ndata must be a sequence of at least two whole numbers of points.")
+    if np.any(sizes < 2):
+        raise ValueError("every entry of ndata must be at least 2 (one interval).")
+    a, b = _check_interval(interval)
+    if int(ntest) < 2:
+        raise ValueError("ntest must be at least 2 test points.")
+    xtest = np.linspace(a, b, int(ntest))
+    exact, _ = _values_and_slopes(f, xtest, method)
+    scale = np.max(np.abs(exact))
+    errors = np.array(
+        [np.max(np.abs(exact - _interpolate(method, f, a, b, n, xtest))) / scale for n in sizes]
+    )
+    name = "Runge function" if f is runge else getattr(f, "__name__", "f")
+    return ConvergenceTable(f"{name}, {METHOD_TITLES[method]}", sizes, errors)
+
+
+def _check_interval(interval):
+    try:
+        a, b = (float(v) for v in interval)
+    except (TypeError, ValueError):
+        raise ValueError("interval must be a pair (a, b) of numbers.") from None
+    if not (np.isfinite(a) and np.isfinite(b) and a < b):
+        raise ValueError(f"interval must satisfy a < b with finite ends; got ({a}, {b}).")
+    return a, b
+
+
+def _values_and_slopes(f, x, method):
+    out = f(x)
+    if isinstance(out, tuple):
+        return np.asarray(out[0], dtype=float), np.asarray(out[1], dtype=float)
+    if method in NEEDS_DERIVATIVE:
+        raise ValueError(
+            f"method {method!r} needs derivatives: f must return (values, derivatives) "
+            "as labkit.runge does."
+        )
+    return np.asarray(out, dtype=float), None
+
+
+def _interpolate(method, f, a, b, n, xtest):
+    """Build the interpolant of f from n equally spaced points; evaluate it."""
+    x = np.linspace(a, b, n)
+    y, yp = _values_and_slopes(f, x, method)
+    if method == "plin":
+        return eval_plin(x, y, xtest)
+    slopes = {
+        "pherm": lambda: yp,
+        "complete": lambda: ccspline(x, y, yp[0], yp[-1]),
+        "natural": lambda: ncspline(x, y),
+        "notaknot": lambda: nakspline(x, y),
+        "pchip": lambda: pchip_slopes(x, y),
+    }[method]()
+    return _hermite_eval(x, y, slopes, xtest)

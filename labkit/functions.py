@@ -1,0 +1,45 @@
+"""Test functions of the lab: the Runge function in one and two variables."""
+import numpy as np
+
+from ._validate import as_float_array, scalar_or_array
+
+
+def runge(x):
+    """The Runge function ``1 / (1 + x**2)`` and its derivative.
+
+    Parameters
+    ----------
+    x : array_like
+        Points, any shape.
+
+    Returns
+    -------
+    y, yprime : float or ndarray, same shape as `x`
+        ``y = 1/(1+x^2)`` and ``y' = -2x/(1+x^2)^2``.
+
+    Examples
+    --------
+    >>> from labkit import runge
+    >>> [float(v) for v in runge(1.0)]
+    [0.5, -0.5]
+    """
+    xa = as_float_array(x, "x")
+    y = 1.0 / (1.0 + xa * xa)
+    yprime = -2.0 * xa * y * y
+    return scalar_or_array(y, x), scalar_or_array(yprime, x)
+
+
+def runge2d(x, y):
+    """The two-dimensional Runge function ``1 / (1 + (x + y)**2)``.
+
+    `x` and `y` broadcast against each other, so ``runge2d(X, Y)`` on
+    ``np.meshgrid(..., indexing='ij')`` grids gives a table of values.
+
+    Examples
+    --------
+    >>> from labkit import runge2d
+    >>> float(runge2d(0.5, 0.5))
+    0.5
+    """
+    s = as_float_array(x, "x") + as_float_array(y, "y")
+    return scalar_or_array(1.0 / (1.0 + s * s), s)
