@@ -22,6 +22,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_core.py
+	$(PY) benchmarks/bench_2d.py
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis

@@ -3,14 +3,23 @@
 Everything a notebook needs is importable from here, e.g.
 ``from labkit import eval_pherm, ccspline, convergence_table``.
 """
-from .convergence import ConvergenceTable, convergence_table
+from .bilinear import eval_pbilin
+from .convergence import ConvergenceTable, bilinear_convergence, convergence_table
 from .functions import runge, runge2d
+from .mesh import QuadMesh, quad_mesh
 from .monotone import pchip, pchip_slopes
+from .patches import Corner, patch
 from .piecewise import bracket, eval_pherm, eval_plin, hermite_basis
 from .splines import ccspline, nakspline, ncspline, spline
 
 __all__ = [
     "ConvergenceTable",
+    "Corner",
+    "QuadMesh",
+    "bilinear_convergence",
+    "eval_pbilin",
+    "patch",
+    "quad_mesh",
     "bracket",
     "ccspline",
     "convergence_table",

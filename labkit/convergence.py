@@ -9,7 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .functions import runge
+from .bilinear import eval_pbilin
+from .functions import runge, runge2d
 from .monotone import pchip_slopes
 from .piecewise import _hermite_eval, eval_plin
 from .splines import ccspline, nakspline, ncspline
@@ -167,3 +168,35 @@ def _interpolate(method, f, a, b, n, xtest):
         "pchip": lambda: pchip_slopes(x, y),
     }[method]()
     return _hermite_eval(x, y, slopes, xtest)
+
+
+def bilinear_convergence(ndata=(11, 21, 41, 81, 161), f=runge2d, square=(0.0, 5.0), ntest=401):
+    """Errors of piecewise bilinear interpolation on a square, as in exercise 16.
+
+    Data on an ``n x n`` equally spaced grid of `square` squared; the error
+    is ``max|f - I| / max|f|`` on an ``ntest x ntest`` grid of test points.
+
+    Returns
+    -------
+    ConvergenceTable
+
+    Examples
+    --------
+    >>> from labkit import bilinear_convergence
+    >>> bilinear_convergence().order
+    2
+    """
+    sizes = np.asarray(ndata)
+    if sizes.ndim != 1 or sizes.size < 2 or np.any(sizes < 2):
+        raise ValueError("ndata must list at least two grid sizes, each at least 2.")
+    a, b = _check_interval(square)
+    test = np.linspace(a, b, int(ntest))
+    X, Y = np.meshgrid(test, test, indexing="ij")
+    exact = np.asarray(f(X, Y), dtype=float)
+    scale = np.max(np.abs(exact))
+    errors = []
+    for n in sizes:
+        grid = np.linspace(a, b, n)
+        errors.append(np.max(np.abs(exact - eval_pbilin(f, grid, grid, test, test))) / scale)
+    name = "Runge2d function" if f is runge2d else getattr(f, "__name__", "f")
+    return ConvergenceTable(f"{name}, Piecewise Bilinear", sizes, np.array(errors))
