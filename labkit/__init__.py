@@ -5,7 +5,7 @@ Everything a notebook needs is importable from here, e.g.
 """
 from .bilinear import eval_pbilin
 from .convergence import ConvergenceTable, bilinear_convergence, convergence_table
-from .functions import runge, runge2d
+from .functions import limacon, runge, runge2d
 from .mesh import QuadMesh, quad_mesh
 from .monotone import pchip, pchip_slopes
 from .patches import Corner, patch
@@ -26,6 +26,7 @@ __all__ = [
     "eval_pherm",
     "eval_plin",
     "hermite_basis",
+    "limacon",
     "nakspline",
     "ncspline",
     "pchip",

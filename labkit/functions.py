@@ -43,3 +43,31 @@ def runge2d(x, y):
     """
     s = as_float_array(x, "x") + as_float_array(y, "y")
     return scalar_or_array(1.0 / (1.0 + s * s), s)
+
+
+def limacon(t, r0=1.15):
+    """The limaçon r = r0 + cos t as a parametric curve, with its t-derivatives.
+
+    Parameters
+    ----------
+    t : array_like
+        Parameter values (a full turn is 0 .. 2 pi).
+    r0 : float
+        Offset of the radius; r0 = 1 is the cardioid.
+
+    Returns
+    -------
+    x, y, dxdt, dydt : ndarray
+        ``x = r cos t``, ``y = r sin t`` and their derivatives.
+
+    Examples
+    --------
+    >>> from labkit import limacon
+    >>> [round(float(v), 12) + 0.0 for v in limacon(0.0, r0=1.0)]
+    [2.0, 0.0, 0.0, 2.0]
+    """
+    ta = as_float_array(t, "t")
+    r = r0 + np.cos(ta)
+    drdt = -np.sin(ta)
+    x, y = r * np.cos(ta), r * np.sin(ta)
+    return x, y, drdt * np.cos(ta) - y, drdt * np.sin(ta) + x

@@ -1,0 +1,47 @@
+"""Re-execute the kit's notebooks and save them clean (the committed reference outputs).
+
+Clean means: executed top to bottom in a fresh ``python3`` kernel, no widget
+state stored in the metadata (it churns on every run), no error outputs.
+Used by ``labkit execute`` and checked by tests/test_notebooks_clean.py.
+"""
+from pathlib import Path
+
+import nbformat
+from nbclient import NotebookClient
+
+KERNEL = "python3"
+KERNELSPEC = {"display_name": "Python 3 (ipykernel)", "language": "python", "name": KERNEL}
+
+
+def notebook_paths(directory):
+    """The notebooks of a folder, in teaching order, skipping checkpoint copies."""
+    paths = sorted(Path(directory).glob("*.ipynb"))
+    if not paths:
+        raise ValueError(f"no notebooks (*.ipynb) in {directory}.")
+    return paths
+
+
+def execute(path, timeout=300):
+    """Run one notebook in a fresh kernel in its own folder and save it cleaned."""
+    path = Path(path)
+    nb = nbformat.read(path, as_version=4)
+    client = NotebookClient(
+        nb, timeout=timeout, kernel_name=KERNEL, resources={"metadata": {"path": str(path.parent)}}
+    )
+    client.execute()
+    clean(nb)
+    nbformat.write(nb, path)
+    return nb
+
+
+def clean(nb):
+    """Drop widget state and volatile metadata; pin the kernelspec."""
+    nb.metadata.pop("widgets", None)
+    nb.metadata["kernelspec"] = dict(KERNELSPEC)
+    for cell in nb.cells:
+        cell.metadata.pop("execution", None)
+        if cell.cell_type == "code":
+            for output in cell.get("outputs", []):
+                data = output.get("data", {})
+                data.pop("application/vnd.jupyter.widget-view+json", None)
+    return nb

@@ -1,0 +1,53 @@
+"""The committed notebooks are the reference outputs: they must be clean."""
+from pathlib import Path
+
+import nbformat
+import pytest
+
+NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
+EXERCISES = range(1, 17)
+
+
+def test_there_is_a_notebook_per_topic():
+    assert len(NOTEBOOKS) >= 6
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_notebook_is_clean(path):
+    nb = nbformat.read(path, as_version=4)
+    assert nb.metadata["kernelspec"]["name"] == "python3"
+    assert "widgets" not in nb.metadata, "widget state stored: run `labkit execute`"
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert [c.execution_count for c in code] == list(range(1, len(code) + 1)), "not executed top to bottom"
+    for cell in code:
+        assert not any(o.output_type == "error" for o in cell.outputs), cell.source[:60]
+        if "widgets.interact" in cell.source:
+            assert "nbval-ignore-output" in cell.metadata.get("tags", [])
+
+
+def test_no_checkpoint_folders_are_committed():
+    root = Path(__file__).resolve().parents[1] / "notebooks"
+    import subprocess
+
+    tracked = subprocess.run(["git", "ls-files", str(root)], capture_output=True, text=True, cwd=root).stdout
+    assert ".ipynb_checkpoints" not in tracked
+
+
+def test_every_exercise_has_a_section_and_the_readme_maps_it():
+    headings = {}
+    for path in NOTEBOOKS:
+        for cell in nbformat.read(path, as_version=4).cells:
+            if cell.cell_type == "markdown":
+                for line in cell.source.splitlines():
+                    if line.startswith("## Exercise"):
+                        number = int(line.split()[2])
+                        headings.setdefault(number, path.name)
+    assert set(headings) == set(EXERCISES)
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    for number, name in headings.items():
+        assert f"| {number} " in readme and name in readme
+    # sections appear in order within each notebook
+    for path in NOTEBOOKS:
+        numbers = [int(line.split()[2]) for cell in nbformat.read(path, as_version=4).cells
+                   if cell.cell_type == "markdown" for line in cell.source.splitlines() if line.startswith("## Exercise")]
+        assert numbers == sorted(numbers), path.name
