@@ -22,6 +22,7 @@ from urllib.parse import urlparse
 
 import pytest
 
+LATENCIES = {}  # notebook name -> median ms, printed by conftest.py's terminal summary
 ROOT = Path(__file__).resolve().parents[2]
 CHROMIUM = Path("/usr/bin/chromium")
 SCREENSHOTS = ROOT / "build" / "screenshots"
@@ -206,6 +207,7 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
         assert readout.inner_text() != old_readout
     page.screenshot(path=str(SCREENSHOTS / f"{stem}-after.png"))
     median_ms = 1000 * statistics.median(latencies)
+    LATENCIES[notebook.name] = median_ms
     print(f"\n{notebook.name}: slider move -> new plot, median of {len(latencies)}: {median_ms:.0f} ms")
 
     context.close()
