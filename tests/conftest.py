@@ -1,6 +1,7 @@
+import sys
+
 import numpy as np
 import pytest
-from hypothesis import strategies as st
 
 
 @pytest.fixture
@@ -8,16 +9,11 @@ def rng():
     return np.random.default_rng(20261122)
 
 
-def unequal_knots(rng, n, start=-2.0):
-    """Strictly increasing knots with spacings between 0.05 and 1."""
-    return start + np.concatenate(([0.0], np.cumsum(rng.uniform(0.05, 1.0, n - 1))))
-
-
-@st.composite
-def knots(draw, min_size=2, max_size=25):
-    """Hypothesis strategy: strictly increasing, well-separated abscissae."""
-    gaps = draw(
-        st.lists(st.floats(0.05, 5.0), min_size=min_size - 1, max_size=max_size - 1)
-    )
-    start = draw(st.floats(-10.0, 10.0))
-    return start + np.concatenate(([0.0], np.cumsum(gaps)))
+def pytest_terminal_summary(terminalreporter):
+    """Show the browser test's slider latencies in every run's summary, not only with -s."""
+    module = sys.modules.get("test_jupyterlab")
+    latencies = getattr(module, "LATENCIES", {})
+    if latencies:
+        terminalreporter.section("slider move -> new plot in JupyterLab (median of 4 moves)")
+        for name, ms in latencies.items():
+            terminalreporter.write_line(f"{name:<24}{ms:6.0f} ms")

@@ -3,7 +3,7 @@ import pytest
 from scipy.interpolate import RegularGridInterpolator
 
 from labkit import bilinear_convergence, eval_pbilin, runge2d
-from conftest import unequal_knots
+from helpers import unequal_knots
 
 
 @pytest.mark.parametrize(

@@ -3,7 +3,7 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 from labkit import pchip, pchip_slopes
-from conftest import unequal_knots
+from helpers import unequal_knots
 
 
 @pytest.mark.parametrize("n", [2, 3, 4, 60])

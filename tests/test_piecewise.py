@@ -3,7 +3,7 @@ import pytest
 from scipy.interpolate import CubicHermiteSpline
 
 from labkit import bracket, eval_pherm, eval_plin, hermite_basis
-from conftest import unequal_knots
+from helpers import unequal_knots
 
 
 def test_bracket_finds_the_interval_and_clips_to_the_ends():

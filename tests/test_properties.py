@@ -3,7 +3,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 from labkit import ccspline, eval_pherm, eval_plin, nakspline, ncspline, pchip, spline
-from conftest import knots
+from helpers import knots
 
 coefficient = st.floats(-5.0, 5.0)
 settings.register_profile("labkit", max_examples=60, deadline=None)

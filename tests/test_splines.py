@@ -4,7 +4,7 @@ from scipy.interpolate import CubicSpline
 
 from labkit import ccspline, eval_pherm, nakspline, ncspline, spline
 from labkit.splines import natural_curvatures
-from conftest import unequal_knots
+from helpers import unequal_knots
 
 
 @pytest.fixture

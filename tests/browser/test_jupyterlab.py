@@ -22,7 +22,7 @@ from urllib.parse import urlparse
 
 import pytest
 
-LATENCIES = {}  # notebook name -> median ms, printed by conftest.py's terminal summary
+LATENCIES = {}  # notebook name -> median ms, printed by tests/conftest.py's terminal summary
 ROOT = Path(__file__).resolve().parents[2]
 CHROMIUM = Path("/usr/bin/chromium")
 SCREENSHOTS = ROOT / "build" / "screenshots"

@@ -1,0 +1,18 @@
+"""Data generators shared by the tests (imported as ``from helpers import ...``)."""
+import numpy as np
+from hypothesis import strategies as st
+
+
+def unequal_knots(rng, n, start=-2.0):
+    """Strictly increasing knots with spacings between 0.05 and 1."""
+    return start + np.concatenate(([0.0], np.cumsum(rng.uniform(0.05, 1.0, n - 1))))
+
+
+@st.composite
+def knots(draw, min_size=2, max_size=25):
+    """Hypothesis strategy: strictly increasing, well-separated abscissae."""
+    gaps = draw(
+        st.lists(st.floats(0.05, 5.0), min_size=min_size - 1, max_size=max_size - 1)
+    )
+    start = draw(st.floats(-10.0, 10.0))
+    return start + np.concatenate(([0.0], np.cumsum(gaps)))
