@@ -3,6 +3,7 @@
 Everything a notebook needs is importable from here, e.g.
 ``from labkit import eval_pherm, ccspline, convergence_table``.
 """
+from . import check
 from .bilinear import eval_pbilin
 from .convergence import ConvergenceTable, bilinear_convergence, convergence_table
 from .functions import limacon, runge, runge2d
