@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_core.py
 	$(PY) benchmarks/bench_2d.py
 	$(PY) benchmarks/bench_sliders.py
+	$(PY) benchmarks/bench_grading.py
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis

@@ -132,28 +132,35 @@ def eval_pherm(fn):
 
 
 def _narrow_pherm(fn, result):
+    """The lab's debugging steps iii to v for eval_pherm."""
     wrong_unit = _monomials(fn, [0.0, 1.0], result, "[0, 1]")
     if wrong_unit is None:
         return result
-    if not wrong_unit:
-        result.step("monomials on [0, 1] (interval length 1)", True)
-        result.hint = ("every monomial is right on [0, 1] but not on [0, 2]: the denominators of "
-                       "h1..h4, (x_k - x_{k+1})^3 and (x_k - x_{k+1})^2, are wrong.")
+    unit_ok = result.step("monomials on [0, 1] (interval length 1)", not wrong_unit,
+                          f"wrong for x^{wrong_unit}" if wrong_unit else "")
+    # on [0, 1] every denominator is 1; on [0, 2] they are not
+    interval = [0.0, 1.0] if not unit_ok else [0.0, 2.0]
+    bad = _basis_failures(fn, interval, result)
+    if bad is None:
         return result
-    result.step("monomials on [0, 1] (interval length 1)", False, f"wrong for x^{wrong_unit}")
-    for interval in ([0.0, 1.0], [0.0, 2.0]):
-        bad = _basis_failures(fn, interval, result)
-        if bad is None:
-            return result
-        label = f"each Hermite basis function alone on [{interval[0]:g}, {interval[1]:g}]"
-        if bad:
-            result.fail(label, f"wrong: {', '.join(bad)}",
-                        f"{bad[0]} is wrong: compare your formula with the lab's definition of the four Hermite "
-                        "polynomials, factor by factor.")
-            return result
+    label = f"each Hermite basis function alone on [{interval[0]:g}, {interval[1]:g}]"
+    if not bad:
         result.step(label, True)
-    result.hint = ("each basis function is right, so the combination is wrong: "
-                   "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
+        result.hint = ("each basis function is right, so the combination is wrong: "
+                       "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
+        return result
+    name, factor = bad[0]
+    if factor is not None or unit_ok:
+        times = f" times {factor:g}" if factor is not None else ""
+        hint = (f"{name} is the right polynomial{times} on [{interval[0]:g}, {interval[1]:g}]: its denominator is wrong "
+                "(the denominators are (x_k - x_{k+1})^3 for h1, (x_k - x_{k+1})^2 for h2, "
+                "(x_{k+1} - x_k)^3 for h3 and (x_{k+1} - x_k)^2 for h4).")
+        if factor is None:
+            hint = hint.replace(" is the right polynomial on", " is right on [0, 1] but not on")
+    else:
+        hint = (f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
+                "polynomials, factor by factor.")
+    result.fail(label, f"wrong: {', '.join(n for n, _ in bad)}", hint)
     return result
 
 
@@ -168,8 +175,21 @@ def _basis_failures(fn, interval, result):
         if not ok:
             return None
         if not _close(got, want):
-            bad.append(f"h{m}")
+            bad.append((f"h{m}", _constant_factor(got, want)))
     return bad
+
+
+def _constant_factor(got, want):
+    """c if got == c * want at every point (a wrong constant such as a denominator), else None."""
+    try:
+        got = np.asarray(got, dtype=float)
+    except (TypeError, ValueError):
+        return None
+    nonzero = np.abs(want) > 1e-12
+    if got.shape != want.shape or not nonzero.any() or not np.allclose(got[~nonzero], 0, atol=1e-12):
+        return None
+    ratios = got[nonzero] / want[nonzero]
+    return float(ratios[0]) if np.allclose(ratios, ratios[0], rtol=1e-9) else None
 
 
 # -- Exercise 3 ---------------------------------------------------------------
@@ -195,10 +215,14 @@ def runge(fn):
 
 
 def test_pherm_interpolate(fn):
-    """Check the convergence driver ``test_pherm_interpolate(ndata) -> relative max error``."""
+    """Check the driver ``test_pherm_interpolate(ndata, interpolate) -> relative max error``.
+
+    The driver is run with labkit's ``eval_pherm`` as `interpolate`, so a
+    mistake in the student's interpolant does not count against the driver.
+    """
     result = CheckResult("test_pherm_interpolate")
     for ndata in (5, 11, 21):
-        ok, err = _call(result, f"ndata = {ndata}", fn, ndata)
+        ok, err = _call(result, f"ndata = {ndata}", fn, ndata, piecewise.eval_pherm)
         if not ok:
             return result
         x = np.linspace(0.0, 5.0, ndata)
@@ -241,10 +265,14 @@ def coons(fn):
     if not ok or result.step("random corner data with twists agree with labkit.patch", _close(out, expected),
                              "" if _close(out, expected) else _worst(out, expected)):
         return result
-    untwisted = [patches.Corner(c.point, c.ds, c.dt) for c in corners]
-    if _close(out, patches.patch(*untwisted, s, t)):
-        result.hint = ("your patch ignores the twists: dxdtAB and dxdtDC must be Hermite cubics in s with "
-                       "values dx/dt and slopes d2x/dsdt at the corners (likewise for y).")
+    for edge, untwist in (("AB and DC", "ABCD"), ("AB", "AB"), ("DC", "DC")):
+        candidate = [patches.Corner(c.point, c.ds, c.dt) if label in untwist else c
+                     for label, c in zip("ABCD", corners)]
+        if _close(out, patches.patch(*candidate, s, t)):
+            result.hint = (f"your patch ignores the twists along {edge}: the t-derivative along an edge "
+                           "(dxdtAB, dxdtDC) is a Hermite cubic in s with values dx/dt and slopes d2x/dsdt "
+                           "at its corners (likewise for y).")
+            break
     else:
         result.hint = ("compare the four edge curves one at a time with labkit.patch: values along AB and DC, "
                        "then the t-derivatives along them, then the join in t.")
@@ -510,6 +538,7 @@ def eval_pbilin(fn):
 
 # -- grading -------------------------------------------------------------------
 
+# exercise -> (names the student's notebook defines, checks to run on them)
 EXERCISES = {
     2: lambda ns: [eval_pherm(ns["eval_pherm"])],
     3: lambda ns: [runge(ns["runge"]), test_pherm_interpolate(ns["test_pherm_interpolate"])],
@@ -523,16 +552,27 @@ EXERCISES = {
     16: lambda ns: [runge2d(ns["runge2d"]), eval_pbilin(ns["eval_pbilin"])],
 }
 POINTS = {number: 10 for number in EXERCISES}
+NAMES = {2: ["eval_pherm"], 3: ["runge", "test_pherm_interpolate"], 5: ["coons"], 6: ["graded"],
+         7: ["straight"], 8: ["circle_sides"], 9: ["two_patches", "mirror"], 10: ["ccspline", "complete_system"],
+         12: ["ncspline"], 16: ["runge2d", "eval_pbilin"]}
 
 
 def grade(number, namespace):
-    """Run the checks of exercise `number` on a notebook's variables; a dict for the grader."""
+    """Run the checks of exercise `number` on a notebook's variables; a dict for the grader.
+
+    ``defined`` says whether the notebook defines any of the exercise's names,
+    so the grader can tell the exercise's own notebook from one that only
+    mentions it.
+    """
+    defined = any(name in namespace for name in NAMES[number])
     try:
         results = EXERCISES[number](namespace)
     except KeyError as exc:
-        return {"exercise": number, "passed": False, "points": 0,
-                "checks": [{"name": str(exc).strip("'"), "passed": False, "steps": [],
-                            "hint": f"{exc} is not defined: run the cell that defines it (and keep its name)."}]}
+        name = str(exc).strip("'")
+        missing = CheckResult(name)
+        missing.fail(f"{name} is defined", "not defined when the notebook finished",
+                     f"run the cell that defines {name} (and keep its name); a cell that raised stops it.")
+        results = [missing]
     passed = all(r.passed for r in results)
     return {"exercise": number, "passed": passed, "points": POINTS[number] if passed else 0,
-            "checks": [r.as_dict() for r in results]}
+            "defined": defined, "checks": [r.as_dict() for r in results]}

@@ -1,31 +1,86 @@
-"""The ``labkit`` command: ``labkit execute [NOTEBOOK_DIR]``."""
+"""The ``labkit`` command: execute, release and grade the lab's notebooks.
+
+``labkit execute [DIR]``            re-run the instructor notebooks and save them clean
+``labkit release [DIR] --out DIR``  write the student version
+``labkit grade SUBMISSION... --out DIR``  grade submitted notebooks (or folders of them)
+"""
 import argparse
 import sys
+import time
 from pathlib import Path
 
 DEFAULT_NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 
 
 def _execute(args):
+    from nbclient.exceptions import CellExecutionError
+
     from .notebooks import execute, notebook_paths
 
     for path in notebook_paths(args.notebooks):
         print(f"executing {path.name} ...", flush=True)
-        execute(path, timeout=args.timeout)
+        try:
+            execute(path, timeout=args.timeout)
+        except CellExecutionError as exc:
+            raise ValueError(f"{path.name} failed; it was not saved.\n{str(exc)[:2000]}") from None
+    return 0
+
+
+def _release(args):
+    from .grading import release
+
+    for path in release(args.notebooks, args.out):
+        print(f"wrote {path}")
+    return 0
+
+
+def _grade(args):
+    from .grading import grade
+
+    start = time.perf_counter()
+    grades = grade(args.submissions, args.out, jobs=args.jobs, cell_timeout=args.cell_timeout,
+                   total_timeout=args.total_timeout, progress=not args.quiet)
+    for g in grades:
+        print(f"{g.name:<30} {g.total:4d}")
+    print(f"graded {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
+          f"wrote {Path(args.out) / 'grades.csv'} and {Path(args.out) / 'feedback'}/")
     return 0
 
 
 def build_parser():
-    parser = argparse.ArgumentParser(prog="labkit", description="Course kit tools for the interpolation lab.")
+    parser = argparse.ArgumentParser(
+        prog="labkit", description="Course kit tools for the higher-order interpolation lab.",
+        epilog="Grading runs student code with your permissions: it is not a security sandbox. "
+               "Grade untrusted submissions inside a container.")
     commands = parser.add_subparsers(dest="command", required=True)
-    run = commands.add_parser(
-        "execute",
-        help="re-execute every notebook in a fresh kernel and save it clean (the reference outputs)",
-    )
+
+    run = commands.add_parser("execute", help="re-execute every notebook in a fresh kernel and save it clean",
+                              description="Re-execute the notebooks top to bottom in a fresh python3 kernel and save "
+                                          "them without widget state: the reference outputs nbval compares against.")
     run.add_argument("notebooks", nargs="?", type=Path, default=DEFAULT_NOTEBOOKS,
                      help="folder of notebooks (default: the kit's notebooks/)")
-    run.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell")
+    run.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell (default 300)")
     run.set_defaults(handler=_execute)
+
+    rel = commands.add_parser("release", help="write the student version of the notebooks",
+                              description="Replace every '### BEGIN SOLUTION' ... '### END SOLUTION' region by a stub "
+                                          "that raises NotImplementedError, remove hidden tests, clear outputs.")
+    rel.add_argument("notebooks", nargs="?", type=Path, default=DEFAULT_NOTEBOOKS,
+                     help="folder of instructor notebooks (default: the kit's notebooks/)")
+    rel.add_argument("--out", type=Path, required=True, help="folder for the student notebooks")
+    rel.set_defaults(handler=_release)
+
+    grd = commands.add_parser("grade", help="grade submitted notebooks",
+                              description="Execute each submission (a notebook, or a folder with a student's "
+                                          "notebooks) in a fresh kernel in a temporary folder, check every exercise, "
+                                          "write grades.csv and feedback/<submission>.txt.")
+    grd.add_argument("submissions", nargs="+", type=Path, help="notebooks or folders of notebooks, one per student")
+    grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv and feedback/")
+    grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
+    grd.add_argument("--cell-timeout", type=int, default=60, help="seconds per cell before it is interrupted (default 60)")
+    grd.add_argument("--total-timeout", type=int, default=600, help="seconds per notebook in all (default 600)")
+    grd.add_argument("--quiet", action="store_true", help="no progress bar")
+    grd.set_defaults(handler=_grade)
     return parser
 
 

@@ -4,6 +4,7 @@ Clean means: executed top to bottom in a fresh ``python3`` kernel, no widget
 state stored in the metadata (it churns on every run), no error outputs.
 Used by ``labkit execute`` and checked by tests/test_notebooks_clean.py.
 """
+import subprocess
 from pathlib import Path
 
 import nbformat
@@ -28,7 +29,7 @@ def execute(path, timeout=300):
     client = NotebookClient(
         nb, timeout=timeout, kernel_name=KERNEL, resources={"metadata": {"path": str(path.parent)}}
     )
-    client.execute()
+    client.execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # kernel log noise only
     clean(nb)
     nbformat.write(nb, path)
     return nb

@@ -1,0 +1,98 @@
+"""labkit.check: passes the reference implementations, and narrows real mistakes down."""
+import numpy as np
+import pytest
+
+import labkit
+from labkit import check
+
+
+def test_reference_implementations_pass_every_check():
+    assert check.eval_pherm(labkit.eval_pherm).passed
+    assert check.runge(labkit.runge).passed
+    assert check.ccspline(labkit.ccspline, check._reference_complete_system).passed
+    assert check.ncspline(labkit.ncspline).passed
+    assert check.runge2d(labkit.runge2d).passed
+    assert check.eval_pbilin(labkit.eval_pbilin).passed
+    assert check.coons(lambda *args: tuple(labkit.patch(*args))).passed
+
+
+def _hermite(combine):
+    def eval_pherm(xdata, ydata, ypdata, xval):
+        xdata, ydata, ypdata, xval = map(np.asarray, (xdata, ydata, ypdata, xval))
+        k = labkit.bracket(xdata, xval)
+        h = labkit.hermite_basis(xdata[k], xdata[k + 1], xval)
+        return combine(ydata, ypdata, k, h)
+    return eval_pherm
+
+
+def test_swapped_basis_functions_are_named():
+    swapped = _hermite(lambda y, yp, k, h: y[k] * h[0] + yp[k] * h[3] + y[k + 1] * h[2] + yp[k + 1] * h[1])
+    result = check.eval_pherm(swapped)
+    assert "h2 is wrong" in result.hint  # the lab's step iv: reproduce each h_k with eval_pherm
+
+
+def test_wrong_combination_is_found_after_the_basis_checks_pass():
+    # squares the values: right for the 0/1 data of the basis checks, wrong for monomials
+    squared = _hermite(lambda y, yp, k, h: y[k] ** 2 * h[0] + yp[k] * h[1] + y[k + 1] ** 2 * h[2] + yp[k + 1] * h[3])
+    result = check.eval_pherm(squared)
+    assert not result.passed
+    assert "each basis function is right, so the combination is wrong" in result.hint
+
+
+def test_single_interval_code_fails_on_several_intervals():
+    first_interval_only = _hermite(lambda y, yp, k, h: y[0] * h[0] + yp[0] * h[1] + y[1] * h[2] + yp[1] * h[3])
+    result = check.eval_pherm(first_interval_only)
+    assert "use bracket" in result.hint
+
+
+def test_exceptions_and_wrong_shapes_are_reported_not_raised():
+    assert "raised ZeroDivisionError" in repr(check.runge(lambda x: 1 / 0))
+    assert not check.eval_pherm(lambda *a: None).passed
+    assert "return both values" in check.runge(lambda x: 1 / (1 + x**2)).hint
+
+
+def test_runge_with_a_wrong_derivative():
+    result = check.runge(lambda x: (1 / (1 + x**2), -2 * x / (1 + x**2)))
+    assert [ok for _, ok, _ in result.steps] == [True, False] and "chain rule" in result.hint
+
+
+def test_ccspline_subscript_mistake_is_located_by_the_equal_interval_case():
+    def shifted_h(xdata, ydata, y1p, ynp):
+        xdata = np.asarray(xdata, float)
+        h = np.diff(xdata)[::-1]  # wrong interval lengths, right when they are all equal
+        return labkit.ccspline(np.concatenate(([xdata[0]], xdata[0] + np.cumsum(h))), ydata, y1p, ynp)
+
+    result = check.ccspline(shifted_h)
+    assert not result.passed and "a subscript of h is off" in result.hint
+
+
+def test_ccspline_asymmetric_matrix_is_reported():
+    def system(xdata, ydata, y1p, ynp):
+        A, D = check._reference_complete_system(np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp)
+        A[1, 0] *= 2
+        return A, D
+
+    result = check.ccspline(lambda *a: labkit.ccspline(*a) * 1.1, system)
+    assert "A is symmetric" in repr(result) and "h(k-1)/6" in result.hint
+
+
+def test_eval_pbilin_transposed_output_fails_at_the_single_cell():
+    result = check.eval_pbilin(lambda f, xd, yd, xv, yv: labkit.eval_pbilin(f, xd, yd, xv, yv).T + 0 * xv[0])
+    assert not result.passed
+
+
+@pytest.mark.parametrize("corners, passed", [
+    ([labkit.Corner([0, 0], [3, 0], [0, 1]), labkit.Corner([1, 0], [0.1, 0], [0, 1]),
+      labkit.Corner([1, 1], [0.1, 0], [0, 1]), labkit.Corner([0, 1], [3, 0], [0, 1])], True),
+    ([labkit.Corner([0, 0], [0.1, 0], [0, 1]), labkit.Corner([1, 0], [3, 0], [0, 1]),
+      labkit.Corner([1, 1], [3, 0], [0, 1]), labkit.Corner([0, 1], [0.1, 0], [0, 1])], False),
+    ("not corners", False),
+])
+def test_graded_corner_data(corners, passed):
+    assert check.graded_corners(corners).passed is passed
+
+
+def test_grade_reports_missing_names_with_a_hint():
+    verdict = check.grade(16, {"runge2d": labkit.runge2d})
+    assert verdict["points"] == 0 and verdict["defined"]
+    assert "eval_pbilin" in verdict["checks"][-1]["hint"]
