@@ -201,6 +201,15 @@ def _client(nb, workdir, cell_timeout):
                         extra_arguments=["--InlineBackend.figure_formats=[]"])
 
 
+def _kill_kernel(client):
+    """Stop a kernel whose run was abandoned (the alarm leaves nbclient no chance to)."""
+    provisioner = getattr(getattr(client, "km", None), "provisioner", None)
+    process = getattr(provisioner, "process", None)
+    if process is not None and process.poll() is None:
+        process.kill()
+        process.wait(timeout=10)
+
+
 def grade_notebook(path, cell_timeout=60, total_timeout=600):
     """Run one notebook and return ({exercise: grade dict}, [problems])."""
     try:
@@ -215,12 +224,14 @@ def grade_notebook(path, cell_timeout=60, total_timeout=600):
     problems = []
     with tempfile.TemporaryDirectory(prefix="labkit-grade-") as workdir:
         shutil.copy(path, Path(workdir) / Path(path).name)
+        client = _client(nb, workdir, cell_timeout)
         previous = signal.signal(signal.SIGALRM, _on_alarm)
         signal.alarm(int(total_timeout))
         try:
             # the kernel's own log (not the student's output) would clutter the progress bar
-            _client(nb, workdir, cell_timeout).execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            client.execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         except _TotalTimeout:
+            _kill_kernel(client)
             problems.append(f"{Path(path).name}: stopped after the total time limit of {total_timeout} s.")
         except Exception as exc:  # noqa: BLE001 - a broken kernel must not stop the other submissions
             problems.append(f"{Path(path).name}: the run failed ({type(exc).__name__}: {str(exc)[:300]}).")
