@@ -7,7 +7,7 @@ basis functions is in ``notebooks/06_bilinear.ipynb``.
 import numpy as np
 
 from ._validate import as_float_array, as_knots, require_finite
-from .piecewise import _locate
+from ._locate import locate
 
 
 def eval_pbilin(f, xdata, ydata, xval, yval):
@@ -55,7 +55,7 @@ def eval_pbilin(f, xdata, ydata, xval, yval):
 
 
 def _cell_and_weight(knots, points):
-    k = _locate(knots, points)
+    k = locate(knots, points)
     return k, (points - knots[k]) / (knots[k + 1] - knots[k])
 
 

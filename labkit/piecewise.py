@@ -6,6 +6,7 @@ interpolants is in ``notebooks/01_limacon.ipynb``.
 """
 import numpy as np
 
+from ._locate import blockwise, locate
 from ._validate import as_data, as_knots, as_points, scalar_or_array
 
 
@@ -24,7 +25,8 @@ def bracket(xdata, xval):
     k : int or ndarray of int, same shape as `xval`
         ``xdata[k] <= xval < xdata[k+1]``, clipped to ``[0, n-2]`` so that
         points left of the data use the first interval and points at or
-        right of ``xdata[-1]`` use the last one.
+        right of ``xdata[-1]`` use the last one. A NaN point gets some valid
+        index (every interpolant gives NaN there).
 
     Examples
     --------
@@ -34,12 +36,7 @@ def bracket(xdata, xval):
     """
     x = as_knots(xdata)
     xv = as_points(xval)
-    return scalar_or_array(_locate(x, xv), xval)
-
-
-def _locate(x, xv):
-    k = np.searchsorted(x, xv, side="right") - 1
-    return np.clip(k, 0, x.size - 2)
+    return scalar_or_array(locate(x, xv), xval)
 
 
 def eval_plin(xdata, ydata, xval):
@@ -68,9 +65,15 @@ def eval_plin(xdata, ydata, xval):
     x = as_knots(xdata)
     y = as_data(ydata, x.size, "ydata")
     xv = as_points(xval)
-    k = _locate(x, xv)
-    slope = np.diff(y) / np.diff(x)
-    return scalar_or_array(y[k] + slope[k] * (xv - x[k]), xval)
+    slope = np.diff(y)
+    slope /= np.diff(x)
+
+    def line(k, p, out):
+        np.subtract(p, np.take(x, k), out=out)
+        out *= np.take(slope, k)
+        out += np.take(y, k)
+
+    return scalar_or_array(blockwise(x, xv, line), xval)
 
 
 def hermite_basis(xk, xk1, x):
@@ -149,6 +152,16 @@ def eval_pherm(xdata, ydata, ypdata, xval):
 
 def _hermite_eval(x, y, yp, xv):
     """Evaluate validated Hermite data; shared by the splines and pchip."""
-    k = _locate(x, xv)
-    h1, h2, h3, h4 = hermite_basis(x[k], x[k + 1], xv)
-    return y[k] * h1 + yp[k] * h2 + y[k + 1] * h3 + yp[k + 1] * h4
+
+    def cubic(k, p, out):
+        right = k + 1
+        h1, h2, h3, h4 = hermite_basis(np.take(x, k), np.take(x, right), p)
+        np.multiply(h1, np.take(y, k), out=out)
+        h2 *= np.take(yp, k)
+        h3 *= np.take(y, right)
+        h4 *= np.take(yp, right)
+        out += h2
+        out += h3
+        out += h4
+
+    return blockwise(x, xv, cubic)
