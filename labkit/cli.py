@@ -1,8 +1,9 @@
 """The ``labkit`` command: execute, release and grade the lab's notebooks.
 
-``labkit execute [DIR]``            re-run the instructor notebooks and save them clean
-``labkit release [DIR] --out DIR``  write the student version
-``labkit grade SUBMISSION... --out DIR``  grade submitted notebooks (or folders of them)
+``labkit execute [DIR]``                   re-run the instructor notebooks and save them clean
+``labkit release [DIR] --out DIR``         write the student version
+``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
+``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
 """
 import argparse
 import sys
@@ -34,24 +35,43 @@ def _release(args):
     return 0
 
 
-def _grade(args):
-    from .grading import grade
-
-    start = time.perf_counter()
-    grades = grade(args.submissions, args.out, jobs=args.jobs, cell_timeout=args.cell_timeout,
-                   total_timeout=args.total_timeout, progress=not args.quiet)
+def _summary(grades, out, start, what):
     for g in grades:
         print(f"{g.name:<30} {g.total:4d}")
-    print(f"graded {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
-          f"wrote {Path(args.out) / 'grades.csv'} and {Path(args.out) / 'feedback'}/")
+    print(f"{what} {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
+          f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/")
+
+
+def _grade(args):
+    from .grading import grade, merge
+    from .grading.sandbox import Limits
+
+    start = time.perf_counter()
+    if args.merge:
+        if args.submissions:
+            raise ValueError("--merge takes output folders of earlier runs, not submissions; give one or the other.")
+        _summary(merge(args.merge, args.out), args.out, start, "merged")
+        return 0
+    if not args.submissions:
+        raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
+    for name in ("jobs", "cell_timeout", "total_timeout", "memory"):
+        if getattr(args, name) < 1:
+            raise ValueError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
+    limits = Limits(memory=args.memory * 1024**2, cpu_seconds=args.total_timeout + 30)
+    grades = grade(args.submissions, args.out, jobs=args.jobs, cell_timeout=args.cell_timeout,
+                   total_timeout=args.total_timeout, progress=not args.quiet, seed=args.seed,
+                   sandboxed=not args.no_sandbox, limits=limits)
+    _summary(grades, args.out, start, "graded")
+    print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} "
+          f"(repeat the run with --seed)")
     return 0
 
 
 def build_parser():
     parser = argparse.ArgumentParser(
         prog="labkit", description="Course kit tools for the higher-order interpolation lab.",
-        epilog="Grading runs student code with your permissions: it is not a security sandbox. "
-               "Grade untrusted submissions inside a container.")
+        epilog="Grading runs every notebook in a bubblewrap sandbox (no network, read-only system, a private "
+               "folder, resource limits) and checks it from outside; see the README's 'For instructors'.")
     commands = parser.add_subparsers(dest="command", required=True)
 
     run = commands.add_parser("execute", help="re-execute every notebook in a fresh kernel and save it clean",
@@ -70,15 +90,23 @@ def build_parser():
     rel.add_argument("--out", type=Path, required=True, help="folder for the student notebooks")
     rel.set_defaults(handler=_release)
 
-    grd = commands.add_parser("grade", help="grade submitted notebooks",
-                              description="Execute each submission (a notebook, or a folder with a student's "
-                                          "notebooks) in a fresh kernel in a temporary folder, check every exercise, "
-                                          "write grades.csv and feedback/<submission>.txt.")
-    grd.add_argument("submissions", nargs="+", type=Path, help="notebooks or folders of notebooks, one per student")
-    grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv and feedback/")
+    grd = commands.add_parser(
+        "grade", help="grade submitted notebooks",
+        description="Run each submission (a notebook, or a folder with a student's notebooks) in a sandbox, "
+                    "check every exercise from outside it, and write grades.csv, feedback/<submission>.txt, "
+                    "results/<submission>.json and seed.txt. With --merge, combine earlier runs' results instead.")
+    grd.add_argument("submissions", nargs="*", type=Path, help="notebooks or folders of notebooks, one per student")
+    grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv, feedback/ and results/")
+    grd.add_argument("--merge", nargs="+", type=Path, metavar="DIR",
+                     help="combine the results/ of these earlier --out folders into one grades.csv")
     grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
-    grd.add_argument("--cell-timeout", type=int, default=60, help="seconds per cell before it is interrupted (default 60)")
+    grd.add_argument("--cell-timeout", type=int, default=60,
+                     help="seconds per cell, and per call of a graded function (default 60)")
     grd.add_argument("--total-timeout", type=int, default=600, help="seconds per notebook in all (default 600)")
+    grd.add_argument("--memory", type=int, default=4096, help="MiB of address space per process (default 4096)")
+    grd.add_argument("--seed", type=int, help="seed of the random test data (default: a fresh one, saved in seed.txt)")
+    grd.add_argument("--no-sandbox", action="store_true",
+                     help="run student code UNCONFINED, with your permissions (only for code you trust)")
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)
     return parser

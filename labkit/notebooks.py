@@ -8,7 +8,6 @@ import subprocess
 from pathlib import Path
 
 import nbformat
-from nbclient import NotebookClient
 
 KERNEL = "python3"
 KERNELSPEC = {"display_name": "Python 3 (ipykernel)", "language": "python", "name": KERNEL}
@@ -22,8 +21,22 @@ def notebook_paths(directory):
     return paths
 
 
+def read_notebook(path):
+    """A notebook file as an nbformat v4 object; ValueError if it is not text or not a notebook."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"{Path(path).name} is not a text file, so not a notebook.") from None
+    try:
+        return nbformat.reads(text, as_version=4)
+    except Exception as exc:  # nbformat raises several kinds for broken files
+        raise ValueError(f"{Path(path).name} is not a valid notebook ({type(exc).__name__}: {str(exc)[:200]}).") from None
+
+
 def execute(path, timeout=300):
     """Run one notebook in a fresh kernel in its own folder and save it cleaned."""
+    from nbclient import NotebookClient
+
     path = Path(path)
     nb = nbformat.read(path, as_version=4)
     client = NotebookClient(

@@ -1,0 +1,78 @@
+"""Checks for exercise 16: runge2d and the piecewise bilinear interpolant.
+
+The maths is derived in ``notebooks/06_bilinear.ipynb``. References are
+:func:`labkit.runge2d` and the functions 1, x, y and xy, which a bilinear
+interpolant reproduces exactly on any grid.
+
+The functions handed to the student's ``eval_pbilin`` are module-level
+functions (not lambdas), so that ``labkit grade`` can name them to the
+sandboxed notebook (:data:`labkit.grading.protocol.PASSABLE`).
+"""
+import numpy as np
+
+from .. import functions
+from .result import CheckResult, call, case_rng, close, worst
+
+
+def one(x, y):
+    """f(x, y) = 1 on arrays x, y of one shape."""
+    return np.ones_like(np.asarray(x, dtype=float) * np.asarray(y, dtype=float))
+
+
+def x_only(x, y):
+    """f(x, y) = x."""
+    return np.asarray(x, dtype=float) + 0 * np.asarray(y, dtype=float)
+
+
+def y_only(x, y):
+    """f(x, y) = y."""
+    return np.asarray(y, dtype=float) + 0 * np.asarray(x, dtype=float)
+
+
+def product(x, y):
+    """f(x, y) = x y."""
+    return np.asarray(x, dtype=float) * np.asarray(y, dtype=float)
+
+
+BILINEAR_FUNCTIONS = (("1", one), ("x", x_only), ("y", y_only), ("xy", product))
+
+
+def runge2d(fn, seed=None):
+    """Check ``runge2d(x, y)`` = 1/(1+(x+y)^2), on arrays."""
+    result = CheckResult("runge2d")
+    X, Y = np.meshgrid(np.linspace(-2, 2, 5), np.linspace(0, 3, 4), indexing="ij")
+    if seed is not None:
+        X, Y = case_rng(seed, 16).uniform(-3, 3, (2, 5, 4))
+    ok, out = call(result, "runge2d on a grid", fn, X, Y)
+    if ok and not result.step("1/(1+(x+y)^2) on arrays", close(out, functions.runge2d(X, Y)), worst(out, functions.runge2d(X, Y))):
+        result.hint = "use componentwise operations: 1 / (1 + (x + y)**2)."
+    return result
+
+
+def eval_pbilin(fn, seed=None):
+    """Check ``eval_pbilin(f, xdata, ydata, xval, yval)``: one cell, then 1, x, y, xy on a grid."""
+    result = CheckResult("eval_pbilin")
+    unit = np.array([0.0, 1.0])
+    ok, z = call(result, "corners of [0, 1]^2", fn, functions.runge2d, unit, unit, unit, unit)
+    if not ok:
+        return result
+    X, Y = np.meshgrid(unit, unit, indexing="ij")
+    if not result.step("returns runge2d at the four corners of [0, 1]^2", close(z, functions.runge2d(X, Y)),
+                       worst(z, functions.runge2d(X, Y))):
+        result.hint = "zval(k, l) is I(xval(k), yval(l)): check the order of the indices and the four basis functions."
+        return result
+    xdata, ydata = np.array([0.0, 0.5, 2.0, 3.0]), np.array([-1.0, 0.0, 2.5])
+    if seed is not None:
+        rng = case_rng(seed, 17)
+        xdata, ydata = (np.cumsum(rng.uniform(0.2, 1.5, n)) - 1.0 for n in (5, 4))
+    xval, yval = np.linspace(xdata[0], xdata[-1], 7), np.linspace(ydata[0], ydata[-1], 6)
+    XV, YV = np.meshgrid(xval, yval, indexing="ij")
+    for name, f in BILINEAR_FUNCTIONS:
+        ok, z = call(result, f"f = {name}", fn, f, xdata, ydata, xval, yval)
+        if not ok:
+            return result
+        if not result.step(f"reproduces f = {name} on an unequal grid", close(z, f(XV, YV)), worst(z, f(XV, YV))):
+            result.hint = ("one cell works but a grid does not: use bracket on xval and on yval to find the cell "
+                           "and that cell's corners in the basis functions.")
+            return result
+    return result

@@ -1,0 +1,161 @@
+"""Checks for exercises 2 and 3: the piecewise cubic Hermite interpolant, runge, its table.
+
+The maths is derived in ``notebooks/02_convergence.ipynb``. References are
+labkit's :func:`labkit.eval_pherm` and :func:`labkit.hermite_basis`, and the
+polynomials a cubic Hermite interpolant must reproduce exactly.
+"""
+import numpy as np
+
+from .. import functions, piecewise
+from .result import CheckResult, call, case_rng, close, shown, worst
+
+MONOMIAL_POINTS = np.array([-1.0, 0.5, 1.5, 3.0])
+
+
+def _monomials(fn, interval, result, label):
+    """Interpolate 1, x, x^2, x^3 on one interval; return the failing powers."""
+    xdata = np.array(interval, dtype=float)
+    wrong = []
+    for power in range(4):
+        ydata, ypdata = xdata**power, power * xdata ** max(power - 1, 0)
+        ok, yval = call(result, f"y = x^{power} on {label}", fn, xdata, ydata, ypdata, MONOMIAL_POINTS)
+        if not ok:
+            return None
+        if not close(yval, MONOMIAL_POINTS**power):
+            wrong.append(power)
+    return wrong
+
+
+def eval_pherm(fn, seed=None):
+    """Check a student's ``eval_pherm(xdata, ydata, ypdata, xval)`` (exercise 2).
+
+    Steps: the four monomials on [0, 2] at x = -1, 0.5, 1.5, 3; if that fails,
+    the monomials on [0, 1] (interval length 1 hides wrong denominators),
+    then each Hermite basis function alone on [0, 1] and on [0, 2]. Last,
+    several unequal intervals against labkit's reference.
+    """
+    result = CheckResult("eval_pherm")
+    wrong = _monomials(fn, [0.0, 2.0], result, "[0, 2]")
+    if wrong is None:
+        return result
+    if not result.step("reproduces 1, x, x^2, x^3 on [0, 2] at x = -1, 0.5, 1.5, 3", not wrong,
+                       f"wrong for x^{wrong}" if wrong else ""):
+        return _narrow_pherm(fn, result)
+    rng = case_rng(seed, 2)
+    xdata = np.cumsum(rng.uniform(0.2, 1.5, 8))
+    ydata, ypdata = rng.normal(size=8), rng.normal(size=8)
+    xval = np.linspace(xdata[0] - 0.5, xdata[-1] + 0.5, 57)
+    ok, yval = call(result, "several unequal intervals", fn, xdata, ydata, ypdata, xval)
+    if ok and not result.step("several unequal intervals agree with labkit.eval_pherm",
+                              close(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval)),
+                              worst(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval))):
+        result.hint = ("one interval works but several do not: use bracket(xdata, xval) to pick the "
+                       "interval k of each point, and x_k, x_{k+1} of that interval in h1..h4.")
+    return result
+
+
+def _narrow_pherm(fn, result):
+    """The lab's debugging steps iii to v for eval_pherm."""
+    wrong_unit = _monomials(fn, [0.0, 1.0], result, "[0, 1]")
+    if wrong_unit is None:
+        return result
+    unit_ok = result.step("monomials on [0, 1] (interval length 1)", not wrong_unit,
+                          f"wrong for x^{wrong_unit}" if wrong_unit else "")
+    # on [0, 1] every denominator is 1; on [0, 2] they are not
+    interval = [0.0, 1.0] if not unit_ok else [0.0, 2.0]
+    bad = _basis_failures(fn, interval, result)
+    if bad is None:
+        return result
+    label = f"each Hermite basis function alone on [{interval[0]:g}, {interval[1]:g}]"
+    if not bad:
+        result.step(label, True)
+        result.hint = ("each basis function is right, so the combination is wrong: "
+                       "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
+        return result
+    name, factor = bad[0]
+    if factor is not None or unit_ok:
+        times = f" times {factor:g}" if factor is not None else ""
+        hint = (f"{name} is the right polynomial{times} on [{interval[0]:g}, {interval[1]:g}]: its denominator is wrong "
+                "(the denominators are (x_k - x_{k+1})^3 for h1, (x_k - x_{k+1})^2 for h2, "
+                "(x_{k+1} - x_k)^3 for h3 and (x_{k+1} - x_k)^2 for h4).")
+        if factor is None:
+            hint = hint.replace(" is the right polynomial on", " is right on [0, 1] but not on")
+    else:
+        hint = (f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
+                "polynomials, factor by factor.")
+    result.fail(label, f"wrong: {', '.join(n for n, _ in bad)}", hint)
+    return result
+
+
+def _basis_failures(fn, interval, result):
+    xdata = np.array(interval, dtype=float)
+    xcheck = np.array([xdata[0], xdata[1], xdata[0] + 0.25 * (xdata[1] - xdata[0]), xdata.mean()])
+    expected = piecewise.hermite_basis(xdata[0], xdata[1], xcheck)
+    data = [([1, 0], [0, 0]), ([0, 0], [1, 0]), ([0, 1], [0, 0]), ([0, 0], [0, 1])]
+    bad = []
+    for m, ((y, yp), want) in enumerate(zip(data, expected), start=1):
+        ok, got = call(result, f"h{m} on {interval}", fn, xdata, np.array(y, float), np.array(yp, float), xcheck)
+        if not ok:
+            return None
+        if not close(got, want):
+            bad.append((f"h{m}", _constant_factor(got, want)))
+    return bad
+
+
+def _constant_factor(got, want):
+    """c if got == c * want at every point (a wrong constant such as a denominator), else None."""
+    try:
+        got = np.asarray(got, dtype=float)
+    except (TypeError, ValueError):
+        return None
+    nonzero = np.abs(want) > 1e-12
+    if got.shape != want.shape or not nonzero.any() or not np.allclose(got[~nonzero], 0, atol=1e-12):
+        return None
+    ratios = got[nonzero] / want[nonzero]
+    return float(ratios[0]) if np.allclose(ratios, ratios[0], rtol=1e-9) else None
+
+
+# -- Exercise 3 ---------------------------------------------------------------
+
+def runge(fn, seed=None):
+    """Check ``runge(x) -> (y, yprime)`` against 1/(1+x^2) and its derivative."""
+    result = CheckResult("runge")
+    x = np.concatenate((np.linspace(-3.0, 3.0, 13), case_rng(seed, 3).uniform(-5.0, 5.0, 8)))
+    ok, out = call(result, "runge(x) returns (y, yprime)", fn, x)
+    if not ok:
+        return result
+    if not (isinstance(out, tuple) and len(out) == 2):
+        return result.fail("runge(x) returns (y, yprime)", f"got {type(out).__name__}",
+                           "return both values: `return y, yprime`.")
+    y, yprime = functions.runge(x)
+    if not result.step("y = 1/(1+x^2)", close(out[0], y), "" if close(out[0], y) else worst(out[0], y)):
+        result.hint = "use componentwise operations: 1 / (1 + x**2)."
+        return result
+    if not result.step("yprime = -2x/(1+x^2)^2", close(out[1], yprime),
+                       "" if close(out[1], yprime) else worst(out[1], yprime)):
+        result.hint = "differentiate 1/(1+x^2) with the chain rule: -2x/(1+x^2)^2."
+    return result
+
+
+def test_pherm_interpolate(fn, seed=None):
+    """Check the driver ``test_pherm_interpolate(ndata, interpolate) -> relative max error``.
+
+    The driver is run with labkit's ``eval_pherm`` as `interpolate`, so a
+    mistake in the student's interpolant does not count against the driver.
+    """
+    result = CheckResult("test_pherm_interpolate")
+    for ndata in (5, 11, 21, int(case_rng(seed, 4).integers(6, 60))):
+        ok, err = call(result, f"ndata = {ndata}", fn, ndata, piecewise.eval_pherm)
+        if not ok:
+            return result
+        x = np.linspace(0.0, 5.0, ndata)
+        xtest = np.linspace(0.0, 5.0, 4001)
+        y, yp = functions.runge(x)
+        exact = functions.runge(xtest)[0]
+        expected = np.max(np.abs(piecewise.eval_pherm(x, y, yp, xtest) - exact)) / np.max(np.abs(exact))
+        if not result.step(f"Err({ndata}) on [0, 5] with 4001 test points", close(err, expected, 1e-6),
+                           "" if close(err, expected, 1e-6) else f"got {shown(err)}, expected {expected:.6e}"):
+            result.hint = ("the error is max|f - p| / max|f| over 4001 equally spaced points of [0, 5], "
+                           "with ndata equally spaced data points from runge (values and derivatives).")
+            return result
+    return result

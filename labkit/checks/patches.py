@@ -1,0 +1,155 @@
+"""Checks for exercises 5 to 9: the Coons patch and the corner data of the meshes.
+
+The maths is derived in ``notebooks/03_meshes.ipynb``. References are
+:func:`labkit.patch` and the geometry each exercise asks for (the bilinear
+map of a straight quadrilateral, quarter circles, a conforming join).
+"""
+import numpy as np
+
+from .. import patches
+from .result import CheckResult, call, case_rng, close, worst
+
+def _identity_corners():
+    e1, e2 = [1.0, 0.0], [0.0, 1.0]
+    return [patches.Corner(p, e1, e2) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+
+
+def coons(fn, seed=None):
+    """Check a student's ``coons(A, B, C, D, s, t) -> (x, y)`` (the script of exercise 5)."""
+    result = CheckResult("coons")
+    s, t = np.linspace(0, 1, 4), np.linspace(0, 1, 5)
+    ok, out = call(result, "identity patch", fn, *_identity_corners(), s, t)
+    if not ok:
+        return result
+    S, T = np.meshgrid(s, t, indexing="ij")
+    if not result.step("the unit square with the identity data gives the 4 x 5 grid", close(out, [S, T]),
+                       "" if close(out, [S, T]) else worst(out, [S, T])):
+        result.hint = ("start with the outline: x along AB is eval_pherm([0, 1], [xA, xB], [dxdsA, dxdsB], s); "
+                       "DC uses D and C; then join them in t for every s.")
+        return result
+    rng = case_rng(seed, 5)
+    corners = [patches.Corner(*rng.normal(size=(4, 2))) for _ in range(4)]
+    expected = patches.patch(*corners, s, t)
+    ok, out = call(result, "random corner data with twists", fn, *corners, s, t)
+    if not ok or result.step("random corner data with twists agree with labkit.patch", close(out, expected),
+                             "" if close(out, expected) else worst(out, expected)):
+        return result
+    for edge, untwist in (("AB and DC", "ABCD"), ("AB", "AB"), ("DC", "DC")):
+        candidate = [patches.Corner(c.point, c.ds, c.dt) if label in untwist else c
+                     for label, c in zip("ABCD", corners)]
+        if close(out, patches.patch(*candidate, s, t)):
+            result.hint = (f"your patch ignores the twists along {edge}: the t-derivative along an edge "
+                           "(dxdtAB, dxdtDC) is a Hermite cubic in s with values dx/dt and slopes d2x/dsdt "
+                           "at its corners (likewise for y).")
+            break
+    else:
+        result.hint = ("compare the four edge curves one at a time with labkit.patch: values along AB and DC, "
+                       "then the t-derivatives along them, then the join in t.")
+    return result
+
+
+def _corner_list(corners, result, label):
+    if not (isinstance(corners, (list, tuple)) and len(corners) == 4
+            and all(isinstance(c, patches.Corner) for c in corners)):
+        result.fail(label, "expected a list of four labkit.Corner objects A, B, C, D",
+                    "build them with Corner(point, ds, dt, dsdt).")
+        return False
+    return True
+
+
+def graded_corners(corners):
+    """Exercise 6: the unit square with dx/ds 3 at A, D and 0.1 at B, C."""
+    result = CheckResult("exercise 6 corners")
+    if not _corner_list(corners, result, "four corners"):
+        return result
+    x, y = patches.patch(*corners, np.linspace(0, 1, 11), np.linspace(0, 1, 16))
+    outline = close([x[0], x[-1]], [np.zeros(16), np.ones(16)]) and close([y[:, 0], y[:, -1]], [np.zeros(11), np.ones(11)])
+    if not result.step("outline is still the unit square", outline):
+        result.hint = "only dx/ds changes; every other value stays as in exercise 5."
+        return result
+    dxds = [c.ds[0] for c in corners]
+    if not result.step("dx/ds is 3 at A and D and 0.1 at B and C", close(dxds, [3.0, 0.1, 0.1, 3.0]),
+                       f"got {dxds}"):
+        result.hint = "A and D are on the left (s = 0), B and C on the right (s = 1)."
+        return result
+    widths = np.diff(x, axis=0)
+    result.step("elements get thinner towards the right", np.all(np.diff(widths, axis=0) < 0))
+    return result
+
+
+def straight_corners(corners):
+    """Exercise 7: A(-1,0), B(1,0), C(1,0.5), D(0,1); the patch must be the bilinear map."""
+    result = CheckResult("exercise 7 corners")
+    if not _corner_list(corners, result, "four corners"):
+        return result
+    A, B, C, D = (np.array(p) for p in ([-1.0, 0.0], [1.0, 0.0], [1.0, 0.5], [0.0, 1.0]))
+    if not result.step("corner points A, B, C, D", close([c.point for c in corners], [A, B, C, D])):
+        result.hint = "A = (-1, 0), B = (1, 0), C = (1, 0.5), D = (0, 1)."
+        return result
+    if not result.step("twists d2x/dsdt = -1, d2y/dsdt = -0.5", close([c.dsdt for c in corners], [A - B + C - D] * 4)):
+        result.hint = "set d2xdsdt = -1 and d2ydsdt = -0.5 at all four corners."
+        return result
+    s, t = np.linspace(0, 1, 20), np.linspace(0, 1, 15)
+    S, T = np.meshgrid(s, t, indexing="ij")
+    bilinear_map = [(1 - S) * (1 - T) * A[i] + S * (1 - T) * B[i] + S * T * C[i] + (1 - S) * T * D[i] for i in (0, 1)]
+    got = patches.patch(*corners, s, t)
+    if not result.step("mesh lines straight and evenly spaced", close(got, bilinear_map), worst(got, bilinear_map)):
+        result.hint = ("along a straight side with even spacing the derivative is the vector along that side: "
+                       "d/ds = B - A on AB and C - D on DC, d/dt = D - A on AD and C - B on BC.")
+    return result
+
+
+def circle_corners(corners):
+    """Exercise 8: quarter-circle sides through the unit square's corners, two-fold symmetric."""
+    result = CheckResult("exercise 8 corners")
+    if not _corner_list(corners, result, "four corners"):
+        return result
+    u = np.linspace(0, 1, 25)
+    x, y = patches.patch(*corners, u, u)
+    if not result.step("corners at the unit square's corners",
+                       close([c.point for c in corners], [[0, 0], [1, 0], [1, 1], [0, 1]])):
+        result.hint = "A = (0, 0), B = (1, 0), C = (1, 1), D = (0, 1) as in exercise 5."
+        return result
+    radius = np.sqrt(2) / 2
+    bound = np.sqrt(2) * radius * (np.pi / 2) ** 4 / 384
+    sides = {"AB": (x[:, 0], y[:, 0], [(0.5, 0.5), (0.5, -0.5)]), "DC": (x[:, -1], y[:, -1], [(0.5, 0.5), (0.5, 1.5)]),
+             "AD": (x[0], y[0], [(0.5, 0.5), (-0.5, 0.5)]), "BC": (x[-1], y[-1], [(0.5, 0.5), (1.5, 0.5)])}
+    for name, (xs, ys, centres) in sides.items():
+        near = min(np.max(np.abs(np.hypot(xs - cx, ys - cy) - radius)) for cx, cy in centres)
+        if not result.step(f"side {name} close to a quarter circle of radius sqrt(2)/2", near < bound,
+                           f"off by {near:.3f}"):
+            result.hint = ("parametrise the arc (centre, radius sqrt(2)/2, angle growing by pi/2 over s in [0, 1]) "
+                           "and differentiate: the derivative's length is (sqrt(2)/2)(pi/2) = pi/(2 sqrt 2).")
+            return result
+    symmetric = close(x + x[::-1], np.ones_like(x)) and close(y + y[:, ::-1], np.ones_like(y))
+    if not result.step("left-right and top-bottom symmetric", symmetric):
+        result.hint = "mirror the bottom side's data to get the top, and the left side's to get the right."
+    return result
+
+
+def two_patches(fn, corners):
+    """Exercise 9: ``two_patches(A, B, C, D) -> (mesh1, mesh2)`` joins along BC / dc."""
+    result = CheckResult("exercise 9 patches")
+    if not _corner_list(corners, result, "corners of ABCD"):
+        return result
+    for label, ABCD in (("sharp corner", corners),
+                        ("rounded corner", [*corners[:2], patches.Corner([1.8, 1.8], [0.5, -0.5], corners[2].dt), corners[3]])):
+        ok, out = call(result, label, fn, *ABCD)
+        if not ok:
+            return result
+        try:
+            first, second = out
+            merged = first + second
+        except Exception as exc:  # noqa: BLE001
+            return result.fail(label, f"could not join the two meshes ({exc})",
+                               "return the two QuadMesh objects: `return first, second`.")
+        expected_nodes = len(first.points) + len(second.points) - 30
+        if not result.step(f"{label}: the 30 nodes of the shared edge merge", len(merged.points) == expected_nodes,
+                           f"{len(first.points)} + {len(second.points)} nodes gave {len(merged.points)}"):
+            result.hint = ("abcd is ABCD mirrored in y = x with s and t swapped: give each corner the mirrored "
+                           "dt as ds and the mirrored ds as dt, and use 30 points along dc.")
+            return result
+        if not result.step(f"{label}: every element positively oriented", merged.quality().min() > 0):
+            result.hint = "a folded element means a corner derivative of abcd points the wrong way."
+            return result
+    return result

@@ -1,0 +1,131 @@
+"""The check framework: a check's result, calling student code safely, comparing numbers.
+
+Every exercise's check is a function of the student's function (or data)
+that returns a :class:`CheckResult`. It calls the student's code only through
+:func:`call`, so whatever the code does (raise, return nonsense, refuse a
+reference implementation while being graded) becomes a failed step with a
+hint, never an exception. The same check runs in a student's notebook, on
+the real function, and in ``labkit grade``, on a proxy that forwards the call
+into the sandboxed notebook: see :mod:`labkit.grading.remote`.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+TOLERANCE = 1e-9
+
+
+@dataclass
+class CheckResult:
+    """Outcome of one check: the steps run, whether all passed, and a hint if not."""
+
+    name: str
+    steps: list = field(default_factory=list)  # (description, passed, detail)
+    hint: str = ""
+
+    @property
+    def passed(self):
+        return bool(self.steps) and all(ok for _, ok, _ in self.steps)
+
+    def step(self, description, ok, detail=""):
+        """Record a step; the detail explains a failure, so a passed step drops it."""
+        self.steps.append((description, bool(ok), "" if ok else detail))
+        return bool(ok)
+
+    def fail(self, description, detail, hint):
+        self.step(description, False, detail)
+        self.hint = hint
+        return self
+
+    def __repr__(self):
+        verdict = "all checks passed" if self.passed else "FAILED"
+        lines = [f"{self.name}: {verdict}"]
+        for description, ok, detail in self.steps:
+            lines.append(f"  [{'ok' if ok else 'FAIL'}] {description}" + (f": {detail}" if detail else ""))
+        if self.hint:
+            lines.append(f"  hint: {self.hint}")
+        return "\n".join(lines)
+
+    def as_dict(self):
+        return {"name": self.name, "passed": self.passed, "hint": self.hint,
+                "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps]}
+
+
+def case_rng(seed, default):
+    """Random test data: fixed (``default``) in a notebook's self-check, fresh per grading run.
+
+    ``labkit grade`` passes its run's seed, so the data differ from run to run
+    (no table of answers can be prepared) yet a run can be repeated exactly.
+    """
+    return np.random.default_rng(default if seed is None else [int(seed), default])
+
+
+def call(result, description, fn, *args):
+    """Run student code; an exception becomes a failed step (never escapes).
+
+    Returns ``(True, value)``, or ``(False, None)`` after recording the failure.
+    Errors that come back from a sandboxed notebook carry the student's
+    exception type in ``kind``; a refused reference implementation carries
+    ``refused``.
+    """
+    try:
+        return True, fn(*args)
+    except NotImplementedError:
+        result.fail(description, "not implemented yet", "replace the `raise NotImplementedError()` with your code.")
+    except Exception as exc:  # noqa: BLE001 - any student error is reported, not raised
+        kind = getattr(exc, "kind", type(exc).__name__)
+        refused = getattr(exc, "refused", None)
+        if refused:
+            result.fail(description, f"called {refused}, which is switched off while this exercise is graded",
+                        f"the exercise asks you to write this yourself: do not call {refused}.")
+        else:
+            result.fail(description, f"raised {kind}: {exc}",
+                        "read the error above; run the cell on its own to see the traceback.")
+    return False, None
+
+
+class _NotNumbers(Exception):
+    pass
+
+
+def _floats(value):
+    """A float ndarray, or _NotNumbers with what the value is instead."""
+    if getattr(value, "not_numbers", False):  # a value from a sandboxed notebook that was not numbers
+        raise _NotNumbers(str(value))
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise _NotNumbers(f"got {type(value).__name__}, not numbers") from None
+
+
+def close(actual, expected, tol=TOLERANCE):
+    """True if `actual` is a finite float array of `expected`'s shape and agrees to `tol`."""
+    try:
+        actual = _floats(actual)
+    except _NotNumbers:
+        return False
+    expected = np.asarray(expected, dtype=float)
+    return (actual.shape == expected.shape and bool(np.all(np.isfinite(actual)))
+            and bool(np.allclose(actual, expected, rtol=tol, atol=tol)))
+
+
+def worst(actual, expected):
+    """Why `actual` is not `expected`: what it is instead, or the largest difference."""
+    try:
+        actual = _floats(actual)
+    except _NotNumbers as exc:
+        return str(exc)
+    expected = np.asarray(expected, dtype=float)
+    if actual.shape != expected.shape:
+        return f"expected shape {expected.shape}, got {actual.shape}"
+    if not np.all(np.isfinite(actual)):
+        return f"{int(np.sum(~np.isfinite(actual)))} value(s) are NaN or infinite"
+    return f"largest difference {np.max(np.abs(actual - expected)):.2e}"
+
+
+def shown(value):
+    """Short text of a student's value for a failure message (rounded numbers, or what it is)."""
+    try:
+        return str(np.round(_floats(value), 6))
+    except _NotNumbers as exc:
+        return str(exc)

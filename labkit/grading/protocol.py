@@ -1,0 +1,208 @@
+"""What crosses between the grader and a sandboxed notebook: plain numbers in tagged JSON.
+
+Both directions use one format, one JSON object per line:
+
+* a float ``["f", x]``, an integer ``["i", n]``, ``["none"]``, text ``["s", text]``;
+* an array ``["a", shape, base64 of little-endian float64]`` (integers and
+  booleans are sent as floats; complex and object arrays are not numbers);
+* a tuple ``["t", [...]]`` or a list ``["l", [...]]``;
+* a :class:`labkit.Corner` ``["corner", point, ds, dt, dsdt]`` and a
+  :class:`labkit.QuadMesh` ``["mesh", points, quads]``, rebuilt (and
+  validated) by their constructors;
+* towards the notebook only, a function of labkit's that the checks hand to
+  student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``
+  (:data:`PASSABLE`);
+* from the notebook only, ``["obj", description]`` for anything else.
+
+The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
+and shapes are checked, every number becomes a float64 array or a Python
+float, and anything else becomes a :class:`NotNumbers` that fails every
+comparison with a message saying what it was. Nothing is unpickled or
+evaluated. The notebook side encodes with :func:`encode`.
+"""
+import base64
+import json
+import math
+
+import numpy as np
+
+MAX_DEPTH = 12
+MAX_ELEMENTS = 20_000_000  # numbers in one message
+MAX_TEXT = 2_000
+MAX_LINE = 256 * 1024 * 1024  # bytes in one message
+
+# functions the checks may hand to student code, by the name both sides know
+PASSABLE = {
+    "labkit.piecewise:eval_pherm",
+    "labkit.functions:runge2d",
+    "labkit.checks.bilinear:one",
+    "labkit.checks.bilinear:x_only",
+    "labkit.checks.bilinear:y_only",
+    "labkit.checks.bilinear:product",
+}
+
+
+class ProtocolError(ValueError):
+    """A message that is not in the format (sizes, tags, shapes)."""
+
+
+class NotNumbers:
+    """Stands for a value from the notebook that is not numbers; every check step on it fails."""
+
+    not_numbers = True
+
+    def __init__(self, description):
+        self.description = str(description)[:MAX_TEXT]
+
+    def __str__(self):
+        return f"got {self.description}, not numbers"
+
+    __repr__ = __str__
+
+
+# -- the notebook's side --------------------------------------------------------
+
+def _array_tag(value):
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "biuf":
+        kind = "complex numbers" if arr.dtype.kind == "c" else f"an array of {arr.dtype}"
+        return ["obj", kind]
+    if arr.size > MAX_ELEMENTS:
+        return ["obj", f"an array of {arr.size} numbers (too large)"]
+    data = np.ascontiguousarray(arr, dtype="<f8").tobytes()
+    return ["a", list(arr.shape), base64.b64encode(data).decode("ascii")]
+
+
+def encode(value, depth=0):
+    """Tagged plain form of a value (the notebook's side; may be hostile, so it is re-checked)."""
+    from ..mesh import QuadMesh
+    from ..patches import Corner
+
+    if depth > MAX_DEPTH:
+        return ["obj", "a value nested too deeply"]
+    if value is None:
+        return ["none"]
+    if isinstance(value, (bool, np.bool_)):
+        return ["f", float(value)]
+    if isinstance(value, (int, np.integer)):
+        number = int(value)
+        return ["i", number] if abs(number) < 2**53 else ["f", float(number)]
+    if isinstance(value, (float, np.floating)):
+        return ["f", float(value)]
+    if isinstance(value, str):
+        return ["s", value[:MAX_TEXT]]
+    if isinstance(value, np.ndarray):
+        return _array_tag(value)
+    if isinstance(value, Corner):
+        return ["corner"] + [_array_tag(getattr(value, name)) for name in ("point", "ds", "dt", "dsdt")]
+    if isinstance(value, QuadMesh):
+        return ["mesh", _array_tag(value.points), _array_tag(value.quads)]
+    if callable(value) and f"{getattr(value, '__module__', '')}:{getattr(value, '__qualname__', '')}" in PASSABLE:
+        return ["fn", f"{value.__module__}:{value.__qualname__}"]
+    if type(value) in (tuple, list):
+        return ["t" if type(value) is tuple else "l", [encode(item, depth + 1) for item in value[:100_000]]]
+    return ["obj", f"a {type(value).__name__} object"]
+
+
+def dumps(message):
+    """One line of JSON (NaN and infinities allowed: they are numbers a student may return)."""
+    return (json.dumps(message, allow_nan=True, separators=(",", ":")) + "\n").encode("utf-8")
+
+
+def resolve_function(name):
+    """The labkit function a ``["fn", name]`` stands for (the notebook's side).
+
+    A copy with the function's own code, so that switching the reference off
+    while the call runs (:func:`labkit.grading.refusals.switched_off`) does
+    not switch off what the checks hand over.
+    """
+    import importlib
+    import types
+
+    if name not in PASSABLE:
+        raise ProtocolError(f"{name!r} is not a function the checks pass")
+    module, _, attribute = name.partition(":")
+    original = getattr(importlib.import_module(module), attribute)
+    copy = types.FunctionType(original.__code__, original.__globals__, original.__name__,
+                              original.__defaults__, original.__closure__)
+    copy.__kwdefaults__, copy.__qualname__ = original.__kwdefaults__, original.__qualname__
+    return copy
+
+
+# -- the grader's side -----------------------------------------------------------
+
+def loads(line):
+    """Parse one message line; anything but a JSON object of bounded size is a ProtocolError."""
+    if len(line) > MAX_LINE:
+        raise ProtocolError(f"a message of {len(line)} bytes is larger than {MAX_LINE}")
+    try:
+        message = json.loads(line)
+    except (ValueError, RecursionError) as exc:
+        raise ProtocolError(f"not JSON ({str(exc)[:100]})") from None
+    if not isinstance(message, dict):
+        raise ProtocolError("a message must be a JSON object")
+    return message
+
+
+def _array(tag):
+    if len(tag) != 3 or not isinstance(tag[1], list) or not isinstance(tag[2], str):
+        raise ProtocolError("malformed array")
+    shape = tag[1]
+    if len(shape) > 32 or not all(type(n) is int and 0 <= n <= MAX_ELEMENTS for n in shape):
+        raise ProtocolError("malformed array shape")
+    size = math.prod(shape)
+    if size > MAX_ELEMENTS or len(tag[2]) != 4 * math.ceil(8 * size / 3):
+        raise ProtocolError("array data does not match its shape")
+    try:
+        raw = base64.b64decode(tag[2], validate=True)
+    except ValueError:
+        raise ProtocolError("array data is not base64") from None
+    arr = np.frombuffer(raw, dtype="<f8").astype(float).reshape(shape)
+    return arr
+
+
+def decode(tag, depth=0, functions=False):
+    """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
+    Corners, QuadMeshes, or a NotNumbers. ``functions=True`` (the notebook's side) also
+    turns ``["fn", name]`` into the labkit function."""
+    from ..mesh import QuadMesh
+    from ..patches import Corner
+
+    if depth > MAX_DEPTH + 1:
+        raise ProtocolError("nested too deeply")
+    if not isinstance(tag, list) or not tag or not isinstance(tag[0], str):
+        raise ProtocolError("malformed value")
+    kind = tag[0]
+    if kind == "f" and len(tag) == 2 and type(tag[1]) in (int, float):
+        return float(tag[1])
+    if kind == "i" and len(tag) == 2 and type(tag[1]) is int:
+        return tag[1]
+    if kind == "none":
+        return None
+    if kind == "s" and len(tag) == 2 and isinstance(tag[1], str):
+        return tag[1][:MAX_TEXT]
+    if kind == "a":
+        return _array(tag)
+    if kind in ("t", "l") and len(tag) == 2 and isinstance(tag[1], list):
+        items = [decode(item, depth + 1, functions) for item in tag[1]]
+        return tuple(items) if kind == "t" else items
+    if kind == "corner" and len(tag) == 5:
+        point, ds, dt, dsdt = (_array(part) if isinstance(part, list) and part[:1] == ["a"]
+                               else NotNumbers("a corner with a field that is not numbers") for part in tag[1:])
+        try:
+            return Corner(point, ds, dt, dsdt)
+        except (ValueError, TypeError) as exc:
+            return NotNumbers(f"an invalid Corner ({exc})")
+    if kind == "mesh" and len(tag) == 3:
+        try:
+            points, quads = _array(tag[1]), _array(tag[2])
+            if not np.array_equal(quads, np.round(quads)):
+                return NotNumbers("a QuadMesh whose quads are not node numbers")
+            return QuadMesh(points, quads.astype(np.intp))
+        except (ValueError, TypeError, ProtocolError) as exc:
+            return NotNumbers(f"an invalid QuadMesh ({exc})")
+    if kind == "obj" and len(tag) == 2 and isinstance(tag[1], str):
+        return NotNumbers(tag[1])
+    if kind == "fn" and functions and len(tag) == 2 and isinstance(tag[1], str):
+        return resolve_function(tag[1])
+    raise ProtocolError(f"unknown value tag {kind!r}")

@@ -1,0 +1,69 @@
+"""The student version of the instructor notebooks.
+
+Code between ``### BEGIN SOLUTION`` / ``### END SOLUTION`` becomes a stub
+that raises ``NotImplementedError``, hidden tests between ``### BEGIN HIDDEN
+TESTS`` / ``### END HIDDEN TESTS`` disappear, outputs are cleared. The
+markers are nbgrader's.
+"""
+import json
+from pathlib import Path
+
+import nbformat
+
+from ..notebooks import notebook_paths, read_notebook
+
+BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
+BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
+STUB = ["# YOUR CODE HERE", "raise NotImplementedError()"]
+
+
+def strip_solutions(source, where="cell"):
+    """Replace solution regions by stubs and drop hidden-test regions in one cell's source."""
+    lines, out, region = source.split("\n"), [], None
+    for number, line in enumerate(lines, start=1):
+        marker = line.strip()
+        if marker in (BEGIN_SOLUTION, BEGIN_HIDDEN):
+            if region:
+                raise ValueError(f"{where}, line {number}: {marker!r} inside an open {region!r} region.")
+            region = marker
+            if marker == BEGIN_SOLUTION:
+                indent = line[: len(line) - len(line.lstrip())]
+                out.extend(indent + stub for stub in STUB)
+        elif marker in (END_SOLUTION, END_HIDDEN):
+            expected = BEGIN_SOLUTION if marker == END_SOLUTION else BEGIN_HIDDEN
+            if region != expected:
+                raise ValueError(f"{where}, line {number}: {marker!r} without a matching {expected!r}.")
+            region = None
+        elif region is None:
+            out.append(line)
+    if region:
+        raise ValueError(f"{where}: the {region!r} region is never closed.")
+    return "\n".join(out)
+
+
+def release_notebook(nb, name="notebook"):
+    """The student version of an instructor notebook (a new object)."""
+    student = nbformat.from_dict(json.loads(json.dumps(nb)))
+    student.metadata.pop("widgets", None)
+    for index, cell in enumerate(student.cells):
+        if cell.cell_type == "code":
+            cell.source = strip_solutions(cell.source, f"{name}, cell {index}")
+            cell.outputs = []
+            cell.execution_count = None
+    return student
+
+
+def release(notebook_dir, out_dir):
+    """Write the student version of every notebook of `notebook_dir` into `out_dir`."""
+    paths = notebook_paths(notebook_dir)
+    out = Path(out_dir)
+    if out.resolve() == Path(notebook_dir).resolve():
+        raise ValueError("--out must differ from the notebook folder; the release would overwrite the solutions.")
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for path in paths:
+        student = release_notebook(read_notebook(path), path.name)
+        target = out / path.name
+        nbformat.write(student, target)
+        written.append(target)
+    return written

@@ -1,0 +1,161 @@
+"""The box a student's notebook runs in: bubblewrap namespaces and resource limits.
+
+:func:`command` builds the ``bwrap`` command line for one notebook:
+
+* a new, empty root: the system (``/usr``, ``/etc``) and the Python
+  environment (its prefixes and labkit's own package folder) mounted
+  read-only, nothing else of the machine (no other home folders, no course
+  folder, no instructor notebooks, no output folder, no other submission);
+* the submission's private folder, a copy made for this run, as the only
+  writable place on disk; it is ``HOME`` and the working directory;
+* ``/tmp`` a small private tmpfs; ``/proc`` of its own; a minimal ``/dev``;
+* no network (``--unshare-net``: only a loopback of its own), its own PID,
+  IPC and UTS namespaces, a new session (no terminal to inject into), and
+  ``--die-with-parent``, so every process of the notebook dies with the grader;
+* all capabilities dropped but the two the worker needs to give up root
+  (it then runs as an otherwise unused uid, so the process limit holds).
+
+:func:`apply_limits` sets the rlimits (address space, CPU seconds, processes,
+file size, open files) in the child before ``bwrap`` starts; they are
+inherited by everything inside.
+"""
+import os
+import resource
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+HOME = "/home/student"
+INSTALL_HINT = ("install bubblewrap (Debian/Ubuntu: `sudo apt-get install bubblewrap`; Fedora: `sudo dnf install "
+                "bubblewrap`) on a Linux machine that allows user namespaces, or grade inside a container that "
+                "allows them; `labkit grade --no-sandbox` runs student code unconfined (not recommended)")
+
+
+class SandboxUnavailable(RuntimeError):
+    """bwrap is missing or cannot create namespaces here."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Resource limits of one notebook's sandbox."""
+
+    memory: int = 4 * 1024**3  # bytes of address space per process
+    cpu_seconds: int = 900  # per process
+    processes: int = 64  # processes and threads of the sandbox's uid
+    file_size: int = 64 * 1024**2  # bytes per file written
+    open_files: int = 256
+    tmp_size: int = 256 * 1024**2  # bytes of the private /tmp
+
+
+def available():
+    """Raise SandboxUnavailable with what to do if bwrap cannot run a sandbox here."""
+    bwrap = shutil.which("bwrap")
+    if bwrap is None:
+        raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
+    probe = subprocess.run([bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev",
+                            "true"], capture_output=True, text=True, timeout=30)
+    if probe.returncode != 0:
+        raise SandboxUnavailable(f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): {INSTALL_HINT}.")
+    return bwrap
+
+
+def _namespaces():
+    user = [] if os.geteuid() == 0 else ["--unshare-user"]
+    return [*user, "--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts", "--unshare-cgroup-try",
+            "--die-with-parent", "--new-session"]
+
+
+def sandbox_uid():
+    """An unused uid for this grading process's sandboxes (0 when not root: bwrap maps the caller's).
+
+    Sandboxes graded at the same time come from different processes, so they
+    get different uids and one notebook's processes never count against
+    another's limit.
+    """
+    return 61000 + os.getpid() % 4000 if os.geteuid() == 0 else 0
+
+
+def _read_only_paths():
+    """The Python environment the worker needs: its prefixes and labkit's package folder."""
+    import labkit
+
+    paths = {Path(p).resolve() for p in (sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix)}
+    paths.add(Path(labkit.__file__).resolve().parent)
+    paths.add(Path(sys.executable).resolve().parent.parent)
+    system = (Path("/usr"), Path("/etc"))
+    paths = {p for p in paths if p.exists() and not any(p == s or s in p.parents for s in system)}
+    # a folder inside another one is mounted with it
+    return sorted(p for p in paths if not any(q != p and q in p.parents for q in paths))
+
+
+def _parents(path):
+    """--dir for every folder above `path`, world-readable (bwrap would make them 0700)."""
+    args = []
+    for parent in reversed(Path(path).parents):
+        if str(parent) != "/":
+            args += ["--perms", "0755", "--dir", str(parent)]
+    return args
+
+
+def command(workdir, argv, uid, limits=Limits()):
+    """The bwrap command that runs `argv` on the private folder `workdir`."""
+    args = [shutil.which("bwrap") or "bwrap", *_namespaces(), "--clearenv",
+            "--cap-drop", "ALL"]
+    if os.geteuid() == 0:
+        args += ["--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID"]
+    for name in ("usr", "etc"):
+        args += ["--ro-bind", f"/{name}", f"/{name}"]
+    for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
+        top = Path("/") / name
+        if top.is_symlink():
+            args += ["--symlink", os.readlink(top), str(top)]
+        elif top.is_dir():
+            args += ["--ro-bind", str(top), str(top)]
+    mounted = set()
+    for path in _read_only_paths():
+        for parent in reversed(path.parents):
+            if str(parent) != "/" and parent not in mounted:
+                args += ["--perms", "0755", "--dir", str(parent)]
+                mounted.add(parent)
+        args += ["--ro-bind", str(path), str(path)]
+    args += ["--proc", "/proc", "--dev", "/dev",
+             "--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp",
+             *_parents(HOME), "--bind", str(workdir), HOME, "--chdir", HOME]
+    environment = {"HOME": HOME, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin", "LANG": "C.UTF-8",
+                   "MPLBACKEND": "Agg", "MPLCONFIGDIR": f"{HOME}/.matplotlib", "PYTHONDONTWRITEBYTECODE": "1",
+                   "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+    for name in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE"):  # set on some machines for correct results
+        if name in os.environ:
+            environment[name] = os.environ[name]
+    for name, value in environment.items():
+        args += ["--setenv", name, value]
+    return args + ["--", *argv]
+
+
+def apply_limits(limits, processes_base=0):
+    """Set the rlimits of the calling process (a child about to exec bwrap or the worker)."""
+    def cap(kind, value):
+        soft, hard = resource.getrlimit(kind)
+        value = value if hard == resource.RLIM_INFINITY else min(value, hard)
+        resource.setrlimit(kind, (value, value))
+
+    cap(resource.RLIMIT_AS, limits.memory)
+    cap(resource.RLIMIT_CPU, limits.cpu_seconds)
+    cap(resource.RLIMIT_NPROC, processes_base + limits.processes)
+    cap(resource.RLIMIT_FSIZE, limits.file_size)
+    cap(resource.RLIMIT_NOFILE, limits.open_files)
+
+
+def processes_of_this_user():
+    """How many processes the calling uid already has (the process limit counts them too)."""
+    uid = os.getuid()
+    count = 0
+    for entry in os.scandir("/proc"):
+        if entry.name.isdigit():
+            try:
+                count += entry.stat().st_uid == uid
+            except OSError:
+                pass
+    return count
