@@ -112,7 +112,9 @@ def _constant_factor(got, want):
     if got.shape != want.shape or not nonzero.any() or not np.allclose(got[~nonzero], 0, atol=1e-12):
         return None
     ratios = got[nonzero] / want[nonzero]
-    return float(ratios[0]) if np.allclose(ratios, ratios[0], rtol=1e-9) else None
+    if abs(ratios[0]) < 1e-12 or not np.allclose(ratios, ratios[0], rtol=1e-9):
+        return None  # zero everywhere is no denominator mistake
+    return float(ratios[0])
 
 
 # -- Exercise 3 ---------------------------------------------------------------

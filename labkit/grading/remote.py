@@ -10,6 +10,7 @@ So the checks of :mod:`labkit.checks` run unchanged on this side, never in
 the student's process.
 """
 import os
+import secrets
 import selectors
 import signal
 import subprocess
@@ -41,7 +42,7 @@ class Notebook:
         self.deadline = deadline if deadline is not None else time.monotonic() + 600
         self.stopped = None  # why the worker can no longer answer
         self._buffer = b""
-        self._next_id = 0
+        self._next_id = None
         argv = [sys.executable, "-I", "-m", "labkit.grading.worker"]
         if confined:
             uid = sandbox.sandbox_uid()
@@ -89,7 +90,7 @@ class Notebook:
         """Send one request; its answer (a dict), or WorkerError after stopping the worker."""
         if self.stopped:
             raise WorkerError(self.stopped)
-        self._next_id += 1
+        self._next_id = secrets.token_hex(8)  # unguessable: a line the notebook forges cannot pose as the answer
         message = {**message, "id": self._next_id}
         try:
             self.process.stdin.write(protocol.dumps(message))

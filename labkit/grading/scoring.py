@@ -58,7 +58,7 @@ def _own_code(findings):
 def _run_problems(name, ran, total_timeout):
     problems = []
     if ran["errors"]:
-        shown = "; ".join(f"cell {e['cell'] + 1} raised {e['kind']}: {e['message'][:160]}" for e in ran["errors"][:3])
+        shown = "; ".join(f"cell {e['cell'] + 1} raised {e['kind']}: {e['message'][:300]}" for e in ran["errors"][:3])
         more = f"; and {len(ran['errors']) - 3} more" if len(ran["errors"]) > 3 else ""
         problems.append(f"{name}: {len(ran['errors'])} cell(s) raised an error (graded as far as it got): "
                         f"{shown}{more}.")
