@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 ROOT_FLAG := $(if $(filter 0,$(shell id -u)),--allow-root,)
 
-.PHONY: lab test bench notebooks chromium clean
+.PHONY: lab test bench notebooks chromium bwrap clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 lab: $(STAMP)
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(ROOT_FLAG) $(ARGS)
 
-test: $(STAMP) chromium
+test: $(STAMP) chromium bwrap
 	$(PY) -m pytest tests labkit --nbval --nbval-current-env --nbval-sanitize-with tests/nbval_sanitize.cfg notebooks
 
 # The browser test drives Debian's Chromium (never a Playwright download).
@@ -25,6 +25,12 @@ chromium:
 	@test -x /usr/bin/chromium || { [ "$$(id -u)" = 0 ] \
 	  && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
 	  || echo "!! /usr/bin/chromium is missing and could not be installed: the browser test will be SKIPPED"; }
+
+# Grading runs every submission in a bubblewrap sandbox; the grading tests need it.
+bwrap:
+	@command -v bwrap >/dev/null || { [ "$$(id -u)" = 0 ] \
+	  && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq bubblewrap >/dev/null) \
+	  || echo "!! bwrap is missing and could not be installed: install bubblewrap, or the grading tests fail"; }
 
 notebooks: $(STAMP)
 	$(VENV)/bin/labkit execute notebooks

@@ -96,3 +96,43 @@ def test_grade_reports_missing_names_with_a_hint():
     verdict = check.grade(16, {"runge2d": labkit.runge2d})
     assert verdict["points"] == 0 and verdict["defined"]
     assert "eval_pbilin" in verdict["checks"][-1]["hint"]
+
+
+def _recording(calls):
+    def eval_pherm(xdata, ydata, ypdata, xval):
+        calls.append(np.asarray(xdata, float).copy())
+        return labkit.eval_pherm(xdata, ydata, ypdata, xval)
+    return eval_pherm
+
+
+def test_seeded_random_cases_are_fresh_per_seed_and_repeatable():
+    runs = {}
+    for label, seed in (("a", None), ("b", None), ("c", 1), ("d", 1), ("e", 2)):
+        calls = []
+        assert check.eval_pherm(_recording(calls), seed=seed).passed
+        runs[label] = calls[-1]  # the random unequal intervals
+    assert np.array_equal(runs["a"], runs["b"]) and np.array_equal(runs["c"], runs["d"])
+    assert not np.array_equal(runs["a"], runs["c"]) and not np.array_equal(runs["c"], runs["e"])
+
+
+@pytest.mark.parametrize("seed", [None, 7, 2**62])
+def test_reference_implementations_pass_with_any_seed(seed):
+    assert check.runge(labkit.runge, seed=seed).passed
+    assert check.test_pherm_interpolate(lambda n, f: _table_error(n, f), seed=seed).passed
+    assert check.ccspline(labkit.ccspline, check._reference_complete_system, seed=seed).passed
+    assert check.ncspline(labkit.ncspline, seed=seed).passed
+    assert check.runge2d(labkit.runge2d, seed=seed).passed
+    assert check.eval_pbilin(labkit.eval_pbilin, seed=seed).passed
+    assert check.coons(lambda *args: tuple(labkit.patch(*args)), seed=seed).passed
+
+
+def _table_error(ndata, interpolate):
+    x, xtest = np.linspace(0, 5, ndata), np.linspace(0, 5, 4001)
+    y, yp = labkit.runge(x)
+    exact = labkit.runge(xtest)[0]
+    return np.max(np.abs(interpolate(x, y, yp, xtest) - exact)) / np.max(np.abs(exact))
+
+
+def test_a_zero_function_gets_no_denominator_hint():
+    result = check.eval_pherm(lambda xd, yd, yp, xv: 0.0 * np.asarray(xv))
+    assert not result.passed and "times 0" not in result.hint and "wrong" in result.hint

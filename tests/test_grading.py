@@ -1,6 +1,8 @@
 """Student release and grading: instructor = full marks, release = zero, planted bugs lose
 exactly their exercise with the matching hint, broken submissions never stop the run."""
 import csv
+import json
+import shutil
 import subprocess
 import sys
 import time
@@ -222,3 +224,80 @@ def test_cli_rejects_bad_paths_and_non_notebooks(tmp_path):
     assert run.returncode != 0 and "is not a notebook" in run.stderr
     run = _cli("release", str(tmp_path), "--out", str(tmp_path / "r"))
     assert run.returncode != 0 and "no notebooks" in run.stderr
+
+
+def test_every_submission_gets_a_result_file_and_the_seed_is_saved(graded):
+    results, out, _, subs = graded
+    seed = int((out / "seed.txt").read_text())
+    for name, grade in results.items():
+        data = json.loads((out / "results" / f"{grading.report.safe_name(grade.name)}.json").read_text())
+        assert data["total"] == grade.total and data["seed"] == seed
+        assert {int(n): v for n, v in data["points"].items()} == grade.points
+
+
+@pytest.fixture(scope="module")
+def two_runs(tmp_path_factory, released):
+    """The class split over two 'batch jobs' with one seed, as on a cluster, and merged."""
+    tmp = tmp_path_factory.mktemp("split")
+    solved, bare = tmp / "alice.ipynb", tmp / "bob.ipynb"
+    shutil.copy(NOTEBOOKS / "06_bilinear.ipynb", solved)
+    shutil.copy(released / "06_bilinear.ipynb", bare)
+    first = grading.grade([solved], tmp / "job1", jobs=1, seed=4242, progress=False)
+    second = grading.grade([bare], tmp / "job2", jobs=1, seed=4242, progress=False)
+    again = grading.grade([solved], tmp / "job3", jobs=1, seed=4242, progress=False)
+    return tmp, first + second, again
+
+
+def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
+    tmp, graded_apart, _ = two_runs
+    run = _cli("grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp / "merged"))
+    assert run.returncode == 0, run.stderr
+    with open(tmp / "merged" / "grades.csv", newline="") as handle:
+        rows = {row[0]: row for row in csv.reader(handle)}
+    assert sorted(rows) == ["alice", "bob", "submission"]
+    assert rows["alice"][-1] == str(POINTS[16]) and rows["bob"][-1] == "0"
+    for grade in graded_apart:
+        assert int(rows[grade.name][-1]) == grade.total
+        assert (tmp / "merged" / "feedback" / f"{grade.name}.txt").read_text() == grade.feedback()
+    assert (tmp / "merged" / "seed.txt").read_text() == "4242\n"
+
+
+def test_merge_refuses_a_submission_graded_twice_and_folders_without_results(two_runs, tmp_path):
+    tmp, *_ = two_runs
+    with pytest.raises(ValueError, match="graded twice"):
+        grading.merge([tmp / "job1", tmp / "job3"], tmp_path / "m")
+    with pytest.raises(ValueError, match="holds no results"):
+        grading.merge([tmp_path], tmp_path / "m")
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "x.json").write_text('{"format": "something else"}')
+    with pytest.raises(ValueError, match="is not a labkit grade result"):
+        grading.merge([tmp_path], tmp_path / "m")
+
+
+def test_the_same_seed_gives_the_same_feedback(two_runs):
+    tmp, *_ = two_runs
+    assert (tmp / "job1" / "feedback" / "alice.txt").read_text() == (tmp / "job3" / "feedback" / "alice.txt").read_text()
+
+
+def test_grading_without_bwrap_stops_and_says_how_to_install_it(tmp_path, monkeypatch):
+    monkeypatch.setenv("PATH", str(tmp_path))  # no bwrap on this PATH
+    with pytest.raises(ValueError, match="install bubblewrap"):
+        grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", progress=False)
+    assert not (tmp_path / "out").exists()
+
+
+def test_no_sandbox_warns_loudly_and_still_grades(tmp_path):
+    run = _cli("grade", str(NOTEBOOKS / "06_bilinear.ipynb"), "--out", str(tmp_path / "g"), "--no-sandbox",
+               "--quiet", "--seed", "5")
+    assert run.returncode == 0, run.stderr
+    assert "UNCONFINED" in run.stderr and "random test data from seed 5" in run.stdout
+    assert f"06_bilinear{' ' * 20}" in run.stdout and run.stdout.split("06_bilinear")[1].split()[0] == str(POINTS[16])
+
+
+def test_cli_grade_needs_submissions_or_merge(tmp_path):
+    run = _cli("grade", "--out", str(tmp_path))
+    assert run.returncode == 2 and "give the submissions" in run.stderr
+    run = _cli("grade", str(NOTEBOOKS), "--merge", str(tmp_path), "--out", str(tmp_path))
+    assert run.returncode == 2 and "not submissions" in run.stderr
+    run = _cli("grade", str(NOTEBOOKS), "--jobs", "0", "--out", str(tmp_path))
+    assert run.returncode == 2 and "--jobs must be at least 1" in run.stderr
