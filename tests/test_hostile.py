@@ -201,6 +201,7 @@ def test_no_process_outlives_grading(attacked):
         time.sleep(0.2)
     assert _processes_with("sleep 7777") == []
     assert _processes_with("labkit.grading.worker") == []
+    assert _processes_with("bwrap") == []
 
 
 def test_the_listening_socket_saw_no_connection(attacked):

@@ -122,7 +122,9 @@ def _constant_factor(got, want):
 def runge(fn, seed=None):
     """Check ``runge(x) -> (y, yprime)`` against 1/(1+x^2) and its derivative."""
     result = CheckResult("runge")
-    x = np.concatenate((np.linspace(-3.0, 3.0, 13), case_rng(seed, 3).uniform(-5.0, 5.0, 8)))
+    x = np.linspace(-3.0, 3.0, 13)
+    if seed is not None:  # the grader's fresh points besides the fixed ones
+        x = np.concatenate((x, case_rng(seed, 3).uniform(-5.0, 5.0, 8)))
     ok, out = call(result, "runge(x) returns (y, yprime)", fn, x)
     if not ok:
         return result
@@ -146,7 +148,8 @@ def test_pherm_interpolate(fn, seed=None):
     mistake in the student's interpolant does not count against the driver.
     """
     result = CheckResult("test_pherm_interpolate")
-    for ndata in (5, 11, 21, int(case_rng(seed, 4).integers(6, 60))):
+    fresh = () if seed is None else (int(case_rng(seed, 4).integers(6, 60)),)  # the grader's extra size
+    for ndata in (5, 11, 21) + fresh:
         ok, err = call(result, f"ndata = {ndata}", fn, ndata, piecewise.eval_pherm)
         if not ok:
             return result
