@@ -105,6 +105,8 @@ def command(workdir, argv, uid, limits=Limits()):
             "--cap-drop", "ALL"]
     if os.geteuid() == 0:
         args += ["--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID"]
+    # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
+    args += ["--proc", "/proc", "--dev", "/dev", "--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
     for name in ("usr", "etc"):
         args += ["--ro-bind", f"/{name}", f"/{name}"]
     for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
@@ -113,16 +115,14 @@ def command(workdir, argv, uid, limits=Limits()):
             args += ["--symlink", os.readlink(top), str(top)]
         elif top.is_dir():
             args += ["--ro-bind", str(top), str(top)]
-    mounted = set()
+    made = {Path("/tmp")}
     for path in _read_only_paths():
         for parent in reversed(path.parents):
-            if str(parent) != "/" and parent not in mounted:
+            if str(parent) != "/" and parent not in made:
                 args += ["--perms", "0755", "--dir", str(parent)]
-                mounted.add(parent)
+                made.add(parent)
         args += ["--ro-bind", str(path), str(path)]
-    args += ["--proc", "/proc", "--dev", "/dev",
-             "--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp",
-             *_parents(HOME), "--bind", str(workdir), HOME, "--chdir", HOME]
+    args += [*_parents(HOME), "--bind", str(workdir), HOME, "--chdir", HOME]
     environment = {"HOME": HOME, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin", "LANG": "C.UTF-8",
                    "MPLBACKEND": "Agg", "MPLCONFIGDIR": f"{HOME}/.matplotlib", "PYTHONDONTWRITEBYTECODE": "1",
                    "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
