@@ -1,4 +1,4 @@
-"""Quadrilateral meshes from patch grids: connectivity, quality, merging, files, plots.
+"""Quadrilateral meshes from patch grids: connectivity, quality, merging, files, drawing.
 
 ``quad_mesh(x, y)`` turns the coordinate arrays of :func:`labkit.patch` into
 nodes and counter-clockwise quadrilaterals; ``m1 + m2`` joins meshes that
@@ -122,15 +122,33 @@ class QuadMesh:
         meshio.write(path, mesh, file_format=file_format, **options)
         return path
 
-    def plot(self, ax=None, color_by_quality=False, title=None, **line_kw):
+    def plot(self, ax=None, color_by_quality=False, title=None, colorbar=True, **line_kw):
         """Draw the element edges (x and y) with matplotlib; return the axes.
 
         With ``color_by_quality`` the elements are filled by their quality
-        (red: folded or inverted, green: square) with a colour bar.
+        (red: folded or inverted, green: square), with a colour bar unless
+        ``colorbar=False``. ``labkit.plots`` builds its mesh figures on this.
         """
-        from . import plots
+        import matplotlib.pyplot as plt
+        from matplotlib.collections import PolyCollection
 
-        return plots.draw_mesh(self, ax=ax, color_by_quality=color_by_quality, title=title, **line_kw)
+        if ax is None:
+            _, ax = plt.subplots(figsize=(5, 5))
+        polygons = self.points[self.quads][..., :2]
+        style = {"edgecolor": "tab:blue", "linewidth": 0.8, **line_kw}
+        if color_by_quality:
+            cells = PolyCollection(polygons, array=self.quality(), cmap="RdYlGn", clim=(-1, 1), **style)
+            ax.add_collection(cells)
+            if colorbar:
+                ax.figure.colorbar(cells, ax=ax, label="quality (min scaled Jacobian)", shrink=0.8)
+        else:
+            ax.add_collection(PolyCollection(polygons, facecolor="none", **style))
+        ax.autoscale_view()
+        ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_title(title or f"{len(self.quads)} quadrilaterals")
+        return ax
 
 
 def quad_mesh(x, y, z=None):

@@ -14,6 +14,6 @@ def pytest_terminal_summary(terminalreporter):
     module = sys.modules.get("test_jupyterlab")
     latencies = getattr(module, "LATENCIES", {})
     if latencies:
-        terminalreporter.section("slider move -> new plot in JupyterLab (median of 4 moves)")
-        for name, ms in latencies.items():
-            terminalreporter.write_line(f"{name:<24}{ms:6.0f} ms")
+        terminalreporter.section("JupyterLab: key press or drag step -> new picture")
+        for name, (median, p90, moves) in latencies.items():
+            terminalreporter.write_line(f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)")

@@ -9,6 +9,8 @@ import pytest  # noqa: E402
 import labkit  # noqa: E402
 from labkit import plots  # noqa: E402
 
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+
 
 @pytest.fixture(autouse=True)
 def close_figures():
@@ -92,3 +94,152 @@ def test_plot_patch_titles_with_the_worst_quality_and_colours_folds():
     _labelled(ax)
     assert "worst quality -" in ax.get_title()
     assert ax.collections[0].get_array().min() < 0
+
+
+# -- views updated in place, explorers, the patch editor -----------------------------------------
+
+def test_a_view_updates_its_own_artists_instead_of_drawing_new_ones():
+    view = plots.LimaconView()
+    view.update(8, 1.3, "pherm")
+    lines = view.ax.get_lines()
+    view.update(20, 0.8, "plin")
+    assert view.ax.get_lines() == lines and len(lines) == 3
+    tdata = np.linspace(0, 2 * np.pi, 21)
+    x, y, _, _ = labkit.limacon(tdata, 0.8)
+    np.testing.assert_allclose(view.data.get_xydata(), np.column_stack((x, y)))
+    assert "0.8" in view.ax.get_title() and "20 intervals" in view.ax.get_title()
+    # the new limits hold the smaller curve
+    assert view.ax.get_xlim()[1] < 2.0
+
+
+def test_error_curves_view_hides_unselected_methods_and_rescales():
+    view = plots.ErrorCurvesView(["complete", "natural"])
+    view.update(["natural"], 9)
+    assert not view.lines["complete"].get_visible() and view.lines["natural"].get_visible()
+    low, high = view.ax.get_ylim()
+    error = view.lines["natural"].get_ydata()
+    assert low <= error.min() and error.max() <= high and high - low < 2 * np.ptp(error)
+
+
+def test_patch_view_moves_the_same_collection_and_recolours_folds():
+    e1, e2 = [1, 0], [0, 1]
+    square = [labkit.Corner(p, e1, e2) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+    view = plots.PatchView()
+    view.update(square, 5, 5)
+    cells = view.ax.collections[0]
+    folded = [square[0], labkit.Corner([1, 0], [-1.5, 0], e2), labkit.Corner([1, 1], [-1.5, 0], e2), square[3]]
+    view.update(folded, 11, 3)
+    assert view.ax.collections[0] is cells and len(cells.get_paths()) == 10 * 2
+    np.testing.assert_allclose(cells.get_array(), view.mesh.quality())
+    assert cells.get_array().min() < 0 and "worst quality -" in view.ax.get_title()
+
+
+def _png_size(data):
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+@pytest.mark.parametrize("factory, control, value", [
+    (plots.limacon_explorer, "intervals", 7),
+    (plots.convergence_explorer, "ndata", 21),
+    (plots.mesh_explorer, "dxds_BC", -1.0),
+    (plots.spline_explorer, "natural", False),
+    (plots.pchip_explorer, "y3", 2.5),
+    (plots.bilinear_explorer, "ndata", 5),
+])
+def test_every_explorer_redraws_while_dragged_and_sends_a_new_picture(factory, control, value):
+    explorer = factory()
+    sliders = [c for c in explorer.controls.values() if hasattr(c, "continuous_update")]
+    assert sliders and all(c.continuous_update for c in sliders)
+    before, redraws = explorer.image.value, explorer.redraws
+    explorer.controls[control].value = value
+    assert explorer.redraws == redraws + 1 and explorer.image.value != before
+    assert _png_size(explorer.image.value) == tuple(int(v) for v in explorer.figure.canvas.get_width_height())
+    bundle = explorer._repr_mimebundle_()
+    assert "application/vnd.jupyter.widget-view+json" in bundle and "interactive" not in bundle["text/plain"]
+    assert _png_size(__import__("base64").b64decode(bundle["image/png"]))[0] > 100
+
+
+def test_the_explorer_figure_shows_what_the_controls_say():
+    explorer = plots.pchip_explorer()
+    explorer.controls["y3"].value = 2.5
+    x = np.arange(5.0)
+    y = np.array([0.0, explorer.controls["y1"].value, 2.0, 2.5, 2.0])
+    spline_line, pchip_line, data = explorer.figure.axes[0].get_lines()
+    np.testing.assert_allclose(data.get_ydata(), y)
+    np.testing.assert_allclose(pchip_line.get_ydata(), labkit.pchip(x, y, pchip_line.get_xdata()))
+
+
+def test_no_slider_of_the_kit_waits_for_release():
+    sources = [p.read_text() for p in (ROOT / "labkit" / "plots").glob("*.py")]
+    sources += [p.read_text() for p in (ROOT / "notebooks").glob("*.ipynb")]
+    assert not any("continuous_update=False" in s for s in sources)
+
+
+def test_mesh_does_not_import_plots():
+    import ast
+
+    tree = ast.parse((ROOT / "labkit" / "mesh.py").read_text())
+    imported = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    imported |= {a.name for node in ast.walk(tree) if isinstance(node, ast.Import) for a in node.names}
+    assert not any(name and "plots" in name for name in imported)
+
+
+SQUARE = [labkit.Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+
+
+def test_handles_are_the_corners_and_the_arrow_tips():
+    positions = plots.handle_positions(SQUARE, scale=0.5)
+    np.testing.assert_allclose(positions[:4], [[0, 0], [1, 0], [1, 1], [0, 1]])
+    np.testing.assert_allclose(positions[4:8], positions[:4] + [0.5, 0])
+    np.testing.assert_allclose(positions[8:], positions[:4] + [0, 0.5])
+
+
+def test_the_nearest_handle_within_reach_is_picked():
+    positions = plots.handle_positions(SQUARE, scale=0.25)
+    assert plots.nearest_handle(positions, [1.02, 0.01], 0.05) == 1
+    assert plots.nearest_handle(positions, [1.24, 0.0], 0.05) == 5  # B's d/ds tip
+    assert plots.nearest_handle(positions, [0.5, 0.5], 0.05) is None
+
+
+def test_dragging_a_corner_carries_its_arrows_and_a_tip_sets_its_derivative():
+    moved = plots.move_handle(SQUARE, 1, [1.5, -0.5], scale=0.25)
+    assert moved[1].point.tolist() == [1.5, -0.5] and moved[1].ds.tolist() == [1.0, 0.0]
+    assert moved[0] is SQUARE[0]
+    tip = plots.move_handle(SQUARE, 9, [1.0, 0.5], scale=0.25)  # B's d/dt tip
+    assert tip[1].dt.tolist() == [0.0, 2.0] and tip[1].point.tolist() == [1.0, 0.0]
+    with pytest.raises(ValueError, match="0 to 11"):
+        plots.move_handle(SQUARE, 12, [0, 0])
+
+
+def test_the_readout_is_code_that_rebuilds_the_corners():
+    corners = [labkit.Corner([0.1234, -2], [np.pi, 0], [0, 1e-5], [0.5, -0.25])] + SQUARE[1:]
+    namespace = {"Corner": labkit.Corner}
+    exec(plots.corner_code(corners), namespace)
+    for name, corner in zip("ABCD", corners):
+        for field in ("point", "ds", "dt", "dsdt"):
+            np.testing.assert_allclose(getattr(namespace[name], field), getattr(corner, field), atol=5e-4)
+    assert "-0," not in plots.corner_code(corners) and "Corner([0.123, -2], ds=[3.142, 0]" in plots.corner_code(corners)
+
+
+def test_the_editor_follows_a_drag_and_reports_folds():
+    editor = plots.patch_editor(SQUARE, elements=6)
+    widget, picture = editor.widget_, editor.widget_.image
+    assert widget.worst == pytest.approx(1.0) and len(widget.handles) == 12
+    widget.drag = {"index": 5, "x": 0.6, "y": 0.0, "seq": 1}  # B's d/ds tip dragged back past A
+    assert editor.corners[1].ds[0] < 0 and widget.worst <= 0 and "folded" in widget.readout
+    assert widget.image != picture
+    frame = widget.frame
+    assert frame["left"] < frame["right"] <= frame["width"] and frame["x0"] < 0 < 1 < frame["x1"]
+    widget.drag = {"index": "nonsense"}
+    assert editor.redraws == 2
+    editor.twist.value = 0.7
+    assert all(c.dsdt.tolist() == [0.7, 0.7] for c in editor.corners)
+    assert "dsdt=[0.7, 0.7]" in widget.readout
+
+
+def test_the_editor_refuses_what_it_cannot_edit():
+    with pytest.raises(ValueError, match="four labkit.Corner"):
+        plots.patch_editor(SQUARE[:3])
+    with pytest.raises(ValueError, match="plane patches"):
+        plots.patch_editor([labkit.Corner([0, 0, 0], [1, 0, 0], [0, 1, 0])] * 4)

@@ -1,0 +1,161 @@
+// The browser side of labkit.plots.patch_editor (an anywidget module).
+// The kernel sends the mesh picture, the handles in data coordinates and where the axes lie in
+// the picture; this module draws the handles over the picture, moves them under the mouse at once,
+// and sends the dragged handle's position to the kernel, one request at a time (the newest wins).
+const SVG = "http://www.w3.org/2000/svg";
+const COLORS = ["#111", "#d62728", "#6a3d9a"]; // corner, d/ds tip, d/dt tip
+const NAMES = "ABCD";
+
+function make(tag, attrs, parent) {
+  const node = document.createElementNS(SVG, tag);
+  for (const [key, value] of Object.entries(attrs)) node.setAttribute(key, value);
+  if (parent) parent.appendChild(node);
+  return node;
+}
+
+function render({ model, el }) {
+  const root = document.createElement("div");
+  root.className = "labkit-editor";
+  root.tabIndex = 0;
+  root.style.cssText = "display:flex; gap:12px; align-items:flex-start; outline:none";
+  const stage = document.createElement("div");
+  stage.style.cssText = "position:relative; line-height:0";
+  const img = document.createElement("img");
+  img.className = "labkit-editor-image";
+  img.draggable = false;
+  const svg = make("svg", { class: "labkit-editor-handles" });
+  svg.style.cssText = "position:absolute; left:0; top:0; touch-action:none; cursor:default";
+  const readout = document.createElement("pre");
+  readout.className = "labkit-editor-readout";
+  readout.style.cssText = "font-size:12px; margin:0; padding:6px; border:1px solid #ccc; user-select:text";
+  stage.append(img, svg);
+  root.append(stage, readout);
+  el.appendChild(root);
+
+  let positions = model.get("handles").map((p) => p.slice());
+  let dragging = null, selected = 0, waiting = false, queued = null, seq = 0, url = null, timer = null;
+
+  const frame = () => model.get("frame");
+  function toPixels([x, y]) {
+    const f = frame();
+    return [f.left + ((x - f.x0) / (f.x1 - f.x0)) * (f.right - f.left),
+            f.bottom - ((y - f.y0) / (f.y1 - f.y0)) * (f.bottom - f.top)];
+  }
+  function toData(px, py) {
+    const f = frame();
+    return [f.x0 + ((px - f.left) / (f.right - f.left)) * (f.x1 - f.x0),
+            f.y0 + ((f.bottom - py) / (f.bottom - f.top)) * (f.y1 - f.y0)];
+  }
+
+  function draw() {
+    const f = frame();
+    svg.setAttribute("width", f.width);
+    svg.setAttribute("height", f.height);
+    img.style.width = f.width + "px";
+    svg.replaceChildren();
+    for (let c = 0; c < 4; c++) {
+      const [cx, cy] = toPixels(positions[c]);
+      for (const tip of [c + 4, c + 8]) {
+        const [tx, ty] = toPixels(positions[tip]);
+        make("line", { x1: cx, y1: cy, x2: tx, y2: ty, stroke: COLORS[Math.floor(tip / 4)], "stroke-width": 2 }, svg);
+      }
+      make("text", { x: cx + 8, y: cy - 8, "font-size": 13, "font-weight": "bold" }, svg).textContent = NAMES[c];
+    }
+    positions.forEach((p, index) => {
+      const [x, y] = toPixels(p);
+      make("circle", {
+        cx: x, cy: y, r: index < 4 ? 7 : 5, fill: COLORS[Math.floor(index / 4)], "data-handle": index,
+        stroke: index === selected ? "#ffbf00" : "white", "stroke-width": index === selected ? 3 : 1.5,
+        class: "labkit-handle", style: "cursor:grab",
+      }, svg);
+    });
+  }
+
+  function send(index) {
+    if (waiting) { queued = index; return; }
+    waiting = true;
+    const [x, y] = positions[index];
+    model.set("drag", { index, x, y, seq: ++seq });
+    model.save_changes();
+    clearTimeout(timer);
+    timer = setTimeout(() => { waiting = false; }, 2000); // never stall if an answer is lost
+  }
+
+  function place(index, point) {
+    if (index < 4) { // a corner carries its two arrows along
+      const dx = point[0] - positions[index][0], dy = point[1] - positions[index][1];
+      for (const tip of [index + 4, index + 8]) positions[tip] = [positions[tip][0] + dx, positions[tip][1] + dy];
+    }
+    positions[index] = point;
+    draw();
+    send(index);
+  }
+
+  function mouse(event) {
+    const box = svg.getBoundingClientRect();
+    return toData(event.clientX - box.left, event.clientY - box.top);
+  }
+
+  svg.addEventListener("pointerdown", (event) => {
+    const index = event.target.getAttribute && event.target.getAttribute("data-handle");
+    if (index === null || index === undefined) return;
+    dragging = selected = Number(index);
+    svg.setPointerCapture(event.pointerId);
+    root.focus();
+    event.preventDefault();
+    draw();
+  });
+  svg.addEventListener("pointermove", (event) => {
+    if (dragging !== null) place(dragging, mouse(event));
+  });
+  const release = (event) => {
+    if (dragging === null) return;
+    place(dragging, mouse(event));
+    dragging = null;
+  };
+  svg.addEventListener("pointerup", release);
+  svg.addEventListener("pointercancel", release);
+
+  root.addEventListener("keydown", (event) => {
+    const f = frame();
+    const step = (event.shiftKey ? 0.05 : 0.01) * (f.x1 - f.x0);
+    const moves = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, step], ArrowDown: [0, -step] };
+    if (event.key === "Tab" || event.key === "n") {
+      selected = (selected + (event.shiftKey ? 11 : 1)) % 12;
+      draw();
+    } else if (moves[event.key]) {
+      const [dx, dy] = moves[event.key];
+      place(selected, [positions[selected][0] + dx, positions[selected][1] + dy]);
+    } else {
+      return;
+    }
+    event.preventDefault();
+    event.stopPropagation();
+  });
+
+  function showImage() {
+    const blob = new Blob([model.get("image")], { type: "image/png" });
+    if (url) URL.revokeObjectURL(url);
+    url = URL.createObjectURL(blob);
+    img.src = url;
+    waiting = false;
+    if (queued !== null) { const index = queued; queued = null; send(index); }
+  }
+  function showReadout() {
+    readout.textContent = model.get("readout");
+    readout.style.borderColor = model.get("worst") <= 0 ? "#d62728" : "#ccc";
+  }
+
+  model.on("change:image", showImage);
+  model.on("change:readout", showReadout);
+  model.on("change:handles", () => {
+    if (dragging === null && !waiting) { positions = model.get("handles").map((p) => p.slice()); draw(); }
+  });
+  model.on("change:frame", draw);
+  showImage();
+  showReadout();
+  draw();
+  return () => { if (url) URL.revokeObjectURL(url); clearTimeout(timer); };
+}
+
+export default { render };

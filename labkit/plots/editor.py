@@ -1,0 +1,205 @@
+"""The patch editor of exercises 5 to 9: shape a Coons patch by dragging its corners and derivatives.
+
+:func:`patch_editor` shows a patch's mesh, filled by element quality (folded
+elements red), with twelve handles drawn over it in the browser: the four
+corners, and the tips of each corner's d/ds and d/dt arrows. Dragging a
+handle moves it at once in the browser and sends its position to the kernel,
+which rebuilds the mesh and sends the new picture, the worst quality and the
+corner data as ``Corner(...)`` lines to copy into an exercise cell. Sliders
+set the mesh size and the twist; the arrow keys nudge the selected handle.
+
+The handles' logic is plain Python, tested without a browser
+(``tests/test_plots.py``): :func:`handle_positions`, :func:`nearest_handle`,
+:func:`move_handle`, :func:`corner_code`. The browser side is
+``editor.js`` beside this file, an anywidget module.
+"""
+import pathlib
+
+import numpy as np
+
+from ..patches import Corner
+from .explorers import freeze_layout, new_figure, png
+from .figures import PatchView
+
+NAMES = "ABCD"
+ARROW = 0.25  # an arrow is this fraction of its derivative, so the handles stay near the patch
+
+
+def handle_positions(corners, scale=ARROW):
+    """The twelve handles, shape (12, 2): corners A-D, then the d/ds tips, then the d/dt tips."""
+    points = np.array([c.point[:2] for c in corners], dtype=float)
+    ds = np.array([c.ds[:2] for c in corners], dtype=float)
+    dt = np.array([c.dt[:2] for c in corners], dtype=float)
+    return np.concatenate((points, points + scale * ds, points + scale * dt))
+
+
+def nearest_handle(positions, point, radius):
+    """Index of the handle nearest to `point`, or None if none lies within `radius`."""
+    distance = np.hypot(*(np.asarray(positions, float) - np.asarray(point, float)).T)
+    index = int(np.argmin(distance))
+    return index if distance[index] <= radius else None
+
+
+def move_handle(corners, index, point, scale=ARROW):
+    """The corners after handle `index` is dropped at `point` (a corner carries its arrows along)."""
+    corners = list(corners)
+    point = np.asarray(point, dtype=float)
+    which, kind = index % 4, index // 4
+    c = corners[which]
+    if kind == 0:
+        corners[which] = Corner(point, c.ds, c.dt, c.dsdt)
+    elif kind == 1:
+        corners[which] = Corner(c.point, (point - c.point) / scale, c.dt, c.dsdt)
+    elif kind == 2:
+        corners[which] = Corner(c.point, c.ds, (point - c.point) / scale, c.dsdt)
+    else:
+        raise ValueError(f"handle index must be 0 to 11; got {index}.")
+    return corners
+
+
+def with_twist(corners, twist):
+    """The same corners with the twist d2/dsdt = (twist, twist) at all four."""
+    return [Corner(c.point, c.ds, c.dt, [twist, twist]) for c in corners]
+
+
+def _number(value):
+    text = f"{value:.3f}".rstrip("0").rstrip(".")
+    return "0" if text in ("", "-0") else text
+
+
+def _numbers(vector):
+    return "[" + ", ".join(_number(v) for v in vector) + "]"
+
+
+def corner_code(corners):
+    """The corner data as the Corner(...) lines an exercise cell uses, rounded to 3 decimals."""
+    return "\n".join(f"{name} = Corner({_numbers(c.point)}, ds={_numbers(c.ds)}, dt={_numbers(c.dt)}, "
+                     f"dsdt={_numbers(c.dsdt)})" for name, c in zip(NAMES, corners))
+
+
+def _editor_class():
+    import anywidget
+    import traitlets
+
+    class PatchEditor(anywidget.AnyWidget):
+        """The editor's widget: picture, handles and readout synced with editor.js."""
+
+        _esm = pathlib.Path(__file__).with_name("editor.js")
+        image = traitlets.Bytes(b"").tag(sync=True)
+        handles = traitlets.List([]).tag(sync=True)  # [[x, y], ...] in data coordinates
+        frame = traitlets.Dict({}).tag(sync=True)  # where the axes lie in the picture, for mouse -> data
+        drag = traitlets.Dict({}).tag(sync=True)  # {"index", "x", "y", "seq"} from the browser
+        readout = traitlets.Unicode("").tag(sync=True)
+        worst = traitlets.Float(1.0).tag(sync=True)
+
+    return PatchEditor
+
+
+class Editor:
+    """A patch editor: the widget, the corners it holds, and the sliders for mesh size and twist."""
+
+    def __init__(self, corners, elements=10, limits=None):
+        import ipywidgets as widgets
+
+        self.corners = list(corners)
+        self.figure, self.ax = new_figure((5, 5))
+        self.view = PatchView(self.ax, colorbar=False)
+        self.elements = _size_slider(elements)
+        self.twist = widgets.FloatSlider(value=float(np.mean([c.dsdt[0] for c in self.corners])), min=-3.0,
+                                         max=3.0, step=0.1, description="twist", continuous_update=True)
+        self.widget_ = _editor_class()()
+        self.limits = limits or self._fit_limits()
+        self.redraws = 0
+        self._draw_mesh()
+        freeze_layout(self.figure)
+        self.widget_.observe(self._dragged, names="drag")
+        self.elements.observe(lambda change: self.refresh(), names="value")
+        self.twist.observe(self._twisted, names="value")
+        self.refresh()
+        self.widget = widgets.VBox([self.widget_, widgets.HBox([self.elements, self.twist])])
+        self.widget.add_class("labkit-patch-editor")
+
+    def _fit_limits(self):
+        points = np.concatenate((handle_positions(self.corners), [c.point[:2] for c in self.corners]))
+        low, high = points.min(axis=0), points.max(axis=0)
+        centre, half = (low + high) / 2, max(high - low) * 0.8 + 0.2
+        return (centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half)
+
+    def _dragged(self, change):
+        drag = change["new"]
+        try:
+            index, point = int(drag["index"]), (float(drag["x"]), float(drag["y"]))
+        except (KeyError, TypeError, ValueError):
+            return
+        if 0 <= index < 12 and all(np.isfinite(point)):
+            self.corners = move_handle(self.corners, index, point)
+            self.refresh()
+
+    def _twisted(self, change):
+        self.corners = with_twist(self.corners, change["new"])
+        self.refresh()
+
+    def _draw_mesh(self):
+        n = self.elements.value + 1
+        self.view.update(self.corners, n, n)
+        self.ax.set_xlim(*self.limits[:2])
+        self.ax.set_ylim(*self.limits[2:])
+        self.ax.set_aspect("equal")
+
+    def refresh(self):
+        """Rebuild the mesh from the corners; send the picture, handles, readout and worst quality."""
+        self._draw_mesh()
+        worst = float(self.view.mesh.quality().min())
+        picture = png(self.figure)
+        self.widget_.frame = self._frame()
+        self.widget_.handles = handle_positions(self.corners).round(6).tolist()
+        folded = int(np.sum(self.view.mesh.quality() <= 0))
+        self.widget_.readout = (f"worst quality {worst:.2f}" + (f", {folded} folded" if folded else "")
+                                + "\n" + corner_code(self.corners))
+        self.widget_.worst = worst
+        self.widget_.image = picture
+        self.redraws += 1
+
+    def _frame(self):
+        """The axes' data limits and pixel box in the last picture, so the browser can map the mouse."""
+        width, height = self.figure.canvas.get_width_height()
+        box = self.ax.get_window_extent()  # pixels, as drawn (after the equal aspect was applied)
+        (x0, x1), (y0, y1) = self.ax.get_xlim(), self.ax.get_ylim()
+        return {"width": width, "height": height, "left": float(box.x0), "right": float(box.x1),
+                "top": float(height - box.y1), "bottom": float(height - box.y0),
+                "x0": float(x0), "x1": float(x1), "y0": float(y0), "y1": float(y1)}
+
+    def _repr_mimebundle_(self, **kwargs):
+        import base64
+
+        bundle = self.widget._repr_mimebundle_(**kwargs)
+        data = bundle[0] if isinstance(bundle, tuple) else bundle
+        data["image/png"] = base64.b64encode(self.widget_.image).decode("ascii")
+        data["text/plain"] = self.widget_.readout
+        return bundle
+
+
+def _size_slider(elements):
+    import ipywidgets as widgets
+
+    return widgets.IntSlider(value=elements, min=2, max=40, description="elements", continuous_update=True)
+
+
+def patch_editor(corners=None, elements=10):
+    """An editor for a Coons patch; `corners` default to exercise 5's unit square.
+
+    Examples
+    --------
+    >>> from labkit import Corner
+    >>> from labkit.plots import patch_editor
+    >>> editor = patch_editor()
+    >>> print(editor.widget_.readout.splitlines()[1])
+    A = Corner([0, 0], ds=[1, 0], dt=[0, 1], dsdt=[0, 0])
+    """
+    if corners is None:
+        corners = [Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+    if len(corners) != 4 or not all(isinstance(c, Corner) for c in corners):
+        raise ValueError("patch_editor needs a list of four labkit.Corner objects A, B, C, D.")
+    if any(c.point.size != 2 for c in corners):
+        raise ValueError("patch_editor edits plane patches: give corners with 2 coordinates.")
+    return Editor(corners, elements)

@@ -1,0 +1,190 @@
+"""The Explore sections' sliders: a figure built once that follows the controls while they move.
+
+An :class:`Explorer` holds ipywidgets controls and a view of
+:mod:`labkit.plots.figures`. Every change of a control (while it is being
+dragged, not only when it is let go) updates the view's artists in place
+and sends one PNG into an ``ipywidgets.Image``: no new figure, no output area
+cleared and redrawn. Shown in a notebook it is the widget; where widgets
+cannot run (nbval, ``jupyter nbconvert --execute``, GitHub's or nbviewer's
+static view, ``labkit grade``) the same output carries a PNG of the first
+picture, so a static copy of the notebook still shows the figure.
+
+One function per notebook builds its explorer, so a notebook's Explore cell
+is one line, e.g. ``plots.limacon_explorer()``.
+"""
+import base64
+import io
+
+import numpy as np
+
+from ..patches import Corner
+from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
+
+DPI = 80  # pixels per inch of the slider pictures: sharp enough, and quick to render and send
+
+
+def new_figure(size, dpi=DPI):
+    """A matplotlib Figure outside pyplot (never shown twice, never kept alive by pyplot) and its axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=size, dpi=dpi, layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure, figure.add_subplot()
+
+
+def png(figure):
+    """The figure as PNG bytes: one Agg draw, fast compression."""
+    from PIL import Image
+
+    canvas = figure.canvas
+    canvas.draw()
+    buffer = io.BytesIO()
+    Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).save(
+        buffer, format="png", compress_level=1)
+    return buffer.getvalue()
+
+
+def freeze_layout(figure):
+    """Lay the figure out once (constrained layout) and keep those positions: later draws skip the solver."""
+    figure.canvas.draw()
+    figure.set_layout_engine("none")
+
+
+class Explorer:
+    """Controls and a figure that follows them.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        Drawn into by `update`; rendered to PNG after every change.
+    update : callable
+        ``update(**values)`` with the controls' current values by name; it
+        changes the figure's artists in place.
+    controls : dict of str to ipywidgets widget
+        Each control's ``value`` is passed to `update` under its name.
+    """
+
+    def __init__(self, figure, update, controls):
+        import ipywidgets as widgets
+
+        self.figure, self._update, self.controls = figure, update, dict(controls)
+        self.image = widgets.Image(format="png")
+        self.image.add_class("labkit-explorer-image")
+        self.redraws = 0
+        for control in self.controls.values():
+            control.observe(self.refresh, names="value")
+        self._update(**self.values())
+        freeze_layout(figure)
+        self.refresh()
+        self.widget = widgets.VBox([*self.controls.values(), self.image])
+        self.widget.add_class("labkit-explorer")
+
+    def values(self):
+        return {name: control.value for name, control in self.controls.items()}
+
+    def refresh(self, change=None):
+        """Update the figure from the controls and send its new picture."""
+        self._update(**self.values())
+        self.image.value = self.png()
+        self.redraws += 1
+
+    def png(self):
+        return png(self.figure)
+
+    def _repr_mimebundle_(self, **kwargs):
+        bundle = self.widget._repr_mimebundle_(**kwargs)
+        data = bundle[0] if isinstance(bundle, tuple) else bundle
+        data["image/png"] = base64.b64encode(self.png()).decode("ascii")
+        data["text/plain"] = f"<{type(self).__name__}: {', '.join(self.controls)}>"
+        return bundle
+
+
+def _slider(kind, value, low, high, step=None, description=""):
+    import ipywidgets as widgets
+
+    options = {"value": value, "min": low, "max": high, "description": description, "continuous_update": True}
+    if step is not None:
+        options["step"] = step
+    return (widgets.IntSlider if kind is int else widgets.FloatSlider)(**options)
+
+
+def limacon_explorer():
+    """01: the limaçon interpolated from n points, linear or Hermite, for a radius r0."""
+    import ipywidgets as widgets
+
+    figure, ax = new_figure((5, 5))
+    view = LimaconView(ax)
+    return Explorer(figure, lambda intervals, r0, method: view.update(intervals, r0, method), {
+        "intervals": _slider(int, 20, 3, 60, description="intervals"),
+        "r0": _slider(float, 1.15, 0.5, 2.0, 0.05, "r0"),
+        "method": widgets.Dropdown(options=[("Hermite", "pherm"), ("linear", "plin")], value="pherm",
+                                   description="method"),
+    })
+
+
+def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notaknot", "pchip")):
+    """02: the error curve p - f of one method for ndata points."""
+    import ipywidgets as widgets
+
+    from ..convergence import METHOD_TITLES
+
+    figure, ax = new_figure((6, 4))
+    view = ErrorCurvesView(methods, ax)
+    return Explorer(figure, lambda method, ndata: view.update([method], ndata), {
+        "method": widgets.Dropdown(options=[(METHOD_TITLES[m], m) for m in methods],
+                                   value="natural" if "natural" in methods else methods[0], description="method"),
+        "ndata": _slider(int, 11, 3, 81, description="ndata"),
+    })
+
+
+def mesh_explorer():
+    """03: the graded unit-square patch: dx/ds at A, D and at B, C, the twist and the mesh size."""
+    figure, ax = new_figure((5.5, 5))
+    view = PatchView(ax)
+
+    def update(dxds_AD, dxds_BC, twist, elements):
+        corners = [Corner([0, 0], [dxds_AD, 0], [0, 1], [twist, 0]), Corner([1, 0], [dxds_BC, 0], [0, 1], [twist, 0]),
+                   Corner([1, 1], [dxds_BC, 0], [0, 1], [twist, 0]), Corner([0, 1], [dxds_AD, 0], [0, 1], [twist, 0])]
+        view.update(corners, elements + 1, elements + 1)
+
+    return Explorer(figure, update, {
+        "dxds_AD": _slider(float, 3.0, -2.0, 5.0, 0.1, "dx/ds A,D"),
+        "dxds_BC": _slider(float, 0.1, -2.0, 5.0, 0.1, "dx/ds B,C"),
+        "twist": _slider(float, 0.0, -3.0, 3.0, 0.1, "twist"),
+        "elements": _slider(int, 10, 2, 40, description="elements"),
+    })
+
+
+def spline_explorer():
+    """04: the error curves of the complete, natural and not-a-knot splines for ndata points."""
+    import ipywidgets as widgets
+
+    figure, ax = new_figure((6, 4))
+    methods = ("complete", "natural", "notaknot")
+    view = ErrorCurvesView(methods, ax)
+
+    def update(ndata, **shown):
+        view.update([m for m in methods if shown[m]] or ["notaknot"], ndata)
+
+    controls = {"ndata": _slider(int, 11, 4, 41, description="ndata")}
+    for method, label in zip(methods, ("complete", "natural", "not-a-knot")):
+        controls[method] = widgets.Checkbox(value=True, description=label)
+    return Explorer(figure, update, controls)
+
+
+def pchip_explorer(xdata=(0.0, 1.0, 2.0, 3.0, 4.0)):
+    """05: move two data values and watch the spline overshoot while pchip keeps the shape."""
+    figure, ax = new_figure((6, 4))
+    view = SplinePchipView(np.asarray(xdata, dtype=float), ax)
+    return Explorer(figure, lambda y1, y3: view.update([0.0, y1, 2.0, y3, 2.0]), {
+        "y1": _slider(float, 1.0, 0.0, 2.5, 0.05, "y at t=1"),
+        "y3": _slider(float, 2.0, 0.5, 3.0, 0.05, "y at t=3"),
+    })
+
+
+def bilinear_explorer():
+    """06: the bilinear interpolation error over the square for an ndata x ndata grid."""
+    figure, ax = new_figure((5.5, 4.5))
+    view = BilinearErrorView(ax, ntest=161)
+    return Explorer(figure, view.update, {"ndata": _slider(int, 11, 2, 41, description="ndata")})

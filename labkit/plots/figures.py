@@ -1,0 +1,228 @@
+"""Figures of the lab: each a *view* built once and updated in place, and a one-call plot function.
+
+A view draws its artists (lines, a mesh collection, a colour map) into an axes
+when it is made, and ``update(...)`` puts new data into those same artists:
+``set_data``, ``set_verts``, ``set_array`` and the title, never a new figure.
+The sliders of :mod:`labkit.plots.explorers` call ``update`` on every move;
+the ``plot_*`` functions are a view updated once, for a static figure.
+Every function labels its axes, sets a title and returns the axes.
+"""
+import numpy as np
+
+from ..bilinear import eval_pbilin
+from ..convergence import METHOD_TITLES, _interpolate
+from ..functions import limacon, runge, runge2d
+from ..mesh import quad_mesh
+from ..monotone import pchip
+from ..patches import patch
+from ..piecewise import eval_pherm, eval_plin
+from ..splines import spline
+
+
+def new_axes(ax=None, size=(5, 5)):
+    """`ax`, or the axes of a new pyplot figure of this size."""
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=size)
+    return ax
+
+
+def _label(ax, xlabel, ylabel, title):
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    return ax
+
+
+def _fit(ax, x, y, margin=0.05):
+    """Axis limits around the points (x, y), with a margin; for artists relim() does not see."""
+    x, y = np.asarray(x)[np.isfinite(x)], np.asarray(y)[np.isfinite(y)]
+    if x.size == 0 or y.size == 0:
+        return
+    for setter, values in ((ax.set_xlim, x), (ax.set_ylim, y)):
+        low, high = values.min(), values.max()
+        pad = margin * (high - low) or 0.5
+        setter(low - pad, high + pad)
+
+
+class LimaconView:
+    """The limaçon r = r0 + cos t: exact curve, its interpolant from the sampled points, the data."""
+
+    def __init__(self, ax=None):
+        self.ax = new_axes(ax)
+        self.exact, = self.ax.plot([], [], color="0.75", lw=3, label="exact")
+        self.curve, = self.ax.plot([], [], color="tab:blue", label="interpolant")
+        self.data, = self.ax.plot([], [], "o", color="tab:red", ms=4, label="data")
+        self.ax.set_aspect("equal")
+        _label(self.ax, "x", "y", "")
+
+    def update(self, nintervals=20, r0=1.15, method="pherm"):
+        if method not in ("plin", "pherm"):
+            raise ValueError("method must be 'plin' (piecewise linear) or 'pherm' (Hermite).")
+        tdata = np.linspace(0, 2 * np.pi, nintervals + 1)
+        xdata, ydata, xpdata, ypdata = limacon(tdata, r0)
+        tval = np.linspace(0, 2 * np.pi, 10 * (nintervals + 1))
+        if method == "plin":
+            xval, yval = eval_plin(tdata, xdata, tval), eval_plin(tdata, ydata, tval)
+        else:
+            xval, yval = eval_pherm(tdata, xdata, xpdata, tval), eval_pherm(tdata, ydata, ypdata, tval)
+        exact = limacon(np.linspace(0, 2 * np.pi, 2001), r0)
+        self.exact.set_data(exact[0], exact[1])
+        self.curve.set_data(xval, yval)
+        self.curve.set_label(METHOD_TITLES[method].lower())
+        self.data.set_data(xdata, ydata)
+        self.ax.legend(loc="upper right", fontsize="small")
+        _fit(self.ax, exact[0], exact[1])
+        self.ax.set_title(f"limaçon r = {r0:g} + cos t, {nintervals} intervals")
+        return self.ax
+
+
+class ErrorCurvesView:
+    """Pointwise error p - f of several interpolation methods from ndata equally spaced points."""
+
+    def __init__(self, methods, ax=None, f=runge, interval=(0.0, 5.0)):
+        self.ax = new_axes(ax, size=(6, 4))
+        self.f, (self.a, self.b) = f, interval
+        self.x = np.linspace(self.a, self.b, 1001)
+        self.exact = f(self.x)[0]
+        self.lines = {m: self.ax.plot(self.x, 0 * self.x, label=METHOD_TITLES[m])[0] for m in methods}
+        self.points, = self.ax.plot([], [], "k.", ms=4, label="data points")
+        self.ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+        _label(self.ax, "x", "p(x) - f(x)", "")
+
+    def update(self, methods, ndata):
+        low, high = 0.0, 0.0
+        for method, line in self.lines.items():
+            line.set_visible(method in methods)
+            if method in methods:
+                error = _interpolate(method, self.f, self.a, self.b, ndata, self.x) - self.exact
+                line.set_ydata(error)
+                low, high = min(low, error.min()), max(high, error.max())
+        self.points.set_data(np.linspace(self.a, self.b, ndata), np.zeros(ndata))
+        pad = 0.05 * (high - low) or 1e-16
+        self.ax.set_xlim(self.a - 0.02 * (self.b - self.a), self.b + 0.02 * (self.b - self.a))
+        self.ax.set_ylim(low - pad, high + pad)
+        shown = [line for method, line in self.lines.items() if method in methods] + [self.points]
+        self.ax.legend(handles=shown, fontsize="small")
+        self.ax.set_title(f"Interpolation error, {ndata} equally spaced points")
+        return self.ax
+
+
+class SplinePchipView:
+    """Data as circles, the not-a-knot spline and pchip through them, on 201 points."""
+
+    def __init__(self, xdata, ax=None):
+        self.ax = new_axes(ax, size=(6, 4))
+        self.xdata = np.asarray(xdata, dtype=float)
+        self.xv = np.linspace(self.xdata[0], self.xdata[-1], 201)
+        self.spline, = self.ax.plot(self.xv, 0 * self.xv, label="not-a-knot spline")
+        self.pchip, = self.ax.plot(self.xv, 0 * self.xv, label="pchip")
+        self.data, = self.ax.plot(self.xdata, 0 * self.xdata, "o", mfc="none", color="k", label="data")
+        self.ax.legend(fontsize="small")
+        _label(self.ax, "time", "temperature", "Spline overshoots, pchip keeps the data's shape")
+
+    def update(self, ydata):
+        ydata = np.asarray(ydata, dtype=float)
+        curve = spline(self.xdata, ydata, self.xv)
+        self.spline.set_ydata(curve)
+        self.pchip.set_ydata(pchip(self.xdata, ydata, self.xv))
+        self.data.set_ydata(ydata)
+        _fit(self.ax, self.xv, np.concatenate((curve, ydata)))
+        return self.ax
+
+
+class BilinearErrorView:
+    """Colour map of I - f for bilinear interpolation from an ndata x ndata grid."""
+
+    def __init__(self, ax=None, f=runge2d, square=(0.0, 5.0), ntest=201):
+        self.ax = new_axes(ax, size=(5.5, 4.5))
+        self.f, (self.a, self.b) = f, square
+        self.test = np.linspace(self.a, self.b, ntest)
+        X, Y = np.meshgrid(self.test, self.test, indexing="ij")
+        self.exact = f(X, Y)
+        self.image = self.ax.pcolormesh(self.test, self.test, 0 * self.exact.T, cmap="coolwarm", shading="auto")
+        self.ax.figure.colorbar(self.image, ax=self.ax, label="I(x, y) - f(x, y)")
+        self.ax.set_aspect("equal")
+        _label(self.ax, "x", "y", "")
+
+    def update(self, ndata):
+        grid = np.linspace(self.a, self.b, ndata)
+        error = eval_pbilin(self.f, grid, grid, self.test, self.test) - self.exact
+        largest = np.abs(error).max()
+        self.image.set_array(error.T)
+        self.image.set_clim(-largest or -1e-16, largest or 1e-16)
+        self.ax.set_title(f"Bilinear error, {ndata} x {ndata} data, max {largest:.1e}")
+        return self.ax
+
+
+class PatchView:
+    """A Coons patch's mesh, filled by element quality (folded elements red), with the worst in the title."""
+
+    def __init__(self, ax=None, color_by_quality=True, colorbar=True):
+        self.ax = new_axes(ax)
+        self.color_by_quality, self.colorbar = color_by_quality, colorbar
+        self.cells = None
+        self.mesh = None
+
+    def update(self, corners, ns=11, nt=11, s=None, t=None, title=None):
+        s = np.linspace(0, 1, ns) if s is None else s
+        t = np.linspace(0, 1, nt) if t is None else t
+        self.mesh = quad_mesh(*patch(*corners, s, t))
+        worst = self.mesh.quality().min()
+        title = title or f"{len(s) - 1} x {len(t) - 1} elements, worst quality {worst:.2f}"
+        if self.cells is None:
+            self.mesh.plot(ax=self.ax, color_by_quality=self.color_by_quality, title=title, colorbar=self.colorbar)
+            self.cells = self.ax.collections[-1]
+        else:
+            self.cells.set_verts(self.mesh.points[self.mesh.quads][..., :2])
+            if self.color_by_quality:
+                self.cells.set_array(self.mesh.quality())
+            self.ax.set_title(title)
+        _fit(self.ax, self.mesh.points[:, 0], self.mesh.points[:, 1])
+        return self.ax
+
+
+def draw_mesh(mesh, ax=None, color_by_quality=False, title=None, **line_kw):
+    """Draw a QuadMesh's element edges (x-y plane); fill by quality if asked (see QuadMesh.plot)."""
+    return mesh.plot(ax=ax, color_by_quality=color_by_quality, title=title, **line_kw)
+
+
+def plot_patch(corners, ns=11, nt=11, ax=None, color_by_quality=False, title=None, s=None, t=None):
+    """Mesh a Coons patch on an ns x nt grid (or given s, t) and draw it; return the axes."""
+    return PatchView(ax, color_by_quality).update(corners, ns, nt, s, t, title)
+
+
+def plot_limacon(nintervals=20, r0=1.15, method="pherm", ax=None):
+    """Interpolate the limaçon from nintervals+1 points with 'plin' or 'pherm' and draw it."""
+    if method not in ("plin", "pherm"):
+        raise ValueError("method must be 'plin' (piecewise linear) or 'pherm' (Hermite).")
+    return LimaconView(ax).update(nintervals, r0, method)
+
+
+def plot_convergence(tables, ax=None):
+    """Log-log plot of error against number of data for ConvergenceTables, with slopes -2 and -4."""
+    ax = new_axes(ax, size=(6, 4.5))
+    for table in tables:
+        ax.loglog(table.ndata, table.errors, "o-", ms=4, label=f"{table.title.split(', ')[-1]} (order {table.order})")
+    n = np.array([tables[0].ndata[2], tables[0].ndata[-1]], dtype=float)
+    for order, style in ((2, "k--"), (4, "k:")):
+        anchor = min(t.errors[2] for t in tables)
+        ax.loglog(n, anchor * (n / n[0]) ** -order, style, lw=1, label=f"slope -{order}")
+    ax.legend(fontsize="small")
+    return _label(ax, "number of data points", "relative max error", "Convergence on the Runge function")
+
+
+def plot_interpolation_error(methods, ndata, ax=None, f=runge, interval=(0.0, 5.0)):
+    """Pointwise error p - f of each method with ndata equally spaced points."""
+    return ErrorCurvesView(methods, ax, f, interval).update(methods, ndata)
+
+
+def plot_spline_vs_pchip(xdata, ydata, ax=None):
+    """Data as circles, the not-a-knot spline and pchip on 201 points."""
+    return SplinePchipView(xdata, ax).update(ydata)
+
+
+def plot_bilinear_error(ndata, ax=None, f=runge2d, square=(0.0, 5.0), ntest=201):
+    """Colour map of I - f for bilinear interpolation from an ndata x ndata grid."""
+    return BilinearErrorView(ax, f, square, ntest).update(ndata)
