@@ -227,6 +227,7 @@ def test_the_editor_follows_a_drag_and_reports_folds():
     widget, picture = editor.widget_, editor.widget_.image
     assert widget.worst == pytest.approx(1.0) and len(widget.handles) == 12
     widget.drag = {"index": 5, "x": 0.6, "y": 0.0, "seq": 1}  # B's d/ds tip dragged back past A
+    assert widget.ack == 1  # the browser sends its next position once this one is drawn
     assert editor.corners[1].ds[0] < 0 and widget.worst <= 0 and "folded" in widget.readout
     assert widget.image != picture
     frame = widget.frame

@@ -17,6 +17,7 @@ function render({ model, el }) {
   const root = document.createElement("div");
   root.className = "labkit-editor";
   root.tabIndex = 0;
+  root.dataset.lmSuppressShortcuts = "true"; // keys here are the editor's, not JupyterLab's commands
   root.style.cssText = "display:flex; gap:12px; align-items:flex-start; outline:none";
   const stage = document.createElement("div");
   stage.style.cssText = "position:relative; line-height:0";
@@ -78,7 +79,14 @@ function render({ model, el }) {
     model.set("drag", { index, x, y, seq: ++seq });
     model.save_changes();
     clearTimeout(timer);
-    timer = setTimeout(() => { waiting = false; }, 2000); // never stall if an answer is lost
+    timer = setTimeout(answered, 2000); // never stall if an answer is lost
+  }
+
+  // the kernel acknowledges every position it has drawn (even one that leaves the picture unchanged)
+  function answered() {
+    clearTimeout(timer);
+    waiting = false;
+    if (queued !== null) { const index = queued; queued = null; send(index); }
   }
 
   function place(index, point) {
@@ -114,6 +122,8 @@ function render({ model, el }) {
     dragging = null;
   };
   svg.addEventListener("pointerup", release);
+  // a click anywhere on the editor gives it the keyboard (after JupyterLab has focused the cell)
+  root.addEventListener("pointerup", () => setTimeout(() => root.focus(), 0));
   svg.addEventListener("pointercancel", release);
 
   root.addEventListener("keydown", (event) => {
@@ -138,8 +148,6 @@ function render({ model, el }) {
     if (url) URL.revokeObjectURL(url);
     url = URL.createObjectURL(blob);
     img.src = url;
-    waiting = false;
-    if (queued !== null) { const index = queued; queued = null; send(index); }
   }
   function showReadout() {
     readout.textContent = model.get("readout");
@@ -147,6 +155,7 @@ function render({ model, el }) {
   }
 
   model.on("change:image", showImage);
+  model.on("change:ack", answered);
   model.on("change:readout", showReadout);
   model.on("change:handles", () => {
     if (dragging === null && !waiting) { positions = model.get("handles").map((p) => p.slice()); draw(); }

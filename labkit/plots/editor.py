@@ -91,6 +91,7 @@ def _editor_class():
         drag = traitlets.Dict({}).tag(sync=True)  # {"index", "x", "y", "seq"} from the browser
         readout = traitlets.Unicode("").tag(sync=True)
         worst = traitlets.Float(1.0).tag(sync=True)
+        ack = traitlets.Int(0).tag(sync=True)  # the seq of the last drag drawn
 
     return PatchEditor
 
@@ -134,6 +135,8 @@ class Editor:
         if 0 <= index < 12 and all(np.isfinite(point)):
             self.corners = move_handle(self.corners, index, point)
             self.refresh()
+        if isinstance(drag.get("seq"), int):
+            self.widget_.ack = drag["seq"]
 
     def _twisted(self, change):
         self.corners = with_twist(self.corners, change["new"])

@@ -54,6 +54,7 @@ class LimaconView:
         self.exact, = self.ax.plot([], [], color="0.75", lw=3, label="exact")
         self.curve, = self.ax.plot([], [], color="tab:blue", label="interpolant")
         self.data, = self.ax.plot([], [], "o", color="tab:red", ms=4, label="data")
+        self._r0 = None
         self.ax.set_aspect("equal")
         _label(self.ax, "x", "y", "")
 
@@ -67,13 +68,15 @@ class LimaconView:
             xval, yval = eval_plin(tdata, xdata, tval), eval_plin(tdata, ydata, tval)
         else:
             xval, yval = eval_pherm(tdata, xdata, xpdata, tval), eval_pherm(tdata, ydata, ypdata, tval)
-        exact = limacon(np.linspace(0, 2 * np.pi, 2001), r0)
-        self.exact.set_data(exact[0], exact[1])
+        if self._r0 != r0:  # the exact curve depends on r0 only
+            exact = limacon(np.linspace(0, 2 * np.pi, 2001), r0)
+            self.exact.set_data(exact[0], exact[1])
+            _fit(self.ax, exact[0], exact[1])
+            self._r0 = r0
         self.curve.set_data(xval, yval)
         self.curve.set_label(METHOD_TITLES[method].lower())
         self.data.set_data(xdata, ydata)
         self.ax.legend(loc="upper right", fontsize="small")
-        _fit(self.ax, exact[0], exact[1])
         self.ax.set_title(f"limaçon r = {r0:g} + cos t, {nintervals} intervals")
         return self.ax
 
@@ -86,17 +89,26 @@ class ErrorCurvesView:
         self.f, (self.a, self.b) = f, interval
         self.x = np.linspace(self.a, self.b, 1001)
         self.exact = f(self.x)[0]
+        self._errors = {}
         self.lines = {m: self.ax.plot(self.x, 0 * self.x, label=METHOD_TITLES[m])[0] for m in methods}
         self.points, = self.ax.plot([], [], "k.", ms=4, label="data points")
         self.ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
         _label(self.ax, "x", "p(x) - f(x)", "")
+
+    def _error(self, method, ndata):
+        """p - f, computed once per method and ndata (a checkbox shows a curve again without recomputing it)."""
+        if (method, ndata) not in self._errors:
+            if len(self._errors) > 64:
+                self._errors.clear()
+            self._errors[method, ndata] = _interpolate(method, self.f, self.a, self.b, ndata, self.x) - self.exact
+        return self._errors[method, ndata]
 
     def update(self, methods, ndata):
         low, high = 0.0, 0.0
         for method, line in self.lines.items():
             line.set_visible(method in methods)
             if method in methods:
-                error = _interpolate(method, self.f, self.a, self.b, ndata, self.x) - self.exact
+                error = self._error(method, ndata)
                 line.set_ydata(error)
                 low, high = min(low, error.min()), max(high, error.max())
         self.points.set_data(np.linspace(self.a, self.b, ndata), np.zeros(ndata))

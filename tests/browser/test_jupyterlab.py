@@ -248,10 +248,23 @@ def _drag_a_corner(page, panel):
         steps.append(time.perf_counter() - start)
         changed_during = True
     page.mouse.up()
-    page.wait_for_function("([old]) => { const r = window.jupyterapp.shell.currentWidget.node"
-                           ".querySelector('.labkit-editor-readout'); return r && r.innerText !== old; }",
-                           arg=[before_readout], timeout=10_000)
-    return steps, changed_during, before_readout, readout.inner_text()
+    changed = "([node, old]) => node.innerText !== old"
+    page.wait_for_function(changed, arg=[readout.element_handle(), before_readout], timeout=10_000)
+    after_drag = readout.inner_text()
+    # the keyboard fallback: the dragged handle stays selected; Tab picks the next one, arrows nudge it
+    page.wait_for_function("() => document.activeElement && document.activeElement.classList.contains('labkit-editor')",
+                           timeout=5_000)
+    page.keyboard.press("ArrowUp")
+    page.wait_for_function(changed, arg=[readout.element_handle(), after_drag], timeout=10_000)
+    nudged = readout.inner_text()
+    for _ in range(4):  # handles: corners A-D (0-3), then the d/ds tips (4-7), then the d/dt tips
+        page.keyboard.press("Tab")
+    page.keyboard.press("ArrowRight")  # now B's d/ds tip: B's ds changes, its point does not
+    page.wait_for_function(changed, arg=[readout.element_handle(), nudged], timeout=10_000)
+    keyed = readout.inner_text()
+    assert keyed.splitlines()[2].split(", ds=")[0] == nudged.splitlines()[2].split(", ds=")[0]
+    assert keyed.splitlines()[2] != nudged.splitlines()[2]
+    return steps, changed_during, before_readout, after_drag
 
 
 @pytest.mark.parametrize("notebook", NOTEBOOKS, ids=lambda p: p.name)
