@@ -83,7 +83,9 @@ def test_bilinear_error_map_is_interpolant_minus_function():
     test = np.linspace(0, 5, 21)
     X, Y = np.meshgrid(test, test, indexing="ij")
     expected = labkit.eval_pbilin(labkit.runge2d, np.linspace(0, 5, 5), np.linspace(0, 5, 5), test, test) - labkit.runge2d(X, Y)
-    np.testing.assert_allclose(ax.collections[0].get_array().reshape(21, 21), expected.T)
+    image = ax.images[0]
+    np.testing.assert_allclose(image.get_array(), expected.T)  # row j is y = test[j], from the bottom
+    assert image.origin == "lower" and image.get_extent()[0] < 0 < 5 < image.get_extent()[1]
 
 
 def test_plot_patch_titles_with_the_worst_quality_and_colours_folds():

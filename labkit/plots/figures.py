@@ -153,7 +153,10 @@ class BilinearErrorView:
         self.test = np.linspace(self.a, self.b, ntest)
         X, Y = np.meshgrid(self.test, self.test, indexing="ij")
         self.exact = f(X, Y)
-        self.image = self.ax.pcolormesh(self.test, self.test, 0 * self.exact.T, cmap="coolwarm", shading="auto")
+        step = (self.b - self.a) / (ntest - 1)  # one pixel per test point, centred on it
+        extent = (self.a - step / 2, self.b + step / 2, self.a - step / 2, self.b + step / 2)
+        self.image = self.ax.imshow(0 * self.exact.T, origin="lower", extent=extent, cmap="coolwarm",
+                                    interpolation="nearest")
         self.ax.figure.colorbar(self.image, ax=self.ax, label="I(x, y) - f(x, y)")
         self.ax.set_aspect("equal")
         _label(self.ax, "x", "y", "")

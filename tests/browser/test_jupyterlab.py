@@ -2,60 +2,35 @@
 
 For every notebook: open it, Run All, wait for the kernel to go idle, then check
 that no cell failed, the browser logged no error, nothing was requested from
-outside localhost, every slider rendered as a widget, and that moving one
-slider with the keyboard changes its readout and redraws the plot. The time
-from the key press to the new image is printed per notebook.
+outside localhost, every slider rendered as a widget, and that moving every
+slider with the keyboard changes its readout and redraws the plot within the
+goal; in 03_meshes, drag a corner of the patch editor with the mouse. The times
+from key press (or drag step) to the new picture are printed per slider.
 
 Run alone: ``.venv/bin/python -m pytest tests/browser -s``.
 """
 import json
-import os
 import shutil
-import socket
 import statistics
-import subprocess
-import sys
 import time
 import urllib.request
 from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
+from jupyterlab_session import (CELL_SUMMARY, CHROMIUM_FLAGS, COUNT_IMAGE_FRAMES, TOKEN, api, frames, jupyterlab,
+                                run_all)
 
 LATENCIES = {}  # slider -> (median ms, 90th percentile ms, moves), printed by tests/conftest.py's summary
 ROOT = Path(__file__).resolve().parents[2]
 CHROMIUM = Path("/usr/bin/chromium")
 SCREENSHOTS = ROOT / "build" / "screenshots"
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
-TOKEN = "labkit-browser-test"
-CHROMIUM_FLAGS = [
-    "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-]
-LAB_SETTINGS = {
-    "@jupyterlab/apputils-extension/notification.jupyterlab-settings": {"fetchNews": "false", "checkForUpdates": False},
-    "@jupyterlab/docmanager-extension/plugin.jupyterlab-settings": {"autosave": False},
-    # render every cell, so widgets far down the notebook exist and are visible to the test
-    "@jupyterlab/notebook-extension/tracker.jupyterlab-settings": {"windowingMode": "none"},
-}
-
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 if not CHROMIUM.exists():
     pytest.skip(
         "!! BROWSER TEST SKIPPED: /usr/bin/chromium is missing (install Debian's chromium package; "
         "`make test` does this when run as root)", allow_module_level=True)
-
-
-def _free_port():
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-def _api(base, path):
-    request = urllib.request.Request(f"{base}{path}", headers={"Authorization": f"token {TOKEN}"})
-    with urllib.request.urlopen(request, timeout=5) as response:
-        return json.loads(response.read())
 
 
 @pytest.fixture(scope="module")
@@ -64,44 +39,8 @@ def lab(tmp_path_factory):
     home = tmp_path_factory.mktemp("lab")
     served = home / "notebooks"
     shutil.copytree(ROOT / "notebooks", served, ignore=shutil.ignore_patterns("*.vtu", ".ipynb_checkpoints"))
-    settings = home / "settings"
-    for name, values in LAB_SETTINGS.items():
-        (settings / name).parent.mkdir(parents=True, exist_ok=True)
-        (settings / name).write_text(json.dumps(values))
-    env = dict(os.environ)
-    for var in ("JUPYTER_RUNTIME_DIR", "JUPYTER_DATA_DIR", "JUPYTER_CONFIG_DIR", "IPYTHONDIR", "MPLCONFIGDIR"):
-        env[var] = str(home / var.lower())
-    env["JUPYTERLAB_SETTINGS_DIR"] = str(settings)
-    env["JUPYTERLAB_WORKSPACES_DIR"] = str(home / "workspaces")
-    port = _free_port()
-    command = [
-        sys.executable, "-m", "jupyterlab", "--no-browser", "--ip=127.0.0.1", f"--port={port}",
-        "--ServerApp.port_retries=0", f"--IdentityProvider.token={TOKEN}", f"--ServerApp.root_dir={served}",
-        "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate", "--LabApp.extension_manager=readonly",
-        "--LabApp.expose_app_in_browser=True", "--allow-root",
-    ]
-    log = open(home / "server.log", "w")
-    server = subprocess.Popen(command, env=env, stdout=log, stderr=subprocess.STDOUT)
-    base = f"http://127.0.0.1:{port}"
-    try:
-        deadline = time.monotonic() + 60
-        while True:
-            try:
-                _api(base, "/api/status")
-                break
-            except OSError:
-                if server.poll() is not None or time.monotonic() > deadline:
-                    raise RuntimeError(f"JupyterLab did not start: {(home / 'server.log').read_text()[-2000:]}")
-                time.sleep(0.3)
+    with jupyterlab(home, served) as base:
         yield base
-    finally:
-        server.terminate()
-        try:
-            server.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            server.wait()
-        log.close()
 
 
 @pytest.fixture(scope="module")
@@ -112,64 +51,10 @@ def browser():
         chromium.close()
 
 
-def _wait_for_idle_kernel(base, timeout=60):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        kernels = _api(base, "/api/kernels")
-        if kernels and all(k["execution_state"] == "idle" and k["connections"] > 0 for k in kernels):
-            return
-        time.sleep(0.25)
-    raise AssertionError(f"kernel not connected and idle after {timeout} s: {kernels}")
-
-
-CELL_SUMMARY = """() => {
-  const panel = window.jupyterapp.shell.currentWidget;
-  const cells = panel.content.model.sharedModel.cells;
-  return cells.filter(c => c.cell_type === 'code').map(c => ({
-    source: c.source, count: c.execution_count,
-    errors: c.outputs.filter(o => o.output_type === 'error').map(o => o.ename + ': ' + o.evalue)}));
-}"""
-
-
-def _run_all(page, base, expected_cells):
-    page.wait_for_function("() => window.jupyterapp && window.jupyterapp.shell.currentWidget"
-                           " && window.jupyterapp.shell.currentWidget.sessionContext"
-                           " && window.jupyterapp.shell.currentWidget.sessionContext.session")
-    _wait_for_idle_kernel(base)
-    page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
-    page.wait_for_function(
-        f"() => {{ const cells = ({CELL_SUMMARY})(); return cells.length === {expected_cells}"
-        " && cells.every(c => c.count !== null && c.count > 0); }", timeout=120_000)
-    _wait_for_idle_kernel(base)
-
-
 # sliders each notebook's Explore section shows (labkit.plots.explorers; 03 adds the patch editor's two)
 SLIDERS = {"01_limacon": 2, "02_convergence": 1, "03_meshes": 6, "04_splines": 1, "05_monotone": 2, "06_bilinear": 1}
 MOVES = 8  # key presses per slider
 GOAL_MS = 100  # median key press -> new picture, per slider
-
-COUNT_IMAGE_FRAMES = """() => {
-  if (window.__labkitCounting) return;
-  window.__labkitCounting = true;
-  window.__labkitImageFrames = 0;
-  const Original = window.WebSocket;
-  window.WebSocket = function (...args) {
-    const socket = new Original(...args);
-    socket.addEventListener('message', (event) => {
-      const data = event.data;
-      const size = data.byteLength !== undefined ? data.byteLength : (data.size !== undefined ? data.size : 0);
-      if (size > 2000 || (typeof data === 'string' && data.includes('image/png'))) window.__labkitImageFrames += 1;
-    });
-    return socket;
-  };
-  window.WebSocket.prototype = Original.prototype;
-  Object.assign(window.WebSocket, Original);
-}"""
-
-
-def _frames(page):
-    return page.evaluate("() => window.__labkitImageFrames || 0")
-
 
 def _percentile(values, fraction):
     ordered = sorted(values)
@@ -192,7 +77,7 @@ def _move_every_slider(page, panel, name):
             key = "ArrowRight"
             for _ in range(MOVES):
                 old_readout = readout.inner_text()
-                old_src, frames = _picture_src_nth(page, e), _frames(page)
+                old_src, frames_before = _picture_src_nth(page, e), frames(page)
                 handle.focus()
                 start = time.perf_counter()
                 page.keyboard.press(key)
@@ -202,7 +87,7 @@ def _move_every_slider(page, panel, name):
                 except playwright_api.TimeoutError:  # at the end of its range: go back
                     key = "ArrowLeft" if key == "ArrowRight" else "ArrowRight"
                     continue
-                page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames], timeout=10_000)
+                page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
                 times.append(time.perf_counter() - start)
             assert len(times) >= MOVES - 1, f"{label}: the slider did not move"
             timings[label] = times
@@ -241,10 +126,10 @@ def _drag_a_corner(page, panel):
     page.mouse.down()
     steps, changed_during = [], False
     for k in range(1, MOVES + 1):
-        old_src, frames = _picture_src_nth(page, e), _frames(page)
+        old_src, frames_before = _picture_src_nth(page, e), frames(page)
         start = time.perf_counter()
         page.mouse.move(x + 6 * k, y + 3 * k)
-        page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames], timeout=10_000)
+        page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
         steps.append(time.perf_counter() - start)
         changed_during = True
     page.mouse.up()
@@ -288,7 +173,7 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
     # a workspace of its own, reset: only this notebook is open
     page.goto(f"{lab}/lab/workspaces/{notebook.stem}/tree/{notebook.name}?reset&token={TOKEN}")
     code_cells = sum(c["cell_type"] == "code" for c in json.loads(notebook.read_text())["cells"])
-    _run_all(page, lab, code_cells)
+    run_all(page, lab, code_cells)
 
     cells = page.evaluate(CELL_SUMMARY)
     failures = [c["errors"] for c in cells if c["errors"]]
@@ -325,7 +210,7 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
     assert not slow, f"median key press -> new picture above {GOAL_MS} ms: {slow}"
 
     context.close()
-    for session in _api(lab, "/api/sessions"):
+    for session in api(lab, "/api/sessions"):
         request = urllib.request.Request(f"{lab}/api/sessions/{session['id']}", method="DELETE",
                                          headers={"Authorization": f"token {TOKEN}"})
         urllib.request.urlopen(request, timeout=10).close()
