@@ -246,3 +246,30 @@ def test_the_editor_refuses_what_it_cannot_edit():
         plots.patch_editor(SQUARE[:3])
     with pytest.raises(ValueError, match="plane patches"):
         plots.patch_editor([labkit.Corner([0, 0, 0], [1, 0, 0], [0, 1, 0])] * 4)
+
+
+@pytest.mark.parametrize("factory, control, value", [
+    (plots.mesh_explorer, "dxds_BC", 0.6),
+    (plots.mesh_explorer, "twist", 1.2),
+    (plots.limacon_explorer, "intervals", 9),
+])
+def test_a_blitted_picture_is_the_full_drawing_pixel_for_pixel(factory, control, value):
+    import io
+
+    from PIL import Image
+
+    explorer = factory()
+    explorer.controls[control].value = value
+    assert explorer.painter.blitted == 1  # only the changing artists were drawn
+    blitted = np.asarray(Image.open(io.BytesIO(explorer.image.value)))
+    explorer.painter.key = None  # force a full drawing of the same state
+    full = np.asarray(Image.open(io.BytesIO(explorer.png())))
+    assert np.array_equal(blitted, full)
+
+
+def test_a_change_of_limits_draws_everything_again():
+    explorer = plots.limacon_explorer()
+    explorer.controls["r0"].value = 1.9  # a bigger curve: new limits, new ticks
+    assert explorer.painter.blitted == 0
+    x0, x1 = explorer.figure.axes[0].get_xlim()
+    assert x1 > 2.8

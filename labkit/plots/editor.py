@@ -18,7 +18,7 @@ import pathlib
 import numpy as np
 
 from ..patches import Corner
-from .explorers import freeze_layout, new_figure, png
+from .explorers import Painter, freeze_layout, new_figure, png
 from .figures import PatchView
 
 NAMES = "ABCD"
@@ -113,6 +113,7 @@ class Editor:
         self.redraws = 0
         self._draw_mesh()
         freeze_layout(self.figure)
+        self.painter = Painter(self.figure, self.view)
         self.widget_.observe(self._dragged, names="drag")
         self.elements.observe(lambda change: self.refresh(), names="value")
         self.twist.observe(self._twisted, names="value")
@@ -153,7 +154,7 @@ class Editor:
         """Rebuild the mesh from the corners; send the picture, handles, readout and worst quality."""
         self._draw_mesh()
         worst = float(self.view.mesh.quality().min())
-        picture = png(self.figure)
+        picture = png(self.figure, self.painter)
         self.widget_.frame = self._frame()
         self.widget_.handles = handle_positions(self.corners).round(6).tolist()
         folded = int(np.sum(self.view.mesh.quality() <= 0))

@@ -33,12 +33,39 @@ def new_figure(size, dpi=DPI):
     return figure, figure.add_subplot()
 
 
-def png(figure):
-    """The figure as PNG bytes: one Agg draw, fast compression."""
+class Painter:
+    """Draws a figure for a new picture: in full, or, for a view that names its changing artists,
+    only those over a copy of the rest (blitting) while the rest has not changed."""
+
+    def __init__(self, figure, view=None):
+        self.figure, self.view = figure, view
+        self.key, self.background = None, None
+        self.blitted = 0
+
+    def draw(self):
+        canvas = self.figure.canvas
+        if not hasattr(self.view, "dynamic"):
+            canvas.draw()
+            return
+        dynamic, key = self.view.dynamic(), self.view.static_key()
+        if key != self.key or self.background is None:
+            for artist in dynamic:
+                artist.set_animated(True)
+            canvas.draw()  # everything but the changing artists
+            self.background, self.key = canvas.copy_from_bbox(self.figure.bbox), key
+        else:
+            canvas.restore_region(self.background)
+            self.blitted += 1
+        for artist in dynamic:
+            self.figure.draw_artist(artist)
+
+
+def png(figure, painter=None):
+    """The figure as PNG bytes: one Agg draw (or a blit), fast compression."""
     from PIL import Image
 
     canvas = figure.canvas
-    canvas.draw()
+    (painter or Painter(figure)).draw()
     buffer = io.BytesIO()
     Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).save(
         buffer, format="png", compress_level=1)
@@ -65,10 +92,11 @@ class Explorer:
         Each control's ``value`` is passed to `update` under its name.
     """
 
-    def __init__(self, figure, update, controls):
+    def __init__(self, figure, update, controls, view=None):
         import ipywidgets as widgets
 
         self.figure, self._update, self.controls = figure, update, dict(controls)
+        self.painter = Painter(figure, view)
         self.image = widgets.Image(format="png")
         self.image.add_class("labkit-explorer-image")
         self.redraws = 0
@@ -90,7 +118,7 @@ class Explorer:
         self.redraws += 1
 
     def png(self):
-        return png(self.figure)
+        return png(self.figure, self.painter)
 
     def _repr_mimebundle_(self, **kwargs):
         bundle = self.widget._repr_mimebundle_(**kwargs)
@@ -115,7 +143,7 @@ def limacon_explorer():
 
     figure, ax = new_figure((5, 5))
     view = LimaconView(ax)
-    return Explorer(figure, lambda intervals, r0, method: view.update(intervals, r0, method), {
+    return Explorer(figure, lambda intervals, r0, method: view.update(intervals, r0, method), view=view, controls={
         "intervals": _slider(int, 20, 3, 60, description="intervals"),
         "r0": _slider(float, 1.15, 0.5, 2.0, 0.05, "r0"),
         "method": widgets.Dropdown(options=[("Hermite", "pherm"), ("linear", "plin")], value="pherm",
@@ -148,7 +176,7 @@ def mesh_explorer():
                    Corner([1, 1], [dxds_BC, 0], [0, 1], [twist, 0]), Corner([0, 1], [dxds_AD, 0], [0, 1], [twist, 0])]
         view.update(corners, elements + 1, elements + 1)
 
-    return Explorer(figure, update, {
+    return Explorer(figure, update, view=view, controls={
         "dxds_AD": _slider(float, 3.0, -2.0, 5.0, 0.1, "dx/ds A,D"),
         "dxds_BC": _slider(float, 0.1, -2.0, 5.0, 0.1, "dx/ds B,C"),
         "twist": _slider(float, 0.0, -3.0, 3.0, 0.1, "twist"),

@@ -81,6 +81,14 @@ class LimaconView:
         return self.ax
 
 
+    def dynamic(self):
+        """The artists a move of the interval count changes (see PatchView.dynamic)."""
+        return [self.curve, self.data, self.ax.title]
+
+    def static_key(self):
+        return self.ax.get_xlim(), self.ax.get_ylim(), self.curve.get_label(), self._r0
+
+
 class ErrorCurvesView:
     """Pointwise error p - f of several interpolation methods from ndata equally spaced points."""
 
@@ -196,6 +204,15 @@ class PatchView:
             self.ax.set_title(title)
         _fit(self.ax, self.mesh.points[:, 0], self.mesh.points[:, 1])
         return self.ax
+
+
+    def dynamic(self):
+        """The artists a move changes (the rest is drawn once and copied: see Explorer)."""
+        return [self.cells, self.ax.title]
+
+    def static_key(self):
+        """What the copied background depends on: a new key means a full redraw."""
+        return self.ax.get_xlim(), self.ax.get_ylim()
 
 
 def draw_mesh(mesh, ax=None, color_by_quality=False, title=None, **line_kw):
