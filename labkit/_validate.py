@@ -7,15 +7,69 @@ says what is wrong and how to fix it.
 import numpy as np
 
 
-def as_float_array(values, name):
-    """Convert to a float ndarray, refusing complex, object or string input."""
+_NOT_NUMBERS = {
+    "c": "complex numbers (the imaginary parts would be lost): interpolate the real and imaginary parts "
+         "separately, e.g. with {name}.real and {name}.imag",
+    "b": "booleans (True/False), not numbers: if you mean 0 and 1, convert on purpose with "
+         "np.asarray({name}, dtype=float)",
+    "U": "text, not numbers: convert it first, e.g. np.asarray({name}, dtype=float)",
+    "S": "text, not numbers: convert it first, e.g. np.asarray({name}, dtype=float)",
+    "M": "dates, not numbers: convert them to numbers first (e.g. seconds since a start time)",
+    "m": "time spans, not numbers: convert them to numbers first (e.g. / np.timedelta64(1, 's'))",
+    "V": "records, not numbers: pass one field as an array of numbers",
+}
+
+
+def _refuse(name, kind):
+    raise ValueError(f"{name} holds {_NOT_NUMBERS[kind].format(name=name)}.")
+
+
+def _check_object_item(item, name):
+    """An element of an object array: a real number, or a ValueError saying what it is."""
+    if item is None:
+        raise ValueError(f"{name} holds None where a number should be: fill in the value or drop that point.")
+    for kind, types in (("c", (complex, np.complexfloating)), ("b", (bool, np.bool_)), ("U", (str, bytes))):
+        if isinstance(item, types):
+            _refuse(name, kind)
     try:
-        arr = np.asarray(values, dtype=float)
+        float(item)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} holds a {type(item).__name__} object where a number should be; "
+                         "give real numbers only.") from None
+
+
+def as_float_array(values, name):
+    """Convert to a float ndarray, refusing what is not real numbers.
+
+    Complex numbers, booleans, text, dates, None and other objects raise a
+    ValueError that names the argument and says how to convert it on
+    purpose; nothing is cast silently.
+    """
+    if values is None:
+        raise ValueError(f"{name} is None: give an array of real numbers.")
+    try:
+        arr = np.asarray(values)
     except (TypeError, ValueError) as exc:
-        raise ValueError(
-            f"{name} must be an array of real numbers; could not convert it ({exc})."
-        ) from None
-    return arr
+        raise ValueError(f"{name} must be an array of real numbers; could not read it ({exc}).") from None
+    kind = arr.dtype.kind
+    if kind in _NOT_NUMBERS:
+        _refuse(name, kind)
+    if kind == "O":
+        for item in arr.flat:
+            _check_object_item(item, name)
+    if arr.dtype == np.float64:
+        return arr
+    try:
+        return arr.astype(float)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ValueError(f"{name} must be an array of real numbers; could not convert it ({exc}).") from None
+
+
+def as_order(der, highest):
+    """A derivative order: a whole number from 0 to `highest`."""
+    if isinstance(der, (bool, np.bool_)) or not isinstance(der, (int, np.integer)) or not 0 <= der <= highest:
+        raise ValueError(f"der must be a whole number from 0 (the values) to {highest}; got {der!r}.")
+    return int(der)
 
 
 def as_knots(xdata, name="xdata"):
@@ -62,7 +116,7 @@ def as_data(values, n, name, xname="xdata"):
 def as_scalar(value, name):
     """Validate a finite real number (an end slope, say)."""
     if value is None:
-        raise ValueError(f"{name} is required: give the derivative at that end.")
+        raise ValueError(f"{name} is None, but it is required: give a number.")
     v = as_float_array(value, name)
     if v.ndim != 0:
         raise ValueError(f"{name} must be a single number; got shape {v.shape}.")

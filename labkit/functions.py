@@ -1,7 +1,7 @@
 """Test functions of the lab: the Runge function in one and two variables."""
 import numpy as np
 
-from ._validate import as_float_array, scalar_or_array
+from ._validate import as_float_array, as_scalar, scalar_or_array
 
 
 def runge(x):
@@ -67,7 +67,7 @@ def limacon(t, r0=1.15):
     [2.0, 0.0, 0.0, 2.0]
     """
     ta = as_float_array(t, "t")
-    r = r0 + np.cos(ta)
+    r = as_scalar(r0, "r0") + np.cos(ta)
     drdt = -np.sin(ta)
     x, y = r * np.cos(ta), r * np.sin(ta)
     return x, y, drdt * np.cos(ta) - y, drdt * np.sin(ta) + x

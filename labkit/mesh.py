@@ -29,8 +29,11 @@ class QuadMesh:
     """
 
     def __init__(self, points, quads):
-        self.points = np.asarray(points, dtype=float)
-        self.quads = np.asarray(quads, dtype=np.intp)
+        self.points = as_float_array(points, "points")
+        quads = as_float_array(quads, "quads")
+        if not np.all(np.isfinite(quads)) or np.any(quads != np.round(quads)):
+            raise ValueError("quads must hold whole node numbers (0, 1, 2, ...).")
+        self.quads = quads.astype(np.intp)
         if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
             raise ValueError(f"points must have shape (N, 2) or (N, 3); got {self.points.shape}.")
         if self.quads.ndim != 2 or self.quads.shape[1] != 4:
@@ -179,7 +182,7 @@ def quad_mesh(x, y, z=None):
     >>> mesh.points.shape, mesh.quads.shape
     ((20, 2), (12, 4))
     """
-    coords = [_grid(c, name) for c, name in ((x, "x"), (y, "y"), (z, "z")) if c is not None]
+    coords = [_grid(c, name) for c, name in ((x, "x"), (y, "y"), (z, "z")) if c is not None or name != "z"]
     shapes = {c.shape for c in coords}
     if len(shapes) != 1:
         raise ValueError(

@@ -8,7 +8,8 @@ scipy use. See ``notebooks/05_monotone.ipynb``.
 """
 import numpy as np
 
-from ._validate import as_data, as_knots, as_points, scalar_or_array
+from ._frame import Frame
+from ._validate import as_data, as_knots, as_order, as_points, scalar_or_array
 from .piecewise import _hermite_eval
 
 
@@ -36,15 +37,19 @@ def pchip_slopes(xdata, ydata):
     """
     x = as_knots(xdata)
     y = as_data(ydata, x.size, "ydata")
-    h = np.diff(x)
-    delta = np.diff(y) / h
-    if x.size == 2:
-        return np.full(2, delta[0])
-    slopes = np.empty(x.size)
-    slopes[1:-1] = _interior_slopes(h, delta)
-    slopes[0] = _end_slope(h[0], h[1], delta[0], delta[1])
-    slopes[-1] = _end_slope(h[-1], h[-2], delta[-1], delta[-2])
-    return slopes
+    frame = Frame(x, y)
+    with np.errstate(all="ignore"):
+        h = np.diff(frame.knots)
+        delta = np.diff(frame.values) / h
+        if not np.all(np.isfinite(delta)):
+            frame.knot_slopes(delta, "pchip")  # raises: the data rise too steeply for the float range
+        if x.size == 2:
+            return frame.knot_slopes(np.full(2, delta[0]), "pchip")
+        slopes = np.empty(x.size)
+        slopes[1:-1] = _interior_slopes(h, delta)
+        slopes[0] = _end_slope(h[0], h[1], delta[0], delta[1])
+        slopes[-1] = _end_slope(h[-1], h[-2], delta[-1], delta[-2])
+    return frame.knot_slopes(slopes, "pchip")
 
 
 def _interior_slopes(h, delta):
@@ -52,8 +57,8 @@ def _interior_slopes(h, delta):
     left, right = delta[:-1], delta[1:]
     w1 = 2.0 * h[1:] + h[:-1]
     w2 = h[1:] + 2.0 * h[:-1]
-    same_sign = left * right > 0
-    with np.errstate(divide="ignore", invalid="ignore"):
+    same_sign = np.sign(left) * np.sign(right) > 0  # a product of tiny secants could underflow to 0
+    with np.errstate(all="ignore"):
         mean = (w1 + w2) / (w1 / left + w2 / right)
     return np.where(same_sign, mean, 0.0)
 
@@ -68,7 +73,7 @@ def _end_slope(h_end, h_next, delta_end, delta_next):
     return slope
 
 
-def pchip(xdata, ydata, xval):
+def pchip(xdata, ydata, xval, der=0):
     """Evaluate the shape-preserving piecewise cubic interpolant.
 
     Parameters
@@ -80,6 +85,9 @@ def pchip(xdata, ydata, xval):
     xval : array_like
         Evaluation points, any shape; outside the knots the end cubics are
         extended.
+    der : {0, 1, 2, 3}
+        0 for the values, else that derivative (at a knot, of the piece to
+        its right). pchip is only C1: its second derivative jumps at the knots.
 
     Returns
     -------
@@ -90,8 +98,10 @@ def pchip(xdata, ydata, xval):
     >>> from labkit import pchip
     >>> pchip([0, 1, 2, 3, 4], [0, 1, 2, 2, 2], [2.5, 3.5]).tolist()
     [2.0, 2.0]
+    >>> pchip([0, 1, 2, 3, 4], [0, 1, 2, 2, 2], [0.5, 2.5], der=1).tolist()
+    [1.0, 0.0]
     """
     x = as_knots(xdata)
     y = as_data(ydata, x.size, "ydata")
     xv = as_points(xval)
-    return scalar_or_array(_hermite_eval(x, y, pchip_slopes(x, y), xv), xval)
+    return scalar_or_array(_hermite_eval(x, y, pchip_slopes(x, y), xv, as_order(der, 3)), xval)

@@ -6,8 +6,9 @@ interpolants is in ``notebooks/01_limacon.ipynb``.
 """
 import numpy as np
 
+from ._frame import Frame
 from ._locate import blockwise, locate
-from ._validate import as_data, as_knots, as_points, scalar_or_array
+from ._validate import as_data, as_float_array, as_knots, as_order, as_points, scalar_or_array
 
 
 def bracket(xdata, xval):
@@ -39,7 +40,7 @@ def bracket(xdata, xval):
     return scalar_or_array(locate(x, xv), xval)
 
 
-def eval_plin(xdata, ydata, xval):
+def eval_plin(xdata, ydata, xval, der=0):
     """Piecewise linear interpolant of ``(xdata, ydata)`` evaluated at `xval`.
 
     Parameters
@@ -51,6 +52,9 @@ def eval_plin(xdata, ydata, xval):
     xval : array_like
         Evaluation points, any shape. Points outside the data are
         extrapolated linearly from the end pieces; NaN gives NaN.
+    der : {0, 1}
+        0 for the values, 1 for the slope of the piece that holds each point
+        (at a data point, the piece to its right; outside, the end pieces).
 
     Returns
     -------
@@ -61,23 +65,32 @@ def eval_plin(xdata, ydata, xval):
     >>> from labkit import eval_plin
     >>> eval_plin([0, 1, 3], [0, 2, 3], [0.5, 2.0, 4.0]).tolist()
     [1.0, 2.5, 3.5]
+    >>> eval_plin([0, 1, 3], [0, 2, 3], [0.5, 2.0, 4.0], der=1).tolist()
+    [2.0, 0.5, 0.5]
     """
     x = as_knots(xdata)
     y = as_data(ydata, x.size, "ydata")
     xv = as_points(xval)
-    slope = np.diff(y)
-    slope /= np.diff(x)
+    der = as_order(der, 1)
+    frame = Frame(x, y)
+    x, y, xv = frame.knots, frame.values, frame.points(xv)
+    with np.errstate(all="ignore"):
+        slope = np.diff(y)
+        slope /= np.diff(x)
 
     def line(k, p, out):
+        if der:
+            out[...] = np.take(slope, k)
+            return
         np.subtract(p, np.take(x, k), out=out)
         out *= np.take(slope, k)
         out += np.take(y, k)
 
-    return scalar_or_array(blockwise(x, xv, line), xval)
+    return scalar_or_array(frame.result(blockwise(x, xv, line), der, xv), xval)
 
 
-def hermite_basis(xk, xk1, x):
-    """The four cubic Hermite basis polynomials on the interval ``[xk, xk1]``.
+def hermite_basis(xk, xk1, x, der=0):
+    """The four cubic Hermite basis polynomials on the interval ``[xk, xk1]``, or their derivatives.
 
     ``h1`` and ``h3`` carry the values at the left and right ends, ``h2`` and
     ``h4`` the derivatives: ``h1(xk) = 1``, ``h2'(xk) = 1``, ``h3(xk1) = 1``,
@@ -89,6 +102,8 @@ def hermite_basis(xk, xk1, x):
         Left and right ends of the interval (broadcast against `x`).
     x : float or ndarray
         Evaluation points.
+    der : {0, 1, 2, 3}
+        Which derivative of the four polynomials (0: the polynomials).
 
     Returns
     -------
@@ -99,26 +114,37 @@ def hermite_basis(xk, xk1, x):
     >>> from labkit import hermite_basis
     >>> [float(h) for h in hermite_basis(0.0, 2.0, 1.0)]
     [0.5, 0.25, 0.5, -0.25]
+    >>> [float(h) for h in hermite_basis(0.0, 2.0, 1.0, der=1)]   # h1' = -h3' = -3/(2h) in the middle
+    [-0.75, -0.25, 0.75, -0.25]
     """
-    h = np.asarray(xk1, dtype=float) - xk
+    der = as_order(der, 3)
+    xk = as_float_array(xk, "xk")
+    h = as_float_array(xk1, "xk1") - xk
     # t is the position inside the interval scaled to [0, 1]; in that variable
-    # the lab's formulas become polynomials with the length h factored out.
-    t = (np.asarray(x, dtype=float) - xk) / h
+    # the lab's formulas become polynomials with the length h factored out,
+    # and each derivative in x is a derivative in t divided by h.
+    t = (as_float_array(x, "x") - xk) / h
     s = 1.0 - t
-    h1 = s * s * (1.0 + 2.0 * t)
-    h2 = h * t * s * s
-    h3 = t * t * (3.0 - 2.0 * t)
-    h4 = -h * t * t * s
-    return h1, h2, h3, h4
+    if der == 0:
+        return s * s * (1.0 + 2.0 * t), h * t * s * s, t * t * (3.0 - 2.0 * t), -h * t * t * s
+    if der == 1:
+        h1 = 6.0 * t * (t - 1.0) / h
+        return h1, s * (1.0 - 3.0 * t), -h1, t * (3.0 * t - 2.0)
+    if der == 2:
+        h1 = (12.0 * t - 6.0) / (h * h)
+        return h1, (6.0 * t - 4.0) / h, -h1, (6.0 * t - 2.0) / h
+    ones = np.ones_like(t)
+    return 12.0 / h**3 * ones, 6.0 / (h * h) * ones, -12.0 / h**3 * ones, 6.0 / (h * h) * ones
 
 
-def eval_pherm(xdata, ydata, ypdata, xval):
-    """Piecewise cubic Hermite interpolant from values and slopes.
+def eval_pherm(xdata, ydata, ypdata, xval, der=0):
+    """Piecewise cubic Hermite interpolant from values and slopes, or its derivatives.
 
     On each interval ``[x_k, x_{k+1}]`` the interpolant is
     ``y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4`` with the basis of
     :func:`hermite_basis`, so it matches values and first derivatives at
-    every data point and is continuously differentiable.
+    every data point and is continuously differentiable (its second
+    derivative jumps at the data points: see ``notebooks/04_splines.ipynb``).
 
     Parameters
     ----------
@@ -129,33 +155,52 @@ def eval_pherm(xdata, ydata, ypdata, xval):
     xval : array_like
         Evaluation points, any shape. Points outside the data use the cubic
         of the nearest end interval; NaN gives NaN.
+    der : {0, 1, 2, 3}
+        0 for the values, else that derivative (at a data point, of the piece
+        to its right).
 
     Returns
     -------
     yval : float or ndarray, same shape as `xval`
 
+    Raises
+    ------
+    ValueError
+        If the input is not real numbers, or a value is beyond the float
+        range (a point far outside the data, or slopes too steep).
+
     Examples
     --------
-    Cubics are reproduced exactly, inside and outside the data:
+    Cubics are reproduced exactly, inside and outside the data, and so are
+    their derivatives:
 
     >>> from labkit import eval_pherm
     >>> x = [0.0, 2.0]
     >>> eval_pherm(x, [0.0, 8.0], [0.0, 12.0], [-1.0, 1.0, 3.0]).tolist()
     [-1.0, 1.0, 27.0]
+    >>> eval_pherm(x, [0.0, 8.0], [0.0, 12.0], [-1.0, 1.0, 3.0], der=2).tolist()
+    [-6.0, 6.0, 18.0]
     """
     x = as_knots(xdata)
     y = as_data(ydata, x.size, "ydata")
     yp = as_data(ypdata, x.size, "ypdata")
     xv = as_points(xval)
-    return scalar_or_array(_hermite_eval(x, y, yp, xv), xval)
+    return scalar_or_array(_hermite_eval(x, y, yp, xv, as_order(der, 3)), xval)
 
 
-def _hermite_eval(x, y, yp, xv):
-    """Evaluate validated Hermite data; shared by the splines and pchip."""
+def _hermite_eval(x, y, yp, xv, der=0):
+    """Evaluate validated Hermite data (or a derivative); shared by the splines and pchip.
+
+    Very large or very small numbers are handled in a frame scaled by powers
+    of two (:class:`labkit._frame.Frame`), so the cubic never overflows on the
+    way to a representable answer.
+    """
+    frame = Frame(x, y)
+    x, y, yp, xv = frame.knots, frame.values, frame.slopes(yp), frame.points(xv)
 
     def cubic(k, p, out):
         right = k + 1
-        h1, h2, h3, h4 = hermite_basis(np.take(x, k), np.take(x, right), p)
+        h1, h2, h3, h4 = hermite_basis(np.take(x, k), np.take(x, right), p, der)
         np.multiply(h1, np.take(y, k), out=out)
         h2 *= np.take(yp, k)
         h3 *= np.take(y, right)
@@ -164,4 +209,6 @@ def _hermite_eval(x, y, yp, xv):
         out += h3
         out += h4
 
-    return blockwise(x, xv, cubic)
+    with np.errstate(all="ignore"):
+        values = blockwise(x, xv, cubic)
+    return frame.result(values, der, xv)

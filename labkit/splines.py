@@ -12,7 +12,8 @@ matrix is ever formed.
 import numpy as np
 from scipy.linalg import lapack
 
-from ._validate import as_data, as_knots, as_points, as_scalar, scalar_or_array
+from ._frame import Frame
+from ._validate import as_data, as_knots, as_order, as_points, as_scalar, scalar_or_array
 from .piecewise import _hermite_eval
 
 
@@ -43,11 +44,18 @@ def _interior_system(h, secants):
     return h[:-1] / 6.0, (h[:-1] + h[1:]) / 3.0, h[1:] / 6.0, np.diff(secants)
 
 
-def _prepare(xdata, ydata):
+def _prepare(xdata, ydata, name):
+    """Validated knots and values in a frame of ordinary magnitude, their intervals and secants."""
     x = as_knots(xdata)
     y = as_data(ydata, x.size, "ydata")
-    h = np.diff(x)
-    return x, y, h, np.diff(y) / h
+    frame = Frame(x, y)
+    x, y = frame.knots, frame.values
+    with np.errstate(all="ignore"):
+        h = np.diff(x)
+        secants = np.diff(y) / h
+    if not np.all(np.isfinite(secants)):
+        frame.knot_slopes(secants, name)  # raises: the data rise too steeply for the float range
+    return frame, h, secants
 
 
 def ccspline(xdata, ydata, y1p=None, ynp=None):
@@ -76,17 +84,19 @@ def ccspline(xdata, ydata, y1p=None, ynp=None):
     >>> ccspline([0, 1, 2, 4], [0, 1, 8, 64], 0, 48).round(12).tolist()
     [0.0, 3.0, 12.0, 48.0]
     """
-    x, y, h, secants = _prepare(xdata, ydata)
     first = as_scalar(y1p, "y1p (the slope at xdata[0])")
     last = as_scalar(ynp, "ynp (the slope at xdata[-1])")
-    sub_i, diag_i, sup_i, rhs_i = _interior_system(h, secants)
-    # First and last rows (lab eq. 10): the given end slopes close the system.
-    diag = np.concatenate(([h[0] / 3.0], diag_i, [h[-1] / 3.0]))
-    rhs = np.concatenate(([secants[0] - first], rhs_i, [last - secants[-1]]))
-    M = _solve_tridiagonal(h / 6.0, diag, h / 6.0, rhs)
-    slopes = _slopes_from_curvatures(h, secants, M)
+    frame, h, secants = _prepare(xdata, ydata, "complete spline's")
+    first, last = frame.slopes(first), frame.slopes(last)
+    with np.errstate(all="ignore"):
+        sub_i, diag_i, sup_i, rhs_i = _interior_system(h, secants)
+        # First and last rows (lab eq. 10): the given end slopes close the system.
+        diag = np.concatenate(([h[0] / 3.0], diag_i, [h[-1] / 3.0]))
+        rhs = np.concatenate(([secants[0] - first], rhs_i, [last - secants[-1]]))
+        M = _solve_tridiagonal(h / 6.0, diag, h / 6.0, rhs)
+        slopes = _slopes_from_curvatures(h, secants, M)
     slopes[0], slopes[-1] = first, last
-    return slopes
+    return frame.knot_slopes(slopes, "complete spline's")
 
 
 def ncspline(xdata, ydata):
@@ -112,8 +122,10 @@ def ncspline(xdata, ydata):
     >>> ncspline([0, 1, 2, 3], [0, 2, 4, 6]).tolist()
     [2.0, 2.0, 2.0, 2.0]
     """
-    x, y, h, secants = _prepare(xdata, ydata)
-    return _slopes_from_curvatures(h, secants, natural_curvatures(h, secants))
+    frame, h, secants = _prepare(xdata, ydata, "natural spline's")
+    with np.errstate(all="ignore"):
+        slopes = _slopes_from_curvatures(h, secants, natural_curvatures(h, secants))
+    return frame.knot_slopes(slopes, "natural spline's")
 
 
 def natural_curvatures(h, secants):
@@ -150,12 +162,15 @@ def nakspline(xdata, ydata):
     >>> nakspline([0, 1, 3], [0, 1, 9]).round(12).tolist()
     [0.0, 2.0, 6.0]
     """
-    x, y, h, secants = _prepare(xdata, ydata)
-    if x.size == 2:
-        return np.full(2, secants[0])
-    if x.size == 3:
-        return _parabola_slopes(h, secants)
-    return _slopes_from_curvatures(h, secants, _notaknot_curvatures(h, secants))
+    frame, h, secants = _prepare(xdata, ydata, "not-a-knot spline's")
+    with np.errstate(all="ignore"):
+        if h.size == 1:
+            slopes = np.full(2, secants[0])
+        elif h.size == 2:
+            slopes = _parabola_slopes(h, secants)
+        else:
+            slopes = _slopes_from_curvatures(h, secants, _notaknot_curvatures(h, secants))
+    return frame.knot_slopes(slopes, "not-a-knot spline's")
 
 
 def _parabola_slopes(h, secants):
@@ -188,7 +203,7 @@ def _notaknot_curvatures(h, secants):
     return M
 
 
-def spline(xdata, ydata, xval):
+def spline(xdata, ydata, xval, der=0):
     """Cubic spline interpolation with MATLAB's ``spline`` conventions.
 
     Parameters
@@ -202,6 +217,10 @@ def spline(xdata, ydata, xval):
     xval : array_like
         Evaluation points, any shape; outside the knots the end cubics are
         extended.
+    der : {0, 1, 2, 3}
+        0 for the values, else that derivative (at a knot, of the piece to
+        its right). The spline's first and second derivatives are continuous;
+        its third jumps at the knots (``notebooks/04_splines.ipynb``).
 
     Returns
     -------
@@ -215,6 +234,8 @@ def spline(xdata, ydata, xval):
     27.0
     >>> float(spline(x, [0, 0, 1, 8, 64, 48], 3.0))   # slopes 0 and 48 at the ends
     27.0
+    >>> float(spline(x, [0, 1, 8, 64], 3.0, der=2))   # (x**3)'' = 6 x
+    18.0
     """
     x = as_knots(xdata)
     y = as_points(ydata, "ydata")
@@ -225,4 +246,4 @@ def spline(xdata, ydata, xval):
         values = as_data(y, x.size, "ydata (n values, or n + 2 with end slopes)")
         slopes = nakspline(x, values)
     xv = as_points(xval)
-    return scalar_or_array(_hermite_eval(x, values, slopes, xv), xval)
+    return scalar_or_array(_hermite_eval(x, values, slopes, xv, as_order(der, 3)), xval)

@@ -136,3 +136,9 @@ def _table_error(ndata, interpolate):
 def test_a_zero_function_gets_no_denominator_hint():
     result = check.eval_pherm(lambda xd, yd, yp, xv: 0.0 * np.asarray(xv))
     assert not result.passed and "times 0" not in result.hint and "wrong" in result.hint
+
+
+def test_natural_spline_check_reads_the_end_curvature_from_the_derivative():
+    result = check.ncspline(lambda x, y: labkit.ccspline(x, y, 0.0, 0.0))  # the complete spline's ends
+    assert not result.passed and "M1 = 0 and Mn = 0" in result.hint
+    assert "s'' = [" in repr(result)

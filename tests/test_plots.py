@@ -273,3 +273,24 @@ def test_a_change_of_limits_draws_everything_again():
     assert explorer.painter.blitted == 0
     x0, x1 = explorer.figure.axes[0].get_xlim()
     assert x1 > 2.8
+
+
+def test_second_derivative_plot_shows_hermite_jumps_and_c2_splines():
+    ax = plots.plot_second_derivatives(7)
+    _labelled(ax)
+    hermite, complete, natural, notaknot, _ = ax.get_lines()
+
+    def jumps(line):
+        pieces = np.split(line.get_ydata(), np.flatnonzero(np.isnan(line.get_ydata())))
+        pieces = [p[~np.isnan(p)] for p in pieces if np.any(~np.isnan(p))]
+        return np.array([left[-1] - right[0] for left, right in zip(pieces, pieces[1:])])
+
+    assert np.max(np.abs(jumps(hermite))) > 0.05
+    for line in (complete, natural, notaknot):
+        assert np.max(np.abs(jumps(line))) < 1e-9
+    s2 = natural.get_ydata()[~np.isnan(natural.get_ydata())]
+    assert abs(s2[0]) < 1e-12 and abs(s2[-1]) < 1e-12
+    x = np.linspace(0, 5, 7)
+    y, _ = labkit.runge(x)
+    np.testing.assert_allclose(notaknot.get_ydata()[:40],
+                               labkit.spline(x, y, np.linspace(x[0], x[1], 40), der=2), rtol=1e-12, atol=1e-12)

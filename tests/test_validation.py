@@ -79,7 +79,7 @@ def test_complete_spline_needs_both_end_slopes():
 
 
 def test_non_numeric_input():
-    with pytest.raises(ValueError, match="array of real numbers"):
+    with pytest.raises(ValueError, match="xdata holds text, not numbers"):
         eval_plin(["a", "b"], [1, 2], 0.5)
 
 

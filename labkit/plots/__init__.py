@@ -10,10 +10,11 @@ from .explorers import (Explorer, bilinear_explorer, convergence_explorer, limac
                         pchip_explorer, spline_explorer)
 from .figures import (BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView, draw_mesh,
                       plot_bilinear_error, plot_convergence, plot_interpolation_error, plot_limacon, plot_patch,
-                      plot_spline_vs_pchip)
+                      plot_second_derivatives, plot_spline_vs_pchip)
 
 __all__ = ["BilinearErrorView", "ErrorCurvesView", "Explorer", "LimaconView", "PatchView", "SplinePchipView",
            "bilinear_explorer", "convergence_explorer", "corner_code", "draw_mesh", "handle_positions",
            "limacon_explorer", "mesh_explorer", "move_handle", "nearest_handle", "patch_editor", "pchip_explorer",
            "plot_bilinear_error", "plot_convergence", "plot_interpolation_error", "plot_limacon", "plot_patch",
+           "plot_second_derivatives",
            "plot_spline_vs_pchip", "spline_explorer"]

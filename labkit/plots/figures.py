@@ -16,7 +16,7 @@ from ..mesh import quad_mesh
 from ..monotone import pchip
 from ..patches import patch
 from ..piecewise import eval_pherm, eval_plin
-from ..splines import spline
+from ..splines import ccspline, nakspline, ncspline, spline
 
 
 def new_axes(ax=None, size=(5, 5)):
@@ -248,6 +248,35 @@ def plot_convergence(tables, ax=None):
 def plot_interpolation_error(methods, ndata, ax=None, f=runge, interval=(0.0, 5.0)):
     """Pointwise error p - f of each method with ndata equally spaced points."""
     return ErrorCurvesView(methods, ax, f, interval).update(methods, ndata)
+
+
+def plot_second_derivatives(ndata=7, ax=None, f=runge, interval=(0.0, 5.0)):
+    """s'' of the Hermite interpolant and of the three cubic splines of f from ndata equally spaced points.
+
+    The Hermite cubics (values and true slopes of f) only match first derivatives at the data
+    points, so their s'' jumps there; a spline's s'' is continuous, and the natural spline's is
+    0 at both ends. See ``notebooks/04_splines.ipynb``.
+    """
+    ax = new_axes(ax, size=(6, 4))
+    a, b = interval
+    xdata = np.linspace(a, b, ndata)
+    y, yp = f(xdata)
+    # each piece is evaluated on its own interval (its own cubic up to both ends), with a NaN between
+    # pieces, so that a jump of s'' at a data point shows as a jump
+    pieces = [np.linspace(xdata[k], xdata[k + 1], 40) for k in range(ndata - 1)]
+    x = np.concatenate([np.append(piece, np.nan) for piece in pieces])
+
+    def curve(slopes):
+        return np.concatenate([np.append(eval_pherm(xdata[k:k + 2], y[k:k + 2], slopes[k:k + 2], piece, der=2), np.nan)
+                               for k, piece in enumerate(pieces)])
+
+    ax.plot(x, curve(yp), color="0.5", lw=2.5, label="Hermite (true slopes): s'' jumps")
+    ax.plot(x, curve(ccspline(xdata, y, yp[0], yp[-1])), label="complete spline")
+    ax.plot(x, curve(ncspline(xdata, y)), "--", label="natural spline (s'' = 0 at the ends)")
+    ax.plot(x, curve(nakspline(xdata, y)), ":", lw=2, label="not-a-knot spline")
+    ax.plot(xdata, np.zeros(ndata), "k|", ms=12, label="data points")
+    ax.legend(fontsize="small")
+    return _label(ax, "x", "s''(x)", f"Second derivatives, {ndata} equally spaced points")
 
 
 def plot_spline_vs_pchip(xdata, ydata, ax=None):
