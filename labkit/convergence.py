@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._validate import as_float_array, as_scalar
 from .bilinear import eval_pbilin
 from .functions import runge, runge2d
 from .monotone import pchip_slopes
@@ -110,19 +111,13 @@ def convergence_table(method, ndata=DEFAULT_NDATA, f=runge, interval=(0.0, 5.0),
     >>> print(str(table).splitlines()[2])
     ndata = 11  Err( 11) =  1.252e-03  Err(  5)/Err( 11) =   28.446
     """
-    if method not in METHOD_TITLES:
+    if not isinstance(method, str) or method not in METHOD_TITLES:
         raise ValueError(
             f"unknown method {method!r}; choose one of {', '.join(map(repr, METHOD_TITLES))}."
         )
-    sizes = np.asarray(ndata)
-    if sizes.ndim != 1 or sizes.size < 2 or not np.issubdtype(sizes.dtype, np.integer):
-        raise ValueError("ndata must be a sequence of at least two whole numbers of points.")
-    if np.any(sizes < 2):
-        raise ValueError("every entry of ndata must be at least 2 (one interval).")
+    sizes = _sizes(ndata)
     a, b = _check_interval(interval)
-    if int(ntest) < 2:
-        raise ValueError("ntest must be at least 2 test points.")
-    xtest = np.linspace(a, b, int(ntest))
+    xtest = np.linspace(a, b, _count(ntest, "ntest"))
     exact, _ = _values_and_slopes(f, xtest, method)
     scale = np.max(np.abs(exact))
     errors = np.array(
@@ -132,11 +127,29 @@ def convergence_table(method, ndata=DEFAULT_NDATA, f=runge, interval=(0.0, 5.0),
     return ConvergenceTable(f"{name}, {METHOD_TITLES[method]}", sizes, errors)
 
 
-def _check_interval(interval):
-    try:
-        a, b = (float(v) for v in interval)
-    except (TypeError, ValueError):
-        raise ValueError("interval must be a pair (a, b) of numbers.") from None
+def _sizes(ndata):
+    """ndata: at least two whole numbers, each at least 2."""
+    sizes = as_float_array(ndata, "ndata")
+    if sizes.ndim != 1 or sizes.size < 2 or not np.all(np.isfinite(sizes)) or np.any(sizes != np.round(sizes)):
+        raise ValueError("ndata must be a sequence of at least two whole numbers of points.")
+    if np.any(sizes < 2):
+        raise ValueError("every entry of ndata must be at least 2 (one interval).")
+    return sizes.astype(int)
+
+
+def _count(value, name):
+    """A whole number of test points, at least 2."""
+    number = as_scalar(value, name)
+    if number != round(number) or number < 2:
+        raise ValueError(f"{name} must be a whole number of test points, at least 2; got {value!r}.")
+    return int(number)
+
+
+def _check_interval(interval, name="interval"):
+    ends = as_float_array(interval, name)
+    if ends.shape != (2,):
+        raise ValueError(f"{name} must be a pair (a, b) of numbers.")
+    a, b = float(ends[0]), float(ends[1])
     if not (np.isfinite(a) and np.isfinite(b) and a < b):
         raise ValueError(f"interval must satisfy a < b with finite ends; got ({a}, {b}).")
     return a, b
@@ -186,11 +199,9 @@ def bilinear_convergence(ndata=(11, 21, 41, 81, 161), f=runge2d, square=(0.0, 5.
     >>> bilinear_convergence().order
     2
     """
-    sizes = np.asarray(ndata)
-    if sizes.ndim != 1 or sizes.size < 2 or np.any(sizes < 2):
-        raise ValueError("ndata must list at least two grid sizes, each at least 2.")
-    a, b = _check_interval(square)
-    test = np.linspace(a, b, int(ntest))
+    sizes = _sizes(ndata)
+    a, b = _check_interval(square, "square")
+    test = np.linspace(a, b, _count(ntest, "ntest"))
     X, Y = np.meshgrid(test, test, indexing="ij")
     exact = np.asarray(f(X, Y), dtype=float)
     scale = np.max(np.abs(exact))

@@ -140,6 +140,7 @@ def test_fuzz_extremes_against_scipy_or_a_clear_error(data, name):
 # -- what is not real numbers ------------------------------------------------------------------
 
 X3, Y3 = [0.0, 1.0, 2.0], [0.0, 1.0, 0.0]
+SQUARE = [labkit.Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
 BAD = {
     "complex": lambda good: np.asarray(good, dtype=float) + 1j,
     "None": lambda good: None,
@@ -169,6 +170,9 @@ CALLS = {
     "Corner": (labkit.Corner, {"point": [0.0, 0.0], "ds": [1.0, 0.0], "dt": [0.0, 1.0], "dsdt": [0.0, 0.0]}),
     "quad_mesh": (labkit.quad_mesh, {"x": np.zeros((2, 2)) + [[0, 0], [1, 1]], "y": np.zeros((2, 2)) + [0, 1]}),
     "QuadMesh": (labkit.QuadMesh, {"points": [[0, 0], [1, 0], [1, 1], [0, 1]], "quads": [[0, 1, 2, 3]]}),
+    "patch": (lambda s, t: labkit.patch(*SQUARE, s, t), {"s": [0.0, 0.5, 1.0], "t": [0.0, 1.0]}),
+    "convergence_table": (labkit.convergence_table, {"ndata": [5, 11], "interval": [0.0, 5.0], "ntest": 101}),
+    "bilinear_convergence": (labkit.bilinear_convergence, {"ndata": [5, 9], "square": [0.0, 5.0], "ntest": 11}),
 }
 CASES = [(name, arg, bad) for name, (_, kwargs) in CALLS.items() for arg in kwargs for bad in BAD
          if not (arg == "dsdt" and bad == "None")]  # a Corner without a twist is allowed: dsdt=None means 0
@@ -181,3 +185,14 @@ def test_every_argument_refuses_what_is_not_real_numbers(name, arg, bad):
     kwargs = {**kwargs, arg: BAD[bad](kwargs[arg])}
     with pytest.raises(ValueError, match=MESSAGE[bad] if arg != "quads" else "quads"):
         function(**kwargs)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: labkit.convergence_table(np.array(["plin"], dtype=object)), "unknown method"),
+    (lambda: labkit.convergence_table("plin", ndata=[5, 10.5]), "whole numbers"),
+    (lambda: labkit.convergence_table("plin", ntest=2.5), "whole number of test points"),
+    (lambda: labkit.bilinear_convergence(ntest=True), "booleans"),
+])
+def test_tables_refuse_what_is_not_a_count(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()
