@@ -171,7 +171,8 @@ CALLS = {
     "quad_mesh": (labkit.quad_mesh, {"x": np.zeros((2, 2)) + [[0, 0], [1, 1]], "y": np.zeros((2, 2)) + [0, 1]}),
     "QuadMesh": (labkit.QuadMesh, {"points": [[0, 0], [1, 0], [1, 1], [0, 1]], "quads": [[0, 1, 2, 3]]}),
     "patch": (lambda s, t: labkit.patch(*SQUARE, s, t), {"s": [0.0, 0.5, 1.0], "t": [0.0, 1.0]}),
-    "convergence_table": (labkit.convergence_table, {"ndata": [5, 11], "interval": [0.0, 5.0], "ntest": 101}),
+    "convergence_table": (lambda **kw: labkit.convergence_table("plin", **kw),
+                          {"ndata": [5, 11], "interval": [0.0, 5.0], "ntest": 101}),
     "bilinear_convergence": (labkit.bilinear_convergence, {"ndata": [5, 9], "square": [0.0, 5.0], "ntest": 11}),
 }
 CASES = [(name, arg, bad) for name, (_, kwargs) in CALLS.items() for arg in kwargs for bad in BAD
