@@ -252,6 +252,7 @@ def test_the_editor_refuses_what_it_cannot_edit():
     (plots.mesh_explorer, "dxds_BC", 0.6),
     (plots.mesh_explorer, "twist", 1.2),
     (plots.limacon_explorer, "intervals", 9),
+    (plots.bilinear_explorer, "ndata", 5),
 ])
 def test_a_blitted_picture_is_the_full_drawing_pixel_for_pixel(factory, control, value):
     import io

@@ -215,4 +215,4 @@ def bilinear_explorer():
     """06: the bilinear interpolation error over the square for an ndata x ndata grid."""
     figure, ax = new_figure((5.5, 4.5))
     view = BilinearErrorView(ax, ntest=161)
-    return Explorer(figure, view.update, {"ndata": _slider(int, 11, 2, 41, description="ndata")})
+    return Explorer(figure, view.update, {"ndata": _slider(int, 11, 2, 41, description="ndata")}, view=view)

@@ -74,9 +74,11 @@ class LimaconView:
             _fit(self.ax, exact[0], exact[1])
             self._r0 = r0
         self.curve.set_data(xval, yval)
-        self.curve.set_label(METHOD_TITLES[method].lower())
+        label = METHOD_TITLES[method].lower()
+        if label != self.curve.get_label() or self.ax.get_legend() is None:
+            self.curve.set_label(label)
+            self.ax.legend(loc="upper right", fontsize="small")
         self.data.set_data(xdata, ydata)
-        self.ax.legend(loc="upper right", fontsize="small")
         self.ax.set_title(f"limaçon r = {r0:g} + cos t, {nintervals} intervals")
         return self.ax
 
@@ -97,7 +99,7 @@ class ErrorCurvesView:
         self.f, (self.a, self.b) = f, interval
         self.x = np.linspace(self.a, self.b, 1001)
         self.exact = f(self.x)[0]
-        self._errors = {}
+        self._errors, self._shown = {}, None
         self.lines = {m: self.ax.plot(self.x, 0 * self.x, label=METHOD_TITLES[m])[0] for m in methods}
         self.points, = self.ax.plot([], [], "k.", ms=4, label="data points")
         self.ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
@@ -124,7 +126,9 @@ class ErrorCurvesView:
         self.ax.set_xlim(self.a - 0.02 * (self.b - self.a), self.b + 0.02 * (self.b - self.a))
         self.ax.set_ylim(low - pad, high + pad)
         shown = [line for method, line in self.lines.items() if method in methods] + [self.points]
-        self.ax.legend(handles=shown, fontsize="small")
+        if shown != self._shown:  # a new legend only when the set of curves changes
+            self.ax.legend(handles=shown, fontsize="small")
+            self._shown = shown
         self.ax.set_title(f"Interpolation error, {ndata} equally spaced points")
         return self.ax
 
@@ -165,7 +169,7 @@ class BilinearErrorView:
         extent = (self.a - step / 2, self.b + step / 2, self.a - step / 2, self.b + step / 2)
         self.image = self.ax.imshow(0 * self.exact.T, origin="lower", extent=extent, cmap="coolwarm",
                                     interpolation="nearest")
-        self.ax.figure.colorbar(self.image, ax=self.ax, label="I(x, y) - f(x, y)")
+        self.colorbar = self.ax.figure.colorbar(self.image, ax=self.ax, label="I(x, y) - f(x, y)")
         self.ax.set_aspect("equal")
         _label(self.ax, "x", "y", "")
 
@@ -177,6 +181,13 @@ class BilinearErrorView:
         self.image.set_clim(-largest or -1e-16, largest or 1e-16)
         self.ax.set_title(f"Bilinear error, {ndata} x {ndata} data, max {largest:.1e}")
         return self.ax
+
+    def dynamic(self):
+        """The map, the title and the colour bar (its scale follows the error): see PatchView.dynamic."""
+        return [self.image, self.ax.title, self.colorbar.ax]
+
+    def static_key(self):
+        return self.ax.get_xlim(), self.ax.get_ylim()
 
 
 class PatchView:
