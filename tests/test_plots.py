@@ -121,6 +121,14 @@ def test_error_curves_view_hides_unselected_methods_and_rescales():
     low, high = view.ax.get_ylim()
     error = view.lines["natural"].get_ydata()
     assert low <= error.min() and error.max() <= high and high - low < 2 * np.ptp(error)
+    view.update(["natural"], 10)  # a small change keeps the axis still, the curve still inside
+    assert view.ax.get_ylim() == (low, high)
+    error = view.lines["natural"].get_ydata()
+    assert low <= error.min() and error.max() <= high
+    view.update(["natural"], 41)  # a curve four times smaller: the axis follows it
+    error = view.lines["natural"].get_ydata()
+    low, high = view.ax.get_ylim()
+    assert high - low < 2 * np.ptp(error)
 
 
 def test_patch_view_moves_the_same_collection_and_recolours_folds():
@@ -253,6 +261,9 @@ def test_the_editor_refuses_what_it_cannot_edit():
     (plots.mesh_explorer, "twist", 1.2),
     (plots.limacon_explorer, "intervals", 9),
     (plots.bilinear_explorer, "ndata", 5),
+    (plots.spline_explorer, "ndata", 12),
+    (plots.convergence_explorer, "ndata", 12),
+    (plots.pchip_explorer, "y1", 1.05),
 ])
 def test_a_blitted_picture_is_the_full_drawing_pixel_for_pixel(factory, control, value):
     import io

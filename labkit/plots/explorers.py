@@ -159,7 +159,7 @@ def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notak
 
     figure, ax = new_figure((6, 4))
     view = ErrorCurvesView(methods, ax)
-    return Explorer(figure, lambda method, ndata: view.update([method], ndata), {
+    return Explorer(figure, lambda method, ndata: view.update([method], ndata), view=view, controls={
         "method": widgets.Dropdown(options=[(METHOD_TITLES[m], m) for m in methods],
                                    value="natural" if "natural" in methods else methods[0], description="method"),
         "ndata": _slider(int, 11, 3, 81, description="ndata"),
@@ -198,14 +198,14 @@ def spline_explorer():
     controls = {"ndata": _slider(int, 11, 4, 41, description="ndata")}
     for method, label in zip(methods, ("complete", "natural", "not-a-knot")):
         controls[method] = widgets.Checkbox(value=True, description=label)
-    return Explorer(figure, update, controls)
+    return Explorer(figure, update, controls, view=view)
 
 
 def pchip_explorer(xdata=(0.0, 1.0, 2.0, 3.0, 4.0)):
     """05: move two data values and watch the spline overshoot while pchip keeps the shape."""
     figure, ax = new_figure((6, 4))
     view = SplinePchipView(np.asarray(xdata, dtype=float), ax)
-    return Explorer(figure, lambda y1, y3: view.update([0.0, y1, 2.0, y3, 2.0]), {
+    return Explorer(figure, lambda y1, y3: view.update([0.0, y1, 2.0, y3, 2.0]), view=view, controls={
         "y1": _slider(float, 1.0, 0.0, 2.5, 0.05, "y at t=1"),
         "y3": _slider(float, 2.0, 0.5, 3.0, 0.05, "y at t=3"),
     })

@@ -122,15 +122,28 @@ class ErrorCurvesView:
                 line.set_ydata(error)
                 low, high = min(low, error.min()), max(high, error.max())
         self.points.set_data(np.linspace(self.a, self.b, ndata), np.zeros(ndata))
-        pad = 0.05 * (high - low) or 1e-16
         self.ax.set_xlim(self.a - 0.02 * (self.b - self.a), self.b + 0.02 * (self.b - self.a))
-        self.ax.set_ylim(low - pad, high + pad)
+        # the y-axis keeps its limits while the curves fit and fill a quarter of them: a small move
+        # of a slider then leaves the axis still (and only the curves are redrawn)
+        bottom, top = self.ax.get_ylim()
+        span = high - low
+        if low < bottom or high > top or top - bottom > 4 * span or self._shown is None:
+            pad = 0.05 * span or 1e-16
+            self.ax.set_ylim(low - pad, high + pad)
         shown = [line for method, line in self.lines.items() if method in methods] + [self.points]
         if shown != self._shown:  # a new legend only when the set of curves changes
             self.ax.legend(handles=shown, fontsize="small")
             self._shown = shown
         self.ax.set_title(f"Interpolation error, {ndata} equally spaced points")
         return self.ax
+
+
+    def dynamic(self):
+        """The curves, the data points and the title: see PatchView.dynamic."""
+        return [*self.lines.values(), self.points, self.ax.title]
+
+    def static_key(self):
+        return self.ax.get_xlim(), self.ax.get_ylim(), tuple(self._shown or ())
 
 
 class SplinePchipView:
@@ -143,6 +156,7 @@ class SplinePchipView:
         self.spline, = self.ax.plot(self.xv, 0 * self.xv, label="not-a-knot spline")
         self.pchip, = self.ax.plot(self.xv, 0 * self.xv, label="pchip")
         self.data, = self.ax.plot(self.xdata, 0 * self.xdata, "o", mfc="none", color="k", label="data")
+        self._fitted = False
         self.ax.legend(fontsize="small")
         _label(self.ax, "time", "temperature", "Spline overshoots, pchip keeps the data's shape")
 
@@ -152,8 +166,20 @@ class SplinePchipView:
         self.spline.set_ydata(curve)
         self.pchip.set_ydata(pchip(self.xdata, ydata, self.xv))
         self.data.set_ydata(ydata)
-        _fit(self.ax, self.xv, np.concatenate((curve, ydata)))
+        values = np.concatenate((curve, ydata))
+        low, high = values.min(), values.max()
+        bottom, top = self.ax.get_ylim()
+        if not self._fitted or low < bottom or high > top or top - bottom > 4 * (high - low):
+            _fit(self.ax, self.xv, values)  # otherwise the axes stay still while the curves fit
+            self._fitted = True
         return self.ax
+
+    def dynamic(self):
+        """The two curves and the data: see PatchView.dynamic."""
+        return [self.spline, self.pchip, self.data]
+
+    def static_key(self):
+        return self.ax.get_xlim(), self.ax.get_ylim()
 
 
 class BilinearErrorView:
