@@ -184,8 +184,9 @@ def test_no_hostile_submission_gets_a_point(attacked):
 
 
 def test_the_class_is_graded_within_its_limits(attacked):
-    # 60 s total per notebook, two at a time: far less than that in all
-    assert attacked["elapsed"] < 30 * attacked["count"], attacked["elapsed"]
+    # every notebook is bounded by its 60 s total limit; stopped, crashed and flooding ones end
+    # far sooner, so the class of 20, two at a time, takes well under two minutes
+    assert attacked["elapsed"] < 120, attacked["elapsed"]
 
 
 def test_nothing_outside_the_sandbox_changed(attacked):
