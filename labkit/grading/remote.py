@@ -160,8 +160,6 @@ def _value(answer):
         refused = error.get("refused")
         if kind == "NotImplementedError" and not refused:
             raise NotImplementedError(message)
-        if kind == "Timeout":
-            raise StudentError(kind, message)
         raise StudentError(kind, message, str(refused)[:200] if refused else None)
     try:
         return protocol.decode(answer.get("value"))

@@ -90,12 +90,13 @@ def _read_only_paths():
     return sorted(p for p in paths if not any(q != p and q in p.parents for q in paths))
 
 
-def _parents(path):
-    """--dir for every folder above `path`, world-readable (bwrap would make them 0700)."""
+def _parents(path, made):
+    """--dir for every folder above `path` not made yet, world-readable (bwrap would make them 0700)."""
     args = []
     for parent in reversed(Path(path).parents):
-        if str(parent) != "/":
+        if str(parent) != "/" and parent not in made:
             args += ["--perms", "0755", "--dir", str(parent)]
+            made.add(parent)
     return args
 
 
@@ -117,12 +118,8 @@ def command(workdir, argv, uid, limits=Limits()):
             args += ["--ro-bind", str(top), str(top)]
     made = {Path("/tmp")}
     for path in _read_only_paths():
-        for parent in reversed(path.parents):
-            if str(parent) != "/" and parent not in made:
-                args += ["--perms", "0755", "--dir", str(parent)]
-                made.add(parent)
-        args += ["--ro-bind", str(path), str(path)]
-    args += [*_parents(HOME), "--bind", str(workdir), HOME, "--chdir", HOME]
+        args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
+    args += [*_parents(HOME, made), "--bind", str(workdir), HOME, "--chdir", HOME]
     environment = {"HOME": HOME, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin", "LANG": "C.UTF-8",
                    "MPLBACKEND": "Agg", "MPLCONFIGDIR": f"{HOME}/.matplotlib", "PYTHONDONTWRITEBYTECODE": "1",
                    "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}

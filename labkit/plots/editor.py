@@ -18,7 +18,7 @@ import pathlib
 import numpy as np
 
 from ..patches import Corner
-from .explorers import Painter, freeze_layout, new_figure, png
+from .explorers import Painter, freeze_layout, new_figure, png, widget_with_picture
 from .figures import PatchView
 
 NAMES = "ABCD"
@@ -174,13 +174,7 @@ class Editor:
                 "x0": float(x0), "x1": float(x1), "y0": float(y0), "y1": float(y1)}
 
     def _repr_mimebundle_(self, **kwargs):
-        import base64
-
-        bundle = self.widget._repr_mimebundle_(**kwargs)
-        data = bundle[0] if isinstance(bundle, tuple) else bundle
-        data["image/png"] = base64.b64encode(self.widget_.image).decode("ascii")
-        data["text/plain"] = self.widget_.readout
-        return bundle
+        return widget_with_picture(self.widget, self.widget_.image, self.widget_.readout, **kwargs)
 
 
 def _size_slider(elements):

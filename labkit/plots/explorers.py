@@ -121,11 +121,18 @@ class Explorer:
         return png(self.figure, self.painter)
 
     def _repr_mimebundle_(self, **kwargs):
-        bundle = self.widget._repr_mimebundle_(**kwargs)
-        data = bundle[0] if isinstance(bundle, tuple) else bundle
-        data["image/png"] = base64.b64encode(self.png()).decode("ascii")
-        data["text/plain"] = f"<{type(self).__name__}: {', '.join(self.controls)}>"
-        return bundle
+        return widget_with_picture(self.widget, self.png(), f"<{type(self).__name__}: {', '.join(self.controls)}>",
+                                   **kwargs)
+
+
+def widget_with_picture(widget, picture, text, **kwargs):
+    """A widget's output bundle that also carries a PNG: front ends with widgets show the widget,
+    static views (nbconvert, GitHub, nbviewer, nbval's saved outputs) the picture."""
+    bundle = widget._repr_mimebundle_(**kwargs)
+    data = bundle[0] if isinstance(bundle, tuple) else bundle
+    data["image/png"] = base64.b64encode(picture).decode("ascii")
+    data["text/plain"] = text
+    return bundle
 
 
 def _slider(kind, value, low, high, step=None, description=""):
