@@ -5,7 +5,7 @@ Everything a notebook needs is importable from here, e.g.
 """
 from . import check
 from .bilinear import eval_pbilin
-from .convergence import ConvergenceTable, bilinear_convergence, convergence_table
+from .convergence import ConvergenceTable, bilinear_convergence, convergence_table, ratio_table
 from .functions import limacon, runge, runge2d
 from .mesh import QuadMesh, quad_mesh
 from .monotone import pchip, pchip_slopes
@@ -32,6 +32,7 @@ __all__ = [
     "ncspline",
     "pchip",
     "pchip_slopes",
+    "ratio_table",
     "runge",
     "runge2d",
     "spline",

@@ -13,13 +13,16 @@ functions through a proxy into a sandbox. The checks live in
 :mod:`labkit.checks`, one module per topic; this module gathers the names
 the notebooks use.
 """
-from .checks.bilinear import eval_pbilin, runge2d
+from .checks.bilinear import eval_pbilin, phi_table, runge2d
+from .checks.drivers import driver, rate, table
 from .checks.exercises import EXERCISES, NAMES, POINTS, Exercise, grade
-from .checks.hermite import eval_pherm, runge, test_pherm_interpolate
-from .checks.patches import circle_corners, coons, graded_corners, straight_corners, two_patches
+from .checks.hermite import eval_pherm, limacon_derivatives, runge
+from .checks.patches import circle_corners, combined_mesh, coons, graded_corners, straight_corners, two_patches
+from .checks.plotted import boiling_plot, limacon_plot
 from .checks.result import TOLERANCE, CheckResult
 from .checks.splines import _reference_complete_system, ccspline, ncspline
 
-__all__ = ["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "ccspline", "circle_corners",
-           "coons", "eval_pbilin", "eval_pherm", "grade", "graded_corners", "ncspline", "runge", "runge2d",
-           "straight_corners", "test_pherm_interpolate", "two_patches", "_reference_complete_system"]
+__all__ = ["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "boiling_plot", "ccspline",
+           "circle_corners", "combined_mesh", "coons", "driver", "eval_pbilin", "eval_pherm", "grade",
+           "graded_corners", "limacon_derivatives", "limacon_plot", "ncspline", "phi_table", "rate", "runge",
+           "runge2d", "straight_corners", "table", "two_patches", "_reference_complete_system"]

@@ -4,6 +4,7 @@
 ``labkit release [DIR] --out DIR``         write the student version
 ``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
 ``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
+``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
 """
 import argparse
 import sys
@@ -36,8 +37,10 @@ def _release(args):
 
 
 def _summary(grades, out, start, what):
+    from .grading.rubric import points_text
+
     for g in grades:
-        print(f"{g.name:<30} {g.total:4d}")
+        print(f"{g.name:<30} {points_text(g.total):>6}")
     print(f"{what} {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
           f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/")
 
@@ -46,11 +49,14 @@ def _grade(args):
     from .grading import grade, merge
     from .grading.sandbox import Limits
 
+    from .grading.rubric import load
+
     start = time.perf_counter()
+    rubric = load(args.rubric)
     if args.merge:
         if args.submissions:
             raise ValueError("--merge takes output folders of earlier runs, not submissions; give one or the other.")
-        _summary(merge(args.merge, args.out), args.out, start, "merged")
+        _summary(merge(args.merge, args.out, rubric), args.out, start, "merged")
         return 0
     if not args.submissions:
         raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
@@ -60,7 +66,7 @@ def _grade(args):
     limits = Limits(memory=args.memory * 1024**2, cpu_seconds=args.total_timeout + 30)
     grades = grade(args.submissions, args.out, jobs=args.jobs, cell_timeout=args.cell_timeout,
                    total_timeout=args.total_timeout, progress=not args.quiet, seed=args.seed,
-                   sandboxed=not args.no_sandbox, limits=limits)
+                   sandboxed=not args.no_sandbox, limits=limits, rubric=rubric)
     _summary(grades, args.out, start, "graded")
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} "
           f"(repeat the run with --seed)")
@@ -107,9 +113,28 @@ def build_parser():
     grd.add_argument("--seed", type=int, help="seed of the random test data (default: a fresh one, saved in seed.txt)")
     grd.add_argument("--no-sandbox", action="store_true",
                      help="run student code UNCONFINED, with your permissions (only for code you trust)")
+    grd.add_argument("--rubric", type=Path,
+                     help="TOML rubric: points, required exercises, branches, extra credit "
+                          "(default: the lab's; `labkit rubric` prints it)")
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)
+
+    rub = commands.add_parser("rubric", help="print the lab's rubric (TOML) to copy and edit",
+                              description="Print the lab's own rubric. Save it, edit it and pass it to "
+                                          "`labkit grade --rubric FILE`; `--check FILE` validates an edited one.")
+    rub.add_argument("--check", type=Path, metavar="FILE", help="validate this rubric and summarise it instead")
+    rub.set_defaults(handler=_rubric)
     return parser
+
+
+def _rubric(args):
+    from .grading.rubric import DEFAULT, load
+
+    if args.check:
+        print(load(args.check).describe())
+    else:
+        print(DEFAULT.read_text(encoding="utf-8"), end="")
+    return 0
 
 
 def main(argv=None):

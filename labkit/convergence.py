@@ -67,15 +67,56 @@ class ConvergenceTable:
         return int(np.rint(np.mean(self.rates[-3:])))
 
     def __str__(self):
-        lines = [self.title]
-        for i, (n, err) in enumerate(zip(self.ndata, self.errors)):
-            row = f"ndata ={n:3d}  Err({n:3d}) = {err:10.3e}"
-            if i:
-                prev = self.ndata[i - 1]
-                row += f"  Err({prev:3d})/Err({n:3d}) = {self.ratios[i - 1]:8.3f}"
-            lines.append(row)
-        lines.append(f"Estimated order of convergence: {self.order}")
-        return "\n".join(lines)
+        return _rows(self.title, self.ndata, self.errors) + f"\nEstimated order of convergence: {self.order}"
+
+
+def _rows(title, ndata, errors):
+    lines = [title]
+    for i, (n, err) in enumerate(zip(ndata, errors)):
+        row = f"ndata ={n:3d}  Err({n:3d}) = {err:10.3e}"
+        if i:
+            row += f"  Err({ndata[i - 1]:3d})/Err({n:3d}) = {errors[i - 1] / err:8.3f}"
+        lines.append(row)
+    return "\n".join(lines)
+
+
+def ratio_table(title, ndata, errors):
+    """The lab's table layout for your own errors: each row's error and its ratio to the row above.
+
+    Unlike ``str(convergence_table(...))`` it does not state an order: reading
+    the order off the ratios is the exercise.
+
+    Parameters
+    ----------
+    title : str
+        First line, e.g. ``"Runge function, Piecewise Hermite Cubic"``.
+    ndata : sequence of int
+        Number of data points of each row.
+    errors : sequence of float
+        The error of each row, as your driver returns them.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from labkit import ratio_table
+    >>> print(ratio_table("halving", [3, 5, 9], [0.4, 0.1, 0.025]))
+    halving
+    ndata =  3  Err(  3) =  4.000e-01
+    ndata =  5  Err(  5) =  1.000e-01  Err(  3)/Err(  5) =    4.000
+    ndata =  9  Err(  9) =  2.500e-02  Err(  5)/Err(  9) =    4.000
+    """
+    sizes = _sizes(ndata)
+    values = as_float_array(errors, "errors")
+    if values.shape != sizes.shape:
+        raise ValueError(f"errors has {values.size} entries but ndata has {sizes.size}; give one error per row "
+                         "(e.g. [test_pherm_interpolate(n) for n in ndata]).")
+    if not np.all(np.isfinite(values)) or np.any(values <= 0):
+        raise ValueError("every error must be a positive finite number; a zero or NaN error means the driver "
+                         "measured at the wrong points or failed.")
+    return _rows(str(title), sizes, values)
 
 
 def convergence_table(method, ndata=DEFAULT_NDATA, f=runge, interval=(0.0, 5.0), ntest=4001):

@@ -94,8 +94,11 @@ def test_graded_corner_data(corners, passed):
 
 def test_grade_reports_missing_names_with_a_hint():
     verdict = check.grade(16, {"runge2d": labkit.runge2d})
-    assert verdict["points"] == 0 and verdict["defined"]
-    assert "eval_pbilin" in verdict["checks"][-1]["hint"]
+    assert verdict["defined"] and not verdict["passed"]
+    passed = [c["name"] for c in verdict["checks"] if c["passed"]]
+    assert passed == ["runge2d"] and verdict["points"] == 1 and verdict["fraction"] == 1 / 8
+    missing = next(c for c in verdict["checks"] if c["name"] == "eval_pbilin")
+    assert "run the cell that defines eval_pbilin" in missing["hint"]
 
 
 def _recording(calls):
@@ -118,7 +121,7 @@ def test_seeded_random_cases_are_fresh_per_seed_and_repeatable():
 @pytest.mark.parametrize("seed", [None, 7, 2**62])
 def test_reference_implementations_pass_with_any_seed(seed):
     assert check.runge(labkit.runge, seed=seed).passed
-    assert check.test_pherm_interpolate(lambda n, f: _table_error(n, f), seed=seed).passed
+    assert check.driver("pherm", _table_error, seed=seed).passed
     assert check.ccspline(labkit.ccspline, check._reference_complete_system, seed=seed).passed
     assert check.ncspline(labkit.ncspline, seed=seed).passed
     assert check.runge2d(labkit.runge2d, seed=seed).passed
@@ -126,10 +129,10 @@ def test_reference_implementations_pass_with_any_seed(seed):
     assert check.coons(lambda *args: tuple(labkit.patch(*args)), seed=seed).passed
 
 
-def _table_error(ndata, interpolate):
+def _table_error(ndata, f=labkit.runge, interpolate=labkit.eval_pherm):
     x, xtest = np.linspace(0, 5, ndata), np.linspace(0, 5, 4001)
-    y, yp = labkit.runge(x)
-    exact = labkit.runge(xtest)[0]
+    y, yp = f(x)
+    exact = f(xtest)[0]
     return np.max(np.abs(interpolate(x, y, yp, xtest) - exact)) / np.max(np.abs(exact))
 
 

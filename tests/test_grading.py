@@ -1,5 +1,6 @@
-"""Student release and grading: instructor = full marks, release = zero, planted bugs lose
-exactly their exercise with the matching hint, broken submissions never stop the run."""
+"""Student release and grading: instructor = full marks and all extra credit, release = zero,
+the lab's branch rubric, planted mistakes lose exactly their part with the matching hint,
+broken submissions never stop the run."""
 import csv
 import json
 import shutil
@@ -12,11 +13,14 @@ import nbformat
 import pytest
 
 from labkit import grading
-from labkit.check import EXERCISES, POINTS
+from labkit.check import EXERCISES
+from labkit.grading.rubric import default
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
-FULL = sum(POINTS.values())
+RUBRIC = default()
+FULL = RUBRIC.full_credit
+EVERYTHING = RUBRIC.maximum
 
 
 def test_strip_solutions_keeps_signature_indentation_and_drops_hidden_tests():
@@ -69,20 +73,36 @@ def test_required_student_code_sits_in_solution_regions_with_signatures_outside(
     sources = [c.source for p in sorted(NOTEBOOKS.glob("*.ipynb"))
                for c in nbformat.read(p, as_version=4).cells if c.cell_type == "code"]
     stripped = "\n".join(grading.strip_solutions(source) for source in sources)
-    for name in ("eval_pherm", "runge", "test_pherm_interpolate", "coons", "mirror", "two_patches",
-                 "complete_system", "ccspline", "ncspline", "eval_pbilin", "runge2d"):
+    for name in ("eval_pherm", "runge", "test_pherm_interpolate", "limacon_derivatives", "coons", "mirror",
+                 "two_patches", "complete_system", "ccspline", "ncspline", "test_ccspline_interpolate",
+                 "test_ncspline_interpolate", "test_spline_interpolate", "test_pchip_interpolate", "eval_pbilin",
+                 "runge2d", "test_pbilin_interpolate"):
         body = stripped.split(f"def {name}(", 1)[1].split("\ndef ", 1)[0]
         assert '"""' in body.split("# YOUR CODE HERE")[0], f"{name} keeps its docstring"
-        assert "raise NotImplementedError()" in body and "return" not in body, name
-    for data in ("graded =", "straight =", "circle_sides =", "A = Corner("):
-        assert data in "\n".join(sources) and data not in stripped
+        assert "raise NotImplementedError()" in body and "\n    return" not in body, name
+    data = ["graded =", "straight =", "circle_sides =", "A = Corner(", "region =", "phi_table =",
+            "xdata = r * np.cos(tdata)", "ax14.plot(", "ax4.plot("]
+    for key in ("pherm", "complete", "natural", "notaknot", "pchip", "bilinear"):
+        data += [f"errors_{key} =", f"rate_{key} ="]
+    for line in data:
+        assert line in "\n".join(sources) and line not in stripped, line
+    # every graded name has a hidden test that asserts its check
+    hidden = "\n".join(s.split("### BEGIN HIDDEN TESTS")[1] for s in sources if "### BEGIN HIDDEN TESTS" in s)
+    for exercise in EXERCISES.values():
+        for part in exercise.parts:
+            name = part.name.split(":")[0]
+            assert name in hidden, f"exercise {exercise.number}: no hidden test mentions {name}"
 
 
-def _plant(tmp_path, name, notebook, old, new):
-    """A submission folder: the instructor notebooks with one solution line changed."""
+def _plant(tmp_path, name, notebook, old, new, released=None, untouched=()):
+    """A submission folder: the instructor notebooks with one solution line changed
+    (and the notebooks in `untouched` as released, not done)."""
     folder = tmp_path / name
     folder.mkdir()
     for path in NOTEBOOKS.glob("*.ipynb"):
+        if path.name in untouched:
+            shutil.copy(released / path.name, folder / path.name)
+            continue
         nb = nbformat.read(path, as_version=4)
         if path.name == notebook:
             hits = [c for c in nb.cells if old in c.source]
@@ -90,6 +110,24 @@ def _plant(tmp_path, name, notebook, old, new):
             hits[0].source = hits[0].source.replace(old, new)
         nbformat.write(nb, folder / path.name)
     return folder
+
+
+# planted mistakes of the lab's student work: (name, notebook, old text, new text, exercise, part, hint)
+PLANTED = [
+    ("wrong_sign_dydt", "01_limacon.ipynb", "dydt = -np.sin(t) ** 2 + r * np.cos(t)",
+     "dydt = np.sin(t) ** 2 - r * np.cos(t)", 4, "limacon_derivatives", "dy/dt has the wrong sign"),
+    ("absolute_error", "04_splines.ipynb",
+     "labkit.eval_pherm(xdata, ydata, sprime, xtest))) / np.max(np.abs(exact))",
+     "labkit.eval_pherm(xdata, ydata, sprime, xtest)))", 11, "test_ccspline_interpolate",
+     "the error is absolute, not relative to max|f|"),
+    ("rate_eight", "04_splines.ipynb", "rate_complete = 4", "rate_complete = 8", 11, "rate_complete",
+     "take the ratios"),
+    ("data_joined", "05_monotone.ipynb", 'ax14.plot(xdata, ydata, "o", color="k"',
+     'ax14.plot(xdata, ydata, "o-", color="k"', 14, "ax14: the data", "linestyle 'none'"),
+    ("spline_20_points", "05_monotone.ipynb", "ax14.plot(xval, labkit.spline(xdata, ydata, xval)",
+     "ax14.plot(xval[::10], labkit.spline(xdata, ydata, xval[::10])", 14, "ax14: the not-a-knot spline",
+     "at least 100 points"),
+]
 
 
 def _broken(tmp_path, name, first_cell_source):
@@ -120,7 +158,14 @@ def graded(tmp_path_factory, released):
         "syntax_error": _broken(tmp, "syntax_error", "def broken(:\n    pass"),
         "prints_megabytes": _broken(tmp, "prints_megabytes", "for _ in range(50):\n    print('x' * 1_000_000)"),
         "deletes_files": _broken(tmp, "deletes_files", "import os\nfor f in os.listdir('.'):\n    os.remove(f)"),
+        # the lab's rubric: exercises 1-4 and one branch is full credit, the other branch extra
+        "spline_branch_only": _plant(tmp, "spline_branch_only", "01_limacon.ipynb", "nintervals = 20",
+                                     "nintervals = 20", released, ("03_meshes.ipynb", "06_bilinear.ipynb")),
+        "both_branches": _plant(tmp, "both_branches", "01_limacon.ipynb", "nintervals = 20", "nintervals = 20",
+                                released, ("06_bilinear.ipynb",)),
     }
+    for name, notebook, old, new, *_ in PLANTED:
+        subs[name] = _plant(tmp, name, notebook, old, new)
     not_json = tmp / "not_json.ipynb"
     not_json.write_text("{ this is not json")
     subs["not_json"] = not_json
@@ -129,9 +174,44 @@ def graded(tmp_path_factory, released):
     return {name: r for name, r in zip(subs, results)}, out, sentinel, subs
 
 
-def test_instructor_notebooks_score_full_marks(graded):
+def test_instructor_notebooks_score_full_marks_and_all_extra_credit(graded):
     results, *_ = graded
-    assert results["instructor"].total == FULL, results["instructor"].feedback()
+    grade = results["instructor"]
+    assert (FULL, EVERYTHING) == (100, 118)  # the lab: 10 points for the second branch, 8 for exercise 16
+    assert grade.total == EVERYTHING, grade.feedback()
+    assert all(verdict["passed"] for verdict in grade.results.values()) and set(grade.results) == set(EXERCISES)
+
+
+def test_spline_branch_alone_is_full_credit_without_extra(graded):
+    results, *_ = graded
+    score = results["spline_branch_only"].score
+    assert score.total == FULL and score.branch == "splines" and score.extra_total == 0, \
+        results["spline_branch_only"].feedback()
+    assert "Branch that counts: splines, 60 / 60" in results["spline_branch_only"].feedback()
+
+
+def test_the_second_branch_is_ten_points_of_extra_credit(graded):
+    results, *_ = graded
+    score = results["both_branches"].score
+    assert score.total == FULL + 10 and score.extra == {"exercise 16": 0, "branch splines": 10.0}, \
+        results["both_branches"].feedback()
+    assert "Extra credit, branch splines: 10" in results["both_branches"].feedback()
+
+
+@pytest.mark.parametrize("name, exercise, part, hint", [(p[0], p[4], p[5], p[6]) for p in PLANTED])
+def test_planted_mistake_loses_exactly_its_part_with_the_matching_hint(graded, name, exercise, part, hint):
+    results, *_ = graded
+    grade, instructor = results[name], results["instructor"]
+    failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
+    assert failed == [(exercise, part)], grade.feedback()
+    lost = RUBRIC.points[exercise] * next(p.weight for p in EXERCISES[exercise].parts if p.name == part) \
+        / EXERCISES[exercise].points
+    assert grade.points[exercise] == pytest.approx(RUBRIC.points[exercise] - lost, abs=0.01), grade.feedback()
+    assert grade.total < EVERYTHING
+    assert {n: p for n, p in grade.points.items() if n != exercise} == \
+        {n: p for n, p in instructor.points.items() if n != exercise}
+    section = grade.feedback().split(f"Exercise {exercise}:")[1].split("\nExercise ")[0]
+    assert hint in section, section
 
 
 def test_student_release_scores_zero_without_crashing(graded):
@@ -140,16 +220,20 @@ def test_student_release_scores_zero_without_crashing(graded):
     assert "not implemented yet" in results["student_release"].feedback()
 
 
-@pytest.mark.parametrize("name, exercise, hint", [
-    ("wrong_denominator", 2, "denominators"),
-    ("natural_rows", 12, "M1 = 0 and Mn = 0"),
-    ("missing_twist", 5, "ignores the twists"),
+@pytest.mark.parametrize("name, exercise, part, hint", [
+    ("wrong_denominator", 2, "eval_pherm", "denominators"),
+    ("natural_rows", 12, "ncspline", "M1 = 0 and Mn = 0"),
+    ("missing_twist", 5, "coons", "ignores the twists"),
 ])
-def test_planted_bug_loses_exactly_its_exercise_with_the_matching_hint(graded, name, exercise, hint):
+def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, name, exercise, part, hint):
     results, *_ = graded
     grade = results[name]
-    assert grade.points[exercise] == 0
-    assert grade.total == FULL - POINTS[exercise], grade.feedback()
+    # a wrong function does not cost the drivers, tables and rates built on it: the driver's check
+    # hands in labkit's function, the table follows the student's own driver, the rate their table
+    failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
+    assert failed == [(exercise, part)], grade.feedback()
+    assert {n: p for n, p in grade.points.items() if n != exercise} == \
+        {n: p for n, p in results["instructor"].points.items() if n != exercise}, grade.feedback()
     feedback = grade.feedback()
     section = feedback.split(f"Exercise {exercise}:")[1].split("\nExercise ")[0]
     assert hint in section
@@ -165,7 +249,7 @@ def test_planted_bug_loses_exactly_its_exercise_with_the_matching_hint(graded, n
 def test_broken_submissions_are_graded_as_far_as_they_get(graded, name, problem):
     results, *_ = graded
     grade = results[name]
-    assert grade.points[16] == POINTS[16], grade.feedback()  # the rest of the notebook still ran
+    assert grade.points[16] == RUBRIC.points[16], grade.feedback()  # the rest of the notebook still ran
     if problem:
         assert problem in grade.feedback()
 
@@ -198,10 +282,18 @@ def test_grades_csv_and_feedback_files(graded):
     results, out, _, subs = graded
     with open(out / "grades.csv", newline="") as handle:
         rows = list(csv.reader(handle))
-    assert rows[0] == ["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + ["total"]
+    assert rows[0] == ["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + [
+        "required", "branch", "branch points", "extra credit", "total", "full credit"]
     assert [row[0] for row in rows[1:]] == [results[name].name for name in subs]
+    column = {name: i for i, name in enumerate(rows[0])}
     for row in rows[1:]:
-        assert sum(int(v) for v in row[1:-1]) == int(row[-1])
+        value = {name: row[i] for name, i in column.items()}
+        assert float(value["required"]) == sum(float(value[f"exercise {n}"]) for n in (2, 3, 4))
+        assert float(value["total"]) == pytest.approx(
+            float(value["required"]) + float(value["branch points"]) + float(value["extra credit"]))
+        assert value["full credit"] == "100"
+    row = next(r for r in rows if r[0] == "spline_branch_only")
+    assert row[column["branch"]] == "splines" and row[column["total"]] == "100"
     assert len(list((out / "feedback").glob("*.txt"))) == len(subs)
 
 
@@ -255,9 +347,10 @@ def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
     with open(tmp / "merged" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}
     assert sorted(rows) == ["alice", "bob", "submission"]
-    assert rows["alice"][-1] == str(POINTS[16]) and rows["bob"][-1] == "0"
+    total = rows["submission"].index("total")
+    assert rows["alice"][total] == "8" and rows["bob"][total] == "0"
     for grade in graded_apart:
-        assert int(rows[grade.name][-1]) == grade.total
+        assert float(rows[grade.name][total]) == grade.total
         assert (tmp / "merged" / "feedback" / f"{grade.name}.txt").read_text() == grade.feedback()
     assert (tmp / "merged" / "seed.txt").read_text() == "4242\n"
 
@@ -272,6 +365,25 @@ def test_merge_refuses_a_submission_graded_twice_and_folders_without_results(two
     (tmp_path / "results" / "x.json").write_text('{"format": "something else"}')
     with pytest.raises(ValueError, match="is not a labkit grade result"):
         grading.merge([tmp_path], tmp_path / "m")
+
+
+def test_merge_scores_with_the_rubric_it_is_given(two_runs, tmp_path):
+    tmp, *_ = two_runs
+    rubric = tmp_path / "rubric.toml"
+    rubric.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n')
+    run = _cli("grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"),
+               "--rubric", str(rubric))
+    assert run.returncode == 0, run.stderr
+    with open(tmp_path / "m" / "grades.csv", newline="") as handle:
+        rows = {row[0]: row for row in csv.reader(handle)}
+    assert rows["submission"][1:] == ["exercise 16", "required", "branch", "branch points", "extra credit", "total",
+                                      "full credit"]
+    assert rows["alice"][1:] == ["20", "20", "", "0", "0", "20", "20"] and rows["bob"][-2] == "0"
+    assert "Rubric: bilinear only" in (tmp_path / "m" / "feedback" / "alice.txt").read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[points]\n17 = 5\n")
+    run = _cli("grade", "--merge", str(tmp / "job1"), "--out", str(tmp_path / "m2"), "--rubric", str(bad))
+    assert run.returncode == 2 and "exercise '17', which labkit does not grade" in run.stderr
 
 
 def test_the_same_seed_gives_the_same_feedback(two_runs):
@@ -291,7 +403,7 @@ def test_no_sandbox_warns_loudly_and_still_grades(tmp_path):
                "--quiet", "--seed", "5")
     assert run.returncode == 0, run.stderr
     assert "UNCONFINED" in run.stderr and "random test data from seed 5" in run.stdout
-    assert f"06_bilinear{' ' * 20}" in run.stdout and run.stdout.split("06_bilinear")[1].split()[0] == str(POINTS[16])
+    assert f"06_bilinear{' ' * 20}" in run.stdout and run.stdout.split("06_bilinear")[1].split()[0] == "8"
 
 
 def test_cli_grade_needs_submissions_or_merge(tmp_path):

@@ -76,3 +76,22 @@ def eval_pbilin(fn, seed=None):
                            "and that cell's corners in the basis functions.")
             return result
     return result
+
+
+def phi_table(table):
+    """Exercise 16(a): the table of phi_m(P_n), rows P_1..P_4 and columns phi_1..phi_4.
+
+    The reference is the definition: each phi_m evaluated at each corner of a
+    rectangle (any rectangle gives the same table).
+    """
+    result = CheckResult("phi_table")
+    x0, x1, y0, y1 = 1.0, 3.0, -1.0, 0.5
+    area = (x1 - x0) * (y1 - y0)
+    P = np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+    x, y = P[:, 0], P[:, 1]
+    expected = np.stack(((x1 - x) * (y1 - y), (x - x0) * (y1 - y), (x - x0) * (y - y0), (x1 - x) * (y - y0)),
+                        axis=1) / area  # expected[n, m] = phi_m(P_n)
+    if not result.step("a 4 x 4 table of phi_m(P_n)", close(table, expected), worst(table, expected)):
+        result.hint = ("evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
+                       "on the side x = x1, so each phi_m vanishes at three corners.")
+    return result

@@ -9,7 +9,7 @@ notebook in the grader (:mod:`labkit.grading.remote`).
 """
 from dataclasses import dataclass
 
-from . import bilinear, hermite, patches, splines
+from . import bilinear, drivers, hermite, patches, plotted, splines
 from .result import CheckResult
 
 # scipy's interpolants that would answer a 1-D interpolation exercise outright
@@ -22,13 +22,30 @@ _LABKIT_SPLINES = ("labkit.ccspline", "labkit.ncspline", "labkit.nakspline", "la
                    "labkit.pchip", "labkit.pchip_slopes", "labkit.convergence_table")
 
 
+_CONVERGENCE = ("labkit.convergence_table", "labkit.ConvergenceTable", "labkit.bilinear_convergence")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One graded piece of an exercise: a check of some of the notebook's names, and its weight.
+
+    ``run(ns, seed)`` returns one :class:`CheckResult`. The weights of an
+    exercise's parts are its points in the lab's rubric; a rubric that gives
+    the exercise other points scales them (:mod:`labkit.grading.rubric`).
+    """
+
+    name: str
+    weight: int
+    run: object
+
+
 @dataclass(frozen=True)
 class Exercise:
     """One graded exercise.
 
     ``names`` are what the student's notebook defines (any of them present
-    means the notebook is the exercise's own). ``run(ns, seed)`` returns the
-    check results. ``refused`` are reference implementations switched off
+    means the notebook is the exercise's own). ``parts`` are its checks with
+    their weights. ``refused`` are reference implementations switched off
     while the grader calls this exercise's functions (the lab asks students
     to write them); anything not listed, such as ``labkit.bracket``, stays
     available.
@@ -36,39 +53,91 @@ class Exercise:
 
     number: int
     names: tuple
-    run: object
-    points: int = 10
+    parts: tuple
     refused: tuple = ()
+
+    @property
+    def points(self):
+        return sum(part.weight for part in self.parts)
+
+
+def _driver_parts(key, driver_weight, table_weight=1, rate_weight=1):
+    """The three parts of a convergence experiment: driver, table, rate answer."""
+    method = drivers.METHODS[key]
+    return (Part(method.driver, driver_weight, lambda ns, seed: drivers.driver(key, ns[method.driver], seed)),
+            Part(method.table, table_weight, lambda ns, seed: drivers.table(key, ns[method.table], ns[method.driver])),
+            Part(method.rate, rate_weight, lambda ns, seed: drivers.rate(key, ns[method.rate], ns.get(method.table))))
+
+
+def _experiment_names(key):
+    method = drivers.METHODS[key]
+    return (method.driver, method.table, method.rate)
+
+
+def _limacon_data(ns):
+    """The notebook's own tdata, xdata, ydata, xpdata, ypdata, or None."""
+    values = [ns.get(name) for name in ("tdata", "xdata", "ydata", "xpdata", "ypdata")]
+    return None if any(v is None for v in values) else values
+
+
+def _boiling_part(index):
+    return lambda ns, seed: plotted.boiling_plot(ns["ax14"])[index]
 
 
 EXERCISES = {e.number: e for e in (
-    Exercise(2, ("eval_pherm",), lambda ns, seed: [hermite.eval_pherm(ns["eval_pherm"], seed=seed)],
+    Exercise(2, ("eval_pherm",), (Part("eval_pherm", 10, lambda ns, seed: hermite.eval_pherm(ns["eval_pherm"], seed=seed)),),
              refused=("labkit.eval_pherm", "labkit.hermite_basis") + _SCIPY_1D),
-    Exercise(3, ("runge", "test_pherm_interpolate"),
-             lambda ns, seed: [hermite.runge(ns["runge"], seed=seed),
-                               hermite.test_pherm_interpolate(ns["test_pherm_interpolate"], seed=seed)],
-             refused=("labkit.runge", "labkit.convergence_table", "labkit.ConvergenceTable")),
-    Exercise(5, ("coons",), lambda ns, seed: [patches.coons(ns["coons"], seed=seed)],
+    Exercise(3, ("runge",) + _experiment_names("pherm"),
+             (Part("runge", 3, lambda ns, seed: hermite.runge(ns["runge"], seed=seed)),) + _driver_parts("pherm", 6, 3, 3),
+             refused=("labkit.runge",) + _CONVERGENCE),
+    Exercise(4, ("limacon_derivatives", "ax4"),
+             (Part("limacon_derivatives", 8,
+                   lambda ns, seed: hermite.limacon_derivatives(ns["limacon_derivatives"], seed=seed)),
+              Part("ax4", 7, lambda ns, seed: plotted.limacon_plot(ns["ax4"], _limacon_data(ns)))),
+             refused=("labkit.limacon",)),
+    Exercise(5, ("coons",), (Part("coons", 12, lambda ns, seed: patches.coons(ns["coons"], seed=seed)),),
              refused=("labkit.patch",)),
-    Exercise(6, ("graded",), lambda ns, seed: [patches.graded_corners(ns["graded"])]),
-    Exercise(7, ("straight",), lambda ns, seed: [patches.straight_corners(ns["straight"])]),
-    Exercise(8, ("circle_sides",), lambda ns, seed: [patches.circle_corners(ns["circle_sides"])]),
-    Exercise(9, ("two_patches", "mirror"),
-             lambda ns, seed: [patches.two_patches(ns["two_patches"], [ns["A9"], ns["B9"], ns["C9"], ns["D9"]])]),
+    Exercise(6, ("graded",), (Part("graded", 10, lambda ns, seed: patches.graded_corners(ns["graded"])),)),
+    Exercise(7, ("straight",), (Part("straight", 10, lambda ns, seed: patches.straight_corners(ns["straight"])),)),
+    Exercise(8, ("circle_sides",), (Part("circle_sides", 12, lambda ns, seed: patches.circle_corners(ns["circle_sides"])),)),
+    Exercise(9, ("two_patches", "mirror", "region"),
+             (Part("two_patches", 10, lambda ns, seed: patches.two_patches(ns["two_patches"], _corners9(ns))),
+              Part("region", 6, lambda ns, seed: patches.combined_mesh(ns["region"], _corners9(ns))))),
     Exercise(10, ("ccspline", "complete_system"),
-             lambda ns, seed: [splines.ccspline(ns["ccspline"], ns.get("complete_system"), seed=seed)],
+             (Part("ccspline", 15, lambda ns, seed: splines.ccspline(ns["ccspline"], ns.get("complete_system"), seed=seed)),),
              refused=_LABKIT_SPLINES + _SCIPY_1D),
-    Exercise(12, ("ncspline",), lambda ns, seed: [splines.ncspline(ns["ncspline"], seed=seed)],
+    Exercise(11, _experiment_names("complete"), _driver_parts("complete", 5, 2, 2), refused=_CONVERGENCE),
+    Exercise(12, ("ncspline",) + _experiment_names("natural"),
+             (Part("ncspline", 9, lambda ns, seed: splines.ncspline(ns["ncspline"], seed=seed)),)
+             + _driver_parts("natural", 2, 2, 2),
              refused=_LABKIT_SPLINES + _SCIPY_1D),
-    Exercise(16, ("runge2d", "eval_pbilin"),
-             lambda ns, seed: [bilinear.runge2d(ns["runge2d"], seed=seed), bilinear.eval_pbilin(ns["eval_pbilin"], seed=seed)],
-             refused=("labkit.eval_pbilin", "labkit.runge2d", "labkit.bilinear_convergence",
-                      "scipy.interpolate.RegularGridInterpolator", "scipy.interpolate.interpn",
-                      "scipy.interpolate.RectBivariateSpline", "scipy.interpolate.LinearNDInterpolator",
-                      "scipy.interpolate.griddata")),
+    Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2), refused=_CONVERGENCE),
+    Exercise(14, ("ax14",), tuple(Part(name, 2, _boiling_part(i))
+                                  for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline",
+                                                            "ax14: pchip"))),
+             refused=()),
+    Exercise(15, _experiment_names("pchip"), _driver_parts("pchip", 4, 2, 2), refused=_CONVERGENCE),
+    Exercise(16, ("phi_table", "runge2d", "eval_pbilin") + _experiment_names("bilinear"),
+             (Part("phi_table", 1, lambda ns, seed: bilinear.phi_table(ns["phi_table"])),
+              Part("runge2d", 1, lambda ns, seed: bilinear.runge2d(ns["runge2d"], seed=seed)),
+              Part("eval_pbilin", 3, lambda ns, seed: bilinear.eval_pbilin(ns["eval_pbilin"], seed=seed)))
+             + _driver_parts("bilinear", 1, 1, 1),
+             refused=("labkit.eval_pbilin", "labkit.runge2d", "scipy.interpolate.RegularGridInterpolator",
+                      "scipy.interpolate.interpn", "scipy.interpolate.RectBivariateSpline",
+                      "scipy.interpolate.LinearNDInterpolator", "scipy.interpolate.griddata") + _CONVERGENCE),
 )}
 POINTS = {number: exercise.points for number, exercise in EXERCISES.items()}
 NAMES = {number: list(exercise.names) for number, exercise in EXERCISES.items()}
+
+
+def _corners9(ns):
+    return [ns["A9"], ns["B9"], ns["C9"], ns["D9"]]
+
+
+def _missing(name):
+    result = CheckResult(name)
+    return result.fail(f"{name} is defined", "not defined when the notebook finished",
+                       f"run the cell that defines {name} (and keep its name); a cell that raised stops it.")
 
 
 def grade(number, namespace, seed=None):
@@ -77,19 +146,21 @@ def grade(number, namespace, seed=None):
     `namespace` is any mapping of names to the student's functions and data.
     ``defined`` says whether the notebook defines any of the exercise's names,
     so the grader can tell the exercise's own notebook from one that only
-    mentions it. `seed` draws the random test data afresh (see
+    mentions it. Each check in ``checks`` carries its part's ``weight``;
+    ``fraction`` is the share of the weight that passed and ``points`` the
+    weights that passed. `seed` draws the random test data afresh (see
     :func:`labkit.checks.result.case_rng`).
     """
     exercise = EXERCISES[number]
     defined = any(name in namespace for name in exercise.names)
-    try:
-        results = exercise.run(namespace, seed)
-    except KeyError as exc:
-        name = str(exc).strip("'\"")
-        missing = CheckResult(name)
-        missing.fail(f"{name} is defined", "not defined when the notebook finished",
-                     f"run the cell that defines {name} (and keep its name); a cell that raised stops it.")
-        results = [missing]
-    passed = all(r.passed for r in results)
-    return {"exercise": number, "passed": passed, "points": exercise.points if passed else 0,
-            "defined": defined, "checks": [r.as_dict() for r in results]}
+    checks = []
+    for part in exercise.parts:
+        try:
+            result = part.run(namespace, seed)
+        except KeyError as exc:
+            result = _missing(str(exc).strip("'\""))
+            result.name = part.name
+        checks.append({**result.as_dict(), "weight": part.weight})
+    points = sum(check["weight"] for check in checks if check["passed"])
+    return {"exercise": number, "passed": points == exercise.points, "points": points,
+            "fraction": points / exercise.points, "defined": defined, "checks": checks}

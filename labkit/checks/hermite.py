@@ -1,4 +1,6 @@
-"""Checks for exercises 2 and 3: the piecewise cubic Hermite interpolant, runge, its table.
+"""Checks for exercises 2 to 4: the piecewise cubic Hermite interpolant, runge, the limaçon's slopes.
+
+Exercise 3's driver, table and rate are checked in :mod:`labkit.checks.drivers`.
 
 The maths is derived in ``notebooks/02_convergence.ipynb``. References are
 labkit's :func:`labkit.eval_pherm` and :func:`labkit.hermite_basis`, and the
@@ -141,26 +143,39 @@ def runge(fn, seed=None):
     return result
 
 
-def test_pherm_interpolate(fn, seed=None):
-    """Check the driver ``test_pherm_interpolate(ndata, interpolate) -> relative max error``.
+# -- Exercise 4 ---------------------------------------------------------------
 
-    The driver is run with labkit's ``eval_pherm`` as `interpolate`, so a
-    mistake in the student's interpolant does not count against the driver.
-    """
-    result = CheckResult("test_pherm_interpolate")
-    fresh = () if seed is None else (int(case_rng(seed, 4).integers(6, 60)),)  # the grader's extra size
-    for ndata in (5, 11, 21) + fresh:
-        ok, err = call(result, f"ndata = {ndata}", fn, ndata, piecewise.eval_pherm)
+def _sign_slip(got, want):
+    """'has the wrong sign' if got == -want (and want is not zero), else ''."""
+    try:
+        got = np.asarray(got, dtype=float)
+    except (TypeError, ValueError):
+        return ""
+    if got.shape == want.shape and np.any(np.abs(want) > 1e-6) and np.allclose(got, -want, atol=1e-9):
+        return "has the wrong sign"
+    return ""
+
+
+def limacon_derivatives(fn, seed=None):
+    """Check ``limacon_derivatives(t, r0) -> (dxdt, dydt)`` of x = r cos t, y = r sin t, r = r0 + cos t."""
+    result = CheckResult("limacon_derivatives")
+    cases = [(np.linspace(0, 2 * np.pi, 21), 1.15)]
+    rng = case_rng(seed, 4)
+    cases.append((rng.uniform(-7.0, 7.0, 15), float(rng.uniform(0.3, 2.0)) if seed is not None else 0.5))
+    for t, r0 in cases:
+        label = f"{t.size} values of t, r0 = {r0:g}"
+        ok, out = call(result, label, fn, t, r0)
         if not ok:
             return result
-        x = np.linspace(0.0, 5.0, ndata)
-        xtest = np.linspace(0.0, 5.0, 4001)
-        y, yp = functions.runge(x)
-        exact = functions.runge(xtest)[0]
-        expected = np.max(np.abs(piecewise.eval_pherm(x, y, yp, xtest) - exact)) / np.max(np.abs(exact))
-        if not result.step(f"Err({ndata}) on [0, 5] with 4001 test points", close(err, expected, 1e-6),
-                           "" if close(err, expected, 1e-6) else f"got {shown(err)}, expected {expected:.6e}"):
-            result.hint = ("the error is max|f - p| / max|f| over 4001 equally spaced points of [0, 5], "
-                           "with ndata equally spaced data points from runge (values and derivatives).")
-            return result
+        if not (isinstance(out, tuple) and len(out) == 2):
+            return result.fail(label, f"got {shown(out)}", "return both derivatives: `return dxdt, dydt`.")
+        _, _, dxdt, dydt = functions.limacon(t, r0=r0)
+        for name, got, want, formula in (("dx/dt", out[0], dxdt, "-sin t cos t - r sin t"),
+                                         ("dy/dt", out[1], dydt, "-sin^2 t + r cos t")):
+            if not result.step(f"{label}: {name} = {formula}", close(got, want), worst(got, want)):
+                slip = _sign_slip(got, want)
+                result.hint = (f"{name} {slip}: differentiate with the product rule, r' = -sin t."
+                               if slip else f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "
+                               "with the product rule, using dr/dt = -sin t; compare with a centred difference.")
+                return result
     return result

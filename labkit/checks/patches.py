@@ -7,6 +7,7 @@ map of a straight quadrilateral, quarter circles, a conforming join).
 import numpy as np
 
 from .. import patches
+from ..mesh import QuadMesh, quad_mesh
 from .result import CheckResult, call, case_rng, close, worst
 
 def _identity_corners():
@@ -152,4 +153,51 @@ def two_patches(fn, corners):
         if not result.step(f"{label}: every element positively oriented", merged.quality().min() > 0):
             result.hint = "a folded element means a corner derivative of abcd points the wrong way."
             return result
+    return result
+
+
+def _boundary_edges(mesh):
+    """How many element edges belong to one element only (a crack between patches adds to them)."""
+    quads = np.asarray(mesh.quads)
+    edges = np.sort(np.stack((quads, np.roll(quads, -1, axis=1)), axis=-1).reshape(-1, 2), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return int(np.sum(counts == 1))
+
+
+def combined_mesh(region, corners):
+    """Exercise 9(c): ``region`` is one conforming mesh of the two patches, judged from its data.
+
+    The reference is built from labkit's patch with the lab's corners: the
+    same nodes (in any order), the same number of elements, no crack along
+    the shared edge (no more boundary edges than the reference) and no folded
+    element.
+    """
+    result = CheckResult("region")
+    if not isinstance(region, QuadMesh):
+        return result.fail("region is a QuadMesh", f"got {getattr(region, 'description', type(region).__name__)}",
+                           "join the two patch meshes with +: region = first + second.")
+    A, B, C, D = corners
+    first = quad_mesh(*patches.patch(A, B, C, D, np.linspace(0, 1, 20), np.linspace(0, 1, 30)))
+    mirrored = [patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]) for c in (A, D, C, B)]
+    second = quad_mesh(*patches.patch(*mirrored, np.linspace(0, 1, 30), np.linspace(0, 1, 20)))
+    reference = first + second
+    if not result.step(f"{len(reference.points)} nodes and {len(reference.quads)} elements",
+                       len(region.points) == len(reference.points) and len(region.quads) == len(reference.quads),
+                       f"got {len(region.points)} nodes and {len(region.quads)} elements"):
+        result.hint = ("the shared edge's 30 nodes appear once in a conforming mesh: join the two meshes with "
+                       "+, which merges them (20 x 30 + 30 x 20 - 30 nodes).")
+        return result
+    order = np.lexsort(np.round(region.points, 9).T[::-1])
+    expected = np.lexsort(np.round(reference.points, 9).T[::-1])
+    if not result.step("the nodes are those of the two patches", close(region.points[order], reference.points[expected], 1e-7),
+                       worst(region.points[order], reference.points[expected])):
+        result.hint = "mesh ABCD with 20 x 30 points and abcd with 30 x 20, from the corners A9, B9, C9, D9."
+        return result
+    if not result.step("conforming: no crack along the shared edge",
+                       _boundary_edges(region) == _boundary_edges(reference),
+                       f"{_boundary_edges(region)} boundary edges, {_boundary_edges(reference)} expected"):
+        result.hint = "elements on both sides of the shared edge must use the same nodes: join the meshes with +."
+        return result
+    if not result.step("no folded element", region.quality().min() > 0, f"worst quality {region.quality().min():.2f}"):
+        result.hint = "a folded element means a corner derivative of abcd points the wrong way."
     return result

@@ -51,6 +51,17 @@ class CheckResult:
                 "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps]}
 
 
+class Checks(list):
+    """Several check results shown together, such as the parts of one plot."""
+
+    @property
+    def passed(self):
+        return bool(self) and all(result.passed for result in self)
+
+    def __repr__(self):
+        return "\n".join(map(repr, self))
+
+
 def case_rng(seed, default):
     """Random test data: fixed (``default``) in a notebook's self-check, fresh per grading run.
 

@@ -9,6 +9,7 @@ One module per concern:
 * :mod:`~labkit.grading.remote` - the grader's handle on a sandbox and its proxies;
 * :mod:`~labkit.grading.refusals` - reference implementations a graded function may not use;
 * :mod:`~labkit.grading.scoring` - grading one notebook and one submission;
+* :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
 * :mod:`~labkit.grading.batch` - grading a class in parallel;
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging.
 
@@ -17,7 +18,8 @@ Student code never runs in the grading process: see the README's "For instructor
 from .batch import grade
 from .release import release, release_notebook, strip_solutions
 from .report import SubmissionGrade, merge
+from .rubric import Rubric, load as load_rubric
 from .scoring import exercises_in, grade_notebook, grade_submission, submission_notebooks
 
-__all__ = ["SubmissionGrade", "exercises_in", "grade", "grade_notebook", "grade_submission", "merge", "release",
+__all__ = ["Rubric", "SubmissionGrade", "load_rubric", "exercises_in", "grade", "grade_notebook", "grade_submission", "merge", "release",
            "release_notebook", "strip_solutions", "submission_notebooks"]

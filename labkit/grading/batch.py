@@ -12,8 +12,8 @@ import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-from ..checks.exercises import EXERCISES
 from . import sandbox
+from .rubric import default as default_rubric
 from .report import SubmissionGrade, write_report
 from .scoring import grade_submission, submission_notebooks
 
@@ -33,12 +33,13 @@ def _progress(done, total, width=30):
 
 
 def grade(submissions, out_dir, jobs=2, cell_timeout=60, total_timeout=600, progress=True, seed=None,
-          sandboxed=True, limits=None):
+          sandboxed=True, limits=None, rubric=None):
     """Grade submissions in parallel; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
 
     `seed` fixes the random test data (a fresh one is drawn and written to
     ``seed.txt`` when it is None). `sandboxed=False` runs student code
-    unconfined, after a warning on stderr.
+    unconfined, after a warning on stderr. `rubric` turns the checks' results into
+    grades (:mod:`labkit.grading.rubric`; the lab's own when None).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:
@@ -61,15 +62,15 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=60, total_timeout=600, prog
     # spawn, not fork: a forked process would inherit the parent's threads and locks
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=max(1, jobs), mp_context=context) as pool:
-        futures = {pool.submit(grade_submission, p, cell_timeout, total_timeout, seed, sandboxed, limits): p
+        futures = {pool.submit(grade_submission, p, cell_timeout, total_timeout, seed, sandboxed, limits, rubric): p
                    for p in submissions}
         for done, future in enumerate(as_completed(futures), start=1):
             path = futures[future]
             try:
                 result = future.result()
             except Exception as exc:  # noqa: BLE001 - one broken submission must not stop the class
-                result = SubmissionGrade(path.stem if path.is_file() else path.name,
-                                         {n: 0 for n in sorted(EXERCISES)}, {}, [f"grading failed: {exc}"], seed)
+                result = SubmissionGrade(path.stem if path.is_file() else path.name, {}, [f"grading failed: {exc}"],
+                                         seed, rubric or default_rubric())
             grades[path] = result
             if progress:
                 _progress(done, len(submissions))

@@ -9,6 +9,10 @@ Both directions use one format, one JSON object per line:
 * a :class:`labkit.Corner` ``["corner", point, ds, dt, dsdt]`` and a
   :class:`labkit.QuadMesh` ``["mesh", points, quads]``, rebuilt (and
   validated) by their constructors;
+* a plot (a matplotlib Axes or Figure) ``["lines", [[x, y, marker, linestyle], ...]]``:
+  the data of its Line2D objects (:func:`labkit.checks.plotted.lines_of`),
+  rebuilt as :class:`labkit.checks.plotted.Line` records, so plots are judged
+  from their data on the grader's side;
 * towards the notebook only, a function of labkit's that the checks hand to
   student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``
   (:data:`PASSABLE`);
@@ -30,11 +34,18 @@ MAX_DEPTH = 12
 MAX_ELEMENTS = 20_000_000  # numbers in one message
 MAX_TEXT = 2_000
 MAX_LINE = 256 * 1024 * 1024  # bytes in one message
+MAX_LINES = 1_000  # Line2D objects of one plot
 
 # functions the checks may hand to student code, by the name both sides know
 PASSABLE = {
     "labkit.piecewise:eval_pherm",
+    "labkit.functions:runge",
     "labkit.functions:runge2d",
+    "labkit.splines:ccspline",
+    "labkit.splines:ncspline",
+    "labkit.bilinear:eval_pbilin",
+    "labkit.checks.drivers:scaled_runge",
+    "labkit.checks.drivers:scaled_runge2d",
     "labkit.checks.bilinear:one",
     "labkit.checks.bilinear:x_only",
     "labkit.checks.bilinear:y_only",
@@ -97,11 +108,33 @@ def encode(value, depth=0):
         return ["corner"] + [_array_tag(getattr(value, name)) for name in ("point", "ds", "dt", "dsdt")]
     if isinstance(value, QuadMesh):
         return ["mesh", _array_tag(value.points), _array_tag(value.quads)]
+    if _is_plot(value):
+        return _lines_tag(value)
     if callable(value) and f"{getattr(value, '__module__', '')}:{getattr(value, '__qualname__', '')}" in PASSABLE:
         return ["fn", f"{value.__module__}:{value.__qualname__}"]
     if type(value) in (tuple, list):
         return ["t" if type(value) is tuple else "l", [encode(item, depth + 1) for item in value[:100_000]]]
     return ["obj", f"a {type(value).__name__} object"]
+
+
+def _is_plot(value):
+    """A matplotlib Axes or Figure (matplotlib is only imported if the notebook did)."""
+    import sys
+
+    module = sys.modules.get("matplotlib.artist")
+    return module is not None and isinstance(value, module.Artist) and hasattr(value, "get_children") and (
+        hasattr(value, "get_lines") or isinstance(getattr(value, "axes", None), list))
+
+
+def _lines_tag(plot):
+    from ..checks.plotted import lines_of
+
+    try:
+        lines = lines_of(plot)
+    except Exception as exc:  # noqa: BLE001 - a hostile artist
+        return ["obj", f"a plot whose lines cannot be read ({type(exc).__name__})"]
+    return ["lines", [[_array_tag(line.x), _array_tag(line.y), line.marker[:20], line.linestyle[:20]]
+                      for line in lines[:MAX_LINES]]]
 
 
 def dumps(message):
@@ -161,6 +194,16 @@ def _array(tag):
     return arr
 
 
+def _line(item):
+    from ..checks.plotted import Line
+
+    if not (isinstance(item, list) and len(item) == 4 and all(isinstance(part, list) for part in item[:2])
+            and all(isinstance(part, str) for part in item[2:])):
+        raise ProtocolError("malformed plotted line")
+    x, y = _array(item[0]).ravel(), _array(item[1]).ravel()
+    return Line(x, y, item[2][:20], item[3][:20])
+
+
 def decode(tag, depth=0, functions=False):
     """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
     Corners, QuadMeshes, or a NotNumbers. ``functions=True`` (the notebook's side) also
@@ -201,6 +244,8 @@ def decode(tag, depth=0, functions=False):
             return QuadMesh(points, quads.astype(np.intp))
         except (ValueError, TypeError, ProtocolError) as exc:
             return NotNumbers(f"an invalid QuadMesh ({exc})")
+    if kind == "lines" and len(tag) == 2 and isinstance(tag[1], list) and len(tag[1]) <= MAX_LINES:
+        return [_line(item) for item in tag[1]]
     if kind == "obj" and len(tag) == 2 and isinstance(tag[1], str):
         return NotNumbers(tag[1])
     if kind == "fn" and functions and len(tag) == 2 and isinstance(tag[1], str):

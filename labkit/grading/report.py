@@ -2,7 +2,8 @@
 
 Layout of an output folder::
 
-    grades.csv               one row per submission, one column per exercise, and the total
+    grades.csv               one row per submission: points per exercise, the branch that
+                             counted, the extra credit, the total (under the rubric)
     feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
     results/<name>.json      the same grade as data: merged by ``labkit grade --merge``
     seed.txt                 the seed of the run's random test data
@@ -13,72 +14,117 @@ it comes from a student's process but plain numbers and short texts.
 import csv
 import json
 import re
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..checks.exercises import EXERCISES, POINTS
+from ..checks.exercises import EXERCISES
+from . import rubric as rubrics
+from .rubric import points_text
 
-FORMAT = "labkit-grade/1"
+FORMAT = "labkit-grade/2"
 
 
 @dataclass
 class SubmissionGrade:
-    """Points per exercise and the feedback for one submission."""
+    """The checks' results for one submission, and its grade under a rubric."""
 
     name: str
-    points: dict = field(default_factory=dict)
-    results: dict = field(default_factory=dict)  # exercise -> grade dict from labkit.check.grade
+    results: dict = field(default_factory=dict)  # exercise -> grade dict from labkit.checks.exercises.grade
     problems: list = field(default_factory=list)  # what went wrong while running, per notebook
     seed: int = None
+    rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
+
+    @property
+    def fractions(self):
+        return {n: float(v.get("fraction", 0.0)) for n, v in self.results.items()}
+
+    @property
+    def score(self):
+        return self.rubric.score(self.fractions)
+
+    @property
+    def points(self):
+        """Points per graded exercise under the rubric."""
+        return self.score.points
 
     @property
     def total(self):
-        return sum(self.points.values())
+        return self.score.total
 
     def feedback(self):
-        lines = [f"Feedback for {self.name}: {self.total} / {sum(POINTS.values())} points", ""]
+        score, rubric = self.score, self.rubric
+        extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
+        lines = [f"Feedback for {self.name}: {points_text(score.total)} points "
+                 f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})", ""]
         lines += [f"! {problem}" for problem in self.problems]
         if self.problems:
             lines.append("")
-        for number in sorted(EXERCISES):
-            verdict = self.results.get(number)
-            if verdict is None:
-                lines.append(f"Exercise {number}: 0 / {POINTS[number]} - not found: no notebook has its section "
-                             f"('## Exercise {number}') or it never ran.")
-                continue
-            status = "passed" if verdict["passed"] else "FAILED"
-            lines.append(f"Exercise {number}: {verdict['points']} / {POINTS[number]} - {status}")
-            for check in verdict["checks"]:
-                for step in check["steps"]:
-                    mark = "ok  " if step["passed"] else "FAIL"
-                    detail = f": {step['detail']}" if step["detail"] else ""
-                    lines.append(f"    [{mark}] {check['name']}: {step['step']}{detail}")
-                if check["hint"] and not check["passed"]:
-                    lines.append(f"    hint: {check['hint']}")
+        lines += [rubric.describe(), ""]
+        for number in rubric.graded:
+            lines += self._exercise_lines(number)
+        lines += ["", self._summary()]
         if self.seed is not None:
             lines += ["", f"(random test data from seed {self.seed})"]
         return "\n".join(lines) + "\n"
 
+    def _exercise_lines(self, number):
+        points = self.rubric.points[number]
+        verdict = self.results.get(number)
+        if verdict is None:
+            return [f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
+                    f"('## Exercise {number}') or it never ran."]
+        status = "passed" if verdict["passed"] else "FAILED"
+        lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(points)} - {status}"]
+        total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
+        for check in verdict["checks"]:
+            weight = check.get("weight") or 0
+            share = points * weight / total_weight
+            worth = f" ({points_text(share)} point{'' if share == 1 else 's'})" if weight else ""
+            for step in check["steps"]:
+                mark = "ok  " if step["passed"] else "FAIL"
+                detail = f": {step['detail']}" if step["detail"] else ""
+                lines.append(f"    [{mark}] {check['name']}{worth}: {step['step']}{detail}")
+            if check["hint"] and not check["passed"]:
+                lines.append(f"    hint: {check['hint']}")
+        return lines
+
+    def _summary(self):
+        score, rubric = self.score, self.rubric
+        lines = [f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
+                 f"{points_text(sum(rubric.points[n] for n in rubric.required))}"]
+        if score.branch == "none":
+            lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
+        elif score.branch:
+            full = sum(rubric.points[n] for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
+            lines.append(f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
+                         "(the better of the branches)")
+        for what, value in score.extra.items():
+            lines.append(f"Extra credit, {what}: {points_text(value)}")
+        lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
+        return "\n".join(lines)
+
     def as_dict(self):
-        data = asdict(self)
-        data["format"] = FORMAT
-        data["total"] = self.total
-        data["results"] = {str(n): v for n, v in self.results.items()}
-        data["points"] = {str(n): v for n, v in self.points.items()}
-        return data
+        score = self.score
+        return {"format": FORMAT, "name": self.name, "seed": self.seed, "problems": list(self.problems),
+                "results": {str(n): v for n, v in self.results.items()},
+                "rubric": self.rubric.title, "points": {str(n): v for n, v in score.points.items()},
+                "branch": score.branch, "extra_credit": score.extra, "total": score.total}
 
     @classmethod
-    def from_dict(cls, data, source="a result file"):
-        """Read back what :meth:`as_dict` wrote; ValueError names the file if it is not one."""
+    def from_dict(cls, data, source="a result file", rubric=None):
+        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file."""
         try:
             if data.get("format") != FORMAT:
                 raise ValueError(f"format is {data.get('format')!r}, not {FORMAT!r}")
-            grade = cls(str(data["name"]), {int(n): int(v) for n, v in data["points"].items()},
-                        {int(n): v for n, v in data["results"].items()}, list(data["problems"]), data.get("seed"))
+            results = {int(n): v for n, v in data["results"].items()}
+            for verdict in results.values():
+                float(verdict["fraction"])
+            grade = cls(str(data["name"]), results, list(data["problems"]), data.get("seed"),
+                        rubric or rubrics.default())
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
-        if set(grade.points) != set(EXERCISES):
-            raise ValueError(f"{source} grades exercises {sorted(grade.points)}, not {sorted(EXERCISES)}: "
+        if not set(grade.results) <= set(EXERCISES):
+            raise ValueError(f"{source} grades exercises {sorted(grade.results)}, not {sorted(EXERCISES)}: "
                              "it was written by another version of labkit.")
         return grade
 
@@ -88,12 +134,20 @@ def safe_name(name):
     return re.sub(r"[^\w.-]+", "_", name)
 
 
+CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit"]
+
+
 def write_csv(path, grades):
+    """One row per submission: points per exercise, the branch that counted, extra credit, total."""
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + ["total"])
+        graded = grades[0].rubric.graded if grades else []
+        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL)
         for g in grades:
-            writer.writerow([g.name] + [g.points[n] for n in sorted(EXERCISES)] + [g.total])
+            s = g.score
+            writer.writerow([g.name] + [points_text(s.points[n]) for n in graded]
+                            + [points_text(s.required), s.branch, points_text(s.counted), points_text(s.extra_total), points_text(s.total),
+                               points_text(s.full_credit)])
 
 
 def write_result(out_dir, grade):
@@ -115,7 +169,7 @@ def write_report(out_dir, grades):
     write_csv(out / "grades.csv", grades)
 
 
-def read_results(folders):
+def read_results(folders, rubric=None):
     """Every results/*.json of the given output folders, in name order; ValueError on a clash."""
     grades = {}
     for folder in map(Path, folders):
@@ -127,16 +181,17 @@ def read_results(folders):
                 data = json.loads(path.read_text(encoding="utf-8"))
             except (UnicodeDecodeError, ValueError) as exc:
                 raise ValueError(f"{path} is not JSON ({exc}).") from None
-            grade = SubmissionGrade.from_dict(data, str(path))
+            grade = SubmissionGrade.from_dict(data, str(path), rubric)
             if grade.name in grades:
                 raise ValueError(f"submission {grade.name!r} is graded twice ({path}); keep one of the two results.")
             grades[grade.name] = grade
     return [grades[name] for name in sorted(grades)]
 
 
-def merge(folders, out_dir):
-    """Combine the results of several grading runs (e.g. one per batch job) into one grades.csv."""
-    grades = read_results(folders)
+def merge(folders, out_dir, rubric=None):
+    """Combine the results of several grading runs (e.g. one per batch job) into one grades.csv,
+    scored with `rubric` (the lab's when None)."""
+    grades = read_results(folders, rubric)
     write_report(out_dir, grades)
     seeds = sorted({g.seed for g in grades if g.seed is not None})
     (Path(out_dir) / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")

@@ -20,6 +20,7 @@ from . import refusals, remote, sandbox
 from .report import SubmissionGrade
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
+SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
 HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
 
 
@@ -58,8 +59,9 @@ def _own_code(findings):
 def _run_problems(name, ran, total_timeout):
     problems = []
     if ran["errors"]:
-        shown = "; ".join(f"cell {e['cell'] + 1} raised {e['kind']}: {e['message'][:300]}" for e in ran["errors"][:3])
-        more = f"; and {len(ran['errors']) - 3} more" if len(ran["errors"]) > 3 else ""
+        shown = "; ".join(f"cell {e['cell'] + 1} raised {e['kind']}: {e['message'][:300]}"
+                          for e in ran["errors"][:SHOWN_ERRORS])
+        more = f"; and {len(ran['errors']) - SHOWN_ERRORS} more" if len(ran["errors"]) > SHOWN_ERRORS else ""
         problems.append(f"{name}: {len(ran['errors'])} cell(s) raised an error (graded as far as it got): "
                         f"{shown}{more}.")
     if ran["output_chars"] > OUTPUT_LIMIT:
@@ -98,17 +100,19 @@ def grade_notebook(path, cell_timeout=60, total_timeout=600, seed=None, confined
                 findings = refusals.scan(sources, exercise.names, exercise.refused)
                 if findings:
                     verdict["checks"].append(_own_code(findings))
-                    verdict["passed"], verdict["points"] = False, 0
+                    verdict["passed"], verdict["points"], verdict["fraction"] = False, 0, 0.0
                 results[number] = verdict
             if notebook.stopped:
                 problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")
     return results, problems
 
 
-def grade_submission(path, cell_timeout=60, total_timeout=600, seed=None, confined=True, limits=None):
-    """Grade one submission (a notebook or a folder of them)."""
+def grade_submission(path, cell_timeout=60, total_timeout=600, seed=None, confined=True, limits=None, rubric=None):
+    """Grade one submission (a notebook or a folder of them), scored with `rubric` (the lab's when None)."""
     path = Path(path)
     grade = SubmissionGrade(path.stem if path.is_file() else path.name, seed=seed)
+    if rubric is not None:
+        grade.rubric = rubric
     for notebook in submission_notebooks(path):
         results, problems = grade_notebook(notebook, cell_timeout, total_timeout, seed, confined, limits)
         grade.problems.extend(problems)
@@ -118,5 +122,4 @@ def grade_submission(path, cell_timeout=60, total_timeout=600, seed=None, confin
             # or else the one that defines its functions
             if best is None or (verdict["points"], verdict["defined"]) > (best["points"], best["defined"]):
                 grade.results[number] = verdict
-    grade.points = {n: (grade.results[n]["points"] if n in grade.results else 0) for n in sorted(EXERCISES)}
     return grade

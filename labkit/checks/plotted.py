@@ -1,0 +1,210 @@
+"""Checks for plots, judged from the data drawn, never from pixels.
+
+A plot is read as its lines: for every ``Line2D`` of an Axes (or of every
+Axes of a Figure), its x and y data, its marker and whether a line is drawn
+between the points (:func:`lines_of`). In a notebook that is the real
+Axes; in ``labkit grade`` the sandboxed notebook sends the same lines as
+plain numbers (:mod:`labkit.grading.protocol`) and the decisions are made
+here, on the grader's side.
+
+* Exercise 4 (:func:`limacon_plot`): a curve of at least 100 points that
+  lies on the limaçon to the accuracy of Hermite interpolation and goes
+  all the way round;
+* Exercise 14 (:func:`boiling_plot`): the data as circles with no lines, and
+  the not-a-knot spline and pchip each as a curve of at least 100 points
+  over the whole data range.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import functions, monotone, piecewise, splines
+from .result import CheckResult, Checks
+
+MIN_POINTS = 100
+HERMITE_LIMACON = 2e-3  # largest distance from the curve: Hermite with 20 intervals is 2.3e-4, linear 3.8e-2
+NO_LINE = ("None", "none", "", " ")
+CIRCLE = "o"
+
+
+@dataclass(frozen=True)
+class Line:
+    """One plotted line as plain data."""
+
+    x: np.ndarray
+    y: np.ndarray
+    marker: str  # matplotlib's marker code: "o" for circles, "None" for none
+    linestyle: str  # "-", "--", ... or "None"
+
+    @property
+    def joined(self):
+        """Whether a line is drawn between the points."""
+        return self.linestyle not in NO_LINE
+
+
+def line_of(line):
+    """A matplotlib Line2D as a :class:`Line`."""
+    x = np.asarray(line.get_xdata(orig=False), dtype=float).ravel()
+    y = np.asarray(line.get_ydata(orig=False), dtype=float).ravel()
+    marker = line.get_marker()
+    style = line.get_linestyle() if line.get_linewidth() > 0 else "None"
+    return Line(x, y, str(marker) if isinstance(marker, str) else "custom", str(style))
+
+
+def lines_of(plot):
+    """The lines of an Axes, of every Axes of a Figure, or a list of lines already read; else None."""
+    if isinstance(plot, (list, tuple)) and all(isinstance(line, Line) for line in plot):
+        return list(plot)
+    axes = getattr(plot, "axes", None)
+    if hasattr(plot, "get_lines"):
+        return [line_of(line) for line in plot.get_lines()]
+    if isinstance(axes, list):  # a Figure
+        return [line_of(line) for ax in axes for line in ax.get_lines()]
+    return None
+
+
+def _no_plot(result, name, plot):
+    what = getattr(plot, "description", None) or type(plot).__name__
+    return result.fail(f"{name} is a plot", f"got {what}",
+                       f"draw on the Axes `{name}` the cell gives you (e.g. `{name}.plot(x, y)`), and keep the name.")
+
+
+# -- Exercise 4 ---------------------------------------------------------------
+
+def _distances(points, curve):
+    """For each of `points` (2, n) the distance to the nearest of `curve` (2, m); blocks keep memory small."""
+    out = np.empty(points.shape[1])
+    for start in range(0, points.shape[1], 512):
+        block = points[:, start:start + 512]
+        d = np.hypot(block[0][:, None] - curve[0][None, :], block[1][:, None] - curve[1][None, :])
+        out[start:start + 512] = d.min(axis=1)
+    return out
+
+
+def _limacon_curve(r0=1.15, count=20001):
+    x, y, _, _ = functions.limacon(np.linspace(0, 2 * np.pi, count), r0=r0)
+    return np.stack((x, y))
+
+
+def limacon_plot(plot, own=None, r0=1.15):
+    """Check Exercise 4's plot: a smooth limaçon, the Hermite curve through the data.
+
+    `own` is ``(tdata, xdata, ydata, xpdata, ypdata)`` of the notebook, if it
+    has them: a curve that is exactly the Hermite interpolant of the
+    student's own slopes passes too (a wrong slope is marked where the
+    slopes are checked, not twice).
+    """
+    result = CheckResult("ax4")
+    lines = lines_of(plot)
+    if lines is None:
+        return _no_plot(result, "ax4", plot)
+    long = [line for line in lines if line.x.size >= MIN_POINTS and line.x.size == line.y.size]
+    if not result.step(f"a curve of at least {MIN_POINTS} points", bool(long),
+                       f"the longest line has {max((line.x.size for line in lines), default=0)} points"):
+        result.hint = ("plot the Hermite interpolant at the 10*(nintervals+1) values of tval, not only the data "
+                       "points.")
+        return result
+    truth = _limacon_curve(r0)
+    curves = [("the limaçon", truth)]
+    own_curve = _own_hermite(own)
+    if own_curve is not None:
+        curves.append(("the Hermite curve of your xpdata, ypdata", own_curve))
+    best = None
+    for line in long:
+        points = np.stack((line.x, line.y))
+        if not np.all(np.isfinite(points)):
+            continue
+        for name, curve in curves:
+            far = float(_distances(points, curve).max())
+            cover = float(_distances(curve[:, ::50], points).max())  # every part of the curve is drawn
+            if best is None or (far, cover) < best[:2]:
+                best = (far, cover, name)
+    if best is None:
+        return result.fail("the curve is the limaçon", "every long line has NaN or infinite points",
+                           "plot xherm, yherm from eval_pherm.")
+    far, cover, name = best
+    ok = result.step(f"the curve lies on {name} (r0 = {r0}) to Hermite accuracy ({HERMITE_LIMACON:g})",
+                     far <= HERMITE_LIMACON, f"a point is {far:.2e} away from it")
+    if not ok:
+        result.hint = ("corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
+                       "xpdata or ypdata bends the curve away; use eval_pherm with the derivatives of Exercise 4.")
+        return result
+    if not result.step("the curve goes all the way round", cover <= 0.1,
+                       f"part of the limaçon is {cover:.2f} away from every plotted point"):
+        result.hint = "interpolate over the whole turn: tval from 0 to 2*pi."
+    return result
+
+
+def _own_hermite(own):
+    """The Hermite curve of the notebook's own data (densely), or None."""
+    if own is None:
+        return None
+    try:
+        tdata, xdata, ydata, xpdata, ypdata = (np.asarray(v, dtype=float) for v in own)
+        t = np.linspace(tdata[0], tdata[-1], 20001)
+        curve = np.stack((piecewise.eval_pherm(tdata, xdata, xpdata, t), piecewise.eval_pherm(tdata, ydata, ypdata, t)))
+    except (TypeError, ValueError, IndexError):
+        return None
+    return curve if np.all(np.isfinite(curve)) else None
+
+
+# -- Exercise 14 ----------------------------------------------------------------
+
+BOILING = (np.array([0.0, 1.0, 2.0, 3.0, 4.0]), np.array([0.0, 1.0, 2.0, 2.0, 2.0]))
+
+
+def _matches(line, values):
+    return bool(np.allclose(line.y, values, rtol=0, atol=1e-6))
+
+
+def boiling_plot(plot):
+    """Check Exercise 14's plot: data circles without lines, then the spline and pchip curves."""
+    xdata, ydata = BOILING
+    results = Checks()
+    lines = lines_of(plot)
+    if lines is None:
+        failed = _no_plot(CheckResult("ax14"), "ax14", plot)
+        return Checks([failed, failed, failed])
+    lines = [ln for ln in lines if ln.x.size == ln.y.size and ln.x.size and np.all(np.isfinite(ln.x))
+             and np.all(np.isfinite(ln.y))]
+
+    data = CheckResult("ax14: the data")
+    at_data = [ln for ln in lines if ln.x.size == xdata.size and np.allclose(np.sort(ln.x), xdata)
+               and _matches(ln, np.interp(ln.x, xdata, ydata))]
+    if not data.step("a line at the five data points", bool(at_data), "no line has exactly the data's points"):
+        data.hint = "plot xdata, ydata themselves: ax14.plot(xdata, ydata, 'o')."
+    elif data.step("drawn as circles", any(ln.marker == CIRCLE for ln in at_data),
+                   f"markers {sorted({ln.marker for ln in at_data})}"):
+        if not data.step("with no lines between them", any(ln.marker == CIRCLE and not ln.joined for ln in at_data),
+                         "the circles are joined by lines"):
+            data.hint = "circles only: marker 'o' with linestyle 'none' (the format string 'o')."
+    else:
+        data.hint = "use the marker 'o'."
+    results.append(data)
+
+    curves = [ln for ln in lines if all(ln is not d for d in at_data)]
+    for name, interpolant in (("the not-a-knot spline", splines.spline), ("pchip", monotone.pchip)):
+        check = CheckResult(f"ax14: {name}")
+        matching = [ln for ln in curves if _matches(ln, interpolant(xdata, ydata, ln.x))
+                    and not _matches(ln, _other(interpolant)(xdata, ydata, ln.x))]
+        if not check.step(f"a curve that is {name}", bool(matching),
+                          f"none of the {len(curves)} other line(s) follows it"):
+            check.hint = (f"evaluate {name} of the data at many points xval and plot them: "
+                          f"ax14.plot(xval, {'labkit.spline' if 'spline' in name else 'labkit.pchip'}(xdata, ydata, xval)).")
+        else:
+            most = max(matching, key=lambda ln: ln.x.size)
+            if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS,
+                              f"only {most.x.size} points"):
+                check.hint = f"use at least {MIN_POINTS} points, e.g. xval = np.linspace(0, 4, 201)."
+            elif not check.step("over the whole data range [0, 4]", most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
+                                f"from {most.x.min():.3g} to {most.x.max():.3g}"):
+                check.hint = "let xval run from the first data point to the last: np.linspace(0, 4, 201)."
+            elif not check.step("drawn as a line", most.joined, "drawn as separate markers"):
+                check.hint = "draw the curve as a line (format string '-')."
+        results.append(check)
+    return results
+
+
+def _other(interpolant):
+    """The other of the two interpolants: a curve that is both (where they agree) identifies neither."""
+    return monotone.pchip if interpolant is splines.spline else splines.spline

@@ -1,0 +1,225 @@
+"""The rubric: how the exercises' results become a grade.
+
+A rubric is data (TOML, see ``rubric.toml`` next to this module, the lab's
+own): points per exercise, the exercises everyone does, alternative
+branches of which the best counts towards full credit while each other one
+is extra credit, and extra-credit exercises. :func:`load` reads and
+validates one; :meth:`Rubric.score` turns the fractions an exercise's parts
+earned (:func:`labkit.checks.exercises.grade`) into points, the branch that
+counted, the extra credit and the total.
+"""
+import functools
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..checks.exercises import EXERCISES
+
+DEFAULT = Path(__file__).with_name("rubric.toml")
+
+
+@dataclass(frozen=True)
+class Branch:
+    name: str
+    exercises: tuple
+
+
+@dataclass(frozen=True)
+class Score:
+    """One submission's grade under a rubric."""
+
+    points: dict  # exercise -> points earned (rounded to 0.01)
+    required: float
+    branch: str  # the branch that counted ("" without branches, "none" if no branch earned points)
+    counted: float  # its points
+    extra: dict  # what earned extra credit -> points
+    full_credit: float
+
+    @property
+    def extra_total(self):
+        return round(sum(self.extra.values()), 2)
+
+    @property
+    def total(self):
+        return round(self.required + self.counted + self.extra_total, 2)
+
+
+@dataclass(frozen=True)
+class Rubric:
+    title: str
+    points: dict  # exercise -> points
+    required: tuple
+    branches: tuple = ()
+    branch_extra: float = 0.0
+    extra_credit: tuple = ()
+    source: str = field(default="the lab's rubric", compare=False)
+
+    @property
+    def graded(self):
+        """Every exercise the rubric counts, in order."""
+        return sorted(self.points)
+
+    @property
+    def full_credit(self):
+        branch = sum(self.points[n] for n in self.branches[0].exercises) if self.branches else 0
+        return sum(self.points[n] for n in self.required) + branch
+
+    @property
+    def maximum(self):
+        """Full credit plus every extra credit."""
+        return self.full_credit + self.branch_extra * max(len(self.branches) - 1, 0) + sum(
+            self.points[n] for n in self.extra_credit)
+
+    def score(self, fractions):
+        """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1)."""
+        points = {n: round(self.points[n] * float(fractions.get(n, 0.0)), 2) for n in self.graded}
+        required = round(sum(points[n] for n in self.required), 2)
+        extra = {f"exercise {n}": points[n] for n in self.extra_credit}
+        branch, counted = "", 0.0
+        if self.branches:
+            earned = [round(sum(points[n] for n in b.exercises), 2) for b in self.branches]
+            best = max(range(len(self.branches)), key=lambda i: (earned[i], -i))
+            branch, counted = (self.branches[best].name if earned[best] else "none"), earned[best]
+            for i, other in enumerate(self.branches):
+                if i != best:
+                    full = sum(self.points[n] for n in other.exercises)
+                    share = earned[i] / full if full else 0.0
+                    extra[f"branch {other.name}"] = round(self.branch_extra * share, 2)
+        return Score(points, required, branch, counted, extra, self.full_credit)
+
+    def describe(self):
+        """The rubric in a few lines, for the feedback."""
+        lines = [f"Rubric: {self.title}",
+                 f"  full credit {points_text(self.full_credit)}: exercises {_list(self.required)} for everyone"]
+        if self.branches:
+            names = " or ".join(f"{b.name} ({_list(b.exercises)})" for b in self.branches)
+            lines[-1] += f", plus one branch: {names}; the better branch counts"
+            lines.append(f"  extra credit: the other branch, up to {points_text(self.branch_extra)}")
+        if self.extra_credit:
+            extra = ", ".join(f"exercise {n} ({points_text(self.points[n])})" for n in self.extra_credit)
+            lines.append(("  " if not self.branches else "  and ") + f"extra credit: {extra}")
+        return "\n".join(lines)
+
+
+def points_text(value):
+    """Points as text: whole numbers without a decimal point."""
+    value = round(float(value), 2)
+    return f"{int(value)}" if value == int(value) else f"{value:g}"
+
+
+def _list(numbers):
+    return ", ".join(map(str, numbers))
+
+
+def _exercise(value, where, source):
+    try:
+        number = int(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{source}: {where} has {value!r}, which is not an exercise number.") from None
+    if str(value).strip() != str(number) or number not in EXERCISES:
+        known = ", ".join(map(str, sorted(EXERCISES)))
+        raise ValueError(f"{source}: {where} names exercise {value!r}, which labkit does not grade "
+                         f"(graded exercises: {known}; exercise 1 is not graded).")
+    return number
+
+
+def _exercise_list(value, where, source):
+    if not isinstance(value, list):
+        raise ValueError(f"{source}: {where} must be a list of exercise numbers, e.g. [2, 3, 4].")
+    numbers = [_exercise(v, where, source) for v in value]
+    if len(set(numbers)) != len(numbers):
+        raise ValueError(f"{source}: {where} lists an exercise twice.")
+    return tuple(numbers)
+
+
+def from_dict(data, source="the rubric"):
+    """A validated :class:`Rubric` from parsed TOML; ValueError says what is wrong and where."""
+    known = {"title", "required", "extra_credit", "points", "branches"}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
+    raw_points = data.get("points")
+    if not isinstance(raw_points, dict) or not raw_points:
+        raise ValueError(f"{source}: needs a [points] table: one line `N = points` per graded exercise.")
+    points = {}
+    for key, value in raw_points.items():
+        number = _exercise(key, "[points]", source)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
+            raise ValueError(f"{source}: [points] gives exercise {number} {value!r}; points must be a number.")
+        if value < 0:
+            raise ValueError(f"{source}: [points] gives exercise {number} negative points ({value}); "
+                             "use 0 to leave an exercise ungraded.")
+        points[number] = float(value)
+    required = _exercise_list(data.get("required", []), "required", source)
+    extra_credit = _exercise_list(data.get("extra_credit", []), "extra_credit", source)
+    branches, branch_extra = _branches(data.get("branches"), source)
+    groups = [("required", required), ("extra_credit", extra_credit)]
+    groups += [(f"branch {b.name!r}", b.exercises) for b in branches]
+    seen = {}
+    for group, numbers in groups:
+        for number in numbers:
+            if number in seen:
+                raise ValueError(f"{source}: exercise {number} is in {seen[number]} and in {group}; "
+                                 "each exercise belongs to one group (branches may not overlap).")
+            seen[number] = group
+            if number not in points:
+                raise ValueError(f"{source}: exercise {number} is in {group} but has no points in [points].")
+    for number in points:
+        if number not in seen:
+            raise ValueError(f"{source}: exercise {number} has points but is in no group: add it to required, "
+                             "extra_credit or a branch, or remove its points.")
+    totals = {b.name: sum(points[n] for n in b.exercises) for b in branches}
+    if len(set(totals.values())) > 1:
+        shown = ", ".join(f"{name} {points_text(total)}" for name, total in totals.items())
+        raise ValueError(f"{source}: the branches must be worth the same points, since either one gives full "
+                         f"credit; they are worth {shown}.")
+    title = data.get("title", "rubric")
+    if not isinstance(title, str):
+        raise ValueError(f"{source}: title must be text.")
+    return Rubric(title, points, required, branches, branch_extra, extra_credit, source)
+
+
+def _branches(table, source):
+    if table is None:
+        return (), 0.0
+    if not isinstance(table, dict):
+        raise ValueError(f"{source}: [branches] must be a table with extra_credit and [[branches.choice]] entries.")
+    unknown = sorted(set(table) - {"extra_credit", "choice"})
+    if unknown:
+        raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)} in [branches]; it has extra_credit and choice.")
+    extra = table.get("extra_credit", 0)
+    if isinstance(extra, bool) or not isinstance(extra, (int, float)) or extra < 0:
+        raise ValueError(f"{source}: [branches] extra_credit must be a number of points, at least 0; got {extra!r}.")
+    choices = table.get("choice", [])
+    if not isinstance(choices, list) or len(choices) < 2:
+        raise ValueError(f"{source}: [branches] needs at least two [[branches.choice]] entries (alternatives).")
+    branches = []
+    for index, choice in enumerate(choices, start=1):
+        if not isinstance(choice, dict) or not isinstance(choice.get("name"), str) or "exercises" not in choice:
+            raise ValueError(f"{source}: branch {index} needs a name and a list of exercises.")
+        branches.append(Branch(choice["name"], _exercise_list(choice["exercises"], f"branch {choice['name']!r}",
+                                                              source)))
+    if len({b.name for b in branches}) != len(branches):
+        raise ValueError(f"{source}: two branches have the same name.")
+    return tuple(branches), float(extra)
+
+
+@functools.lru_cache(maxsize=None)
+def default():
+    """The lab's own rubric (:data:`DEFAULT`)."""
+    return load(DEFAULT)
+
+
+def load(path=None):
+    """The rubric in TOML file `path`, or the lab's own (:data:`DEFAULT`) when None."""
+    path = DEFAULT if path is None else Path(path)
+    source = "the lab's rubric" if path == DEFAULT else str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"cannot read the rubric {path}: {exc}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{source} is not valid TOML: {exc}") from None
+    return from_dict(data, source)

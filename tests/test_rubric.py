@@ -1,0 +1,123 @@
+"""The rubric: the lab's branch rule as data, its scoring, and clear errors for a bad file."""
+import subprocess
+import sys
+import tomllib
+
+import pytest
+
+from labkit.checks.exercises import EXERCISES
+from labkit.grading import rubric as rubrics
+from labkit.grading.report import SubmissionGrade
+
+MESH, SPLINES = (5, 6, 7, 8, 9), (10, 11, 12, 13, 14, 15)
+
+
+def _fractions(*groups, value=1.0):
+    return {n: value for group in groups for n in group}
+
+
+def test_the_lab_rubric_is_its_branch_rule():
+    lab = rubrics.default()
+    assert lab.required == (2, 3, 4) and lab.extra_credit == (16,)
+    assert [b.exercises for b in lab.branches] == [MESH, SPLINES]
+    assert lab.full_credit == 100 and lab.branch_extra == 10 and lab.points[16] == 8 and lab.maximum == 118
+    assert set(lab.points) == set(EXERCISES)
+
+
+@pytest.mark.parametrize("done, total, branch, extra", [
+    (((2, 3, 4), SPLINES), 100, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
+    (((2, 3, 4), MESH), 100, "mesh generation", {"exercise 16": 0, "branch splines": 0}),
+    (((2, 3, 4), MESH, SPLINES), 110, "mesh generation", {"exercise 16": 0, "branch splines": 10}),
+    (((2, 3, 4), SPLINES, (16,)), 108, "splines", {"exercise 16": 8, "branch mesh generation": 0}),
+    (((2, 3, 4), MESH, SPLINES, (16,)), 118, "mesh generation", {"exercise 16": 8, "branch splines": 10}),
+    ((SPLINES,), 60, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
+    ((), 0, "none", {"exercise 16": 0, "branch splines": 0}),
+])
+def test_the_better_branch_counts_and_the_other_is_extra_credit(done, total, branch, extra):
+    score = rubrics.default().score(_fractions(*done))
+    assert (score.total, score.branch, score.extra) == (total, branch, extra)
+
+
+def test_a_partly_done_second_branch_earns_its_share_of_the_extra_credit():
+    lab = rubrics.default()
+    fractions = {**_fractions((2, 3, 4), SPLINES), 5: 1.0, 9: 0.5}  # 12 + 8 of the mesh branch's 60 points
+    score = lab.score(fractions)
+    assert score.branch == "splines" and score.counted == 60
+    assert score.extra["branch mesh generation"] == pytest.approx(10 * 20 / 60, abs=0.01)
+    assert score.total == pytest.approx(100 + 10 * 20 / 60, abs=0.01)
+    # the mesh branch ahead of the spline branch swaps the roles
+    swapped = lab.score({**_fractions((2, 3, 4), MESH), 10: 1.0})
+    assert swapped.branch == "mesh generation" and swapped.extra["branch splines"] == pytest.approx(2.5)
+
+
+def test_parts_scale_with_the_points_an_edited_rubric_gives():
+    data = tomllib.loads(rubrics.DEFAULT.read_text())
+    data["points"]["11"] = 18  # twice the lab's 9
+    data["points"]["5"] = 21
+    edited = rubrics.from_dict(data, "edited")
+    assert edited.score({11: 5 / 9}).points[11] == 10  # the driver part: 5 of 9, now of 18
+
+
+def test_the_feedback_explains_the_rubric_and_where_the_points_came_from():
+    lab = rubrics.default()
+    results = {n: {"exercise": n, "passed": True, "points": EXERCISES[n].points, "fraction": 1.0,
+                   "defined": True, "checks": []} for n in (2, 3, 4) + SPLINES}
+    text = SubmissionGrade("ada", results, [], None, lab).feedback()
+    assert "Feedback for ada: 100 points (100 / 100)" in text
+    assert "plus one branch: mesh generation (5, 6, 7, 8, 9) or splines (10, 11, 12, 13, 14, 15)" in text
+    assert "Branch that counts: splines, 60 / 60" in text and "Extra credit, branch mesh generation: 0" in text
+    assert "Exercise 5: 0 / 12 - not found" in text
+
+
+def _write(tmp_path, text):
+    path = tmp_path / "rubric.toml"
+    path.write_text(text)
+    return path
+
+
+GOOD = """
+required = [2, 3]
+[points]
+2 = 10
+3 = 10
+"""
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[points]\n17 = 5\n", "names exercise '17', which labkit does not grade"),
+    ("required = [1]\n[points]\n1 = 5\n", "exercise 1 is not graded"),
+    ("required = [2]\n[points]\n2 = -5\n", "negative points"),
+    ("required = [2]\n[points]\n2 = 'ten'\n", "points must be a number"),
+    ("[points]\n2 = 5\n5 = 5\n10 = 5\n[branches]\nextra_credit = 1\n[[branches.choice]]\nname = 'a'\nexercises = [5, 2]\n"
+     "[[branches.choice]]\nname = 'b'\nexercises = [10, 2]\n", "branches may not overlap"),
+    ("required = [2]\n[points]\n2 = 5\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
+     "[[branches.choice]]\nname = 'b'\nexercises = [2]\n", "branches may not overlap"),
+    ("[points]\n5 = 5\n10 = 6\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
+     "[[branches.choice]]\nname = 'b'\nexercises = [10]\n", "must be worth the same points"),
+    ("[points]\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n", "at least two"),
+    ("required = [2, 3]\n[points]\n2 = 5\n", "exercise 3 is in required but has no points"),
+    ("required = [2]\n[points]\n2 = 5\n3 = 5\n", "exercise 3 has points but is in no group"),
+    ("required = [2]\nbonus = [3]\n[points]\n2 = 5\n", "unknown key(s) bonus"),
+    ("required = 2\n[points]\n2 = 5\n", "must be a list of exercise numbers"),
+    ("required = [2]\n", "needs a [points] table"),
+    ("required = [2\n", "is not valid TOML"),
+])
+def test_rubric_errors_are_clear(tmp_path, text, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[")
+                       .replace("]", r"\]")):
+        rubrics.load(_write(tmp_path, text))
+
+
+def test_a_small_rubric_without_branches_loads(tmp_path):
+    small = rubrics.load(_write(tmp_path, GOOD))
+    assert small.full_credit == 20 and small.maximum == 20 and small.score({2: 1.0, 3: 0.5}).total == 15
+    assert small.score({2: 1.0}).branch == ""
+
+
+def test_cli_prints_the_lab_rubric_and_checks_an_edited_one(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "rubric"], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0 and rubrics.from_dict(tomllib.loads(run.stdout)) == rubrics.default()
+    path = _write(tmp_path, run.stdout.replace("16 = 8", "16 = -8"))
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "rubric", "--check", str(path)], capture_output=True,
+                         text=True, timeout=60)
+    assert run.returncode == 2 and "negative points" in run.stderr
