@@ -1,5 +1,5 @@
 # Two entry points for a fresh clone (see README): `make lab` and `make test`.
-# Both create .venv with the package installed editable and its test extras.
+# Both create .venv with the package installed editable with every extra (lab, grade, test).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -11,7 +11,7 @@ ROOT_FLAG := $(if $(filter 0,$(shell id -u)),--allow-root,)
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet -e '.[lab,grade,test]'
 	touch $(STAMP)
 
 lab: $(STAMP)
@@ -32,8 +32,10 @@ bwrap:
 	  && (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq bubblewrap >/dev/null) \
 	  || echo "!! bwrap is missing and could not be installed: install bubblewrap, or the grading tests fail"; }
 
+# Re-execute the instructor notebooks, then regenerate the student copies shipped in the package.
 notebooks: $(STAMP)
 	$(VENV)/bin/labkit execute notebooks
+	$(VENV)/bin/labkit release notebooks --out labkit/student_notebooks
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_core.py

@@ -1,7 +1,8 @@
 """The ``labkit`` command: execute, release and grade the lab's notebooks.
 
-``labkit execute [DIR]``                   re-run the instructor notebooks and save them clean
-``labkit release [DIR] --out DIR``         write the student version
+``labkit notebooks DIR``                   write the student notebooks shipped with labkit into DIR
+``labkit execute DIR``                     re-run the instructor notebooks of DIR and save them clean
+``labkit release DIR --out DIR``           write the student version of the instructor notebooks
 ``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
 ``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
 ``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
@@ -11,18 +12,35 @@ import sys
 import time
 from pathlib import Path
 
-DEFAULT_NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
+GRADE_EXTRA = ("nbformat", "nbclient")
+
+
+def _notebooks(args):
+    from .student_notebooks import paths
+
+    out = args.out
+    sources = paths()
+    existing = [out / p.name for p in sources if (out / p.name).exists()]
+    if existing and not args.force:
+        raise ValueError(f"{existing[0]} already exists (your work?); choose another folder, or --force to "
+                         "overwrite the notebooks there.")
+    out.mkdir(parents=True, exist_ok=True)
+    for source in sources:
+        (out / source.name).write_bytes(source.read_bytes())
+        print(f"wrote {out / source.name}")
+    return 0
 
 
 def _execute(args):
     from nbclient.exceptions import CellExecutionError
 
+    from .grading.nbgrader import mark
     from .notebooks import execute, notebook_paths
 
     for path in notebook_paths(args.notebooks):
         print(f"executing {path.name} ...", flush=True)
         try:
-            execute(path, timeout=args.timeout)
+            execute(path, timeout=args.timeout, before_save=mark)
         except CellExecutionError as exc:
             raise ValueError(f"{path.name} failed; it was not saved.\n{str(exc)[:2000]}") from None
     return 0
@@ -80,19 +98,24 @@ def build_parser():
                "folder, resource limits) and checks it from outside; see the README's 'For instructors'.")
     commands = parser.add_subparsers(dest="command", required=True)
 
+    nbs = commands.add_parser("notebooks", help="write the student notebooks shipped with labkit into a folder",
+                              description="Write the lab's six student notebooks (exercises to do, with their "
+                                          "self-checks) into DIR, e.g. for Colab, a JupyterHub or VS Code.")
+    nbs.add_argument("out", type=Path, metavar="DIR", help="folder for the notebooks (created if needed)")
+    nbs.add_argument("--force", action="store_true", help="overwrite notebooks of the same name in DIR")
+    nbs.set_defaults(handler=_notebooks)
+
     run = commands.add_parser("execute", help="re-execute every notebook in a fresh kernel and save it clean",
                               description="Re-execute the notebooks top to bottom in a fresh python3 kernel and save "
                                           "them without widget state: the reference outputs nbval compares against.")
-    run.add_argument("notebooks", nargs="?", type=Path, default=DEFAULT_NOTEBOOKS,
-                     help="folder of notebooks (default: the kit's notebooks/)")
+    run.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     run.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell (default 300)")
     run.set_defaults(handler=_execute)
 
     rel = commands.add_parser("release", help="write the student version of the notebooks",
                               description="Replace every '### BEGIN SOLUTION' ... '### END SOLUTION' region by a stub "
                                           "that raises NotImplementedError, remove hidden tests, clear outputs.")
-    rel.add_argument("notebooks", nargs="?", type=Path, default=DEFAULT_NOTEBOOKS,
-                     help="folder of instructor notebooks (default: the kit's notebooks/)")
+    rel.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     rel.add_argument("--out", type=Path, required=True, help="folder for the student notebooks")
     rel.set_defaults(handler=_release)
 
@@ -143,6 +166,12 @@ def main(argv=None):
         return args.handler(args)
     except ValueError as exc:
         print(f"labkit {args.command}: {exc}", file=sys.stderr)
+        return 2
+    except ModuleNotFoundError as exc:
+        if exc.name not in GRADE_EXTRA:
+            raise
+        print(f"labkit {args.command}: needs {exc.name}, which comes with the instructor's extra: "
+              "pip install 'labkit[grade]'", file=sys.stderr)
         return 2
 
 

@@ -33,8 +33,11 @@ def read_notebook(path):
         raise ValueError(f"{Path(path).name} is not a valid notebook ({type(exc).__name__}: {str(exc)[:200]}).") from None
 
 
-def execute(path, timeout=300):
-    """Run one notebook in a fresh kernel in its own folder and save it cleaned."""
+def execute(path, timeout=300, before_save=None):
+    """Run one notebook in a fresh kernel in its own folder and save it cleaned.
+
+    `before_save(nb, name)` may add to the notebook before it is written (``labkit
+    execute`` gives the cells nbgrader's metadata)."""
     from nbclient import NotebookClient
 
     path = Path(path)
@@ -44,6 +47,8 @@ def execute(path, timeout=300):
     )
     client.execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # kernel log noise only
     clean(nb)
+    if before_save is not None:
+        before_save(nb, path.name)
     nbformat.write(nb, path)
     return nb
 

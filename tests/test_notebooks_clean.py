@@ -64,3 +64,46 @@ def test_every_exercise_has_a_section_and_the_readme_maps_it():
         numbers = [int(line.split()[2]) for cell in nbformat.read(path, as_version=4).cells
                    if cell.cell_type == "markdown" for line in cell.source.splitlines() if line.startswith("## Exercise")]
         assert numbers == sorted(numbers), path.name
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_nbgrader_metadata_is_kept_and_valid(path):
+    """`labkit execute` writes nbgrader's cell metadata (schema version 3); nbgrader's own validator accepts it."""
+    import copy
+
+    from labkit.grading.nbgrader import mark
+
+    nb = nbformat.read(path, as_version=4)
+    expected = mark(copy.deepcopy(nb), path.name)
+    for cell, want in zip(nb.cells, expected.cells):
+        assert cell.metadata.get("nbgrader") == want.metadata["nbgrader"], cell.source[:60]
+        meta = cell.metadata["nbgrader"]
+        assert meta["solution"] == ("### BEGIN SOLUTION" in cell.source)
+        assert meta["grade"] == ("### BEGIN HIDDEN TESTS" in cell.source)
+        assert meta["locked"] == (not meta["solution"])
+    validator = pytest.importorskip("nbgrader.nbgraderformat").MetadataValidator()
+    validator.validate_nb(nb)
+
+
+def test_nbgrader_points_per_exercise_are_labkits():
+    from labkit.checks.exercises import EXERCISES
+
+    points = {}
+    for path in NOTEBOOKS:
+        for cell in nbformat.read(path, as_version=4).cells:
+            meta = cell.metadata["nbgrader"]
+            if meta["grade"]:
+                number = int(re.search(r"# tests for exercise (\d+)", cell.source).group(1))
+                points[number] = points.get(number, 0) + meta["points"]
+    assert points == {n: e.points for n, e in EXERCISES.items()}
+
+
+def test_the_first_code_cell_says_how_to_install_labkit():
+    for path in NOTEBOOKS:
+        first = next(c for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code")
+        namespace = {}
+        source = "\n".join(line for line in first.source.splitlines() if not line.startswith("%"))
+        source = source.replace("import labkit\n", "import labkit_is_not_here_at_all\n", 1)
+        source = source.replace('missing.name != "labkit"', 'missing.name != "labkit_is_not_here_at_all"')
+        with pytest.raises(ModuleNotFoundError, match=r'%pip install "labkit @ git\+https://'):
+            exec(compile(source, path.name, "exec"), namespace)

@@ -1,26 +1,106 @@
-"""The conda environment and the pip metadata must ask for the same packages."""
+"""Packaging: the dependency layout, the student notebooks shipped in the package, one repository URL."""
 import re
+import subprocess
+import sys
 import tomllib
 from pathlib import Path
 
+import nbformat
+import pytest
 import yaml
 
+from labkit.grading import release_notebook
+from labkit.student_notebooks import paths
+
 ROOT = Path(__file__).resolve().parents[1]
+PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+REPOSITORY = PROJECT["urls"]["Repository"]
 
 
 def _normalise(requirement):
     return re.sub(r"\s+", "", requirement).lower()
 
 
-def test_environment_yml_lists_the_runtime_dependencies_of_pyproject():
-    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+def test_environment_yml_is_the_core_plus_the_lab_extra():
     conda = yaml.safe_load((ROOT / "environment.yml").read_text())["dependencies"]
     conda_packages = {_normalise(d) for d in conda if isinstance(d, str)}
     conda_packages -= {"pip"} | {d for d in conda_packages if d.startswith("python")}
-    assert conda_packages == {_normalise(d) for d in project["dependencies"]}
+    wanted = PROJECT["dependencies"] + PROJECT["optional-dependencies"]["lab"]
+    assert conda_packages == {_normalise(d) for d in wanted}
 
 
 def test_environment_yml_python_matches_requires_python():
-    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
     conda = yaml.safe_load((ROOT / "environment.yml").read_text())["dependencies"]
-    assert f"python{project['requires-python']}" in conda
+    assert f"python{PROJECT['requires-python']}" in conda
+
+
+def test_the_core_is_light_and_the_extras_hold_the_rest():
+    core = {re.split(r"[<>=;\[ ]", d)[0].lower() for d in PROJECT["dependencies"]}
+    assert core == {"numpy", "scipy", "matplotlib", "ipywidgets", "anywidget", "meshio", "ipykernel"}
+    extras = PROJECT["optional-dependencies"]
+    assert [d.split(">")[0] for d in extras["lab"]] == ["jupyterlab"]
+    assert {d.split(">")[0] for d in extras["grade"]} == {"nbformat", "nbclient"}
+    assert "labkit[lab,grade]" in extras["test"] and any(d.startswith("nbgrader") for d in extras["test"])
+    assert "'.[lab,grade,test]'" in (ROOT / "Makefile").read_text()
+
+
+def test_import_labkit_needs_neither_jupyterlab_nor_nbclient():
+    code = ("import sys, labkit, labkit.check, labkit.plots\n"
+            "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'jupyterlab', 'nbclient', 'nbformat', "
+            "'jupyter_server', 'notebook', 'nbconvert'})\n"
+            "print(heavy)")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
+
+
+def test_the_packaged_student_notebooks_are_the_release_of_the_instructor_notebooks():
+    packaged = paths()
+    assert [p.name for p in packaged] == [p.name for p in NOTEBOOKS]
+    for source, shipped in zip(NOTEBOOKS, packaged):
+        expected = nbformat.writes(release_notebook(nbformat.read(source, as_version=4), source.name)) + "\n"
+        assert shipped.read_text() == expected, f"{shipped.name} is stale: run `make notebooks`"
+        text = shipped.read_text()
+        for marker in ("BEGIN SOLUTION", "END SOLUTION", "BEGIN HIDDEN TESTS", "assert labkit.check"):
+            assert marker not in text, (shipped.name, marker)
+        nb = nbformat.reads(text, as_version=4)
+        assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+
+
+def test_no_solved_notebook_is_part_of_the_package():
+    shipped = [p for p in (ROOT / "labkit").rglob("*.ipynb")]
+    assert sorted(p.name for p in shipped) == [p.name for p in NOTEBOOKS]
+    for path in shipped:
+        assert "### BEGIN SOLUTION" not in path.read_text() and "### BEGIN HIDDEN TESTS" not in path.read_text()
+
+
+def test_labkit_notebooks_writes_them_and_never_overwrites_work(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "notebooks", str(tmp_path / "lab")],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+    assert sorted(p.name for p in (tmp_path / "lab").iterdir()) == [p.name for p in NOTEBOOKS]
+    (tmp_path / "lab" / "01_limacon.ipynb").write_text("my work")
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "notebooks", str(tmp_path / "lab")],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and "already exists" in run.stderr
+    assert (tmp_path / "lab" / "01_limacon.ipynb").read_text() == "my work"
+
+
+@pytest.mark.parametrize("command", ["execute", "release"])
+def test_instructor_commands_take_the_instructor_folder(command, tmp_path):
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", command], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and "notebooks" in run.stderr  # the folder is required: no repository is assumed
+
+
+def test_one_repository_url_for_the_badges_and_the_install_line():
+    readme = (ROOT / "README.md").read_text()
+    owner_repo = REPOSITORY.removeprefix("https://github.com/")
+    assert f"https://mybinder.org/v2/gh/{owner_repo}/HEAD" in readme
+    assert f"https://colab.research.google.com/github/{owner_repo}/blob/main/labkit/student_notebooks/" in readme
+    assert f'%pip install "labkit @ git+{REPOSITORY}"' in readme
+    urls = set(re.findall(r"https://(?:github\.com|mybinder\.org/v2/gh|colab\.research\.google\.com/github)/"
+                          r"([\w.-]+/[\w.-]+)", readme))
+    assert urls == {owner_repo}, urls
+    for path in NOTEBOOKS + paths():
+        assert f'%pip install \\"labkit @ git+{REPOSITORY}\\"' in Path(path).read_text() or \
+            f'%pip install "labkit @ git+{REPOSITORY}"' in Path(path).read_text(), path

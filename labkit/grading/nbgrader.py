@@ -1,0 +1,83 @@
+"""nbgrader's cell metadata for the instructor notebooks (cell metadata schema version 3).
+
+A course that runs nbgrader takes ``notebooks/`` as its ``source/<assignment>/``
+folder. nbgrader reads what each cell is from ``cell.metadata["nbgrader"]``:
+
+* a code cell with a ``### BEGIN SOLUTION`` region is a *solution* cell
+  (``solution: true``): nbgrader replaces the region by its stub, as
+  ``labkit release`` does;
+* a cell with ``### BEGIN HIDDEN TESTS`` is an *autograded test* cell
+  (``grade: true``, ``locked: true``) worth the points of the parts its
+  asserts check, the weights of :data:`labkit.checks.exercises.EXERCISES`,
+  so nbgrader's points per exercise are labkit's;
+* every other cell is *locked*: students cannot edit it (they can add cells).
+
+:func:`mark` computes this from the cells' markers, so it never drifts from the
+notebooks; ``labkit execute`` applies it before saving. The keys and their
+meaning follow nbgrader's ``nbgrader/nbgraderformat/v3.json``.
+"""
+import re
+
+from ..checks.drivers import METHODS
+from ..checks.exercises import EXERCISES
+from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
+
+SCHEMA_VERSION = 3
+EXERCISE_OF_TESTS = re.compile(r"^# tests for exercise (\d+)\s*$", re.MULTILINE)
+
+
+def _hidden_region(source):
+    return source.split(BEGIN_HIDDEN, 1)[1].split(END_HIDDEN, 1)[0]
+
+
+CHECK_CALL = re.compile(r"labkit\.check\.(\w+)\(\s*(?:\"(\w+)\"|(\w+))")
+
+
+def _checked_part(function, key, name):
+    """The part name a ``labkit.check.function(first argument`` call checks."""
+    if function in ("driver", "table", "rate") and key in METHODS:
+        return getattr(METHODS[key], function)
+    return name
+
+
+def test_points(source, where="a test cell"):
+    """(exercise, points) of a hidden-test cell: the weights of the parts its asserts check.
+
+    Each ``labkit.check.f(x, ...)`` call checks the part named ``x`` (for
+    ``driver``, ``table`` and ``rate``, the experiment's driver, table or rate
+    name); a part such as ``ax14: the data`` is named by its first word."""
+    found = EXERCISE_OF_TESTS.search(source)
+    if not found or int(found.group(1)) not in EXERCISES:
+        raise ValueError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
+    number = int(found.group(1))
+    checked = {_checked_part(function, key, name) for function, key, name in CHECK_CALL.findall(_hidden_region(source))}
+    points = sum(part.weight for part in EXERCISES[number].parts if part.name.split(":")[0] in checked)
+    if not points:
+        raise ValueError(f"{where} tests exercise {number} but checks none of its parts "
+                         f"({', '.join(p.name for p in EXERCISES[number].parts)}).")
+    return number, points
+
+
+def mark(nb, name="notebook"):
+    """Give every cell of an instructor notebook nbgrader's metadata (in place); returns `nb`."""
+    counters = {}
+
+    def grade_id(kind):
+        counters[kind] = counters.get(kind, 0) + 1
+        return f"{kind}-{counters[kind]}"
+
+    for index, cell in enumerate(nb.cells):
+        meta = {"schema_version": SCHEMA_VERSION, "grade": False, "solution": False, "locked": True}
+        if cell.cell_type == "code" and BEGIN_SOLUTION in cell.source:
+            meta.update(solution=True, locked=False, grade_id=grade_id(f"{_stem(name)}-solution"))
+        elif cell.cell_type == "code" and BEGIN_HIDDEN in cell.source:
+            number, points = test_points(cell.source, f"{name}, cell {index}")
+            meta.update(grade=True, points=points, grade_id=grade_id(f"exercise{number}-tests"))
+        else:
+            meta["grade_id"] = grade_id(f"{_stem(name)}-locked")
+        cell.metadata["nbgrader"] = meta
+    return nb
+
+
+def _stem(name):
+    return re.sub(r"[^a-zA-Z0-9_-]+", "-", name.rsplit(".", 1)[0])
