@@ -7,8 +7,6 @@ Used by ``labkit execute`` and checked by tests/test_notebooks_clean.py.
 import subprocess
 from pathlib import Path
 
-import nbformat
-
 KERNEL = "python3"
 KERNELSPEC = {"display_name": "Python 3 (ipykernel)", "language": "python", "name": KERNEL}
 
@@ -23,6 +21,8 @@ def notebook_paths(directory):
 
 def read_notebook(path):
     """A notebook file as an nbformat v4 object; ValueError if it is not text or not a notebook."""
+    import nbformat  # the [grade] extra; imported here so that `import labkit` stays light
+
     try:
         text = Path(path).read_text(encoding="utf-8")
     except UnicodeDecodeError:
@@ -38,6 +38,7 @@ def execute(path, timeout=300, before_save=None):
 
     `before_save(nb, name)` may add to the notebook before it is written (``labkit
     execute`` gives the cells nbgrader's metadata)."""
+    import nbformat
     from nbclient import NotebookClient
 
     path = Path(path)

@@ -104,3 +104,14 @@ def test_one_repository_url_for_the_badges_and_the_install_line():
     for path in NOTEBOOKS + paths():
         assert f'%pip install \\"labkit @ git+{REPOSITORY}\\"' in Path(path).read_text() or \
             f'%pip install "labkit @ git+{REPOSITORY}"' in Path(path).read_text(), path
+
+
+def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
+    # every notebook starts a worker: what it imports is paid once per notebook graded
+    code = ("import sys, labkit.grading.worker\n"
+            "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.batch', "
+            "'labkit.grading.scoring', 'labkit.grading.report', 'concurrent.futures.process'}))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
+    from labkit import grading
+    assert callable(grading.release) and callable(grading.grade) and grading.report.safe_name("a b") == "a_b"

@@ -15,11 +15,31 @@ One module per concern:
 
 Student code never runs in the grading process: see the README's "For instructors".
 """
-from .batch import grade
-from .release import release, release_notebook, strip_solutions
-from .report import SubmissionGrade, merge
-from .rubric import Rubric, load as load_rubric
-from .scoring import exercises_in, grade_notebook, grade_submission, submission_notebooks
+import importlib
 
-__all__ = ["Rubric", "SubmissionGrade", "load_rubric", "exercises_in", "grade", "grade_notebook", "grade_submission", "merge", "release",
-           "release_notebook", "strip_solutions", "submission_notebooks"]
+from .release import release, release_notebook, strip_solutions  # light: nbformat is imported when used
+
+# Names are imported on first use (PEP 562), so that the sandboxed worker, started as
+# ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
+_EXPORTS = {"grade": "batch", "SubmissionGrade": "report", "merge": "report", "Rubric": "rubric",
+            "load_rubric": "rubric", "exercises_in": "scoring", "grade_notebook": "scoring", "grade_submission": "scoring",
+            "submission_notebooks": "scoring"}
+_MODULES = {"batch", "nbgrader", "protocol", "refusals", "release", "remote", "report", "rubric", "sandbox",
+            "scoring", "worker"}
+
+__all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]
+
+
+def __getattr__(name):
+    if name in _MODULES:
+        return importlib.import_module(f".{name}", __name__)
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module = importlib.import_module(f".{_EXPORTS[name]}", __name__)
+    value = getattr(module, "load" if name == "load_rubric" else name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS) | _MODULES)

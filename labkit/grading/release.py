@@ -8,8 +8,6 @@ markers are nbgrader's.
 import json
 from pathlib import Path
 
-import nbformat
-
 from ..notebooks import notebook_paths, read_notebook
 
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
@@ -43,6 +41,8 @@ def strip_solutions(source, where="cell"):
 
 def release_notebook(nb, name="notebook"):
     """The student version of an instructor notebook (a new object)."""
+    import nbformat  # the [grade] extra
+
     student = nbformat.from_dict(json.loads(json.dumps(nb)))
     student.metadata.pop("widgets", None)
     for index, cell in enumerate(student.cells):
@@ -55,6 +55,8 @@ def release_notebook(nb, name="notebook"):
 
 def release(notebook_dir, out_dir):
     """Write the student version of every notebook of `notebook_dir` into `out_dir`."""
+    import nbformat
+
     paths = notebook_paths(notebook_dir)
     out = Path(out_dir)
     if out.resolve() == Path(notebook_dir).resolve():
