@@ -158,12 +158,14 @@ def driver(key, fn, seed=None):
     sizes = method.ndata[:3]
     if seed is not None:  # the grader's fresh size
         sizes += (int(case_rng(seed, 40 + len(key)).integers(6, 60)),)
+    where = (f"[0, 5]^2 with {method.ntest} x {method.ntest} test points" if key == "bilinear"
+             else f"[0, 5] with {method.ntest} test points")
     for ndata in sizes:
         ok, err = call(result, f"ndata = {ndata}", fn, ndata, method.f(), *method.pieces)
         if not ok:
             return result
         expected = method.reference([ndata])[0]
-        if not result.step(f"Err({ndata}) = max|f - p| / max|f| on [0, 5] with {method.ntest} test points",
+        if not result.step(f"Err({ndata}) = max|f - p| / max|f| on {where}",
                            _agrees(err, expected), f"got {shown(err)}, expected {expected:.6e}"):
             slip = _diagnosis(method, err, ndata)
             result.hint = (slip if slip else
