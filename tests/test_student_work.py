@@ -358,3 +358,16 @@ def test_every_exercise_but_the_first_is_graded_in_parts_whose_weights_are_the_l
     for number, exercise in EXERCISES.items():
         assert exercise.points == rubric.points[number]
         assert len({part.name for part in exercise.parts}) == len(exercise.parts)
+
+
+def test_very_long_lines_are_judged_on_a_sample_with_the_same_verdict():
+    # the grader bounds its work on a plot (plotted.SAMPLE points per line, plotted.MAX_CURVES lines)
+    t = np.linspace(0, 2 * np.pi, 3 * plotted.SAMPLE + 7)
+    x, y, _, _ = labkit.limacon(t)
+    on_curve = plotted.Line(x, y, "None", "-")
+    assert check.limacon_plot([on_curve]).passed
+    off = plotted.Line(x + np.where(np.arange(t.size) % 2 == 0, 0.05, 0.0), y, "None", "-")
+    result = check.limacon_plot([off])
+    assert not result.passed and "more than 0.02 away" in repr(result)
+    nowhere = plotted.Line(np.zeros(t.size), np.zeros(t.size), "None", "-")
+    assert not check.limacon_plot([nowhere] * (plotted.MAX_CURVES + 5)).passed
