@@ -94,15 +94,20 @@ def test_required_student_code_sits_in_solution_regions_with_signatures_outside(
             assert name in hidden, f"exercise {exercise.number}: no hidden test mentions {name}"
 
 
-def _plant(tmp_path, name, notebook, old, new, released=None, untouched=()):
-    """A submission folder: the instructor notebooks with one solution line changed
-    (and the notebooks in `untouched` as released, not done)."""
+def _partly_done(tmp_path, name, released, untouched):
+    """A submission folder: the instructor notebooks, but those in `untouched` as released (not done)."""
     folder = tmp_path / name
     folder.mkdir()
     for path in NOTEBOOKS.glob("*.ipynb"):
-        if path.name in untouched:
-            shutil.copy(released / path.name, folder / path.name)
-            continue
+        shutil.copy((released if path.name in untouched else NOTEBOOKS) / path.name, folder / path.name)
+    return folder
+
+
+def _plant(tmp_path, name, notebook, old, new):
+    """A submission folder: the instructor notebooks with one solution line changed."""
+    folder = tmp_path / name
+    folder.mkdir()
+    for path in NOTEBOOKS.glob("*.ipynb"):
         nb = nbformat.read(path, as_version=4)
         if path.name == notebook:
             hits = [c for c in nb.cells if old in c.source]
@@ -159,10 +164,9 @@ def graded(tmp_path_factory, released):
         "prints_megabytes": _broken(tmp, "prints_megabytes", "for _ in range(50):\n    print('x' * 1_000_000)"),
         "deletes_files": _broken(tmp, "deletes_files", "import os\nfor f in os.listdir('.'):\n    os.remove(f)"),
         # the lab's rubric: exercises 1-4 and one branch is full credit, the other branch extra
-        "spline_branch_only": _plant(tmp, "spline_branch_only", "01_limacon.ipynb", "nintervals = 20",
-                                     "nintervals = 20", released, ("03_meshes.ipynb", "06_bilinear.ipynb")),
-        "both_branches": _plant(tmp, "both_branches", "01_limacon.ipynb", "nintervals = 20", "nintervals = 20",
-                                released, ("06_bilinear.ipynb",)),
+        "spline_branch_only": _partly_done(tmp, "spline_branch_only", released,
+                                           ("03_meshes.ipynb", "06_bilinear.ipynb")),
+        "both_branches": _partly_done(tmp, "both_branches", released, ("06_bilinear.ipynb",)),
     }
     for name, notebook, old, new, *_ in PLANTED:
         subs[name] = _plant(tmp, name, notebook, old, new)

@@ -21,6 +21,7 @@ an earlier exercise is not counted again here. The functions handed over are
 module-level functions, so ``labkit grade`` can name them to the sandboxed
 notebook (:data:`labkit.grading.protocol.PASSABLE`).
 """
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,7 +81,13 @@ class Method:
     @property
     def order(self):
         """The order the reference table shows (the lab's answer)."""
-        return convergence.ConvergenceTable(self.title, np.array(self.ndata), self.reference(self.ndata)).order
+        return _reference_order(self)
+
+
+@functools.lru_cache(maxsize=None)
+def _reference_order(method):
+    """Computed once per experiment: a grading run asks for it once per submission."""
+    return convergence.ConvergenceTable(method.title, np.array(method.ndata), method.reference(method.ndata)).order
 
 
 LAB_NDATA = convergence.DEFAULT_NDATA
@@ -259,11 +266,12 @@ def rate(key, answer, errors=None):
     if p in accepted:
         result.step(description, True)
         return result
-    ratio_hint = (f"{p} is the ratio itself, 2**{int(np.log2(p))}; the rate is its exponent {int(np.log2(p))}"
-                  if p > 1 and 2 ** int(round(np.log2(p))) == p and int(round(np.log2(p))) in accepted else None)
+    exponent = p.bit_length() - 1 if p > 1 else None
     supported = f"your table's ratios support {own}" if own is not None else "look at the ratios of the table"
-    result.fail(description, f"got {p}; {supported}",
-                (ratio_hint + "." if ratio_hint else
-                 f"take the ratios Err(41)/Err(81), Err(81)/Err(161), ...; they settle near a power of two 2**p, "
-                 f"and p is the rate ({supported})."))
+    if exponent is not None and p == 2 ** exponent and exponent in accepted:
+        hint = f"{p} is the ratio itself, 2**{exponent}; the rate is its exponent {exponent}."
+    else:
+        hint = (f"take the ratios Err(41)/Err(81), Err(81)/Err(161), ...; they settle near a power of two 2**p, "
+                f"and p is the rate ({supported}).")
+    result.fail(description, f"got {p}; {supported}", hint)
     return result

@@ -29,7 +29,8 @@ _CONVERGENCE = ("labkit.convergence_table", "labkit.ConvergenceTable", "labkit.b
 class Part:
     """One graded piece of an exercise: a check of some of the notebook's names, and its weight.
 
-    ``run(ns, seed)`` returns one :class:`CheckResult`. The weights of an
+    ``run(ns, seed)`` returns one :class:`CheckResult`, or, for parts that share
+    one check (``index`` set), a list of them, run once for all. The weights of an
     exercise's parts are its points in the lab's rubric; a rubric that gives
     the exercise other points scales them (:mod:`labkit.grading.rubric`).
     """
@@ -37,6 +38,7 @@ class Part:
     name: str
     weight: int
     run: object
+    index: int = None  # when `run` checks several parts at once (one plot), which of its results is this part's
 
 
 @dataclass(frozen=True)
@@ -80,8 +82,8 @@ def _limacon_data(ns):
     return None if any(v is None for v in values) else values
 
 
-def _boiling_part(index):
-    return lambda ns, seed: plotted.boiling_plot(ns["ax14"])[index]
+def _boiling(ns, seed):
+    return plotted.boiling_plot(ns["ax14"])
 
 
 EXERCISES = {e.number: e for e in (
@@ -112,7 +114,7 @@ EXERCISES = {e.number: e for e in (
              + _driver_parts("natural", 2, 2, 2),
              refused=_LABKIT_SPLINES + _SCIPY_1D),
     Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2), refused=_CONVERGENCE),
-    Exercise(14, ("ax14",), tuple(Part(name, 2, _boiling_part(i))
+    Exercise(14, ("ax14",), tuple(Part(name, 2, _boiling, index=i)
                                   for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline",
                                                             "ax14: pchip"))),
              refused=()),
@@ -153,10 +155,15 @@ def grade(number, namespace, seed=None):
     """
     exercise = EXERCISES[number]
     defined = any(name in namespace for name in exercise.names)
-    checks = []
+    checks, shared = [], {}
     for part in exercise.parts:
         try:
-            result = part.run(namespace, seed)
+            if part.index is None:
+                result = part.run(namespace, seed)
+            else:
+                if part.run not in shared:
+                    shared[part.run] = part.run(namespace, seed)
+                result = shared[part.run][part.index]
         except KeyError as exc:
             result = _missing(str(exc).strip("'\""))
             result.name = part.name
