@@ -37,11 +37,13 @@ notebooks: $(STAMP)
 	$(VENV)/bin/labkit execute notebooks
 	$(VENV)/bin/labkit release notebooks --out labkit/student_notebooks
 
-bench: $(STAMP)
+# Speed limits live here, never in `make test`: the last step fails if a slider's median is above 100 ms.
+bench: $(STAMP) chromium
 	$(PY) benchmarks/bench_core.py
 	$(PY) benchmarks/bench_2d.py
 	$(PY) benchmarks/bench_sliders.py
 	$(PY) benchmarks/bench_grading.py
+	$(PY) benchmarks/bench_browser_latency.py
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis

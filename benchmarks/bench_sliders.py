@@ -4,8 +4,8 @@ Run: ``.venv/bin/python benchmarks/bench_sliders.py``. "Before" is what a slider
 did until now: build a new figure with the ``plot_*`` function and render it to
 PNG at 100 dpi, as the inline backend does. "After" is what an explorer of
 :mod:`labkit.plots.explorers` does: change a control, update the same artists,
-render one PNG. The browser adds the trip to the page: see the browser test's
-summary in ``make test``.
+render one PNG. The browser adds the trip to the page: see
+``benchmarks/bench_browser_latency.py``.
 """
 import io
 import time

@@ -1,5 +1,5 @@
-"""A JupyterLab server and what a test does with it in the browser: shared by the browser test
-and benchmarks/bench_backends.py.
+"""A JupyterLab server and what a test does with it in the browser: shared by the browser test,
+benchmarks/bench_backends.py and benchmarks/bench_browser_latency.py.
 
 The server runs on 127.0.0.1 with a token, with every Jupyter/IPython/matplotlib folder in a
 temporary directory, news, update checks and autosave off.
@@ -7,13 +7,18 @@ temporary directory, news, update checks and autosave off.
 import contextlib
 import json
 import os
+import shutil
 import socket
+import statistics
 import subprocess
 import sys
 import time
 import urllib.request
 from pathlib import Path
 
+ROOT = Path(__file__).resolve().parents[2]
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+MOVES = 8  # key presses per slider, mouse steps per drag
 TOKEN = "labkit-browser-test"
 CHROMIUM_FLAGS = [
     "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -83,6 +88,23 @@ def jupyterlab(home, served):
         log.close()
 
 
+@contextlib.contextmanager
+def course_lab(home):
+    """A JupyterLab server serving a copy of the course's notebooks/ made in `home`; yields its base URL."""
+    served = Path(home) / "notebooks"
+    shutil.copytree(ROOT / "notebooks", served, ignore=shutil.ignore_patterns("*.vtu", ".ipynb_checkpoints"))
+    with jupyterlab(home, served) as base:
+        yield base
+
+
+def close_sessions(base):
+    """Shut down every notebook's kernel, so the next notebook runs alone."""
+    for session in api(base, "/api/sessions"):
+        request = urllib.request.Request(f"{base}/api/sessions/{session['id']}", method="DELETE",
+                                         headers={"Authorization": f"token {TOKEN}"})
+        urllib.request.urlopen(request, timeout=10).close()
+
+
 def wait_for_idle_kernel(base, timeout=60):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -137,3 +159,110 @@ def frames(page):
     return page.evaluate("() => window.__labkitImageFrames || 0")
 
 
+def open_and_run(page, base, notebook):
+    """Open `notebook` alone in a fresh workspace and Run All; the code cells' summary (CELL_SUMMARY)."""
+    page.goto(f"{base}/lab/workspaces/{notebook.stem}/tree/{notebook.name}?reset&token={TOKEN}")
+    code_cells = sum(c["cell_type"] == "code" for c in json.loads(notebook.read_text())["cells"])
+    run_all(page, base, code_cells)
+    return page.evaluate(CELL_SUMMARY)
+
+
+def show_explorers(page):
+    """Scroll to the notebook's last cell and wait until its last slider is visible; the notebook's panel."""
+    panel = page.locator("#" + page.evaluate("() => window.jupyterapp.shell.currentWidget.id"))
+    sliders = panel.locator(".widget-slider")
+    sliders.first.wait_for(state="attached", timeout=30_000)
+    page.evaluate("""() => { const panel = window.jupyterapp.shell.currentWidget;
+        const last = panel.content.widgets.length - 1;
+        panel.content.activeCellIndex = last; return panel.content.scrollToItem(last, 'start'); }""")
+    sliders.last.wait_for(state="visible", timeout=30_000)
+    return panel
+
+
+NEW_PICTURE_NTH = """([e, old, framesBefore]) => {
+  // a new picture: an <img> in explorer e whose src changed, or (a canvas backend such as ipympl)
+  // image data that arrived on the kernel's websocket
+  const node = window.jupyterapp.shell.currentWidget.node.querySelectorAll('.labkit-explorer, .labkit-patch-editor')[e];
+  const img = node && node.querySelector('img');
+  if (img) return img.src !== old;
+  return window.__labkitImageFrames > framesBefore;
+}"""
+
+
+def _picture_src_nth(page, e):
+    return page.evaluate("e => { const n = window.jupyterapp.shell.currentWidget.node"
+                         ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')[e];"
+                         " const img = n && n.querySelector('img'); return img ? img.src : null; }", e)
+
+
+def move_every_slider(page, panel, name):
+    """Press the arrow keys on each explorer slider; {slider: [seconds from key press to new picture]}."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    timings = {}
+    explorers = panel.locator(".labkit-explorer, .labkit-patch-editor")
+    for e in range(explorers.count()):
+        explorer = explorers.nth(e)
+        kind = "editor " if "labkit-patch-editor" in (explorer.get_attribute("class") or "") else ""
+        sliders = explorer.locator(".widget-slider")
+        for k in range(sliders.count()):
+            slider = sliders.nth(k)
+            label = f"{name} {kind}{slider.locator('.widget-label').inner_text() or k}"
+            readout, handle = slider.locator(".widget-readout"), slider.locator(".noUi-handle")
+            times = []
+            key = "ArrowRight"
+            for _ in range(MOVES):
+                old_readout = readout.inner_text()
+                old_src, frames_before = _picture_src_nth(page, e), frames(page)
+                handle.focus()
+                start = time.perf_counter()
+                page.keyboard.press(key)
+                try:
+                    page.wait_for_function("([node, old]) => node.innerText !== old",
+                                           arg=[readout.element_handle(), old_readout], timeout=2_000)
+                except PlaywrightTimeout:  # at the end of its range: go back
+                    key = "ArrowLeft" if key == "ArrowRight" else "ArrowRight"
+                    continue
+                page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
+                times.append(time.perf_counter() - start)
+            assert len(times) >= MOVES - 1, f"{label}: the slider did not move"
+            timings[label] = times
+    return timings
+
+
+def drag_a_corner(page, panel):
+    """Drag corner B of the patch editor in steps and let go; (seconds per step, readout before, readout after)."""
+    editor = panel.locator(".labkit-patch-editor").first
+    e = page.evaluate("() => [...window.jupyterapp.shell.currentWidget.node"
+                      ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')]"
+                      ".findIndex(n => n.classList.contains('labkit-patch-editor'))")
+    corner = editor.locator("circle[data-handle='1']")
+    corner.scroll_into_view_if_needed()
+    readout = editor.locator(".labkit-editor-readout")
+    before_readout = readout.inner_text()
+    box = corner.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    steps = []
+    for k in range(1, MOVES + 1):
+        old_src, frames_before = _picture_src_nth(page, e), frames(page)
+        start = time.perf_counter()
+        page.mouse.move(x + 6 * k, y + 3 * k)
+        page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
+        steps.append(time.perf_counter() - start)
+    page.mouse.up()
+    page.wait_for_function("([node, old]) => node.innerText !== old", arg=[readout.element_handle(), before_readout],
+                           timeout=10_000)
+    return steps, before_readout, readout.inner_text()
+
+
+def percentile(values, fraction):
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(round(fraction * (len(ordered) - 1))))]
+
+
+def latencies(timings):
+    """{slider: (median ms, 90th percentile ms, moves)} from move_every_slider's {slider: [seconds]}."""
+    return {label: (1000 * statistics.median(times), 1000 * percentile(times, 0.9), len(times))
+            for label, times in timings.items()}
