@@ -9,7 +9,7 @@ from labkit import check
 def test_reference_implementations_pass_every_check():
     assert check.eval_pherm(labkit.eval_pherm).passed
     assert check.runge(labkit.runge).passed
-    assert check.ccspline(labkit.ccspline, check._reference_complete_system).passed
+    assert check.ccspline(labkit.ccspline, labkit.checks.splines._reference_complete_system).passed
     assert check.ncspline(labkit.ncspline).passed
     assert check.runge2d(labkit.runge2d).passed
     assert check.eval_pbilin(labkit.eval_pbilin).passed
@@ -68,7 +68,7 @@ def test_ccspline_subscript_mistake_is_located_by_the_equal_interval_case():
 
 def test_ccspline_asymmetric_matrix_is_reported():
     def system(xdata, ydata, y1p, ynp):
-        A, D = check._reference_complete_system(np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp)
+        A, D = labkit.checks.splines._reference_complete_system(np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp)
         A[1, 0] *= 2
         return A, D
 
@@ -122,7 +122,7 @@ def test_seeded_random_cases_are_fresh_per_seed_and_repeatable():
 def test_reference_implementations_pass_with_any_seed(seed):
     assert check.runge(labkit.runge, seed=seed).passed
     assert check.driver("pherm", _table_error, seed=seed).passed
-    assert check.ccspline(labkit.ccspline, check._reference_complete_system, seed=seed).passed
+    assert check.ccspline(labkit.ccspline, labkit.checks.splines._reference_complete_system, seed=seed).passed
     assert check.ncspline(labkit.ncspline, seed=seed).passed
     assert check.runge2d(labkit.runge2d, seed=seed).passed
     assert check.eval_pbilin(labkit.eval_pbilin, seed=seed).passed

@@ -7,7 +7,6 @@ import pytest
 import labkit
 from labkit.checks.result import close, worst
 from labkit.grading import protocol
-from labkit.grading.refusals import switched_off
 
 
 def _roundtrip(value, functions=False):
@@ -95,16 +94,36 @@ def test_functions_cross_only_by_name_and_only_the_listed_ones():
     assert tag == ["fn", "labkit.piecewise:eval_pherm"]
     assert protocol.encode(np.sin)[0] == "obj"
     with pytest.raises(protocol.ProtocolError, match="not a function the checks pass"):
-        protocol.decode(["fn", "os:system"], functions=True)
+        protocol.passable("os:system")
+    assert protocol.passable("labkit.functions:runge2d") is labkit.runge2d
+    # the notebook's side takes only what this request handed over, by name
+    handed = {"labkit.functions:runge2d": labkit.runge2d}
+    assert protocol.decode(["fn", "labkit.functions:runge2d"], functions=handed) is labkit.runge2d
+    with pytest.raises(protocol.ProtocolError, match="not handed over"):
+        protocol.decode(["fn", "labkit.piecewise:eval_pherm"], functions=handed)
+    assert protocol.function_names([["t", [["fn", "a:b"], ["l", [["fn", "c:d"]]]]], ["f", 1.0]]) == {"a:b", "c:d"}
 
 
-def test_a_passed_function_still_works_while_its_reference_is_switched_off():
-    x, y = np.array([0.0, 1.0]), np.array([1.0, 2.0])
-    passed = protocol.decode(["fn", "labkit.functions:runge2d"], functions=True)
-    with switched_off(["labkit.runge2d"]):
-        with pytest.raises(RuntimeError, match="switched off"):
-            labkit.runge2d(x, y)
-        assert np.allclose(passed(x, y), 1 / (1 + (x + y) ** 2))
+def test_a_corner_is_rebuilt_checked_without_running_its_class_code():
+    corner = protocol.decode(protocol.encode(labkit.Corner([0, 1], [1, 0], [0, 2])))
+    assert isinstance(corner, labkit.Corner) and corner.dsdt.tolist() == [0.0, 0.0] and corner.dim == 2
+    mismatched = ["corner", protocol.encode(np.zeros(2)), protocol.encode(np.zeros(3)), protocol.encode(np.zeros(2)),
+                  protocol.encode(np.zeros(2))]
+    assert "same size" in str(protocol.decode(mismatched))
+    infinite = ["corner"] + [protocol.encode(np.array([np.inf, 0.0]))] * 4
+    assert "NaN or infinite" in str(protocol.decode(infinite))
+
+
+def test_a_message_is_bounded_before_it_is_parsed():
+    # a line of nested empty lists costs the JSON parser some thirty times its size: refused on its bytes
+    bomb = b'{"id": "x", "value": ' + b"[" * (protocol.MAX_CONTAINERS + 1) + b"]" * (protocol.MAX_CONTAINERS + 1) + b"}"
+    with pytest.raises(protocol.ProtocolError, match="lists and objects"):
+        protocol.loads(bomb)
+    with pytest.raises(protocol.ProtocolError, match="larger than"):
+        protocol.loads(b" " * (protocol.MAX_LINE + 1))
+    # the largest honest answer fits: the lab's meshes and a long plotted curve
+    line = protocol.dumps({"id": "x", "value": protocol.encode([np.zeros((100_000, 2)), list(range(50_000))])})
+    assert protocol.loads(line)["id"] == "x"
 
 
 def test_dumps_is_one_line_of_json():

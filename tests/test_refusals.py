@@ -1,63 +1,222 @@
-"""Reference implementations a graded function may not call: switched off at run time, found in source."""
+"""What a graded function may not reach: the sandbox's watch at run time, the source scan on the grader's side.
+
+The watch is tested through a real worker (unconfined here, so the tests
+run without bubblewrap; the hostile suite repeats the important attacks in
+the sandbox): each attack is a notebook's cells, and the grader's proxy
+calls the student's function with a part's refusal, as grading does.
+"""
 import numpy as np
 import pytest
-import scipy.interpolate
 
 import labkit
 from labkit.checks import exercises, hermite
-from labkit.grading.refusals import RefusedReference, scan, switched_off
+from labkit.checks.exercises import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN_PATCH, REFUSALS
+from labkit.grading import guard, refusals, remote, scoring
+from labkit.grading.scan import Unreadable, python_source, scan
 
 X, Y, YP = np.array([0.0, 1.0, 3.0]), np.array([1.0, -1.0, 2.0]), np.array([0.0, 2.0, -1.0])
 XV = np.linspace(-0.5, 3.5, 9)
+HONEST_PHERM = """
+import numpy as np, labkit
+
+def eval_pherm(xdata, ydata, ypdata, xval):
+    xdata, ydata, ypdata, xval = (np.asarray(v, dtype=float) for v in (xdata, ydata, ypdata, xval))
+    k = labkit.bracket(xdata, xval)
+    a, b = xdata[k], xdata[k + 1]
+    h = b - a
+    s = (xval - a) / h
+    return (ydata[k] * (1 + 2 * s) * (1 - s) ** 2 + ypdata[k] * h * s * (1 - s) ** 2
+            + ydata[k + 1] * s**2 * (3 - 2 * s) + ypdata[k + 1] * h * s**2 * (s - 1))
+"""
+PROFILES = scoring._for_sandbox(refusals.wire(REFUSALS))
 
 
-def test_every_alias_of_a_refused_function_raises_and_is_restored_after():
-    captured = labkit.eval_pherm  # taken before grading, as a student's `from labkit import ...` would
-    from labkit.piecewise import eval_pherm as deep
-    expected = scipy.interpolate.CubicHermiteSpline(X, Y, YP)(XV)
-    with switched_off(["labkit.eval_pherm"]) as attempts:
-        for alias in (captured, deep, labkit.eval_pherm):
-            with pytest.raises(RefusedReference, match="labkit.eval_pherm is switched off"):
-                alias(X, Y, YP, XV)
-        assert attempts == ["labkit.eval_pherm"] * 3
-    assert np.allclose(captured(X, Y, YP, XV), expected)
+@pytest.fixture(scope="module")
+def open_notebooks():
+    started = []
+    yield started
+    for notebook in started:
+        notebook.close()
 
 
-def test_a_refused_class_raises_through_aliases_and_classmethods():
-    Hermite = scipy.interpolate.CubicHermiteSpline
-    with switched_off(exercises.EXERCISES[2].refused) as attempts:
-        with pytest.raises(RefusedReference, match="CubicHermiteSpline"):
-            Hermite(X, Y, YP)
-        with pytest.raises(RefusedReference, match="BPoly"):
-            scipy.interpolate.BPoly.from_derivatives(X, np.c_[Y, YP])
-        try:  # caught by the student's code: still logged
-            scipy.interpolate.CubicSpline(X, Y)
-        except RefusedReference:
-            pass
-        assert attempts[-1] == "scipy.interpolate.CubicSpline"
-        assert labkit.bracket(X, XV).tolist() == np.clip(np.searchsorted(X, XV, "right") - 1, 0, 1).tolist()
-    assert np.allclose(Hermite(X, Y, YP)(XV), labkit.eval_pherm(X, Y, YP, XV))
-    assert "__init__" not in scipy.interpolate.CubicHermiteSpline.__dict__ or \
-        scipy.interpolate.CubicHermiteSpline.__init__.__name__ == "__init__"
+def _notebook(open_notebooks, *cells):
+    notebook = remote.Notebook(confined=False, profiles=PROFILES)
+    open_notebooks.append(notebook)
+    ran = notebook.request({"op": "run", "cells": list(cells), "cell_timeout": 30}, 120)
+    assert not ran["errors"], ran["errors"]
+    return notebook
 
 
-def test_a_student_eval_pherm_built_on_the_allowed_helpers_is_graded_as_usual():
-    def eval_pherm(xdata, ydata, ypdata, xval):
-        k = labkit.bracket(xdata, xval)
-        xdata, ydata, ypdata, xval = map(np.asarray, (xdata, ydata, ypdata, xval))
-        a, b, t = xdata[k], xdata[k + 1], np.asarray(xval, float)
-        h = b - a
-        s = (t - a) / h
-        return (ydata[k] * (1 + 2 * s) * (1 - s) ** 2 + ypdata[k] * h * s * (1 - s) ** 2
-                + ydata[k + 1] * s**2 * (3 - 2 * s) + ypdata[k + 1] * h * s**2 * (s - 1))
+def _call(notebook, name, refusal, *args):
+    return remote.Function(notebook, name, refusal, 30)(*args)
 
-    def in_the_sandbox(*args):  # as the worker calls it: references off during the call only
-        with switched_off(exercises.EXERCISES[2].refused) as attempts:
-            value = eval_pherm(*args)
-        assert attempts == []
-        return value
 
-    assert hermite.eval_pherm(in_the_sandbox, seed=3).passed
+def test_an_honest_function_built_on_the_allowed_helpers_passes_the_check_under_its_refusal(open_notebooks):
+    notebook = _notebook(open_notebooks, HONEST_PHERM)
+    assert hermite.eval_pherm(lambda *a: _call(notebook, "eval_pherm", INTERPOLANTS, *a), seed=3).passed
+    assert np.allclose(_call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV), labkit.eval_pherm(X, Y, YP, XV))
+
+
+ATTACKS = {
+    "the reference itself": "def eval_pherm(*a):\n    return labkit.eval_pherm(*a)",
+    "an alias taken before grading": "from labkit.piecewise import eval_pherm as ref\n"
+                                     "def eval_pherm(*a):\n    return ref(*a)",
+    "a private helper": "def eval_pherm(x, y, yp, xv):\n"
+                        "    return labkit.piecewise._hermite_eval(*map(np.asarray, (x, y, yp, xv)))",
+    "BPoly through a subclass and construct_fast": (
+        "from scipy.interpolate import BPoly\n"
+        "class H(BPoly):\n"
+        "    def __new__(cls, x, c):\n        return BPoly.construct_fast.__func__(cls, c, x)\n"
+        "    def __init__(self, *a):\n        pass\n"
+        "def eval_pherm(x, y, yp, xv):\n"
+        "    x, y, yp = map(np.asarray, (x, y, yp))\n"
+        "    h = np.diff(x)\n"
+        "    c = np.stack([y[:-1], y[:-1] + yp[:-1] * h / 3, y[1:] - yp[1:] * h / 3, y[1:]])\n"
+        "    return H(x, c)(xv)"),
+    "a saved code object put back under a new function": (
+        "import types\nsaved = labkit.piecewise.eval_pherm.__code__\n"
+        "def eval_pherm(*a):\n    return types.FunctionType(saved, labkit.piecewise.__dict__, None, (0,))(*a)"),
+    "labkit's code pasted into the notebook": (
+        "import inspect\nexec(inspect.getsource(labkit.piecewise).replace('from ._', 'from labkit._'), globals())"),
+    "scipy's CubicHermiteSpline": "import scipy.interpolate as si\n"
+                                  "def eval_pherm(x, y, yp, xv):\n    return si.CubicHermiteSpline(x, y, yp)(xv)",
+    "a compiled routine of scipy.interpolate": (
+        "from scipy.interpolate import _ppoly\n"
+        "def eval_pherm(x, y, yp, xv):\n"
+        "    f = getattr(__import__('scipy.interpolate._ppoly').interpolate._ppoly, 'evaluate')\n"
+        "    return f(np.zeros((4, 1, 1)), np.asarray(x, float)[:2], np.asarray(xv, float), 0, True,\n"
+        "             np.empty((len(xv), 1)))[:, 0]"),
+}
+
+
+@pytest.mark.parametrize("name", ATTACKS)
+def test_every_path_to_a_library_interpolant_is_refused(open_notebooks, name):
+    notebook = _notebook(open_notebooks, "import numpy as np, labkit", ATTACKS[name])
+    with pytest.raises(remote.StudentError) as refused:
+        _call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV)
+    assert refused.value.kind == "RefusedReference", (refused.value.kind, str(refused.value))
+    assert "switched off" in str(refused.value)
+
+
+def test_private_spline_helpers_and_ndimage_are_refused_like_the_public_functions(open_notebooks):
+    notebook = _notebook(
+        open_notebooks, "import numpy as np, labkit\nfrom labkit import splines\nimport scipy.ndimage",
+        "def ncspline(x, y):\n    x, y = np.asarray(x, float), np.asarray(y, float)\n    h = np.diff(x)\n"
+        "    s = np.diff(y) / h\n    return splines._slopes_from_curvatures(h, s, splines.natural_curvatures(h, s))",
+        "def eval_pbilin(f, xd, yd, xv, yv):\n    z = f(*np.meshgrid(xd, yd, indexing='ij'))\n"
+        "    i = np.interp(xv, xd, np.arange(len(xd)))\n    j = np.interp(yv, yd, np.arange(len(yd)))\n"
+        "    I, J = np.meshgrid(i, j, indexing='ij')\n"
+        "    return scipy.ndimage.map_coordinates(z, [I, J], order=1)")
+    for name, args, reference in (("ncspline", (X, Y), "labkit.splines"),
+                                  ("eval_pbilin", (labkit.runge2d, X, X, XV, XV), "interp")):
+        with pytest.raises(remote.StudentError, match="switched off") as refused:
+            _call(notebook, name, INTERPOLANTS, *args)
+        assert reference in str(refused.value)
+
+
+def test_a_handed_over_function_is_trusted_only_in_the_call_it_was_handed_to(open_notebooks):
+    notebook = _notebook(open_notebooks, "import numpy as np\nkept = []",
+                         "def driver(n, f):\n    kept.append(f)\n    return float(np.max(f(np.linspace(0, 5, n))[0]))",
+                         "def runge(x):\n    return kept[0](x)")
+    # the driver may use the labkit runge the check hands it (labkit.functions is refused in its part too)
+    assert _call(notebook, "driver", OWN_FUNCTIONS, 11, labkit.runge) == pytest.approx(1.0)
+    # but a student who kept it cannot use it for the part that asks for their own runge
+    with pytest.raises(remote.StudentError, match="labkit.functions.runge"):
+        _call(notebook, "runge", OWN_FUNCTIONS, XV)
+
+
+def test_a_handed_over_function_gets_plain_numbers_whatever_it_is_given(open_notebooks):
+    notebook = _notebook(open_notebooks, "import numpy as np, labkit",
+                         "class Sly:\n    def __array__(self, *a, **k):\n"
+                         "        return labkit.convergence_table('pherm').errors[:1]\n"
+                         "def driver(n, f):\n    return float(f(Sly())[0][0])")
+    # the student's hook runs before the trusted copy does, so its refused call is seen
+    with pytest.raises(remote.StudentError, match="labkit.convergence"):
+        _call(notebook, "driver", EXPERIMENTS, 11, labkit.runge)
+
+
+def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
+    notebook = _notebook(open_notebooks, "import numpy as np, labkit",
+                         "def coons(A, B, C, D, s, t):\n    assert A.dim == 2\n"
+                         "    x = labkit.eval_pherm([0, 1], [A.point[0], B.point[0]], [A.ds[0], B.ds[0]], s)\n"
+                         "    return np.add.outer(x, 0 * np.asarray(t)), np.add.outer(0 * x, np.asarray(t))",
+                         "def cheat(A, B, C, D, s, t):\n    return labkit.patch(A, B, C, D, s, t)")
+    corners = [labkit.Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+    x, y = _call(notebook, "coons", OWN_PATCH, *corners, np.linspace(0, 1, 4), np.linspace(0, 1, 5))
+    assert x.shape == (4, 5)
+    with pytest.raises(remote.StudentError, match="labkit.patches"):
+        _call(notebook, "cheat", OWN_PATCH, *corners, np.linspace(0, 1, 4), np.linspace(0, 1, 5))
+
+
+@pytest.mark.parametrize("cells, says", [
+    (["import gc\ndef eval_pherm(*a):\n    gc.get_objects()\n    return 0.0"], "gc.get_objects"),
+    (["import sys\ndef eval_pherm(*a):\n    sys.setprofile(None)\n    return labkit.eval_pherm(*a)"],
+     "without the grader's watch"),
+    (["import threading, time\nthreading.Thread(target=time.sleep, args=(30,), daemon=True).start()"],
+     "a new thread"),
+    (["from labkit.grading import protocol\nseen, decode, encode = [], protocol.decode, protocol.encode\n"
+      "def peek(tag, *a, **k):\n    value = decode(tag, *a, **k)\n    seen.append(value)\n    return value\n"
+      "def answer(value, *a):\n    return encode(labkit.eval_pherm(*seen[-4:]) if len(seen) >= 4 else value, *a)\n"
+      "protocol.decode, protocol.encode = peek, answer"],  # the worker's own helpers, rewritten
+     "switched off"),
+    (["import labkit.grading.protocol as p, json\nreal = p.loads\nstash = {}\n"
+      "def peek(line):\n    request = real(line)\n    if request.get('op') == 'call':\n"
+      "        stash['answer'] = labkit.eval_pherm(X, Y, YP, XV)\n    return request\np.loads = peek"],
+     "switched off"),
+    (["import labkit.grading.guard as g\ndef eval_pherm(*a):\n    g.end_request(b'{}')\n    return labkit.eval_pherm(*a)"],
+     "switched off"),
+])
+def test_switching_the_watch_off_or_going_round_it_voids_the_answer(open_notebooks, cells, says):
+    notebook = _notebook(open_notebooks, "import numpy as np, labkit\nX, Y, YP, XV = "
+                         "np.array([0., 1, 3]), np.array([1., -1, 2]), np.array([0., 2, -1]), np.linspace(-.5, 3.5, 9)",
+                         HONEST_PHERM, *cells)
+    with pytest.raises(remote.StudentError) as voided:
+        _call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV)
+    assert says in str(voided.value), str(voided.value)
+
+
+def test_a_forged_answer_line_never_reaches_the_grader(open_notebooks):
+    notebook = _notebook(open_notebooks, HONEST_PHERM,
+                         "import os, json\nfor fd in range(3, 40):\n    try:\n"
+                         "        os.write(fd, (json.dumps({'id': 'x', 'value': ['f', 1.0]}) + '\\n').encode())\n"
+                         "    except OSError:\n        pass")
+    assert np.allclose(_call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV), labkit.eval_pherm(X, Y, YP, XV))
+
+
+def test_a_call_that_ends_the_process_costs_only_that_call(open_notebooks):
+    notebook = _notebook(open_notebooks, HONEST_PHERM, "import os\ndef quits(*a):\n    os._exit(7)")
+    with pytest.raises(remote.StudentError, match="exited with status 7"):
+        _call(notebook, "quits", None, 1.0)
+    # the next request starts a fresh notebook process, which runs the cells again
+    assert np.allclose(_call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV), labkit.eval_pherm(X, Y, YP, XV))
+
+
+def test_the_grader_computes_the_digests_from_the_library_files():
+    names, modules, c_names = refusals.recognised(INTERPOLANTS)
+    recognised = set(names.values())
+    assert {"labkit.piecewise.eval_pherm", "labkit.piecewise._hermite_eval", "labkit.splines._slopes_from_curvatures",
+            "scipy.interpolate._interpolate._PPolyBase.construct_fast", "labkit.checks.splines._reference_complete_system",
+            "numpy.lib._function_base_impl.interp"} <= recognised
+    assert "labkit.piecewise.bracket" not in recognised  # the lab lets students use it
+    # what the sandbox recognises is the live code's digest
+    assert names[guard.code_key(labkit.eval_pherm.__code__)] == "labkit.piecewise.eval_pherm"
+    assert ("numpy._core._multiarray_umath", "interp") in c_names and "scipy.ndimage" in modules
+    # a student's function of the same name and size is not mistaken for labkit's
+    student = compile(HONEST_PHERM, "<cell>", "exec").co_consts
+    assert not any(guard.code_key(code) in names for code in student if hasattr(code, "co_code"))
+
+
+def test_labkit_check_exports_no_reference_of_the_grader():
+    assert not [name for name in dir(labkit.check) if name.startswith("_reference")]
+
+
+# -- the source scan ---------------------------------------------------------
+
+WIRED = refusals.wire(REFUSALS)
+
+
+def _scan(sources, names, refusal):
+    return scan(sources, names, WIRED[refusal.name])
 
 
 def test_scan_names_references_through_aliases_helpers_and_magics():
@@ -70,15 +229,53 @@ def test_scan_names_references_through_aliases_helpers_and_magics():
         "def runge(x):\n    return lk.runge(x)",
         "def broken(:\n",
     ]
-    found = scan(sources, ["eval_pherm"], exercises.EXERCISES[2].refused)
-    assert ("eval_pherm", 4, "scipy.interpolate.CubicHermiteSpline") in found
-    assert ("helper", 2, "labkit.eval_pherm") in found
-    assert all(name != "labkit.bracket" for *_, name in found)
-    assert scan(sources, ["runge"], exercises.EXERCISES[3].refused) == [("runge", 2, "labkit.runge")]
+    found = _scan(sources, ["eval_pherm"], INTERPOLANTS)
+    assert any(f[:2] == ("eval_pherm", 4) and "as scipy.interpolate.CubicHermiteSpline" in f[2] for f in found), found
+    assert ("helper", 2, "labkit.piecewise.eval_pherm") in found
+    assert all("bracket" not in what for *_, what in found)
+    assert _scan(sources, ["runge"], OWN_FUNCTIONS) == [("runge", 2, "labkit.functions.runge (as labkit.runge)")]
 
 
-def test_scan_leaves_a_students_own_function_of_the_same_name_alone():
-    sources = ["from labkit import eval_pherm\n", "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-               "    return 0 * xval if len(xdata) > 2 else eval_pherm(xdata[:2], ydata, ypdata, xval)"]
-    assert scan(sources, ["eval_pherm"], exercises.EXERCISES[2].refused) == []
-    assert scan(sources, ["eval_pherm"], ()) == []
+@pytest.mark.parametrize("sources, what", [
+    (["import labkit\nref = labkit.eval_pherm", "def eval_pherm(*a):\n    return ref(*a)"], "labkit.eval_pherm"),
+    (["import labkit\neval_pherm = labkit.eval_pherm"], "labkit.eval_pherm"),
+    (["from scipy.interpolate import CubicHermiteSpline\nclass H(CubicHermiteSpline):\n    pass",
+      "def eval_pherm(x, y, yp, xv):\n    return H(x, y, yp)(xv)"], "CubicHermiteSpline"),
+    (["import numpy as np\ndef eval_pherm(x, y, yp, xv):\n    return np.interp(xv, x, y)"], "interp"),
+    (["def eval_pherm(*a):\n    m = __import__('lab' + 'kit')\n    return m.eval_pherm(*a)"], "__import__"),
+    (["import importlib\nm = importlib.import_module('labkit')", "def eval_pherm(*a):\n    return m.eval_pherm(*a)"],
+     "importlib"),
+    (["def eval_pherm(*a):\n    return getattr(__builtins__, 'ev' + 'al')('1')"], "getattr with a computed name"),
+    (["import types, labkit\nc = labkit.eval_pherm.__code__\ndef eval_pherm(*a):\n    return 0"], None),
+])
+def test_scan_follows_module_level_names_classes_and_dynamic_access(sources, what):
+    found = _scan(sources, ["eval_pherm"], INTERPOLANTS)
+    if what is None:  # a name the graded function never reaches is none of its business
+        assert found == []
+    else:
+        assert any(what in reference for *_, reference in found), found
+
+
+def test_scan_leaves_honest_code_alone():
+    sources = ["from labkit import eval_pherm\nimport numpy as np\nM = 3\nydata = np.zeros(3)",
+               "def eval_pherm(xdata, ydata, ypdata, xval):\n    M = len(xdata)\n"
+               "    return 0 * xval if M > 2 else eval_pherm(xdata[:2], ydata, ypdata, xval)"]
+    assert _scan(sources, ["eval_pherm"], INTERPOLANTS) == []
+    assert scan(sources, ["eval_pherm"], None) == []
+
+
+def test_scan_is_bounded_and_reads_magics_as_ipython_runs_them():
+    assert python_source("%%bash\nls") is None
+    assert python_source("%%time\nx = 1").strip() == "x = 1"
+    assert python_source("  !ls\nx = %time f()") == "  pass\nx = None"
+    with pytest.raises(Unreadable, match="more than"):
+        _scan(["x = 1\n" * 100_000], ["eval_pherm"], INTERPOLANTS)
+    many_magics = "\n".join("%time x" for _ in range(20_000))  # IPython's own reader took minutes on this
+    assert _scan([many_magics, HONEST_PHERM], ["eval_pherm"], INTERPOLANTS) == []
+
+
+def test_every_refusal_of_every_part_is_wired():
+    parts = [part for exercise in exercises.EXERCISES.values() for part in exercise.parts if part.refused]
+    assert {part.refused for part in parts} == set(REFUSALS)
+    for refusal in REFUSALS:
+        assert refusals.recognised(refusal)[0], refusal.name

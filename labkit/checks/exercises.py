@@ -1,4 +1,4 @@
-"""The graded exercises: what the student defines, which checks run, points, refused references.
+"""The graded exercises: what the student defines, which checks run, points, what is switched off.
 
 A new exercise's check goes in the topic module it belongs to (``hermite``,
 ``patches``, ``splines``, ``bilinear``, or a new one), and gets one entry in
@@ -12,17 +12,37 @@ from dataclasses import dataclass
 from . import bilinear, drivers, hermite, patches, plotted, splines
 from .result import CheckResult
 
-# scipy's interpolants that would answer a 1-D interpolation exercise outright
-_SCIPY_1D = ("scipy.interpolate.CubicHermiteSpline", "scipy.interpolate.PchipInterpolator",
-             "scipy.interpolate.CubicSpline", "scipy.interpolate.Akima1DInterpolator",
-             "scipy.interpolate.BPoly", "scipy.interpolate.PPoly", "scipy.interpolate.KroghInterpolator",
-             "scipy.interpolate.make_interp_spline", "scipy.interpolate.interp1d",
-             "scipy.interpolate.splrep", "scipy.interpolate.InterpolatedUnivariateSpline")
-_LABKIT_SPLINES = ("labkit.ccspline", "labkit.ncspline", "labkit.nakspline", "labkit.spline",
-                   "labkit.pchip", "labkit.pchip_slopes", "labkit.convergence_table")
+@dataclass(frozen=True)
+class Refusal:
+    """What a graded function may not reach while the grader calls it: whole modules, not names.
+
+    ``modules`` are module prefixes: every Python function, method and
+    compiled routine in them is switched off, private helpers included.
+    ``functions`` are single functions of other modules (numpy's linear
+    ``interp``). ``allowed`` are the few functions of those modules that the
+    lab lets students reuse. :mod:`labkit.grading.refusals` turns this into
+    what the sandbox recognises, and the source scan reads the same lists.
+    """
+
+    name: str
+    modules: tuple
+    functions: tuple = ()
+    allowed: tuple = ()
 
 
-_CONVERGENCE = ("labkit.convergence_table", "labkit.ConvergenceTable", "labkit.bilinear_convergence")
+# the lab's answers and the grader's own references: refused in every graded call that has a refusal
+_GRADER = ("labkit.checks",)
+INTERPOLANTS = Refusal(
+    "library interpolants",
+    modules=("scipy.interpolate", "scipy.ndimage", "scipy.signal._bsplines", "scipy.signal._spline",
+             "scipy.signal._spline_filters", "labkit.piecewise", "labkit.splines", "labkit.monotone",
+             "labkit.bilinear", "labkit.patches", "labkit.convergence", "labkit.functions") + _GRADER,
+    functions=("numpy.lib._function_base_impl.interp", "numpy._core._multiarray_umath.interp",
+               "numpy._core._multiarray_umath.interp_complex"),
+    allowed=("labkit.piecewise.bracket",))
+OWN_FUNCTIONS = Refusal("the lab's functions", modules=("labkit.functions",) + _GRADER)
+OWN_PATCH = Refusal("labkit's patch", modules=("labkit.patches",) + _GRADER, allowed=("labkit.patches.Corner", "labkit.patches._vector"))
+EXPERIMENTS = Refusal("labkit's experiments", modules=("labkit.convergence",) + _GRADER)
 
 
 @dataclass(frozen=True)
@@ -39,6 +59,13 @@ class Part:
     weight: int
     run: object
     index: int = None  # when `run` checks several parts at once (one plot), which of its results is this part's
+    refused: Refusal = None  # switched off while the grader calls the student's functions for this part
+    functions: tuple = ()  # the student's functions the part calls, when not just the one named like it
+
+    @property
+    def scanned(self):
+        """The student's names whose source the grader reads for refused references."""
+        return self.functions or (self.name,)
 
 
 @dataclass(frozen=True)
@@ -47,16 +74,14 @@ class Exercise:
 
     ``names`` are what the student's notebook defines (any of them present
     means the notebook is the exercise's own). ``parts`` are its checks with
-    their weights. ``refused`` are reference implementations switched off
-    while the grader calls this exercise's functions (the lab asks students
-    to write them); anything not listed, such as ``labkit.bracket``, stays
-    available.
+    their weights, each with what is switched off while it calls the
+    student's functions (:class:`Refusal`); anything not listed, such as
+    ``labkit.bracket``, stays available.
     """
 
     number: int
     names: tuple
     parts: tuple
-    refused: tuple = ()
 
     @property
     def points(self):
@@ -66,8 +91,10 @@ class Exercise:
 def _driver_parts(key, driver_weight, table_weight=1, rate_weight=1):
     """The three parts of a convergence experiment: driver, table, rate answer."""
     method = drivers.METHODS[key]
-    return (Part(method.driver, driver_weight, lambda ns, seed: drivers.driver(key, ns[method.driver], seed)),
-            Part(method.table, table_weight, lambda ns, seed: drivers.table(key, ns[method.table], ns[method.driver])),
+    return (Part(method.driver, driver_weight, lambda ns, seed: drivers.driver(key, ns[method.driver], seed),
+                 refused=EXPERIMENTS),
+            Part(method.table, table_weight, lambda ns, seed: drivers.table(key, ns[method.table], ns[method.driver]),
+                 refused=EXPERIMENTS),
             Part(method.rate, rate_weight, lambda ns, seed: drivers.rate(key, ns[method.rate], ns.get(method.table))))
 
 
@@ -87,18 +114,18 @@ def _boiling(ns, seed):
 
 
 EXERCISES = {e.number: e for e in (
-    Exercise(2, ("eval_pherm",), (Part("eval_pherm", 10, lambda ns, seed: hermite.eval_pherm(ns["eval_pherm"], seed=seed)),),
-             refused=("labkit.eval_pherm", "labkit.hermite_basis") + _SCIPY_1D),
+    Exercise(2, ("eval_pherm",), (Part("eval_pherm", 10, lambda ns, seed: hermite.eval_pherm(ns["eval_pherm"], seed=seed),
+                                       refused=INTERPOLANTS),)),
     Exercise(3, ("runge",) + _experiment_names("pherm"),
-             (Part("runge", 3, lambda ns, seed: hermite.runge(ns["runge"], seed=seed)),) + _driver_parts("pherm", 6, 3, 3),
-             refused=("labkit.runge",) + _CONVERGENCE),
+             (Part("runge", 3, lambda ns, seed: hermite.runge(ns["runge"], seed=seed), refused=OWN_FUNCTIONS),)
+             + _driver_parts("pherm", 6, 3, 3)),
     Exercise(4, ("limacon_derivatives", "ax4"),
              (Part("limacon_derivatives", 8,
-                   lambda ns, seed: hermite.limacon_derivatives(ns["limacon_derivatives"], seed=seed)),
-              Part("ax4", 7, lambda ns, seed: plotted.limacon_plot(ns["ax4"], _limacon_data(ns)))),
-             refused=("labkit.limacon",)),
-    Exercise(5, ("coons",), (Part("coons", 12, lambda ns, seed: patches.coons(ns["coons"], seed=seed)),),
-             refused=("labkit.patch",)),
+                   lambda ns, seed: hermite.limacon_derivatives(ns["limacon_derivatives"], seed=seed),
+                   refused=OWN_FUNCTIONS),
+              Part("ax4", 7, lambda ns, seed: plotted.limacon_plot(ns["ax4"], _limacon_data(ns))))),
+    Exercise(5, ("coons",), (Part("coons", 12, lambda ns, seed: patches.coons(ns["coons"], seed=seed),
+                                  refused=OWN_PATCH),)),
     Exercise(6, ("graded",), (Part("graded", 10, lambda ns, seed: patches.graded_corners(ns["graded"])),)),
     Exercise(7, ("straight",), (Part("straight", 10, lambda ns, seed: patches.straight_corners(ns["straight"])),)),
     Exercise(8, ("circle_sides",), (Part("circle_sides", 12, lambda ns, seed: patches.circle_corners(ns["circle_sides"])),)),
@@ -106,29 +133,27 @@ EXERCISES = {e.number: e for e in (
              (Part("two_patches", 10, lambda ns, seed: patches.two_patches(ns["two_patches"], _corners9(ns))),
               Part("region", 6, lambda ns, seed: patches.combined_mesh(ns["region"], _corners9(ns))))),
     Exercise(10, ("ccspline", "complete_system"),
-             (Part("ccspline", 15, lambda ns, seed: splines.ccspline(ns["ccspline"], ns.get("complete_system"), seed=seed)),),
-             refused=_LABKIT_SPLINES + _SCIPY_1D),
-    Exercise(11, _experiment_names("complete"), _driver_parts("complete", 5, 2, 2), refused=_CONVERGENCE),
+             (Part("ccspline", 15, lambda ns, seed: splines.ccspline(ns["ccspline"], ns.get("complete_system"), seed=seed),
+                   refused=INTERPOLANTS, functions=("ccspline", "complete_system")),)),
+    Exercise(11, _experiment_names("complete"), _driver_parts("complete", 5, 2, 2)),
     Exercise(12, ("ncspline",) + _experiment_names("natural"),
-             (Part("ncspline", 9, lambda ns, seed: splines.ncspline(ns["ncspline"], seed=seed)),)
-             + _driver_parts("natural", 2, 2, 2),
-             refused=_LABKIT_SPLINES + _SCIPY_1D),
-    Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2), refused=_CONVERGENCE),
+             (Part("ncspline", 9, lambda ns, seed: splines.ncspline(ns["ncspline"], seed=seed), refused=INTERPOLANTS),)
+             + _driver_parts("natural", 2, 2, 2)),
+    Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2)),
     Exercise(14, ("ax14",), tuple(Part(name, 2, _boiling, index=i)
                                   for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline",
-                                                            "ax14: pchip"))),
-             refused=()),
-    Exercise(15, _experiment_names("pchip"), _driver_parts("pchip", 4, 2, 2), refused=_CONVERGENCE),
+                                                            "ax14: pchip")))),
+    Exercise(15, _experiment_names("pchip"), _driver_parts("pchip", 4, 2, 2)),
     Exercise(16, ("phi_table", "runge2d", "eval_pbilin") + _experiment_names("bilinear"),
              (Part("phi_table", 1, lambda ns, seed: bilinear.phi_table(ns["phi_table"])),
-              Part("runge2d", 1, lambda ns, seed: bilinear.runge2d(ns["runge2d"], seed=seed)),
-              Part("eval_pbilin", 3, lambda ns, seed: bilinear.eval_pbilin(ns["eval_pbilin"], seed=seed)))
-             + _driver_parts("bilinear", 1, 1, 1),
-             refused=("labkit.eval_pbilin", "labkit.runge2d", "scipy.interpolate.RegularGridInterpolator",
-                      "scipy.interpolate.interpn", "scipy.interpolate.RectBivariateSpline",
-                      "scipy.interpolate.LinearNDInterpolator", "scipy.interpolate.griddata") + _CONVERGENCE),
+              Part("runge2d", 1, lambda ns, seed: bilinear.runge2d(ns["runge2d"], seed=seed), refused=OWN_FUNCTIONS),
+              Part("eval_pbilin", 3, lambda ns, seed: bilinear.eval_pbilin(ns["eval_pbilin"], seed=seed),
+                   refused=INTERPOLANTS))
+             + _driver_parts("bilinear", 1, 1, 1)),
 )}
 POINTS = {number: exercise.points for number, exercise in EXERCISES.items()}
+REFUSALS = tuple(sorted({part.refused for e in EXERCISES.values() for part in e.parts if part.refused},
+                        key=lambda refusal: refusal.name))
 NAMES = {number: list(exercise.names) for number, exercise in EXERCISES.items()}
 
 
@@ -156,7 +181,10 @@ def grade(number, namespace, seed=None):
     exercise = EXERCISES[number]
     defined = any(name in namespace for name in exercise.names)
     checks, shared = [], {}
+    refusing = getattr(namespace, "refusing", None)  # the grader's proxy switches references off per part
     for part in exercise.parts:
+        if refusing is not None:
+            refusing(part.refused)
         try:
             if part.index is None:
                 result = part.run(namespace, seed)

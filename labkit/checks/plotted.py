@@ -14,11 +14,10 @@ here, on the grader's side.
   the not-a-knot spline and pchip each as a curve of at least 100 points
   over the whole data range.
 """
-from dataclasses import dataclass
-
 import numpy as np
 
 from .. import functions, monotone, piecewise, splines
+from ..plotdata import NO_LINE, Line, line_of, lines_of  # noqa: F401 - Line and line_of for the checks' users
 from .result import CheckResult, Checks
 
 MIN_POINTS = 100
@@ -27,44 +26,7 @@ MIN_POINTS = 100
 MAX_CURVES = 10
 SAMPLE = 20_000
 HERMITE_LIMACON = 2e-3  # largest distance from the curve: Hermite with 20 intervals is 2.3e-4, linear 3.8e-2
-NO_LINE = ("None", "none", "", " ")
 CIRCLE = "o"
-
-
-@dataclass(frozen=True)
-class Line:
-    """One plotted line as plain data."""
-
-    x: np.ndarray
-    y: np.ndarray
-    marker: str  # matplotlib's marker code: "o" for circles, "None" for none
-    linestyle: str  # "-", "--", ... or "None"
-
-    @property
-    def joined(self):
-        """Whether a line is drawn between the points."""
-        return self.linestyle not in NO_LINE
-
-
-def line_of(line):
-    """A matplotlib Line2D as a :class:`Line`."""
-    x = np.asarray(line.get_xdata(orig=False), dtype=float).ravel()
-    y = np.asarray(line.get_ydata(orig=False), dtype=float).ravel()
-    marker = line.get_marker()
-    style = line.get_linestyle() if line.get_linewidth() > 0 else "None"
-    return Line(x, y, str(marker) if isinstance(marker, str) else "custom", str(style))
-
-
-def lines_of(plot):
-    """The lines of an Axes, of every Axes of a Figure, or a list of lines already read; else None."""
-    if isinstance(plot, (list, tuple)) and all(isinstance(line, Line) for line in plot):
-        return list(plot)
-    axes = getattr(plot, "axes", None)
-    if hasattr(plot, "get_lines"):
-        return [line_of(line) for line in plot.get_lines()]
-    if isinstance(axes, list):  # a Figure
-        return [line_of(line) for ax in axes for line in ax.get_lines()]
-    return None
 
 
 def _no_plot(result, name, plot):

@@ -3,14 +3,19 @@
 One module per concern:
 
 * :mod:`~labkit.grading.release` - the student version of the instructor notebooks;
+* :mod:`~labkit.grading.options` - the limits of a grading run, defaults defined once;
 * :mod:`~labkit.grading.sandbox` - the bubblewrap box and resource limits a notebook runs in;
+* :mod:`~labkit.grading.seccomp` - the system calls a sandboxed notebook may not make;
+* :mod:`~labkit.grading.cgroup` - a memory cgroup around each sandbox and grading process;
 * :mod:`~labkit.grading.protocol` - the plain-number messages between grader and sandbox;
-* :mod:`~labkit.grading.worker` - the sandboxed side: runs the cells, answers calls;
+* :mod:`~labkit.grading.worker` - the sandboxed side: a pristine supervisor and the notebook's process;
+* :mod:`~labkit.grading.guard` - the watch in the notebook's process: refusals, tampering, attestations;
 * :mod:`~labkit.grading.remote` - the grader's handle on a sandbox and its proxies;
-* :mod:`~labkit.grading.refusals` - reference implementations a graded function may not use;
-* :mod:`~labkit.grading.scoring` - grading one notebook and one submission;
+* :mod:`~labkit.grading.refusals` - what a graded function may not reach, as the watch recognises it;
+* :mod:`~labkit.grading.scan` - reading a notebook's source for refused references;
+* :mod:`~labkit.grading.scoring` - grading one notebook and one submission (one process per submission);
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
-* :mod:`~labkit.grading.batch` - grading a class in parallel;
+* :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own;
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging.
 
 Student code never runs in the grading process: see the README's "For instructors".
@@ -23,9 +28,9 @@ from .release import release, release_notebook, strip_solutions  # light: nbform
 # ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {"grade": "batch", "SubmissionGrade": "report", "merge": "report", "Rubric": "rubric",
             "load_rubric": "rubric", "exercises_in": "scoring", "grade_notebook": "scoring", "grade_submission": "scoring",
-            "submission_notebooks": "scoring"}
-_MODULES = {"batch", "nbgrader", "protocol", "refusals", "release", "remote", "report", "rubric", "sandbox",
-            "scoring", "worker"}
+            "submission_notebooks": "scoring", "GradeOptions": "options"}
+_MODULES = {"batch", "cgroup", "guard", "nbgrader", "options", "protocol", "refusals", "release", "remote", "report",
+            "rubric", "sandbox", "scan", "scoring", "seccomp", "worker"}
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]
 

@@ -1,27 +1,48 @@
-"""Grading a class: many submissions in parallel, one seed, one output folder.
+"""Grading a class: every submission in a grading process of its own, a few at a time.
 
 :func:`grade` checks the sandbox once, draws the run's seed (or takes the one
-given), grades the submissions a few at a time in worker processes and
-writes the output folder (:mod:`labkit.grading.report`). A course that
-outgrows one machine grades one submission per batch job into folders of
-its own and combines them with :func:`labkit.grading.report.merge`.
+given), computes what the sandbox refuses once, and then starts one process
+per submission (``python -m labkit.grading.scoring``), at most `jobs` at a
+time. Each has its own limits: address space and a memory cgroup for the
+grader's own work, and the submission's time limit plus a grace for the
+checks. So a submission that makes its grading crash, run out of memory or
+hang costs only its own grade: its process is started once more, and if
+that fails too the submission is reported as "could not be graded" with
+the reason, while every other submission is graded as usual.
+
+Before each submission the free space of the temporary and output folders
+is checked; when it runs low the run stops starting new submissions and
+says so, rather than grading students into zeros. The output folder
+(:mod:`labkit.grading.report`) always gets a ``grades.csv`` with every
+submission once.
 """
-import multiprocessing
+import json
+import os
+import resource
 import secrets
+import shutil
+import signal
+import subprocess
 import sys
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import tempfile
+import time
 from pathlib import Path
 
-from . import sandbox
+from ..checks.exercises import REFUSALS
+from . import cgroup, refusals, sandbox
+from .options import GradeOptions
+from .report import SubmissionGrade, one_line, safe_name, write_report
 from .rubric import default as default_rubric
-from .report import SubmissionGrade, write_report
-from .scoring import grade_submission, submission_notebooks
+from .scoring import submission_name
 
 UNCONFINED_WARNING = """\
 !!! labkit grade --no-sandbox: student code runs UNCONFINED, with your permissions.
 !!! It can read, change or delete anything you can, reach the network and leave
 !!! processes behind. Use this only for code you trust.
 """
+MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
+ATTEMPTS = 2  # a grading process that breaks is started once more
+MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file
 
 
 def _progress(done, total, width=30):
@@ -32,48 +53,208 @@ def _progress(done, total, width=30):
     sys.stderr.flush()
 
 
-def grade(submissions, out_dir, jobs=2, cell_timeout=60, total_timeout=600, progress=True, seed=None,
-          sandboxed=True, limits=None, rubric=None):
-    """Grade submissions in parallel; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
+def _low_space(out):
+    """Why grading cannot go on (a folder with too little free space), or None."""
+    for folder in (Path(tempfile.gettempdir()), out):
+        try:
+            free = shutil.disk_usage(folder).free
+        except OSError:
+            continue
+        if free < MIN_FREE:
+            return (f"only {free / 1024**2:.0f} MiB free in {folder} (grading needs {MIN_FREE // 1024**2} MiB); "
+                    "free some space and grade these submissions again, then combine the runs with --merge")
+    return None
 
-    `seed` fixes the random test data (a fresh one is drawn and written to
-    ``seed.txt`` when it is None). `sandboxed=False` runs student code
-    unconfined, after a warning on stderr. `rubric` turns the checks' results into
-    grades (:mod:`labkit.grading.rubric`; the lab's own when None).
+
+class _Job:
+    """One submission's grading process."""
+
+    def __init__(self, path, name, work, options, profiles_file):
+        self.path, self.name, self.attempt = Path(path), name, 0
+        self.work, self.options, self.profiles_file = work, options, profiles_file
+        self.process, self.cgroup, self.started = None, None, None
+
+    def start(self):
+        self.attempt += 1
+        self.result = self.work / f"{safe_name(self.name)}-{self.attempt}.json"
+        spec = self.work / f"{safe_name(self.name)}-{self.attempt}.spec.json"
+        spec.write_text(json.dumps({"submission": str(self.path), "name": self.name, "result": str(self.result),
+                                    "profiles": str(self.profiles_file), "options": self.options.as_dict()}),
+                        encoding="utf-8")
+        memory = self.options.grader_memory
+        self.cgroup = cgroup.create(memory, label="labkit-grader")
+        group = self.cgroup
+
+        def prepare():
+            if group is not None:
+                group.join()
+            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
+        with open(self.log, "wb") as log:
+            self.process = subprocess.Popen([sys.executable, "-m", "labkit.grading.scoring", str(spec)],
+                                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log,
+                                            start_new_session=True, preexec_fn=prepare, env=environment)
+        self.started = time.monotonic()
+
+    @property
+    def limit(self):
+        return self.options.total_timeout + self.options.grader_grace
+
+    def overdue(self):
+        return time.monotonic() - self.started > self.limit
+
+    def stop(self):
+        """Kill the grading process and everything it started (its sandboxes die with it)."""
+        try:
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        self.process.wait()
+        self.finish()
+
+    def last_words(self):
+        """The last line the grading process wrote to stderr (a Python error's summary), as one printable line."""
+        try:
+            with open(self.log, "rb") as log:
+                log.seek(max(0, os.path.getsize(self.log) - 4096))
+                lines = log.read().decode("utf-8", "replace").strip().splitlines()
+        except OSError:
+            return ""
+        return f": {one_line(lines[-1], 200)}" if lines else ""
+
+    def finish(self):
+        if self.cgroup is not None:
+            self.out_of_memory = self.cgroup.out_of_memory()
+            self.cgroup.remove()
+        else:
+            self.out_of_memory = False
+
+    def outcome(self, rubric, timed_out):
+        """(SubmissionGrade, None) from the result file, or (None, why the grading process failed)."""
+        code = self.process.returncode
+        if timed_out:
+            return None, (f"its grading took longer than {self.limit} s (the submission's time limit plus "
+                          f"{self.options.grader_grace} s for the checks) and was stopped")
+        if code != 0 or not self.result.exists():
+            if getattr(self, "out_of_memory", False) or code in (-signal.SIGKILL, -signal.SIGSEGV):
+                return None, ("its grading ran out of memory (the grader's limit of "
+                              f"{self.options.grader_memory // 1024**2} MiB) and was stopped"
+                              if getattr(self, "out_of_memory", False) or code == -signal.SIGKILL
+                              else f"its grading process crashed ({signal.Signals(-code).name})")
+            if code is not None and code < 0:
+                name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else str(-code)
+                return None, f"its grading process was killed by {name}"
+            return None, f"its grading process ended with status {code} without a result{self.last_words()}"
+        try:
+            if self.result.stat().st_size > MAX_RESULT:
+                return None, "its result was larger than the grader accepts"
+            data = json.loads(self.result.read_text(encoding="utf-8"))
+            grade = SubmissionGrade.from_dict(data, self.name, rubric)
+        except (OSError, ValueError) as exc:
+            return None, f"its result could not be read ({str(exc)[:200]})"
+        grade.name = self.name
+        return grade, None
+
+
+def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, progress=True, seed=None,
+          sandboxed=True, limits=None, rubric=None, options=None):
+    """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
+
+    `options` (a :class:`labkit.grading.options.GradeOptions`) or the single
+    keywords bound the run; `seed` fixes the random test data (a fresh one is
+    drawn and written to ``seed.txt`` when it is None); `sandboxed=False`
+    runs student code unconfined, after a warning on stderr. `rubric` turns
+    the checks' results into grades (the lab's when None). Returns the
+    grades in the order given; those with ``graded`` False could not be
+    graded (their ``failure`` says why).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:
-        submission_notebooks(path)  # bad paths stop here, before any work
-    names = [p.stem if p.is_file() else p.name for p in submissions]
+        if not os.path.lexists(path):
+            raise ValueError(f"{path} does not exist.")
+        if not path.is_symlink() and path.is_file() and path.suffix != ".ipynb":
+            raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
+    names = [submission_name(p) for p in submissions]
     if len(set(names)) != len(names):
         raise ValueError("two submissions have the same name; their feedback files would collide.")
-    if sandboxed:
+    given = {key: value for key, value in (("cell_timeout", cell_timeout), ("total_timeout", total_timeout),
+                                           ("limits", limits)) if value is not None}
+    options = options or GradeOptions()
+    from dataclasses import replace
+
+    options = replace(options, **given, confined=bool(sandboxed) and options.confined)
+    if options.confined:
         try:
             sandbox.available()
         except sandbox.SandboxUnavailable as exc:
             raise ValueError(f"cannot grade in a sandbox: {exc}") from None
     else:
         sys.stderr.write(UNCONFINED_WARNING)
+    seed = seed if seed is not None else options.seed
     seed = secrets.randbits(63) if seed is None else int(seed)
+    options = replace(options, seed=seed)
+    rubric = rubric or default_rubric()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
-    grades = {}
-    # spawn, not fork: a forked process would inherit the parent's threads and locks
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=max(1, jobs), mp_context=context) as pool:
-        futures = {pool.submit(grade_submission, p, cell_timeout, total_timeout, seed, sandboxed, limits, rubric): p
-                   for p in submissions}
-        for done, future in enumerate(as_completed(futures), start=1):
-            path = futures[future]
-            try:
-                result = future.result()
-            except Exception as exc:  # noqa: BLE001 - one broken submission must not stop the class
-                result = SubmissionGrade(path.stem if path.is_file() else path.name, {}, [f"grading failed: {exc}"],
-                                         seed, rubric or default_rubric())
-            grades[path] = result
-            if progress:
-                _progress(done, len(submissions))
+    work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
+    try:
+        profiles_file = work / "profiles.json"
+        profiles_file.write_text(json.dumps(refusals.wire(REFUSALS)), encoding="utf-8")
+        grades = _schedule(submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out,
+                           progress)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
     ordered = [grades[p] for p in submissions]
     write_report(out, ordered)
     return ordered
+
+
+def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, out, progress):
+    """Run the grading processes, `jobs` at a time; {path: SubmissionGrade} for every submission."""
+    pending = [_Job(path, name, work, options, profiles_file) for path, name in zip(submissions, names)]
+    pending.reverse()
+    running, grades, stopped = [], {}, None
+    while pending or running:
+        while pending and len(running) < jobs and stopped is None:
+            stopped = _low_space(out)
+            if stopped is None:
+                job = pending.pop()
+                job.start()
+                running.append(job)
+        if stopped is not None and not running:
+            for job in pending:
+                grades[job.path] = SubmissionGrade(job.name, seed=options.seed, rubric=rubric,
+                                                   failure=stopped)
+            pending = []
+            break
+        time.sleep(0.05)
+        for job in list(running):
+            timed_out = False
+            if job.process.poll() is None:
+                if not job.overdue():
+                    continue
+                job.stop()
+                timed_out = True
+            else:
+                job.finish()
+            running.remove(job)
+            result, why = job.outcome(rubric, timed_out)
+            if result is None and job.attempt < ATTEMPTS:
+                pending.append(job)  # once more, in a fresh process
+                continue
+            grades[job.path] = result or SubmissionGrade(job.name, seed=options.seed, rubric=rubric,
+                                                         failure=f"{why} (tried {job.attempt} times)")
+            if progress:
+                _progress(len(grades), len(submissions))
+    return grades
+
+
+def report_failures(grades, stream=sys.stderr):
+    """Name every submission that could not be graded (printable, one line each); how many there were."""
+    failed = [g for g in grades if not g.graded]
+    for g in failed:
+        stream.write(f"could not grade {one_line(g.name, 80)}: {one_line(g.failure, 300)}\n")
+    return len(failed)

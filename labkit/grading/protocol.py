@@ -10,12 +10,13 @@ Both directions use one format, one JSON object per line:
   :class:`labkit.QuadMesh` ``["mesh", points, quads]``, rebuilt (and
   validated) by their constructors;
 * a plot (a matplotlib Axes or Figure) ``["lines", [[x, y, marker, linestyle], ...]]``:
-  the data of its Line2D objects (:func:`labkit.checks.plotted.lines_of`),
-  rebuilt as :class:`labkit.checks.plotted.Line` records, so plots are judged
+  the data of its Line2D objects (:func:`labkit.plotdata.lines_of`),
+  rebuilt as :class:`labkit.plotdata.Line` records, so plots are judged
   from their data on the grader's side;
 * towards the notebook only, a function of labkit's that the checks hand to
   student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``
-  (:data:`PASSABLE`);
+  (:data:`PASSABLE`); the notebook's side gets the watch's trusted copy
+  (:mod:`labkit.grading.guard`);
 * from the notebook only, ``["obj", description]`` for anything else.
 
 The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
@@ -31,9 +32,10 @@ import math
 import numpy as np
 
 MAX_DEPTH = 12
-MAX_ELEMENTS = 20_000_000  # numbers in one message
+MAX_ELEMENTS = 4_000_000  # numbers in one message (the lab's largest answer has a few thousand)
 MAX_TEXT = 2_000
-MAX_LINE = 256 * 1024 * 1024  # bytes in one message
+MAX_LINE = 48 * 1024 * 1024  # bytes in one message: enforced while reading, before any parsing
+MAX_CONTAINERS = 250_000  # JSON lists and objects in one message: bounds what parsing it allocates
 MAX_LINES = 1_000  # Line2D objects of one plot
 
 # functions the checks may hand to student code, by the name both sides know
@@ -127,7 +129,7 @@ def _is_plot(value):
 
 
 def _lines_tag(plot):
-    from ..checks.plotted import lines_of
+    from ..plotdata import lines_of
 
     try:
         lines = lines_of(plot)
@@ -137,37 +139,49 @@ def _lines_tag(plot):
                       for line in lines[:MAX_LINES]]]
 
 
+def function_names(tags):
+    """The names of every ``["fn", name]`` in encoded values (the functions a request hands over)."""
+    found, todo = set(), list(tags)
+    while todo:
+        tag = todo.pop()
+        if isinstance(tag, list) and tag:
+            if tag[0] == "fn" and len(tag) == 2 and isinstance(tag[1], str):
+                found.add(tag[1])
+            elif tag[0] in ("t", "l") and len(tag) == 2 and isinstance(tag[1], list):
+                todo.extend(tag[1])
+    return found
+
+
 def dumps(message):
     """One line of JSON (NaN and infinities allowed: they are numbers a student may return)."""
     return (json.dumps(message, allow_nan=True, separators=(",", ":")) + "\n").encode("utf-8")
 
 
-def resolve_function(name):
-    """The labkit function a ``["fn", name]`` stands for (the notebook's side).
-
-    A copy with the function's own code, so that switching the reference off
-    while the call runs (:func:`labkit.grading.refusals.switched_off`) does
-    not switch off what the checks hand over.
-    """
+def passable(name):
+    """The pristine labkit function a ``["fn", name]`` stands for (the watch copies it before any cell runs)."""
     import importlib
-    import types
 
     if name not in PASSABLE:
         raise ProtocolError(f"{name!r} is not a function the checks pass")
     module, _, attribute = name.partition(":")
-    original = getattr(importlib.import_module(module), attribute)
-    copy = types.FunctionType(original.__code__, original.__globals__, original.__name__,
-                              original.__defaults__, original.__closure__)
-    copy.__kwdefaults__, copy.__qualname__ = original.__kwdefaults__, original.__qualname__
-    return copy
+    return getattr(importlib.import_module(module), attribute)
 
 
 # -- the grader's side -----------------------------------------------------------
 
 def loads(line):
-    """Parse one message line; anything but a JSON object of bounded size is a ProtocolError."""
+    """Parse one message line; anything but a JSON object of bounded size and structure is a ProtocolError.
+
+    The bounds are checked on the bytes, before parsing: a line of nested
+    empty lists would otherwise cost the parser some thirty times its size.
+    """
     if len(line) > MAX_LINE:
         raise ProtocolError(f"a message of {len(line)} bytes is larger than {MAX_LINE}")
+    if isinstance(line, str):
+        line = line.encode("utf-8", "surrogatepass")
+    containers = line.count(b"[") + line.count(b"{")
+    if containers > MAX_CONTAINERS:
+        raise ProtocolError(f"a message of {containers} lists and objects is more than {MAX_CONTAINERS}")
     try:
         message = json.loads(line)
     except (ValueError, RecursionError) as exc:
@@ -195,7 +209,7 @@ def _array(tag):
 
 
 def _line(item):
-    from ..checks.plotted import Line
+    from ..plotdata import Line
 
     if not (isinstance(item, list) and len(item) == 4 and all(isinstance(part, list) for part in item[:2])
             and all(isinstance(part, str) for part in item[2:])):
@@ -204,12 +218,29 @@ def _line(item):
     return Line(x, y, item[2][:20], item[3][:20])
 
 
-def decode(tag, depth=0, functions=False):
-    """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
-    Corners, QuadMeshes, or a NotNumbers. ``functions=True`` (the notebook's side) also
-    turns ``["fn", name]`` into the labkit function."""
-    from ..mesh import QuadMesh
+def _corner(parts):
+    """A Corner from four arrays, checked here and built without running labkit.patches' code (which
+    the grader's watch may refuse while the student's function that receives it runs)."""
     from ..patches import Corner
+
+    fields = [_array(part).ravel() if isinstance(part, list) and part[:1] == ["a"] else None for part in parts]
+    if any(f is None for f in fields):
+        return NotNumbers("a corner with a field that is not numbers")
+    if fields[0].size not in (2, 3) or any(f.size != fields[0].size for f in fields):
+        return NotNumbers("an invalid Corner (its fields must be vectors of 2 or 3 numbers, all the same size)")
+    if not all(np.all(np.isfinite(f)) for f in fields):
+        return NotNumbers("an invalid Corner (NaN or infinite numbers)")
+    corner = object.__new__(Corner)
+    for name, value in zip(("point", "ds", "dt", "dsdt"), fields):
+        object.__setattr__(corner, name, value.copy())
+    return corner
+
+
+def decode(tag, depth=0, functions=None):
+    """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
+    Corners, QuadMeshes, or a NotNumbers. On the notebook's side `functions` maps the
+    names of ``["fn", name]`` to the functions handed over for this request."""
+    from ..mesh import QuadMesh
 
     if depth > MAX_DEPTH + 1:
         raise ProtocolError("nested too deeply")
@@ -230,12 +261,7 @@ def decode(tag, depth=0, functions=False):
         items = [decode(item, depth + 1, functions) for item in tag[1]]
         return tuple(items) if kind == "t" else items
     if kind == "corner" and len(tag) == 5:
-        point, ds, dt, dsdt = (_array(part) if isinstance(part, list) and part[:1] == ["a"]
-                               else NotNumbers("a corner with a field that is not numbers") for part in tag[1:])
-        try:
-            return Corner(point, ds, dt, dsdt)
-        except (ValueError, TypeError) as exc:
-            return NotNumbers(f"an invalid Corner ({exc})")
+        return _corner(tag[1:])
     if kind == "mesh" and len(tag) == 3:
         try:
             points, quads = _array(tag[1]), _array(tag[2])
@@ -248,6 +274,8 @@ def decode(tag, depth=0, functions=False):
         return [_line(item) for item in tag[1]]
     if kind == "obj" and len(tag) == 2 and isinstance(tag[1], str):
         return NotNumbers(tag[1])
-    if kind == "fn" and functions and len(tag) == 2 and isinstance(tag[1], str):
-        return resolve_function(tag[1])
+    if kind == "fn" and functions is not None and len(tag) == 2 and isinstance(tag[1], str):
+        if tag[1] not in functions:
+            raise ProtocolError(f"{tag[1]!r} was not handed over for this request")
+        return functions[tag[1]]
     raise ProtocolError(f"unknown value tag {kind!r}")

@@ -1,172 +1,167 @@
-"""Reference implementations a graded function may not call: switched off at run time, named in its source.
+"""What a graded function may not reach, as the sandbox's watch recognises it (the grader's side).
 
-Each exercise lists its refused references (:attr:`labkit.checks.exercises.Exercise.refused`),
-for example ``labkit.eval_pherm`` and scipy's cubic interpolants for
-exercise 2. Two things use the list:
+An exercise's part declares a :class:`labkit.checks.exercises.Refusal`:
+whole modules (scipy's interpolation and spline modules, labkit's
+interpolation modules and the grader's own references), a few single
+functions, and the few functions the lab lets students reuse. This module
+turns one into what :mod:`labkit.grading.guard` needs inside the sandbox:
 
-* inside the sandbox, :func:`switched_off` replaces each reference while the
-  grader calls the exercise's function: a Python function gets the code of
-  a stub (so every alias of it, ``from labkit import eval_pherm as ref``
-  included, is caught), a class gets a stub ``__init__``; the stub raises
-  :class:`RefusedReference` naming the call, and the attempt is logged even
-  if the student's code catches the error;
-* on the grader's side, :func:`scan` reads the notebook's source (``ast``,
-  nothing is run) and names the references a graded function, or a
-  function of the notebook it calls, reaches for.
+* a digest (:func:`labkit.grading.guard.code_key`) of every Python function,
+  method and nested function of those modules, computed here by compiling
+  the library's own files, so nothing the notebook did to the live modules
+  (a patched class, a saved code object) changes what is recognised;
+* the module prefixes, whose compiled routines are refused by name;
+* single compiled functions ``(module, name)``.
+
+For the source scan (:mod:`labkit.grading.scan`) it also lists every dotted
+spelling under which labkit, scipy and numpy export a refused object
+(``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``) and every
+spelling of the allowed ones. Everything is computed once per grading run
+(:func:`wire`) and sent to the sandbox before the notebook's first cell
+runs.
 """
-import ast
 import functools
 import importlib
-from contextlib import contextmanager
+import importlib.util
+import sys
+import types
+from pathlib import Path
 
-_MISSING = object()
-_attempts = []  # refused names called during the current graded call (the sandbox's side)
-
-
-class RefusedReference(RuntimeError):
-    """A graded function called a reference implementation that its exercise asks the student to write."""
-
-    def __init__(self, name):
-        super().__init__(f"{name} is switched off while this exercise is graded: "
-                         "the exercise asks you to write it yourself")
-        self.refused = name
+from .guard import code_key, codes_in
 
 
-def refuse(name):
-    """What every stub does: log the attempt and raise."""
-    _attempts.append(name)
-    raise RefusedReference(name)
+def _module_files(prefix):
+    """(module name, file) of every Python source file of a module or package (tests left out)."""
+    try:
+        spec = importlib.util.find_spec(prefix)
+    except (ImportError, ValueError):
+        return []
+    if spec is None:
+        return []
+    if spec.submodule_search_locations:
+        found = []
+        for location in spec.submodule_search_locations:
+            for path in sorted(Path(location).rglob("*.py")):
+                parts = path.relative_to(location).with_suffix("").parts
+                if "tests" in parts:
+                    continue
+                if parts[-1] == "__init__":
+                    parts = parts[:-1]
+                found.append((".".join((prefix,) + parts), path))
+        return found
+    if spec.origin and spec.origin.endswith(".py"):
+        return [(prefix, Path(spec.origin))]
+    return []  # a compiled module: its routines are refused by the module's name
+
+
+@functools.lru_cache(maxsize=None)
+def _compiled_codes(path):
+    """Every code object of one source file, compiled as the import system does."""
+    source = Path(path).read_bytes()
+    return tuple(codes_in(compile(source, str(path), "exec", dont_inherit=True)))
+
+
+def _inside(qualname, names):
+    return any(qualname == name or qualname.startswith(name + ".") for name in names)
+
+
+@functools.lru_cache(maxsize=None)
+def recognised(refusal):
+    """``(names, modules, c_names)`` for the sandbox: {digest: readable name}, module prefixes, compiled functions."""
+    allowed = {}
+    for dotted in refusal.allowed:
+        module, _, qualname = dotted.rpartition(".")
+        allowed.setdefault(module, []).append(qualname)
+    names, c_names = {}, set()
+    for prefix in refusal.modules:
+        for module, path in _module_files(prefix):
+            for code in _compiled_codes(path):
+                if code.co_name == "<module>" or _inside(code.co_qualname, allowed.get(module, ())):
+                    continue
+                names.setdefault(code_key(code), f"{module}.{code.co_qualname}")
+    for dotted in refusal.functions:
+        module, _, qualname = dotted.rpartition(".")
+        files = _module_files(module)
+        if files and files[0][0] == module:
+            for code in _compiled_codes(files[0][1]):
+                if _inside(code.co_qualname, (qualname,)):
+                    names.setdefault(code_key(code), dotted)
+        else:
+            c_names.add((module, qualname))
+    return names, tuple(refusal.modules), frozenset(c_names)
+
+
+LIBRARIES = ("labkit", "scipy", "numpy")  # the packages whose names the scan resolves
 
 
 def _resolve(dotted):
-    """(object, module, attribute) for 'package.module.Name', or None if it does not exist here."""
-    module_name, _, attribute = dotted.rpartition(".")
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError:
+    """The object a dotted name of labkit, scipy or numpy is (importing their modules only), or None."""
+    parts = dotted.split(".")
+    if parts[0] not in LIBRARIES:
         return None
-    obj = getattr(module, attribute, _MISSING)
-    return None if obj is _MISSING else (obj, module, attribute)
-
-
-def _stub_code(name):
-    namespace = {}
-    exec(f"def stub(*args, **kwargs):\n    import labkit.grading.refusals as _r\n    _r.refuse({name!r})\n",
-         namespace)
-    return namespace["stub"].__code__
-
-
-def _stub_init(name):
-    def __init__(self, *args, **kwargs):
-        refuse(name)
-    return __init__
-
-
-@contextmanager
-def switched_off(refused):
-    """Within the block every reference in `refused` raises RefusedReference; yields the attempt log."""
-    undo = []
-    _attempts.clear()
-    try:
-        for name in refused:
-            found = _resolve(name)
-            if found is None:
-                continue
-            obj, module, attribute = found
-            if isinstance(obj, type):
-                before = obj.__dict__.get("__init__", _MISSING)
-                obj.__init__ = _stub_init(name)
-                undo.append(lambda cls=obj, before=before: (setattr(cls, "__init__", before) if before is not _MISSING
-                                                             else delattr(cls, "__init__")))
-            elif hasattr(obj, "__code__") and not obj.__code__.co_freevars:
-                code = obj.__code__
-                obj.__code__ = _stub_code(name)
-                undo.append(lambda fn=obj, code=code: setattr(fn, "__code__", code))
-            else:  # a compiled function: only the module attribute can be replaced
-                setattr(module, attribute, lambda *args, _name=name, **kwargs: refuse(_name))
-                undo.append(lambda module=module, attribute=attribute, obj=obj: setattr(module, attribute, obj))
-        yield _attempts
-    finally:
-        for restore in reversed(undo):
-            restore()
-
-
-# -- the grader's side: reading the source --------------------------------------------
-
-def spellings(refused):
-    """Every dotted name under which each refused reference can be written: {spelling: name}."""
-    names = {}
-    for name in refused:
-        names[name] = name
-        found = _resolve(name)
-        if found is not None:
-            defining = getattr(found[0], "__module__", None)
-            if defining:
-                names[f"{defining}.{found[2]}"] = name
-    return names
-
-
-@functools.lru_cache(maxsize=4096)
-def _parse(source):
-    """The ast of a notebook cell (IPython magics turned into Python first), or None.
-
-    Cached: the grader scans the same cells once per exercise. The trees are only read."""
-    try:
-        from IPython.core.inputtransformer2 import TransformerManager
-
-        source = TransformerManager().transform_cell(source)
-    except Exception:  # noqa: BLE001 - a cell IPython cannot read is simply not scanned
-        pass
-    try:
-        return ast.parse(source)
-    except (SyntaxError, ValueError, RecursionError, MemoryError):
-        return None
-
-
-def _dotted(node, aliases):
-    parts = []
-    while isinstance(node, ast.Attribute):
-        parts.append(node.attr)
-        node = node.value
-    if not isinstance(node, ast.Name) or node.id not in aliases:
-        return None
-    return ".".join([aliases[node.id]] + parts[::-1])
-
-
-def scan(sources, names, refused):
-    """Findings ``(function, line, reference)``: where the functions `names` of a notebook,
-    or notebook functions they call, name a refused reference."""
-    if not refused:
-        return []
-    spelled = spellings(refused)
-    trees = [tree for tree in map(_parse, sources) if tree is not None]
-    aliases, functions = {}, {}
-    for tree in trees:
-        for node in ast.walk(tree):
-            if isinstance(node, ast.Import):
-                for alias in node.names:
-                    local = alias.asname or alias.name.split(".")[0]
-                    aliases[local] = alias.name if alias.asname else local
-            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
-                for alias in node.names:
-                    aliases[alias.asname or alias.name] = f"{node.module}.{alias.name}"
-        for node in tree.body:
-            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                functions[node.name] = node
-    findings, seen, todo = [], set(), [n for n in names if n in functions]
-    while todo:
-        name = todo.pop()
-        if name in seen:
+    for split in range(len(parts), 0, -1):
+        try:
+            value = importlib.import_module(".".join(parts[:split]))
+        except (ImportError, ValueError, TypeError):
             continue
-        seen.add(name)
-        for node in ast.walk(functions[name]):
-            if isinstance(node, ast.Name) and node.id in functions and node.id not in seen:
-                todo.append(node.id)
-            if isinstance(node, (ast.Name, ast.Attribute)):
-                dotted = _dotted(node, {k: v for k, v in aliases.items() if k not in functions})
-                while dotted:
-                    if dotted in spelled:
-                        findings.append((name, node.lineno - functions[name].lineno + 1, spelled[dotted]))
-                        break
-                    dotted = dotted.rpartition(".")[0]
-    return sorted(set(findings))
+        try:
+            for attribute in parts[split:]:
+                value = getattr(value, attribute)
+        except AttributeError:
+            return None
+        return value
+    return None
+
+
+def _within(module, prefixes):
+    return any(module == p or module.startswith(p + ".") for p in prefixes)
+
+
+@functools.lru_cache(maxsize=None)
+def spellings(refusal):
+    """({spelling: the refused object's own name}, [spellings of allowed objects]) in labkit, scipy and numpy."""
+    for prefix in refusal.modules:
+        if prefix.split(".")[0] in LIBRARIES:
+            try:
+                importlib.import_module(prefix)
+            except ImportError:
+                pass
+    libraries = [(name, module) for name, module in list(sys.modules.items())
+                 if module is not None and name.split(".")[0] in LIBRARIES]
+    allowed = {id(value): value for value in map(_resolve, refusal.allowed) if value is not None}
+    refused = {}
+    for name, module in libraries:
+        if not _within(name, refusal.modules):
+            continue
+        for attribute, value in list(vars(module).items()):
+            if isinstance(value, types.ModuleType) or id(value) in allowed:
+                continue
+            home = getattr(value, "__module__", None)
+            if isinstance(home, str) and _within(home, refusal.modules) and (
+                    id(value) not in refused or home == name):
+                refused[id(value)] = (value, f"{name}.{attribute}")
+    for dotted in refusal.functions:
+        value = _resolve(dotted)
+        if value is not None:
+            refused.setdefault(id(value), (value, dotted))
+    spelled, allowed_spellings = {}, set(refusal.allowed)
+    for name, module in libraries:
+        for attribute, value in list(vars(module).items()):
+            found = refused.get(id(value))
+            if found is not None and found[0] is value:
+                spelled[f"{name}.{attribute}"] = found[1]
+            elif id(value) in allowed and allowed[id(value)] is value:
+                allowed_spellings.add(f"{name}.{attribute}")
+    return spelled, sorted(allowed_spellings)
+
+
+def wire(refusals):
+    """The profiles of these refusals as JSON-ready data for the sandbox and the scan: {name: {...}}."""
+    profiles = {}
+    for refusal in refusals:
+        names, modules, c_names = recognised(refusal)
+        spelled, allowed = spellings(refusal)
+        profiles[refusal.name] = {"names": {key.hex(): name for key, name in names.items()},
+                                  "modules": list(modules), "c_names": sorted(map(list, c_names)),
+                                  "spellings": spelled, "allowed": allowed}
+    return profiles

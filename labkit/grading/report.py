@@ -9,9 +9,15 @@ Layout of an output folder::
     seed.txt                 the seed of the run's random test data
 
 Every file here is written by the grader from its own results; nothing in
-it comes from a student's process but plain numbers and short texts.
+it comes from a student's process but plain numbers and short texts, and
+those are data: a submission's name becomes a file name through
+:func:`safe_name` (a hash keeps two students apart), every text is stripped
+of control characters (:func:`printable`) before it reaches a file or a
+terminal, and every CSV cell that a spreadsheet would run as a formula is
+neutralised (:func:`csv_cell`).
 """
 import csv
+import hashlib
 import json
 import re
 from dataclasses import dataclass, field
@@ -33,6 +39,11 @@ class SubmissionGrade:
     problems: list = field(default_factory=list)  # what went wrong while running, per notebook
     seed: int = None
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
+    failure: str = None  # why the submission could not be graded at all (then it has no points, not zero)
+
+    @property
+    def graded(self):
+        return self.failure is None
 
     @property
     def fractions(self):
@@ -52,6 +63,9 @@ class SubmissionGrade:
         return self.score.total
 
     def feedback(self):
+        if not self.graded:
+            return printable(f"Feedback for {self.name}: not graded\n\n! could not be graded: {self.failure}\n"
+                             "Your instructor has been told; nothing of this submission was scored.\n")
         score, rubric = self.score, self.rubric
         extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
         lines = [f"Feedback for {self.name}: {points_text(score.total)} points "
@@ -65,7 +79,7 @@ class SubmissionGrade:
         lines += ["", self._summary()]
         if self.seed is not None:
             lines += ["", f"(random test data from seed {self.seed})"]
-        return "\n".join(lines) + "\n"
+        return printable("\n".join(lines) + "\n")
 
     def _exercise_lines(self, number):
         points = self.rubric.points[number]
@@ -106,6 +120,7 @@ class SubmissionGrade:
     def as_dict(self):
         score = self.score
         return {"format": FORMAT, "name": self.name, "seed": self.seed, "problems": list(self.problems),
+                "failure": self.failure,
                 "results": {str(n): v for n, v in self.results.items()},
                 "rubric": self.rubric.title, "points": {str(n): v for n, v in score.points.items()},
                 "branch": score.branch, "extra_credit": score.extra, "total": score.total}
@@ -119,8 +134,10 @@ class SubmissionGrade:
             results = {int(n): v for n, v in data["results"].items()}
             for verdict in results.values():
                 float(verdict["fraction"])
-            grade = cls(str(data["name"]), results, list(data["problems"]), data.get("seed"),
-                        rubric or rubrics.default())
+            grade = cls(str(data["name"]), results, [str(p) for p in data["problems"]], data.get("seed"),
+                        rubric or rubrics.default(), data.get("failure"))
+            if grade.failure is not None:
+                grade.failure = str(grade.failure)
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
         if not set(grade.results) <= set(EXERCISES):
@@ -129,25 +146,57 @@ class SubmissionGrade:
         return grade
 
 
+CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u200b-\u200f\u202a-\u202e\u2066-\u2069]")
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+
+
+def printable(text):
+    """`text` without control characters but newline and tab (no escape sequence reaches a terminal)."""
+    return CONTROL.sub("\ufffd", str(text))
+
+
+def one_line(text, limit=200):
+    """A submission's text as one printable line (a name in a table or a terminal)."""
+    line = printable(str(text)).replace("\n", " ").replace("\t", " ")
+    return line if len(line) <= limit else line[: limit - 1] + "\u2026"
+
+
 def safe_name(name):
-    """A submission's name as a file name."""
-    return re.sub(r"[^\w.-]+", "_", name)
+    """A submission's name as a file name: safe characters, at most 60 of them, and a hash of the whole name,
+    so two students never share a file ("jane doe" and "jane_doe" differ)."""
+    readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"
+    return f"{readable}-{hashlib.sha256(str(name).encode('utf-8', 'surrogatepass')).hexdigest()[:10]}"
 
 
-CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit"]
+def csv_cell(value):
+    """A cell a spreadsheet shows as text: one starting like a formula gets a leading apostrophe (OWASP)."""
+    text = one_line(value, 500) if isinstance(value, str) else value
+    if isinstance(text, str) and text.startswith(FORMULA_START):
+        return "'" + text
+    return text
+
+
+CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
 
 
 def write_csv(path, grades):
-    """One row per submission: points per exercise, the branch that counted, extra credit, total."""
+    """One row per submission: points per exercise, the branch that counted, extra credit, total, status.
+
+    A submission that could not be graded has empty points and says why in its status."""
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         graded = grades[0].rubric.graded if grades else []
         writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL)
         for g in grades:
+            if not g.graded:
+                writer.writerow([csv_cell(g.name)] + [""] * (len(graded) + len(CSV_TAIL) - 1)
+                                + [csv_cell(f"not graded: {g.failure}")])
+                continue
             s = g.score
-            writer.writerow([g.name] + [points_text(s.points[n]) for n in graded]
-                            + [points_text(s.required), s.branch, points_text(s.counted), points_text(s.extra_total), points_text(s.total),
-                               points_text(s.full_credit)])
+            writer.writerow([csv_cell(g.name)] + [points_text(s.points[n]) for n in graded]
+                            + [points_text(s.required), csv_cell(s.branch), points_text(s.counted),
+                               points_text(s.extra_total), points_text(s.total), points_text(s.full_credit),
+                               "graded"])
 
 
 def write_result(out_dir, grade):

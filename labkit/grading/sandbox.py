@@ -6,14 +6,22 @@
   environment (its prefixes and labkit's own package folder) mounted
   read-only, nothing else of the machine (no other home folders, no course
   folder, no instructor notebooks, no output folder, no other submission);
-* the submission's private folder, a copy made for this run, as the only
-  writable place on disk; it is ``HOME`` and the working directory;
-* ``/tmp`` a small private tmpfs; ``/proc`` of its own; a minimal ``/dev``;
+* ``HOME`` (the working directory) and ``/tmp``: small private tmpfs of
+  their own, the only writable places; they live in the sandbox's mount
+  namespace and vanish with it, so nothing the notebook writes is left on
+  the machine and there is nothing to clean up;
+* ``/proc`` of its own, read-only (no process writes its own memory
+  through ``/proc/self/mem``); a minimal ``/dev``;
+* a seccomp filter (:mod:`labkit.grading.seccomp`): no anonymous memory
+  files, no kernel keyrings, no reading or writing another process's memory;
 * no network (``--unshare-net``: only a loopback of its own), its own PID,
   IPC and UTS namespaces, a new session (no terminal to inject into), and
   ``--die-with-parent``, so every process of the notebook dies with the grader;
 * all capabilities dropped but the two the worker needs to give up root
   (it then runs as an otherwise unused uid, so the process limit holds).
+
+The grader adds a memory cgroup around the whole sandbox where it can
+(:mod:`labkit.grading.cgroup`).
 
 :func:`apply_limits` sets the rlimits (address space, CPU seconds, processes,
 file size, open files) in the child before ``bwrap`` starts; they are
@@ -41,12 +49,13 @@ class SandboxUnavailable(RuntimeError):
 class Limits:
     """Resource limits of one notebook's sandbox."""
 
-    memory: int = 4 * 1024**3  # bytes of address space per process
+    memory: int = 4 * 1024**3  # bytes of address space per process, and of the whole sandbox's cgroup
     cpu_seconds: int = 900  # per process
     processes: int = 64  # processes and threads of the sandbox's uid
     file_size: int = 64 * 1024**2  # bytes per file written
     open_files: int = 256
     tmp_size: int = 256 * 1024**2  # bytes of the private /tmp
+    home_size: int = 256 * 1024**2  # bytes of the private home folder
 
 
 def available():
@@ -71,10 +80,10 @@ def sandbox_uid():
     """An unused uid for this grading process's sandboxes (0 when not root: bwrap maps the caller's).
 
     Sandboxes graded at the same time come from different processes, so they
-    get different uids and one notebook's processes never count against
-    another's limit.
+    get different uids (one per process id) and one notebook's processes
+    never count against another's limit.
     """
-    return 61000 + os.getpid() % 4000 if os.geteuid() == 0 else 0
+    return 100_000 + os.getpid() if os.geteuid() == 0 else 0
 
 
 def _read_only_paths():
@@ -100,14 +109,16 @@ def _parents(path, made):
     return args
 
 
-def command(workdir, argv, uid, limits=Limits()):
-    """The bwrap command that runs `argv` on the private folder `workdir`."""
-    args = [shutil.which("bwrap") or "bwrap", *_namespaces(), "--clearenv",
-            "--cap-drop", "ALL"]
+def command(argv, limits=Limits(), seccomp_fd=None):
+    """The bwrap command that runs `argv` in a new sandbox (pass `seccomp_fd` to the process with pass_fds)."""
+    args = [shutil.which("bwrap") or "bwrap", *_namespaces(), "--clearenv", "--cap-drop", "ALL"]
     if os.geteuid() == 0:
         args += ["--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID"]
+    if seccomp_fd is not None:
+        args += ["--seccomp", str(seccomp_fd)]
     # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
-    args += ["--proc", "/proc", "--dev", "/dev", "--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
+    args += ["--proc", "/proc", "--remount-ro", "/proc", "--dev", "/dev",
+             "--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
     for name in ("usr", "etc"):
         args += ["--ro-bind", f"/{name}", f"/{name}"]
     for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
@@ -119,7 +130,8 @@ def command(workdir, argv, uid, limits=Limits()):
     made = {Path("/tmp")}
     for path in _read_only_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
-    args += [*_parents(HOME, made), "--bind", str(workdir), HOME, "--chdir", HOME]
+    args += [*_parents(HOME, made), "--perms", "1777", "--size", str(limits.home_size), "--tmpfs", HOME,
+             "--chdir", HOME]
     environment = {"HOME": HOME, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin", "LANG": "C.UTF-8",
                    "MPLBACKEND": "Agg", "MPLCONFIGDIR": f"{HOME}/.matplotlib", "PYTHONDONTWRITEBYTECODE": "1",
                    "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}

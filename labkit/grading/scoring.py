@@ -1,125 +1,319 @@
 """Grading one notebook and one submission, on the grader's (trusted) side.
 
-For each notebook: read it here (JSON only, nothing run), copy it into a
-private folder, start the sandboxed worker on that folder, have it run the
-code cells, then run every exercise's checks here through proxies into the
-worker (:mod:`labkit.grading.remote`), with the exercise's reference
-implementations switched off in the sandbox and named if the source reaches
-for them (:mod:`labkit.grading.refusals`). Scores, hints and problems are
-all computed on this side.
+For each notebook: check its size and read it here (JSON only, nothing
+run), start the sandboxed worker, have it run the code cells, then run
+every exercise's checks here through proxies into the worker
+(:mod:`labkit.grading.remote`), each part with its references switched off
+in the sandbox (:mod:`labkit.grading.guard`) and named if the source
+reaches for them (:mod:`labkit.grading.scan`). Scores, hints and problems
+are all computed on this side.
+
+A submission has one time limit for all its notebooks together. An
+exercise counts from the first notebook (in name order) that defines its
+names; later notebooks are not checked for it.
+
+``python -m labkit.grading.scoring SPEC`` grades one submission in a
+process of its own and writes its result file: :mod:`labkit.grading.batch`
+starts one per submission, so whatever one submission does to the grader's
+memory or time costs only its own grade.
 """
+import json
+import os
 import re
-import shutil
-import tempfile
+import stat
+import sys
 import time
 from pathlib import Path
 
-from ..checks.exercises import EXERCISES, grade as run_checks
-from ..notebooks import read_notebook
-from . import refusals, remote, sandbox
+from ..checks.exercises import EXERCISES, REFUSALS, grade as run_checks
+from . import refusals, remote, scan
+from .options import GradeOptions
 from .report import SubmissionGrade
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
+MAX_NOTEBOOK_BYTES = 10 * 1024**2  # a lab notebook with its pictures is a few megabytes
+MAX_NOTEBOOKS = 20  # notebooks graded per submission
+MAX_FILES = 5_000  # entries looked at in one submission folder
+MAX_DEPTH = 8  # folder levels looked into
 HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
 
 
-def exercises_in(nb):
-    """Graded exercises whose section heading ('## Exercise N') the notebook has."""
-    found = {int(n) for cell in nb.cells if cell.cell_type == "markdown" for n in HEADING.findall(cell.source)}
+def read_cells(path):
+    """(code sources, markdown sources) of a notebook file; ValueError says why it is not one.
+
+    The size is checked before anything is read, and a link is never followed."""
+    path = Path(path)
+    info = os.lstat(path)
+    if stat.S_ISLNK(info.st_mode):
+        raise ValueError(f"{path.name} is a symbolic link; links are never followed.")
+    if info.st_size > MAX_NOTEBOOK_BYTES:
+        raise ValueError(f"{path.name} is {info.st_size / 1024**2:.1f} MB, more than the "
+                         f"{MAX_NOTEBOOK_BYTES // 1024**2} MB a lab notebook needs (clear its outputs and hand it in "
+                         "again); it was not graded.")
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
+    with os.fdopen(fd, "rb") as handle:
+        raw = handle.read(MAX_NOTEBOOK_BYTES + 1)
+    if len(raw) > MAX_NOTEBOOK_BYTES:
+        raise ValueError(f"{path.name} is more than {MAX_NOTEBOOK_BYTES // 1024**2} MB; it was not graded.")
+    try:
+        nb = json.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise ValueError(f"{path.name} is not a text file, so not a notebook.") from None
+    except (ValueError, RecursionError) as exc:
+        raise ValueError(f"{path.name} is not a valid notebook (not JSON: {str(exc)[:200]}).") from None
+    if not isinstance(nb, dict) or not isinstance(nb.get("cells"), list) or nb.get("nbformat") != 4:
+        raise ValueError(f"{path.name} is not a valid notebook (no list of cells in nbformat 4).")
+    code, markdown = [], []
+    for cell in nb["cells"]:
+        source = cell.get("source", "") if isinstance(cell, dict) else None
+        if isinstance(source, list) and all(isinstance(line, str) for line in source):
+            source = "".join(source)
+        if not isinstance(source, str):
+            raise ValueError(f"{path.name} is not a valid notebook (a cell without text).")
+        kind = cell.get("cell_type")
+        if kind == "code":
+            code.append(source)
+        elif kind == "markdown":
+            markdown.append(source)
+    return code, markdown
+
+
+def exercises_in(markdown):
+    """Graded exercises whose section heading ('## Exercise N') the markdown has."""
+    if hasattr(markdown, "cells"):  # an nbformat notebook
+        markdown = [cell.source for cell in markdown.cells if cell.cell_type == "markdown"]
+    found = {int(n) for text in markdown for n in HEADING.findall(text) if len(n) < 4}
     return sorted(found & set(EXERCISES))
 
 
 def submission_notebooks(path):
-    """The notebooks of a submission: one .ipynb file, or every .ipynb in a folder (no links followed)."""
+    """The notebooks of a submission: one .ipynb file, or the .ipynb files in a folder.
+
+    No link is ever followed, at any level: a submission that is a link, a
+    linked folder or a linked notebook inside is refused or left out. The
+    walk is bounded in depth and in entries."""
     path = Path(path)
-    if path.is_dir():
-        notebooks = sorted(p for p in path.rglob("*.ipynb")
-                           if ".ipynb_checkpoints" not in p.parts and p.is_file() and not p.is_symlink())
-        if not notebooks:
-            raise ValueError(f"{path} contains no notebooks (*.ipynb).")
-        return notebooks
-    if not path.exists():
-        raise ValueError(f"{path} does not exist.")
-    if path.suffix != ".ipynb":
-        raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
-    return [path]
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        raise ValueError(f"{path} does not exist.") from None
+    if stat.S_ISLNK(info.st_mode):
+        raise ValueError(f"{path} is a symbolic link; links are never followed (grade the folder it points to "
+                         "by its own name if it is really a submission).")
+    if stat.S_ISREG(info.st_mode):
+        if path.suffix != ".ipynb":
+            raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
+        return [path]
+    if not stat.S_ISDIR(info.st_mode):
+        raise ValueError(f"{path} is neither a notebook nor a folder.")
+    found, todo, seen = [], [(path, 0)], 0
+    while todo:
+        folder, depth = todo.pop()
+        try:
+            entries = sorted(os.scandir(folder), key=lambda e: e.name)
+        except OSError:
+            continue
+        for entry in entries:
+            seen += 1
+            if seen > MAX_FILES:
+                raise ValueError(f"{path} holds more than {MAX_FILES} files; a submission is a few notebooks.")
+            if entry.is_symlink() or entry.name == ".ipynb_checkpoints":
+                continue
+            if entry.is_dir(follow_symlinks=False) and depth < MAX_DEPTH:
+                todo.append((Path(entry.path), depth + 1))
+            elif entry.is_file(follow_symlinks=False) and entry.name.endswith(".ipynb"):
+                found.append(Path(entry.path))
+    if not found:
+        raise ValueError(f"{path} contains no notebooks (*.ipynb).")
+    return sorted(found)[:MAX_NOTEBOOKS]
 
 
-def _own_code(findings):
-    """A failed check naming the references a graded function reaches for."""
+def _failed_part(check, name, step, detail, hint):
+    return {"name": name, "passed": False, "hint": hint, "weight": check.get("weight", 0),
+            "steps": [{"step": step, "passed": False, "detail": detail}]}
+
+
+def _own_code(check, findings):
+    """The part's check, failed: the graded function reaches for refused references."""
     details = "; ".join(f"{function} (line {line} of its definition) reaches for {name}"
-                        for function, line, name in findings)
-    return {"name": "own code", "passed": False,
-            "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab "
-                    "names stay available.",
-            "steps": [{"step": "calls no reference implementation", "passed": False, "detail": details}]}
+                        for function, line, name in findings[:8])
+    return _failed_part(check, check["name"], "calls no reference implementation", details,
+                        "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab "
+                        "names stay available.")
 
 
-def _run_problems(name, ran, total_timeout):
+def _rescore(verdict):
+    exercise = EXERCISES[verdict["exercise"]]
+    points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"])
+    verdict.update(points=points, passed=points == exercise.points, fraction=points / exercise.points)
+    return verdict
+
+
+def _run_problems(name, ran):
     problems = []
-    if ran["errors"]:
-        shown = "; ".join(f"cell {e['cell'] + 1} raised {e['kind']}: {e['message'][:300]}"
-                          for e in ran["errors"][:SHOWN_ERRORS])
-        more = f"; and {len(ran['errors']) - SHOWN_ERRORS} more" if len(ran["errors"]) > SHOWN_ERRORS else ""
-        problems.append(f"{name}: {len(ran['errors'])} cell(s) raised an error (graded as far as it got): "
-                        f"{shown}{more}.")
-    if ran["output_chars"] > OUTPUT_LIMIT:
-        problems.append(f"{name}: printed {ran['output_chars']:,} characters of output (none of it is kept).")
+    errors = ran.get("errors") if isinstance(ran.get("errors"), list) else []
+    if errors:
+        shown = []
+        for error in errors[:SHOWN_ERRORS]:
+            error = error if isinstance(error, dict) else {}
+            text = f"cell {int(error.get('cell', -1)) + 1} raised {str(error.get('kind'))[:100]}: " \
+                   f"{str(error.get('message', ''))[:300]}"
+            tail = str(error.get("traceback", ""))[-1500:]
+            if tail:
+                text += "\n" + "\n".join(f"      | {line}" for line in tail.splitlines()[-6:])
+            shown.append(text)
+        more = f"\n    and {len(errors) - SHOWN_ERRORS} more" if len(errors) > SHOWN_ERRORS else ""
+        problems.append(f"{name}: {len(errors)} cell(s) raised an error (graded as far as it got):\n    "
+                        + "\n    ".join(shown) + more)
+    if int(ran.get("output_chars", 0) or 0) > OUTPUT_LIMIT:
+        problems.append(f"{name}: printed {int(ran['output_chars']):,} characters of output (none of it is kept).")
     return problems
 
 
-def grade_notebook(path, cell_timeout=60, total_timeout=600, seed=None, confined=True, limits=None):
-    """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems])."""
+def _profiles():
+    """The refusals of every exercise, computed once per grading process."""
+    if not hasattr(_profiles, "value"):
+        _profiles.value = refusals.wire(REFUSALS)
+    return _profiles.value
+
+
+def _for_sandbox(profiles):
+    return {name: {key: profile[key] for key in ("names", "modules", "c_names")} for name, profile in profiles.items()}
+
+
+def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None,
+                   options=None, deadline=None, skip=(), profiles=None):
+    """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
+
+    `options` (a :class:`GradeOptions`) or the single keywords bound it; `deadline`
+    (monotonic) is the submission's; exercises in `skip` are not checked here."""
+    options = _options(options, cell_timeout, total_timeout, seed, confined, limits)
+    deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
+    profiles = profiles or _profiles()
     name = Path(path).name
     try:
-        nb = read_notebook(path)
-    except ValueError as exc:
-        return {}, [str(exc)]
-    numbers = exercises_in(nb)
+        code, markdown = read_cells(path)
+    except (ValueError, OSError) as exc:
+        return {}, [f"{name}: {exc}" if name not in str(exc) else str(exc)]
+    numbers = [n for n in exercises_in(markdown) if n not in skip]
     if not numbers:
         return {}, []
-    sources = [cell.source for cell in nb.cells if cell.cell_type == "code"]
-    limits = limits or sandbox.Limits(cpu_seconds=int(total_timeout) + 30)
-    deadline = time.monotonic() + total_timeout
-    with tempfile.TemporaryDirectory(prefix="labkit-grade-") as workdir:
-        shutil.copyfile(path, Path(workdir) / name)
-        with remote.Notebook(workdir, limits, confined, deadline) as notebook:
-            try:
-                ran = notebook.request({"op": "run", "cells": sources, "cell_timeout": cell_timeout}, total_timeout)
-            except remote.WorkerError as exc:
-                why = (f"stopped after the total time limit of {total_timeout} s" if "total time limit" in str(exc)
-                       else f"{exc} while running its cells")
-                return {}, [f"{name}: {why}."]
-            problems = _run_problems(name, ran, total_timeout) if "errors" in ran else []
-            results = {}
-            for number in numbers:
-                exercise = EXERCISES[number]
-                namespace = remote.Namespace(notebook, exercise.refused, cell_timeout)
-                verdict = run_checks(number, namespace, seed=seed)
-                findings = refusals.scan(sources, exercise.names, exercise.refused)
+    size = sum(len(source.encode("utf-8", "surrogatepass")) for source in code)
+    if size > scan.MAX_CODE_BYTES:
+        return {}, [f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
+                    "notebook needs; it was not graded."]
+    if deadline - time.monotonic() <= 1:
+        return {}, [f"{name}: not run: the submission's time limit of {options.total_timeout} s was used up "
+                    "by the notebooks before it."]
+    problems, results = [], {}
+    try:
+        notebook = remote.Notebook(options.limits, options.confined, deadline, _for_sandbox(profiles))
+    except remote.WorkerError as exc:
+        return {}, [f"{name}: the sandbox could not start ({exc})."]
+    with notebook:
+        try:
+            ran = notebook.request({"op": "run", "cells": code, "cell_timeout": options.cell_timeout},
+                                   options.total_timeout)
+        except remote.WorkerTimeout as exc:
+            why = (f"stopped after the submission's time limit of {options.total_timeout} s" if exc.total
+                   else str(exc))
+            return {}, [f"{name}: {why}."]
+        except remote.WorkerError as exc:
+            return {}, [f"{name}: {exc} while running its cells."]
+        if "error" in ran:  # the notebook's process died while its cells ran: nothing to check
+            error = ran["error"] if isinstance(ran["error"], dict) else {}
+            return {}, [f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."]
+        problems += _run_problems(name, ran)
+        if notebook.tampered:
+            problems.append(f"{name}: {notebook.tampered}; none of its answers count.")
+        for number in numbers:
+            exercise = EXERCISES[number]
+            if notebook.tampered:
+                checks = [_failed_part({"weight": part.weight}, part.name, "the notebook's answers can be trusted",
+                                       notebook.tampered, "remove what the message names and hand it in again.")
+                          for part in exercise.parts]
+                results[number] = _rescore({"exercise": number, "defined": True, "checks": checks})
+                continue
+            verdict = run_checks(number, remote.Namespace(notebook, options.cell_timeout), seed=options.seed)
+            for index, part in enumerate(exercise.parts):
+                if part.refused is None:
+                    continue
+                try:
+                    findings = scan.scan(code, part.scanned, profiles[part.refused.name])
+                except scan.Unreadable as exc:
+                    verdict["checks"][index] = _failed_part(
+                        verdict["checks"][index], verdict["checks"][index]["name"], "its source can be read",
+                        str(exc), "keep the notebook's code to what the lab asks for.")
+                    continue
                 if findings:
-                    verdict["checks"].append(_own_code(findings))
-                    verdict["passed"], verdict["points"], verdict["fraction"] = False, 0, 0.0
-                results[number] = verdict
-            if notebook.stopped:
-                problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")
+                    verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
+            results[number] = _rescore(verdict)
+        if notebook.stopped:
+            problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")
     return results, problems
 
 
-def grade_submission(path, cell_timeout=60, total_timeout=600, seed=None, confined=True, limits=None, rubric=None):
-    """Grade one submission (a notebook or a folder of them), scored with `rubric` (the lab's when None)."""
+def _options(options, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None):
+    given = {key: value for key, value in (("cell_timeout", cell_timeout), ("total_timeout", total_timeout),
+                                           ("seed", seed), ("confined", confined), ("limits", limits))
+             if value is not None}
+    if options is None:
+        return GradeOptions(**given)
+    if given:
+        from dataclasses import replace
+
+        return replace(options, **given)
+    return options
+
+
+def submission_name(path):
     path = Path(path)
-    grade = SubmissionGrade(path.stem if path.is_file() else path.name, seed=seed)
+    return path.stem if path.suffix == ".ipynb" else path.name
+
+
+def grade_submission(path, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None,
+                     rubric=None, options=None, profiles=None):
+    """Grade one submission (a notebook or a folder of them), scored with `rubric` (the lab's when None).
+
+    One time limit covers every notebook of the submission."""
+    options = _options(options, cell_timeout, total_timeout, seed, confined, limits)
+    deadline = time.monotonic() + options.total_timeout
+    grade = SubmissionGrade(submission_name(path), seed=options.seed)
     if rubric is not None:
         grade.rubric = rubric
-    for notebook in submission_notebooks(path):
-        results, problems = grade_notebook(notebook, cell_timeout, total_timeout, seed, confined, limits)
+    try:
+        notebooks = submission_notebooks(path)
+    except ValueError as exc:
+        grade.problems.append(str(exc))
+        return grade
+    for notebook in notebooks:
+        claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
+        results, problems = grade_notebook(notebook, options=options, deadline=deadline, skip=claimed,
+                                           profiles=profiles)
         grade.problems.extend(problems)
         for number, verdict in results.items():
-            best = grade.results.get(number)
-            # an exercise may be mentioned in several notebooks: keep the one that scores,
-            # or else the one that defines its functions
-            if best is None or (verdict["points"], verdict["defined"]) > (best["points"], best["defined"]):
+            # an exercise counts from the first notebook that defines its names (or else the first to mention it)
+            current = grade.results.get(number)
+            if current is None or (verdict["defined"] and not current.get("defined")):
                 grade.results[number] = verdict
     return grade
+
+
+def main(argv=None):
+    """Grade the submission a spec file describes; write its result file. Used by :mod:`labkit.grading.batch`."""
+    argv = sys.argv[1:] if argv is None else argv
+    spec = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+    profiles = json.loads(Path(spec["profiles"]).read_text(encoding="utf-8"))
+    options = GradeOptions.from_dict(spec["options"])
+    grade = grade_submission(spec["submission"], options=options, profiles=profiles)
+    grade.name = spec["name"]
+    result = Path(spec["result"])
+    partial = result.with_suffix(".partial")
+    partial.write_text(json.dumps(grade.as_dict()), encoding="utf-8")
+    os.replace(partial, result)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,294 @@
+"""Reading a notebook's source for refused references, on the grader's side (``ast``; nothing is run).
+
+For a graded name, :func:`scan` follows what its last definition in the
+notebook reaches: the functions, classes and module-level variables of the
+notebook it names (``ref = labkit.eval_pherm``, ``eval_pherm = ...``,
+``class H(CubicHermiteSpline)``), through import aliases, and reports
+
+* every reference into a refused module (``scipy.interpolate.X``,
+  ``labkit.splines._any_private_helper``) or to a refused function under any
+  name it has (``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``);
+* every way of reaching code that a reader cannot follow: ``__import__``,
+  ``importlib``, ``eval``/``exec``, ``getattr`` with a computed name,
+  ``globals()``, ``sys.modules``, ``gc``, ``ctypes``, a function's
+  ``__code__`` or ``__globals__``, a frame's locals, or a module the
+  notebook wrote itself.
+
+The scan is bounded: a notebook's code cells may hold at most
+:data:`MAX_CODE_BYTES`, and reading them may take at most
+:data:`TIME_BUDGET` seconds (:class:`Unreadable` otherwise). Cell magics
+that run Python (``%%time``, ``%%capture``) are read as Python; other cells
+that IPython would hand to another program are skipped.
+"""
+import ast
+import re
+import time
+
+MAX_CODE_BYTES = 512 * 1024  # a lab notebook's code is a few tens of kilobytes
+TIME_BUDGET = 20.0  # seconds to read one notebook's code
+
+PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
+# modules a graded function may reach without the scan asking what they are
+KNOWN = {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator",
+         "collections", "numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings",
+         "bisect", "heapq", "copy", "enum", "abc"}
+DYNAMIC_NAMES = {"__import__": "__import__", "eval": "eval", "exec": "exec", "compile": "compile",
+                 "globals": "globals()", "vars": "vars()", "locals": "locals()", "setattr": "setattr",
+                 "delattr": "delattr", "breakpoint": "breakpoint"}
+DYNAMIC_ATTRIBUTES = {"__code__", "__closure__", "__globals__", "__builtins__", "__dict__", "__subclasses__",
+                      "__func__", "f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame", "__wrapped__"}
+DYNAMIC_MODULES = {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill", "builtins",
+                   "imp", "pkgutil", "runpy", "code", "codeop", "threading", "_thread", "multiprocessing",
+                   "subprocess", "signal"}
+DYNAMIC_DOTTED = {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace",
+                  "sys.gettrace", "sys._current_frames", "types.FunctionType", "types.CodeType", "os.system",
+                  "os.fork", "os.popen", "os.exec", "os.spawn"}
+
+
+class Unreadable(ValueError):
+    """The notebook's code is too large, or too slow, to be read within the scan's budget."""
+
+
+def python_source(cell):
+    """A code cell as Python: IPython's magics and shell escapes become ``pass`` (line numbers kept); None to skip."""
+    lines = cell.split("\n")
+    first = next((i for i, line in enumerate(lines) if line.strip()), None)
+    if first is not None and lines[first].lstrip().startswith("%%"):
+        magic = lines[first].lstrip()[2:].split(maxsplit=1)
+        if not magic or magic[0] not in PYTHON_CELL_MAGICS:
+            return None
+        lines[first] = ""
+    out = []
+    for line in lines:
+        stripped = line.lstrip()
+        if stripped.startswith(("%", "!")):
+            out.append(line[: len(line) - len(stripped)] + "pass")
+        else:
+            out.append(re.sub(r"=\s*[%!].*$", "= None", line) if re.search(r"=\s*[%!]\w", line) else line)
+    return "\n".join(out)
+
+
+class _Reader:
+    """The notebook's top-level definitions and import aliases, and the walk from a graded name."""
+
+    def __init__(self, sources, deadline):
+        self.deadline = deadline
+        self.trees = []
+        for source in sources:
+            text = python_source(source)
+            if text is None:
+                continue
+            self._tick()
+            try:
+                self.trees.append(ast.parse(text))
+            except (SyntaxError, ValueError, RecursionError, MemoryError):
+                continue  # IPython could not run it either: it defines nothing
+        self.aliases, self.definitions = {}, {}
+        for tree in self.trees:
+            for node in tree.body:
+                self._record(node)
+
+    def _tick(self):
+        if time.monotonic() > self.deadline:
+            raise Unreadable(f"reading the notebook's code took more than {TIME_BUDGET:g} s")
+
+    def _record(self, node):
+        """Top-level names: the last definition wins, as when the cells run in order."""
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            for local, dotted in _imported(node):
+                self.aliases[local] = dotted
+                self.definitions.pop(local, None)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            self.definitions[node.name] = node
+            self.aliases.pop(node.name, None)
+        elif isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for target in targets:
+                for name in ast.walk(target):
+                    if isinstance(name, ast.Name):
+                        self.definitions[name.id] = node
+                        self.aliases.pop(name.id, None)
+        elif isinstance(node, (ast.If, ast.For, ast.While, ast.With, ast.Try)):
+            for child in ast.iter_child_nodes(node):
+                if isinstance(child, ast.stmt):
+                    self._record(child)
+
+    def reached(self, name):
+        """(definition name, definition node, its local names) of everything the definition of `name` reaches."""
+        seen, todo, found = set(), [name], []
+        while todo:
+            current = todo.pop()
+            if current in seen or current not in self.definitions:
+                continue
+            seen.add(current)
+            node = self.definitions[current]
+            local = _locals(node)
+            found.append((current, node, local))
+            for inner in ast.walk(node):
+                self._tick()
+                if (isinstance(inner, ast.Name) and isinstance(inner.ctx, ast.Load) and inner.id in self.definitions
+                        and inner.id not in seen and inner.id not in local):
+                    todo.append(inner.id)
+        return found
+
+
+def _locals(node):
+    """The names a function definition (and the functions inside it) binds for itself: not the notebook's."""
+    if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+        return set()
+    bound, declared = set(), set()
+    for inner in ast.walk(node):
+        if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+            arguments = inner.args
+            for arg in arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg,
+                                                                                        arguments.kwarg]:
+                if arg is not None:
+                    bound.add(arg.arg)
+            if inner is not node and not isinstance(inner, ast.Lambda):
+                bound.add(inner.name)
+        elif isinstance(inner, ast.Name) and isinstance(inner.ctx, (ast.Store, ast.Del)):
+            bound.add(inner.id)
+        elif isinstance(inner, (ast.Global, ast.Nonlocal)):
+            declared.update(inner.names)
+        elif isinstance(inner, (ast.Import, ast.ImportFrom)):
+            bound.update(local for local, _ in _imported(inner))
+    return bound - declared
+
+
+def _imported(node):
+    if isinstance(node, ast.Import):
+        for alias in node.names:
+            yield (alias.asname or alias.name.split(".")[0]), (alias.name if alias.asname else alias.name.split(".")[0])
+    elif node.module and not node.level:
+        for alias in node.names:
+            yield (alias.asname or alias.name), f"{node.module}.{alias.name}"
+    else:  # a relative import: a module the notebook wrote itself
+        for alias in node.names:
+            yield (alias.asname or alias.name), f".{node.module or ''}.{alias.name}"
+
+
+def _dotted(node, aliases):
+    parts = []
+    while isinstance(node, ast.Attribute):
+        parts.append(node.attr)
+        node = node.value
+    if not isinstance(node, ast.Name) or node.id not in aliases:
+        return None
+    return ".".join([aliases[node.id]] + parts[::-1])
+
+
+def _within(dotted, prefixes):
+    return next((p for p in prefixes if dotted == p or dotted.startswith(p + ".")), None)
+
+
+class _Refused:
+    """What one refusal refuses, as the scan asks it: a module prefix, or a known spelling of a refused object."""
+
+    def __init__(self, profile):
+        self.modules = tuple(profile["modules"])
+        self.spellings = dict(profile["spellings"])  # dotted spelling -> the refused object's own name
+        self.allowed = set(profile["allowed"])
+
+    def reason(self, dotted):
+        """Why `dotted` (a name as the notebook writes it, aliases resolved) is refused, or None."""
+        if dotted in self.allowed:
+            return None
+        if dotted in self.spellings:
+            own = self.spellings[dotted]
+            return dotted if own == dotted else f"{own} (as {dotted})"
+        if _within(dotted, self.modules):
+            return dotted
+        return None
+
+
+def _dynamic(node, aliases):
+    """A way of reaching code that the scan cannot follow, written at `node`, or None."""
+    if isinstance(node, ast.Name) and node.id in DYNAMIC_NAMES and node.id not in aliases:
+        return DYNAMIC_NAMES[node.id]
+    if isinstance(node, ast.Attribute) and node.attr in DYNAMIC_ATTRIBUTES:
+        return node.attr
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "getattr" \
+            and len(node.args) >= 2 and not isinstance(node.args[1], ast.Constant):
+        return "getattr with a computed name"
+    if isinstance(node, (ast.Name, ast.Attribute)):
+        dotted = _dotted(node, aliases)
+        if dotted:
+            top = dotted.split(".")[0]
+            if dotted.startswith("."):
+                return f"a module of the notebook's own ({dotted.lstrip('.')})"
+            if top in DYNAMIC_MODULES or any(dotted == d or dotted.startswith(d) for d in DYNAMIC_DOTTED):
+                return dotted
+            if top not in KNOWN and not _installed(top):
+                return f"{dotted} (a module the notebook wrote itself?)"
+    return None
+
+
+def _installed(top):
+    """Whether a top-level module is the standard library's or installed here (found, never imported)."""
+    import importlib.util
+    import sys
+
+    if top in sys.stdlib_module_names:
+        return True
+    try:
+        return importlib.util.find_spec(top) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def scan(sources, names, profile, deadline=None):
+    """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a
+    reference that `profile` switches off, or reach for code in a way the scan cannot follow.
+
+    `profile` is one refusal as :func:`labkit.grading.refusals.wire` gives it (modules, spellings,
+    allowed). Raises :class:`Unreadable` when the code is over :data:`MAX_CODE_BYTES` or reading it
+    takes longer than :data:`TIME_BUDGET` seconds."""
+    if profile is None:
+        return []
+    size = sum(len(s.encode("utf-8", "surrogatepass")) for s in sources)
+    if size > MAX_CODE_BYTES:
+        raise Unreadable(f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} "
+                         "a lab notebook needs")
+    deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
+    reader = _reader(tuple(sources), deadline)
+    refused = _Refused(profile)
+    findings = set()
+    for name in names:
+        for owner, definition, own_names in reader.reached(name):
+            local = {k: v for k, v in reader.aliases.items() if k not in own_names}
+            start = getattr(definition, "lineno", 1)
+            for node in ast.walk(definition):
+                reader._tick()
+                if isinstance(node, (ast.Import, ast.ImportFrom)):
+                    for alias_name, dotted in _imported(node):
+                        local[alias_name] = dotted
+                        why = refused.reason(dotted) or (dotted.split(".")[0] if dotted.split(".")[0]
+                                                         in DYNAMIC_MODULES else None)
+                        if why:
+                            findings.add((owner, node.lineno - start + 1, why))
+            for node in ast.walk(definition):
+                reader._tick()
+                what = None
+                if isinstance(node, (ast.Name, ast.Attribute)):
+                    dotted = _dotted(node, {k: v for k, v in local.items() if k not in reader.definitions})
+                    while dotted and what is None:
+                        what = refused.reason(dotted)
+                        dotted = dotted.rpartition(".")[0]
+                what = what or _dynamic(node, {k: v for k, v in local.items() if k not in reader.definitions})
+                if what:
+                    findings.add((owner, getattr(node, "lineno", start) - start + 1, what))
+    # an attribute chain reports itself and its prefixes: keep the longest on each line
+    return sorted(f for f in findings if not any(g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2])
+                                                  for g in findings))
+
+
+_READERS = {}
+
+
+def _reader(sources, deadline):
+    found = _READERS.get(sources)
+    if found is None:
+        _READERS.clear()  # one notebook at a time
+        found = _READERS[sources] = _Reader(sources, deadline)
+    found.deadline = deadline
+    return found
