@@ -55,39 +55,47 @@ def _release(args):
 
 
 def _summary(grades, out, start, what):
+    from .grading.report import one_line
     from .grading.rubric import points_text
 
     for g in grades:
-        print(f"{g.name:<30} {points_text(g.total):>6}")
+        print(f"{one_line(g.name, 30):<30} {points_text(g.total) if g.graded else 'not graded':>10}")
     print(f"{what} {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
           f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/")
 
 
 def _grade(args):
-    from .grading import grade, merge
-    from .grading.sandbox import Limits
-
+    from .grading import GradeOptions, grade, merge
+    from .grading.batch import report_failures
     from .grading.rubric import load
+    from .grading.sandbox import Limits
 
     start = time.perf_counter()
     rubric = load(args.rubric)
     if args.merge:
         if args.submissions:
             raise ValueError("--merge takes output folders of earlier runs, not submissions; give one or the other.")
-        _summary(merge(args.merge, args.out, rubric), args.out, start, "merged")
-        return 0
+        grades = merge(args.merge, args.out, rubric)
+        _summary(grades, args.out, start, "merged")
+        return 1 if report_failures(grades) else 0
     if not args.submissions:
         raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
-    for name in ("jobs", "cell_timeout", "total_timeout", "memory"):
+    for name in ("jobs", "cell_timeout", "total_timeout", "memory", "grader_memory"):
         if getattr(args, name) < 1:
             raise ValueError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
-    limits = Limits(memory=args.memory * 1024**2, cpu_seconds=args.total_timeout + 30)
-    grades = grade(args.submissions, args.out, jobs=args.jobs, cell_timeout=args.cell_timeout,
-                   total_timeout=args.total_timeout, progress=not args.quiet, seed=args.seed,
-                   sandboxed=not args.no_sandbox, limits=limits, rubric=rubric)
+    options = GradeOptions(cell_timeout=args.cell_timeout, total_timeout=args.total_timeout, seed=args.seed,
+                           confined=not args.no_sandbox, grader_memory=args.grader_memory * 1024**2,
+                           limits=Limits(memory=args.memory * 1024**2, cpu_seconds=args.total_timeout + 30))
+    grades = grade(args.submissions, args.out, jobs=args.jobs, progress=not args.quiet, rubric=rubric,
+                   options=options, sandboxed=not args.no_sandbox)
     _summary(grades, args.out, start, "graded")
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} "
           f"(repeat the run with --seed)")
+    failed = report_failures(grades)
+    if failed:
+        print(f"labkit grade: {failed} submission(s) could not be graded (see above and their feedback); "
+              "every other submission is in grades.csv.", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -131,8 +139,12 @@ def build_parser():
     grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
     grd.add_argument("--cell-timeout", type=int, default=60,
                      help="seconds per cell, and per call of a graded function (default 60)")
-    grd.add_argument("--total-timeout", type=int, default=600, help="seconds per notebook in all (default 600)")
-    grd.add_argument("--memory", type=int, default=4096, help="MiB of address space per process (default 4096)")
+    grd.add_argument("--total-timeout", type=int, default=600,
+                     help="seconds per submission in all, every notebook of it together (default 600)")
+    grd.add_argument("--memory", type=int, default=4096,
+                     help="MiB of memory for a notebook's sandbox, and of address space per process (default 4096)")
+    grd.add_argument("--grader-memory", type=int, default=3072,
+                     help="MiB of memory for the grader's own work on one submission (default 3072)")
     grd.add_argument("--seed", type=int, help="seed of the random test data (default: a fresh one, saved in seed.txt)")
     grd.add_argument("--no-sandbox", action="store_true",
                      help="run student code UNCONFINED, with your permissions (only for code you trust)")

@@ -215,7 +215,24 @@ def _shortest_edge(mesh):
 
 
 def _merge_coincident(points, quads, tolerance):
-    """Renumber nodes so that points closer than `tolerance` become one node."""
+    """Renumber nodes so that points closer than `tolerance` become one node.
+
+    The pairs are counted before they are listed: meshes meet along edges,
+    so a join has about as many coinciding pairs as shared nodes, and one
+    with far more (thousands of nodes piled on one spot) is refused instead
+    of listing billions of pairs. The count is of the pairs in one cell of
+    a grid whose cells' diagonal is `tolerance` (each such pair coincides,
+    and a pile of nodes fills some cell), so it costs a sort."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        cells = np.floor(points / (tolerance / np.sqrt(points.shape[1]))) if tolerance > 0 else points
+    if not np.all(np.isfinite(cells)):
+        cells = points  # a tolerance too small for a grid: count exact duplicates
+    _, counts = np.unique(cells, axis=0, return_counts=True)
+    count = int(np.sum(counts.astype(np.int64) * (counts - 1) // 2))
+    limit = max(10_000, 10 * len(points))
+    if count > limit:
+        raise ValueError(f"{count:,} pairs of nodes coincide; meshes should meet only along their shared edges. "
+                         "Check that each mesh's nodes are distinct (no points piled on one spot).")
     pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
     target = np.arange(len(points))
     if len(pairs):

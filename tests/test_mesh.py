@@ -5,6 +5,8 @@ import meshio
 import numpy as np
 import pytest
 
+import labkit
+
 from labkit import Corner, QuadMesh, patch, quad_mesh
 
 matplotlib.use("Agg")
@@ -163,3 +165,16 @@ def test_plot_draws_every_element_with_labels():
     np.testing.assert_allclose(cells.get_array(), mesh.quality())
     assert ax.get_title() == "exercise 8" and ax.get_xlabel() == "x" and ax.get_aspect() == 1.0
     plt.close(ax.figure)
+
+
+def test_joining_meshes_with_nodes_piled_on_one_spot_is_refused_not_enumerated():
+    # 60,000 nodes each at the origin: listing the coinciding pairs would take some 115 GB
+    quads = np.array([[0, 1, 2, 3]])
+    heap = labkit.QuadMesh(np.zeros((60_000, 2)), quads)
+    unit = labkit.QuadMesh(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]] * 15_000), quads)
+    with pytest.raises(ValueError, match="pairs of nodes coincide"):
+        heap + unit
+    # an honest join along a shared edge merges its nodes as before
+    x, y = np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 3), indexing="ij")
+    left, right = labkit.quad_mesh(x, y), labkit.quad_mesh(x + 1, y)
+    assert len((left + right).points) == 12 + 12 - 3

@@ -139,7 +139,7 @@ def test_a_table_is_what_the_students_own_driver_gives():
 ])
 def test_a_table_that_is_not_eight_errors_says_what_to_give(errors, detail):
     result = check.table("pherm", errors, _driver_1d("pherm"))
-    assert not result.passed and "make errors_pherm a list of 8 errors" in result.hint
+    assert not result.passed and "make errors_pherm a list of 8 positive errors" in result.hint
 
 
 # -- rate answers ---------------------------------------------------------------------
@@ -148,31 +148,56 @@ def test_a_table_that_is_not_eight_errors_says_what_to_give(errors, detail):
                                            ("pchip", 2), ("bilinear", 2)])
 def test_the_true_order_is_right_and_its_ratio_or_a_neighbour_is_not(method, order):
     assert drivers.METHODS[method].order == order
-    assert check.rate(method, order, None).passed
-    assert check.rate(method, float(order), None).passed
-    ratio = check.rate(method, 2 ** order, None)
+    table = drivers.METHODS[method].reference(drivers.METHODS[method].ndata)
+    assert check.rate(method, order, table).passed
+    assert check.rate(method, float(order), table).passed
+    ratio = check.rate(method, 2 ** order, table)
     assert not ratio.passed and f"the rate is its exponent {order}" in ratio.hint
-    assert not check.rate(method, order + 1, None).passed
+    assert not check.rate(method, order + 1, table).passed
+    # without a table there is nothing to read the rate from, even for the right answer
+    bare = check.rate(method, order, None)
+    assert not bare.passed and "nothing to read the rate from" in repr(bare)
 
 
 def test_eight_for_the_complete_spline_fails_with_the_ratios_hint():
     errors = labkit.convergence_table("complete").errors
     result = check.rate("complete", 8, errors)
-    assert not result.passed and "take the ratios" in result.hint and "support 4" in result.hint
+    assert not result.passed and "take the ratios" in result.hint and "support 4" in repr(result)
 
 
-def test_a_rate_consistent_with_the_students_own_table_is_right():
-    # a table whose errors fall like h^3 supports 3, so 3 is accepted along with the true 4
+def test_the_rate_is_read_from_the_students_own_table():
+    # a table whose errors fall like h^3 supports 3: the answer 3 is right, the true 4 is not
     ndata = np.array(drivers.LAB_NDATA)
     errors = 1.0 / (ndata - 1.0) ** 3
     assert drivers.supported_order("complete", errors) == 3
-    assert check.rate("complete", 3, errors).passed and check.rate("complete", 4, errors).passed
+    assert check.rate("complete", 3, errors).passed
+    four = check.rate("complete", 4, errors)
+    assert not four.passed and "your table's ratios support 3" in repr(four)
     assert not check.rate("complete", 2, errors).passed
+
+
+@pytest.mark.parametrize("errors", [[1.0] * 8, list(np.linspace(0.1, 0.2, 8)), [1e-3] * 7 + [0.9e-3]])
+def test_a_table_that_shows_no_experiment_earns_nothing_and_supports_no_rate(errors):
+    constant = lambda ndata, *rest: errors[drivers.LAB_NDATA.index(ndata)]  # noqa: E731 - a driver that returns it
+    table = check.table("pherm", errors, constant)
+    assert not table.passed and "shows no experiment" in repr(table)
+    for answer in (0, 1, 4):
+        rate = check.rate("pherm", answer, errors)
+        assert not rate.passed and "supports no rate" in repr(rate)
+
+
+def test_a_table_copied_from_the_printout_counts():
+    driver = _driver_1d("pherm")
+    exact = [driver(n) for n in drivers.LAB_NDATA]
+    copied = [float(f"{e:.3e}") for e in exact]  # what ratio_table prints
+    assert check.table("pherm", copied, driver).passed
+    assert not check.table("pherm", [e * 1.002 for e in exact], driver).passed
 
 
 @pytest.mark.parametrize("answer", ["4", None, 3.5, [4, 4], np.nan])
 def test_a_rate_that_is_not_a_whole_number_says_so(answer):
-    result = check.rate("pherm", answer, None)
+    table = drivers.METHODS["pherm"].reference(drivers.LAB_NDATA)
+    result = check.rate("pherm", answer, table)
     assert not result.passed and "whole number" in result.hint
 
 
@@ -212,12 +237,19 @@ def _limacon_axes(method="pherm", sign_y=1.0, nval=210, turn=2 * np.pi):
     return ax, (t, x, y, xp, yp)
 
 
-def test_the_hermite_limacon_plot_passes_and_the_polygon_does_not():
+def test_the_hermite_limacon_plot_passes_and_the_polygon_and_the_exact_curve_do_not():
     ax, own = _limacon_axes()
-    assert check.limacon_plot(ax, own).passed
+    assert check.limacon_plot(ax, own).passed and check.limacon_plot(ax, None).passed
     polygon, own = _limacon_axes("plin")
     result = check.limacon_plot(polygon, own)
     assert not result.passed and "corners or wiggles" in result.hint
+    # the exact limaçon, drawn with no interpolation at all, is not the exercise's plot
+    fig, exact = plt.subplots()
+    x, y, _, _ = labkit.limacon(np.linspace(0, 2 * np.pi, 210))
+    exact.plot(x, y)
+    plt.close(fig)
+    result = check.limacon_plot(exact, own)
+    assert not result.passed and "exact limaçon, not its Hermite interpolant" in result.hint
 
 
 def test_a_plot_that_follows_the_students_wrong_slopes_is_not_marked_twice():
@@ -363,7 +395,9 @@ def test_every_exercise_but_the_first_is_graded_in_parts_whose_weights_are_the_l
 def test_very_long_lines_are_judged_on_a_sample_with_the_same_verdict():
     # the grader bounds its work on a plot (plotted.SAMPLE points per line, plotted.MAX_CURVES lines)
     t = np.linspace(0, 2 * np.pi, 3 * plotted.SAMPLE + 7)
-    x, y, _, _ = labkit.limacon(t)
+    data = np.linspace(0, 2 * np.pi, 21)
+    xd, yd, xp, yp = labkit.limacon(data)
+    x, y = labkit.eval_pherm(data, xd, xp, t), labkit.eval_pherm(data, yd, yp, t)
     on_curve = plotted.Line(x, y, "None", "-")
     assert check.limacon_plot([on_curve]).passed
     off = plotted.Line(x + np.where(np.arange(t.size) % 2 == 0, 0.05, 0.0), y, "None", "-")

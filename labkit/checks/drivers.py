@@ -10,10 +10,13 @@ things, so one check of each kind serves every method:
   usual slips (another interval, other test points, an absolute error) so
   the hint can name the slip;
 * :func:`table` - the error list for the lab's sizes is what the student's
-  driver returns for them;
+  driver returns for them (to the four significant digits that
+  :func:`labkit.ratio_table` prints, so a table typed in from the printout
+  counts), and it shows an experiment: its errors shrink as ``ndata`` grows,
+  with an observed order of at least :data:`MIN_ORDER` across the table;
 * :func:`rate` - the rate answer is the order the student's own table
-  supports (or the method's true order), stated as the exponent ``p`` of
-  the nearest power of two ``2**p`` to the ratios.
+  supports, stated as the exponent ``p`` of the nearest power of two
+  ``2**p`` to the ratios; a table that shows no experiment supports none.
 
 The pieces a driver builds on (the Runge function, the interpolant or the
 spline's slopes) are handed to it by the check, from labkit, so a mistake in
@@ -30,6 +33,8 @@ from .. import bilinear, convergence, functions, piecewise, splines
 from .result import CheckResult, call, case_rng, shown
 
 DRIVER_TOLERANCE = 1e-6  # relative: the driver's error against the reference error
+PRINTED = 6e-4  # relative: a table copied from ratio_table's four significant digits (half a unit is 5e-4)
+MIN_ORDER = 0.5  # observed order across the table below which it shows no experiment
 
 
 def scaled_runge(x):
@@ -195,12 +200,28 @@ def driver(key, fn, seed=None):
     return result
 
 
+def observed_order(key, errors):
+    """The order across a whole table: log(Err(first)/Err(last)) / log(h(first)/h(last)); None if not a table."""
+    method = _method(key)
+    values = _numbers(errors)
+    if values is None or values.shape != (len(method.ndata),):
+        return None
+    return float(np.log(values[0] / values[-1]) / np.log((method.ndata[-1] - 1) / (method.ndata[0] - 1)))
+
+
+def _no_experiment(method, values):
+    return (f"the errors do not shrink as ndata grows (Err({method.ndata[0]}) = {values[0]:.3e}, "
+            f"Err({method.ndata[-1]}) = {values[-1]:.3e}): this table shows no experiment")
+
+
 def table(key, errors, fn):
-    """Check the error list of experiment `key`: what the student's driver `fn` returns for the lab's sizes.
+    """Check the error list of experiment `key`: what the student's driver `fn` returns for the lab's
+    sizes, and an experiment that converges.
 
     The driver is called as the student would, ``fn(ndata)`` with its own
     defaults, so the table follows the student's own functions: a mistake
-    in them is marked where they are checked, not again here.
+    in them is marked where they are checked, not again here. A table that
+    does not shrink (a driver returning a constant, say) earns nothing.
     """
     method = _method(key)
     result = CheckResult(method.table)
@@ -209,7 +230,7 @@ def table(key, errors, fn):
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
         return result.fail(description, f"got {shown(errors)}",
-                           f"make {method.table} a list of {len(method.ndata)} errors: "
+                           f"make {method.table} a list of {len(method.ndata)} positive errors: "
                            f"[{method.driver}(n) for n in {list(method.ndata)}].")
     result.step(description, True)
     own = []
@@ -219,10 +240,16 @@ def table(key, errors, fn):
             result.hint = f"{method.table} is checked against what {method.driver} returns, so the driver must run."
             return result
         own.append(_number(err))
-    agree = None not in own and bool(np.allclose(values, own, rtol=1e-9, atol=0))
-    if not result.step(f"the errors are what {method.driver} returns for each ndata", agree,
-                       f"got {np.array2string(values, precision=3)}"):
+    agree = None not in own and bool(np.allclose(values, own, rtol=PRINTED, atol=0))
+    if not result.step(f"the errors are what {method.driver} returns for each ndata (to 4 significant digits)",
+                       agree, f"got {np.array2string(values, precision=3)}"):
         result.hint = f"fill the table by running your driver: [{method.driver}(n) for n in {list(method.ndata)}]."
+        return result
+    order = observed_order(key, values)
+    if not result.step(f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across "
+                       "the table)", order >= MIN_ORDER, _no_experiment(method, values)):
+        result.hint = (f"{method.driver} must interpolate f from ndata points and measure the error at the test "
+                       "points; with more points the error gets smaller.")
     return result
 
 
@@ -237,41 +264,51 @@ def _numbers(value):
 
 
 def supported_order(key, errors):
-    """The order a table of errors supports, as labkit estimates it; None if the table is not one."""
+    """The order a table of errors supports, as labkit estimates it; None if it is not a table that
+    shows an experiment (errors that shrink with an observed order of at least MIN_ORDER)."""
     method = _method(key)
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
+        return None
+    if observed_order(key, values) < MIN_ORDER:
         return None
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
 
 
 def rate(key, answer, errors=None):
-    """Check the rate answer of experiment `key`: the exponent p with Err(n)/Err(2n-1) close to 2**p.
+    """Check the rate answer of experiment `key`: the exponent p with Err(n)/Err(2n-1) close to 2**p,
+    read from the student's own table `errors`.
 
-    It is right if it is the order the student's own table `errors`
-    supports, or the method's true order: a student whose table is off
-    but who reads it correctly is not marked down twice.
+    The answer must be the order that table supports: a student whose
+    table is off but who reads it correctly is not marked down twice, and a
+    rate with no table that shows an experiment earns nothing.
     """
     method = _method(key)
     result = CheckResult(method.rate)
-    true_order = method.order
-    own = supported_order(key, errors)
-    accepted = {true_order} | ({own} if own is not None else set())
+    description = "the rate is the exponent p of the nearest power of two 2**p to your table's ratios"
+    values = _numbers(errors)
+    if values is None or values.shape != (len(method.ndata),):
+        return result.fail(description, f"{method.table} is not a table of {len(method.ndata)} positive errors "
+                                        "yet, so there is nothing to read the rate from",
+                           f"fill {method.table} first, then read the rate off its ratios.")
+    own = supported_order(key, values)
+    if own is None:
+        return result.fail(description, _no_experiment(method, values) + ", so it supports no rate",
+                           f"fix {method.driver} so that its errors shrink, refill {method.table}, then read the "
+                           "rate off the ratios.")
     number = _number(answer)
-    description = "the rate is the exponent p of the nearest power of two 2**p to the ratios"
     if number is None or number != round(number):
         return result.fail(description, f"got {shown(answer)}",
                            f"set {method.rate} to a whole number p: the ratios Err(41)/Err(81), ... are close to 2**p.")
     p = int(round(number))
-    if p in accepted:
+    if p == own:
         result.step(description, True)
         return result
     exponent = p.bit_length() - 1 if p > 1 else None
-    supported = f"your table's ratios support {own}" if own is not None else "look at the ratios of the table"
-    if exponent is not None and p == 2 ** exponent and exponent in accepted:
+    if exponent is not None and p == 2 ** exponent and exponent == own:
         hint = f"{p} is the ratio itself, 2**{exponent}; the rate is its exponent {exponent}."
     else:
-        hint = (f"take the ratios Err(41)/Err(81), Err(81)/Err(161), ...; they settle near a power of two 2**p, "
-                f"and p is the rate ({supported}).")
-    result.fail(description, f"got {p}; {supported}", hint)
+        hint = ("take the ratios Err(41)/Err(81), Err(81)/Err(161), ... of your table; they settle near a power "
+                "of two 2**p, and p is the rate.")
+    result.fail(description, f"got {p}; your table's ratios support {own}", hint)
     return result

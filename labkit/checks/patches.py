@@ -10,6 +10,9 @@ from .. import patches
 from ..mesh import QuadMesh, quad_mesh
 from .result import CheckResult, call, case_rng, close, worst
 
+# the grader's work on a student's meshes is bounded by the lab's sizes (600 and 1170 nodes): far larger is refused
+MAX_NODES = 20_000
+
 def _identity_corners():
     e1, e2 = [1.0, 0.0], [0.0, 1.0]
     return [patches.Corner(p, e1, e2) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
@@ -140,6 +143,14 @@ def two_patches(fn, corners):
             return result
         try:
             first, second = out
+            sizes = [len(first.points), len(second.points), len(first.quads), len(second.quads)]
+        except Exception:  # noqa: BLE001
+            return result.fail(label, f"got {getattr(out, 'description', type(out).__name__)}",
+                               "return the two QuadMesh objects: `return first, second`.")
+        if max(sizes) > MAX_NODES:
+            return result.fail(label, f"meshes of {sizes[0]:,} and {sizes[1]:,} nodes",
+                               "each patch is meshed with 20 x 30 points (600 nodes); keep to the lab's sizes.")
+        try:
             merged = first + second
         except Exception as exc:  # noqa: BLE001
             return result.fail(label, f"could not join the two meshes ({exc})",
@@ -176,6 +187,9 @@ def combined_mesh(region, corners):
     if not isinstance(region, QuadMesh):
         return result.fail("region is a QuadMesh", f"got {getattr(region, 'description', type(region).__name__)}",
                            "join the two patch meshes with +: region = first + second.")
+    if max(len(region.points), len(region.quads)) > MAX_NODES:
+        return result.fail("region has the lab's size", f"{len(region.points):,} nodes and {len(region.quads):,} "
+                           "elements", "mesh the two patches with 20 x 30 points each and join them with +.")
     A, B, C, D = corners
     first = quad_mesh(*patches.patch(A, B, C, D, np.linspace(0, 1, 20), np.linspace(0, 1, 30)))
     mirrored = [patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]) for c in (A, D, C, B)]

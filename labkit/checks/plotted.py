@@ -8,8 +8,8 @@ plain numbers (:mod:`labkit.grading.protocol`) and the decisions are made
 here, on the grader's side.
 
 * Exercise 4 (:func:`limacon_plot`): a curve of at least 100 points that
-  lies on the limaçon to the accuracy of Hermite interpolation and goes
-  all the way round;
+  is the Hermite interpolant (of the notebook's own slopes, or the lab's),
+  not the exact limaçon, and goes all the way round;
 * Exercise 14 (:func:`boiling_plot`): the data as circles with no lines, and
   the not-a-knot spline and pchip each as a curve of at least 100 points
   over the whole data range.
@@ -25,7 +25,8 @@ MIN_POINTS = 100
 # and the points of each (evenly strided; an interpolant's error is no isolated point)
 MAX_CURVES = 10
 SAMPLE = 20_000
-HERMITE_LIMACON = 2e-3  # largest distance from the curve: Hermite with 20 intervals is 2.3e-4, linear 3.8e-2
+HERMITE_LIMACON = 2e-3  # near the curve: Hermite with 20 intervals is 2.3e-4 from the limaçon, linear 3.8e-2
+ON_CURVE = 1e-5  # on the Hermite interpolant itself (the polyline standing for it is within 1e-7)
 CIRCLE = "o"
 
 
@@ -38,24 +39,55 @@ def _no_plot(result, name, plot):
 # -- Exercise 4 ---------------------------------------------------------------
 
 def _distances(points, curve, bound):
-    """For each of `points` (2, n) the distance to the nearest of `curve` (2, m), or inf beyond `bound`."""
+    """For each of `points` (2, n) its distance to the polyline `curve` (2, m), or inf beyond `bound`.
+
+    The nearest vertex comes from a k-d tree; the distance is then taken to the
+    two segments at that vertex, so a dense polyline stands for the curve
+    to within its chord error (about 1e-7 here)."""
     from scipy.spatial import cKDTree
 
-    return cKDTree(curve.T).query(points.T, distance_upper_bound=bound)[0]
+    near, index = cKDTree(curve.T).query(points.T, distance_upper_bound=bound)
+    found = np.isfinite(near)
+    best = near.copy()
+    last = curve.shape[1] - 1
+    for step in (-1, 1):
+        other = np.clip(index[found] + step, 0, last)
+        a, b, p = curve[:, np.minimum(index[found], last)], curve[:, other], points[:, found]
+        ab = b - a
+        length2 = np.maximum(np.sum(ab * ab, axis=0), 1e-300)
+        u = np.clip(np.sum((p - a) * ab, axis=0) / length2, 0.0, 1.0)
+        best[found] = np.minimum(best[found], np.hypot(*(a + u * ab - p)))
+    return best
 
 
-def _limacon_curve(r0=1.15, count=20001):
-    x, y, _, _ = functions.limacon(np.linspace(0, 2 * np.pi, count), r0=r0)
-    return np.stack((x, y))
+def _nearest(points, cloud, bound):
+    """For each of `points` (2, n) the distance to the nearest point of `cloud` (2, m), or inf beyond `bound`."""
+    from scipy.spatial import cKDTree
+
+    return cKDTree(cloud.T).query(points.T, distance_upper_bound=bound)[0]
+
+
+def _hermite_curve(tdata, xdata, ydata, xpdata, ypdata, count=20001):
+    t = np.linspace(tdata[0], tdata[-1], count)
+    return np.stack((piecewise.eval_pherm(tdata, xdata, xpdata, t), piecewise.eval_pherm(tdata, ydata, ypdata, t)))
+
+
+def _lab_hermite(r0=1.15, nintervals=20):
+    """The lab's Hermite limaçon: 21 points of the curve with its exact derivatives."""
+    tdata = np.linspace(0, 2 * np.pi, nintervals + 1)
+    x, y, dx, dy = functions.limacon(tdata, r0=r0)
+    return _hermite_curve(tdata, x, y, dx, dy)
 
 
 def limacon_plot(plot, own=None, r0=1.15):
-    """Check Exercise 4's plot: a smooth limaçon, the Hermite curve through the data.
+    """Check Exercise 4's plot: the Hermite interpolant of the limaçon, drawn all the way round.
 
-    `own` is ``(tdata, xdata, ydata, xpdata, ypdata)`` of the notebook, if it
-    has them: a curve that is exactly the Hermite interpolant of the
-    student's own slopes passes too (a wrong slope is marked where the
-    slopes are checked, not twice).
+    The curve must be the piecewise cubic Hermite interpolant itself (to
+    1e-5), not the exact limaçon (which differs from it by up to 2.3e-4) and
+    not straight segments: the interpolant of the notebook's own data `own`
+    (``tdata, xdata, ydata, xpdata, ypdata``) when it has them, so a wrong
+    slope is marked where the slopes are checked and not again here, or the
+    lab's (21 points, exact derivatives).
     """
     result = CheckResult("ax4")
     lines = lines_of(plot)
@@ -68,11 +100,10 @@ def limacon_plot(plot, own=None, r0=1.15):
                        "points.")
         return result
     long = long[:MAX_CURVES]
-    truth = _limacon_curve(r0)
-    curves = [("the limaçon", truth)]
+    curves = [("the Hermite interpolant of the lab's data", _lab_hermite(r0))]
     own_curve = _own_hermite(own)
     if own_curve is not None:
-        curves.append(("the Hermite curve of your xpdata, ypdata", own_curve))
+        curves.insert(0, ("the Hermite interpolant of your tdata, xdata, ydata, xpdata, ypdata", own_curve))
     best = None
     for line in long:
         points = np.stack((line.x, line.y))[:, ::-(-line.x.size // SAMPLE)]
@@ -81,25 +112,40 @@ def limacon_plot(plot, own=None, r0=1.15):
         for name, curve in curves:
             far = float(_distances(points, curve, 10 * HERMITE_LIMACON).max())
             # every part of the curve is drawn (repeated points are dropped: they would unbalance the tree)
-            cover = float(_distances(curve[:, ::50], np.unique(points, axis=1), 1.0).max())
+            cover = float(_nearest(curve[:, ::50], np.unique(points, axis=1), 1.0).max())
             if best is None or (far, cover) < best[:2]:
                 best = (far, cover, name)
     if best is None:
-        return result.fail("the curve is the limaçon", "every long line has NaN or infinite points",
+        return result.fail("the curve is the Hermite interpolant", "every long line has NaN or infinite points",
                            "plot xherm, yherm from eval_pherm.")
     far, cover, name = best
-    ok = result.step(f"the curve lies on {name} (r0 = {r0}) to Hermite accuracy ({HERMITE_LIMACON:g})",
-                     far <= HERMITE_LIMACON,
+    exact = _limacon_curve(r0)
+    on_exact = all(float(_distances(np.stack((ln.x, ln.y))[:, ::-(-ln.x.size // SAMPLE)], exact,
+                                    10 * HERMITE_LIMACON).max()) <= ON_CURVE for ln in long
+                   if np.all(np.isfinite(ln.x)) and np.all(np.isfinite(ln.y)))
+    ok = result.step(f"the curve is {name} (within {ON_CURVE:g})", far <= ON_CURVE,
                      f"a point is {far:.2e} away from it" if np.isfinite(far) else
                      f"points are more than {10 * HERMITE_LIMACON:g} away from it")
     if not ok:
-        result.hint = ("corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
-                       "xpdata or ypdata bends the curve away; use eval_pherm with the derivatives of Exercise 4.")
+        if on_exact:
+            result.hint = ("that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
+                           "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm.")
+        elif far <= HERMITE_LIMACON:
+            result.hint = ("close to the curve but not the interpolant of your data: plot eval_pherm of tdata, "
+                           "xdata, xpdata and of tdata, ydata, ypdata at tval.")
+        else:
+            result.hint = ("corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
+                           "bends the curve away; use eval_pherm with the derivatives of Exercise 4.")
         return result
     if not result.step("the curve goes all the way round", cover <= 0.1,
-                       f"part of the limaçon is {min(cover, 1.0):.2f} or more away from every plotted point"):
+                       f"part of the curve is {min(cover, 1.0):.2f} or more away from every plotted point"):
         result.hint = "interpolate over the whole turn: tval from 0 to 2*pi."
     return result
+
+
+def _limacon_curve(r0=1.15, count=20001):
+    x, y, _, _ = functions.limacon(np.linspace(0, 2 * np.pi, count), r0=r0)
+    return np.stack((x, y))
 
 
 def _own_hermite(own):
@@ -108,8 +154,7 @@ def _own_hermite(own):
         return None
     try:
         tdata, xdata, ydata, xpdata, ypdata = (np.asarray(v, dtype=float) for v in own)
-        t = np.linspace(tdata[0], tdata[-1], 20001)
-        curve = np.stack((piecewise.eval_pherm(tdata, xdata, xpdata, t), piecewise.eval_pherm(tdata, ydata, ypdata, t)))
+        curve = _hermite_curve(tdata, xdata, ydata, xpdata, ypdata)
     except (TypeError, ValueError, IndexError):
         return None
     return curve if np.all(np.isfinite(curve)) else None

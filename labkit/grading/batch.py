@@ -14,7 +14,8 @@ Before each submission the free space of the temporary and output folders
 is checked; when it runs low the run stops starting new submissions and
 says so, rather than grading students into zeros. The output folder
 (:mod:`labkit.grading.report`) always gets a ``grades.csv`` with every
-submission once.
+submission once, and ``run.json`` says how the run went (its seed, how many
+could not be graded, its time, the grader's peak memory for one submission).
 """
 import json
 import os
@@ -91,6 +92,8 @@ class _Job:
             resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
 
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
+            environment[cgroup.PARENT] = group.sibling_parent
         self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen([sys.executable, "-m", "labkit.grading.scoring", str(spec)],
@@ -125,11 +128,11 @@ class _Job:
         return f": {one_line(lines[-1], 200)}" if lines else ""
 
     def finish(self):
+        self.out_of_memory, self.peak = False, None
         if self.cgroup is not None:
             self.out_of_memory = self.cgroup.out_of_memory()
+            self.peak = self.cgroup.peak()
             self.cgroup.remove()
-        else:
-            self.out_of_memory = False
 
     def outcome(self, rubric, timed_out):
         """(SubmissionGrade, None) from the result file, or (None, why the grading process failed)."""
@@ -200,19 +203,24 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     out.mkdir(parents=True, exist_ok=True)
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
     work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
+    start, peaks = time.monotonic(), []
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(REFUSALS)), encoding="utf-8")
         grades = _schedule(submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out,
-                           progress)
+                           progress, peaks)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     ordered = [grades[p] for p in submissions]
     write_report(out, ordered)
+    (out / "run.json").write_text(json.dumps({
+        "seed": seed, "submissions": len(ordered), "not graded": sum(not g.graded for g in ordered),
+        "seconds": round(time.monotonic() - start, 1), "jobs": int(jobs),
+        "grader peak bytes": max((p for p in peaks if p), default=None)}, indent=1), encoding="utf-8")
     return ordered
 
 
-def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, out, progress):
+def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, out, progress, peaks):
     """Run the grading processes, `jobs` at a time; {path: SubmissionGrade} for every submission."""
     pending = [_Job(path, name, work, options, profiles_file) for path, name in zip(submissions, names)]
     pending.reverse()
@@ -241,6 +249,7 @@ def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, ou
             else:
                 job.finish()
             running.remove(job)
+            peaks.append(job.peak)
             result, why = job.outcome(rubric, timed_out)
             if result is None and job.attempt < ATTEMPTS:
                 pending.append(job)  # once more, in a fresh process

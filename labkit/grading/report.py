@@ -64,13 +64,16 @@ class SubmissionGrade:
 
     def feedback(self):
         if not self.graded:
-            return printable(f"Feedback for {self.name}: not graded\n\n! could not be graded: {self.failure}\n"
+            return printable(f"Feedback for {one_line(self.name)}: not graded\n\n! could not be graded: "
+                             f"{one_line(self.failure, 500)}\n"
                              "Your instructor has been told; nothing of this submission was scored.\n")
         score, rubric = self.score, self.rubric
         extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
-        lines = [f"Feedback for {self.name}: {points_text(score.total)} points "
+        lines = [f"Feedback for {one_line(self.name)}: {points_text(score.total)} points "
                  f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})", ""]
-        lines += [f"! {problem}" for problem in self.problems]
+        # a problem's first line is the grader's; what follows (a traceback) is indented, so no line can pose
+        # as one of the grader's own
+        lines += [line for problem in self.problems for line in _problem_lines(problem)]
         if self.problems:
             lines.append("")
         lines += [rubric.describe(), ""]
@@ -96,10 +99,10 @@ class SubmissionGrade:
             worth = f" ({points_text(share)} point{'' if share == 1 else 's'})" if weight else ""
             for step in check["steps"]:
                 mark = "ok  " if step["passed"] else "FAIL"
-                detail = f": {step['detail']}" if step["detail"] else ""
-                lines.append(f"    [{mark}] {check['name']}{worth}: {step['step']}{detail}")
+                detail = f": {one_line(step['detail'], 1000)}" if step["detail"] else ""
+                lines.append(f"    [{mark}] {one_line(check['name'], 100)}{worth}: {one_line(step['step'], 300)}{detail}")
             if check["hint"] and not check["passed"]:
-                lines.append(f"    hint: {check['hint']}")
+                lines.append(f"    hint: {one_line(check['hint'], 1000)}")
         return lines
 
     def _summary(self):
@@ -144,6 +147,13 @@ class SubmissionGrade:
             raise ValueError(f"{source} grades exercises {sorted(grade.results)}, not {sorted(EXERCISES)}: "
                              "it was written by another version of labkit.")
         return grade
+
+
+def _problem_lines(problem):
+    first, *rest = str(problem).split("\n") or [""]
+    return [f"! {one_line(first, 1000)}"] + ["    " + printable(line).replace("\t", " ")[:1000]
+                                               if line.startswith(" ") else "    | " + one_line(line, 1000)
+                                               for line in rest[:40]]
 
 
 CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u200b-\u200f\u202a-\u202e\u2066-\u2069]")

@@ -28,7 +28,7 @@ from pathlib import Path
 from ..checks.exercises import EXERCISES, REFUSALS, grade as run_checks
 from . import refusals, remote, scan
 from .options import GradeOptions
-from .report import SubmissionGrade
+from .report import SubmissionGrade, one_line
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -135,12 +135,14 @@ def _failed_part(check, name, step, detail, hint):
 
 
 def _own_code(check, findings):
-    """The part's check, failed: the graded function reaches for refused references."""
+    """The part's check, failed: the graded function reaches for refused references (its other steps kept)."""
     details = "; ".join(f"{function} (line {line} of its definition) reaches for {name}"
                         for function, line, name in findings[:8])
-    return _failed_part(check, check["name"], "calls no reference implementation", details,
-                        "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab "
-                        "names stay available.")
+    return {**check, "passed": False,
+            "steps": list(check.get("steps", [])) + [{"step": "calls no reference implementation", "passed": False,
+                                                       "detail": details}],
+            "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names "
+                    "stay available."}
 
 
 def _rescore(verdict):
@@ -157,8 +159,8 @@ def _run_problems(name, ran):
         shown = []
         for error in errors[:SHOWN_ERRORS]:
             error = error if isinstance(error, dict) else {}
-            text = f"cell {int(error.get('cell', -1)) + 1} raised {str(error.get('kind'))[:100]}: " \
-                   f"{str(error.get('message', ''))[:300]}"
+            text = f"cell {int(error.get('cell', -1)) + 1} raised {one_line(error.get('kind'), 100)}: " \
+                   f"{one_line(error.get('message', ''), 300)}"
             tail = str(error.get("traceback", ""))[-1500:]
             if tail:
                 text += "\n" + "\n".join(f"      | {line}" for line in tail.splitlines()[-6:])
@@ -191,7 +193,7 @@ def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confi
     options = _options(options, cell_timeout, total_timeout, seed, confined, limits)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     profiles = profiles or _profiles()
-    name = Path(path).name
+    name = one_line(Path(path).name, 120)
     try:
         code, markdown = read_cells(path)
     except (ValueError, OSError) as exc:

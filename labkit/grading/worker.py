@@ -33,7 +33,6 @@ still only evidence: the grader checks it and computes every score itself.
 import hashlib
 import hmac
 import io
-import json
 import os
 import select
 import signal
@@ -120,15 +119,20 @@ class _Lines:
         line, _, self.buffer = self.buffer.partition(b"\n")
         return line
 
-    def available(self):
-        """Every whole line that can be read now without waiting."""
-        while select.select([self.fd], [], [], 0)[0]:
+    def pump(self):
+        """Read what is there now (one chunk); ProtocolError when more piles up than `limit`."""
+        if select.select([self.fd], [], [], 0)[0]:
             chunk = os.read(self.fd, 1 << 16)
-            if not chunk:
-                break
             self.buffer += chunk
             if len(self.buffer) > self.limit:
-                break
+                raise protocol.ProtocolError(f"more than {self.limit} bytes written to the grader's watch")
+            return bool(chunk)
+        return False
+
+    def available(self):
+        """Every whole line that can be read now without waiting."""
+        while self.pump():
+            pass
         *lines, self.buffer = self.buffer.split(b"\n")
         return lines
 
@@ -357,9 +361,20 @@ class Supervisor:
             self.stop()
             return _error("WorkerError", self.ended)
         until = None if timeout is None else time.monotonic() + float(timeout) + 1.0
+        answers, verdicts = self.child["answers"], self.child["verdicts"]
         while True:
             try:
-                line = self.child["answers"].readline(until)
+                # the watch's pipe is read while waiting, so nothing the notebook writes to it can stall it
+                while b"\n" not in answers.buffer:
+                    remaining = None if until is None else until - time.monotonic()
+                    if remaining is not None and remaining <= 0:
+                        raise TimeoutError()
+                    ready = select.select([answers.fd, verdicts.fd], [], [], remaining)[0]
+                    if verdicts.fd in ready:
+                        verdicts.pump()
+                    if answers.fd in ready:
+                        break
+                line = answers.readline(until)
             except TimeoutError:
                 self.stop("stopped after the time limit: the notebook did not answer in time")
                 return _error("Timeout", "interrupted: it ran longer than the time limit")
@@ -370,8 +385,8 @@ class Supervisor:
                 self.stop()
                 return _error("WorkerError", self.ended)
             try:
-                answer = json.loads(line)
-            except (ValueError, RecursionError):
+                answer = protocol.loads(line)
+            except protocol.ProtocolError:
                 continue  # not an answer: something the notebook wrote itself
             if isinstance(answer, dict) and answer.get("id") == request.get("id"):
                 break
