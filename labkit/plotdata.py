@@ -1,5 +1,9 @@
 """A plot read as plain data: each line's points, marker and whether a line joins them.
 
+Every artist that puts marks at points counts: a ``Line2D`` (``plot``, and
+the lines ``errorbar`` and ``stem`` draw) and a ``PathCollection``
+(``scatter``), whose marker is recognised from its shape.
+
 Used by the plot checks in a notebook (:mod:`labkit.checks.plotted`) and by
 the sandboxed notebook when it sends a plot to the grader
 (:mod:`labkit.grading.protocol`), so a plot is judged from its data, never
@@ -37,13 +41,48 @@ def line_of(line):
     return Line(x, y, str(marker) if isinstance(marker, str) else "custom", str(style))
 
 
+MARKERS = ("o", "s", "^", "v", "<", ">", "D", "d", "p", "h", "*", "+", "x", ".")
+
+
+def _marker_shapes():
+    from matplotlib.markers import MarkerStyle
+
+    shapes = {}
+    for code in MARKERS:
+        style = MarkerStyle(code)
+        shapes[code] = style.get_path().transformed(style.get_transform()).vertices
+    return shapes
+
+
+def scatter_of(collection):
+    """A scatter plot's PathCollection as a :class:`Line` of unjoined marks (its marker from its shape)."""
+    offsets = np.asarray(collection.get_offsets(), dtype=float).reshape(-1, 2)
+    marker = "custom"
+    paths = collection.get_paths()
+    if len(paths) == 1:
+        vertices = paths[0].vertices
+        for code, shape in _marker_shapes().items():
+            if shape.shape == vertices.shape and np.allclose(shape, vertices, atol=1e-6):
+                marker = code
+                break
+    return Line(offsets[:, 0], offsets[:, 1], marker, "None")
+
+
+def _marks(ax):
+    from matplotlib.collections import PathCollection
+
+    lines = [line_of(line) for line in ax.get_lines()]
+    lines += [scatter_of(c) for c in ax.collections if type(c) is PathCollection and len(c.get_offsets())]
+    return lines
+
+
 def lines_of(plot):
-    """The lines of an Axes, of every Axes of a Figure, or a list of lines already read; else None."""
+    """The marks of an Axes, of every Axes of a Figure, or a list of lines already read; else None."""
     if isinstance(plot, (list, tuple)) and all(isinstance(line, Line) for line in plot):
         return list(plot)
     axes = getattr(plot, "axes", None)
     if hasattr(plot, "get_lines"):
-        return [line_of(line) for line in plot.get_lines()]
+        return _marks(plot)
     if isinstance(axes, list):  # a Figure
-        return [line_of(line) for ax in axes for line in ax.get_lines()]
+        return [line for ax in axes for line in _marks(ax)]
     return None

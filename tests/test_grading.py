@@ -14,6 +14,7 @@ import pytest
 
 from labkit import grading
 from labkit.check import EXERCISES
+from labkit.checks.exercises import ANSWERS
 from labkit.grading.rubric import default
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -294,8 +295,11 @@ def test_grades_csv_and_feedback_files(graded):
     results, out, _, subs = graded
     with open(out / "grades.csv", newline="") as handle:
         rows = list(csv.reader(handle))
-    assert rows[0] == ["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + [
+    assert rows[0][:len(EXERCISES) + 8] == ["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + [
         "required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
+    # then one empty column per answer in words, for the instructor to fill in after reading it
+    assert rows[0][len(EXERCISES) + 8:] == [f"to read: exercise {n}, {what}" for n, what in ANSWERS.values()]
+    assert all(row[len(EXERCISES) + 8:] == [""] * len(ANSWERS) for row in rows[1:])
     assert [row[0] for row in rows[1:]] == [results[name].name for name in subs]
     column = {name: i for i, name in enumerate(rows[0])}
     for row in rows[1:]:
@@ -389,9 +393,10 @@ def test_merge_scores_with_the_rubric_it_is_given(two_runs, tmp_path):
     assert run.returncode == 0, run.stderr
     with open(tmp_path / "m" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}
-    assert rows["submission"][1:] == ["exercise 16", "required", "branch", "branch points", "extra credit", "total",
-                                      "full credit", "status"]
-    assert rows["alice"][1:] == ["20", "20", "", "0", "0", "20", "20", "graded"] and rows["bob"][-3] == "0"
+    assert rows["submission"][1:9] == ["exercise 16", "required", "branch", "branch points", "extra credit",
+                                       "total", "full credit", "status"]
+    assert [c.split(",")[0] for c in rows["submission"][9:]] == ["to read: exercise 16"] * 2
+    assert rows["alice"][1:9] == ["20", "20", "", "0", "0", "20", "20", "graded"] and rows["bob"][6] == "0"
     feedback = tmp_path / "m" / "feedback" / f"{grading.report.safe_name('alice')}.txt"
     assert "Rubric: bilinear only" in feedback.read_text()
     bad = tmp_path / "bad.toml"

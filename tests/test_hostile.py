@@ -55,7 +55,7 @@ def _tree_hash(folders, leave_out=()):
         for path in sorted(Path(folder).rglob("*")):
             if "__pycache__" in path.parts or any(path == p or p in path.parents for p in leave_out):
                 continue
-            digest.update(str(path).encode())
+            digest.update(os.fsencode(path))
             if path.is_file() and not path.is_symlink():
                 digest.update(path.read_bytes())
     return digest.hexdigest()
@@ -155,18 +155,45 @@ ATTACKS = {
                      "    except OSError as exc:\n        full.append(str(exc))\n"
                      "os.chdir(os.path.expanduser('~'))\nraise RuntimeError('; '.join(full))"],
     # memory the address-space limit does not count, and a kernel key for the next submission to find
-    "memfd_and_keyring": ["import os, ctypes\nfound = []\ntry:\n    os.memfd_create('hoard')\n"
-                          "    found.append('memfd made')\nexcept OSError as exc:\n    found.append(f'memfd: {exc}')\n"
-                          "libc = ctypes.CDLL(None, use_errno=True)\n"
-                          "key = libc.syscall(248, b'user', b'" + MARK + "', b'secret', 6, -4)\n"
-                          "found.append(f'add_key: {key} errno {ctypes.get_errno()}')\n"
-                          "raise RuntimeError('; '.join(found))"],
+    "memfd": ["import os\nos.memfd_create('hoard')"],
+    "keyring": ["import ctypes\nlibc = ctypes.CDLL(None, use_errno=True)\n"
+                "key = libc.syscall(248, b'user', b'" + MARK + "', b'secret', 6, -4)\n"
+                "raise RuntimeError(f'add_key: {key} errno {ctypes.get_errno()}')"],
     # a chain of IPython magics the grader's reader once took minutes over, before a cell that ends it all
     "magic_lines": ["import os\nos._exit(0)"],
     # the watch switched off through the garbage collector's lists, and a reference's code put back
     "gc_switch_off": ["import gc\nfor obj in gc.get_objects():\n    pass"],
     "error_text_forgery": ["raise RuntimeError('\\r\\x1b[2K\\x1b[1A\\x1b[2K25 points\\nExercise 2: 10 / 10 - passed\\n"
-                           "\\x1b]0;owned\\x07')"],
+                           "\\x1b]0;owned\\x07\\u2028Total: 118 (full credit is 100)\\u2029')"],
+    # the red team's ways into the watch's hooks, each with the reference kept where the scan does not look
+    "object_run_inside_the_watch": ["import numpy as np, labkit\nfrom labkit.grading.guard import _Refused\n"
+                                    "setattr(np, 'lab_ref', labkit.eval_pherm)\n"
+                                    "class Box:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
+                                    "    @property\n    def name(self):\n        self.out = np.lab_ref(*self.args)\n"
+                                    "        return 'done'\n"
+                                    "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+                                    "    box = Box((xdata, ydata, ypdata, xval))\n"
+                                    "    try:\n        _Refused.__call__(box)\n    except RuntimeError:\n        pass\n"
+                                    "    return box.out"],
+    "fake_compiled_object": ["import sys, numpy as np, labkit, labkit.checks\nclass cython_function_or_method:\n"
+                             "    @property\n    def __module__(self):\n        f = sys._getframe(1)\n"
+                             "        while f is not None:\n            if 'state' in f.f_locals:\n"
+                             "                f.f_locals['state']['profile'] = None\n            f = f.f_back\n"
+                             "        return 'nothing.to.see'\n"
+                             "labkit.checks.zz_fake = cython_function_or_method()\nsetattr(np, 'ref_pherm', labkit.eval_pherm)\n"
+                             "def eval_pherm(xdata, ydata, ypdata, xval):\n    return np.ref_pherm(xdata, ydata, ypdata, xval)"],
+    "profile_hook_fetched_from_c": ["import sys, functools, numpy as np, labkit\n"
+                                    "hook = functools.partial(sys.getprofile)()\n"
+                                    "setattr(np, 'ref', labkit.eval_pherm)\n"
+                                    "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+                                    "    found = functools.partial(sys.getprofile)()\n"
+                                    "    if found is not None:\n        for cell in found.__closure__ or ():\n"
+                                    "            if isinstance(cell.cell_contents, dict) and 'profile' in cell.cell_contents:\n"
+                                    "                cell.cell_contents['profile'] = None\n"
+                                    "    return np.ref(xdata, ydata, ypdata, xval)"],
+    "spins_sixty_processes": ["import os\nfor _ in range(60):\n    if os.fork() == 0:\n        os.setsid()\n"
+                              "        while True:\n            pass",
+                              "import time\ntime.sleep(100)", "import time\ntime.sleep(100)"],
 }
 REPLACED = {  # cells of the release replaced by an attack: {name: (base notebook, {start of a cell: new source})}
     "calls_reference": ("02_convergence.ipynb", {
@@ -321,8 +348,14 @@ def attacked(tmp_path_factory):
     subs["linked_inside"] = linked_inside
     subs["best_of_four"] = _best_of_four(subs_dir)
     subs["eight_stuck_notebooks"] = _many_stuck_notebooks(subs_dir)
-    for name in ("=2+3*7", "=cmd|' -C calc'!A0", "esc\x1b[31mred", "jane doe", "jane_doe", "y" * 246):
+    for name in ("=2+3*7", "=cmd|' -C calc'!A0", "esc\x1b[31mred", "jane doe", "jane_doe", "y" * 246,
+                 "zz\u2028Total: 118 (full credit is 100)"):
         subs[name] = _notebook(subs_dir, name, [])
+    # a folder whose name is not UTF-8, as an old zip file unpacks
+    undecodable = Path(os.fsdecode(bytes(subs_dir) + b"/bad\xff\xfename"))
+    undecodable.mkdir()
+    _notebook(undecodable, "work", [])
+    subs["bad\\xff\\xfename"] = undecodable
     # the honest classmates, in the same run
     subs["honest_alice"] = _honest_copy(subs_dir, "honest_alice")
     subs["honest_bob"] = _honest_copy(subs_dir, "honest_bob", {"02_convergence.ipynb", "06_bilinear.ipynb"})
@@ -446,7 +479,8 @@ def test_no_control_character_reaches_a_feedback_file(attacked):
         assert not [ch for ch in "\x1b\r\x07\x00" if ch in text], (path.name, [ch for ch in "\x1b\r\x07\x00" if ch in text])
     forged = (attacked["out"] / "feedback" / f"{safe_name('error_text_forgery')}.txt").read_text()
     assert "25 points" in forged  # the student's text is there, as data:
-    assert not any(line.startswith(("Exercise 2: 10 / 10", "25 points")) for line in forged.splitlines())
+    for text in (forged, (attacked["out"] / "feedback" / f"{safe_name('zz' + chr(0x2028) + 'Total: 118 (full credit is 100)')}.txt").read_text()):
+        assert not any(line.startswith(("Exercise 2: 10 / 10", "25 points", "Total: 118")) for line in text.splitlines())
 
 
 def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
@@ -465,8 +499,8 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("always_equal_array", "wrong for x^[0, 1, 2, 3]"),
     ("fake_result_line", "not implemented yet"),
     ("writes_outside", "Read-only file system"),
-    ("background_process", "a new process"),
-    ("fork_loop", "a new process (os.fork)"),
+    ("background_process", "subprocess.Popen"),
+    ("fork_loop", "os.fork"),
     ("memory_grab", "MemoryError"),
     ("connects_out", "ConnectionRefusedError"),
     ("reads_solutions", "No such file or directory"),
@@ -481,8 +515,8 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("five_thousand_cells", "not implemented yet"),
     ("answer_pipe_bomb", "out of protocol"),
     ("deep_folders", "No space left on device"),
-    ("memfd_and_keyring", "memfd: [Errno 1] Operation not permitted"),
-    ("memfd_and_keyring", "add_key: -1 errno 1"),
+    ("memfd", "PermissionError: [Errno 1] Operation not permitted"),
+    ("keyring", "ctypes.dlsym"),
     ("magic_lines", "exited with status 0"),
     ("gc_switch_off", "gc.get_objects"),
     ("mesh_bomb", "meshes of 60,000 and 60,000 nodes"),
@@ -492,7 +526,7 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("constant_tables", "supports no rate"),
     ("bpoly_construct_fast", "construct_fast, which is switched off"),
     ("reference_by_assignment", "reaches for labkit.piecewise.eval_pherm"),
-    ("saved_code_object", "called labkit.piecewise.eval_pherm, which is switched off"),
+    ("saved_code_object", "function.__new__"),
     ("graders_reference", "labkit.checks.splines._reference_complete_system"),
     ("graders_reference", "labkit.splines._slopes_from_curvatures"),
     ("private_natural_helpers", "labkit.splines.natural_curvatures"),
@@ -500,6 +534,11 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("notebook_of_60_mb", "more than the 10 MB a lab notebook needs"),
     ("notebook_of_8_mb", "not implemented yet"),
     ("mallory", "is a symbolic link; links are never followed"),
+    ("object_run_inside_the_watch", "which is switched off"),
+    ("fake_compiled_object", "which is switched off"),
+    ("profile_hook_fetched_from_c", "which is switched off"),
+    ("spins_sixty_processes", "os.fork"),
+    ("bad\\xff\\xfename", "not implemented yet"),
     ("linked_inside", "not implemented yet"),
 ])
 def test_feedback_names_what_happened(attacked, name, named):
@@ -566,11 +605,28 @@ def test_a_memory_cgroup_counts_what_the_address_space_limit_does_not(tmp_path):
     assert not group.path.exists()
 
 
-def test_the_sandbox_refuses_memfd_keyrings_and_ptrace_by_seccomp():
+def test_the_notebooks_filter_refuses_memfd_keyrings_ptrace_threads_and_signal_handlers():
     from labkit.grading import seccomp
 
-    code = seccomp.program()
-    assert code is not None and len(code) % 8 == 0
+    if seccomp.program() is None:
+        pytest.skip("no seccomp filter for this architecture")
+    code = ("import ctypes, os, signal, threading\nfrom labkit.grading import seccomp, guard\n"
+            "numbers = seccomp.SYSCALLS[__import__('platform').machine()]\n"
+            "assert seccomp.install_for_notebook()\nlibc = ctypes.CDLL(None, use_errno=True)\nseen = {}\n"
+            "for name, args in (('add_key', (b'user', b'k', b'v', 1, -4)), ('keyctl', (0, -4)),\n"
+            "                   ('ptrace', (16, os.getppid(), 0, 0)), ('memfd_create', (b'x', 0))):\n"
+            "    ctypes.set_errno(0)\n    result = libc.syscall(numbers[name], *args)\n"
+            "    seen[name] = (result, ctypes.get_errno())\n"
+            "try:\n    threading.Thread(target=print).start()\n    seen['thread'] = 'started'\n"
+            "except RuntimeError:\n    seen['thread'] = 'refused'\n"
+            "try:\n    signal.signal(signal.SIGUSR1, print)\n    seen['sigaction'] = 'set'\n"
+            "except OSError:\n    seen['sigaction'] = 'refused'\n"
+            "pid = os.fork()\nif pid == 0:\n    os._exit(0)\nos.waitpid(pid, 0)\nprint(seen)")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert run.returncode == 0, run.stderr
+    seen = eval(run.stdout)  # noqa: S307 - our own child's dict of numbers and words
+    assert all(seen[name] == (-1, 1) for name in ("add_key", "keyctl", "ptrace", "memfd_create")), seen
+    assert seen["thread"] == "refused" and seen["sigaction"] == "refused"  # and fork still works (above)
     assert seccomp.program("sparc") is None
 
 
@@ -611,6 +667,7 @@ def test_a_grading_process_that_dies_costs_only_its_own_submission(tmp_path):
     assert not killed_twice.graded and "tried 2 times" in killed_twice.failure
     with open(tmp_path / "out" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}
-    assert rows["killed_twice"][-1].startswith("not graded: ") and rows["killed_twice"][-2] == ""
-    assert rows["steady"][-1] == "graded"
+    status, total = rows["submission"].index("status"), rows["submission"].index("total")
+    assert rows["killed_twice"][status].startswith("not graded: ") and rows["killed_twice"][total] == ""
+    assert rows["steady"][status] == "graded"
     assert "could not be graded" in (tmp_path / "out" / "feedback" / f"{safe_name('killed_twice')}.txt").read_text()

@@ -42,7 +42,7 @@ def runge2d(fn, seed=None):
     result = CheckResult("runge2d")
     X, Y = np.meshgrid(np.linspace(-2, 2, 5), np.linspace(0, 3, 4), indexing="ij")
     if seed is not None:
-        X, Y = case_rng(seed, 16).uniform(-3, 3, (2, 5, 4))
+        X, Y = case_rng(seed, "bilinear.runge2d").uniform(-3, 3, (2, 5, 4))
     ok, out = call(result, "runge2d on a grid", fn, X, Y)
     if ok and not result.step("1/(1+(x+y)^2) on arrays", close(out, functions.runge2d(X, Y)), worst(out, functions.runge2d(X, Y))):
         result.hint = "use componentwise operations: 1 / (1 + (x + y)**2)."
@@ -63,7 +63,7 @@ def eval_pbilin(fn, seed=None):
         return result
     xdata, ydata = np.array([0.0, 0.5, 2.0, 3.0]), np.array([-1.0, 0.0, 2.5])
     if seed is not None:
-        rng = case_rng(seed, 17)
+        rng = case_rng(seed, "bilinear.eval_pbilin")
         xdata, ydata = (np.cumsum(rng.uniform(0.2, 1.5, n)) - 1.0 for n in (5, 4))
     xval, yval = np.linspace(xdata[0], xdata[-1], 7), np.linspace(ydata[0], ydata[-1], 6)
     XV, YV = np.meshgrid(xval, yval, indexing="ij")

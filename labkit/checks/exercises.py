@@ -76,12 +76,16 @@ class Exercise:
     means the notebook is the exercise's own). ``parts`` are its checks with
     their weights, each with what is switched off while it calls the
     student's functions (:class:`Refusal`); anything not listed, such as
-    ``labkit.bracket``, stays available.
+    ``labkit.bracket``, stays available. ``answers`` are the remarks and
+    explanations the student writes in words: no check reads them, the
+    feedback lists them for the instructor, and ``grades.csv`` has an empty
+    column for each.
     """
 
     number: int
     names: tuple
     parts: tuple
+    answers: tuple = ()  # what the student answers in words, in the order of its answer cells (the instructor reads them)
 
     @property
     def points(self):
@@ -118,7 +122,8 @@ EXERCISES = {e.number: e for e in (
                                        refused=INTERPOLANTS),)),
     Exercise(3, ("runge",) + _experiment_names("pherm"),
              (Part("runge", 3, lambda ns, seed: hermite.runge(ns["runge"], seed=seed), refused=OWN_FUNCTIONS),)
-             + _driver_parts("pherm", 6, 3, 3)),
+             + _driver_parts("pherm", 6, 3, 3),
+             answers=("the order the table shows, against piecewise linear",)),
     Exercise(4, ("limacon_derivatives", "ax4"),
              (Part("limacon_derivatives", 8,
                    lambda ns, seed: hermite.limacon_derivatives(ns["limacon_derivatives"], seed=seed),
@@ -127,31 +132,43 @@ EXERCISES = {e.number: e for e in (
     Exercise(5, ("coons",), (Part("coons", 12, lambda ns, seed: patches.coons(ns["coons"], seed=seed),
                                   refused=OWN_PATCH),)),
     Exercise(6, ("graded",), (Part("graded", 10, lambda ns, seed: patches.graded_corners(ns["graded"])),)),
-    Exercise(7, ("straight",), (Part("straight", 10, lambda ns, seed: patches.straight_corners(ns["straight"])),)),
-    Exercise(8, ("circle_sides",), (Part("circle_sides", 12, lambda ns, seed: patches.circle_corners(ns["circle_sides"])),)),
+    Exercise(7, ("straight",), (Part("straight", 10, lambda ns, seed: patches.straight_corners(ns["straight"])),),
+             answers=("why these corner data give straight, evenly divided sides",)),
+    Exercise(8, ("circle_sides",), (Part("circle_sides", 12, lambda ns, seed: patches.circle_corners(ns["circle_sides"])),),
+             answers=("AB as parametric equations, and dx/ds, dy/ds at A and B",)),
     Exercise(9, ("two_patches", "mirror", "region"),
              (Part("two_patches", 10, lambda ns, seed: patches.two_patches(ns["two_patches"], _corners9(ns))),
-              Part("region", 6, lambda ns, seed: patches.combined_mesh(ns["region"], _corners9(ns))))),
+              Part("region", 6, lambda ns, seed: patches.combined_mesh(ns["region"], _corners9(ns),
+                                                                     ns.get("two_patches")))),
+             answers=("why the mirror image's corner data make the two patches match",)),
     Exercise(10, ("ccspline", "complete_system"),
              (Part("ccspline", 15, lambda ns, seed: splines.ccspline(ns["ccspline"], ns.get("complete_system"), seed=seed),
                    refused=INTERPOLANTS, functions=("ccspline", "complete_system")),)),
-    Exercise(11, _experiment_names("complete"), _driver_parts("complete", 5, 2, 2)),
+    Exercise(11, _experiment_names("complete"), _driver_parts("complete", 5, 2, 2),
+             answers=("the order, with f' used only at the ends",)),
     Exercise(12, ("ncspline",) + _experiment_names("natural"),
              (Part("ncspline", 9, lambda ns, seed: splines.ncspline(ns["ncspline"], seed=seed), refused=INTERPOLANTS),)
-             + _driver_parts("natural", 2, 2, 2)),
-    Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2)),
+             + _driver_parts("natural", 2, 2, 2),
+             answers=("why the natural spline's order is lower",)),
+    Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2),
+             answers=("the three splines compared",)),
     Exercise(14, ("ax14",), tuple(Part(name, 2, _boiling, index=i)
                                   for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline",
                                                             "ax14: pchip")))),
-    Exercise(15, _experiment_names("pchip"), _driver_parts("pchip", 4, 2, 2)),
+    Exercise(15, _experiment_names("pchip"), _driver_parts("pchip", 4, 2, 2),
+             answers=("pchip's order against the spline's, and when to choose pchip",)),
     Exercise(16, ("phi_table", "runge2d", "eval_pbilin") + _experiment_names("bilinear"),
              (Part("phi_table", 1, lambda ns, seed: bilinear.phi_table(ns["phi_table"])),
               Part("runge2d", 1, lambda ns, seed: bilinear.runge2d(ns["runge2d"], seed=seed), refused=OWN_FUNCTIONS),
               Part("eval_pbilin", 3, lambda ns, seed: bilinear.eval_pbilin(ns["eval_pbilin"], seed=seed),
                    refused=INTERPOLANTS))
-             + _driver_parts("bilinear", 1, 1, 1)),
+             + _driver_parts("bilinear", 1, 1, 1),
+             answers=("16(a): why the phi table makes I the bilinear interpolant",
+                      "the order, against piecewise linear in one dimension")),
 )}
 POINTS = {number: exercise.points for number, exercise in EXERCISES.items()}
+ANSWERS = {f"exercise{e.number}-answer-{k}": (e.number, text)
+           for e in EXERCISES.values() for k, text in enumerate(e.answers, start=1)}
 REFUSALS = tuple(sorted({part.refused for e in EXERCISES.values() for part in e.parts if part.refused},
                         key=lambda refusal: refusal.name))
 NAMES = {number: list(exercise.names) for number, exercise in EXERCISES.items()}

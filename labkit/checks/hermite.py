@@ -9,7 +9,7 @@ polynomials a cubic Hermite interpolant must reproduce exactly.
 import numpy as np
 
 from .. import functions, piecewise
-from .result import CheckResult, call, case_rng, close, shown, worst
+from .result import CheckResult, call, case_rng, close, several, shown, worst
 
 MONOMIAL_POINTS = np.array([-1.0, 0.5, 1.5, 3.0])
 
@@ -43,7 +43,7 @@ def eval_pherm(fn, seed=None):
     if not result.step("reproduces 1, x, x^2, x^3 on [0, 2] at x = -1, 0.5, 1.5, 3", not wrong,
                        f"wrong for x^{wrong}" if wrong else ""):
         return _narrow_pherm(fn, result)
-    rng = case_rng(seed, 2)
+    rng = case_rng(seed, "hermite.eval_pherm")
     xdata = np.cumsum(rng.uniform(0.2, 1.5, 8))
     ydata, ypdata = rng.normal(size=8), rng.normal(size=8)
     xval = np.linspace(xdata[0] - 0.5, xdata[-1] + 0.5, 57)
@@ -126,12 +126,13 @@ def runge(fn, seed=None):
     result = CheckResult("runge")
     x = np.linspace(-3.0, 3.0, 13)
     if seed is not None:  # the grader's fresh points besides the fixed ones
-        x = np.concatenate((x, case_rng(seed, 3).uniform(-5.0, 5.0, 8)))
-    ok, out = call(result, "runge(x) returns (y, yprime)", fn, x)
+        x = np.concatenate((x, case_rng(seed, "hermite.runge").uniform(-5.0, 5.0, 8)))
+    ok, got = call(result, "runge(x) returns (y, yprime)", fn, x)
     if not ok:
         return result
-    if not (isinstance(out, tuple) and len(out) == 2):
-        return result.fail("runge(x) returns (y, yprime)", f"got {type(out).__name__}",
+    out = several(got, 2)
+    if out is None:
+        return result.fail("runge(x) returns (y, yprime)", f"got {shown(got)}",
                            "return both values: `return y, yprime`.")
     y, yprime = functions.runge(x)
     if not result.step("y = 1/(1+x^2)", close(out[0], y), "" if close(out[0], y) else worst(out[0], y)):
@@ -160,15 +161,16 @@ def limacon_derivatives(fn, seed=None):
     """Check ``limacon_derivatives(t, r0) -> (dxdt, dydt)`` of x = r cos t, y = r sin t, r = r0 + cos t."""
     result = CheckResult("limacon_derivatives")
     cases = [(np.linspace(0, 2 * np.pi, 21), 1.15)]
-    rng = case_rng(seed, 4)
+    rng = case_rng(seed, "hermite.limacon_derivatives")
     cases.append((rng.uniform(-7.0, 7.0, 15), float(rng.uniform(0.3, 2.0)) if seed is not None else 0.5))
     for t, r0 in cases:
         label = f"{t.size} values of t, r0 = {r0:g}"
-        ok, out = call(result, label, fn, t, r0)
+        ok, got = call(result, label, fn, t, r0)
         if not ok:
             return result
-        if not (isinstance(out, tuple) and len(out) == 2):
-            return result.fail(label, f"got {shown(out)}", "return both derivatives: `return dxdt, dydt`.")
+        out = several(got, 2)
+        if out is None:
+            return result.fail(label, f"got {shown(got)}", "return both derivatives: `return dxdt, dydt`.")
         _, _, dxdt, dydt = functions.limacon(t, r0=r0)
         for name, got, want, formula in (("dx/dt", out[0], dxdt, "-sin t cos t - r sin t"),
                                          ("dy/dt", out[1], dydt, "-sin^2 t + r cos t")):

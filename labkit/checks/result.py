@@ -8,6 +8,7 @@ hint, never an exception. The same check runs in a student's notebook, on
 the real function, and in ``labkit grade``, on a proxy that forwards the call
 into the sandboxed notebook: see :mod:`labkit.grading.remote`.
 """
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -62,13 +63,17 @@ class Checks(list):
         return "\n".join(map(repr, self))
 
 
-def case_rng(seed, default):
-    """Random test data: fixed (``default``) in a notebook's self-check, fresh per grading run.
+def case_rng(seed, name):
+    """Random test data of the check `name` (its full name, e.g. ``"drivers.driver.pherm"``): fixed in a
+    notebook's self-check, fresh per grading run.
 
-    ``labkit grade`` passes its run's seed, so the data differ from run to run
-    (no table of answers can be prepared) yet a run can be repeated exactly.
+    Each check has a stream of its own, keyed by a stable hash of its name, so
+    no two checks share one. ``labkit grade`` passes its run's seed, so the
+    data differ from run to run (no table of answers can be prepared) yet a
+    run can be repeated exactly.
     """
-    return np.random.default_rng(default if seed is None else [int(seed), default])
+    key = int.from_bytes(hashlib.sha256(str(name).encode()).digest()[:8], "little")
+    return np.random.default_rng(key if seed is None else [int(seed), key])
 
 
 def call(result, description, fn, *args):
@@ -107,6 +112,22 @@ def _floats(value):
         return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         raise _NotNumbers(f"got {type(value).__name__}, not numbers") from None
+
+
+def several(value, count):
+    """The `count` values a function returned together, or None.
+
+    The lab's functions return several arrays (``[y, yprime] = runge(x)`` in
+    MATLAB): a tuple, a list, or an array whose first axis has `count` rows all
+    count, as in Python any of them unpacks the same way.
+    """
+    if getattr(value, "not_numbers", False) or isinstance(value, (str, bytes)):
+        return None
+    if isinstance(value, (tuple, list)) and len(value) == count:
+        return tuple(value)
+    if isinstance(value, np.ndarray) and value.ndim >= 1 and value.shape[0] == count:
+        return tuple(value)
+    return None
 
 
 def close(actual, expected, tol=TOLERANCE):

@@ -83,7 +83,7 @@ class _Job:
                                     "profiles": str(self.profiles_file), "options": self.options.as_dict()}),
                         encoding="utf-8")
         memory = self.options.grader_memory
-        self.cgroup = cgroup.create(memory, label="labkit-grader")
+        self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
         group = self.cgroup
 
         def prepare():
@@ -93,7 +93,7 @@ class _Job:
 
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
-            environment[cgroup.PARENT] = group.sibling_parent
+            environment.update(group.sibling_environment())
         self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen([sys.executable, "-m", "labkit.grading.scoring", str(spec)],

@@ -1,13 +1,16 @@
-"""A memory cgroup per sandbox: a limit that counts every page, and a list of every process in it.
+"""A cgroup per sandbox: a memory limit that counts every page, a CPU limit, and a list of every process.
 
 An address-space limit (``RLIMIT_AS``) counts what a process maps, not the
 pages of an anonymous file or a tmpfs it writes to, nor what its children
 hold together. A memory cgroup counts them all, and its ``cgroup.procs``
-names every process of the sandbox, so the grader can stop all of them.
+names every process of the sandbox, so the grader can stop all of them. A
+CPU limit of one core per sandbox keeps one submission that spins from
+slowing a classmate graded beside it (with ``--jobs`` no more than the cores).
 
 :class:`MemoryCgroup` makes one under the grading process's own cgroup
-(cgroup v2, or v1's memory hierarchy), moves the sandbox into it from
-inside the new process before it starts bwrap, and removes it afterwards.
+(cgroup v2, or v1's memory hierarchy and, where there is one, its cpu
+hierarchy), moves the sandbox into it from inside the new process before it
+starts bwrap, and removes it afterwards.
 Where no cgroup can be made (not root, no delegation, no cgroup file
 system) :func:`create` returns None and the sandbox relies on its other
 limits; the instructors' documentation says what that leaves open.
@@ -59,20 +62,25 @@ def _candidates():
 
 
 class MemoryCgroup:
-    """One sandbox's cgroup with a memory limit in bytes."""
+    """One sandbox's cgroup with a memory limit in bytes (and, with v1, a cpu cgroup beside it)."""
 
-    def __init__(self, version, path, limit):
+    def __init__(self, version, path, limit, cpu_path=None):
         self.version, self.path, self.limit = version, Path(path), int(limit)
+        self.cpu_path = Path(cpu_path) if cpu_path is not None else None
 
-    @property
-    def sibling_parent(self):
+    def sibling_environment(self):
         """What to put in the environment of a process in this cgroup so its own cgroups are made beside it."""
-        return f"{self.version}:{self.path.parent}"
+        found = {PARENT: f"{self.version}:{self.path.parent}"}
+        if self.cpu_path is not None:
+            found[PARENT + "_CPU"] = str(self.cpu_path.parent)
+        return found
 
     def join(self):
         """Move the calling process (and so everything it starts) into the cgroup: call it in the child."""
-        with open(self.path / "cgroup.procs", "w") as handle:
-            handle.write(str(os.getpid()))
+        for folder in (self.path, self.cpu_path):
+            if folder is not None:
+                with open(folder / "cgroup.procs", "w") as handle:
+                    handle.write(str(os.getpid()))
 
     def pids(self):
         try:
@@ -110,20 +118,54 @@ class MemoryCgroup:
                 except (ProcessLookupError, PermissionError):
                     pass
             time.sleep(0.02)
-        for _ in range(50):
-            try:
-                self.path.rmdir()
-                return
-            except FileNotFoundError:
-                return
-            except OSError:
-                time.sleep(0.02)
+        for folder in (self.path, self.cpu_path):
+            for _ in range(50):
+                if folder is None:
+                    break
+                try:
+                    folder.rmdir()
+                    break
+                except FileNotFoundError:
+                    break
+                except OSError:
+                    time.sleep(0.02)
 
 
-def create(limit, label="labkit"):
-    """A new memory cgroup of `limit` bytes for one sandbox, or None where none can be made here."""
+def _cpu_v1(name, cores):
+    """A v1 cpu cgroup limited to `cores` cores beside our own, or None."""
+    own = None
+    try:
+        for line in Path("/proc/self/cgroup").read_text().splitlines():
+            _, controllers, path = line.split(":", 2)
+            if "cpu" in controllers.split(","):
+                own = path
+    except OSError:
+        return None
+    root = ROOT / "cpu"
+    if own is None or not (root / "cpu.cfs_quota_us").exists():
+        return None
+    given = os.environ.get(PARENT + "_CPU", "")
+    parent = Path(given) if given and os.path.isdir(given) else root / own.lstrip("/")
+    path = parent / name
+    try:
+        path.mkdir()
+        period = int((path / "cpu.cfs_period_us").read_text())
+        (path / "cpu.cfs_quota_us").write_text(str(int(period * cores)))
+    except (OSError, ValueError):
+        try:
+            path.rmdir()
+        except OSError:
+            pass
+        return None
+    return path
+
+
+def create(limit, label="labkit", cores=1):
+    """A new cgroup of `limit` bytes (and `cores` cores, where the CPU can be limited) for one sandbox,
+    or None where none can be made here."""
     for version, parent in _candidates():
-        path = parent / f"{label}-{os.getpid()}-{time.monotonic_ns()}"
+        name = f"{label}-{os.getpid()}-{time.monotonic_ns()}"
+        path = parent / name
         try:
             path.mkdir()
         except OSError:
@@ -137,15 +179,17 @@ def create(limit, label="labkit"):
                     pass
             else:
                 (path / "memory.max").write_text(str(int(limit)))
-                try:
-                    (path / "memory.swap.max").write_text("0")
-                except OSError:
-                    pass
+                for setting, value in (("memory.swap.max", "0"), ("cpu.max", f"{int(100_000 * cores)} 100000")):
+                    try:
+                        (path / setting).write_text(value)
+                    except OSError:
+                        pass
         except OSError:
             try:
                 path.rmdir()
             except OSError:
                 pass
             continue
-        return MemoryCgroup(version, path, limit)
+        cpu = _cpu_v1(name, cores) if version == "v1" and cores else None
+        return MemoryCgroup(version, path, limit, cpu)
     return None

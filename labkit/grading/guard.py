@@ -1,37 +1,43 @@
 """The watch over a notebook's process while it is graded (the sandbox's side).
 
-The notebook's process is the student's: anything its cells leave behind
-(a patched module, a saved code object, a helper that rewrites labkit's own
-grading code) is in it. So the watch is installed before the first cell
-runs, by the pristine process that forks the notebook's
-(:mod:`labkit.grading.worker`), and it is reachable afterwards only through
-the interpreter's profile hook:
+The notebook's process is the student's: anything its cells leave behind (a
+patched module, a saved code object, code that rewrites labkit's own grading
+code) is in it. So the watch is installed before the first cell runs, by
+the pristine process that forks the notebook's (:mod:`labkit.grading.worker`),
+and nothing of it is reachable from Python afterwards:
 
-* **while the cells run** it lets everything happen but notes *tampering*:
-  reading or replacing the profile hook, walking the garbage collector,
-  starting a thread or a process. Any of these voids every answer the
-  notebook gives later, because the watch can no longer vouch for them;
-* **while a graded call runs** (between two sentinel calls made by the
-  worker's own serving code, recognised by their pristine code objects) it
-  also notes every call of a refused reference: any Python function whose
-  code is one of the refused modules' functions, recognised by a digest of
-  its code that the grader computed from the library's files (so a
-  subclass, a saved code object, ``construct_fast``, a private helper or a
-  pasted copy of the code is caught alike), and any compiled function of a
-  refused module that Python code calls directly. Compiled functions and
-  classes of the refused modules are also replaced in their modules for
-  the length of the call;
-* at the end of each answer it writes an *attestation* to a pipe only the
-  pristine worker reads: the request, whether the call stayed clean (or
-  the first refused reference, or the tampering), and a digest of the
-  answer, signed with a key that never existed in the notebook's memory
-  outside the watch. The worker forwards an answer only with a valid
-  attestation, so an answer forged by the notebook, or given after the
-  watch was switched off, never reaches the grader.
+* an **audit hook** (``sys.addaudithook``: it cannot be removed or listed)
+  holds the watch's state and the key it signs with. It reports *tampering*
+  to the supervisor the moment it happens, on a pipe the supervisor reads:
+  switching the profile hook off, walking the garbage collector's lists,
+  ctypes, new processes, new code objects, a function's ``__code__``
+  replaced. Once reported, nothing the notebook does afterwards counts, even
+  if it then reads the process's memory. The audit hook also receives the
+  worker's sentinels (``sys.audit("labkit.begin")``, ``"labkit.chosen"``,
+  ``"labkit.end"``), recognised by the pristine code objects of the serving
+  functions that raise them;
+* while a graded request runs (between ``begin`` and ``end``) a **profile
+  hook**, installed through the C API with no Python object the notebook
+  could fetch (``sys.getprofile()`` stays None), notes every call of a
+  refused reference: any Python function whose code is one of the refused
+  modules' functions, recognised by a digest of its code that the grader
+  computed from the library's files (so a subclass, a saved code object,
+  ``construct_fast``, a private helper or a pasted copy of the code are
+  caught alike). Compiled routines of the refused modules are replaced in
+  their modules for the length of the request;
+* at the end of each answer the audit hook writes an **attestation**: the
+  request, its profile and the functions handed to student code, whether it
+  stayed clean (or the first refused reference), and a digest of the answer,
+  signed with a key that never existed in the notebook's memory outside the
+  watch. The supervisor forwards an answer only with a valid attestation.
 
-Nothing here raises into the student's code: a refused call is allowed to
-run and the answer is voided afterwards (raising from a profile hook would
-switch it off).
+Neither hook ever touches an object of the student's (no attribute, no
+comparison, no hash): they read code objects, frames and exact built-in
+types only, and the garbage collector is off while they work, so no student
+code ever runs while the watch's own frames are on the stack. The sandbox
+makes threads and new signal handlers impossible (:mod:`labkit.grading.seccomp`),
+so nothing interrupts them either. A refused call is allowed to run and its
+answer is voided afterwards: neither hook raises.
 """
 import hashlib
 import hmac
@@ -40,6 +46,17 @@ import sys
 import types
 
 SMALL_CODE = 64  # bytes of bytecode below which a function is only recognised with its name and place
+RUN = "run"  # the profile of the request that runs the cells: nothing is refused, tampering is noted
+BEGIN, CHOSEN, END = "labkit.begin", "labkit.chosen", "labkit.end"  # the worker's sentinels
+# audit events that void the notebook's answers: what reaches the watch's state or goes round it
+TAMPER_EVENTS = frozenset({
+    "sys.setprofile", "sys.settrace", "sys._current_frames", "sys.addaudithook", "gc.get_objects",
+    "gc.get_referrers", "gc.get_referents", "gc.freeze", "os.fork", "os.forkpty", "os.posix_spawn", "os.exec",
+    "os.spawn", "os.system", "subprocess.Popen", "code.__new__", "function.__new__", "_thread.start_new_thread",
+    "cpython._PySys_ClearAuditHooks", "cpython.run_interactivehook", "sys.monitoring.register_callback"})
+TAMPER_PREFIXES = ("ctypes.",)  # but ctypes.dlopen: scipy's own imports open libraries, which is no harm alone
+HARMLESS = frozenset({"ctypes.dlopen"})
+GUARDED_ATTRIBUTES = frozenset({"__code__"})  # libraries set __defaults__ and the like when imported
 
 
 def code_key(code):
@@ -71,56 +88,13 @@ def sign(secret, *parts):
     return hmac.new(secret, "\x1f".join(map(str, parts)).encode(), hashlib.sha256).hexdigest()
 
 
-RUN = "run"  # the profile of the request that runs the cells: nothing is refused, tampering is noted
-STRICTEST = "strictest"  # what is refused before a request has said which profile it needs
-
-
-def begin_request():
-    """Sentinel: the serving code is about to read a request (the watch starts watching strictly)."""
-
-
-def chosen(rid, profile, passables, handoff):
-    """Sentinel: the request read is `rid`, to be answered under `profile`, handing `passables` to student code."""
-
-
-def end_request(payload):
-    """Sentinel: the encoded answer (the watch attests it)."""
-
-
 def attestation_text(rid, profile, passables, status, digest):
     """The fields of one attestation, as signed."""
     return rid, profile or "", ",".join(sorted(passables)), status, digest
 
 
-def _tamper_targets():
-    """Builtins whose use while the notebook is watched voids its answers, by identity: {id: (object, name)}.
-
-    The second set is tampering only during a graded call (an honest cell may collect garbage)."""
-    import _thread
-    import gc
-    import posix
-    import signal
-
-    always = {sys.setprofile: "sys.setprofile", sys.getprofile: "sys.getprofile", sys.settrace: "sys.settrace",
-              sys.gettrace: "sys.gettrace", sys.addaudithook: "sys.addaudithook", gc.get_objects: "gc.get_objects",
-              gc.get_referrers: "gc.get_referrers", gc.get_referents: "gc.get_referents",
-              signal.signal: "signal.signal", _thread.start_new_thread: "a new thread (_thread.start_new_thread)"}
-    for name in ("fork", "forkpty", "posix_spawn", "posix_spawnp", "system", "execv", "execve"):
-        if hasattr(posix, name):
-            always[getattr(posix, name)] = f"a new process (os.{name})"
-    try:
-        import _posixsubprocess
-
-        always[_posixsubprocess.fork_exec] = "a new process (subprocess)"
-    except ImportError:
-        pass
-    graded = {gc.enable: "gc.enable", gc.collect: "gc.collect"}
-    return ({id(obj): (obj, name) for obj, name in always.items()},
-            {id(obj): (obj, name) for obj, name in graded.items()})
-
-
 class _Refused:
-    """Stands in for a refused compiled function or class while a graded call runs."""
+    """Stands in for a refused compiled function or class while a graded request runs."""
 
     def __init__(self, name):
         self.name = name
@@ -128,17 +102,6 @@ class _Refused:
     def __call__(self, *args, **kwargs):
         raise RuntimeError(f"{self.name} is switched off while this exercise is graded: "
                            "the exercise asks you to write it yourself")
-
-
-def _compiled(value):
-    """Whether `value` is a compiled function or a class with no Python methods (it has no code to key)."""
-    if isinstance(value, types.BuiltinFunctionType) or type(value).__name__ in (
-            "cython_function_or_method", "fused_cython_function", "fortran"):
-        return True
-    if isinstance(value, type):
-        return not any(isinstance(v, (types.FunctionType, classmethod, staticmethod, property))
-                       for v in vars(value).values())
-    return False
 
 
 def _within(module, prefixes):
@@ -174,33 +137,58 @@ def _barrier(function):
     return barrier
 
 
+def _compiled_types():
+    """The exact types of compiled functions in this process (builtins, Cython and f2py routines)."""
+    found = {types.BuiltinFunctionType}
+    for module in list(sys.modules.values()):
+        namespace = getattr(module, "__dict__", None) if type(module) is types.ModuleType else None
+        for value in (namespace or {}).values():
+            if type(value).__name__ in ("cython_function_or_method", "fused_cython_function", "fortran"):
+                found.add(type(value))
+    return frozenset(found)
+
+
+def _pristine_functions():
+    """What the watch calls, taken before any student code runs (a module's attribute may be replaced later)."""
+    import gc
+
+    return {"write": os.write, "getframe": sys._getframe, "gc_disable": gc.disable, "gc_enable": gc.enable,
+            "gc_isenabled": gc.isenabled, "sha256": hashlib.sha256, "sign": sign, "key_of": code_key,
+            "fields": attestation_text, "within": _within, "modules": sys.modules}
+
+
 def install(secret, verdict_fd, profiles, passables, chain):
-    """Install the watch in this (still pristine) process; afterwards only the profile hook holds it.
+    """Install the watch in this (still pristine) process; afterwards nothing of it is reachable from Python.
 
     `profiles` maps a profile name to ``(names, modules, c_names)``: the refused
     Python code as {digest: readable name} (:func:`code_key`), the refused
-    module prefixes (their compiled functions are refused, and replaced
-    during a call) and single refused compiled functions ``(module, name)``.
-    `passables` maps the names the grader may hand to student code to
-    pristine functions: the watch makes each a copy with a code object of its
-    own, trusted during the request it is handed to, when it is called
-    through the function handed over (which turns its arguments into plain
-    numbers first). Only the copy's own code is trusted, not what it calls.
-    `chain` is the pristine code of the serving functions, innermost first,
-    that must call the sentinels.
+    module prefixes (their compiled functions are replaced during a request)
+    and single refused compiled functions ``(module, name)``. `passables` maps
+    the names the grader may hand to student code to pristine functions: the
+    watch makes each a copy with a code object of its own, trusted during the
+    request it is handed to, when it is called through the function handed
+    over (which turns its arguments into plain numbers first). Only the
+    copy's own code is trusted, not what it calls. `chain` is the pristine
+    code of the serving functions, innermost first, that must raise the
+    sentinels.
     """
-    import gc
+    import ctypes
 
-    write, gc_disable, gc_enable, sha256 = os.write, gc.disable, gc.enable, hashlib.sha256
-    key_of, signed, within, fields = code_key, sign, _within, attestation_text
-    begin_code, chosen_code, end_code = begin_request.__code__, chosen.__code__, end_request.__code__
-    refused_call = _Refused.__call__.__code__
+    f = _pristine_functions()
+    write, getframe, sha256 = f["write"], f["getframe"], f["sha256"]
+    gc_disable, gc_enable, gc_isenabled = f["gc_disable"], f["gc_enable"], f["gc_isenabled"]
+    key_of, signed, fields, within, modules = f["key_of"], f["sign"], f["fields"], f["within"], f["modules"]
+    refused_call, refused_type = _Refused.__call__.__code__, _Refused
     handed_code = _handed_over(lambda: None).__code__
-    tamper_always, tamper_graded = _tamper_targets()
+    compiled_types, module_type, str_type, bytes_type, dict_type = (_compiled_types(), types.ModuleType, str,
+                                                                    bytes, dict)
+    heap_type = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
+    profiles = {name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in
+                profiles.items()}
     union = ({}, set(), set())
-    for names, modules, c_names in profiles.values():
+    for names, mods, c_names in profiles.values():
         union[0].update(names)
-        union[1].update(modules)
+        union[1].update(mods)
         union[2].update(c_names)
     strictest = (union[0], tuple(union[1]), frozenset(union[2]))
     copies = {}
@@ -210,9 +198,51 @@ def install(secret, verdict_fd, profiles, passables, chain):
                                   function.__closure__)
         copy.__kwdefaults__, copy.__qualname__ = function.__kwdefaults__, function.__qualname__
         copies[name] = (code, _handed_over(copy))
+    # mode: "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
     state = {"mode": "idle", "rid": None, "name": None, "profile": None, "passables": (), "refused": None,
-             "tampered": None, "live": frozenset(), "stubbed": []}
+             "tampered": None, "live": frozenset(), "stubbed": [], "busy": False, "gc": True}
     cache = {}  # id(code) -> (code, key)
+
+    def note_tampering(what):
+        if state["tampered"] is None:
+            state["tampered"] = what
+        try:
+            write(verdict_fd, f"TAMPER\t{what}\n".encode())
+        except OSError:
+            pass
+
+    def genuine(frame):
+        """Whether the Python frame that raised a sentinel is the worker's own serving chain."""
+        caller = frame
+        for expected in chain:
+            if caller is None or caller.f_code is not expected:
+                return False
+            caller = caller.f_back
+        return True
+
+    def stub(profile):
+        """Replace the compiled functions and classes of the refused modules (exact types only)."""
+        mods, c_names = profile[1], profile[2]
+        for module_name, module in list(modules.items()):
+            if type(module_name) is not str_type or type(module) is not module_type:
+                continue
+            namespace = module.__dict__
+            whole = within(module_name, mods)
+            if not whole and not any(m == module_name for m, _ in c_names):
+                continue
+            for attribute, value in list(namespace.items()):
+                if type(attribute) is not str_type:
+                    continue
+                kind = type(value)
+                compiled = kind in compiled_types or (kind is type and not value.__flags__ & heap_type)
+                if ((module_name, attribute) in c_names) or (whole and compiled):
+                    namespace[attribute] = refused_type(f"{module_name}.{attribute}")
+                    state["stubbed"].append((namespace, attribute, value))
+
+    def unstub():
+        for namespace, attribute, value in reversed(state["stubbed"]):
+            namespace[attribute] = value
+        state["stubbed"].clear()
 
     def key(code):
         found = cache.get(id(code))
@@ -221,49 +251,52 @@ def install(secret, verdict_fd, profiles, passables, chain):
             cache[id(code)] = found
         return found[1]
 
-    def genuine(frame):
-        caller = frame.f_back
-        for expected in chain:
-            if caller is None or caller.f_code is not expected:
-                return False
-            caller = caller.f_back
-        return True
+    def profile_hook(obj, frame, what, arg):
+        """Every profile event of a graded request (through the C API): refused calls are noted."""
+        try:
+            if what != 0 or state["refused"] is not None:  # only 'call' events, and only until the first refusal
+                return 0
+            code = frame.f_code
+            profile = state["profile"]
+            if code is refused_call:
+                stand_in = frame.f_locals.get("self")
+                name = (stand_in.__dict__.get("name") if type(stand_in) is refused_type else None) or \
+                    "a switched-off function"
+            else:
+                name = profile[0].get(key(code)) if profile is not None else None
+            if name is not None and not (code in state["live"] and frame.f_back is not None
+                                         and frame.f_back.f_code is handed_code):
+                state["refused"] = str(name)
+        except BaseException:  # noqa: BLE001 - the hook never raises (its traceback would expose the watch)
+            state["tampered"] = state["tampered"] or "an error inside the grader's watch"
+        return 0
 
-    def note_tampering(what):
-        if state["tampered"] is None:
-            state["tampered"] = what
-
-    def stub(profile):
-        modules, c_names = profile[1], profile[2]
-        for module_name, module in list(sys.modules.items()):
-            namespace = getattr(module, "__dict__", None) if type(module) is types.ModuleType else None
-            if namespace is None:
-                continue
-            whole = within(module_name, modules)
-            for attribute, value in list(namespace.items()):
-                if (module_name, attribute) in c_names or (
-                        whole and _compiled(value) and within(str(getattr(value, "__module__", "") or module_name),
-                                                              modules)):
-                    namespace[attribute] = _Refused(f"{module_name}.{attribute}")
-                    state["stubbed"].append((namespace, attribute, value))
+    hook_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.py_object, ctypes.c_int, ctypes.c_void_p)
+    hook = hook_type(profile_hook)
+    set_profile = ctypes.pythonapi.PyEval_SetProfile
+    set_profile.argtypes, set_profile.restype = (ctypes.c_void_p, ctypes.c_void_p), None
+    hook_address = ctypes.cast(hook, ctypes.c_void_p).value
 
     def begin(frame):
-        if not genuine(frame):
-            return
         if state["mode"] != "idle":
             note_tampering("a grading request started inside another")
+            return
+        state["gc"] = gc_isenabled()
+        gc_disable()  # no finalizer of the student's runs while a request is watched
         state.update(mode="reading", rid=None, name=None, profile=strictest, passables=(), refused=None,
                      live=frozenset())
+        set_profile(hook_address, None)  # sys.getprofile() stays None: nothing to fetch
 
-    def choose(frame):
-        if not genuine(frame):
-            return
-        if state["mode"] != "reading":
+    def choose(args):
+        if state["mode"] != "reading" or len(args) != 4:
             note_tampering("a grading request chosen twice")
             return
-        local = frame.f_locals
-        name, handoff = local["profile"], local["handoff"]
-        wanted = tuple(str(n) for n in local["passables"])
+        rid, name, wanted, handoff = args
+        if (type(rid) is not str_type or (name is not None and type(name) is not str_type)
+                or type(wanted) not in (list, tuple) or any(type(w) is not str_type for w in wanted)
+                or type(handoff) is not dict_type or handoff):
+            note_tampering("a grading request with what no grader sends")
+            return
         live = set()
         for passable in wanted:
             if passable in copies:
@@ -271,67 +304,69 @@ def install(secret, verdict_fd, profiles, passables, chain):
                 handoff[passable] = handed
                 live.add(code)
         profile = None if name in (None, RUN) else profiles.get(name, strictest)
-        state.update(rid=str(local["rid"]), name=name, profile=profile, passables=wanted, live=frozenset(live),
+        state.update(rid=rid, name=name, profile=profile, passables=tuple(wanted), live=frozenset(live),
                      mode=RUN if name == RUN else "graded")
-        if state["mode"] == RUN:
-            gc_enable()  # the cells run as in a kernel
+        if name == RUN:
+            set_profile(None, None)  # the cells run unwatched but for tampering, and at full speed
+            if state["gc"]:
+                gc_enable()
         elif profile is not None:
             stub(profile)
 
-    def end(frame):
-        if not genuine(frame) or state["mode"] not in ("graded", RUN):
+    def end(args):
+        if state["mode"] not in ("graded", RUN) or len(args) != 1 or type(args[0]) is not bytes_type:
+            note_tampering("an answer out of turn")
             return
-        payload = frame.f_locals["payload"]
-        for namespace, attribute, value in reversed(state["stubbed"]):
-            namespace[attribute] = value
-        state["stubbed"].clear()
+        set_profile(None, None)
+        unstub()
         status = (f"tampered:{state['tampered']}" if state["tampered"] else
                   f"refused:{state['refused']}" if state["refused"] else "clean")
-        parts = fields(state["rid"], state["name"], state["passables"], status, sha256(payload).hexdigest())
+        parts = fields(state["rid"], state["name"], state["passables"], status, sha256(args[0]).hexdigest())
         state.update(mode="idle", rid=None, name=None, profile=None, passables=(), live=frozenset())
+        if state["gc"]:
+            gc_enable()
         write(verdict_fd, ("\t".join(parts) + "\t" + signed(secret, *parts) + "\n").encode())
 
-    def hook(frame, event, arg):
+    def audit(event, args):
+        if state["busy"]:
+            return
+        if event in TAMPER_EVENTS or (event.startswith(TAMPER_PREFIXES) and event not in HARMLESS):
+            state["busy"] = True
+            try:
+                note_tampering(event)
+            finally:
+                state["busy"] = False
+            return
+        if event == "object.__setattr__":
+            if len(args) == 3 and type(args[1]) is str_type and args[1] in GUARDED_ATTRIBUTES:
+                state["busy"] = True
+                try:
+                    note_tampering(f"a function's {args[1]} replaced")
+                finally:
+                    state["busy"] = False
+            return
+        if event not in (BEGIN, CHOSEN, END):
+            return
+        state["busy"] = True
         try:
-            if event == "c_call":
-                found = tamper_always.get(id(arg))
-                if found is None and state["mode"] in ("reading", "graded"):
-                    found = tamper_graded.get(id(arg))
-                if found is not None and found[0] is arg:
-                    note_tampering(found[1])
-                elif state["profile"] is not None and state["mode"] in ("reading", "graded") \
-                        and state["refused"] is None:
-                    owner = getattr(arg, "__self__", None)
-                    module = getattr(arg, "__module__", None)
-                    if type(module) is not str:
-                        module = owner.__name__ if type(owner) is types.ModuleType else ""
-                    name = getattr(arg, "__name__", "")
-                    profile = state["profile"]
-                    if (module, name) in profile[2] or within(module, profile[1]):
-                        state["refused"] = f"{module}.{name}"
-            elif event == "call":
-                code = frame.f_code
-                if code is begin_code:
-                    gc_disable()  # no finalizer of the student's runs while the watch's frames are on the stack
-                    begin(frame)
-                elif code is chosen_code:
-                    choose(frame)
-                elif code is end_code:
-                    end(frame)
-                    gc_enable()
-                elif state["mode"] in ("reading", "graded") and state["refused"] is None:
-                    profile = state["profile"]
-                    if code is refused_call:
-                        refused_name = frame.f_locals["self"].name
-                    else:
-                        refused_name = profile[0].get(key(code)) if profile is not None else None
-                    if refused_name is not None and not (code in state["live"] and frame.f_back is not None
-                                                         and frame.f_back.f_code is handed_code):
-                        state["refused"] = refused_name
-        except BaseException:  # noqa: BLE001 - the hook must never raise (that would switch it off)
-            note_tampering("an error inside the grader's watch (RecursionError or MemoryError?)")
+            gc_disable()
+            if not genuine(getframe(1)):
+                note_tampering(f"{event} raised by the notebook")
+            elif event == BEGIN:
+                begin(None)
+            elif event == CHOSEN:
+                choose(args)
+            else:
+                end(args)
+        except BaseException:  # noqa: BLE001 - the hook never raises (its traceback would expose the watch)
+            note_tampering("an error inside the grader's watch")
+        finally:
+            if state["mode"] in ("idle", RUN) and state["gc"]:
+                gc_enable()
+            state["busy"] = False
 
-    sys.setprofile(hook)
+    audit.keep = (hook,)  # the C callback lives as long as the audit hook, which lives as long as the process
+    sys.addaudithook(audit)
 
 
 def unwire(profiles):

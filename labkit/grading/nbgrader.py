@@ -6,6 +6,10 @@ folder. nbgrader reads what each cell is from ``cell.metadata["nbgrader"]``:
 * a code cell with a ``### BEGIN SOLUTION`` region is a *solution* cell
   (``solution: true``): nbgrader replaces the region by its stub, as
   ``labkit release`` does;
+* a markdown cell with a ``### BEGIN SOLUTION`` region is a *manually graded
+  answer* (``solution: true``, ``grade: true``, 0 points: the lab's rubric
+  has no points for words, the instructor reads them), with the grade id
+  ``exerciseN-answer-K`` of the exercise whose section it is in;
 * a cell with ``### BEGIN HIDDEN TESTS`` is an *autograded test* cell
   (``grade: true``, ``locked: true``) worth the points of the parts its
   asserts check, the weights of :data:`labkit.checks.exercises.EXERCISES`,
@@ -58,9 +62,28 @@ def test_points(source, where="a test cell"):
     return number, points
 
 
+HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
+
+
+def answer_ids(nb):
+    """The grade ids of a notebook's answers in words, in order: ``exerciseN-answer-K``."""
+    ids, exercise, counters = [], None, {}
+    for cell in nb.cells:
+        if cell.cell_type != "markdown":
+            continue
+        found = HEADING.findall(cell.source)
+        if found:
+            exercise = int(found[-1])
+        if BEGIN_SOLUTION in cell.source:
+            counters[exercise] = counters.get(exercise, 0) + 1
+            ids.append(f"exercise{exercise}-answer-{counters[exercise]}")
+    return ids
+
+
 def mark(nb, name="notebook"):
     """Give every cell of an instructor notebook nbgrader's metadata (in place); returns `nb`."""
     counters = {}
+    answers = iter(answer_ids(nb))
 
     def grade_id(kind):
         counters[kind] = counters.get(kind, 0) + 1
@@ -68,7 +91,9 @@ def mark(nb, name="notebook"):
 
     for index, cell in enumerate(nb.cells):
         meta = {"schema_version": SCHEMA_VERSION, "grade": False, "solution": False, "locked": True}
-        if cell.cell_type == "code" and BEGIN_SOLUTION in cell.source:
+        if cell.cell_type == "markdown" and BEGIN_SOLUTION in cell.source:
+            meta.update(solution=True, grade=True, locked=False, points=0, grade_id=next(answers))
+        elif cell.cell_type == "code" and BEGIN_SOLUTION in cell.source:
             meta.update(solution=True, locked=False, grade_id=grade_id(f"{_stem(name)}-solution"))
         elif cell.cell_type == "code" and BEGIN_HIDDEN in cell.source:
             number, points = test_points(cell.source, f"{name}, cell {index}")

@@ -1,9 +1,11 @@
 """The student version of the instructor notebooks.
 
 Code between ``### BEGIN SOLUTION`` / ``### END SOLUTION`` becomes a stub
-that raises ``NotImplementedError``, hidden tests between ``### BEGIN HIDDEN
-TESTS`` / ``### END HIDDEN TESTS`` disappear, outputs are cleared. The
-markers are nbgrader's.
+that raises ``NotImplementedError``; in a markdown cell the same region is
+an answer in words (a remark, an explanation) and becomes ``YOUR ANSWER
+HERE``, for the student to write and the instructor to read. Hidden tests
+between ``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS`` disappear,
+outputs are cleared. The markers and the stubs are nbgrader's.
 """
 import json
 from pathlib import Path
@@ -13,9 +15,10 @@ from ..notebooks import notebook_paths, read_notebook
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
 BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
 STUB = ["# YOUR CODE HERE", "raise NotImplementedError()"]
+TEXT_STUB = ["YOUR ANSWER HERE"]
 
 
-def strip_solutions(source, where="cell"):
+def strip_solutions(source, where="cell", stub=STUB):
     """Replace solution regions by stubs and drop hidden-test regions in one cell's source."""
     lines, out, region = source.split("\n"), [], None
     for number, line in enumerate(lines, start=1):
@@ -26,7 +29,7 @@ def strip_solutions(source, where="cell"):
             region = marker
             if marker == BEGIN_SOLUTION:
                 indent = line[: len(line) - len(line.lstrip())]
-                out.extend(indent + stub for stub in STUB)
+                out.extend(indent + line for line in stub)
         elif marker in (END_SOLUTION, END_HIDDEN):
             expected = BEGIN_SOLUTION if marker == END_SOLUTION else BEGIN_HIDDEN
             if region != expected:
@@ -50,6 +53,8 @@ def release_notebook(nb, name="notebook"):
             cell.source = strip_solutions(cell.source, f"{name}, cell {index}")
             cell.outputs = []
             cell.execution_count = None
+        elif cell.cell_type == "markdown" and BEGIN_SOLUTION in cell.source:
+            cell.source = strip_solutions(cell.source, f"{name}, cell {index}", TEXT_STUB)
     return student
 
 

@@ -152,8 +152,9 @@ class Notebook:
             except protocol.ProtocolError as exc:
                 self._stop(f"the notebook's process answered out of protocol ({exc})")
             if answer.get("id") == rid:
-                if message.get("op") == "run" and answer.get("tampered"):
-                    self.tampered = str(answer["tampered"])[:500]
+                error = answer.get("error") if isinstance(answer.get("error"), dict) else {}
+                if error.get("kind") == "Tampered":
+                    self.tampered = str(error.get("message", "tampering"))[:500]
                 return answer
 
     def _ended(self):

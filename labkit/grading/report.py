@@ -23,7 +23,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..checks.exercises import EXERCISES
+from ..checks.exercises import ANSWERS, EXERCISES
 from . import rubric as rubrics
 from .rubric import points_text
 
@@ -40,6 +40,7 @@ class SubmissionGrade:
     seed: int = None
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
     failure: str = None  # why the submission could not be graded at all (then it has no points, not zero)
+    answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
 
     @property
     def graded(self):
@@ -80,6 +81,7 @@ class SubmissionGrade:
         for number in rubric.graded:
             lines += self._exercise_lines(number)
         lines += ["", self._summary()]
+        lines += self._answer_lines()
         if self.seed is not None:
             lines += ["", f"(random test data from seed {self.seed})"]
         return printable("\n".join(lines) + "\n")
@@ -105,6 +107,21 @@ class SubmissionGrade:
                 lines.append(f"    hint: {one_line(check['hint'], 1000)}")
         return lines
 
+    def _answer_lines(self):
+        """The answers in words, for the instructor to read (no check scores them)."""
+        if not ANSWERS:
+            return []
+        lines = ["", "For the instructor to read (answers in words, not scored by labkit):"]
+        for grade_id, (number, what) in ANSWERS.items():
+            if number not in self.rubric.points:
+                continue
+            text = str(self.answers.get(grade_id, "")).strip()
+            if not text or text == "YOUR ANSWER HERE":
+                text = "(no answer)"
+            lines.append(f"  Exercise {number}, {what}:")
+            lines += [f"    | {one_line(line, 300)}" for line in text.splitlines()[:20]]
+        return lines
+
     def _summary(self):
         score, rubric = self.score, self.rubric
         lines = [f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
@@ -123,7 +140,7 @@ class SubmissionGrade:
     def as_dict(self):
         score = self.score
         return {"format": FORMAT, "name": self.name, "seed": self.seed, "problems": list(self.problems),
-                "failure": self.failure,
+                "failure": self.failure, "answers": dict(self.answers),
                 "results": {str(n): v for n, v in self.results.items()},
                 "rubric": self.rubric.title, "points": {str(n): v for n, v in score.points.items()},
                 "branch": score.branch, "extra_credit": score.extra, "total": score.total}
@@ -138,7 +155,8 @@ class SubmissionGrade:
             for verdict in results.values():
                 float(verdict["fraction"])
             grade = cls(str(data["name"]), results, [str(p) for p in data["problems"]], data.get("seed"),
-                        rubric or rubrics.default(), data.get("failure"))
+                        rubric or rubrics.default(), data.get("failure"),
+                        {str(k): str(v)[:4000] for k, v in dict(data.get("answers") or {}).items()})
             if grade.failure is not None:
                 grade.failure = str(grade.failure)
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
@@ -156,13 +174,16 @@ def _problem_lines(problem):
                                                for line in rest[:40]]
 
 
-CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u200b-\u200f\u202a-\u202e\u2066-\u2069]")
+# control characters, and the invisible ones that break or reorder lines (line and paragraph separators, bidi marks)
+CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u061c\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff\ufff9-\ufffb]")
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
 def printable(text):
-    """`text` without control characters but newline and tab (no escape sequence reaches a terminal)."""
-    return CONTROL.sub("\ufffd", str(text))
+    """`text` without control characters but newline and tab (no escape sequence reaches a terminal), and
+    with bytes that were not UTF-8 (a file name from an old zip) spelled out as escapes."""
+    text = str(text).encode("utf-8", "backslashreplace").decode("utf-8")
+    return CONTROL.sub("\ufffd", text)
 
 
 def one_line(text, limit=200):
@@ -189,6 +210,11 @@ def csv_cell(value):
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
 
 
+def read_columns(graded):
+    """One empty column per answer in words of the graded exercises, for the instructor to fill in."""
+    return [f"to read: exercise {number}, {what}" for number, what in ANSWERS.values() if number in graded]
+
+
 def write_csv(path, grades):
     """One row per submission: points per exercise, the branch that counted, extra credit, total, status.
 
@@ -196,17 +222,18 @@ def write_csv(path, grades):
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         graded = grades[0].rubric.graded if grades else []
-        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL)
+        to_read = read_columns(graded)
+        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL + to_read)
         for g in grades:
             if not g.graded:
                 writer.writerow([csv_cell(g.name)] + [""] * (len(graded) + len(CSV_TAIL) - 1)
-                                + [csv_cell(f"not graded: {g.failure}")])
+                                + [csv_cell(f"not graded: {g.failure}")] + [""] * len(to_read))
                 continue
             s = g.score
             writer.writerow([csv_cell(g.name)] + [points_text(s.points[n]) for n in graded]
                             + [points_text(s.required), csv_cell(s.branch), points_text(s.counted),
                                points_text(s.extra_total), points_text(s.total), points_text(s.full_credit),
-                               "graded"])
+                               "graded"] + [""] * len(to_read))
 
 
 def write_result(out_dir, grade):

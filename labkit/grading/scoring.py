@@ -25,7 +25,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..checks.exercises import EXERCISES, REFUSALS, grade as run_checks
+from ..checks.exercises import ANSWERS, EXERCISES, REFUSALS, grade as run_checks
 from . import refusals, remote, scan
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line
@@ -36,13 +36,16 @@ MAX_NOTEBOOK_BYTES = 10 * 1024**2  # a lab notebook with its pictures is a few m
 MAX_NOTEBOOKS = 20  # notebooks graded per submission
 MAX_FILES = 5_000  # entries looked at in one submission folder
 MAX_DEPTH = 8  # folder levels looked into
+MAX_ANSWER = 4_000  # characters of one answer in words kept for the instructor
 HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
 
 
-def read_cells(path):
+def read_cells(path, answers=None):
     """(code sources, markdown sources) of a notebook file; ValueError says why it is not one.
 
-    The size is checked before anything is read, and a link is never followed."""
+    The size is checked before anything is read, and a link is never followed.
+    The student's answers in words (markdown cells with an answer's nbgrader
+    grade id) go into `answers`, {grade id: text}, when it is given."""
     path = Path(path)
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode):
@@ -76,6 +79,10 @@ def read_cells(path):
             code.append(source)
         elif kind == "markdown":
             markdown.append(source)
+            meta = cell.get("metadata", {}).get("nbgrader", {}) if isinstance(cell.get("metadata"), dict) else {}
+            grade_id = meta.get("grade_id") if isinstance(meta, dict) else None
+            if answers is not None and grade_id in ANSWERS and grade_id not in answers:
+                answers[grade_id] = source[:MAX_ANSWER]
     return code, markdown
 
 
@@ -185,17 +192,18 @@ def _for_sandbox(profiles):
 
 
 def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None,
-                   options=None, deadline=None, skip=(), profiles=None):
+                   options=None, deadline=None, skip=(), profiles=None, answers=None):
     """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
 
     `options` (a :class:`GradeOptions`) or the single keywords bound it; `deadline`
-    (monotonic) is the submission's; exercises in `skip` are not checked here."""
+    (monotonic) is the submission's; exercises in `skip` are not checked here. The
+    notebook's answers in words go into `answers` ({grade id: text}) when it is given."""
     options = _options(options, cell_timeout, total_timeout, seed, confined, limits)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     profiles = profiles or _profiles()
     name = one_line(Path(path).name, 120)
     try:
-        code, markdown = read_cells(path)
+        code, markdown = read_cells(path, answers)
     except (ValueError, OSError) as exc:
         return {}, [f"{name}: {exc}" if name not in str(exc) else str(exc)]
     numbers = [n for n in exercises_in(markdown) if n not in skip]
@@ -223,7 +231,7 @@ def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confi
             return {}, [f"{name}: {why}."]
         except remote.WorkerError as exc:
             return {}, [f"{name}: {exc} while running its cells."]
-        if "error" in ran:  # the notebook's process died while its cells ran: nothing to check
+        if "error" in ran and not notebook.tampered:  # the notebook's process died while its cells ran
             error = ran["error"] if isinstance(ran["error"], dict) else {}
             return {}, [f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."]
         problems += _run_problems(name, ran)
@@ -270,8 +278,10 @@ def _options(options, cell_timeout=None, total_timeout=None, seed=None, confined
 
 
 def submission_name(path):
+    """A submission's name: its folder's or notebook's, bytes that are not UTF-8 spelled out as escapes."""
     path = Path(path)
-    return path.stem if path.suffix == ".ipynb" else path.name
+    name = path.stem if path.suffix == ".ipynb" else path.name
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
 def grade_submission(path, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None,
@@ -292,7 +302,7 @@ def grade_submission(path, cell_timeout=None, total_timeout=None, seed=None, con
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
         results, problems = grade_notebook(notebook, options=options, deadline=deadline, skip=claimed,
-                                           profiles=profiles)
+                                           profiles=profiles, answers=grade.answers)
         grade.problems.extend(problems)
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)

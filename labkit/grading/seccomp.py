@@ -1,6 +1,6 @@
-"""The system calls a sandboxed notebook may not make: a small seccomp filter for bwrap's ``--seccomp``.
+"""The system calls a sandboxed notebook may not make: small seccomp filters, written out here.
 
-Refused, with ``EPERM``, whatever the notebook's process tries them for:
+The sandbox's filter (bwrap's ``--seccomp``, :func:`pipe_with_program`) refuses:
 
 * ``memfd_create`` and ``memfd_secret``: anonymous files hold memory that
   an address-space limit does not count;
@@ -8,14 +8,23 @@ Refused, with ``EPERM``, whatever the notebook's process tries them for:
   the sandbox and are shared by every process of one uid, so one
   submission could leave a key for the next one to read;
 * ``ptrace``, ``process_vm_readv`` and ``process_vm_writev``: no process of
-  the sandbox reads or writes another's memory (the grading watch lives in
-  the supervisor, :mod:`labkit.grading.worker`).
+  the sandbox reads or writes another's memory;
+* new **threads** (``clone`` with ``CLONE_THREAD``; ``clone3``, whose flags
+  a filter cannot read, answers "not implemented", so the C library falls
+  back to ``clone``): the grading watch follows one thread, and a second one
+  would run unwatched.
+
+The notebook's process installs the same refusals again, with
+``rt_sigaction`` added, once it has set up its own signal handling
+(:func:`install_for_notebook`): so the notebook cannot install a signal
+handler that would interrupt the watch and see its frames, and the refusals
+hold when grading without bubblewrap too.
 
 System calls of another architecture (32-bit calls on a 64-bit machine)
 are refused too: they would reach the same functions under other numbers.
-The filter is classic BPF, written out here because it is a dozen
-instructions; bwrap installs it just before it starts the worker.
+The filters are classic BPF, a few dozen instructions each.
 """
+import errno
 import os
 import platform
 import struct
@@ -23,45 +32,57 @@ import struct
 # numbers of the refused calls on the architectures the grader runs on
 SYSCALLS = {
     "x86_64": {"memfd_create": 319, "memfd_secret": 447, "add_key": 248, "request_key": 249, "keyctl": 250,
-               "ptrace": 101, "process_vm_readv": 310, "process_vm_writev": 311},
+               "ptrace": 101, "process_vm_readv": 310, "process_vm_writev": 311, "clone": 56, "clone3": 435,
+               "rt_sigaction": 13},
     "aarch64": {"memfd_create": 279, "memfd_secret": 447, "add_key": 217, "request_key": 218, "keyctl": 219,
-                "ptrace": 117, "process_vm_readv": 270, "process_vm_writev": 271},
+                "ptrace": 117, "process_vm_readv": 270, "process_vm_writev": 271, "clone": 220, "clone3": 435,
+                "rt_sigaction": 134},
 }
+SANDBOX = ("memfd_create", "memfd_secret", "add_key", "request_key", "keyctl", "ptrace", "process_vm_readv",
+           "process_vm_writev")
 AUDIT_ARCH = {"x86_64": 0xC000003E, "aarch64": 0xC00000B7}
 X32_BIT = 0x40000000  # x86_64's x32 calls: the same functions under numbers with this bit
+CLONE_THREAD = 0x00010000
 
-_LD_W_ABS, _JEQ_K, _JGE_K, _RET_K = 0x20, 0x15, 0x35, 0x06
+_LD_W_ABS, _JEQ_K, _JGE_K, _JSET_K, _RET_K = 0x20, 0x15, 0x35, 0x45, 0x06
 _ALLOW, _ERRNO = 0x7FFF0000, 0x00050000
-_EPERM = 1
+_NR, _ARCH, _ARG0 = 0, 4, 16  # offsets in struct seccomp_data (the low word of args[0] on little-endian)
 
 
 def _instruction(code, jt, jf, k):
     return struct.pack("=HBBI", code, jt, jf, k)
 
 
-def program(machine=None):
-    """The filter as bytes (struct sock_filter[]), or None on an architecture it does not know."""
+def program(machine=None, deny=SANDBOX, threads=True):
+    """A filter as bytes (struct sock_filter[]), or None on an architecture it does not know.
+
+    `deny` are refused with EPERM; with `threads`, ``clone`` with ``CLONE_THREAD`` is refused with
+    EPERM and ``clone3`` with ENOSYS."""
     machine = machine or platform.machine()
     if machine not in SYSCALLS:
         return None
-    numbers = sorted(set(SYSCALLS[machine].values()))
-    deny = _ERRNO | _EPERM
-    body = [_instruction(_LD_W_ABS, 0, 0, 4)]  # the architecture of the call
-    # not ours: jump to the last instruction (deny)
-    tail = len(numbers) + (3 if machine == "x86_64" else 2)
-    body.append(_instruction(_JEQ_K, 0, tail, AUDIT_ARCH[machine]))
-    body.append(_instruction(_LD_W_ABS, 0, 0, 0))  # the call's number
+    numbers = SYSCALLS[machine]
+    # (code, jump if true, jump if false, k), the jumps naming a target: "deny", "nosys", "allow" or a count
+    body = [(_LD_W_ABS, 0, 0, _ARCH), (_JEQ_K, 0, "deny", AUDIT_ARCH[machine]), (_LD_W_ABS, 0, 0, _NR)]
     if machine == "x86_64":
-        body.append(_instruction(_JGE_K, len(numbers) + 1, 0, X32_BIT))
-    for index, number in enumerate(numbers):
-        body.append(_instruction(_JEQ_K, len(numbers) - index, 0, number))
-    body.append(_instruction(_RET_K, 0, 0, _ALLOW))
-    body.append(_instruction(_RET_K, 0, 0, deny))
-    return b"".join(body)
+        body.append((_JGE_K, "deny", 0, X32_BIT))
+    body += [(_JEQ_K, "deny", 0, numbers[name]) for name in deny]
+    if threads:  # last: the flags check leaves the accumulator holding the flags, not the number
+        body += [(_JEQ_K, "nosys", 0, numbers["clone3"]),
+                 (_JEQ_K, 0, 2, numbers["clone"]),
+                 (_LD_W_ABS, 0, 0, _ARG0),
+                 (_JSET_K, "deny", 0, CLONE_THREAD)]
+    body += [(_RET_K, 0, 0, _ALLOW), (_RET_K, 0, 0, _ERRNO | errno.EPERM), (_RET_K, 0, 0, _ERRNO | errno.ENOSYS)]
+    targets = {"allow": len(body) - 3, "deny": len(body) - 2, "nosys": len(body) - 1}
+
+    def jump(index, to):
+        return to if isinstance(to, int) else targets[to] - index - 1
+
+    return b"".join(_instruction(op, jump(i, jt), jump(i, jf), k) for i, (op, jt, jf, k) in enumerate(body))
 
 
 def pipe_with_program():
-    """A readable descriptor holding the filter (for ``bwrap --seccomp FD``), or None."""
+    """A readable descriptor holding the sandbox's filter (for ``bwrap --seccomp FD``), or None."""
     code = program()
     if code is None:
         return None
@@ -69,3 +90,26 @@ def pipe_with_program():
     os.write(write, code)  # far below a pipe's buffer
     os.close(write)
     return read
+
+
+def install_for_notebook():
+    """In the calling process, from now on: the sandbox's refusals and ``rt_sigaction`` too (True), or False
+    where this cannot be done.
+
+    Called by the notebook's process after it has set up its own timer's
+    handler and before any student code runs, so the refusals hold even when
+    grading without bubblewrap."""
+    code = program(deny=SANDBOX + ("rt_sigaction",), threads=True)
+    if code is None:
+        return False
+    import ctypes
+
+    class Program(ctypes.Structure):
+        _fields_ = [("len", ctypes.c_ushort), ("filter", ctypes.c_char_p)]
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(38, 1, 0, 0, 0) != 0:  # PR_SET_NO_NEW_PRIVS, needed to install a filter unprivileged
+        return False
+    filters = ctypes.create_string_buffer(code, len(code))
+    prog = Program(len(code) // 8, ctypes.cast(filters, ctypes.c_char_p))
+    return libc.prctl(22, 2, ctypes.byref(prog), 0, 0) == 0  # PR_SET_SECCOMP, SECCOMP_MODE_FILTER

@@ -39,7 +39,7 @@ import signal
 import sys
 import time
 
-from . import guard, protocol
+from . import guard, protocol, seccomp
 
 RESTARTS = 3  # new notebook processes after one died, per notebook
 _GUARD_FILE = guard.__file__
@@ -205,21 +205,24 @@ class Notebook:
 
 
 def _serve_one(notebook, reader, answers):
-    """Answer one request, between the sentinels the watch recognises (see :mod:`labkit.grading.guard`)."""
+    """Answer one request, between the sentinels the watch recognises (see :mod:`labkit.grading.guard`).
+
+    The request is read only after the watch has started watching, so nothing
+    the notebook left behind sees a request's data unwatched."""
     handoff = {}
-    guard.begin_request()
+    sys.audit(guard.BEGIN)
     line = reader.readline()
     if line is None:
         return False
     request = protocol.loads(line)
-    guard.chosen(request.get("id"), request.get("profile"), request.get("passables", ()), handoff)
+    sys.audit(guard.CHOSEN, request.get("id"), request.get("profile"), request.get("passables", []), handoff)
     try:
         answer = notebook.answer(request, handoff)
     except BaseException as exc:  # noqa: BLE001 - every request gets an answer
         answer = _error(*_describe(exc))
     answer["id"] = request.get("id")
     payload = protocol.dumps(answer)
-    guard.end_request(payload)
+    sys.audit(guard.END, payload)
     view = memoryview(payload)
     while view:
         view = view[os.write(answers, view):]
@@ -232,12 +235,14 @@ def _serve(notebook, reader, answers):
 
 
 def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles, passable_names):
-    """The notebook's process: install the watch first, then answer requests until the pipe closes."""
+    """The notebook's process: its timer, no signal handlers of the notebook's own, the watch, then the
+    requests until the pipe closes."""
     os.setpgrp()  # the supervisor stops it and everything it starts at once
     output = _Counter()
     sys.stdout = sys.stderr = output
     sys.stdin = io.StringIO("")
     signal.signal(signal.SIGALRM, _alarm)
+    seccomp.install_for_notebook()
     passables = {name: protocol.passable(name) for name in passable_names}
     guard.install(os.read(key_fd, 32), verdict_fd, guard.unwire(profiles), passables,
                   chain=(_serve_one.__code__, _serve.__code__, _notebook_main.__code__))
@@ -254,6 +259,7 @@ class Supervisor:
         self.requests, self.answers, self.shell = _Lines(requests_fd), answers_fd, shell
         self.setup, self.run_request = None, None
         self.child, self.restarts, self.ended = None, 0, None
+        self.tampered = None  # what the watch reported: from then on no answer of this notebook counts
 
     def reply(self, message):
         data = protocol.dumps(message)
@@ -336,6 +342,8 @@ class Supervisor:
 
     def forward(self, request):
         op = request.get("op")
+        if self.tampered:
+            return _error("Tampered", self._tamper_text())
         if op == "run":
             self.run_request = request
         problem = self._ensure_child(op)
@@ -372,6 +380,9 @@ class Supervisor:
                     ready = select.select([answers.fd, verdicts.fd], [], [], remaining)[0]
                     if verdicts.fd in ready:
                         verdicts.pump()
+                        if self._read_verdicts():
+                            self.stop("the grader's watch reported tampering")
+                            return _error("Tampered", self._tamper_text())
                     if answers.fd in ready:
                         break
                 line = answers.readline(until)
@@ -392,10 +403,30 @@ class Supervisor:
                 break
         return self._verified(answer, line + b"\n", rid, profile, passables)
 
+    def _tamper_text(self):
+        return (f"the notebook used {self.tampered}, so the grader cannot vouch for its answers (threads, "
+                "processes, ctypes, profilers, debuggers and the garbage collector's lists are not allowed while "
+                "a notebook is graded)")
+
+    def _read_verdicts(self):
+        """File what the watch wrote: tampering (sticky, True when there is some) and attestations."""
+        pending = self.child.setdefault("attestations", [])
+        for line in self.child["verdicts"].available():
+            text = line.decode("utf-8", "replace")
+            if text.startswith("TAMPER\t"):
+                self.tampered = self.tampered or text.split("\t", 1)[1][:200]
+            else:
+                pending.append(text)
+        return bool(self.tampered)
+
     def _verified(self, answer, payload, rid, profile, passables):
         expected = guard.attestation_text(rid, profile, passables, None, hashlib.sha256(payload).hexdigest())
-        for line in self.child["verdicts"].available():
-            parts = line.decode("utf-8", "replace").split("\t")
+        if self._read_verdicts():
+            self.stop("the grader's watch reported tampering")
+            return _error("Tampered", self._tamper_text())
+        pending, self.child["attestations"] = self.child["attestations"], []
+        for text in pending:
+            parts = text.split("\t")
             if len(parts) != 6:
                 continue
             *fields, signature = parts
@@ -410,11 +441,8 @@ class Supervisor:
             if what == "refused":
                 return _error("RefusedReference", f"called {detail}, which is switched off while this part is graded",
                               detail)
-            tampered = (f"the notebook used {detail}, so the grader cannot vouch for its answers (threads, "
-                        "processes, profilers, debuggers and the garbage collector's lists are not allowed)")
-            if "errors" in answer:  # the cells ran: keep what they said, with the reason nothing counts
-                return {**answer, "tampered": tampered}
-            return _error("Tampered", tampered)
+            self.tampered = self.tampered or detail
+            return _error("Tampered", self._tamper_text())
         return _error("Tampered", "the answer came without the grader's watch (it was switched off, or the "
                                   "answer was forged)")
 

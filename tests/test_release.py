@@ -1,0 +1,92 @@
+"""The student release gives no answer away: no stated order, no worked derivation, no remark to copy.
+
+Whatever the lab asks a student to find or explain stays in the instructor notebooks, inside
+solution regions: code the student writes, and answers in words (markdown solution cells, which
+the release turns into ``YOUR ANSWER HERE`` and nbgrader's metadata marks for manual grading).
+"""
+import re
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from labkit.checks.exercises import ANSWERS, EXERCISES
+from labkit.grading.release import strip_solutions
+from labkit.grading.nbgrader import answer_ids, mark
+from labkit.grading.release import BEGIN_SOLUTION, END_SOLUTION
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+STUDENT = ROOT / "labkit" / "student_notebooks"
+
+STATED_ORDER = re.compile(r"\b(first|second|third|fourth|fifth|[1-5](st|nd|rd|th))[- ]order\b"
+                          r"|\border\s+(of\s+(convergence\s+)?)?(is\s+)?\d|Estimated order|\.order\b"
+                          r"|\brate_\w+\s*=\s*\d|\bfourfold\b|\bsixteenfold\b", re.IGNORECASE)
+
+
+def _student(path):
+    return nbformat.read(STUDENT / path.name, as_version=4)
+
+
+def _solution_lines(source):
+    lines, inside = [], False
+    for line in source.split("\n"):
+        if line.strip() == BEGIN_SOLUTION:
+            inside = True
+        elif line.strip() == END_SOLUTION:
+            inside = False
+        elif inside:
+            lines.append(line.strip())
+    return lines
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
+def test_the_release_states_no_order_and_no_rate(path):
+    for index, cell in enumerate(_student(path).cells):
+        found = STATED_ORDER.search(cell.source)
+        assert found is None, f"{path.name}, cell {index}: {found.group(0)!r} in\n{cell.source}"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
+def test_no_worked_answer_is_left_in_the_release(path):
+    teacher = nbformat.read(path, as_version=4)
+    given = {line.strip() for cell in teacher.cells
+             for line in strip_solutions(cell.source).split("\n")}  # what the student is meant to see
+    student_text = "\n".join(cell.source for cell in _student(path).cells)
+    for cell in teacher.cells:
+        for line in _solution_lines(cell.source):
+            if len(line) >= 25 and line not in given:
+                assert line not in student_text, f"{path.name}: a solution line is in the release: {line!r}"
+
+
+def test_the_worked_answers_the_review_found_are_gone():
+    text = {path.stem: "\n".join(c.source for c in _student(path).cells) for path in NOTEBOOKS}
+    meshes = text["03_meshes"]
+    assert "B - A$ on AB" not in meshes and "(\\pi/4, -\\pi/4)" not in meshes  # Exercise 7's rule, 8(b)'s values
+    assert "t$-derivative as" not in meshes and "with s and t swapped" not in meshes  # Exercise 9's mirror rule
+    assert "[0.5, -0.5]" not in meshes  # 9(d)'s corner data
+    assert "natural_curvatures" not in text["04_splines"]  # 12(e) prints the student's own M
+    assert "rows of the identity" not in text["04_splines"]  # 12(b)'s answer
+    assert "The table is the identity" not in text["06_bilinear"]  # 16(a)'s explanation
+    assert "`nintervals`" in text["01_limacon"].split("## Exercise 4")[0]  # Exercise 1 names what it defines
+
+
+def test_every_answer_in_words_is_a_stub_marked_for_manual_grading_and_listed_in_the_registry():
+    found = []
+    for path in NOTEBOOKS:
+        teacher = mark(nbformat.read(path, as_version=4), path.name)
+        student = _student(path)
+        ids = answer_ids(teacher)
+        found += ids
+        answers = [(t, s) for t, s in zip(teacher.cells, student.cells)
+                   if t.cell_type == "markdown" and BEGIN_SOLUTION in t.source]
+        assert len(answers) == len(ids)
+        for (t, s), grade_id in zip(answers, ids):
+            assert s.source == "YOUR ANSWER HERE"
+            meta = t.metadata["nbgrader"]
+            assert meta["grade_id"] == grade_id and meta["solution"] and meta["grade"] and meta["points"] == 0
+            assert not meta["locked"]
+    # the registry declares each answer with its exercise, in the notebooks' order
+    assert found == list(ANSWERS)
+    for grade_id, (number, what) in ANSWERS.items():
+        assert grade_id.startswith(f"exercise{number}-answer-") and what in EXERCISES[number].answers
