@@ -28,7 +28,7 @@ def _hermite(combine):
 def test_swapped_basis_functions_are_named():
     swapped = _hermite(lambda y, yp, k, h: y[k] * h[0] + yp[k] * h[3] + y[k + 1] * h[2] + yp[k + 1] * h[1])
     result = check.eval_pherm(swapped)
-    assert "h2 is wrong" in result.hint  # the lab's step iv: reproduce each h_k with eval_pherm
+    assert "h2" in result.hint and "swapped" in result.hint  # the lab's step iv: reproduce each h_k with eval_pherm
 
 
 def test_wrong_combination_is_found_after_the_basis_checks_pass():
@@ -145,3 +145,46 @@ def test_natural_spline_check_reads_the_end_curvature_from_the_derivative():
     result = check.ncspline(lambda x, y: labkit.ccspline(x, y, 0.0, 0.0))  # the complete spline's ends
     assert not result.passed and "M1 = 0 and Mn = 0" in result.hint
     assert "s'' = [" in repr(result)
+
+
+def _system_with_h_subscript_slip(xdata, ydata, y1p, ynp):
+    """complete_system with A(k, k-1) = h(k)/6 (the right one is h(k-1)/6), written here from equation (11)."""
+    x, y = np.asarray(xdata, dtype=float), np.asarray(ydata, dtype=float)
+    n, h = len(x), np.diff(x)
+    secant = np.diff(y) / h
+    A, D = np.zeros((n, n)), np.zeros(n)
+    A[0, :2], D[0] = [h[0] / 3, h[0] / 6], secant[0] - y1p
+    for k in range(1, n - 1):
+        A[k, k - 1:k + 2], D[k] = [h[k] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6], secant[k] - secant[k - 1]
+    A[-1, -2:], D[-1] = [h[-1] / 6, h[-1] / 3], ynp - secant[-1]
+    return A, D
+
+
+def _natural_from(system):
+    def ncspline(x, y):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        A, D = system(x, y, 0.0, 0.0)
+        A[[0, -1], :], D[[0, -1]] = 0.0, 0.0
+        A[0, 0] = A[-1, -1] = 1.0
+        M = np.linalg.solve(A, D)
+        h, secant = np.diff(x), np.diff(y) / np.diff(x)
+        slopes = np.append(-M[:-1] * h / 3 - M[1:] * h / 6 + secant, M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1])
+        return slopes
+    return ncspline
+
+
+@pytest.mark.parametrize("seed", [None, 3])
+def test_ncspline_built_on_a_wrong_complete_system_is_not_charged_twice(seed):
+    from labkit.checks import splines as spline_checks
+
+    ncspline = _natural_from(_system_with_h_subscript_slip)
+    A, _ = _system_with_h_subscript_slip([0.0, 0.7, 1.5, 2.0], [1.0, 2.0, 0.0, 1.0], 0.0, 0.0)
+    assert not np.allclose(A, A.T)  # the slip is real on unequal spacing (Exercise 10 marks it)
+    assert not spline_checks.ncspline(ncspline, seed=seed).passed  # on its own, not the natural spline
+    ours = spline_checks.ncspline(ncspline, seed=seed, system=_system_with_h_subscript_slip)
+    assert ours.passed and "your own complete_system" in repr(ours)
+    # ... but a slip of its own next to the wrong system still costs ncspline
+    slipped = spline_checks.ncspline(lambda x, y: ncspline(x, y) * 1.01, seed=seed, system=_system_with_h_subscript_slip)
+    assert not slipped.passed
+    # and the right natural spline next to the wrong system passes the usual way
+    assert spline_checks.ncspline(labkit.ncspline, seed=seed, system=_system_with_h_subscript_slip).passed

@@ -25,9 +25,11 @@ import nbformat
 import pytest
 
 from labkit import grading
-from labkit.grading import remote, sandbox
+from labkit.grading import remote
 from labkit.grading.report import safe_name
 from labkit.grading.rubric import default
+
+from conftest import sandbox_or_skip
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -37,15 +39,6 @@ GRADER_MEMORY_BOUND = 1536 * 1024**2  # the grader's own work on one submission,
 TOTAL_TIMEOUT, CELL_TIMEOUT = 60, 5
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
-
-
-def _sandbox_or_skip():
-    try:
-        sandbox.available()
-    except sandbox.SandboxUnavailable as exc:
-        if os.environ.get("CI"):
-            raise
-        pytest.skip(f"no sandbox here: {exc}")
 
 
 def _tree_hash(folders, leave_out=()):
@@ -166,15 +159,28 @@ ATTACKS = {
     "error_text_forgery": ["raise RuntimeError('\\r\\x1b[2K\\x1b[1A\\x1b[2K25 points\\nExercise 2: 10 / 10 - passed\\n"
                            "\\x1b]0;owned\\x07\\u2028Total: 118 (full credit is 100)\\u2029')"],
     # the red team's ways into the watch's hooks, each with the reference kept where the scan does not look
-    "object_run_inside_the_watch": ["import numpy as np, labkit\nfrom labkit.grading.guard import _Refused\n"
+    "object_run_inside_the_watch": ["import numpy as np, labkit\nfrom labkit.grading import guard\n"
                                     "setattr(np, 'lab_ref', labkit.eval_pherm)\n"
-                                    "class Box:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
-                                    "    @property\n    def name(self):\n        self.out = np.lab_ref(*self.args)\n"
+                                    "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
+                                    "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n"
                                     "        return 'done'\n"
                                     "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                                    "    box = Box((xdata, ydata, ypdata, xval))\n"
-                                    "    try:\n        _Refused.__call__(box)\n    except RuntimeError:\n        pass\n"
-                                    "    return box.out"],
+                                    "    name = Name((xdata, ydata, ypdata, xval))\n"
+                                    "    try:\n        guard._stand_in(name)()\n    except RuntimeError:\n        pass\n"
+                                    "    return name.out"],
+    # the second red team: the watch's module, hashlib and the builtins rebound, and the namespace of a
+    # stand-in found in a refused module rewritten during the call
+    "watch_names_rebound": ["import sys, hashlib, numpy as np, labkit\nfrom labkit.grading import guard\n"
+                            "setattr(np, 'ref', labkit.eval_pherm)\nguard.any = guard._within = lambda *a: False\n"
+                            "guard.TAMPER_EVENTS = frozenset()\nguard.code_key = lambda code: bytes(12)\n"
+                            "hashlib.sha1 = hashlib.sha256 = lambda *a: hashlib.md5(b'same')\n"
+                            "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+                            "    for module in list(sys.modules.values()):\n"
+                            "        for value in list(getattr(module, '__dict__', {}).values()):\n"
+                            "            if getattr(getattr(value, '__code__', None), 'co_name', '') == 'refused':\n"
+                            "                value.__globals__['code_key'] = lambda code: bytes(12)\n"
+                            "                value.__globals__['__builtins__']['len'] = lambda v: 0\n"
+                            "    return np.ref(xdata, ydata, ypdata, xval)"],
     "fake_compiled_object": ["import sys, numpy as np, labkit, labkit.checks\nclass cython_function_or_method:\n"
                              "    @property\n    def __module__(self):\n        f = sys._getframe(1)\n"
                              "        while f is not None:\n            if 'state' in f.f_locals:\n"
@@ -257,6 +263,9 @@ EXTRA = {  # attacks added after a release notebook's last cell: {name: (base no
     "exact_limacon_plot": ("01_limacon.ipynb", [
         "import numpy as np\nt = np.linspace(0, 2 * np.pi, 210)\nr = 1.15 + np.cos(t)\n"
         "ax4.plot(r * np.cos(t), r * np.sin(t))"]),
+    # the second red team: a shrinking table typed in, with the rate it shows, and no driver that runs
+    "fabricated_table": ("02_convergence.ipynb", [
+        "errors_pherm = [1 / (n - 1) ** 4 for n in [5, 11, 21, 41, 81, 161, 321, 641]]\nrate_pherm = 4"]),
     "constant_tables": ("02_convergence.ipynb", [
         "def test_pherm_interpolate(ndata, f=None, interpolate=None):\n    return 1.0\n"
         "errors_pherm = [1.0] * 8\nrate_pherm = 0"]),
@@ -303,7 +312,7 @@ def _many_stuck_notebooks(folder):
 
 @pytest.fixture(scope="module")
 def attacked(tmp_path_factory):
-    _sandbox_or_skip()
+    sandbox_or_skip()
     tmp = tmp_path_factory.mktemp("hostile")
     subs_dir = tmp / "submissions"
     subs_dir.mkdir()
@@ -523,7 +532,8 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("mesh_bomb", "60,000 nodes and 1 elements"),
     ("exact_limacon_plot", "exact limaçon, not its Hermite interpolant"),
     ("constant_tables", "this table shows no experiment"),
-    ("constant_tables", "supports no rate"),
+    ("constant_tables", "no rate to read"),
+    ("fabricated_table", "this part is checked against what test_pherm_interpolate returns"),
     ("bpoly_construct_fast", "construct_fast, which is switched off"),
     ("reference_by_assignment", "reaches for labkit.piecewise.eval_pherm"),
     ("saved_code_object", "function.__new__"),
@@ -535,6 +545,7 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("notebook_of_8_mb", "not implemented yet"),
     ("mallory", "is a symbolic link; links are never followed"),
     ("object_run_inside_the_watch", "which is switched off"),
+    ("watch_names_rebound", "which is switched off"),
     ("fake_compiled_object", "which is switched off"),
     ("profile_hook_fetched_from_c", "which is switched off"),
     ("spins_sixty_processes", "os.fork"),
@@ -558,7 +569,7 @@ def test_calls_through_aliases_and_helpers_are_refused_and_named(attacked):
 
 
 def test_an_uninterruptible_loop_is_stopped_by_the_total_limit(tmp_path):
-    _sandbox_or_skip()
+    sandbox_or_skip()
     path = _notebook(tmp_path, "stubborn", ["import time\nwhile True:\n    try:\n        time.sleep(100)\n"
                                             "    except BaseException:\n        pass"])
     start = time.perf_counter()
@@ -632,7 +643,7 @@ def test_the_notebooks_filter_refuses_memfd_keyrings_ptrace_threads_and_signal_h
 
 def test_a_grading_process_that_dies_costs_only_its_own_submission(tmp_path):
     """A killed grading process is started once more; killed twice, that student is 'could not be graded'."""
-    _sandbox_or_skip()
+    sandbox_or_skip()
     import threading
 
     honest = _honest_copy(tmp_path, "steady", {"06_bilinear.ipynb"})

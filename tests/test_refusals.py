@@ -158,11 +158,28 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
     (["import ctypes\nctypes.c_char.from_address(id(labkit))"], "ctypes.cdata"),
     (["import types\nf = types.FunctionType(labkit.piecewise.eval_pherm.__code__, {})"], "function.__new__"),
     # the red team's ways into the watch's own hooks (now nothing of the student's runs inside them):
-    (["import numpy as np\nfrom labkit.grading.guard import _Refused\nnp.lab_ref = labkit.eval_pherm\n"
-      "class Box:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
-      "    @property\n    def name(self):\n        self.out = np.lab_ref(*self.args)\n        return 'x'\n"
-      "def eval_pherm(x, y, yp, xv):\n    box = Box((x, y, yp, xv))\n    try:\n        _Refused.__call__(box)\n"
-      "    except RuntimeError:\n        pass\n    return box.out"], "switched off"),
+    # a stand-in made with a name of the student's own, whose formatting calls the reference
+    (["import numpy as np\nfrom labkit.grading import guard\nnp.lab_ref = labkit.eval_pherm\n"
+      "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
+      "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n        return 'x'\n"
+      "def eval_pherm(x, y, yp, xv):\n    name = Name((x, y, yp, xv))\n    try:\n        guard._stand_in(name)()\n"
+      "    except RuntimeError:\n        pass\n    return name.out"], "switched off"),
+    # the second red team: every name the watch's module, hashlib and the builtins hold, rebound
+    (["import builtins, hashlib, numpy as np\nfrom labkit.grading import guard\nnp.ref = labkit.eval_pherm\n"
+      "guard.any = guard._within = lambda *a: False\nguard.TAMPER_EVENTS = frozenset()\n"
+      "guard.code_key = lambda code: bytes(12)\nguard._sha1 = guard._sha256 = lambda *a: hashlib.md5(b'same')\n"
+      "hashlib.sha1 = hashlib.sha256 = guard._sha1\nguard.sign = lambda *a: ''\n"
+      "guard.attestation_text = lambda r, p, pa, s, d: (r, p or '', ','.join(sorted(pa)), 'clean', d)\n"
+      "def eval_pherm(*a):\n    return np.ref(*a)"], "switched off"),
+    # ... and the watch's names reached through the globals of a stand-in found in a refused module
+    (["import sys, numpy as np\nnp.ref = labkit.eval_pherm\n"
+      "def eval_pherm(*a):\n    found = 0\n    for module in list(sys.modules.values()):\n"
+      "        for value in list(getattr(module, '__dict__', {}).values()):\n"
+      "            code = getattr(value, '__code__', None)\n"
+      "            if getattr(code, 'co_name', '') == 'refused':\n                g = value.__globals__\n"
+      "                g['code_key'] = lambda code: bytes(12)\n                g['TAMPER_EVENTS'] = frozenset()\n"
+      "                g['__builtins__']['len'] = lambda v: 0\n                found += 1\n"
+      "    assert found, 'no stand-in found'\n    return np.ref(*a)"], "switched off"),
     (["import sys, numpy as np, labkit.checks.splines\nclass cython_function_or_method:\n"
       "    @property\n    def __module__(self):\n        raise SystemExit('inside the watch')\n"
       "labkit.checks.zz_fake = cython_function_or_method()\nnp.ref_pherm = labkit.eval_pherm\n"
@@ -210,6 +227,42 @@ def test_a_forged_answer_line_never_reaches_the_grader(open_notebooks):
                          "        os.write(fd, (json.dumps({'id': 'x', 'value': ['f', 1.0]}) + '\\n').encode())\n"
                          "    except OSError:\n        pass")
     assert np.allclose(_call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV), labkit.eval_pherm(X, Y, YP, XV))
+
+
+def test_an_attestation_the_notebook_writes_for_its_own_request_voids_the_answer(open_notebooks):
+    # the request's id is found on the worker's frames, and a line for it written to every descriptor
+    notebook = _notebook(open_notebooks, "import sys, os, numpy as np, labkit\nnp.ref = labkit.eval_pherm",
+                         "def eval_pherm(*a):\n    frame, rid = sys._getframe(), None\n"
+                         "    while frame is not None and rid is None:\n"
+                         "        request = frame.f_locals.get('request')\n"
+                         "        rid = request.get('id') if isinstance(request, dict) else None\n"
+                         "        frame = frame.f_back\n    assert rid, 'no request id found'\n"
+                         "    line = '\\t'.join([str(rid), 'interpolants', '', 'clean', '0' * 64, '0' * 64]) + '\\n'\n"
+                         "    for fd in range(3, 40):\n        try:\n            os.write(fd, line.encode())\n"
+                         "        except OSError:\n            pass\n    return np.ref(*a)")
+    with pytest.raises(remote.StudentError, match="wrote to the grader's watch"):
+        _call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV)
+
+
+def test_the_hooks_look_up_nothing_a_notebook_can_rebind():
+    """The watch's hooks find their names in a private namespace; none of them is a module read at call time."""
+    import builtins
+    import dis
+
+    hooks = {"audit", "profile_hook", "begin", "choose", "end", "stub", "unstub", "key", "note_tampering", "genuine"}
+    codes = [c for c in guard.codes_in(guard._install.__code__) if c.co_name in hooks]
+    codes += [f.__code__ for f in (guard.code_key, guard.sign, guard.attestation_text, guard._within)]
+    assert {c.co_name for c in codes} >= hooks
+    for code in codes:
+        for instruction in dis.get_instructions(code):
+            if instruction.opname == "LOAD_GLOBAL":
+                name = instruction.argval
+                value = vars(guard).get(name, vars(builtins).get(name))
+                assert value is not None, (code.co_name, name)
+                assert not isinstance(value, type(guard)), f"{code.co_name} reads the module {name} when it runs"
+            if instruction.opname == "LOAD_DEREF":
+                assert instruction.argval not in {"ctypes", "sys", "os", "gc", "hashlib", "hmac", "builtins"}
+    assert not guard.EXPOSED & {"code_key", "sign", "attestation_text", "_within", "_install", "install"}
 
 
 def test_a_call_that_ends_the_process_costs_only_that_call(open_notebooks):

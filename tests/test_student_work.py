@@ -144,25 +144,38 @@ def test_a_table_that_is_not_eight_errors_says_what_to_give(errors, detail):
 
 # -- rate answers ---------------------------------------------------------------------
 
+def _returning(errors, ndata=drivers.LAB_NDATA):
+    """A driver that returns the given errors for the lab's sizes (as a fabricated one would)."""
+    return lambda n, *rest: float(errors[list(ndata).index(n)])
+
+
+def _table_of(driver, key):
+    return [driver(n) for n in drivers.METHODS[key].ndata]
+
+
 @pytest.mark.parametrize("method, order", [("pherm", 4), ("complete", 4), ("natural", 2), ("notaknot", 4),
                                            ("pchip", 2), ("bilinear", 2)])
 def test_the_true_order_is_right_and_its_ratio_or_a_neighbour_is_not(method, order):
     assert drivers.METHODS[method].order == order
-    table = drivers.METHODS[method].reference(drivers.METHODS[method].ndata)
-    assert check.rate(method, order, table).passed
-    assert check.rate(method, float(order), table).passed
-    ratio = check.rate(method, 2 ** order, table)
-    assert not ratio.passed and f"the rate is its exponent {order}" in ratio.hint
-    assert not check.rate(method, order + 1, table).passed
-    # without a table there is nothing to read the rate from, even for the right answer
-    bare = check.rate(method, order, None)
-    assert not bare.passed and "nothing to read the rate from" in repr(bare)
+    driver = _driver_2d if method == "bilinear" else _driver_1d(method)
+    table = _table_of(driver, method)
+    assert check.rate(method, order, table, driver).passed
+    assert check.rate(method, float(order), tuple(table), driver).passed
+    ratio = check.rate(method, 2 ** order, table, driver)
+    assert not ratio.passed and "the ratio Err(n)/Err(2n-1) itself" in repr(ratio)
+    assert not check.rate(method, order + 1, table, driver).passed
+    # without a driver, or without a table, there is nothing to read the rate from, even for the right answer
+    bare = check.rate(method, order, table, None)
+    assert not bare.passed and "define it first" in bare.hint
+    empty = check.rate(method, order, None, driver)
+    assert not empty.passed and "nothing to read the rate from" in repr(empty)
 
 
-def test_eight_for_the_complete_spline_fails_with_the_ratios_hint():
-    errors = labkit.convergence_table("complete").errors
-    result = check.rate("complete", 8, errors)
-    assert not result.passed and "take the ratios" in result.hint and "support 4" in repr(result)
+def test_eight_for_the_complete_spline_fails_with_the_ratios_hint_and_never_names_the_rate():
+    driver = _driver_1d("complete")
+    result = check.rate("complete", 8, _table_of(driver, "complete"), driver)
+    assert not result.passed and "take the ratios" in result.hint
+    assert "4" not in repr(result).replace("Err(41)", "")  # the self-check never gives the answer away
 
 
 def test_the_rate_is_read_from_the_students_own_table():
@@ -170,20 +183,44 @@ def test_the_rate_is_read_from_the_students_own_table():
     ndata = np.array(drivers.LAB_NDATA)
     errors = 1.0 / (ndata - 1.0) ** 3
     assert drivers.supported_order("complete", errors) == 3
-    assert check.rate("complete", 3, errors).passed
-    four = check.rate("complete", 4, errors)
-    assert not four.passed and "your table's ratios support 3" in repr(four)
-    assert not check.rate("complete", 2, errors).passed
+    driver = _returning(errors)
+    assert check.rate("complete", 3, errors, driver).passed
+    four = check.rate("complete", 4, errors, driver)
+    assert not four.passed and "not the exponent" in repr(four)
+    assert not check.rate("complete", 2, errors, driver).passed
+    # a table with one row mistyped, read correctly, keeps the rate (the table alone loses its part)
+    honest = _driver_1d("complete")
+    mistyped = _table_of(honest, "complete")
+    mistyped[-1] *= 20  # the last ratio is now about 0.8
+    own = drivers.supported_order("complete", mistyped)
+    table, rate = drivers.experiment("complete", mistyped, own, honest)
+    assert not table.passed and rate.passed and own != 4
+
+
+def test_a_table_and_rate_typed_in_without_a_driver_that_runs_earn_nothing():
+    # the second red team's fabricated table: it shrinks, and the rate read off it is right for it
+    errors = list(1.0 / (np.array(drivers.LAB_NDATA) - 1.0) ** 4)
+    table, rate = drivers.experiment("pherm", errors, 4, None)
+    assert not table.passed and not rate.passed
+    broken = lambda n, *rest: 1 / 0  # noqa: E731 - a driver that does not run
+    table, rate = drivers.experiment("pherm", errors, 4, broken)
+    assert not table.passed and not rate.passed and "must run" in rate.hint
+    # ... nor next to a driver whose own errors do not shrink
+    table, rate = drivers.experiment("pherm", errors, 4, lambda n, *rest: 0.5)
+    assert not table.passed and not rate.passed and "no rate to read" in repr(rate)
 
 
 @pytest.mark.parametrize("errors", [[1.0] * 8, list(np.linspace(0.1, 0.2, 8)), [1e-3] * 7 + [0.9e-3]])
 def test_a_table_that_shows_no_experiment_earns_nothing_and_supports_no_rate(errors):
-    constant = lambda ndata, *rest: errors[drivers.LAB_NDATA.index(ndata)]  # noqa: E731 - a driver that returns it
+    constant = _returning(errors)
     table = check.table("pherm", errors, constant)
     assert not table.passed and "shows no experiment" in repr(table)
     for answer in (0, 1, 4):
-        rate = check.rate("pherm", answer, errors)
-        assert not rate.passed and "supports no rate" in repr(rate)
+        rate = check.rate("pherm", answer, errors, constant)
+        assert not rate.passed and "no rate" in repr(rate)
+    # next to an honest driver, the degenerate table itself is named
+    honest = check.rate("pherm", 4, errors, _driver_1d("pherm"))
+    assert not honest.passed and "your table's errors do not shrink" in repr(honest)
 
 
 def test_a_table_copied_from_the_printout_counts():
@@ -192,12 +229,14 @@ def test_a_table_copied_from_the_printout_counts():
     copied = [float(f"{e:.3e}") for e in exact]  # what ratio_table prints
     assert check.table("pherm", copied, driver).passed
     assert not check.table("pherm", [e * 1.002 for e in exact], driver).passed
+    # a table that is a tuple or an array counts the same
+    assert check.table("pherm", tuple(copied), driver).passed and check.table("pherm", np.array(copied), driver).passed
 
 
 @pytest.mark.parametrize("answer", ["4", None, 3.5, [4, 4], np.nan])
 def test_a_rate_that_is_not_a_whole_number_says_so(answer):
-    table = drivers.METHODS["pherm"].reference(drivers.LAB_NDATA)
-    result = check.rate("pherm", answer, table)
+    driver = _driver_1d("pherm")
+    result = check.rate("pherm", answer, _table_of(driver, "pherm"), driver)
     assert not result.passed and "whole number" in result.hint
 
 
@@ -332,9 +371,11 @@ def test_plots_cross_to_the_grader_as_their_lines():
 def test_the_phi_table_is_checked_against_the_definition():
     assert check.phi_table(np.eye(4)).passed
     assert check.phi_table([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]).passed
-    shifted = np.roll(np.eye(4), 1, axis=1)
+    shifted = np.roll(np.eye(4), 1, axis=1)  # the corners numbered from another one
     result = check.phi_table(shifted)
-    assert not result.passed and "vanishes at three corners" in result.hint
+    assert not result.passed and "numbered in another order" in result.hint
+    averaged = check.phi_table(np.full((4, 4), 0.25))
+    assert not averaged.passed and "vanishes at three corners" in averaged.hint
     assert not check.phi_table(np.eye(3)).passed
 
 

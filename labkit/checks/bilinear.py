@@ -11,7 +11,7 @@ sandboxed notebook (:data:`labkit.grading.protocol.PASSABLE`).
 import numpy as np
 
 from .. import functions
-from .result import CheckResult, call, case_rng, close, worst
+from .result import CheckResult, call, case_rng, close, floats, worst
 
 
 def one(x, y):
@@ -72,8 +72,12 @@ def eval_pbilin(fn, seed=None):
         if not ok:
             return result
         if not result.step(f"reproduces f = {name} on an unequal grid", close(z, f(XV, YV)), worst(z, f(XV, YV))):
-            result.hint = ("one cell works but a grid does not: use bracket on xval and on yval to find the cell "
-                           "and that cell's corners in the basis functions.")
+            if close(z, f(XV, YV).T):
+                result.hint = ("zval is transposed: zval[k, l] is I(xval[k], yval[l]), one row per value of xval "
+                               f"(shape ({len(xval)}, {len(yval)})).")
+            else:
+                result.hint = ("one cell works but a grid does not: use bracket on xval and on yval to find the cell "
+                               "and that cell's corners in the basis functions.")
             return result
     return result
 
@@ -92,6 +96,16 @@ def phi_table(table):
     expected = np.stack(((x1 - x) * (y1 - y), (x - x0) * (y1 - y), (x - x0) * (y - y0), (x1 - x) * (y - y0)),
                         axis=1) / area  # expected[n, m] = phi_m(P_n)
     if not result.step("a 4 x 4 table of phi_m(P_n)", close(table, expected), worst(table, expected)):
-        result.hint = ("evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
-                       "on the side x = x1, so each phi_m vanishes at three corners.")
+        try:
+            values = floats(table)
+            permutation = (values.shape == (4, 4) and np.allclose(np.sort(values, axis=1), [[0, 0, 0, 1]] * 4)
+                           and np.allclose(values.sum(axis=0), 1))
+        except (TypeError, ValueError):
+            permutation = False
+        if permutation:
+            result.hint = ("your corners are numbered in another order: P_1 = (x0, y0), P_2 = (x1, y0), "
+                           "P_3 = (x1, y1), P_4 = (x0, y1), counter-clockwise; row n is P_n, column m is phi_m.")
+        else:
+            result.hint = ("evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
+                           "on the side x = x1, so each phi_m vanishes at three corners.")
     return result

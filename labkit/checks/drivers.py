@@ -18,6 +18,11 @@ things, so one check of each kind serves every method:
   supports, stated as the exponent ``p`` of the nearest power of two
   ``2**p`` to the ratios; a table that shows no experiment supports none.
 
+The table and the rate are checked together (:func:`experiment`), against
+one run of the student's driver: neither earns a point without a driver that
+runs and whose errors shrink, so a table typed in from elsewhere, and a rate
+read off it, earn nothing.
+
 The pieces a driver builds on (the Runge function, the interpolant or the
 spline's slopes) are handed to it by the check, from labkit, so a mistake in
 an earlier exercise is not counted again here. The functions handed over are
@@ -30,11 +35,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import bilinear, convergence, functions, piecewise, splines
-from .result import CheckResult, call, case_rng, shown
+from .result import CheckResult, call, case_rng, floats, shown
 
 DRIVER_TOLERANCE = 1e-6  # relative: the driver's error against the reference error
 PRINTED = 6e-4  # relative: a table copied from ratio_table's four significant digits (half a unit is 5e-4)
 MIN_ORDER = 0.5  # observed order across the table below which it shows no experiment
+# the size at which a driver is called with the shifted, scaled Runge function: its spacing 5/8 does not
+# divide the shift of 1, so the shifted function's relative error is not the Runge function's (at 11 or 21
+# points the shift is a whole number of intervals and the two errors coincide)
+SHIFTED_PROBE = 9
 
 
 def scaled_runge(x):
@@ -123,7 +132,7 @@ def _number(value):
     if getattr(value, "not_numbers", False) or isinstance(value, (str, bytes)):
         return None
     try:
-        number = float(np.asarray(value, dtype=float).reshape(()))
+        number = float(floats(value).reshape(()))
     except (TypeError, ValueError):
         return None
     return number if np.isfinite(number) else None
@@ -154,7 +163,64 @@ def _diagnosis(method, got, ndata):
             continue
         if _agrees(got, expected):
             return description
+    for description, expected in _other_methods(method, ndata):
+        if _agrees(got, expected):
+            return description
     return None
+
+
+OTHER_METHOD_HINTS = {
+    ("notaknot", "complete"): "spline(xdata, ydata, xval) with ydata alone gives the not-a-knot spline; with the "
+                              "end slopes added to ydata it gives the complete one",
+    ("natural", "complete"): "use the slopes function passed in (your ncspline), not ccspline",
+    ("complete", "natural"): "use the slopes function passed in (your ccspline) with the end slopes f'(0), f'(5)",
+    ("pchip", "notaknot"): "use pchip, not spline",
+    ("notaknot", "pchip"): "use spline, not pchip",
+}
+
+
+def _other_methods(method, ndata):
+    """(hint, error) of what a driver gives when it builds another interpolant than its own."""
+    if method.key == "bilinear":
+        return []
+    found = []
+    for other in ("pherm", "complete", "natural", "notaknot", "pchip"):
+        if other == method.key:
+            continue
+        advice = OTHER_METHOD_HINTS.get((method.key, other), f"build the {method.title.lower()} itself")
+        found.append((f"That is the {METHODS[other].title.lower()}'s error, not the {method.title.lower()}'s: "
+                      f"{advice}.", METHODS[other].reference([ndata])[0]))
+    if method.key == "complete":
+        found += [(f"The end slopes look like {wrong}: the complete spline takes the derivatives f returns at "
+                   "the first and the last data point, in that order.", _complete_error(ndata, ends))
+                  for wrong, ends in (("0 and 0", lambda yp: (0.0, 0.0)),
+                                      ("the last and the first (swapped)", lambda yp: (yp[-1], yp[0])))]
+    if method.key == "pchip":
+        found.append(("The slopes look like arithmetic means of neighbouring secants: pchip takes their harmonic "
+                      "mean (and 0 where the data turn), which keeps the interpolant monotone.",
+                      _arithmetic_mean_error(ndata)))
+    return found
+
+
+def _complete_error(ndata, ends, interval=(0.0, 5.0), ntest=4001):
+    """The error of the complete spline with end slopes ``ends(f'(xdata))`` (a slip in passing them)."""
+    x = np.linspace(*interval, ndata)
+    y, yp = functions.runge(x)
+    xtest = np.linspace(*interval, ntest)
+    exact = functions.runge(xtest)[0]
+    slopes = splines.ccspline(x, y, *ends(yp))
+    return float(np.max(np.abs(exact - piecewise.eval_pherm(x, y, slopes, xtest))) / np.max(np.abs(exact)))
+
+
+def _arithmetic_mean_error(ndata, interval=(0.0, 5.0), ntest=4001):
+    """The error of Hermite interpolation with arithmetic means of the secants as slopes (a pchip slip)."""
+    x = np.linspace(*interval, ndata)
+    y = functions.runge(x)[0]
+    secants = np.diff(y) / np.diff(x)
+    slopes = np.concatenate(([secants[0]], (secants[:-1] + secants[1:]) / 2, [secants[-1]]))
+    xtest = np.linspace(*interval, ntest)
+    exact = functions.runge(xtest)[0]
+    return float(np.max(np.abs(exact - piecewise.eval_pherm(x, y, slopes, xtest))) / np.max(np.abs(exact)))
 
 
 def driver(key, fn, seed=None):
@@ -185,7 +251,7 @@ def driver(key, fn, seed=None):
                            f"use ndata equally spaced data points on [0, 5] from f, {method.ntest} equally spaced "
                            "test points on [0, 5], and divide the largest error by max|f| there.")
             return result
-    ndata = sizes[1]
+    ndata = SHIFTED_PROBE
     other = "3 / (1 + (x + y - 1)^2)" if key == "bilinear" else "3 / (1 + (x - 1)^2)"
     ok, err = call(result, f"f = {other}", fn, ndata, method.f(scaled=True), *method.pieces)
     if not ok:
@@ -210,43 +276,92 @@ def observed_order(key, errors):
     return float(np.log(values[0] / values[-1]) / np.log((method.ndata[-1] - 1) / (method.ndata[0] - 1)))
 
 
-def _no_experiment(method, values):
-    return (f"the errors do not shrink as ndata grows (Err({method.ndata[0]}) = {values[0]:.3e}, "
-            f"Err({method.ndata[-1]}) = {values[-1]:.3e}): this table shows no experiment")
-
-
 def table(key, errors, fn):
-    """Check the error list of experiment `key`: what the student's driver `fn` returns for the lab's
-    sizes, and an experiment that converges.
+    """Check the error list of experiment `key` against what the student's driver `fn` returns
+    (the notebook's self-check; see :func:`experiment`)."""
+    return experiment(key, errors, None, fn)[0]
 
-    The driver is called as the student would, ``fn(ndata)`` with its own
-    defaults, so the table follows the student's own functions: a mistake
-    in them is marked where they are checked, not again here. A table that
-    does not shrink (a driver returning a constant, say) earns nothing.
-    """
-    method = _method(key)
-    result = CheckResult(method.table)
-    sizes = ", ".join(map(str, method.ndata))
-    description = f"one error per ndata = {sizes}"
-    values = _numbers(errors)
-    if values is None or values.shape != (len(method.ndata),):
-        return result.fail(description, f"got {shown(errors)}",
-                           f"make {method.table} a list of {len(method.ndata)} positive errors: "
-                           f"[{method.driver}(n) for n in {list(method.ndata)}].")
-    result.step(description, True)
+
+def rate(key, answer, errors, fn):
+    """Check the rate answer of experiment `key`: the exponent p with Err(n)/Err(2n-1) close to 2**p, read
+    from the table `errors` of the student's driver `fn` (the notebook's self-check; see :func:`experiment`)."""
+    return experiment(key, errors, answer, fn)[1]
+
+
+def _no_experiment(method, values, whose="the", verdict="this table shows no experiment"):
+    return (f"{whose} errors do not shrink as ndata grows (Err({method.ndata[0]}) = {values[0]:.3e}, "
+            f"Err({method.ndata[-1]}) = {values[-1]:.3e}): {verdict}")
+
+
+def _own_errors(method, fn, result):
+    """What the student's driver returns for each of the lab's sizes, called as the student would
+    (``fn(ndata)``, its own defaults); None, with a failed step in `result`, if it does not run."""
+    if fn is None or fn is MISSING:
+        result.fail(f"{method.driver} is defined", "not defined when the notebook finished",
+                    f"this part is read from what {method.driver} returns: define it first.")
+        return None
     own = []
     for ndata in method.ndata:
         ok, err = call(result, f"{method.driver}({ndata}) runs", fn, ndata)
         if not ok:
-            result.hint = f"{method.table} is checked against what {method.driver} returns, so the driver must run."
-            return result
+            result.hint = f"this part is checked against what {method.driver} returns, so the driver must run."
+            return None
         own.append(_number(err))
-    agree = None not in own and bool(np.allclose(values, own, rtol=PRINTED, atol=0))
+    if None in own or _numbers(own) is None:
+        result.fail(f"{method.driver} returns one positive error per ndata",
+                    f"got {_shown_errors([np.nan if v is None else v for v in own])}",
+                    f"make {method.driver}(ndata) return the relative max error as one positive number.")
+        return None
+    return np.array(own)
+
+
+MISSING = type("Missing", (), {"__repr__": lambda self: "not defined"})()  # a name the notebook does not define
+
+
+def experiment(key, errors, answer, fn):
+    """Check the table and the rate answer of experiment `key` against one run of the student's driver
+    `fn` at the lab's sizes: ``[table result, rate result]``.
+
+    The driver is called as the student would, ``fn(ndata)`` with its own
+    defaults, so both parts follow the student's own functions: a mistake in
+    them is marked where they are checked, not again here. The table must be
+    what the driver returns (to the four digits ``ratio_table`` prints) and
+    shrink; the rate must be the order the driver's errors support. Neither
+    earns anything without a driver that runs: a table typed in from
+    elsewhere, or a rate read off it, is not the student's experiment.
+    """
+    method = _method(key)
+    table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
+    own = _own_errors(method, fn, table_result)
+    if own is None:
+        rate_result.steps, rate_result.hint = list(table_result.steps), table_result.hint
+    return [_table(method, errors, own, table_result), _rate(method, answer, errors, own, rate_result)]
+
+
+def _table(method, errors, own, result):
+    if own is None:
+        return result
+    sizes = ", ".join(map(str, method.ndata))
+    description = f"one error per ndata = {sizes}"
+    if errors is MISSING:
+        return result.fail(f"{method.table} is defined", "not defined when the notebook finished",
+                           f"run the cell that fills {method.table} (and keep its name).")
+    values = _numbers(errors)
+    if values is None or values.shape != (len(method.ndata),):
+        return result.fail(description, f"got {_shown_errors(errors)}",
+                           f"make {method.table} a list of {len(method.ndata)} positive errors: "
+                           f"[{method.driver}(n) for n in {list(method.ndata)}].")
+    result.step(description, True)
+    agree = bool(np.allclose(values, own, rtol=PRINTED, atol=0))
     if not result.step(f"the errors are what {method.driver} returns for each ndata (to 4 significant digits)",
                        agree, f"got {np.array2string(values, precision=3)}"):
-        result.hint = f"fill the table by running your driver: [{method.driver}(n) for n in {list(method.ndata)}]."
+        wrong = [n for n, mine, theirs in zip(method.ndata, values, own)
+                 if not np.isclose(mine, theirs, rtol=PRINTED, atol=0)]
+        rows = ", ".join(f"Err({n})" for n in wrong[:3]) + (" and more" if len(wrong) > 3 else "")
+        result.hint = (f"{rows} in your table {'is' if len(wrong) == 1 else 'are'} not what {method.driver} returns: "
+                       f"fill the table by running your driver, [{method.driver}(n) for n in {list(method.ndata)}].")
         return result
-    order = observed_order(key, values)
+    order = observed_order(method.key, values)
     if not result.step(f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across "
                        "the table)", order >= MIN_ORDER, _no_experiment(method, values)):
         result.hint = (f"{method.driver} must interpolate f from ndata points and measure the error at the test "
@@ -254,14 +369,37 @@ def table(key, errors, fn):
     return result
 
 
+SANE = (1e-150, 1e150)  # a relative error outside this range is no measurement (and its ratios would overflow)
+
+
 def _numbers(value):
-    if getattr(value, "not_numbers", False):
+    """A 1-d float array of positive errors within :data:`SANE`, or None.
+
+    A table of one-element arrays (a driver that returns ``np.max(..., keepdims=True)``,
+    which the driver check accepts as one number) counts as its numbers.
+    """
+    if value is MISSING or getattr(value, "not_numbers", False) or isinstance(value, (str, bytes)):
         return None
     try:
-        values = np.asarray(value, dtype=float)
+        values = floats(value)
     except (TypeError, ValueError):
         return None
-    return values if values.ndim == 1 and np.all(np.isfinite(values)) and np.all(values > 0) else None
+    if values.ndim > 1 and values.size == values.shape[0]:
+        values = values.reshape(-1)
+    if values.ndim != 1 or not np.all(np.isfinite(values)):
+        return None
+    return values if np.all(values > SANE[0]) and np.all(values < SANE[1]) else None
+
+
+def _shown_errors(value):
+    """A student's table for a failure message: its numbers to four digits, or what it is instead."""
+    try:
+        values = floats(value).reshape(-1)
+    except (TypeError, ValueError):
+        return shown(value)
+    if values.size > 20:
+        return f"{values.size} numbers"
+    return "[" + ", ".join(f"{v:.3e}" for v in values) + "]"
 
 
 def supported_order(key, errors):
@@ -276,40 +414,48 @@ def supported_order(key, errors):
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
 
 
-def rate(key, answer, errors=None):
-    """Check the rate answer of experiment `key`: the exponent p with Err(n)/Err(2n-1) close to 2**p,
-    read from the student's own table `errors`.
+def _rate(method, answer, errors, own, result):
+    """The rate answer: the exponent p with Err(n)/Err(2n-1) close to 2**p, read from the student's table.
 
-    The answer must be the order that table supports: a student whose
-    table is off but who reads it correctly is not marked down twice, and a
-    rate with no table that shows an experiment earns nothing.
+    The table must be read from an experiment: the driver ran (`own` is what it
+    returned) and its errors shrink. Then the answer must be the order the
+    student's own table supports, so a student whose table is off but who reads
+    it correctly is not marked down twice.
     """
-    method = _method(key)
-    result = CheckResult(method.rate)
-    description = "the rate is the exponent p of the nearest power of two 2**p to your table's ratios"
-    values = _numbers(errors)
-    if values is None or values.shape != (len(method.ndata),):
-        return result.fail(description, f"{method.table} is not a table of {len(method.ndata)} positive errors "
-                                        "yet, so there is nothing to read the rate from",
-                           f"fill {method.table} first, then read the rate off its ratios.")
-    own = supported_order(key, values)
     if own is None:
-        return result.fail(description, _no_experiment(method, values) + ", so it supports no rate",
+        return result
+    description = "the rate is the exponent p of the power of two 2**p that your table's ratios settle near"
+    if supported_order(method.key, own) is None:
+        return result.fail(description, _no_experiment(method, own, f"{method.driver}'s",
+                                                       "they show no experiment, so there is no rate to read"),
                            f"fix {method.driver} so that its errors shrink, refill {method.table}, then read the "
                            "rate off the ratios.")
+    if answer is MISSING:
+        return result.fail(f"{method.rate} is defined", "not defined when the notebook finished",
+                           f"run the cell that sets {method.rate} (and keep its name).")
+    values = _numbers(errors)
+    if values is None or values.shape != (len(method.ndata),):
+        return result.fail(description, f"{method.table} is not a table of {len(method.ndata)} positive errors, "
+                                        "so there is nothing to read the rate from",
+                           f"fill {method.table} from your driver first, then read the rate off its ratios.")
+    supported = supported_order(method.key, values)
+    if supported is None:
+        return result.fail(description, _no_experiment(method, values, "your table's",
+                                                       "this table shows no experiment, so it supports no rate"),
+                           f"fill {method.table} by running {method.driver}, then read the rate off the ratios.")
     number = _number(answer)
     if number is None or number != round(number):
         return result.fail(description, f"got {shown(answer)}",
                            f"set {method.rate} to a whole number p: the ratios Err(41)/Err(81), ... are close to 2**p.")
     p = int(round(number))
-    if p == own:
+    if p == supported:
         result.step(description, True)
         return result
     exponent = p.bit_length() - 1 if p > 1 else None
-    if exponent is not None and p == 2 ** exponent and exponent == own:
-        hint = f"{p} is the ratio itself, 2**{exponent}; the rate is its exponent {exponent}."
-    else:
-        hint = ("take the ratios Err(41)/Err(81), Err(81)/Err(161), ... of your table; they settle near a power "
-                "of two 2**p, and p is the rate.")
-    result.fail(description, f"got {p}; your table's ratios support {own}", hint)
-    return result
+    if exponent is not None and p == 2 ** exponent and exponent == supported:
+        return result.fail(description, f"got {p}, which is the ratio Err(n)/Err(2n-1) itself",
+                           f"the rate is the exponent p that gives {p} = 2**p.")
+    return result.fail(description, f"got {p}, which is not the exponent of the power of two your table's "
+                                    "ratios settle near",
+                       "take the ratios Err(41)/Err(81), Err(81)/Err(161), ... of your table; they settle near a "
+                       "power of two 2**p, and p is the rate.")

@@ -93,13 +93,24 @@ class Exercise:
 
 
 def _driver_parts(key, driver_weight, table_weight=1, rate_weight=1):
-    """The three parts of a convergence experiment: driver, table, rate answer."""
+    """The three parts of a convergence experiment: driver, table, rate answer.
+
+    The table and the rate share one run of the student's driver at the lab's
+    sizes (:func:`labkit.checks.drivers.experiment`): both are read from what
+    the driver returns, so neither is earned by numbers typed in from elsewhere.
+    """
     method = drivers.METHODS[key]
+
+    def experiment(ns, seed):
+        given = [ns[name] if name in ns else drivers.MISSING for name in (method.table, method.rate, method.driver)]
+        return drivers.experiment(key, *given)
+
     return (Part(method.driver, driver_weight, lambda ns, seed: drivers.driver(key, ns[method.driver], seed),
                  refused=EXPERIMENTS),
-            Part(method.table, table_weight, lambda ns, seed: drivers.table(key, ns[method.table], ns[method.driver]),
-                 refused=EXPERIMENTS),
-            Part(method.rate, rate_weight, lambda ns, seed: drivers.rate(key, ns[method.rate], ns.get(method.table))))
+            Part(method.table, table_weight, experiment, index=0, refused=EXPERIMENTS,
+                 functions=(method.table, method.driver)),
+            Part(method.rate, rate_weight, experiment, index=1, refused=EXPERIMENTS,
+                 functions=(method.rate, method.driver)))
 
 
 def _experiment_names(key):
@@ -147,7 +158,9 @@ EXERCISES = {e.number: e for e in (
     Exercise(11, _experiment_names("complete"), _driver_parts("complete", 5, 2, 2),
              answers=("the order, with f' used only at the ends",)),
     Exercise(12, ("ncspline",) + _experiment_names("natural"),
-             (Part("ncspline", 9, lambda ns, seed: splines.ncspline(ns["ncspline"], seed=seed), refused=INTERPOLANTS),)
+             (Part("ncspline", 9, lambda ns, seed: splines.ncspline(ns["ncspline"], seed=seed,
+                                                                   system=ns.get("complete_system")),
+                   refused=INTERPOLANTS),)
              + _driver_parts("natural", 2, 2, 2),
              answers=("why the natural spline's order is lower",)),
     Exercise(13, _experiment_names("notaknot"), _driver_parts("notaknot", 3, 2, 2),
@@ -212,7 +225,11 @@ def grade(number, namespace, seed=None):
         except KeyError as exc:
             result = _missing(str(exc).strip("'\""))
             result.name = part.name
-        checks.append({**result.as_dict(), "weight": part.weight})
+        except Exception as exc:  # noqa: BLE001 - a fault of the check itself costs this part, not the others
+            result = CheckResult(part.name)
+            result.fail("the grader could check this part", f"the check failed inside labkit ({type(exc).__name__})",
+                        "this is a fault of the grader, not of your work: tell your instructor.")
+        checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # named as the student names it
     points = sum(check["weight"] for check in checks if check["passed"])
     return {"exercise": number, "passed": points == exercise.points, "points": points,
             "fraction": points / exercise.points, "defined": defined, "checks": checks}

@@ -9,7 +9,7 @@ polynomials a cubic Hermite interpolant must reproduce exactly.
 import numpy as np
 
 from .. import functions, piecewise
-from .result import CheckResult, call, case_rng, close, several, shown, worst
+from .result import CheckResult, call, case_rng, close, floats, several, shown, worst
 
 MONOMIAL_POINTS = np.array([-1.0, 0.5, 1.5, 3.0])
 
@@ -74,8 +74,31 @@ def _narrow_pherm(fn, result):
         result.hint = ("each basis function is right, so the combination is wrong: "
                        "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
         return result
-    name, factor = bad[0]
-    if factor is not None or unit_ok:
+    name, factor, other = bad[0]
+    if factor == -1 and not unit_ok:
+        # -1 on [0, 1] is a sign slip, or a power of (x_k - x_{k+1}) = -1 too many or too few: [0, 2] tells
+        wider = _basis_failures(fn, [0.0, 2.0], result)
+        if wider is None:
+            return result
+        factor2 = next((f for n, f, _ in wider if n == name), None)
+        if factor2 is not None and not np.isclose(factor2, -1.0):
+            factor, interval, unit_ok = factor2, [0.0, 2.0], True
+            label = "each Hermite basis function alone on [0, 2]"
+    if other is not None and {name, other} in ({"h1", "h2"}, {"h3", "h4"}):
+        hint = (f"with only the data of {name} set, your interpolant gives {other}: the values and the slopes are "
+                "swapped in the combination. The value y_k goes with h1 and the slope y'_k with h2 "
+                "(y_{k+1} with h3, y'_{k+1} with h4), equation (4).")
+    elif other is not None and {name, other} in ({"h1", "h3"}, {"h2", "h4"}):
+        hint = (f"with only the data of {name} set, your interpolant gives {other}: the two ends of the interval "
+                "are swapped in the combination. The data at x_k (y_k, y'_k) go with h1 and h2, the data at "
+                "x_{k+1} with h3 and h4, equation (4).")
+    elif other is not None:
+        hint = (f"with only the data of {name} set, your interpolant gives {other}: the combination pairs the data "
+                "with the wrong basis functions. p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
+    elif factor == -1:
+        hint = (f"{name} has the wrong sign: compare its factors with the lab's definition, a minus sign at a time "
+                "(x - x_{k+1} and x_k - x_{k+1} are not the same).")
+    elif factor is not None or unit_ok:
         times = f" times {factor:g}" if factor is not None else ""
         hint = (f"{name} is the right polynomial{times} on [{interval[0]:g}, {interval[1]:g}]: its denominator is wrong "
                 "(the denominators are (x_k - x_{k+1})^3 for h1, (x_k - x_{k+1})^2 for h2, "
@@ -85,7 +108,7 @@ def _narrow_pherm(fn, result):
     else:
         hint = (f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
                 "polynomials, factor by factor.")
-    result.fail(label, f"wrong: {', '.join(n for n, _ in bad)}", hint)
+    result.fail(label, f"wrong: {', '.join(n for n, _, _ in bad)}", hint)
     return result
 
 
@@ -100,14 +123,15 @@ def _basis_failures(fn, interval, result):
         if not ok:
             return None
         if not close(got, want):
-            bad.append((f"h{m}", _constant_factor(got, want)))
+            other = next((f"h{n}" for n, basis in enumerate(expected, start=1) if n != m and close(got, basis)), None)
+            bad.append((f"h{m}", _constant_factor(got, want), other))
     return bad
 
 
 def _constant_factor(got, want):
     """c if got == c * want at every point (a wrong constant such as a denominator), else None."""
     try:
-        got = np.asarray(got, dtype=float)
+        got = floats(got)
     except (TypeError, ValueError):
         return None
     nonzero = np.abs(want) > 1e-12
@@ -138,6 +162,9 @@ def runge(fn, seed=None):
     if not result.step("y = 1/(1+x^2)", close(out[0], y), "" if close(out[0], y) else worst(out[0], y)):
         result.hint = "use componentwise operations: 1 / (1 + x**2)."
         return result
+    if _sign_slip(out[1], yprime):
+        return result.fail("yprime = -2x/(1+x^2)^2", "yprime has the wrong sign",
+                           "yprime has the wrong sign: the derivative of 1/(1+x^2) is -2x/(1+x^2)^2 (chain rule).")
     if not result.step("yprime = -2x/(1+x^2)^2", close(out[1], yprime),
                        "" if close(out[1], yprime) else worst(out[1], yprime)):
         result.hint = "differentiate 1/(1+x^2) with the chain rule: -2x/(1+x^2)^2."
@@ -149,7 +176,7 @@ def runge(fn, seed=None):
 def _sign_slip(got, want):
     """'has the wrong sign' if got == -want (and want is not zero), else ''."""
     try:
-        got = np.asarray(got, dtype=float)
+        got = floats(got)
     except (TypeError, ValueError):
         return ""
     if got.shape == want.shape and np.any(np.abs(want) > 1e-6) and np.allclose(got, -want, atol=1e-9):
@@ -175,6 +202,12 @@ def limacon_derivatives(fn, seed=None):
         for name, got, want, formula in (("dx/dt", out[0], dxdt, "-sin t cos t - r sin t"),
                                          ("dy/dt", out[1], dydt, "-sin^2 t + r cos t")):
             if not result.step(f"{label}: {name} = {formula}", close(got, want), worst(got, want)):
+                r = r0 + np.cos(t)
+                no_product_rule = -r * np.sin(t) if name == "dx/dt" else r * np.cos(t)
+                if close(got, no_product_rule):
+                    result.hint = (f"{name} leaves out the product rule: r = r0 + cos t depends on t too, so it "
+                                   "has a second term with dr/dt = -sin t.")
+                    return result
                 slip = _sign_slip(got, want)
                 result.hint = (f"{name} {slip}: differentiate with the product rule, r' = -sin t."
                                if slip else f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "

@@ -28,8 +28,12 @@ def coons(fn, seed=None):
     S, T = np.meshgrid(s, t, indexing="ij")
     if not result.step("the unit square with the identity data gives the 4 x 5 grid", close(out, [S, T]),
                        "" if close(out, [S, T]) else worst(out, [S, T])):
-        result.hint = ("start with the outline: x along AB is eval_pherm([0, 1], [xA, xB], [dxdsA, dxdsB], s); "
-                       "DC uses D and C; then join them in t for every s.")
+        if close(out, [S.T, T.T]):
+            result.hint = ("x and y are transposed: x[i, j] belongs to s[i] and t[j], so they have one row per "
+                           "value of s (shape (len(s), len(t))).")
+        else:
+            result.hint = ("start with the outline: x along AB is eval_pherm([0, 1], [xA, xB], [dxdsA, dxdsB], s); "
+                           "DC uses D and C; then join them in t for every s.")
         return result
     rng = case_rng(seed, "patches.coons")
     corners = [patches.Corner(*rng.normal(size=(4, 2))) for _ in range(4)]
@@ -122,8 +126,9 @@ def circle_corners(corners):
         near = min(np.max(np.abs(np.hypot(xs - cx, ys - cy) - radius)) for cx, cy in centres)
         if not result.step(f"side {name} close to a quarter circle of radius sqrt(2)/2", near < bound,
                            f"off by {near:.3f}"):
-            result.hint = ("parametrise the arc (centre, radius sqrt(2)/2, angle growing by pi/2 over s in [0, 1]) "
-                           "and differentiate: the derivative's length is (sqrt(2)/2)(pi/2) = pi/(2 sqrt 2).")
+            result.hint = ("write the side as an arc with its angle growing by pi/2 as s goes from 0 to 1, "
+                           "differentiate it, and give each corner that derivative at s = 0 or s = 1: both its "
+                           "direction and its length matter.")
             return result
     symmetric = close(x + x[::-1], np.ones_like(x)) and close(y + y[:, ::-1], np.ones_like(y))
     if not result.step("left-right and top-bottom symmetric", symmetric):

@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import functions, monotone, piecewise, splines
 from ..plotdata import NO_LINE, Line, line_of, lines_of  # noqa: F401 - Line and line_of for the checks' users
-from .result import CheckResult, Checks
+from .result import CheckResult, Checks, floats
 
 MIN_POINTS = 100
 # bounds on the grader's work for one plot, whatever the notebook drew: the long lines examined,
@@ -153,7 +153,7 @@ def _own_hermite(own):
     if own is None:
         return None
     try:
-        tdata, xdata, ydata, xpdata, ypdata = (np.asarray(v, dtype=float) for v in own)
+        tdata, xdata, ydata, xpdata, ypdata = (floats(v) for v in own)
         curve = _hermite_curve(tdata, xdata, ydata, xpdata, ypdata)
     except (TypeError, ValueError, IndexError):
         return None

@@ -94,14 +94,58 @@ def call(result, description, fn, *args):
         if refused:
             result.fail(description, f"called {refused}, which is switched off while this exercise is graded",
                         f"the exercise asks you to write this yourself: do not call {refused}.")
+        elif kind in ("Tampered", "Timeout", "WorkerError"):
+            result.fail(description, _text(exc), "see what the feedback says about the notebook above.")
         else:
-            result.fail(description, f"raised {kind}: {exc}",
-                        "read the error above; run the cell on its own to see the traceback.")
+            where = _where(exc)
+            result.fail(description, f"raised {kind}: {_text(exc)}" + (f" ({where})" if where else ""),
+                        f"the error happened {where}: look at that line." if where else
+                        "run the cell with the error on its own: the traceback shows where it happened.")
     return False, None
+
+
+def _text(exc):
+    """An exception's message, whatever its ``__str__`` does."""
+    try:
+        return str(exc)
+    except Exception:  # noqa: BLE001 - a student's exception class may break str()
+        return f"(an exception of type {type(exc).__name__}, whose message cannot be shown)"
+
+
+def _where(exc):
+    """Where the student's code raised `exc`: 'in f, line 7: `d = 2 / s`', from its traceback (local or remote)."""
+    import re
+    import traceback
+
+    text = getattr(exc, "traceback", None)
+    if not isinstance(text, str):
+        try:
+            text = "".join(traceback.format_tb(exc.__traceback__)) if exc.__traceback__ is not None else ""
+        except Exception:  # noqa: BLE001 - a hostile traceback
+            text = ""
+    frames = re.findall(r'File "([^"]*)", line (\d+), in (\S+)\n\s*(.*)', text or "")
+    own = [f for f in frames if "site-packages" not in f[0] and "/labkit/" not in f[0]]
+    if not own:
+        return ""
+    _, line, function, source = own[-1]
+    return f"in {function}, line {line}: `{source.strip()[:120]}`" if source.strip() else f"in {function}, line {line}"
 
 
 class _NotNumbers(Exception):
     pass
+
+
+def floats(value):
+    """``np.asarray(value, dtype=float)`` for a student's value, raising TypeError (never warning) for what is
+    not real numbers: complex values, strings, a sandboxed value that was not numbers."""
+    if getattr(value, "not_numbers", False) or isinstance(value, (str, bytes)):
+        raise TypeError("not numbers")
+    if np.iscomplexobj(value):
+        raise TypeError("complex numbers, not real ones")
+    try:
+        return np.asarray(value, dtype=float)
+    except OverflowError:
+        raise TypeError("numbers too large for a float") from None
 
 
 def _floats(value):
@@ -109,8 +153,10 @@ def _floats(value):
     if getattr(value, "not_numbers", False):  # a value from a sandboxed notebook that was not numbers
         raise _NotNumbers(str(value))
     try:
+        if np.iscomplexobj(value):
+            raise _NotNumbers("got complex numbers, not real ones")
         return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise _NotNumbers(f"got {type(value).__name__}, not numbers") from None
 
 
@@ -158,6 +204,10 @@ def worst(actual, expected):
 def shown(value):
     """Short text of a student's value for a failure message (rounded numbers, or what it is)."""
     try:
-        return str(np.round(_floats(value), 6))
+        values = _floats(value)
     except _NotNumbers as exc:
         return str(exc)
+    with np.errstate(all="ignore"):  # 1e308 rounds to inf: shown as such, with no warning
+        finite = np.abs(values[np.isfinite(values)])
+        plain = np.all(finite < 1e6) and not np.any((finite > 0) & (finite < 1e-4))  # else numpy's e-notation
+        return str(np.round(values, 6)) if plain else str(values)

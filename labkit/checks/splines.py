@@ -8,7 +8,7 @@ must reproduce exactly.
 import numpy as np
 
 from .. import piecewise, splines
-from .result import CheckResult, call, case_rng, close, shown, worst
+from .result import CheckResult, call, case_rng, close, floats, shown, worst
 
 SPLINE_CASES = [
     ("x^3 on [0 1 2 4] (exercise 10g)", [0.0, 1.0, 2.0, 4.0], [0.0, 1.0, 8.0, 64.0], 0.0, 48.0),
@@ -37,7 +37,7 @@ def _part(AD, index):
 def _matrix(AD):
     """The float matrix A of a student's (A, D), or None if it is not one."""
     try:
-        A = np.asarray(_part(AD, 0), dtype=float)
+        A = floats(_part(AD, 0))
     except (TypeError, ValueError):
         return None
     return A if A.ndim == 2 and np.all(np.isfinite(A)) else None
@@ -71,6 +71,12 @@ def ccspline(fn, system=None, seed=None):
         if A is None:
             return result.fail("the matrix A", "complete_system must return (A, D) with A a matrix of numbers",
                                "end the function with `return A, D`.")
+        natural_rows = A.shape == (4, 4) and np.allclose(A[0], [1, 0, 0, 0]) and np.allclose(A[-1], [0, 0, 0, 1])
+        if natural_rows:
+            return result.fail("the first and last rows of A", "they say M1 = 0 and Mn = 0",
+                               "the first and last rows of A are the natural spline's (M1 = 0, Mn = 0); the complete "
+                               "spline's first row is h1/3, h1/6 and its last h(n-1)/6, h(n-1)/3 (equation 11), with "
+                               "y1p and ynp in D.")
         if not result.step("A is symmetric", A.shape == (4, 4) and np.allclose(A, A.T)):
             result.hint = "A(k, k-1) and A(k-1, k) must both be h(k-1)/6."
             return result
@@ -98,24 +104,44 @@ def ccspline(fn, system=None, seed=None):
         if not result.step("A for xdata = [0 1 3] matches equation (11)", close(AD[0], A_ref), worst(AD[0], A_ref)):
             result.hint = "compute the 3 x 3 matrix by hand from (11) and compare entry by entry."
             return result
-        if not result.step("D for xdata = [0 1 3] matches equation (12)", close(_part(AD, 1), D_ref), worst(_part(AD, 1), D_ref)):
-            result.hint = "compute D by hand from (12): first and last entries use y1p and ynp."
+        D = _part(AD, 1)
+        if not result.step("D for xdata = [0 1 3] matches equation (12)", close(D, D_ref), worst(D, D_ref)):
+            flipped = _flipped_ends(D, D_ref)
+            if flipped:
+                which = flipped[0]
+                formula = "(y2 - y1)/h1 - y1p" if which == "first" else "ynp - (yn - y(n-1))/h(n-1)"
+                result.hint = f"D's {which} entry has the wrong sign: it is {formula} (equation 12)."
+            else:
+                result.hint = "compute D by hand from (12): first and last entries use y1p and ynp."
             return result
-    result.hint = ("A and D are right, so the slopes are wrong: s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
-                   "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp.")
+        result.hint = ("your complete_system's A and D are right, so what ccspline does with them is wrong: it must "
+                       "solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
+                       "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp.")
+        return result
+    result.hint = ("the slopes are wrong for equal intervals too: check A and D against equations (11) and (12) "
+                   "(define complete_system so the grader can check them too), then the slopes against (8).")
     return result
 
 
-def ncspline(fn, seed=None):
-    """Check ``ncspline(xdata, ydata)``: the lab's linear case, zero end curvature, labkit's reference."""
+def ncspline(fn, seed=None, system=None):
+    """Check ``ncspline(xdata, ydata)``: the lab's linear case, zero end curvature, labkit's reference.
+
+    `system` is the student's ``complete_system``, which the lab's ncspline
+    builds on: when it is wrong (Exercise 10 marks that) and ncspline gives
+    exactly the natural spline of the student's own system, ncspline is right.
+    """
     result = CheckResult("ncspline")
+    own = _own_natural(fn, system, seed)
+    if own is not None:
+        result.step("slopes are the natural spline of your own complete_system (its mistake is marked in "
+                    "Exercise 10, not again here)", True)
+        return result
     ok, sprime = call(result, "linear data [0 2 4 6]", fn, np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 2.0, 4.0, 6.0]))
     if not ok:
         return result
     linear_ok = result.step("linear data y = 2x give slopes 2", close(sprime, [2.0] * 4),
                             "" if close(sprime, [2.0] * 4) else f"got {shown(sprime)}")
-    x = np.array([0.0, 0.7, 1.5, 2.0, 3.2, 4.0]) if seed is None else np.cumsum(case_rng(seed, "splines.ncspline").uniform(0.2, 1.5, 6))
-    y = np.exp(x / 2)
+    x, y = _ncspline_data(seed)
     ok, slopes = call(result, "a nonlinear function", fn, x, y)
     if not ok:
         return result
@@ -124,11 +150,85 @@ def ncspline(fn, seed=None):
         ends = piecewise.eval_pherm(x, y, slopes, x[[0, -1]], der=2)
     except (ValueError, IndexError, TypeError):
         return result.fail("slopes for six knots", f"got {slopes!r}", "return one slope per knot.")
-    if not result.step("second derivative zero at both ends (M1 = Mn = 0)", close(ends, [0.0, 0.0]), f"s'' = {np.round(ends, 6)}"):
-        result.hint = ("the first and last rows of A must say M1 = 0 and Mn = 0 (1 on the diagonal, 0 elsewhere, "
-                       "0 in D): they are still the complete spline's rows.")
-        return result
     want = splines.ncspline(x, y)
+    try:
+        got = floats(slopes)
+    except (TypeError, ValueError):
+        return result.fail("slopes for six knots", f"got {shown(slopes)}", "return one slope per knot.")
+    if got.shape == want.shape and np.allclose(got[:-1], want[:-1]) and not np.allclose(got[-1], want[-1]):
+        return result.fail("every slope from the system", "all but the last agree with labkit.ncspline",
+                           "every slope but the last is right: equation (8) gives the slope at the left end of a "
+                           "piece, and the last knot is a right end, which needs (9).")
+    if not result.step("second derivative zero at both ends (M1 = Mn = 0)", close(ends, [0.0, 0.0]), f"s'' = {np.round(ends, 6)}"):
+        if close(slopes, _natural_slopes(x, y, rows_in_d=False)):
+            result.hint = ("A's first and last rows say M1 = 0 and Mn = 0, but D's first and last entries are still "
+                           "the complete spline's: set them to 0 too.")
+        elif close(slopes, _natural_slopes(x, y, rows_in_a=False, rows_in_d=False)):
+            result.hint = ("the first and last rows of A must say M1 = 0 and Mn = 0 (1 on the diagonal, 0 elsewhere, "
+                           "0 in D): they are still the complete spline's rows.")
+        else:
+            result.hint = ("the second derivative is not 0 at the ends: the first and last equations of the system "
+                           "must say M1 = 0 and Mn = 0.")
+        return result
     if not result.step("slopes agree with labkit.ncspline", close(slopes, want), worst(slopes, want)) or not linear_ok:
         result.hint = "the ends are right, so check the interior rows and the slopes from (8) and, at the last knot, (9)."
     return result
+
+
+def _ncspline_data(seed):
+    x = (np.array([0.0, 0.7, 1.5, 2.0, 3.2, 4.0]) if seed is None
+         else np.cumsum(case_rng(seed, "splines.ncspline").uniform(0.2, 1.5, 6)))
+    return x, np.exp(x / 2)
+
+
+def _own_natural(fn, system, seed):
+    """True when the student's complete_system is wrong and `fn` gives exactly the natural spline of it
+    (the lab's cases: linear data and a nonlinear function); None otherwise (the usual check decides)."""
+    if system is None:
+        return None
+    scratch, differs = CheckResult("ncspline"), False
+    for x, y in ((np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 2.0, 4.0, 6.0])), _ncspline_data(seed)):
+        ok, given = call(scratch, "complete_system", system, x, y, 0.0, 0.0)
+        if not ok:
+            return None
+        try:
+            with np.errstate(all="ignore"):
+                own = _natural_slopes(x, y, system=given)
+        except (TypeError, ValueError, IndexError, np.linalg.LinAlgError):
+            return None
+        if not np.all(np.isfinite(own)):
+            return None  # the student's system gives no spline: the usual check decides
+        differs = differs or not close(own, splines.ncspline(x, y))
+        ok, slopes = call(scratch, "ncspline", fn, x, y)
+        if not ok or not close(slopes, own):
+            return None
+    return True if differs else None  # with a right system, the usual check decides
+
+
+def _flipped_ends(D, D_ref):
+    """Which end entries of D ('first', 'last') are the reference's with the sign turned."""
+    try:
+        values = floats(D)
+    except (TypeError, ValueError):
+        return []
+    if values.shape != D_ref.shape:
+        return []
+    return [which for i, which in ((0, "first"), (-1, "last"))
+            if abs(D_ref[i]) > 1e-12 and np.isclose(values[i], -D_ref[i]) and np.allclose(values[1:-1], D_ref[1:-1])]
+
+
+def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None):
+    """The slopes a natural spline comes out with when its end rows are set in A and/or in D (the usual slips),
+    from the complete spline's system: labkit's, or `system` (A, D) as the student's complete_system gave it."""
+    A, D = _reference_complete_system(x, y, 0.0, 0.0) if system is None else (floats(a).copy() for a in system)
+    if rows_in_a:
+        A[0, :], A[-1, :] = 0.0, 0.0
+        A[0, 0], A[-1, -1] = 1.0, 1.0
+    if rows_in_d:
+        D[0], D[-1] = 0.0, 0.0
+    M = np.linalg.solve(A, D)
+    h, secant = np.diff(x), np.diff(y) / np.diff(x)
+    slopes = np.empty_like(x)
+    slopes[:-1] = -M[:-1] * h / 3 - M[1:] * h / 6 + secant
+    slopes[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]
+    return slopes

@@ -39,11 +39,21 @@ makes threads and new signal handlers impossible (:mod:`labkit.grading.seccomp`)
 so nothing interrupts them either. A refused call is allowed to run and its
 answer is voided afterwards: neither hook raises.
 """
-import hashlib
-import hmac
+import _hashlib
+import builtins
+import gc
 import os
 import sys
 import types
+
+# what the watch calls, taken when this module is imported (in the pristine supervisor): the watch's own
+# code resolves its names in a private copy of this module's namespace (:func:`install`), so a notebook
+# that rebinds ``guard.hashlib``, ``builtins.any`` or ``hashlib.sha1`` changes nothing the watch uses
+_sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
+_write, _getframe, _modules = os.write, sys._getframe, sys.modules
+_gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
+_ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (types.ModuleType, types.CodeType, types.FunctionType,
+                                                                types.BuiltinFunctionType)
 
 SMALL_CODE = 64  # bytes of bytecode below which a function is only recognised with its name and place
 RUN = "run"  # the profile of the request that runs the cells: nothing is refused, tampering is noted
@@ -57,6 +67,8 @@ TAMPER_EVENTS = frozenset({
 TAMPER_PREFIXES = ("ctypes.",)  # but ctypes.dlopen: scipy's own imports open libraries, which is no harm alone
 HARMLESS = frozenset({"ctypes.dlopen"})
 GUARDED_ATTRIBUTES = frozenset({"__code__"})  # libraries set __defaults__ and the like when imported
+# the functions of this module whose functions student code may hold (see :func:`install`)
+EXPOSED = frozenset({"_stand_in", "_plain", "_handed_over", "_barrier"})
 
 
 def code_key(code):
@@ -66,9 +78,8 @@ def code_key(code):
     short functions (which an honest student might write identically) are
     also keyed by their name, file and line.
     """
-    consts = tuple(c for c in code.co_consts if isinstance(c, (int, float, complex, type(None))) and c is not True
-                   and c is not False)
-    digest = hashlib.sha1(code.co_code)
+    consts = tuple(c for c in code.co_consts if type(c) in (int, float, complex, type(None)))
+    digest = _sha1(code.co_code)
     digest.update(repr((code.co_names, code.co_varnames, code.co_argcount, consts)).encode())
     if len(code.co_code) < SMALL_CODE:
         digest.update(repr((code.co_qualname, code.co_filename, code.co_firstlineno)).encode())
@@ -79,13 +90,13 @@ def codes_in(code):
     """A code object and every code object nested in it (functions, methods, comprehensions)."""
     yield code
     for const in code.co_consts:
-        if isinstance(const, types.CodeType):
+        if type(const) is _CodeType:
             yield from codes_in(const)
 
 
 def sign(secret, *parts):
-    """The attestation's signature over its parts."""
-    return hmac.new(secret, "\x1f".join(map(str, parts)).encode(), hashlib.sha256).hexdigest()
+    """The attestation's signature over its parts (HMAC-SHA256, computed in C)."""
+    return _hmac_digest(secret, "\x1f".join(map(str, parts)).encode(), "sha256").hex()
 
 
 def attestation_text(rid, profile, passables, status, digest):
@@ -93,15 +104,15 @@ def attestation_text(rid, profile, passables, status, digest):
     return rid, profile or "", ",".join(sorted(passables)), status, digest
 
 
-class _Refused:
-    """Stands in for a refused compiled function or class while a graded request runs."""
+def _stand_in(name):
+    """A function that stands in for a refused compiled function or class while a graded request runs.
 
-    def __init__(self, name):
-        self.name = name
-
-    def __call__(self, *args, **kwargs):
-        raise RuntimeError(f"{self.name} is switched off while this exercise is graded: "
+    The watch recognises a call of one by its code, and reads the name from its frame (a plain string only)."""
+    def refused(*args, **kwargs):
+        raise RuntimeError(f"{name} is switched off while this exercise is graded: "
                            "the exercise asks you to write it yourself")
+
+    return refused
 
 
 def _within(module, prefixes):
@@ -139,26 +150,23 @@ def _barrier(function):
 
 def _compiled_types():
     """The exact types of compiled functions in this process (builtins, Cython and f2py routines)."""
-    found = {types.BuiltinFunctionType}
-    for module in list(sys.modules.values()):
-        namespace = getattr(module, "__dict__", None) if type(module) is types.ModuleType else None
+    found = {_BuiltinFunctionType}
+    for module in list(_modules.values()):
+        namespace = getattr(module, "__dict__", None) if type(module) is _ModuleType else None
         for value in (namespace or {}).values():
             if type(value).__name__ in ("cython_function_or_method", "fused_cython_function", "fortran"):
                 found.add(type(value))
     return frozenset(found)
 
 
-def _pristine_functions():
-    """What the watch calls, taken before any student code runs (a module's attribute may be replaced later)."""
-    import gc
-
-    return {"write": os.write, "getframe": sys._getframe, "gc_disable": gc.disable, "gc_enable": gc.enable,
-            "gc_isenabled": gc.isenabled, "sha256": hashlib.sha256, "sign": sign, "key_of": code_key,
-            "fields": attestation_text, "within": _within, "modules": sys.modules}
-
-
 def install(secret, verdict_fd, profiles, passables, chain):
     """Install the watch in this (still pristine) process; afterwards nothing of it is reachable from Python.
+
+    The watch's code runs in a private copy of this module's namespace, with a
+    private copy of the builtins: every function of this module is rebound to
+    it, so no name the watch looks up can be changed by a notebook. The few
+    functions student code can hold (:data:`EXPOSED`) are rebound to another
+    copy, so their ``__globals__`` lead nowhere.
 
     `profiles` maps a profile name to ``(names, modules, c_names)``: the refused
     Python code as {digest: readable name} (:func:`code_key`), the refused
@@ -172,15 +180,30 @@ def install(secret, verdict_fd, profiles, passables, chain):
     code of the serving functions, innermost first, that must raise the
     sentinels.
     """
+    private = dict(globals())
+    private["__builtins__"] = dict(vars(builtins))
+    # what student code can reach (the stand-ins put in refused modules, the functions handed over and the
+    # barriers around the student's callables) gets a namespace of its own: through their ``__globals__``
+    # a notebook reaches only that, never the names the hooks look up
+    exposed = {"__name__": __name__, "__builtins__": dict(vars(builtins))}
+    for name, value in list(private.items()):
+        if type(value) is _FunctionType and value.__globals__ is globals():
+            home = exposed if name in EXPOSED else private
+            home[name] = private[name] = _FunctionType(value.__code__, home, value.__name__, value.__defaults__,
+                                                       value.__closure__)
+    private["_install"](secret, verdict_fd, profiles, passables, chain)
+
+
+def _install(secret, verdict_fd, profiles, passables, chain):
+    """The watch itself; called by :func:`install` with this module's namespace privately copied."""
     import ctypes
 
-    f = _pristine_functions()
-    write, getframe, sha256 = f["write"], f["getframe"], f["sha256"]
-    gc_disable, gc_enable, gc_isenabled = f["gc_disable"], f["gc_enable"], f["gc_isenabled"]
-    key_of, signed, fields, within, modules = f["key_of"], f["sign"], f["fields"], f["within"], f["modules"]
-    refused_call, refused_type = _Refused.__call__.__code__, _Refused
+    write, getframe, sha256 = _write, _getframe, _sha256
+    gc_disable, gc_enable, gc_isenabled = _gc_disable, _gc_enable, _gc_isenabled
+    key_of, signed, fields, within, modules = code_key, sign, attestation_text, _within, _modules
+    refused_call, make_stand_in = _stand_in("").__code__, _stand_in
     handed_code = _handed_over(lambda: None).__code__
-    compiled_types, module_type, str_type, bytes_type, dict_type = (_compiled_types(), types.ModuleType, str,
+    compiled_types, module_type, str_type, bytes_type, dict_type = (_compiled_types(), _ModuleType, str,
                                                                     bytes, dict)
     heap_type = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
     profiles = {name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in
@@ -194,8 +217,8 @@ def install(secret, verdict_fd, profiles, passables, chain):
     copies = {}
     for name, function in passables.items():
         code = function.__code__.replace()  # equal, but another object: trusted by identity
-        copy = types.FunctionType(code, function.__globals__, function.__name__, function.__defaults__,
-                                  function.__closure__)
+        copy = _FunctionType(code, function.__globals__, function.__name__, function.__defaults__,
+                             function.__closure__)
         copy.__kwdefaults__, copy.__qualname__ = function.__kwdefaults__, function.__qualname__
         copies[name] = (code, _handed_over(copy))
     # mode: "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
@@ -230,13 +253,14 @@ def install(secret, verdict_fd, profiles, passables, chain):
             whole = within(module_name, mods)
             if not whole and not any(m == module_name for m, _ in c_names):
                 continue
-            for attribute, value in list(namespace.items()):
-                if type(attribute) is not str_type:
-                    continue
+            entries = list(namespace.items())
+            if any(type(attribute) is not str_type for attribute, _ in entries):
+                continue  # a key of the notebook's making could run code when the dictionary compares it
+            for attribute, value in entries:
                 kind = type(value)
                 compiled = kind in compiled_types or (kind is type and not value.__flags__ & heap_type)
                 if ((module_name, attribute) in c_names) or (whole and compiled):
-                    namespace[attribute] = refused_type(f"{module_name}.{attribute}")
+                    namespace[attribute] = make_stand_in(f"{module_name}.{attribute}")
                     state["stubbed"].append((namespace, attribute, value))
 
     def unstub():
@@ -259,9 +283,8 @@ def install(secret, verdict_fd, profiles, passables, chain):
             code = frame.f_code
             profile = state["profile"]
             if code is refused_call:
-                stand_in = frame.f_locals.get("self")
-                name = (stand_in.__dict__.get("name") if type(stand_in) is refused_type else None) or \
-                    "a switched-off function"
+                name = frame.f_locals.get("name")
+                name = name if type(name) is str_type and name else "a switched-off function"
             else:
                 name = profile[0].get(key(code)) if profile is not None else None
             if name is not None and not (code in state["live"] and frame.f_back is not None

@@ -159,6 +159,22 @@ def _rescore(verdict):
     return verdict
 
 
+def _student_frames(traceback):
+    """The lines of a traceback that are about the student's code: the header and the frames of the
+    interpreter's own machinery (IPython's ``run_code``, libraries) are left out, the error line kept."""
+    kept, skipping = [], False
+    for line in traceback.splitlines():
+        if line.startswith("Traceback (most recent call last)"):
+            continue
+        if line.startswith("  File "):
+            skipping = "site-packages" in line or "/lib/python" in line
+        elif not line.startswith("    "):
+            skipping = False  # the exception's own line
+        if not skipping:
+            kept.append(line)
+    return kept
+
+
 def _run_problems(name, ran):
     problems = []
     errors = ran.get("errors") if isinstance(ran.get("errors"), list) else []
@@ -168,9 +184,9 @@ def _run_problems(name, ran):
             error = error if isinstance(error, dict) else {}
             text = f"cell {int(error.get('cell', -1)) + 1} raised {one_line(error.get('kind'), 100)}: " \
                    f"{one_line(error.get('message', ''), 300)}"
-            tail = str(error.get("traceback", ""))[-1500:]
+            tail = _student_frames(str(error.get("traceback", ""))[-4000:])
             if tail:
-                text += "\n" + "\n".join(f"      | {line}" for line in tail.splitlines()[-6:])
+                text += "\n" + "\n".join(f"      | {line}" for line in tail[-6:])
             shown.append(text)
         more = f"\n    and {len(errors) - SHOWN_ERRORS} more" if len(errors) > SHOWN_ERRORS else ""
         problems.append(f"{name}: {len(errors)} cell(s) raised an error (graded as far as it got):\n    "

@@ -86,15 +86,16 @@ def _describe(exc):
     return kind, text[:500]
 
 
-def _tail(exc, lines=6):
-    """The last lines of an exception's traceback, as the student's cell would show them."""
+def _tail(exc, lines=40):
+    """The last lines of an exception's traceback, as the student's cell would show them (the grader picks
+    the student's own frames from them, :func:`labkit.grading.scoring._student_frames`)."""
     import traceback
 
     try:
         text = "".join(traceback.format_exception(exc))
     except Exception:  # noqa: BLE001 - a hostile exception
         return ""
-    return "\n".join(text.rstrip().splitlines()[-lines:])[-2000:]
+    return "\n".join(text.rstrip().splitlines()[-lines:])[-4000:]
 
 
 class _Lines:
@@ -425,26 +426,28 @@ class Supervisor:
             self.stop("the grader's watch reported tampering")
             return _error("Tampered", self._tamper_text())
         pending, self.child["attestations"] = self.child["attestations"], []
-        for text in pending:
-            parts = text.split("\t")
-            if len(parts) != 6:
-                continue
-            *fields, signature = parts
-            if (fields[0], fields[1], fields[2], fields[4]) != (expected[0], expected[1], expected[2], expected[4]):
-                continue
-            if not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
-                continue
-            status = fields[3]
-            if status == "clean":
-                return answer
-            what, _, detail = status.partition(":")
-            if what == "refused":
-                return _error("RefusedReference", f"called {detail}, which is switched off while this part is graded",
-                              detail)
-            self.tampered = self.tampered or detail
-            return _error("Tampered", self._tamper_text())
-        return _error("Tampered", "the answer came without the grader's watch (it was switched off, or the "
-                                  "answer was forged)")
+        # exactly one line may speak for this request, and it must be the watch's: a second one, or one
+        # that does not verify, means the notebook found the request's id and wrote to the watch's pipe
+        mine = [text.split("\t") for text in pending if text.split("\t", 1)[0] == expected[0]]
+        if len(mine) != 1:
+            return _error("Tampered", "the answer came without the grader's watch (it was switched off, or the "
+                                      "answer was forged)" if not mine else
+                          "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers")
+        parts = mine[0]
+        *fields, signature = parts if len(parts) == 6 else ([""] * 6)
+        if ((fields[0], fields[1], fields[2], fields[4]) != (expected[0], expected[1], expected[2], expected[4])
+                or not hmac.compare_digest(signature, guard.sign(self.secret, *fields))):
+            return _error("Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for "
+                                      "its answers")
+        status = fields[3]
+        if status == "clean":
+            return answer
+        what, _, detail = status.partition(":")
+        if what == "refused":
+            return _error("RefusedReference", f"called {detail}, which is switched off while this part is graded",
+                          detail)
+        self.tampered = self.tampered or detail
+        return _error("Tampered", self._tamper_text())
 
 
 def _ended(status):

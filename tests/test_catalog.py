@@ -1,0 +1,85 @@
+"""Grades are right in both directions: every correct variation earns full marks, every typical slip costs
+exactly its part and is named (the catalogs are in tests/catalog.py), all graded in one sandboxed run."""
+import json
+import os
+
+import pytest
+
+from labkit import grading
+from labkit.checks.exercises import EXERCISES
+from labkit.grading.rubric import default
+
+from catalog import CORRECT, MISTAKES, plant
+from conftest import sandbox_or_skip
+
+pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
+RUBRIC = default()
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory):
+    sandbox_or_skip()
+    tmp = tmp_path_factory.mktemp("catalog")
+    folders = {}
+    for entry in CORRECT + MISTAKES:
+        plant(entry, tmp / entry.name)
+        folders[entry.name] = tmp / entry.name
+    # one complete MATLAB-style solution set: loops, lists, a dense solve, scatter plots, typed-in tables
+    matlab = tmp / "matlab_style"
+    for entry in CORRECT:
+        if not (matlab / entry.notebook).exists():
+            plant(entry, matlab)
+    by_notebook = {}
+    for entry in CORRECT:
+        by_notebook.setdefault(entry.notebook, []).append(entry)
+    for notebook, entries in by_notebook.items():  # apply every variation of a notebook together
+        path = matlab / notebook
+        text = path.read_text()
+        for entry in entries[1:]:
+            for old, new in entry.replace:
+                encoded_old, encoded_new = json.dumps(old)[1:-1], json.dumps(new)[1:-1]
+                if encoded_old in text:
+                    text = text.replace(encoded_old, encoded_new)
+        path.write_text(text)
+    plant(CORRECT[0].__class__("the meshes as they are", "03_meshes.ipynb", ()), matlab)
+    folders["matlab_style"] = matlab
+    results = grading.grade(list(folders.values()), tmp / "out", jobs=2, progress=False, seed=20261201)
+    return dict(zip(folders, results))
+
+
+def _failed(grade):
+    return {(n, c["name"]) for n, verdict in grade.results.items() for c in verdict["checks"] if not c["passed"]}
+
+
+def _section(grade, number):
+    return grade.feedback().split(f"Exercise {number}:")[1].split("\nExercise ")[0]
+
+
+def test_the_catalogs_are_big_enough_and_cover_every_graded_exercise():
+    assert len(MISTAKES) >= 30 and len(CORRECT) >= 10
+    assert {entry.exercise for entry in MISTAKES} == set(EXERCISES)
+
+
+@pytest.mark.parametrize("entry", CORRECT, ids=lambda e: e.name)
+def test_every_correct_variation_earns_full_marks(graded, entry):
+    grade = graded[entry.name]
+    for number in entry.full:
+        assert grade.points[number] == RUBRIC.points[number], grade.feedback()
+
+
+def test_a_complete_matlab_style_solution_earns_everything(graded):
+    grade = graded["matlab_style"]
+    assert grade.total == RUBRIC.maximum, grade.feedback()
+
+
+@pytest.mark.parametrize("entry", MISTAKES, ids=lambda e: e.name)
+def test_every_slip_costs_exactly_its_part_and_is_named(graded, entry):
+    grade = graded[entry.name]
+    expected = {(entry.exercise, entry.part)} | set(entry.also)
+    assert _failed(grade) == expected, grade.feedback()
+    section = _section(grade, entry.exercise)
+    assert entry.hint in section, section
+    # only those parts' points are lost: every other exercise of the notebook is complete
+    for number in grade.results:
+        if number not in {n for n, _ in expected}:
+            assert grade.points[number] == RUBRIC.points[number], grade.feedback()
