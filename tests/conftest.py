@@ -24,7 +24,16 @@ def sandbox_or_skip():
 
 
 def pytest_terminal_summary(terminalreporter):
-    """Show the browser test's slider latencies in every run's summary, not only with -s."""
+    """Show the browser test's slider latencies, and the hostile class's grading figures, in every run's
+    summary, not only with -s (they are printed, never asserted: see benchmarks/)."""
+    run = getattr(sys.modules.get("test_hostile"), "RUN", {})
+    if run:
+        terminalreporter.section("labkit grade: the hostile class (attackers with honest classmates)")
+        peak = run.get("grader peak bytes")
+        terminalreporter.write_line(
+            f"{run.get('submissions')} submissions in {run.get('seconds')} s with --jobs {run.get('jobs')}; "
+            f"{run.get('not graded')} not graded; grader peak "
+            + (f"{peak / 1024**2:.0f} MiB" if peak else "not measured (no memory cgroup)"))
     module = sys.modules.get("test_jupyterlab")
     latencies = getattr(module, "LATENCIES", {})
     if latencies:
