@@ -578,7 +578,8 @@ def test_an_uninterruptible_loop_is_stopped_by_the_total_limit(tmp_path):
                                             "    except BaseException:\n        pass"])
     start = time.perf_counter()
     results, problems = grading.grade_notebook(path, cell_timeout=1, total_timeout=6)
-    assert time.perf_counter() - start < 30  # the limit is 6 s; slack for a busy machine
+    # the limit is 6 s; unstopped, only the grader's grace would end it (126 s): the rest is slack for a busy machine
+    assert time.perf_counter() - start < 60
     assert results == {} and "the submission's time limit of 6 s" in problems[0]
     assert _processes_with("labkit.grading.worker") == []
 
