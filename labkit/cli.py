@@ -64,11 +64,23 @@ def _summary(grades, out, start, what):
           f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/")
 
 
+def grade_options(args):
+    """The :class:`~labkit.grading.options.GradeOptions` of `labkit grade`'s arguments; ValueError for a bad one."""
+    from .grading.backends.base import Limits
+    from .grading.options import CPU_GRACE, MIB, GradeOptions
+
+    for name in ("jobs", "cell_timeout", "total_timeout", "memory", "grader_memory"):
+        if getattr(args, name) < 1:
+            raise ValueError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
+    return GradeOptions(cell_timeout=args.cell_timeout, total_timeout=args.total_timeout, seed=args.seed,
+                        backend=args.sandbox, rubric=args.rubric, grader_memory=args.grader_memory * MIB,
+                        limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE))
+
+
 def _grade(args):
-    from .grading import GradeOptions, grade, merge
+    from .grading import grade, merge
     from .grading.batch import report_failures
     from .grading.rubric import load
-    from .grading.sandbox import Limits
 
     start = time.perf_counter()
     rubric = load(args.rubric)
@@ -80,14 +92,9 @@ def _grade(args):
         return 1 if report_failures(grades) else 0
     if not args.submissions:
         raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
-    for name in ("jobs", "cell_timeout", "total_timeout", "memory", "grader_memory"):
-        if getattr(args, name) < 1:
-            raise ValueError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
-    options = GradeOptions(cell_timeout=args.cell_timeout, total_timeout=args.total_timeout, seed=args.seed,
-                           confined=not args.no_sandbox, grader_memory=args.grader_memory * 1024**2,
-                           limits=Limits(memory=args.memory * 1024**2, cpu_seconds=args.total_timeout + 30))
+    options = grade_options(args)
     grades = grade(args.submissions, args.out, jobs=args.jobs, progress=not args.quiet, rubric=rubric,
-                   options=options, sandboxed=not args.no_sandbox)
+                   options=options)
     _summary(grades, args.out, start, "graded")
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} "
           f"(repeat the run with --seed)")
@@ -100,10 +107,14 @@ def _grade(args):
 
 
 def build_parser():
+    from .grading import backends
+    from .grading.options import DEFAULTS, MIB
+
     parser = argparse.ArgumentParser(
         prog="labkit", description="Course kit tools for the higher-order interpolation lab.",
-        epilog="Grading runs every notebook in a bubblewrap sandbox (no network, read-only system, a private "
-               "folder, resource limits) and checks it from outside; see the README's 'For instructors'.")
+        epilog="Grading runs every notebook in a sandbox (`labkit grade --help` lists them: the default has no "
+               "network, a read-only system, a private folder and resource limits) and checks it from outside; "
+               "see the README's 'For instructors'.")
     commands = parser.add_subparsers(dest="command", required=True)
 
     nbs = commands.add_parser("notebooks", help="write the student notebooks shipped with labkit into a folder",
@@ -137,18 +148,27 @@ def build_parser():
     grd.add_argument("--merge", nargs="+", type=Path, metavar="DIR",
                      help="combine the results/ of these earlier --out folders into one grades.csv")
     grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
-    grd.add_argument("--cell-timeout", type=int, default=60,
-                     help="seconds per cell, and per call of a graded function (default 60)")
-    grd.add_argument("--total-timeout", type=int, default=600,
-                     help="seconds per submission in all, every notebook of it together (default 600)")
-    grd.add_argument("--memory", type=int, default=4096,
-                     help="MiB of memory for a notebook's sandbox, and of address space per process (default 4096)")
-    grd.add_argument("--grader-memory", type=int, default=3072,
-                     help="MiB of memory for the grader's own work on one submission (default 3072)")
-    grd.add_argument("--seed", type=int, help="seed of the random test data (default: a fresh one, saved in seed.txt)")
-    grd.add_argument("--no-sandbox", action="store_true",
-                     help="run student code UNCONFINED, with your permissions (only for code you trust)")
-    grd.add_argument("--rubric", type=Path,
+    grd.add_argument("--cell-timeout", type=int, default=DEFAULTS.cell_timeout,
+                     help="seconds per cell, and per call of a graded function (default %(default)s)")
+    grd.add_argument("--total-timeout", type=int, default=DEFAULTS.total_timeout,
+                     help="seconds per submission in all, every notebook of it together (default %(default)s)")
+    grd.add_argument("--memory", type=int, default=DEFAULTS.limits.memory // MIB,
+                     help="MiB of memory for a notebook's sandbox, and of address space per process "
+                          "(default %(default)s)")
+    grd.add_argument("--grader-memory", type=int, default=DEFAULTS.grader_memory // MIB,
+                     help="MiB of memory for the grader's own work on one submission (default %(default)s)")
+    grd.add_argument("--seed", type=int, default=DEFAULTS.seed,
+                     help="seed of the random test data (default: a fresh one, saved in seed.txt)")
+    where = grd.add_mutually_exclusive_group()
+    where.add_argument("--sandbox", choices=backends.names(), default=DEFAULTS.backend, metavar="NAME",
+                       help="where student code runs: " + "; ".join(
+                           f"{name}{' (the default)' if name == DEFAULTS.backend else ''}: "
+                           f"{backends.backend_class(name).summary}" for name in backends.names()))
+    where.add_argument("--no-sandbox", dest="sandbox", action="store_const", const=backends.UNCONFINED,
+                       help=f"the old name of --sandbox {backends.UNCONFINED}: student code runs UNCONFINED, with "
+                            "your permissions (only for code you trust, or where each submission is already "
+                            "isolated)")
+    grd.add_argument("--rubric", type=Path, default=DEFAULTS.rubric,
                      help="TOML rubric: points, required exercises, branches, extra credit "
                           "(default: the lab's; `labkit rubric` prints it)")
     grd.add_argument("--quiet", action="store_true", help="no progress bar")

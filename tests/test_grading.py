@@ -421,11 +421,12 @@ def test_grading_without_bwrap_stops_and_says_how_to_install_it(tmp_path, monkey
     assert not (tmp_path / "out").exists()
 
 
-def test_no_sandbox_warns_loudly_and_still_grades(tmp_path):
-    run = _cli("grade", str(NOTEBOOKS / "06_bilinear.ipynb"), "--out", str(tmp_path / "g"), "--no-sandbox",
+@pytest.mark.parametrize("switch", [["--no-sandbox"], ["--sandbox", "none"]])
+def test_no_sandbox_warns_loudly_and_still_grades(tmp_path, switch):
+    run = _cli("grade", str(NOTEBOOKS / "06_bilinear.ipynb"), "--out", str(tmp_path / "g"), *switch,
                "--quiet", "--seed", "5")
     assert run.returncode == 0, run.stderr
-    assert "UNCONFINED" in run.stderr and "random test data from seed 5" in run.stdout
+    assert "student code runs UNCONFINED" in run.stderr and "random test data from seed 5" in run.stdout
     assert f"06_bilinear{' ' * 20}" in run.stdout and run.stdout.split("06_bilinear")[1].split()[0] == "8"
 
 

@@ -12,6 +12,7 @@ import labkit
 from labkit.checks import exercises, hermite
 from labkit.checks.exercises import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN_PATCH, REFUSALS
 from labkit.grading import guard, refusals, remote, scoring
+from labkit.grading.options import GradeOptions
 from labkit.grading.scan import Unreadable, python_source, scan
 
 X, Y, YP = np.array([0.0, 1.0, 3.0]), np.array([1.0, -1.0, 2.0]), np.array([0.0, 2.0, -1.0])
@@ -29,6 +30,7 @@ def eval_pherm(xdata, ydata, ypdata, xval):
             + ydata[k + 1] * s**2 * (3 - 2 * s) + ypdata[k + 1] * h * s**2 * (s - 1))
 """
 PROFILES = scoring._for_sandbox(refusals.wire(REFUSALS))
+UNCONFINED = GradeOptions(backend="none")
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +42,7 @@ def open_notebooks():
 
 
 def _notebook(open_notebooks, *cells, clean=True):
-    notebook = remote.Notebook(confined=False, profiles=PROFILES)
+    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": list(cells), "cell_timeout": 30}, 120)
     if clean:
@@ -215,7 +217,7 @@ def test_switching_the_watch_off_or_going_round_it_voids_the_answer(open_noteboo
 ])
 def test_threads_signal_handlers_and_anonymous_memory_are_refused_even_without_the_sandbox(open_notebooks, cell,
                                                                                             error):
-    notebook = remote.Notebook(confined=False, profiles=PROFILES)
+    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": [cell], "cell_timeout": 30}, 120)
     assert ran["errors"] and error in ran["errors"][0]["message"], ran

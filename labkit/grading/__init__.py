@@ -4,7 +4,7 @@ One module per concern:
 
 * :mod:`~labkit.grading.release` - the student version of the instructor notebooks;
 * :mod:`~labkit.grading.options` - the limits of a grading run, defaults defined once;
-* :mod:`~labkit.grading.sandbox` - the bubblewrap box and resource limits a notebook runs in;
+* :mod:`~labkit.grading.backends` - the sandbox a notebook runs in, one module per backend (``--sandbox NAME``);
 * :mod:`~labkit.grading.seccomp` - the system calls a sandboxed notebook may not make;
 * :mod:`~labkit.grading.cgroup` - a memory cgroup around each sandbox and grading process;
 * :mod:`~labkit.grading.protocol` - the plain-number messages between grader and sandbox;
@@ -28,9 +28,9 @@ from .release import release, release_notebook, strip_solutions  # light: nbform
 # ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {"grade": "batch", "SubmissionGrade": "report", "merge": "report", "Rubric": "rubric",
             "load_rubric": "rubric", "exercises_in": "scoring", "grade_notebook": "scoring", "grade_submission": "scoring",
-            "submission_notebooks": "scoring", "GradeOptions": "options"}
-_MODULES = {"batch", "cgroup", "guard", "nbgrader", "options", "protocol", "refusals", "release", "remote", "report",
-            "rubric", "sandbox", "scan", "scoring", "seccomp", "worker"}
+            "submission_notebooks": "scoring", "GradeOptions": "options", "get_backend": "backends"}
+_MODULES = {"backends", "batch", "cgroup", "guard", "nbgrader", "options", "protocol", "refusals", "release", "remote",
+            "report", "rubric", "scan", "scoring", "seccomp", "worker"}
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]
 

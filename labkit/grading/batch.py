@@ -1,7 +1,8 @@
 """Grading a class: every submission in a grading process of its own, a few at a time.
 
-:func:`grade` checks the sandbox once, draws the run's seed (or takes the one
-given), computes what the sandbox refuses once, and then starts one process
+:func:`grade` checks the sandbox backend once (:mod:`labkit.grading.backends`),
+draws the run's seed (or takes the one given), computes what the sandbox
+refuses once, and then starts one process
 per submission (``python -m labkit.grading.scoring``), at most `jobs` at a
 time. Each has its own limits: address space and a memory cgroup for the
 grader's own work, and the submission's time limit plus a grace for the
@@ -30,17 +31,13 @@ import time
 from pathlib import Path
 
 from ..checks.exercises import REFUSALS
-from . import cgroup, refusals, sandbox
+from . import backends, cgroup, refusals
+from .backends.base import SandboxUnavailable
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line, safe_name, write_report
-from .rubric import default as default_rubric
+from .rubric import Rubric, default as default_rubric, load as load_rubric
 from .scoring import submission_name
 
-UNCONFINED_WARNING = """\
-!!! labkit grade --no-sandbox: student code runs UNCONFINED, with your permissions.
-!!! It can read, change or delete anything you can, reach the network and leave
-!!! processes behind. Use this only for code you trust.
-"""
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
 MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file
@@ -79,8 +76,10 @@ class _Job:
         self.attempt += 1
         self.result = self.work / f"{safe_name(self.name)}-{self.attempt}.json"
         spec = self.work / f"{safe_name(self.name)}-{self.attempt}.spec.json"
+        origin = None if self.options.backend in backends.BUILTIN else backends.origin(self.options.backend)
         spec.write_text(json.dumps({"submission": str(self.path), "name": self.name, "result": str(self.result),
-                                    "profiles": str(self.profiles_file), "options": self.options.as_dict()}),
+                                    "profiles": str(self.profiles_file), "options": self.options.as_dict(),
+                                    "backend_origin": origin}),
                         encoding="utf-8")
         memory = self.options.grader_memory
         self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
@@ -162,15 +161,18 @@ class _Job:
 
 
 def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, progress=True, seed=None,
-          sandboxed=True, limits=None, rubric=None, options=None):
+          sandboxed=None, limits=None, rubric=None, options=None):
     """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
 
-    `options` (a :class:`labkit.grading.options.GradeOptions`) or the single
-    keywords bound the run; `seed` fixes the random test data (a fresh one is
-    drawn and written to ``seed.txt`` when it is None); `sandboxed=False`
-    runs student code unconfined, after a warning on stderr. `rubric` turns
-    the checks' results into grades (the lab's when None). Returns the
-    grades in the order given; those with ``graded`` False could not be
+    `options` (a :class:`labkit.grading.options.GradeOptions`, the defaults
+    when None) bound the run, with the single keywords that are given in
+    place of its own; `seed` fixes the random test data (a fresh one is
+    drawn and written to ``seed.txt`` when it is None); the options'
+    backend is the sandbox (``sandboxed=False``, the old switch, means
+    ``backend="none"``: student code runs unconfined, after a warning on
+    stderr). `rubric` (a :class:`Rubric`, or a TOML file; else the options'
+    rubric, else the lab's) turns the checks' results into grades. Returns
+    the grades in the order given; those with ``graded`` False could not be
     graded (their ``failure`` says why).
     """
     submissions = [Path(s) for s in submissions]
@@ -182,23 +184,24 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     names = [submission_name(p) for p in submissions]
     if len(set(names)) != len(names):
         raise ValueError("two submissions have the same name; their feedback files would collide.")
-    given = {key: value for key, value in (("cell_timeout", cell_timeout), ("total_timeout", total_timeout),
-                                           ("limits", limits)) if value is not None}
-    options = options or GradeOptions()
+    options = GradeOptions.build(options, cell_timeout=cell_timeout, total_timeout=total_timeout, limits=limits,
+                                 seed=seed, sandboxed=sandboxed)
+    if rubric is not None and not isinstance(rubric, Rubric):
+        options = GradeOptions.build(options, rubric=rubric)
+    if not isinstance(rubric, Rubric):
+        rubric = default_rubric() if options.rubric is None else load_rubric(options.rubric)
+    backend = backends.get_backend(options.backend)
+    try:
+        backend.available()
+    except SandboxUnavailable as exc:
+        raise ValueError(f"cannot grade in a sandbox: {exc}") from None
+    warning = backend.warning()
+    if warning:
+        sys.stderr.write(warning)
     from dataclasses import replace
 
-    options = replace(options, **given, confined=bool(sandboxed) and options.confined)
-    if options.confined:
-        try:
-            sandbox.available()
-        except sandbox.SandboxUnavailable as exc:
-            raise ValueError(f"cannot grade in a sandbox: {exc}") from None
-    else:
-        sys.stderr.write(UNCONFINED_WARNING)
-    seed = seed if seed is not None else options.seed
-    seed = secrets.randbits(63) if seed is None else int(seed)
+    seed = secrets.randbits(63) if options.seed is None else int(options.seed)
     options = replace(options, seed=seed)
-    rubric = rubric or default_rubric()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")

@@ -1,21 +1,30 @@
 """How a grading run is bounded: one options object, its defaults defined once.
 
-:class:`GradeOptions` travels from the command line (or :func:`labkit.grading.grade`)
-to each submission's grading process and into the sandbox.
+:class:`GradeOptions` travels from the command line (``labkit grade``, whose
+defaults are read from here) or :func:`labkit.grading.grade` to each
+submission's grading process (:mod:`labkit.grading.scoring`) and into the
+sandbox (:class:`labkit.grading.remote.Notebook`). No other module spells out
+a default of its own: they take the options object, or values from it.
 """
-from dataclasses import asdict, dataclass, field
+import os
+from dataclasses import asdict, dataclass, field, fields, replace
 
-from .sandbox import Limits
+from . import backends
+from .backends.base import Limits
+
+MIB = 1024**2
+CPU_GRACE = 30  # CPU seconds a notebook's process gets beyond the total time limit (`labkit grade`)
 
 
 @dataclass(frozen=True)
 class GradeOptions:
-    """Time, memory and randomness of one grading run."""
+    """Time, memory, randomness, sandbox and rubric of one grading run."""
 
     cell_timeout: int = 60  # seconds per cell, and per call of a student's function
     total_timeout: int = 600  # seconds for one submission in all, every notebook of it together
     seed: int = None  # the random test data's seed (a fresh one per run when None)
-    confined: bool = True  # False runs student code without the sandbox (trusted code only)
+    backend: str = backends.DEFAULT  # the sandbox backend's name (labkit.grading.backends; `--sandbox NAME`)
+    rubric: str = None  # the rubric's TOML file (None: the lab's own, labkit/grading/rubric.toml)
     limits: Limits = field(default_factory=Limits)  # the sandbox's resource limits
     grader_memory: int = 3 * 1024**3  # bytes of address space for the grader's own work on one submission
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
@@ -24,6 +33,36 @@ class GradeOptions:
         for name in ("cell_timeout", "total_timeout"):
             if int(getattr(self, name)) < 1:
                 raise ValueError(f"{name.replace('_', '-')} must be at least 1 second; got {getattr(self, name)}.")
+        backends.backend_class(self.backend)  # ValueError naming the choices
+        if self.rubric is not None:
+            if not isinstance(self.rubric, (str, os.PathLike)):
+                raise ValueError(f"rubric must be the path of a TOML rubric (or None for the lab's own); got "
+                                 f"{self.rubric!r}.")
+            object.__setattr__(self, "rubric", os.fspath(self.rubric))
+        if not isinstance(self.limits, Limits):
+            raise ValueError(f"limits must be a labkit.grading.backends.base.Limits; got {self.limits!r}.")
+
+    @classmethod
+    def build(cls, options=None, *, sandboxed=None, confined=None, **given):
+        """`options` (the defaults when None) with each keyword in `given` that is not None in its place.
+
+        `sandboxed` and `confined` are the old names of the switch: False
+        means ``backend="none"`` (True changes nothing)."""
+        if options is not None and not isinstance(options, cls):
+            raise ValueError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(given) - known)
+        if unknown:
+            raise ValueError(f"unknown grading option(s) {', '.join(unknown)}; the options are "
+                             f"{', '.join(sorted(known))} (and sandboxed=False, the old name of "
+                             f"backend={backends.UNCONFINED!r}).")
+        given = {key: value for key, value in given.items() if value is not None}
+        if sandboxed is False or confined is False:
+            if given.get("backend", backends.UNCONFINED) != backends.UNCONFINED:
+                raise ValueError(f"sandboxed=False means backend={backends.UNCONFINED!r}, but "
+                                 f"backend={given['backend']!r} was given too; give one or the other.")
+            given["backend"] = backends.UNCONFINED
+        return replace(options if options is not None else cls(), **given)
 
     def as_dict(self):
         return asdict(self)
@@ -33,3 +72,6 @@ class GradeOptions:
         data = dict(data)
         data["limits"] = Limits(**data.get("limits", {}))
         return cls(**data)
+
+
+DEFAULTS = GradeOptions()

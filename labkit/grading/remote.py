@@ -1,15 +1,21 @@
 """The grader's handle on one sandboxed notebook: start it, run it, call into it, stop it.
 
 :class:`Notebook` starts the worker (:mod:`labkit.grading.worker`) inside the
-sandbox, in a memory cgroup of its own where one can be made, tells it what
-the watch refuses, sends it requests and reads its answers with a deadline
-and a size limit, and stops every process of the sandbox when it is done,
-stuck or misbehaving. :class:`Namespace` is the mapping the checks read
-(``ns["eval_pherm"]``): a function comes back as a :class:`Function` proxy
-that forwards each call into the sandbox, and data come back decoded as
-plain numbers (:func:`labkit.grading.protocol.decode`). So the checks of
+sandbox of the backend its :class:`~labkit.grading.options.GradeOptions` name
+(:mod:`labkit.grading.backends`), tells it what the watch refuses, sends it
+requests and reads its answers with a deadline and a size limit, and stops
+every process of the sandbox when it is done, stuck or misbehaving.
+:class:`Namespace` is the mapping the checks read (``ns["eval_pherm"]``): a
+function comes back as a :class:`Function` proxy that forwards each call
+into the sandbox, and data come back decoded as plain numbers
+(:func:`labkit.grading.protocol.decode`). So the checks of
 :mod:`labkit.checks` run unchanged on this side, never in the student's
 process.
+
+A time limit is an exception of its own type, raised where it is detected:
+:class:`NotebookTimeout` when the submission's total time is used up,
+:class:`CellTimeout` when a cell, a request or one call of a student's
+function ran past its own limit. Callers tell them apart by type.
 """
 import os
 import secrets
@@ -17,26 +23,37 @@ import selectors
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
-from . import cgroup, protocol, refusals, sandbox, seccomp
+from . import backends, protocol, refusals
+from .backends.base import remove_tree  # noqa: F401 - where callers have found it
+from .options import GradeOptions
+
+WORKER = (sys.executable, "-I", "-m", "labkit.grading.worker")  # the worker's command, run inside the sandbox
+SETUP_TIMEOUT = 120  # seconds for a new worker to import what notebooks need and answer its setup
 
 
 class WorkerError(RuntimeError):
-    """The sandboxed notebook stopped, hung or answered out of protocol."""
+    """The sandboxed notebook stopped, hung or answered out of protocol: the grading error of one notebook."""
 
     kind = "WorkerError"
 
 
 class WorkerTimeout(WorkerError):
-    """The notebook did not answer in time; ``total`` says whether the whole notebook's time is used up."""
+    """The notebook did not answer in time (one of the two kinds below)."""
 
     kind = "Timeout"
+    total = False  # whether the submission's whole time is used up
 
-    def __init__(self, message, total):
-        super().__init__(message)
-        self.total = total
+
+class CellTimeout(WorkerTimeout):
+    """A cell, a request or one call of a student's function ran past its own time limit."""
+
+
+class NotebookTimeout(WorkerTimeout):
+    """The submission's total time limit is used up: nothing more of it can run."""
+
+    total = True
 
 
 class StudentError(Exception):
@@ -49,54 +66,30 @@ class StudentError(Exception):
         self.traceback = traceback
 
 
-def remove_tree(path):
-    """Delete a folder however deep it is and whatever its permissions, without Python's recursion."""
-    if not os.path.lexists(path):
-        return
-    subprocess.run(["chmod", "-R", "u+rwx", "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    subprocess.run(["rm", "-rf", "--one-file-system", "--", str(path)], stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL)
-
-
 class Notebook:
-    """One worker in its sandbox (or, unconfined, in a new session with a private folder)."""
+    """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest."""
 
-    def __init__(self, limits=sandbox.Limits(), confined=True, deadline=None, profiles=None):
-        self.deadline = deadline if deadline is not None else time.monotonic() + 600
+    def __init__(self, options=None, deadline=None, profiles=None):
+        self.options = options if options is not None else GradeOptions()
+        self.deadline = deadline if deadline is not None else time.monotonic() + self.options.total_timeout
         self.stopped = None  # why the worker can no longer answer
         self.tampered = None  # what the notebook did that voids its answers
         self._buffer = b""
-        self._folder = None
-        self.cgroup = cgroup.create(limits.memory + 512 * 1024**2)  # the worker's own imports on top
-        uid = sandbox.sandbox_uid()
-        argv = [sys.executable, "-I", "-m", "labkit.grading.worker"]
-        seccomp_fd = None
-        if confined:
-            seccomp_fd = seccomp.pipe_with_program()
-            argv = sandbox.command(argv + [str(uid)], limits, seccomp_fd)
-            base, cwd, env = (0 if uid else sandbox.processes_of_this_user()), None, None
-        else:
-            self._folder = tempfile.mkdtemp(prefix="labkit-grade-")
-            base, cwd = sandbox.processes_of_this_user(), self._folder
-            env = {**os.environ, "HOME": self._folder, "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1"}
-        group = self.cgroup
-
-        def prepare():
-            if group is not None:
-                group.join()
-            sandbox.apply_limits(limits, base)
-
+        self.backend = backends.get_backend(self.options.backend)
+        self.box = self.backend.box(list(WORKER), self.options.limits)
         try:
-            self.process = subprocess.Popen(
-                argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, cwd=cwd, env=env,
-                start_new_session=True, preexec_fn=prepare, pass_fds=(seccomp_fd,) if seccomp_fd is not None else ())
-        finally:
-            if seccomp_fd is not None:
-                os.close(seccomp_fd)
+            self.process = self.box.start()
+        except OSError as exc:
+            self.box.close()
+            raise WorkerError(f"the {self.backend.name} sandbox could not start the worker ({exc})") from None
+        except BaseException:
+            self.box.stop()
+            self.box.close()
+            raise
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.process.stdout, selectors.EVENT_READ)
         self.request({"op": "setup", "profiles": profiles if profiles is not None else refusals.wire(()),
-                      "passables": sorted(protocol.PASSABLE)}, 120)
+                      "passables": sorted(protocol.PASSABLE)}, SETUP_TIMEOUT)
 
     def __enter__(self):
         return self
@@ -105,34 +98,25 @@ class Notebook:
         self.close()
 
     def peak_memory(self):
-        return self.cgroup.peak() if self.cgroup is not None else None
+        return self.box.peak_memory()
 
     def close(self):
         """Stop the worker and everything it started; nothing of it is left on the machine."""
-        if self.process.poll() is None:
-            try:
-                os.killpg(self.process.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                self.process.kill()
-        self.process.wait()
-        if self.cgroup is not None:
-            if self.stopped is None and self.cgroup.out_of_memory():
-                self.stopped = "the notebook ran out of memory"
-            self.cgroup.remove()
+        self.box.stop()
+        if self.stopped is None and not self.box.closed and self.box.out_of_memory():
+            self.stopped = "the notebook ran out of memory"
+        self.box.close()
         self._selector.close()
         for pipe in (self.process.stdin, self.process.stdout):
             try:
                 pipe.close()
             except OSError:
                 pass
-        if self._folder is not None:
-            remove_tree(self._folder)
-            self._folder = None
 
-    def _stop(self, why, error=WorkerError, **details):
+    def _stop(self, why, error=WorkerError):
         self.stopped = why
         self.close()
-        raise error(why, **details)
+        raise error(why)
 
     def request(self, message, timeout):
         """Send one request; its answer (a dict), or WorkerError after stopping the worker."""
@@ -159,7 +143,7 @@ class Notebook:
 
     def _ended(self):
         code = self.process.poll()
-        if self.cgroup is not None and self.cgroup.out_of_memory():
+        if self.box.out_of_memory():
             return "the notebook ran out of memory (the sandbox's limit)"
         if code is None:
             return "the notebook's process stopped answering"
@@ -172,10 +156,10 @@ class Notebook:
         while b"\n" not in self._buffer:
             remaining = until - time.monotonic()
             if remaining <= 0:
-                total = until >= self.deadline
-                limit = "total time limit" if total else "time limit"
-                self._stop(f"stopped after the {limit}: the notebook did not answer in time", WorkerTimeout,
-                           total=total)
+                if until >= self.deadline:
+                    self._stop("stopped after the total time limit: the notebook did not answer in time",
+                               NotebookTimeout)
+                self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
             if not self._selector.select(remaining):
                 continue
             chunk = os.read(self.process.stdout.fileno(), 1 << 20)
@@ -216,6 +200,8 @@ def _value(answer):
         error = answer["error"] if isinstance(answer["error"], dict) else {}
         kind, message = str(error.get("kind", "Error"))[:100], str(error.get("message", ""))[:500]
         refused = error.get("refused")
+        if kind == WorkerTimeout.kind and error.get("timeout"):  # the worker stopped the call at its time limit
+            raise CellTimeout(message)
         if kind == "NotImplementedError" and not refused:
             raise NotImplementedError(message)
         raise StudentError(kind, message, str(refused)[:200] if refused else None,
@@ -233,8 +219,9 @@ class Namespace:
     (each part of an exercise says its own, :func:`labkit.checks.exercises.grade`).
     """
 
-    def __init__(self, notebook, timeout=60):
-        self.notebook, self.timeout = notebook, timeout
+    def __init__(self, notebook, timeout=None):
+        self.notebook = notebook
+        self.timeout = timeout if timeout is not None else notebook.options.cell_timeout
         self.refusal = None
         self._kinds = {}
 

@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 from ..checks.exercises import ANSWERS, EXERCISES, REFUSALS, grade as run_checks
-from . import refusals, remote, scan
+from . import backends, refusals, remote, scan
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line
 
@@ -207,14 +207,15 @@ def _for_sandbox(profiles):
     return {name: {key: profile[key] for key in ("names", "modules", "c_names")} for name, profile in profiles.items()}
 
 
-def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None,
-                   options=None, deadline=None, skip=(), profiles=None, answers=None):
+def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, **single):
     """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
 
-    `options` (a :class:`GradeOptions`) or the single keywords bound it; `deadline`
-    (monotonic) is the submission's; exercises in `skip` are not checked here. The
-    notebook's answers in words go into `answers` ({grade id: text}) when it is given."""
-    options = _options(options, cell_timeout, total_timeout, seed, confined, limits)
+    `options` (a :class:`GradeOptions`, the defaults when None) bound it, with
+    any single option given as a keyword (``cell_timeout=10``) in its place;
+    `deadline` (monotonic) is the submission's; exercises in `skip` are not
+    checked here. The notebook's answers in words go into `answers`
+    ({grade id: text}) when it is given."""
+    options = GradeOptions.build(options, **single)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     profiles = profiles or _profiles()
     name = one_line(Path(path).name, 120)
@@ -234,17 +235,17 @@ def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confi
                     "by the notebooks before it."]
     problems, results = [], {}
     try:
-        notebook = remote.Notebook(options.limits, options.confined, deadline, _for_sandbox(profiles))
+        notebook = remote.Notebook(options, deadline, _for_sandbox(profiles))
     except remote.WorkerError as exc:
         return {}, [f"{name}: the sandbox could not start ({exc})."]
     with notebook:
         try:
             ran = notebook.request({"op": "run", "cells": code, "cell_timeout": options.cell_timeout},
                                    options.total_timeout)
-        except remote.WorkerTimeout as exc:
-            why = (f"stopped after the submission's time limit of {options.total_timeout} s" if exc.total
-                   else str(exc))
-            return {}, [f"{name}: {why}."]
+        except remote.NotebookTimeout:
+            return {}, [f"{name}: stopped after the submission's time limit of {options.total_timeout} s."]
+        except remote.CellTimeout as exc:
+            return {}, [f"{name}: {exc}."]
         except remote.WorkerError as exc:
             return {}, [f"{name}: {exc} while running its cells."]
         if "error" in ran and not notebook.tampered:  # the notebook's process died while its cells ran
@@ -261,7 +262,7 @@ def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confi
                           for part in exercise.parts]
                 results[number] = _rescore({"exercise": number, "defined": True, "checks": checks})
                 continue
-            verdict = run_checks(number, remote.Namespace(notebook, options.cell_timeout), seed=options.seed)
+            verdict = run_checks(number, remote.Namespace(notebook), seed=options.seed)
             for index, part in enumerate(exercise.parts):
                 if part.refused is None:
                     continue
@@ -280,19 +281,6 @@ def grade_notebook(path, cell_timeout=None, total_timeout=None, seed=None, confi
     return results, problems
 
 
-def _options(options, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None):
-    given = {key: value for key, value in (("cell_timeout", cell_timeout), ("total_timeout", total_timeout),
-                                           ("seed", seed), ("confined", confined), ("limits", limits))
-             if value is not None}
-    if options is None:
-        return GradeOptions(**given)
-    if given:
-        from dataclasses import replace
-
-        return replace(options, **given)
-    return options
-
-
 def submission_name(path):
     """A submission's name: its folder's or notebook's, bytes that are not UTF-8 spelled out as escapes."""
     path = Path(path)
@@ -300,12 +288,19 @@ def submission_name(path):
     return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
-def grade_submission(path, cell_timeout=None, total_timeout=None, seed=None, confined=None, limits=None,
-                     rubric=None, options=None, profiles=None):
-    """Grade one submission (a notebook or a folder of them), scored with `rubric` (the lab's when None).
+def grade_submission(path, options=None, *, rubric=None, profiles=None, **single):
+    """Grade one submission (a notebook or a folder of them), scored with `rubric` (else the options' rubric,
+    else the lab's).
 
-    One time limit covers every notebook of the submission."""
-    options = _options(options, cell_timeout, total_timeout, seed, confined, limits)
+    `options` (a :class:`GradeOptions`, the defaults when None) bound it, with
+    any single option given as a keyword in its place (``confined=False``,
+    the old switch, means ``backend="none"``). One time limit covers every
+    notebook of the submission."""
+    options = GradeOptions.build(options, **single)
+    if rubric is None and options.rubric is not None:
+        from .rubric import load
+
+        rubric = load(options.rubric)
     deadline = time.monotonic() + options.total_timeout
     grade = SubmissionGrade(submission_name(path), seed=options.seed)
     if rubric is not None:
@@ -333,6 +328,8 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     spec = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     profiles = json.loads(Path(spec["profiles"]).read_text(encoding="utf-8"))
+    if spec.get("backend_origin"):  # a backend registered outside labkit: its module registers it here too
+        backends.import_origin(*spec["backend_origin"])
     options = GradeOptions.from_dict(spec["options"])
     grade = grade_submission(spec["submission"], options=options, profiles=profiles)
     grade.name = spec["name"]

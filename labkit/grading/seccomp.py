@@ -1,6 +1,6 @@
 """The system calls a sandboxed notebook may not make: small seccomp filters, written out here.
 
-The sandbox's filter (bwrap's ``--seccomp``, :func:`pipe_with_program`) refuses:
+The sandbox's filter (:func:`pipe_with_program`, for a backend that installs it from a descriptor) refuses:
 
 * ``memfd_create`` and ``memfd_secret``: anonymous files hold memory that
   an address-space limit does not count;
@@ -18,7 +18,7 @@ The notebook's process installs the same refusals again, with
 ``rt_sigaction`` added, once it has set up its own signal handling
 (:func:`install_for_notebook`): so the notebook cannot install a signal
 handler that would interrupt the watch and see its frames, and the refusals
-hold when grading without bubblewrap too.
+hold whatever the sandbox backend, ``--sandbox none`` included.
 
 System calls of another architecture (32-bit calls on a 64-bit machine)
 are refused too: they would reach the same functions under other numbers.
@@ -82,7 +82,7 @@ def program(machine=None, deny=SANDBOX, threads=True):
 
 
 def pipe_with_program():
-    """A readable descriptor holding the sandbox's filter (for ``bwrap --seccomp FD``), or None."""
+    """A readable descriptor holding the sandbox's filter (for a sandbox that loads it from one), or None."""
     code = program()
     if code is None:
         return None
@@ -97,8 +97,8 @@ def install_for_notebook():
     where this cannot be done.
 
     Called by the notebook's process after it has set up its own timer's
-    handler and before any student code runs, so the refusals hold even when
-    grading without bubblewrap."""
+    handler and before any student code runs, so the refusals hold whatever
+    the sandbox backend."""
     code = program(deny=SANDBOX + ("rt_sigaction",), threads=True)
     if code is None:
         return False

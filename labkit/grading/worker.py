@@ -1,7 +1,9 @@
 """The sandboxed side of grading: a pristine supervisor and the notebook's process it watches.
 
 Started by the grader as ``python -I -m labkit.grading.worker [UID]`` inside the
-sandbox (:mod:`labkit.grading.sandbox`). Two processes:
+sandbox its backend made (:mod:`labkit.grading.backends`); a backend that
+starts it as root gives the otherwise unused UID it is to become, so that
+the sandbox's process limit holds. Two processes:
 
 * the **supervisor** holds the grader's pipes and never runs a line of the
   student's code. It imports what notebooks need once, then forks
@@ -389,7 +391,9 @@ class Supervisor:
                 line = answers.readline(until)
             except TimeoutError:
                 self.stop("stopped after the time limit: the notebook did not answer in time")
-                return _error("Timeout", "interrupted: it ran longer than the time limit")
+                answer = _error("Timeout", "interrupted: it ran longer than the time limit")
+                answer["error"]["timeout"] = True  # the grader raises its CellTimeout for this mark, not the words
+                return answer
             except protocol.ProtocolError as exc:
                 self.stop(f"the notebook's process answered out of protocol ({exc})")
                 return _error("WorkerError", self.ended)

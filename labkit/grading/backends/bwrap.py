@@ -1,4 +1,4 @@
-"""The box a student's notebook runs in: bubblewrap namespaces and resource limits.
+"""The default backend: a bubblewrap sandbox on this machine.
 
 :func:`command` builds the ``bwrap`` command line for one notebook:
 
@@ -12,62 +12,36 @@
   the machine and there is nothing to clean up;
 * ``/proc`` of its own, read-only (no process writes its own memory
   through ``/proc/self/mem``); a minimal ``/dev``;
-* a seccomp filter (:mod:`labkit.grading.seccomp`): no anonymous memory
-  files, no kernel keyrings, no reading or writing another process's memory;
+* a seccomp filter (:mod:`labkit.grading.seccomp`, handed to ``bwrap
+  --seccomp`` through a pipe): no anonymous memory files, no kernel
+  keyrings, no reading or writing another process's memory;
 * no network (``--unshare-net``: only a loopback of its own), its own PID,
   IPC and UTS namespaces, a new session (no terminal to inject into), and
   ``--die-with-parent``, so every process of the notebook dies with the grader;
 * all capabilities dropped but the two the worker needs to give up root
-  (it then runs as an otherwise unused uid, so the process limit holds).
+  (it then runs as an otherwise unused uid, :func:`sandbox_uid`, given on
+  its command line, so the process limit holds).
 
-The grader adds a memory cgroup around the whole sandbox where it can
-(:mod:`labkit.grading.cgroup`).
-
-:func:`apply_limits` sets the rlimits (address space, CPU seconds, processes,
-file size, open files) in the child before ``bwrap`` starts; they are
-inherited by everything inside.
+:class:`Bubblewrap` is the backend: its :class:`~.base.Box` adds a memory
+cgroup around the whole sandbox where it can (:mod:`labkit.grading.cgroup`)
+and sets the rlimits in the child before ``bwrap`` starts
+(:func:`~.base.apply_limits`); they are inherited by everything inside.
 """
 import os
-import resource
 import shutil
 import subprocess
 import sys
-from dataclasses import dataclass
 from pathlib import Path
+
+from .. import seccomp
+from . import register
+from .base import Backend, Box, Limits, SandboxUnavailable, processes_of_this_user
 
 HOME = "/home/student"
 INSTALL_HINT = ("install bubblewrap (Debian/Ubuntu: `sudo apt-get install bubblewrap`; Fedora: `sudo dnf install "
                 "bubblewrap`) on a Linux machine that allows user namespaces, or grade inside a container that "
-                "allows them; `labkit grade --no-sandbox` runs student code unconfined (not recommended)")
-
-
-class SandboxUnavailable(RuntimeError):
-    """bwrap is missing or cannot create namespaces here."""
-
-
-@dataclass(frozen=True)
-class Limits:
-    """Resource limits of one notebook's sandbox."""
-
-    memory: int = 4 * 1024**3  # bytes of address space per process, and of the whole sandbox's cgroup
-    cpu_seconds: int = 900  # per process
-    processes: int = 64  # processes and threads of the sandbox's uid
-    file_size: int = 64 * 1024**2  # bytes per file written
-    open_files: int = 256
-    tmp_size: int = 256 * 1024**2  # bytes of the private /tmp
-    home_size: int = 256 * 1024**2  # bytes of the private home folder
-
-
-def available():
-    """Raise SandboxUnavailable with what to do if bwrap cannot run a sandbox here."""
-    bwrap = shutil.which("bwrap")
-    if bwrap is None:
-        raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
-    probe = subprocess.run([bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev",
-                            "true"], capture_output=True, text=True, timeout=30)
-    if probe.returncode != 0:
-        raise SandboxUnavailable(f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): {INSTALL_HINT}.")
-    return bwrap
+                "allows them; where each submission is already isolated (a pod or container of its own), "
+                "`labkit grade --sandbox none` runs student code without a sandbox of labkit's own")
 
 
 def _namespaces():
@@ -143,28 +117,35 @@ def command(argv, limits=Limits(), seccomp_fd=None):
     return args + ["--", *argv]
 
 
-def apply_limits(limits, processes_base=0):
-    """Set the rlimits of the calling process (a child about to exec bwrap or the worker)."""
-    def cap(kind, value):
-        soft, hard = resource.getrlimit(kind)
-        value = value if hard == resource.RLIM_INFINITY else min(value, hard)
-        resource.setrlimit(kind, (value, value))
+@register
+class Bubblewrap(Backend):
+    """Each notebook in a bubblewrap sandbox of its own on this machine (see the module's description)."""
 
-    cap(resource.RLIMIT_AS, limits.memory)
-    cap(resource.RLIMIT_CPU, limits.cpu_seconds)
-    cap(resource.RLIMIT_NPROC, processes_base + limits.processes)
-    cap(resource.RLIMIT_FSIZE, limits.file_size)
-    cap(resource.RLIMIT_NOFILE, limits.open_files)
+    name = "bwrap"
+    summary = ("bubblewrap on this machine: no network, a read-only system, private folders, a seccomp filter "
+               "and resource limits")
 
+    def available(self):
+        """Raise SandboxUnavailable with what to do if bwrap cannot run a sandbox here; bwrap's path otherwise."""
+        bwrap = shutil.which("bwrap")
+        if bwrap is None:
+            raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
+        probe = subprocess.run([bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev",
+                                "true"], capture_output=True, text=True, timeout=30)
+        if probe.returncode != 0:
+            raise SandboxUnavailable(f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): "
+                                     f"{INSTALL_HINT}.")
+        return bwrap
 
-def processes_of_this_user():
-    """How many processes the calling uid already has (the process limit counts them too)."""
-    uid = os.getuid()
-    count = 0
-    for entry in os.scandir("/proc"):
-        if entry.name.isdigit():
-            try:
-                count += entry.stat().st_uid == uid
-            except OSError:
-                pass
-    return count
+    def box(self, argv, limits):
+        uid = sandbox_uid()
+        seccomp_fd = seccomp.pipe_with_program()
+        try:
+            args = command([*argv, str(uid)], limits, seccomp_fd)
+            # as root the worker becomes `uid`, a uid of its own; otherwise the caller's processes count too
+            base = 0 if uid else processes_of_this_user()
+        except BaseException:
+            if seccomp_fd is not None:
+                os.close(seccomp_fd)
+            raise
+        return Box(args, limits, pass_fds=(seccomp_fd,), processes_base=base)

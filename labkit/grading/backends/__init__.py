@@ -1,0 +1,102 @@
+"""Sandbox backends: where a student's notebook runs while it is graded.
+
+The rest of grading knows a backend only through :class:`~.base.Backend`
+(:mod:`labkit.grading.backends.base`): whether it can run here, what to warn
+about once per run, and a :class:`~.base.Box` per notebook, which starts the
+grading worker inside the sandbox and cleans up after it. Everything a
+backend knows about its own tool lives in its own module, named after it:
+
+* :mod:`~labkit.grading.backends.bwrap` - the default: bubblewrap namespaces,
+  a seccomp filter, rlimits and a memory cgroup, on this machine;
+* :mod:`~labkit.grading.backends.none` - no sandbox of labkit's own, for
+  when something outside already isolates each submission (a Kubernetes pod
+  or a batch job's container of its own); it warns that student code runs
+  unconfined.
+
+A Docker or podman backend must be one new module: ``backends/<name>.py``
+with a :class:`~.base.Backend` subclass whose ``name`` is ``<name>``,
+decorated with :func:`register`, and ``<name>`` added to :data:`BUILTIN`.
+Nothing else in labkit changes: ``labkit grade --sandbox <name>`` and
+:class:`labkit.grading.options.GradeOptions` take their choices from here.
+A backend registered from a module outside labkit (a test's, a site's own)
+works too: each grading process imports the module that registered it
+(:func:`origin`, :func:`import_origin`).
+"""
+import importlib
+import importlib.util
+import sys
+
+BUILTIN = ("bwrap", "none")  # one module each, backends/<name>.py; the first is the default
+DEFAULT = BUILTIN[0]
+UNCONFINED = "none"  # the backend the old switches (--no-sandbox, sandboxed=False, confined=False) stand for
+
+_registered = {}  # name -> Backend subclass
+
+
+def register(cls):
+    """Make the Backend subclass `cls` available under ``cls.name`` (use as a class decorator)."""
+    from .base import Backend
+
+    if not (isinstance(cls, type) and issubclass(cls, Backend)):
+        raise ValueError(f"{cls!r} is not a subclass of labkit.grading.backends.base.Backend; only backends "
+                         "can be registered.")
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not name.isidentifier() or name != name.lower():
+        raise ValueError(f"{cls.__qualname__}.name is {name!r}; a backend needs a lower-case name that is a Python "
+                         "identifier, e.g. name = 'podman' (it is what `labkit grade --sandbox` takes).")
+    known = _registered.get(name)
+    if known is not None and (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
+        raise ValueError(f"a backend named {name!r} is already registered ({known.__module__}.{known.__qualname__}); "
+                         f"give {cls.__qualname__} another name.")
+    _registered[name] = cls
+    return cls
+
+
+def names():
+    """Every backend's name: the built-in ones in order (the default first), then any registered later."""
+    return BUILTIN + tuple(sorted(set(_registered) - set(BUILTIN)))
+
+
+def backend_class(name):
+    """The Backend subclass called `name`; ValueError listing the choices for a name there is none of."""
+    if isinstance(name, str) and name in BUILTIN and name not in _registered:
+        importlib.import_module(f"{__name__}.{name}")  # the module registers its backend
+    if not isinstance(name, str) or name not in _registered:
+        raise ValueError(f"there is no sandbox backend called {name!r}; choose one of: {', '.join(names())} "
+                         f"(e.g. `labkit grade --sandbox {DEFAULT}`, the default).")
+    return _registered[name]
+
+
+def get_backend(name):
+    """A new instance of the backend called `name`; ValueError listing the choices for a name there is none of."""
+    return backend_class(name)()
+
+
+def origin(name):
+    """(module name, file) where backend `name` is defined, so that another process can import it."""
+    cls = backend_class(name)
+    module = sys.modules[cls.__module__]
+    return cls.__module__, getattr(module, "__file__", None)
+
+
+def import_origin(module, path=None):
+    """Import `module` (by name, or else from the file `path`) so that the backend it registers is known here."""
+    if module in sys.modules:
+        return
+    try:
+        importlib.import_module(module)
+        return
+    except ImportError:
+        if not path:
+            raise ValueError(f"cannot import {module!r}, which defines the sandbox backend; make it importable "
+                             "(on PYTHONPATH, or installed) in the grading processes.") from None
+    spec = importlib.util.spec_from_file_location(module, path)
+    if spec is None or spec.loader is None:
+        raise ValueError(f"cannot import the sandbox backend's module {module!r} from {path}.")
+    loaded = importlib.util.module_from_spec(spec)
+    sys.modules[module] = loaded
+    try:
+        spec.loader.exec_module(loaded)
+    except BaseException:
+        del sys.modules[module]
+        raise

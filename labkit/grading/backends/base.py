@@ -1,0 +1,180 @@
+"""What every sandbox backend provides, and what backends share.
+
+The grader's handle on a notebook (:class:`labkit.grading.remote.Notebook`)
+and a grading run (:func:`labkit.grading.batch.grade`) use a backend only
+through :class:`Backend`:
+
+* :meth:`Backend.available` raises :class:`SandboxUnavailable`, saying what
+  to do, when the backend cannot run sandboxes on this machine; a grading
+  run asks once, before anything is graded;
+* :meth:`Backend.warning` is printed on stderr once per run, when there is
+  something the instructor must know (student code running unconfined);
+* :meth:`Backend.box` makes one notebook's :class:`Box` from the worker's
+  command (``python -I -m labkit.grading.worker``) and the notebook's
+  :class:`Limits`: the command that starts the worker inside the sandbox,
+  and whatever has to be set up for it and undone after it.
+
+:class:`Box` runs the command as a local process in a session of its own,
+in a memory cgroup of its own where one can be made
+(:mod:`labkit.grading.cgroup`), under the rlimits of :class:`Limits`
+(:func:`apply_limits`); a backend whose sandbox lives elsewhere (a
+container engine) overrides :meth:`Box.start` and :meth:`Box.stop`.
+"""
+import abc
+import os
+import resource
+import signal
+import subprocess
+from dataclasses import dataclass
+
+from .. import cgroup
+
+WORKER_IMPORTS = 512 * 1024**2  # bytes of a notebook's cgroup on top of its limit: the worker's own imports
+
+
+class SandboxUnavailable(RuntimeError):
+    """A backend cannot run sandboxes on this machine; the message says what to do instead."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Resource limits of one notebook's sandbox."""
+
+    memory: int = 4 * 1024**3  # bytes of address space per process, and of the whole sandbox's cgroup
+    cpu_seconds: int = 900  # per process
+    processes: int = 64  # processes and threads of the sandbox's uid
+    file_size: int = 64 * 1024**2  # bytes per file written
+    open_files: int = 256
+    tmp_size: int = 256 * 1024**2  # bytes of the private /tmp
+    home_size: int = 256 * 1024**2  # bytes of the private home folder
+
+
+def apply_limits(limits, processes_base=0):
+    """Set the rlimits of the calling process (a child about to exec the sandbox or the worker)."""
+    def cap(kind, value):
+        soft, hard = resource.getrlimit(kind)
+        value = value if hard == resource.RLIM_INFINITY else min(value, hard)
+        resource.setrlimit(kind, (value, value))
+
+    cap(resource.RLIMIT_AS, limits.memory)
+    cap(resource.RLIMIT_CPU, limits.cpu_seconds)
+    cap(resource.RLIMIT_NPROC, processes_base + limits.processes)
+    cap(resource.RLIMIT_FSIZE, limits.file_size)
+    cap(resource.RLIMIT_NOFILE, limits.open_files)
+
+
+def processes_of_this_user():
+    """How many processes the calling uid already has (the process limit counts them too)."""
+    uid = os.getuid()
+    count = 0
+    for entry in os.scandir("/proc"):
+        if entry.name.isdigit():
+            try:
+                count += entry.stat().st_uid == uid
+            except OSError:
+                pass
+    return count
+
+
+def remove_tree(path):
+    """Delete a folder however deep it is and whatever its permissions, without Python's recursion."""
+    if not os.path.lexists(path):
+        return
+    subprocess.run(["chmod", "-R", "u+rwx", "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    subprocess.run(["rm", "-rf", "--one-file-system", "--", str(path)], stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+
+
+class Box:
+    """One notebook's sandbox, from the start of its worker to the cleanup after it.
+
+    `argv` starts the worker inside the sandbox, with `cwd` and `env` (the
+    grader's when None) and the descriptors `pass_fds`, which are closed on
+    this side once the worker has them. `processes_base` processes are
+    already counted against the sandbox's process limit (those of its uid
+    outside it). `cleanup` is called once, after the worker is stopped.
+    """
+
+    def __init__(self, argv, limits, *, cwd=None, env=None, pass_fds=(), processes_base=0, cleanup=None):
+        self.argv, self.limits, self.cwd, self.env = list(argv), limits, cwd, env
+        self.pass_fds = tuple(fd for fd in pass_fds if fd is not None)
+        self.processes_base, self._cleanup = processes_base, cleanup
+        self.cgroup, self.process, self.closed = None, None, False
+
+    def start(self):
+        """Start the worker; its process (a Popen with pipes on stdin and stdout)."""
+        self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
+        group, limits, base = self.cgroup, self.limits, self.processes_base
+
+        def prepare():
+            if group is not None:
+                group.join()
+            apply_limits(limits, base)
+
+        try:
+            self.process = subprocess.Popen(
+                self.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, cwd=self.cwd,
+                env=self.env, start_new_session=True, preexec_fn=prepare, pass_fds=self.pass_fds)
+        finally:
+            self._close_passed()
+        return self.process
+
+    def _close_passed(self):
+        for fd in self.pass_fds:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        self.pass_fds = ()
+
+    def stop(self):
+        """Stop the worker and every process it started."""
+        if self.process is None:
+            return
+        if self.process.poll() is None:
+            try:
+                os.killpg(self.process.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                self.process.kill()
+        self.process.wait()
+
+    def out_of_memory(self):
+        """Whether the sandbox's memory cgroup ran out of memory (False where there is none)."""
+        return self.cgroup is not None and self.cgroup.out_of_memory()
+
+    def peak_memory(self):
+        """The sandbox's peak memory in bytes, or None where there is no cgroup to tell."""
+        return self.cgroup.peak() if self.cgroup is not None else None
+
+    def close(self):
+        """After :meth:`stop`: undo what was set up for this notebook (nothing of it is left on the machine)."""
+        if self.closed:
+            return
+        self.closed = True
+        self._close_passed()
+        if self.cgroup is not None:
+            self.cgroup.remove()
+        if self._cleanup is not None:
+            self._cleanup()
+
+
+class Backend(abc.ABC):
+    """A way of running the grading worker in a sandbox: subclass it in ``backends/<name>.py``."""
+
+    name = None  # what `labkit grade --sandbox` and GradeOptions.backend call it
+    summary = ""  # one line for `labkit grade --help`
+
+    @abc.abstractmethod
+    def available(self):
+        """Return if this backend can run sandboxes here; else raise SandboxUnavailable saying what to do."""
+
+    def warning(self):
+        """What to print on stderr once before a grading run (None: nothing)."""
+        return None
+
+    @abc.abstractmethod
+    def box(self, argv, limits):
+        """The :class:`Box` that runs the worker's command `argv` in a new sandbox bounded by `limits`."""
+
+    def __repr__(self):
+        return f"<sandbox backend {self.name}>"

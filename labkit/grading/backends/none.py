@@ -1,0 +1,45 @@
+"""No sandbox of labkit's own: for when each submission is already isolated outside labkit.
+
+Meant for a grading run where every submission gets a container of its own
+(a Kubernetes pod, a batch job's container) that is thrown away afterwards:
+that container is the sandbox. The worker then runs as a plain process in
+a session of its own, with a private temporary folder as its home and
+working directory (removed afterwards, whatever the notebook left in it),
+the same rlimits and, where one can be made, the same memory cgroup as in
+a sandbox. The refusals of the notebook's own process (its seccomp filter
+and the grader's watch) hold too. Everything else is open: student code
+runs with the grader's permissions, so every run starts with
+:data:`WARNING` on stderr.
+"""
+import os
+import tempfile
+
+from . import register
+from .base import Backend, Box, processes_of_this_user, remove_tree
+
+WARNING = """\
+!!! labkit grade --sandbox none (--no-sandbox): student code runs UNCONFINED, with your permissions.
+!!! It can read, change or delete anything you can, reach the network and leave
+!!! processes behind. Use this only for code you trust.
+"""
+
+
+@register
+class Unconfined(Backend):
+    """The worker as a plain process with a private folder: only where the submission is isolated already."""
+
+    name = "none"
+    summary = ("no sandbox of labkit's own, for when each submission already has a container of its own "
+               "(a pod, a batch job's container); student code runs with your permissions")
+
+    def available(self):
+        return None  # a process can always be started
+
+    def warning(self):
+        return WARNING
+
+    def box(self, argv, limits):
+        folder = tempfile.mkdtemp(prefix="labkit-grade-")
+        env = {**os.environ, "HOME": folder, "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1"}
+        return Box(argv, limits, cwd=folder, env=env, processes_base=processes_of_this_user(),
+                   cleanup=lambda: remove_tree(folder))

@@ -1,0 +1,228 @@
+"""Sandbox backends behind one interface: the registry, the CLI's switch, a backend that is only a subclass,
+and no knowledge of one backend's tool anywhere else."""
+import inspect
+import io
+import json
+import os
+import re
+import subprocess
+import sys
+import tokenize
+from pathlib import Path
+
+import pytest
+
+from labkit import grading
+from labkit.cli import build_parser, grade_options
+from labkit.grading import backends
+from labkit.grading.backends import bwrap, none
+from labkit.grading.backends.base import Backend, Limits
+from labkit.grading.options import GradeOptions
+
+ROOT = Path(__file__).resolve().parents[1]
+LABKIT = ROOT / "labkit"
+BACKENDS = LABKIT / "grading" / "backends"
+NOTEBOOKS = ROOT / "notebooks"
+RECORD = "LABKIT_TEST_BACKEND_RECORD"  # where the recording backend writes what it was asked, in any process
+
+
+@backends.register
+class Recording(Backend):
+    """The none backend's behaviour, and a line in a file for every notebook it boxes: all a test needs."""
+
+    name = "recording"
+    summary = "the none backend, recording each notebook it runs (tests only)"
+
+    def available(self):
+        self._record({"available": True})
+
+    def warning(self):
+        return "recording backend: student code runs unconfined\n"
+
+    def box(self, argv, limits):
+        self._record({"argv": list(argv), "memory": limits.memory, "pid": os.getpid()})
+        return backends.get_backend("none").box(argv, limits)
+
+    @staticmethod
+    def _record(entry):
+        path = os.environ.get(RECORD)
+        if path:
+            with open(path, "a", encoding="utf-8") as handle:
+                handle.write(json.dumps(entry) + "\n")
+
+
+def test_the_registry_lists_bwrap_first_as_the_default_and_none():
+    assert backends.names()[:2] == ("bwrap", "none") == backends.BUILTIN
+    assert backends.DEFAULT == "bwrap" == GradeOptions().backend
+    assert "recording" in backends.names()  # registered by this module, after the built-in ones
+    assert isinstance(backends.get_backend("bwrap"), bwrap.Bubblewrap)
+    assert isinstance(backends.get_backend("none"), none.Unconfined)
+    assert backends.get_backend("none") is not backends.get_backend("none")  # a new instance each time
+
+
+def test_a_built_in_backend_is_one_module_named_after_it_and_one_registry_entry():
+    modules = sorted(p.stem for p in BACKENDS.glob("*.py") if p.stem not in ("__init__", "base"))
+    assert modules == sorted(backends.BUILTIN)
+    for name in backends.BUILTIN:
+        cls = backends.backend_class(name)
+        assert cls.__module__ == f"labkit.grading.backends.{name}" and cls.name == name
+        assert issubclass(cls, Backend) and cls.summary
+
+
+@pytest.mark.parametrize("name", ["docker", "", "BWRAP", None, 3])
+def test_an_unknown_backend_is_a_value_error_that_lists_the_choices(name):
+    with pytest.raises(ValueError, match=r"no sandbox backend called .*choose one of: bwrap, none"):
+        backends.get_backend(name)
+    with pytest.raises(ValueError, match="choose one of: bwrap, none"):
+        GradeOptions(backend=name)
+
+
+def test_registering_checks_what_it_is_given():
+    with pytest.raises(ValueError, match="not a subclass of .*Backend"):
+        backends.register(object)
+
+    class Nameless(Backend):
+        def available(self):
+            pass
+
+        def box(self, argv, limits):
+            pass
+
+    with pytest.raises(ValueError, match="needs a lower-case name"):
+        backends.register(Nameless)
+
+    class Impostor(Nameless):
+        name = "none"
+
+    with pytest.raises(ValueError, match="already registered .*none.Unconfined"):
+        backends.register(Impostor)
+    assert backends.backend_class("none") is none.Unconfined
+    with pytest.raises(TypeError):  # the interface is abstract: a backend must say how it boxes a notebook
+        type("Half", (Backend,), {"name": "half", "available": lambda self: None})()
+
+
+def _options(*argv):
+    return grade_options(build_parser().parse_args(["grade", "work.ipynb", "--out", "out", *argv]))
+
+
+@pytest.mark.parametrize("argv", [["--no-sandbox"], ["--sandbox", "none"]])
+def test_no_sandbox_is_the_old_name_of_sandbox_none_with_its_warning(argv):
+    options = _options(*argv)
+    assert options.backend == "none" and options == _options("--sandbox", "none")
+    warning = backends.get_backend(options.backend).warning()
+    assert "UNCONFINED" in warning and "--sandbox none" in warning
+    assert backends.get_backend(_options().backend).warning() is None  # the default warns about nothing
+
+
+def test_the_cli_offers_the_registry_and_refuses_other_names():
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "x.ipynb", "--out", "o", "--sandbox",
+                          "docker"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "invalid choice: 'docker' (choose from 'bwrap', 'none')" in run.stderr
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "x.ipynb", "--out", "o", "--sandbox",
+                          "bwrap", "--no-sandbox"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "not allowed with" in run.stderr
+    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "--help"], capture_output=True, text=True,
+                         timeout=120)
+    help_text = " ".join(run.stdout.split())
+    assert "--sandbox NAME" in help_text and "--no-sandbox" in help_text
+    for name in backends.BUILTIN:
+        summary = " ".join(backends.backend_class(name).summary.split())
+        assert f"{name}{' (the default)' if name == backends.DEFAULT else ''}: {summary}" in help_text
+
+
+def test_the_old_switch_of_the_library_is_the_none_backend():
+    assert GradeOptions.build(sandboxed=False).backend == "none"
+    assert GradeOptions.build(confined=False).backend == "none"
+    assert GradeOptions.build(sandboxed=True).backend == "bwrap"  # True never overrides the options
+    assert GradeOptions.build(GradeOptions(backend="none"), sandboxed=True).backend == "none"
+    with pytest.raises(ValueError, match="give one or the other"):
+        GradeOptions.build(sandboxed=False, backend="bwrap")
+
+
+def test_a_backend_defined_in_a_test_module_is_all_grading_needs(tmp_path, monkeypatch, capsys):
+    """Subclass, register, name it in the options: the grading processes import this module and use it."""
+    record = tmp_path / "record.jsonl"
+    monkeypatch.setenv(RECORD, str(record))
+    options = GradeOptions(backend="recording", limits=Limits(memory=3 * 1024**3))
+    [grade] = grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", jobs=1, progress=False, seed=7,
+                            options=options)
+    assert grade.graded and grade.total == 8, grade.feedback()
+    assert "recording backend: student code runs unconfined" in capsys.readouterr().err
+    entries = [json.loads(line) for line in record.read_text().splitlines()]
+    assert entries[0] == {"available": True}  # asked once, in this process, before anything was graded
+    boxed = entries[1:]
+    assert len(boxed) == 1 and boxed[0]["pid"] != os.getpid()  # in the submission's own grading process
+    assert boxed[0]["argv"][-3:] == ["-I", "-m", "labkit.grading.worker"] and boxed[0]["memory"] == 3 * 1024**3
+
+
+def test_a_grading_process_cannot_use_a_backend_it_cannot_import(tmp_path):
+    with pytest.raises(ValueError, match="cannot import 'no_such_backend_module'"):
+        backends.import_origin("no_such_backend_module")
+    with pytest.raises(ValueError, match="cannot import the sandbox backend's module"):
+        backends.import_origin("no_such_backend_module", str(tmp_path / "missing.txt"))
+
+
+def test_the_none_backend_gives_a_private_folder_and_removes_it():
+    box = backends.get_backend("none").box(["python3", "-c", "pass"], Limits())
+    folder = Path(box.cwd)
+    assert folder.is_dir() and box.env["HOME"] == str(folder) and box.argv == ["python3", "-c", "pass"]
+    (folder / "left.txt").write_text("by the notebook")
+    box.close()
+    box.close()  # twice is harmless
+    assert not folder.exists()
+
+
+def test_the_bwrap_backend_gives_the_worker_its_uid_and_hands_over_the_seccomp_descriptor():
+    worker = [sys.executable, "-I", "-m", "labkit.grading.worker"]
+    box = backends.get_backend("bwrap").box(worker, Limits())
+    try:
+        assert box.argv[-len(worker) - 2:] == ["--", *worker, str(bwrap.sandbox_uid())]
+        assert list(inspect.signature(bwrap.command).parameters) == ["argv", "limits", "seccomp_fd"]  # no uid
+        for fd in box.pass_fds:
+            assert f"--seccomp {fd}" in " ".join(box.argv)
+            os.fstat(fd)  # open until the worker has it
+    finally:
+        fds = box.pass_fds
+        box.close()
+    for fd in fds:
+        with pytest.raises(OSError):
+            os.fstat(fd)
+
+
+def _code_and_text(path):
+    """Every token of a module but its comments, and the whole text."""
+    text = path.read_text(encoding="utf-8")
+    tokens = [t.string for t in tokenize.generate_tokens(io.StringIO(text).readline) if t.type != tokenize.COMMENT]
+    return " ".join(tokens), text
+
+
+TOOL_WORDS = re.compile(r"bwrap|bubblewrap|--unshare-|--ro-bind|--die-with-parent", re.IGNORECASE)
+
+
+def test_no_module_outside_the_backends_names_the_bwrap_tool():
+    """Not in code, messages, docstrings or comments: what bubblewrap is and how it is called is bwrap.py's."""
+    checked = 0
+    for path in sorted(LABKIT.rglob("*.py")):
+        if BACKENDS in path.parents:
+            continue
+        _, text = _code_and_text(path)
+        assert not TOOL_WORDS.search(text), f"{path.relative_to(ROOT)} mentions {TOOL_WORDS.search(text)[0]!r}"
+        checked += 1
+    assert checked > 30  # the whole package was read, the grading modules, the CLI and the checks among them
+    # inside the package: the tool's command line only in bwrap.py; the registry only names the backend
+    for path in sorted(BACKENDS.glob("*.py")):
+        code, _ = _code_and_text(path)
+        words = set(m.lower() for m in TOOL_WORDS.findall(code))
+        if path.name == "bwrap.py":
+            assert {"bwrap", "--unshare-", "--ro-bind", "--die-with-parent"} <= words
+        elif path.name == "__init__.py":
+            assert words <= {"bwrap", "bubblewrap"}  # its name in BUILTIN, and the package's description
+        else:
+            assert not words, f"{path.name} knows bwrap's command line: {words}"
+
+
+def test_the_grading_modules_reach_a_sandbox_only_through_the_interface():
+    """remote.py and batch.py name no backend module, only the registry and the base interface."""
+    for name in ("remote.py", "batch.py", "scoring.py", "worker.py", "options.py", "../cli.py"):
+        code, _ = _code_and_text(LABKIT / "grading" / name)
+        assert not re.search(r"backends \. (bwrap|none)\b|backends import (bwrap|none)\b", code), name
