@@ -115,3 +115,10 @@ def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
     from labkit import grading
     assert callable(grading.release) and callable(grading.grade) and grading.report.safe_name("a b").startswith("a_b-")
+
+
+def test_every_package_of_labkit_is_in_the_wheel():
+    listed = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    found = sorted(".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "labkit").rglob("__init__.py"))
+    assert "labkit.grading.backends" in found
+    assert sorted(listed) == found

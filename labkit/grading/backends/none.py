@@ -1,8 +1,10 @@
 """No sandbox of labkit's own: for when each submission is already isolated outside labkit.
 
-Meant for a grading run where every submission gets a container of its own
-(a Kubernetes pod, a batch job's container) that is thrown away afterwards:
-that container is the sandbox. The worker then runs as a plain process in
+Meant for grading where the outer system already isolates each submission:
+one ``labkit grade`` per submission, each in a container of its own that is
+thrown away afterwards (a Kubernetes pod, a batch job's container), the runs
+combined with ``labkit grade --merge``. That container is the sandbox. The
+worker then runs as a plain process in
 a session of its own, with a private temporary folder as its home and
 working directory (removed afterwards, whatever the notebook left in it),
 the same rlimits and, where one can be made, the same memory cgroup as in
