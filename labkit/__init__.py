@@ -2,8 +2,13 @@
 
 Everything a notebook needs is importable from here, e.g.
 ``from labkit import eval_pherm, ccspline, convergence_table``.
+
+``import labkit`` loads the interpolation library only. The students'
+self-checks (:mod:`labkit.check`) and the figures (:mod:`labkit.plots`)
+load when first used, as ``labkit.check`` and ``labkit.plots``.
 """
-from . import check
+import importlib
+
 from .bilinear import eval_pbilin
 from .convergence import ConvergenceTable, bilinear_convergence, convergence_table, ratio_table
 from .functions import limacon, runge, runge2d
@@ -37,3 +42,15 @@ __all__ = [
     "runge2d",
     "spline",
 ]
+
+_LAZY = ("check", "plots", "exercises", "grading")
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'labkit' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))

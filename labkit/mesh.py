@@ -8,7 +8,6 @@ share an edge into one conforming mesh (exercise 9 of the lab). See
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ._validate import as_float_array, require_finite
 
@@ -233,6 +232,8 @@ def _merge_coincident(points, quads, tolerance):
     if count > limit:
         raise ValueError(f"{count:,} pairs of nodes coincide; meshes should meet only along their shared edges. "
                          "Check that each mesh's nodes are distinct (no points piled on one spot).")
+    from scipy.spatial import cKDTree  # loaded when meshes are joined: `import labkit` stays light
+
     pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
     target = np.arange(len(points))
     if len(pairs):

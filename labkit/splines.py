@@ -10,7 +10,6 @@ The systems are solved in O(n) with LAPACK's tridiagonal solver; no dense
 matrix is ever formed.
 """
 import numpy as np
-from scipy.linalg import lapack
 
 from ._frame import Frame
 from ._validate import as_data, as_knots, as_order, as_points, as_scalar, scalar_or_array
@@ -21,6 +20,8 @@ def _solve_tridiagonal(sub, diag, sup, rhs):
     """Solve a tridiagonal system in O(n) (sub/sup diagonals of length n-1)."""
     if diag.size == 1:
         return rhs / diag
+    from scipy.linalg import lapack  # loaded at the first solve: `import labkit` stays light
+
     *_, solution, info = lapack.dgtsv(sub, diag, sup, rhs, 1, 1, 1, 1)
     if info != 0:  # cannot happen for the diagonally dominant systems built here
         raise ValueError(f"the spline system is singular (LAPACK info={info}).")

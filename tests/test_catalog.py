@@ -6,7 +6,7 @@ import os
 import pytest
 
 from labkit import grading
-from labkit.checks.exercises import EXERCISES
+from labkit.check import EXERCISES
 from labkit.grading.rubric import default
 
 from catalog import CORRECT, MISTAKES, plant

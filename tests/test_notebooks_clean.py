@@ -87,7 +87,7 @@ def test_nbgrader_metadata_is_kept_and_valid(path):
 
 
 def test_nbgrader_points_per_exercise_are_labkits():
-    from labkit.checks.exercises import EXERCISES
+    from labkit.check import EXERCISES
 
     points = {}
     for path in NOTEBOOKS:

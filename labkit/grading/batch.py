@@ -29,7 +29,6 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..checks.exercises import REFUSALS
 from . import cgroup, refusals, sandbox
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line, safe_name, write_report
@@ -199,6 +198,7 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     seed = secrets.randbits(63) if seed is None else int(seed)
     options = replace(options, seed=seed)
     rubric = rubric or default_rubric()
+    options = replace(options, exercises=rubric.registry.source)  # the workers load the rubric's exercises
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
@@ -206,7 +206,7 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     start, peaks = time.monotonic(), []
     try:
         profiles_file = work / "profiles.json"
-        profiles_file.write_text(json.dumps(refusals.wire(REFUSALS)), encoding="utf-8")
+        profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
         grades = _schedule(submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out,
                            progress, peaks)
     finally:

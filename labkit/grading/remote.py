@@ -8,7 +8,7 @@ stuck or misbehaving. :class:`Namespace` is the mapping the checks read
 (``ns["eval_pherm"]``): a function comes back as a :class:`Function` proxy
 that forwards each call into the sandbox, and data come back decoded as
 plain numbers (:func:`labkit.grading.protocol.decode`). So the checks of
-:mod:`labkit.checks` run unchanged on this side, never in the student's
+:mod:`labkit.exercises` run unchanged on this side, never in the student's
 process.
 """
 import os
@@ -61,8 +61,9 @@ def remove_tree(path):
 class Notebook:
     """One worker in its sandbox (or, unconfined, in a new session with a private folder)."""
 
-    def __init__(self, limits=sandbox.Limits(), confined=True, deadline=None, profiles=None):
+    def __init__(self, limits=sandbox.Limits(), confined=True, deadline=None, profiles=None, passables=()):
         self.deadline = deadline if deadline is not None else time.monotonic() + 600
+        self.passables = frozenset(passables)  # functions the checks may hand to student code, by name
         self.stopped = None  # why the worker can no longer answer
         self.tampered = None  # what the notebook did that voids its answers
         self._buffer = b""
@@ -96,7 +97,7 @@ class Notebook:
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.process.stdout, selectors.EVENT_READ)
         self.request({"op": "setup", "profiles": profiles if profiles is not None else refusals.wire(()),
-                      "passables": sorted(protocol.PASSABLE)}, 120)
+                      "passables": sorted(self.passables)}, 120)
 
     def __enter__(self):
         return self
@@ -200,7 +201,7 @@ class Function:
         self.__name__ = name
 
     def __call__(self, *args):
-        tags = [protocol.encode(arg) for arg in args]
+        tags = [protocol.encode(arg, self.notebook.passables) for arg in args]
         request = {"op": "call", "name": self.name, "timeout": self.timeout, "args": tags,
                    "profile": self.refusal.name if self.refusal is not None else None,
                    "passables": sorted(protocol.function_names(tags))}
@@ -230,7 +231,7 @@ class Namespace:
     """The student's variables, read through the sandbox: the mapping the checks take.
 
     :meth:`refusing` sets what is switched off for the functions read after it
-    (each part of an exercise says its own, :func:`labkit.checks.exercises.grade`).
+    (each part of an exercise says its own, :meth:`labkit.exercises.registry.Registry.check`).
     """
 
     def __init__(self, notebook, timeout=60):
