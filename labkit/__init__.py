@@ -14,6 +14,7 @@ from .convergence import ConvergenceTable, bilinear_convergence, convergence_tab
 from .functions import limacon, runge, runge2d
 from .mesh import QuadMesh, quad_mesh
 from .monotone import pchip, pchip_slopes
+from .notebook import ready
 from .patches import Corner, patch
 from .piecewise import bracket, eval_pherm, eval_plin, hermite_basis
 from .splines import ccspline, nakspline, ncspline, spline
@@ -38,6 +39,7 @@ __all__ = [
     "pchip",
     "pchip_slopes",
     "ratio_table",
+    "ready",
     "runge",
     "runge2d",
     "spline",

@@ -101,11 +101,19 @@ def test_nbgrader_points_per_exercise_are_labkits():
 
 
 def test_the_first_code_cell_says_how_to_install_labkit():
+    """The install guard is one line that calls labkit; without labkit, its failing line shows the install command."""
+    import linecache
+    import traceback
+
     for path in NOTEBOOKS:
         first = next(c for c in nbformat.read(path, as_version=4).cells if c.cell_type == "code")
-        namespace = {}
+        guard = [line for line in first.source.splitlines() if "labkit" in line and not line.startswith("from labkit")]
+        assert len(guard) == 1 and guard[0].startswith('import labkit; labkit.ready("'), (path.name, guard)
         source = "\n".join(line for line in first.source.splitlines() if not line.startswith("%"))
-        source = source.replace("import labkit\n", "import labkit_is_not_here_at_all\n", 1)
-        source = source.replace('missing.name != "labkit"', 'missing.name != "labkit_is_not_here_at_all"')
-        with pytest.raises(ModuleNotFoundError, match=r'%pip install "labkit @ git\+https://'):
-            exec(compile(source, path.name, "exec"), namespace)
+        source = source.replace("import labkit;", "import labkit_is_not_here_at_all as labkit;", 1)
+        filename = f"<{path.name}>"
+        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)  # as IPython keeps cells
+        with pytest.raises(ModuleNotFoundError) as missing:
+            exec(compile(source, filename, "exec"), {})
+        shown = "".join(traceback.format_exception(missing.value))
+        assert '%pip install "labkit @ git+https://' in shown, shown

@@ -33,14 +33,16 @@ def _hidden_region(source):
     return source.split(BEGIN_HIDDEN, 1)[1].split(END_HIDDEN, 1)[0]
 
 
-CHECK_CALL = re.compile(r"labkit\.check\.(\w+)\(\s*(?:\"(\w+)\"|\w+)?")
+# a self-check call: labkit.check.<name>(...) in the lab, or a course's own check_<name>(...); the first
+# argument, when quoted, is an experiment's key
+CHECK_CALL = re.compile(r"(?:\blabkit\.check\.|\bcheck_)(\w+)\(\s*(?:\"(\w+)\")?")
 
 
 def test_points(source, where="a test cell", rubric=None):
     """(exercise, points) of a hidden-test cell: the points of the parts its asserts check.
 
-    Each ``labkit.check.f(...)`` call checks the parts whose declared check is
-    ``f`` (for ``driver``, ``table`` and ``rate``, of the experiment named by
+    Each ``labkit.check.f(...)`` (or ``check_f(...)``) call checks the parts whose declared check is
+    ``check_f`` (for ``driver``, ``table`` and ``rate``, of the experiment named by
     the first argument). The parts' weights are scaled to the exercise's
     points under `rubric` (the lab's when None)."""
     rubric = rubric or rubrics.default()
