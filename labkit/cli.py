@@ -109,7 +109,7 @@ def build_parser():
     parser = argparse.ArgumentParser(
         prog="labkit", description="Course kit tools for the higher-order interpolation lab.",
         epilog="Grading runs every notebook in a bubblewrap sandbox (no network, read-only system, a private "
-               "folder, resource limits) and checks it from outside; see the README's 'For instructors'.")
+               "folder, resource limits) and checks it from outside; see docs/instructors.md.")
     commands = parser.add_subparsers(dest="command", required=True)
 
     nbs = commands.add_parser("notebooks", help="write the student notebooks shipped with labkit into a folder",

@@ -18,7 +18,7 @@ One module per concern:
 * :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own;
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging.
 
-Student code never runs in the grading process: see the README's "For instructors".
+Student code never runs in the grading process: see docs/instructors.md.
 """
 import importlib
 
