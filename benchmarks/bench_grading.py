@@ -17,7 +17,7 @@ from pathlib import Path
 from labkit import grading
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
-BEFORE = 8.1  # s per submission before the sandbox (nbclient kernels, two at a time), README
+BEFORE = 8.1  # s per submission before the sandbox (nbclient kernels, two at a time), docs/instructors.md
 
 
 def _class(tmp, count):

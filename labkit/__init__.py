@@ -2,13 +2,19 @@
 
 Everything a notebook needs is importable from here, e.g.
 ``from labkit import eval_pherm, ccspline, convergence_table``.
+
+``import labkit`` loads the interpolation library only. The students'
+self-checks (:mod:`labkit.check`) and the figures (:mod:`labkit.plots`)
+load when first used, as ``labkit.check`` and ``labkit.plots``.
 """
-from . import check
+import importlib
+
 from .bilinear import eval_pbilin
 from .convergence import ConvergenceTable, bilinear_convergence, convergence_table, ratio_table
 from .functions import limacon, runge, runge2d
 from .mesh import QuadMesh, quad_mesh
 from .monotone import pchip, pchip_slopes
+from .notebook import ready
 from .patches import Corner, patch
 from .piecewise import bracket, eval_pherm, eval_plin, hermite_basis
 from .splines import ccspline, nakspline, ncspline, spline
@@ -33,7 +39,20 @@ __all__ = [
     "pchip",
     "pchip_slopes",
     "ratio_table",
+    "ready",
     "runge",
     "runge2d",
     "spline",
 ]
+
+_LAZY = ("check", "plots", "exercises", "grading")
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'labkit' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))

@@ -4,13 +4,24 @@ On each grid cell the interpolant is the unique function a + bx + cy + dxy
 that matches the four corner values; the derivation with the four cell
 basis functions is in ``notebooks/06_bilinear.ipynb``.
 """
+from __future__ import annotations
+
+from collections.abc import Callable
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, as_knots, require_finite
 from ._locate import locate
 
 
-def eval_pbilin(f, xdata, ydata, xval, yval):
+def eval_pbilin(
+    f: Callable[[NDArray[np.float64], NDArray[np.float64]], ArrayLike] | ArrayLike,
+    xdata: ArrayLike,
+    ydata: ArrayLike,
+    xval: ArrayLike,
+    yval: ArrayLike,
+) -> float | NDArray[np.float64]:
     """Piecewise bilinear interpolant of `f` on the grid ``xdata x ydata``.
 
     Parameters

@@ -9,20 +9,45 @@ polynomial the method must reproduce), never a stored output.
 In a notebook, put ``labkit.check.eval_pherm(eval_pherm)`` right after the
 function: the result prints as a short report. ``labkit grade`` runs the
 same checks from outside the notebook's process, calling the student's
-functions through a proxy into a sandbox. The checks live in
-:mod:`labkit.checks`, one module per topic; this module gathers the names
-the notebooks use.
-"""
-from .checks.bilinear import eval_pbilin, phi_table, runge2d
-from .checks.drivers import driver, rate, table
-from .checks.exercises import EXERCISES, NAMES, POINTS, Exercise, grade
-from .checks.hermite import eval_pherm, limacon_derivatives, runge
-from .checks.patches import circle_corners, combined_mesh, coons, graded_corners, straight_corners, two_patches
-from .checks.plotted import boiling_plot, limacon_plot
-from .checks.result import TOLERANCE, CheckResult
-from .checks.splines import ccspline, ncspline
+functions through a proxy into a sandbox.
 
-__all__ = ["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "boiling_plot", "ccspline",
-           "circle_corners", "combined_mesh", "coons", "driver", "eval_pbilin", "eval_pherm", "grade",
-           "graded_corners", "limacon_derivatives", "limacon_plot", "ncspline", "phi_table", "rate", "runge",
-           "runge2d", "straight_corners", "table", "two_patches"]
+This module is built from the exercises' declarations
+(:mod:`labkit.exercises.registry`): every part's check is here under its
+name without ``check_``, and a convergence experiment's three checks take
+the experiment's key first: ``labkit.check.table("pherm", errors_pherm,
+test_pherm_interpolate)``.
+"""
+from .exercises import experiments as _experiments
+from .exercises.model import Exercise
+from .exercises.registry import LAB as _LAB
+from .exercises.result import TOLERANCE, CheckResult
+
+EXERCISES = _LAB.exercises
+NAMES = _LAB.names
+POINTS = _LAB.points
+
+globals().update(_LAB.self_checks)
+
+
+def driver(key, fn, seed=None):
+    """Check the driver of the convergence experiment `key` (``"pherm"``, ``"complete"``, ...)."""
+    return _experiments.check_driver(_LAB.experiment(key), fn, seed)
+
+
+def table(key, errors, fn):
+    """Check the error table of experiment `key` against what the student's driver `fn` returns."""
+    return _experiments.check_table(_LAB.experiment(key), errors, fn)
+
+
+def rate(key, answer, errors, fn):
+    """Check the rate answer of experiment `key`, read from the table `errors` of the driver `fn`."""
+    return _experiments.check_rate(_LAB.experiment(key), answer, errors, fn)
+
+
+def grade(number, namespace, seed=None):
+    """Run every check of exercise `number` on a mapping of the notebook's names (what the grader runs)."""
+    return _LAB.check(number, namespace, seed)
+
+
+__all__ = sorted(["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "driver", "grade",
+                  "rate", "table", *_LAB.self_checks])

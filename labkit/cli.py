@@ -34,13 +34,19 @@ def _notebooks(args):
 def _execute(args):
     from nbclient.exceptions import CellExecutionError
 
+    from .execute import execute, notebook_paths
     from .grading.nbgrader import mark
-    from .notebooks import execute, notebook_paths
+    from .grading.rubric import load
+
+    rubric = load(args.rubric)  # nbgrader's points are the rubric's in force
+
+    def marked(nb, name):
+        return mark(nb, name, rubric)
 
     for path in notebook_paths(args.notebooks):
         print(f"executing {path.name} ...", flush=True)
         try:
-            execute(path, timeout=args.timeout, before_save=mark)
+            execute(path, timeout=args.timeout, before_save=marked)
         except CellExecutionError as exc:
             raise ValueError(f"{path.name} failed; it was not saved.\n{str(exc)[:2000]}") from None
     return 0
@@ -114,7 +120,7 @@ def build_parser():
         prog="labkit", description="Course kit tools for the higher-order interpolation lab.",
         epilog="Grading runs every notebook in a sandbox (`labkit grade --help` lists them: the default has no "
                "network, a read-only system, a private folder and resource limits) and checks it from outside; "
-               "see the README's 'For instructors'.")
+               "see docs/instructors.md.")
     commands = parser.add_subparsers(dest="command", required=True)
 
     nbs = commands.add_parser("notebooks", help="write the student notebooks shipped with labkit into a folder",
@@ -129,6 +135,8 @@ def build_parser():
                                           "them without widget state: the reference outputs nbval compares against.")
     run.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     run.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell (default 300)")
+    run.add_argument("--rubric", type=Path,
+                     help="TOML rubric whose points nbgrader's test cells get (default: the lab's)")
     run.set_defaults(handler=_execute)
 
     rel = commands.add_parser("release", help="write the student version of the notebooks",
@@ -183,10 +191,12 @@ def build_parser():
 
 
 def _rubric(args):
-    from .grading.rubric import DEFAULT, load
+    from .grading.rubric import DEFAULT, load, points_text
 
     if args.check:
-        print(load(args.check).describe())
+        rubric = load(args.check)
+        print(rubric.describe())
+        print("  points: " + ", ".join(f"exercise {n} {points_text(p)}" for n, p in rubric.points.items()))
     else:
         print(DEFAULT.read_text(encoding="utf-8"), end="")
     return 0

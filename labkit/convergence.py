@@ -5,9 +5,14 @@ growing size and reports the relative maximum error, the ratios between
 successive errors and the order they imply. The tables the lab asks for are
 printed in ``notebooks/02_convergence.ipynb``.
 """
+from __future__ import annotations
+
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, as_scalar
 from .bilinear import eval_pbilin
@@ -50,23 +55,23 @@ class ConvergenceTable:
     """
 
     title: str
-    ndata: np.ndarray
-    errors: np.ndarray
+    ndata: NDArray[np.int_]
+    errors: NDArray[np.float64]
 
     @property
-    def ratios(self):
+    def ratios(self) -> NDArray[np.float64]:
         return self.errors[:-1] / self.errors[1:]
 
     @property
-    def rates(self):
+    def rates(self) -> NDArray[np.float64]:
         spacing_ratio = (self.ndata[1:] - 1) / (self.ndata[:-1] - 1)
         return np.log(self.ratios) / np.log(spacing_ratio)
 
     @property
-    def order(self):
+    def order(self) -> int:
         return int(np.rint(np.mean(self.rates[-3:])))
 
-    def __str__(self):
+    def __str__(self) -> str:
         return _rows(self.title, self.ndata, self.errors) + f"\nEstimated order of convergence: {self.order}"
 
 
@@ -80,7 +85,7 @@ def _rows(title, ndata, errors):
     return "\n".join(lines)
 
 
-def ratio_table(title, ndata, errors):
+def ratio_table(title: str, ndata: ArrayLike, errors: ArrayLike) -> str:
     """The lab's table layout for your own errors: each row's error and its ratio to the row above.
 
     Unlike ``str(convergence_table(...))`` it does not state an order: reading
@@ -119,7 +124,13 @@ def ratio_table(title, ndata, errors):
     return _rows(str(title), sizes, values)
 
 
-def convergence_table(method, ndata=DEFAULT_NDATA, f=runge, interval=(0.0, 5.0), ntest=4001):
+def convergence_table(
+    method: Literal["plin", "pherm", "complete", "natural", "notaknot", "pchip"],
+    ndata: ArrayLike = DEFAULT_NDATA,
+    f: Callable[[NDArray[np.float64]], ArrayLike | tuple[ArrayLike, ArrayLike]] = runge,
+    interval: tuple[float, float] = (0.0, 5.0),
+    ntest: int = 4001,
+) -> ConvergenceTable:
     """Interpolation errors of `method` on equally spaced data, as in the lab.
 
     Parameters
@@ -224,7 +235,12 @@ def _interpolate(method, f, a, b, n, xtest):
     return _hermite_eval(x, y, slopes, xtest)
 
 
-def bilinear_convergence(ndata=(11, 21, 41, 81, 161), f=runge2d, square=(0.0, 5.0), ntest=401):
+def bilinear_convergence(
+    ndata: ArrayLike = (11, 21, 41, 81, 161),
+    f: Callable[[NDArray[np.float64], NDArray[np.float64]], ArrayLike] = runge2d,
+    square: tuple[float, float] = (0.0, 5.0),
+    ntest: int = 401,
+) -> ConvergenceTable:
     """Errors of piecewise bilinear interpolation on a square, as in exercise 16.
 
     Data on an ``n x n`` equally spaced grid of `square` squared; the error

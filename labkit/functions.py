@@ -1,10 +1,13 @@
 """Test functions of the lab: the Runge function in one and two variables."""
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, as_scalar, scalar_or_array
 
 
-def runge(x):
+def runge(x: ArrayLike) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
     """The Runge function ``1 / (1 + x**2)`` and its derivative.
 
     Parameters
@@ -29,7 +32,7 @@ def runge(x):
     return scalar_or_array(y, x), scalar_or_array(yprime, x)
 
 
-def runge2d(x, y):
+def runge2d(x: ArrayLike, y: ArrayLike) -> float | NDArray[np.float64]:
     """The two-dimensional Runge function ``1 / (1 + (x + y)**2)``.
 
     `x` and `y` broadcast against each other, so ``runge2d(X, Y)`` on
@@ -45,7 +48,11 @@ def runge2d(x, y):
     return scalar_or_array(1.0 / (1.0 + s * s), s)
 
 
-def limacon(t, r0=1.15):
+def limacon(
+    t: ArrayLike, r0: float = 1.15
+) -> tuple[
+    float | NDArray[np.float64], float | NDArray[np.float64], float | NDArray[np.float64], float | NDArray[np.float64]
+]:
     """The limaçon r = r0 + cos t as a parametric curve, with its t-derivatives.
 
     Parameters
@@ -57,7 +64,7 @@ def limacon(t, r0=1.15):
 
     Returns
     -------
-    x, y, dxdt, dydt : ndarray
+    x, y, dxdt, dydt : float or ndarray, same shape as `t`
         ``x = r cos t``, ``y = r sin t`` and their derivatives.
 
     Examples

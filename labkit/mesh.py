@@ -5,12 +5,19 @@ nodes and counter-clockwise quadrilaterals; ``m1 + m2`` joins meshes that
 share an edge into one conforming mesh (exercise 9 of the lab). See
 ``notebooks/03_meshes.ipynb``.
 """
+from __future__ import annotations
+
+import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.spatial import cKDTree
+from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, require_finite
+
+if TYPE_CHECKING:  # matplotlib is imported only when a mesh is drawn
+    from matplotlib.axes import Axes
 
 WRITERS = {".vtu": ("vtu", {}), ".vtk": ("vtk", {}), ".msh": ("gmsh22", {"binary": True})}
 MERGE_TOLERANCE = 1e-6  # relative to the shortest edge of the meshes being joined
@@ -28,12 +35,15 @@ class QuadMesh:
         oriented patch.
     """
 
-    def __init__(self, points, quads):
+    points: NDArray[np.float64]
+    quads: NDArray[np.intp]
+
+    def __init__(self, points: ArrayLike, quads: ArrayLike) -> None:
         self.points = as_float_array(points, "points")
-        quads = as_float_array(quads, "quads")
-        if not np.all(np.isfinite(quads)) or np.any(quads != np.round(quads)):
+        numbers = as_float_array(quads, "quads")
+        if not np.all(np.isfinite(numbers)) or np.any(numbers != np.round(numbers)):
             raise ValueError("quads must hold whole node numbers (0, 1, 2, ...).")
-        self.quads = quads.astype(np.intp)
+        self.quads = numbers.astype(np.intp)
         if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
             raise ValueError(f"points must have shape (N, 2) or (N, 3); got {self.points.shape}.")
         if self.quads.ndim != 2 or self.quads.shape[1] != 4:
@@ -41,19 +51,20 @@ class QuadMesh:
         if self.quads.size and (self.quads.min() < 0 or self.quads.max() >= len(self.points)):
             raise ValueError("quads refer to nodes that do not exist in points.")
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"QuadMesh({len(self.points)} nodes, {len(self.quads)} quads, {self.dim}-D)"
 
     @property
-    def dim(self):
+    def dim(self) -> int:
+        """Number of coordinates of the nodes, 2 or 3."""
         return self.points.shape[1]
 
-    def edge_lengths(self):
+    def edge_lengths(self) -> NDArray[np.float64]:
         """Length of the four edges of every element, shape (M, 4)."""
         corners = self.points[self.quads]
         return np.linalg.norm(np.roll(corners, -1, axis=1) - corners, axis=2)
 
-    def quality(self):
+    def quality(self) -> NDArray[np.float64]:
         """Minimum scaled Jacobian of each element, in [-1, 1].
 
         At every corner the two edges leaving it, scaled to unit length,
@@ -85,11 +96,11 @@ class QuadMesh:
             scaled = np.where(lengths > 0, signed / lengths, 0.0)
         return np.clip(scaled.min(axis=1), -1.0, 1.0)
 
-    def folded(self):
+    def folded(self) -> NDArray[np.bool_]:
         """Boolean mask of elements that are degenerate, folded or inverted (quality <= 0)."""
         return self.quality() <= 0.0
 
-    def __add__(self, other):
+    def __add__(self, other: QuadMesh) -> QuadMesh:
         """Join two meshes, merging nodes that coincide into one conforming mesh."""
         if not isinstance(other, QuadMesh):
             return NotImplemented
@@ -100,7 +111,7 @@ class QuadMesh:
         shortest = min(_shortest_edge(self), _shortest_edge(other))
         return _merge_coincident(points, quads, MERGE_TOLERANCE * shortest)
 
-    def write(self, path):
+    def write(self, path: str | os.PathLike[str]) -> Path:
         """Write the mesh with meshio; the format follows the suffix (.vtu, .vtk, .msh).
 
         Node coordinates are written with three columns (z = 0 for a plane
@@ -117,7 +128,7 @@ class QuadMesh:
             )
         file_format, options = WRITERS[path.suffix.lower()]
         points = self.points if self.dim == 3 else np.column_stack((self.points, np.zeros(len(self.points))))
-        cell_data = {"quality": [self.quality()]}
+        cell_data: dict[str, list[NDArray[Any]]] = {"quality": [self.quality()]}
         if file_format == "gmsh22":
             ones = np.ones(len(self.quads), dtype=np.int32)
             cell_data.update({"gmsh:physical": [ones], "gmsh:geometrical": [ones]})
@@ -125,7 +136,14 @@ class QuadMesh:
         meshio.write(path, mesh, file_format=file_format, **options)
         return path
 
-    def plot(self, ax=None, color_by_quality=False, title=None, colorbar=True, **line_kw):
+    def plot(
+        self,
+        ax: Axes | None = None,
+        color_by_quality: bool = False,
+        title: str | None = None,
+        colorbar: bool = True,
+        **line_kw: Any,
+    ) -> Axes:
         """Draw the element edges (x and y) with matplotlib; return the axes.
 
         With ``color_by_quality`` the elements are filled by their quality
@@ -137,15 +155,17 @@ class QuadMesh:
 
         if ax is None:
             _, ax = plt.subplots(figsize=(5, 5))
+        # shape (M, 4, 2): PolyCollection takes an array, though matplotlib's stubs type it as a Sequence
         polygons = self.points[self.quads][..., :2]
         style = {"edgecolor": "tab:blue", "linewidth": 0.8, **line_kw}
         if color_by_quality:
-            cells = PolyCollection(polygons, array=self.quality(), cmap="RdYlGn", clim=(-1, 1), **style)
+            cells = PolyCollection(polygons, array=self.quality(), cmap="RdYlGn", clim=(-1, 1),  # type: ignore[arg-type]
+                                   **style)
             ax.add_collection(cells)
             if colorbar:
                 ax.figure.colorbar(cells, ax=ax, label="quality (min scaled Jacobian)", shrink=0.8)
         else:
-            ax.add_collection(PolyCollection(polygons, facecolor="none", **style))
+            ax.add_collection(PolyCollection(polygons, facecolor="none", **style))  # type: ignore[arg-type]
         ax.autoscale_view()
         ax.set_aspect("equal")
         ax.set_xlabel("x")
@@ -154,7 +174,7 @@ class QuadMesh:
         return ax
 
 
-def quad_mesh(x, y, z=None):
+def quad_mesh(x: ArrayLike, y: ArrayLike, z: ArrayLike | None = None) -> QuadMesh:
     """Build a :class:`QuadMesh` from coordinate arrays of shape (ns, nt).
 
     Node ``i * nt + j`` is ``(x[i, j], y[i, j])``; the element between
@@ -233,6 +253,8 @@ def _merge_coincident(points, quads, tolerance):
     if count > limit:
         raise ValueError(f"{count:,} pairs of nodes coincide; meshes should meet only along their shared edges. "
                          "Check that each mesh's nodes are distinct (no points piled on one spot).")
+    from scipy.spatial import cKDTree  # loaded when meshes are joined: `import labkit` stays light
+
     pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
     target = np.arange(len(points))
     if len(pairs):

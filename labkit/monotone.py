@@ -6,14 +6,17 @@ interpolant monotone on every interval where the data are; the choice below
 extremum, a clamped three-point formula at the ends) is the one MATLAB and
 scipy use. See ``notebooks/05_monotone.ipynb``.
 """
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._frame import Frame
 from ._validate import as_data, as_knots, as_order, as_points, scalar_or_array
 from .piecewise import _hermite_eval
 
 
-def pchip_slopes(xdata, ydata):
+def pchip_slopes(xdata: ArrayLike, ydata: ArrayLike) -> NDArray[np.float64]:
     """Knot slopes of the shape-preserving piecewise cubic interpolant.
 
     Parameters
@@ -73,7 +76,7 @@ def _end_slope(h_end, h_next, delta_end, delta_next):
     return slope
 
 
-def pchip(xdata, ydata, xval, der=0):
+def pchip(xdata: ArrayLike, ydata: ArrayLike, xval: ArrayLike, der: int = 0) -> float | NDArray[np.float64]:
     """Evaluate the shape-preserving piecewise cubic interpolant.
 
     Parameters

@@ -5,15 +5,18 @@ B (1, 0), C (1, 1) and D (0, 1): the point, the derivatives along s and t,
 and the cross derivative (twist). ``notebooks/03_meshes.ipynb`` builds the
 patch step by step and uses it to generate the lab's meshes.
 """
+from __future__ import annotations
+
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, require_finite
 from .piecewise import hermite_basis
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Corner:
     """The data of a patch at one corner.
 
@@ -33,30 +36,33 @@ class Corner:
     [0.0, 0.0]
     """
 
-    point: np.ndarray
-    ds: np.ndarray
-    dt: np.ndarray
-    dsdt: np.ndarray = None
+    point: NDArray[np.float64]
+    ds: NDArray[np.float64]
+    dt: NDArray[np.float64]
+    dsdt: NDArray[np.float64]
 
-    def __post_init__(self):
-        point = _vector(self.point, "point")
-        if point.size not in (2, 3):
+    # Written out (not generated from the fields) because it takes any array_like
+    # while the fields hold the validated float vectors.
+    def __init__(self, point: ArrayLike, ds: ArrayLike, dt: ArrayLike, dsdt: ArrayLike | None = None) -> None:
+        where = _vector(point, "point")
+        if where.size not in (2, 3):
             raise ValueError(
-                f"Corner point must have 2 (plane) or 3 (space) coordinates; got {point.size}."
+                f"Corner point must have 2 (plane) or 3 (space) coordinates; got {where.size}."
             )
-        twist = np.zeros(point.size) if self.dsdt is None else self.dsdt
-        object.__setattr__(self, "point", point)
-        for name, value in (("ds", self.ds), ("dt", self.dt), ("dsdt", twist)):
+        twist = np.zeros(where.size) if dsdt is None else dsdt
+        object.__setattr__(self, "point", where)
+        for name, value in (("ds", ds), ("dt", dt), ("dsdt", twist)):
             vec = _vector(value, name)
-            if vec.size != point.size:
+            if vec.size != where.size:
                 raise ValueError(
-                    f"Corner {name} has {vec.size} components but point has {point.size}; "
+                    f"Corner {name} has {vec.size} components but point has {where.size}; "
                     "give every field of a corner the same dimension."
                 )
             object.__setattr__(self, name, vec)
 
     @property
-    def dim(self):
+    def dim(self) -> int:
+        """Number of coordinates, 2 or 3."""
         return self.point.size
 
 
@@ -83,7 +89,7 @@ def _parameter(values, name):
     return u
 
 
-def patch(A, B, C, D, s, t):
+def patch(A: Corner, B: Corner, C: Corner, D: Corner, s: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:
     """Evaluate the bicubic Hermite patch with corners A, B, C, D on the grid s x t.
 
     The lab's construction: Hermite cubics in s give the bottom edge AB and

@@ -4,14 +4,17 @@ The maths (the four Hermite basis cubics and why their combination is C1) is
 derived in ``notebooks/02_convergence.ipynb``; the parametric use of both
 interpolants is in ``notebooks/01_limacon.ipynb``.
 """
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._frame import Frame
 from ._locate import blockwise, locate
 from ._validate import as_data, as_float_array, as_knots, as_order, as_points, scalar_or_array
 
 
-def bracket(xdata, xval):
+def bracket(xdata: ArrayLike, xval: ArrayLike) -> np.intp | NDArray[np.intp]:
     """Index of the data interval that holds each evaluation point.
 
     Parameters
@@ -40,7 +43,7 @@ def bracket(xdata, xval):
     return scalar_or_array(locate(x, xv), xval)
 
 
-def eval_plin(xdata, ydata, xval, der=0):
+def eval_plin(xdata: ArrayLike, ydata: ArrayLike, xval: ArrayLike, der: int = 0) -> float | NDArray[np.float64]:
     """Piecewise linear interpolant of ``(xdata, ydata)`` evaluated at `xval`.
 
     Parameters
@@ -89,7 +92,11 @@ def eval_plin(xdata, ydata, xval, der=0):
     return scalar_or_array(frame.result(blockwise(x, xv, line), der, xv), xval)
 
 
-def hermite_basis(xk, xk1, x, der=0):
+def hermite_basis(
+    xk: ArrayLike, xk1: ArrayLike, x: ArrayLike, der: int = 0
+) -> tuple[
+    float | NDArray[np.float64], float | NDArray[np.float64], float | NDArray[np.float64], float | NDArray[np.float64]
+]:
     """The four cubic Hermite basis polynomials on the interval ``[xk, xk1]``, or their derivatives.
 
     ``h1`` and ``h3`` carry the values at the left and right ends, ``h2`` and
@@ -107,7 +114,9 @@ def hermite_basis(xk, xk1, x, der=0):
 
     Returns
     -------
-    h1, h2, h3, h4 : ndarray
+    h1, h2, h3, h4 : float or ndarray
+        Of the broadcast shape of `xk`, `xk1` and `x`; floats if all three
+        are scalars.
 
     Examples
     --------
@@ -137,7 +146,9 @@ def hermite_basis(xk, xk1, x, der=0):
     return 12.0 / h**3 * ones, 6.0 / (h * h) * ones, -12.0 / h**3 * ones, 6.0 / (h * h) * ones
 
 
-def eval_pherm(xdata, ydata, ypdata, xval, der=0):
+def eval_pherm(
+    xdata: ArrayLike, ydata: ArrayLike, ypdata: ArrayLike, xval: ArrayLike, der: int = 0
+) -> float | NDArray[np.float64]:
     """Piecewise cubic Hermite interpolant from values and slopes, or its derivatives.
 
     On each interval ``[x_k, x_{k+1}]`` the interpolant is

@@ -4,7 +4,7 @@ Every artist that puts marks at points counts: a ``Line2D`` (``plot``, and
 the lines ``errorbar`` and ``stem`` draw) and a ``PathCollection``
 (``scatter``), whose marker is recognised from its shape.
 
-Used by the plot checks in a notebook (:mod:`labkit.checks.plotted`) and by
+Used by the plot checks in a notebook (:mod:`labkit.exercises.plotted`) and by
 the sandboxed notebook when it sends a plot to the grader
 (:mod:`labkit.grading.protocol`), so a plot is judged from its data, never
 from pixels. It holds no reference of the lab's: the grader's watch never

@@ -9,8 +9,10 @@ matrix is nonsingular, is in ``notebooks/04_splines.ipynb``.
 The systems are solved in O(n) with LAPACK's tridiagonal solver; no dense
 matrix is ever formed.
 """
+from __future__ import annotations
+
 import numpy as np
-from scipy.linalg import lapack
+from numpy.typing import ArrayLike, NDArray
 
 from ._frame import Frame
 from ._validate import as_data, as_knots, as_order, as_points, as_scalar, scalar_or_array
@@ -21,6 +23,8 @@ def _solve_tridiagonal(sub, diag, sup, rhs):
     """Solve a tridiagonal system in O(n) (sub/sup diagonals of length n-1)."""
     if diag.size == 1:
         return rhs / diag
+    from scipy.linalg import lapack  # loaded at the first solve: `import labkit` stays light
+
     *_, solution, info = lapack.dgtsv(sub, diag, sup, rhs, 1, 1, 1, 1)
     if info != 0:  # cannot happen for the diagonally dominant systems built here
         raise ValueError(f"the spline system is singular (LAPACK info={info}).")
@@ -58,7 +62,9 @@ def _prepare(xdata, ydata, name):
     return frame, h, secants
 
 
-def ccspline(xdata, ydata, y1p=None, ynp=None):
+def ccspline(
+    xdata: ArrayLike, ydata: ArrayLike, y1p: float | None = None, ynp: float | None = None
+) -> NDArray[np.float64]:
     """Knot slopes of the complete cubic spline (end slopes given).
 
     Parameters
@@ -99,7 +105,7 @@ def ccspline(xdata, ydata, y1p=None, ynp=None):
     return frame.knot_slopes(slopes, "complete spline's")
 
 
-def ncspline(xdata, ydata):
+def ncspline(xdata: ArrayLike, ydata: ArrayLike) -> NDArray[np.float64]:
     """Knot slopes of the natural cubic spline (zero second derivative at the ends).
 
     Parameters
@@ -137,7 +143,7 @@ def natural_curvatures(h, secants):
     return M
 
 
-def nakspline(xdata, ydata):
+def nakspline(xdata: ArrayLike, ydata: ArrayLike) -> NDArray[np.float64]:
     """Knot slopes of the not-a-knot cubic spline.
 
     The third derivative is continuous at the second and the second-to-last
@@ -203,7 +209,7 @@ def _notaknot_curvatures(h, secants):
     return M
 
 
-def spline(xdata, ydata, xval, der=0):
+def spline(xdata: ArrayLike, ydata: ArrayLike, xval: ArrayLike, der: int = 0) -> float | NDArray[np.float64]:
     """Cubic spline interpolation with MATLAB's ``spline`` conventions.
 
     Parameters

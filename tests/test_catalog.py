@@ -2,11 +2,12 @@
 exactly its part and is named (the catalogs are in tests/catalog.py), all graded in one sandboxed run."""
 import json
 import os
+from pathlib import Path
 
 import pytest
 
 from labkit import grading
-from labkit.checks.exercises import EXERCISES
+from labkit.check import EXERCISES
 from labkit.grading.rubric import default
 
 from catalog import CORRECT, MISTAKES, plant
@@ -14,6 +15,11 @@ from conftest import sandbox_or_skip
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 RUBRIC = default()
+SEED = 20261201
+# grades.csv of this very class and seed, graded before the exercises were declared once (issue 20): the
+# refactoring changed where things are declared, not one grade
+BEFORE = Path(__file__).with_name("data") / "catalog_grades_seed20261201.csv"
+RUN = {}
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +49,8 @@ def graded(tmp_path_factory):
         path.write_text(text)
     plant(CORRECT[0].__class__("the meshes as they are", "03_meshes.ipynb", ()), matlab)
     folders["matlab_style"] = matlab
-    results = grading.grade(list(folders.values()), tmp / "out", jobs=2, progress=False, seed=20261201)
+    results = grading.grade(list(folders.values()), tmp / "out", jobs=2, progress=False, seed=SEED)
+    RUN["out"] = tmp / "out"
     return dict(zip(folders, results))
 
 
@@ -83,3 +90,8 @@ def test_every_slip_costs_exactly_its_part_and_is_named(graded, entry):
     for number in grade.results:
         if number not in {n for n, _ in expected}:
             assert grade.points[number] == RUBRIC.points[number], grade.feedback()
+
+
+def test_the_same_seed_gives_the_same_grades_csv_as_before_the_exercises_were_declared_once(graded):
+    assert (RUN["out"] / "seed.txt").read_text().strip() == str(SEED)
+    assert (RUN["out"] / "grades.csv").read_text(encoding="utf-8") == BEFORE.read_text(encoding="utf-8")

@@ -9,7 +9,7 @@ from labkit import check
 def test_reference_implementations_pass_every_check():
     assert check.eval_pherm(labkit.eval_pherm).passed
     assert check.runge(labkit.runge).passed
-    assert check.ccspline(labkit.ccspline, labkit.checks.splines._reference_complete_system).passed
+    assert check.ccspline(labkit.ccspline, labkit.exercises.splines._reference_complete_system).passed
     assert check.ncspline(labkit.ncspline).passed
     assert check.runge2d(labkit.runge2d).passed
     assert check.eval_pbilin(labkit.eval_pbilin).passed
@@ -68,7 +68,7 @@ def test_ccspline_subscript_mistake_is_located_by_the_equal_interval_case():
 
 def test_ccspline_asymmetric_matrix_is_reported():
     def system(xdata, ydata, y1p, ynp):
-        A, D = labkit.checks.splines._reference_complete_system(np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp)
+        A, D = labkit.exercises.splines._reference_complete_system(np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp)
         A[1, 0] *= 2
         return A, D
 
@@ -122,7 +122,7 @@ def test_seeded_random_cases_are_fresh_per_seed_and_repeatable():
 def test_reference_implementations_pass_with_any_seed(seed):
     assert check.runge(labkit.runge, seed=seed).passed
     assert check.driver("pherm", _table_error, seed=seed).passed
-    assert check.ccspline(labkit.ccspline, labkit.checks.splines._reference_complete_system, seed=seed).passed
+    assert check.ccspline(labkit.ccspline, labkit.exercises.splines._reference_complete_system, seed=seed).passed
     assert check.ncspline(labkit.ncspline, seed=seed).passed
     assert check.runge2d(labkit.runge2d, seed=seed).passed
     assert check.eval_pbilin(labkit.eval_pbilin, seed=seed).passed
@@ -175,16 +175,16 @@ def _natural_from(system):
 
 @pytest.mark.parametrize("seed", [None, 3])
 def test_ncspline_built_on_a_wrong_complete_system_is_not_charged_twice(seed):
-    from labkit.checks import splines as spline_checks
+    from labkit.exercises import splines as spline_checks
 
     ncspline = _natural_from(_system_with_h_subscript_slip)
     A, _ = _system_with_h_subscript_slip([0.0, 0.7, 1.5, 2.0], [1.0, 2.0, 0.0, 1.0], 0.0, 0.0)
     assert not np.allclose(A, A.T)  # the slip is real on unequal spacing (Exercise 10 marks it)
-    assert not spline_checks.ncspline(ncspline, seed=seed).passed  # on its own, not the natural spline
-    ours = spline_checks.ncspline(ncspline, seed=seed, system=_system_with_h_subscript_slip)
+    assert not spline_checks.check_ncspline(ncspline, seed=seed).passed  # on its own, not the natural spline
+    ours = spline_checks.check_ncspline(ncspline, seed=seed, system=_system_with_h_subscript_slip)
     assert ours.passed and "your own complete_system" in repr(ours)
     # ... but a slip of its own next to the wrong system still costs ncspline
-    slipped = spline_checks.ncspline(lambda x, y: ncspline(x, y) * 1.01, seed=seed, system=_system_with_h_subscript_slip)
+    slipped = spline_checks.check_ncspline(lambda x, y: ncspline(x, y) * 1.01, seed=seed, system=_system_with_h_subscript_slip)
     assert not slipped.passed
     # and the right natural spline next to the wrong system passes the usual way
-    assert spline_checks.ncspline(labkit.ncspline, seed=seed, system=_system_with_h_subscript_slip).passed
+    assert spline_checks.check_ncspline(labkit.ncspline, seed=seed, system=_system_with_h_subscript_slip).passed

@@ -173,8 +173,23 @@ CALLS = {
     "patch": (lambda s, t: labkit.patch(*SQUARE, s, t), {"s": [0.0, 0.5, 1.0], "t": [0.0, 1.0]}),
     "convergence_table": (lambda **kw: labkit.convergence_table("plin", **kw),
                           {"ndata": [5, 11], "interval": [0.0, 5.0], "ntest": 101}),
+    "ratio_table": (lambda ndata, errors: labkit.ratio_table("t", ndata, errors),
+                    {"ndata": [5, 11], "errors": [0.1, 0.01]}),
     "bilinear_convergence": (labkit.bilinear_convergence, {"ndata": [5, 9], "square": [0.0, 5.0], "ntest": 11}),
 }
+# public names that take no numbers from a user, and why: everything else in labkit.__all__ must be in CALLS
+NO_NUMBERS = {
+    "ConvergenceTable": "a record built by convergence_table and bilinear_convergence, which are in CALLS",
+    "ready": "takes a version text; tested in labkit/notebook.py's doctest",
+}
+
+
+def test_every_public_function_has_its_bad_input_cases():
+    """A new public function fails here until it is in CALLS (or in NO_NUMBERS, with a reason)."""
+    assert set(CALLS) | set(NO_NUMBERS) == set(labkit.__all__), set(labkit.__all__) ^ (set(CALLS) | set(NO_NUMBERS))
+    assert not set(CALLS) & set(NO_NUMBERS)
+
+
 CASES = [(name, arg, bad) for name, (_, kwargs) in CALLS.items() for arg in kwargs for bad in BAD
          if not (arg == "dsdt" and bad == "None")]  # a Corner without a twist is allowed: dsdt=None means 0
 

@@ -14,7 +14,9 @@ import pytest
 
 from labkit import grading
 from labkit.check import EXERCISES
-from labkit.checks.exercises import ANSWERS
+from labkit.exercises.registry import LAB
+
+ANSWERS = LAB.answers
 from labkit.grading.rubric import default
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -92,7 +92,7 @@ def _notebook(folder, name, cells, base="02_convergence.ipynb", replace=None):
 ATTACKS = {
     "patched_check": ["import labkit.check as c\nreal = c.grade\n"
                       "c.grade = lambda n, ns, seed=None: {**real(n, ns), 'passed': True, 'points': c.POINTS[n]}\n"
-                      "import labkit.checks.exercises as e\ne.grade = c.grade\n"
+                      "import labkit.exercises.registry as e\ne.LAB.check = c.grade\n"
                       "for name in dir(c):\n    obj = getattr(c, name)\n"
                       "    if callable(obj) and not isinstance(obj, type): setattr(c, name, lambda *a, **k: True)"],
     "patched_numpy": ["import numpy as np, numpy.testing\n"
@@ -181,12 +181,12 @@ ATTACKS = {
                             "                value.__globals__['code_key'] = lambda code: bytes(12)\n"
                             "                value.__globals__['__builtins__']['len'] = lambda v: 0\n"
                             "    return np.ref(xdata, ydata, ypdata, xval)"],
-    "fake_compiled_object": ["import sys, numpy as np, labkit, labkit.checks\nclass cython_function_or_method:\n"
+    "fake_compiled_object": ["import sys, numpy as np, labkit, labkit.exercises\nclass cython_function_or_method:\n"
                              "    @property\n    def __module__(self):\n        f = sys._getframe(1)\n"
                              "        while f is not None:\n            if 'state' in f.f_locals:\n"
                              "                f.f_locals['state']['profile'] = None\n            f = f.f_back\n"
                              "        return 'nothing.to.see'\n"
-                             "labkit.checks.zz_fake = cython_function_or_method()\nsetattr(np, 'ref_pherm', labkit.eval_pherm)\n"
+                             "labkit.exercises.zz_fake = cython_function_or_method()\nsetattr(np, 'ref_pherm', labkit.eval_pherm)\n"
                              "def eval_pherm(xdata, ydata, ypdata, xval):\n    return np.ref_pherm(xdata, ydata, ypdata, xval)"],
     "profile_hook_fetched_from_c": ["import sys, functools, numpy as np, labkit\n"
                                     "hook = functools.partial(sys.getprofile)()\n"
@@ -231,7 +231,7 @@ REPLACED = {  # cells of the release replaced by an attack: {name: (base noteboo
                            "    f = types.FunctionType(saved, labkit.piecewise.__dict__, None, (0,))\n"
                            "    return f(xdata, ydata, ypdata, xval)"}),
     "graders_reference": ("04_splines.ipynb", {
-        "def complete_system(": "import labkit, labkit.checks.splines as s\n"
+        "def complete_system(": "import labkit, labkit.exercises.splines as s\n"
                                 "def complete_system(xdata, ydata, y1p, ynp):\n"
                                 "    return s._reference_complete_system(xdata, ydata, y1p, ynp)\n\n"
                                 "import numpy as np\nfrom labkit import splines\n"
@@ -541,7 +541,7 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ("bpoly_construct_fast", "construct_fast, which is switched off"),
     ("reference_by_assignment", "reaches for labkit.piecewise.eval_pherm"),
     ("saved_code_object", "function.__new__"),
-    ("graders_reference", "labkit.checks.splines._reference_complete_system"),
+    ("graders_reference", "labkit.exercises.splines._reference_complete_system"),
     ("graders_reference", "labkit.splines._slopes_from_curvatures"),
     ("private_natural_helpers", "labkit.splines.natural_curvatures"),
     ("ndimage_bilinear", "scipy.ndimage"),

@@ -15,7 +15,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from labkit.checks.exercises import EXERCISES
+from labkit.check import EXERCISES
 from labkit.grading import release_notebook
 
 nbgrader_api = pytest.importorskip("nbgrader.api")

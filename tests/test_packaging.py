@@ -94,13 +94,19 @@ def test_instructor_commands_take_the_instructor_folder(command, tmp_path):
 
 def test_one_repository_url_for_the_badges_and_the_install_line():
     readme = (ROOT / "README.md").read_text()
+    students = (ROOT / "docs" / "students.md").read_text()  # the install lines for each front end
     owner_repo = REPOSITORY.removeprefix("https://github.com/")
     assert f"https://mybinder.org/v2/gh/{owner_repo}/HEAD" in readme
     assert f"https://colab.research.google.com/github/{owner_repo}/blob/main/labkit/student_notebooks/" in readme
     assert f'%pip install "labkit @ git+{REPOSITORY}"' in readme
-    urls = set(re.findall(r"https://(?:github\.com|mybinder\.org/v2/gh|colab\.research\.google\.com/github)/"
-                          r"([\w.-]+/[\w.-]+)", readme))
-    assert urls == {owner_repo}, urls
+    assert f'%pip install "labkit @ git+{REPOSITORY}"' in students
+    assert f'pip install "labkit[grade] @ git+{REPOSITORY}"' in students
+    def repositories(text):
+        return set(re.findall(r"https://(?:github\.com|mybinder\.org/v2/gh|colab\.research\.google\.com/github)/"
+                              r"([\w.-]+/[\w.-]+)", text))
+    assert repositories(readme) == {owner_repo}, repositories(readme)
+    for path in [ROOT / "CHANGELOG.md", *sorted((ROOT / "docs").glob("*.md"))]:  # no other repository anywhere
+        assert repositories(path.read_text()) <= {owner_repo}, (path.name, repositories(path.read_text()))
     for path in NOTEBOOKS + paths():
         assert f'%pip install \\"labkit @ git+{REPOSITORY}\\"' in Path(path).read_text() or \
             f'%pip install "labkit @ git+{REPOSITORY}"' in Path(path).read_text(), path

@@ -306,3 +306,37 @@ def test_second_derivative_plot_shows_hermite_jumps_and_c2_splines():
     y, _ = labkit.runge(x)
     np.testing.assert_allclose(notaknot.get_ydata()[:40],
                                labkit.spline(x, y, np.linspace(x[0], x[1], 40), der=2), rtol=1e-12, atol=1e-12)
+
+
+def test_every_view_follows_the_written_view_interface_and_a_new_one_needs_only_update():
+    import inspect
+
+    import ipywidgets as widgets
+
+    from labkit.plots import explorers, figures
+
+    views = [cls for _, cls in inspect.getmembers(figures, inspect.isclass)
+             if issubclass(cls, figures.View) and cls is not figures.View]
+    assert len(views) >= 5
+    for cls in views:
+        assert cls.update is not figures.View.update, cls  # each view changes its own artists
+
+    class Sine(figures.View):  # a newcomer's view: update only, no blitting
+        def __init__(self, ax):
+            self.ax = ax
+            self.line, = ax.plot([], [])
+            ax.set_xlim(0, 1)
+            ax.set_ylim(-1, 1)
+
+        def update(self, k=1):
+            x = np.linspace(0, 1, 50)
+            self.line.set_data(x, np.sin(k * x))
+
+    figure, ax = explorers.new_figure((3, 2))
+    view = Sine(ax)
+    explorer = explorers.Explorer(figure, view.update, {"k": widgets.IntSlider(1, 1, 5)}, view)
+    explorer.controls["k"].value = 3
+    assert explorer.redraws == 2 and explorer.painter.blitted == 0  # drawn in full each time
+    assert np.allclose(view.line.get_ydata(), np.sin(3 * np.linspace(0, 1, 50)))
+    with pytest.raises(NotImplementedError, match="must define update"):
+        figures.View().update(k=1)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import labkit
-from labkit.checks.result import close, worst
+from labkit.exercises.result import close, worst
 from labkit.grading import protocol
 
 
@@ -90,10 +90,13 @@ def test_nesting_and_message_shape_are_bounded():
 
 
 def test_functions_cross_only_by_name_and_only_the_listed_ones():
-    tag = protocol.encode(labkit.eval_pherm)
+    from labkit.exercises.registry import LAB
+
+    tag = protocol.encode(labkit.eval_pherm, LAB.passable)
     assert tag == ["fn", "labkit.piecewise:eval_pherm"]
-    assert protocol.encode(np.sin)[0] == "obj"
-    with pytest.raises(protocol.ProtocolError, match="not a function the checks pass"):
+    assert protocol.encode(labkit.eval_pherm)[0] == "obj"  # only the functions the exercises declare cross
+    assert protocol.encode(np.sin, LAB.passable)[0] == "obj"
+    with pytest.raises(protocol.ProtocolError, match="not a labkit function the checks may pass"):
         protocol.passable("os:system")
     assert protocol.passable("labkit.functions:runge2d") is labkit.runge2d
     # the notebook's side takes only what this request handed over, by name

@@ -9,8 +9,11 @@ import numpy as np
 import pytest
 
 import labkit
-from labkit.checks import exercises, hermite
-from labkit.checks.exercises import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN_PATCH, REFUSALS
+from labkit.exercises import hermite
+from labkit.exercises.registry import LAB
+from labkit.exercises.model import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN_PATCH
+
+REFUSALS = LAB.refusals
 from labkit.grading import guard, refusals, remote, scoring
 from labkit.grading.options import GradeOptions
 from labkit.grading.scan import Unreadable, python_source, scan
@@ -42,7 +45,7 @@ def open_notebooks():
 
 
 def _notebook(open_notebooks, *cells, clean=True):
-    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES)
+    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": list(cells), "cell_timeout": 30}, 120)
     if clean:
@@ -56,7 +59,7 @@ def _call(notebook, name, refusal, *args):
 
 def test_an_honest_function_built_on_the_allowed_helpers_passes_the_check_under_its_refusal(open_notebooks):
     notebook = _notebook(open_notebooks, HONEST_PHERM)
-    assert hermite.eval_pherm(lambda *a: _call(notebook, "eval_pherm", INTERPOLANTS, *a), seed=3).passed
+    assert hermite.check_eval_pherm(lambda *a: _call(notebook, "eval_pherm", INTERPOLANTS, *a), seed=3).passed
     assert np.allclose(_call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV), labkit.eval_pherm(X, Y, YP, XV))
 
 
@@ -182,9 +185,9 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
       "                g['code_key'] = lambda code: bytes(12)\n                g['TAMPER_EVENTS'] = frozenset()\n"
       "                g['__builtins__']['len'] = lambda v: 0\n                found += 1\n"
       "    assert found, 'no stand-in found'\n    return np.ref(*a)"], "switched off"),
-    (["import sys, numpy as np, labkit.checks.splines\nclass cython_function_or_method:\n"
+    (["import sys, numpy as np, labkit.exercises.splines\nclass cython_function_or_method:\n"
       "    @property\n    def __module__(self):\n        raise SystemExit('inside the watch')\n"
-      "labkit.checks.zz_fake = cython_function_or_method()\nnp.ref_pherm = labkit.eval_pherm\n"
+      "labkit.exercises.zz_fake = cython_function_or_method()\nnp.ref_pherm = labkit.eval_pherm\n"
       "def eval_pherm(*a):\n    return np.ref_pherm(*a)"], "switched off"),
     (["import sys, functools, numpy as np\nhook = functools.partial(sys.getprofile)()\nassert hook is None\n"
       "np.ref = labkit.eval_pherm\ndef eval_pherm(*a):\n    assert functools.partial(sys.getprofile)() is None\n"
@@ -217,7 +220,7 @@ def test_switching_the_watch_off_or_going_round_it_voids_the_answer(open_noteboo
 ])
 def test_threads_signal_handlers_and_anonymous_memory_are_refused_even_without_the_sandbox(open_notebooks, cell,
                                                                                             error):
-    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES)
+    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": [cell], "cell_timeout": 30}, 120)
     assert ran["errors"] and error in ran["errors"][0]["message"], ran
@@ -279,7 +282,7 @@ def test_the_grader_computes_the_digests_from_the_library_files():
     names, modules, c_names = refusals.recognised(INTERPOLANTS)
     recognised = set(names.values())
     assert {"labkit.piecewise.eval_pherm", "labkit.piecewise._hermite_eval", "labkit.splines._slopes_from_curvatures",
-            "scipy.interpolate._interpolate._PPolyBase.construct_fast", "labkit.checks.splines._reference_complete_system",
+            "scipy.interpolate._interpolate._PPolyBase.construct_fast", "labkit.exercises.splines._reference_complete_system",
             "numpy.lib._function_base_impl.interp"} <= recognised
     assert "labkit.piecewise.bracket" not in recognised  # the lab lets students use it
     # what the sandbox recognises is the live code's digest
@@ -359,7 +362,7 @@ def test_scan_is_bounded_and_reads_magics_as_ipython_runs_them():
 
 
 def test_every_refusal_of_every_part_is_wired():
-    parts = [part for exercise in exercises.EXERCISES.values() for part in exercise.parts if part.refused]
+    parts = [part for exercise in LAB.exercises.values() for part in exercise.parts if part.refused]
     assert {part.refused for part in parts} == set(REFUSALS)
     for refusal in REFUSALS:
         assert refusals.recognised(refusal)[0], refusal.name

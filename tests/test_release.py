@@ -10,7 +10,10 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from labkit.checks.exercises import ANSWERS, EXERCISES
+from labkit.check import EXERCISES
+from labkit.exercises.registry import LAB
+
+ANSWERS = LAB.answers
 from labkit.grading.release import strip_solutions
 from labkit.grading.nbgrader import answer_ids, mark
 from labkit.grading.release import BEGIN_SOLUTION, END_SOLUTION

@@ -5,7 +5,7 @@ import tomllib
 
 import pytest
 
-from labkit.checks.exercises import EXERCISES
+from labkit.check import EXERCISES
 from labkit.grading import rubric as rubrics
 from labkit.grading.report import SubmissionGrade
 
@@ -20,8 +20,13 @@ def test_the_lab_rubric_is_its_branch_rule():
     lab = rubrics.default()
     assert lab.required == (2, 3, 4) and lab.extra_credit == (16,)
     assert [b.exercises for b in lab.branches] == [MESH, SPLINES]
-    assert lab.full_credit == 100 and lab.branch_extra == 10 and lab.points[16] == 8 and lab.maximum == 118
-    assert set(lab.points) == set(EXERCISES)
+    assert lab.branch_extra == 10
+    # the points are the declared parts' weights, kept nowhere else
+    assert lab.points == {n: exercise.points for n, exercise in EXERCISES.items()}
+    assert "[points]" not in "".join(line for line in rubrics.DEFAULT.read_text().splitlines()
+                                     if not line.startswith("#"))
+    assert lab.full_credit == sum(lab.points[n] for n in (2, 3, 4) + MESH)
+    assert lab.maximum == lab.full_credit + 10 + lab.points[16]
 
 
 @pytest.mark.parametrize("done, total, branch, extra", [
@@ -52,8 +57,7 @@ def test_a_partly_done_second_branch_earns_its_share_of_the_extra_credit():
 
 def test_parts_scale_with_the_points_an_edited_rubric_gives():
     data = tomllib.loads(rubrics.DEFAULT.read_text())
-    data["points"]["11"] = 18  # twice the lab's 9
-    data["points"]["5"] = 21
+    data["points"] = {"11": 18, "5": 21}  # 11: twice the lab's 9
     edited = rubrics.from_dict(data, "edited")
     assert edited.score({11: 5 / 9}).points[11] == 10  # the driver part: 5 of 9, now of 18
 
@@ -95,17 +99,24 @@ required = [2, 3]
     ("[points]\n5 = 5\n10 = 6\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
      "[[branches.choice]]\nname = 'b'\nexercises = [10]\n", "must be worth the same points"),
     ("[points]\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n", "at least two"),
-    ("required = [2, 3]\n[points]\n2 = 5\n", "exercise 3 is in required but has no points"),
+    ("title = 'x'\n", "grades nothing"),
+    ("exercises = 'no_such_module:REGISTRY'\nrequired = [2]\n", "cannot load the exercises"),
+    ("exercises = 'labkit.exercises.model:Part'\nrequired = [2]\n", "not a labkit Registry"),
+    ("points = 3\nrequired = [2]\n", "must be a table"),
     ("required = [2]\n[points]\n2 = 5\n3 = 5\n", "exercise 3 has points but is in no group"),
     ("required = [2]\nbonus = [3]\n[points]\n2 = 5\n", "unknown key(s) bonus"),
     ("required = 2\n[points]\n2 = 5\n", "must be a list of exercise numbers"),
-    ("required = [2]\n", "needs a [points] table"),
     ("required = [2\n", "is not valid TOML"),
 ])
 def test_rubric_errors_are_clear(tmp_path, text, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[")
                        .replace("]", r"\]")):
         rubrics.load(_write(tmp_path, text))
+
+
+def test_an_exercise_without_points_in_the_rubric_is_worth_its_parts(tmp_path):
+    small = rubrics.load(_write(tmp_path, "required = [2, 3]\n[points]\n2 = 5\n"))
+    assert small.points == {2: 5.0, 3: float(EXERCISES[3].points)}
 
 
 def test_a_small_rubric_without_branches_loads(tmp_path):
@@ -117,7 +128,7 @@ def test_a_small_rubric_without_branches_loads(tmp_path):
 def test_cli_prints_the_lab_rubric_and_checks_an_edited_one(tmp_path):
     run = subprocess.run([sys.executable, "-m", "labkit.cli", "rubric"], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0 and rubrics.from_dict(tomllib.loads(run.stdout)) == rubrics.default()
-    path = _write(tmp_path, run.stdout.replace("16 = 8", "16 = -8"))
+    path = _write(tmp_path, run.stdout.replace("[branches]", "[points]\n16 = -8\n\n[branches]"))
     run = subprocess.run([sys.executable, "-m", "labkit.cli", "rubric", "--check", str(path)], capture_output=True,
                          text=True, timeout=60)
     assert run.returncode == 2 and "negative points" in run.stderr

@@ -14,8 +14,9 @@ import pytest  # noqa: E402
 
 import labkit  # noqa: E402
 from labkit import check  # noqa: E402
-from labkit.checks import drivers, plotted  # noqa: E402
-from labkit.checks.exercises import EXERCISES  # noqa: E402
+from labkit.exercises import experiments, plotted  # noqa: E402
+from labkit.exercises.registry import LAB  # noqa: E402
+from labkit.check import EXERCISES  # noqa: E402
 from labkit.grading import protocol  # noqa: E402
 
 # -- drivers ---------------------------------------------------------------------
@@ -73,7 +74,7 @@ def test_the_reference_matches_scipy():
                              ("natural", CubicSpline(x, y, bc_type="natural")), ("notaknot", CubicSpline(x, y)),
                              ("pchip", PchipInterpolator(x, y))):
         expected = np.max(np.abs(interpolant(xtest) - exact)) / np.max(np.abs(exact))
-        assert drivers.METHODS[key].reference([21])[0] == pytest.approx(expected, rel=1e-9), key
+        assert LAB.experiment(key).reference([21])[0] == pytest.approx(expected, rel=1e-9), key
 
 
 @pytest.mark.parametrize("method", ONE_D)
@@ -124,10 +125,10 @@ def test_unknown_experiment_is_a_clear_value_error():
 
 def test_a_table_is_what_the_students_own_driver_gives():
     driver = _driver_1d("natural")
-    assert check.table("natural", [driver(n) for n in drivers.LAB_NDATA], driver).passed
+    assert check.table("natural", [driver(n) for n in labkit.convergence.DEFAULT_NDATA], driver).passed
     # consistent with a wrong driver: the driver check marks the driver, the table is not marked twice
     wrong = _driver_1d("natural", ntest=401)
-    assert check.table("natural", [wrong(n) for n in drivers.LAB_NDATA], wrong).passed
+    assert check.table("natural", [wrong(n) for n in labkit.convergence.DEFAULT_NDATA], wrong).passed
     # the reference table copied next to a wrong driver is not the student's table
     reference = labkit.convergence_table("natural").errors
     result = check.table("natural", reference, wrong)
@@ -144,19 +145,20 @@ def test_a_table_that_is_not_eight_errors_says_what_to_give(errors, detail):
 
 # -- rate answers ---------------------------------------------------------------------
 
-def _returning(errors, ndata=drivers.LAB_NDATA):
+def _returning(errors, ndata=labkit.convergence.DEFAULT_NDATA):
     """A driver that returns the given errors for the lab's sizes (as a fabricated one would)."""
     return lambda n, *rest: float(errors[list(ndata).index(n)])
 
 
 def _table_of(driver, key):
-    return [driver(n) for n in drivers.METHODS[key].ndata]
+    return [driver(n) for n in LAB.experiment(key).ndata]
 
 
 @pytest.mark.parametrize("method, order", [("pherm", 4), ("complete", 4), ("natural", 2), ("notaknot", 4),
                                            ("pchip", 2), ("bilinear", 2)])
 def test_the_true_order_is_right_and_its_ratio_or_a_neighbour_is_not(method, order):
-    assert drivers.METHODS[method].order == order
+    assert LAB.experiment(method).order == order  # what the exercise declares ...
+    assert LAB.experiment(method).observed_order == order  # ... is what labkit's own table shows
     driver = _driver_2d if method == "bilinear" else _driver_1d(method)
     table = _table_of(driver, method)
     assert check.rate(method, order, table, driver).passed
@@ -180,9 +182,9 @@ def test_eight_for_the_complete_spline_fails_with_the_ratios_hint_and_never_name
 
 def test_the_rate_is_read_from_the_students_own_table():
     # a table whose errors fall like h^3 supports 3: the answer 3 is right, the true 4 is not
-    ndata = np.array(drivers.LAB_NDATA)
+    ndata = np.array(labkit.convergence.DEFAULT_NDATA)
     errors = 1.0 / (ndata - 1.0) ** 3
-    assert drivers.supported_order("complete", errors) == 3
+    assert experiments.supported_order(LAB.experiment("complete"), errors) == 3
     driver = _returning(errors)
     assert check.rate("complete", 3, errors, driver).passed
     four = check.rate("complete", 4, errors, driver)
@@ -192,21 +194,21 @@ def test_the_rate_is_read_from_the_students_own_table():
     honest = _driver_1d("complete")
     mistyped = _table_of(honest, "complete")
     mistyped[-1] *= 20  # the last ratio is now about 0.8
-    own = drivers.supported_order("complete", mistyped)
-    table, rate = drivers.experiment("complete", mistyped, own, honest)
+    own = experiments.supported_order(LAB.experiment("complete"), mistyped)
+    table, rate = experiments.check_experiment(LAB.experiment("complete"), mistyped, own, honest)
     assert not table.passed and rate.passed and own != 4
 
 
 def test_a_table_and_rate_typed_in_without_a_driver_that_runs_earn_nothing():
     # the second red team's fabricated table: it shrinks, and the rate read off it is right for it
-    errors = list(1.0 / (np.array(drivers.LAB_NDATA) - 1.0) ** 4)
-    table, rate = drivers.experiment("pherm", errors, 4, None)
+    errors = list(1.0 / (np.array(labkit.convergence.DEFAULT_NDATA) - 1.0) ** 4)
+    table, rate = experiments.check_experiment(LAB.experiment("pherm"), errors, 4, None)
     assert not table.passed and not rate.passed
     broken = lambda n, *rest: 1 / 0  # noqa: E731 - a driver that does not run
-    table, rate = drivers.experiment("pherm", errors, 4, broken)
+    table, rate = experiments.check_experiment(LAB.experiment("pherm"), errors, 4, broken)
     assert not table.passed and not rate.passed and "must run" in rate.hint
     # ... nor next to a driver whose own errors do not shrink
-    table, rate = drivers.experiment("pherm", errors, 4, lambda n, *rest: 0.5)
+    table, rate = experiments.check_experiment(LAB.experiment("pherm"), errors, 4, lambda n, *rest: 0.5)
     assert not table.passed and not rate.passed and "no rate to read" in repr(rate)
 
 
@@ -225,7 +227,7 @@ def test_a_table_that_shows_no_experiment_earns_nothing_and_supports_no_rate(err
 
 def test_a_table_copied_from_the_printout_counts():
     driver = _driver_1d("pherm")
-    exact = [driver(n) for n in drivers.LAB_NDATA]
+    exact = [driver(n) for n in labkit.convergence.DEFAULT_NDATA]
     copied = [float(f"{e:.3e}") for e in exact]  # what ratio_table prints
     assert check.table("pherm", copied, driver).passed
     assert not check.table("pherm", [e * 1.002 for e in exact], driver).passed
@@ -420,17 +422,6 @@ def test_a_shuffled_but_equal_mesh_passes_and_the_protocol_carries_it():
     shuffled = labkit.QuadMesh(region.points[order], inverse[region.quads])
     assert check.combined_mesh(shuffled, corners).passed
     assert check.combined_mesh(protocol.decode(protocol.encode(shuffled)), corners).passed
-
-
-# -- the registry -------------------------------------------------------------------------
-
-def test_every_exercise_but_the_first_is_graded_in_parts_whose_weights_are_the_lab_rubric():
-    from labkit.grading.rubric import default
-    assert sorted(EXERCISES) == list(range(2, 17))
-    rubric = default()
-    for number, exercise in EXERCISES.items():
-        assert exercise.points == rubric.points[number]
-        assert len({part.name for part in exercise.parts}) == len(exercise.parts)
 
 
 def test_very_long_lines_are_judged_on_a_sample_with_the_same_verdict():

@@ -71,7 +71,7 @@ class _Stub:
 
     error = None
 
-    def __init__(self, options, deadline, profiles):
+    def __init__(self, options, deadline, profiles, passables=()):
         self.tampered, self.stopped = None, None
 
     def __enter__(self):

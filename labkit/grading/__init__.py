@@ -18,7 +18,7 @@ One module per concern:
 * :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own;
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging.
 
-Student code never runs in the grading process: see the README's "For instructors".
+Student code never runs in the grading process: see docs/instructors.md.
 """
 import importlib
 
@@ -27,8 +27,9 @@ from .release import release, release_notebook, strip_solutions  # light: nbform
 # Names are imported on first use (PEP 562), so that the sandboxed worker, started as
 # ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {"grade": "batch", "SubmissionGrade": "report", "merge": "report", "Rubric": "rubric",
-            "load_rubric": "rubric", "exercises_in": "scoring", "grade_notebook": "scoring", "grade_submission": "scoring",
-            "submission_notebooks": "scoring", "GradeOptions": "options", "get_backend": "backends"}
+            "load_rubric": "rubric", "exercises_in": "scoring", "grade_notebook": "scoring",
+            "grade_submission": "scoring", "submission_notebooks": "scoring", "GradeOptions": "options",
+            "get_backend": "backends"}
 _MODULES = {"backends", "batch", "cgroup", "guard", "nbgrader", "options", "protocol", "refusals", "release", "remote",
             "report", "rubric", "scan", "scoring", "seccomp", "worker"}
 

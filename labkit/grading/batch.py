@@ -30,12 +30,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..checks.exercises import REFUSALS
 from . import backends, cgroup, refusals
 from .backends.base import SandboxUnavailable
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line, safe_name, write_report
-from .rubric import Rubric, default as default_rubric, load as load_rubric
+from .rubric import Rubric
+from .rubric import default as default_rubric
+from .rubric import load as load_rubric
 from .scoring import submission_name
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
@@ -202,6 +203,7 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
 
     seed = secrets.randbits(63) if options.seed is None else int(options.seed)
     options = replace(options, seed=seed)
+    options = replace(options, exercises=rubric.registry.source)  # the workers load the rubric's exercises
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
@@ -209,7 +211,7 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     start, peaks = time.monotonic(), []
     try:
         profiles_file = work / "profiles.json"
-        profiles_file.write_text(json.dumps(refusals.wire(REFUSALS)), encoding="utf-8")
+        profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
         grades = _schedule(submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out,
                            progress, peaks)
     finally:

@@ -12,8 +12,8 @@ folder. nbgrader reads what each cell is from ``cell.metadata["nbgrader"]``:
   ``exerciseN-answer-K`` of the exercise whose section it is in;
 * a cell with ``### BEGIN HIDDEN TESTS`` is an *autograded test* cell
   (``grade: true``, ``locked: true``) worth the points of the parts its
-  asserts check, the weights of :data:`labkit.checks.exercises.EXERCISES`,
-  so nbgrader's points per exercise are labkit's;
+  asserts check: their weights (:mod:`labkit.exercises`), scaled to the
+  points of the rubric in force, so nbgrader's points per exercise are labkit's;
 * every other cell is *locked*: students cannot edit it (they can add cells).
 
 :func:`mark` computes this from the cells' markers, so it never drifts from the
@@ -22,8 +22,7 @@ meaning follow nbgrader's ``nbgrader/nbgraderformat/v3.json``.
 """
 import re
 
-from ..checks.drivers import METHODS
-from ..checks.exercises import EXERCISES
+from . import rubric as rubrics
 from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
 
 SCHEMA_VERSION = 3
@@ -34,32 +33,34 @@ def _hidden_region(source):
     return source.split(BEGIN_HIDDEN, 1)[1].split(END_HIDDEN, 1)[0]
 
 
-CHECK_CALL = re.compile(r"labkit\.check\.(\w+)\(\s*(?:\"(\w+)\"|(\w+))")
+# a self-check call: labkit.check.<name>(...) in the lab, or a course's own check_<name>(...); the first
+# argument, when quoted, is an experiment's key
+CHECK_CALL = re.compile(r"(?:\blabkit\.check\.|\bcheck_)(\w+)\(\s*(?:\"(\w+)\")?")
 
 
-def _checked_part(function, key, name):
-    """The part name a ``labkit.check.function(first argument`` call checks."""
-    if function in ("driver", "table", "rate") and key in METHODS:
-        return getattr(METHODS[key], function)
-    return name
+def test_points(source, where="a test cell", rubric=None):
+    """(exercise, points) of a hidden-test cell: the points of the parts its asserts check.
 
-
-def test_points(source, where="a test cell"):
-    """(exercise, points) of a hidden-test cell: the weights of the parts its asserts check.
-
-    Each ``labkit.check.f(x, ...)`` call checks the part named ``x`` (for
-    ``driver``, ``table`` and ``rate``, the experiment's driver, table or rate
-    name); a part such as ``ax14: the data`` is named by its first word."""
+    Each ``labkit.check.f(...)`` (or ``check_f(...)``) call checks the parts whose declared check is
+    ``check_f`` (for ``driver``, ``table`` and ``rate``, of the experiment named by
+    the first argument). The parts' weights are scaled to the exercise's
+    points under `rubric` (the lab's when None)."""
+    rubric = rubric or rubrics.default()
+    registry = rubric.registry
     found = EXERCISE_OF_TESTS.search(source)
-    if not found or int(found.group(1)) not in EXERCISES:
+    if not found or int(found.group(1)) not in registry.exercises:
         raise ValueError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
     number = int(found.group(1))
-    checked = {_checked_part(function, key, name) for function, key, name in CHECK_CALL.findall(_hidden_region(source))}
-    points = sum(part.weight for part in EXERCISES[number].parts if part.name.split(":")[0] in checked)
-    if not points:
+    exercise = registry.exercises[number]
+    checked = {part.name for function, key in CHECK_CALL.findall(_hidden_region(source))
+               for part in registry.parts_checked(number, function, key or None)}
+    weights = sum(part.weight for part in exercise.parts if part.name in checked)
+    if not weights:
         raise ValueError(f"{where} tests exercise {number} but checks none of its parts "
-                         f"({', '.join(p.name for p in EXERCISES[number].parts)}).")
-    return number, points
+                         f"({', '.join(p.name for p in exercise.parts)}).")
+    scale = rubric.points.get(number, exercise.points) / exercise.points if exercise.points else 0
+    points = weights * scale
+    return number, int(points) if points == int(points) else round(points, 2)
 
 
 HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
@@ -80,7 +81,7 @@ def answer_ids(nb):
     return ids
 
 
-def mark(nb, name="notebook"):
+def mark(nb, name="notebook", rubric=None):
     """Give every cell of an instructor notebook nbgrader's metadata (in place); returns `nb`."""
     counters = {}
     answers = iter(answer_ids(nb))
@@ -96,7 +97,7 @@ def mark(nb, name="notebook"):
         elif cell.cell_type == "code" and BEGIN_SOLUTION in cell.source:
             meta.update(solution=True, locked=False, grade_id=grade_id(f"{_stem(name)}-solution"))
         elif cell.cell_type == "code" and BEGIN_HIDDEN in cell.source:
-            number, points = test_points(cell.source, f"{name}, cell {index}")
+            number, points = test_points(cell.source, f"{name}, cell {index}", rubric)
             meta.update(grade=True, points=points, grade_id=grade_id(f"exercise{number}-tests"))
         else:
             meta["grade_id"] = grade_id(f"{_stem(name)}-locked")

@@ -28,6 +28,7 @@ class GradeOptions:
     limits: Limits = field(default_factory=Limits)  # the sandbox's resource limits
     grader_memory: int = 3 * 1024**3  # bytes of address space for the grader's own work on one submission
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
+    exercises: str = None  # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
 
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):

@@ -14,9 +14,9 @@ Both directions use one format, one JSON object per line:
   rebuilt as :class:`labkit.plotdata.Line` records, so plots are judged
   from their data on the grader's side;
 * towards the notebook only, a function of labkit's that the checks hand to
-  student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``
-  (:data:`PASSABLE`); the notebook's side gets the watch's trusted copy
-  (:mod:`labkit.grading.guard`);
+  student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``. Only the
+  functions the exercises declare (``Registry.passable``) are named; the
+  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.guard`);
 * from the notebook only, ``["obj", description]`` for anything else.
 
 The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
@@ -37,23 +37,6 @@ MAX_TEXT = 2_000
 MAX_LINE = 48 * 1024 * 1024  # bytes in one message: enforced while reading, before any parsing
 MAX_CONTAINERS = 250_000  # JSON lists and objects in one message: bounds what parsing it allocates
 MAX_LINES = 1_000  # Line2D objects of one plot
-
-# functions the checks may hand to student code, by the name both sides know
-PASSABLE = {
-    "labkit.piecewise:eval_pherm",
-    "labkit.functions:runge",
-    "labkit.functions:runge2d",
-    "labkit.splines:ccspline",
-    "labkit.splines:ncspline",
-    "labkit.bilinear:eval_pbilin",
-    "labkit.checks.drivers:scaled_runge",
-    "labkit.checks.drivers:scaled_runge2d",
-    "labkit.checks.bilinear:one",
-    "labkit.checks.bilinear:x_only",
-    "labkit.checks.bilinear:y_only",
-    "labkit.checks.bilinear:product",
-}
-
 
 class ProtocolError(ValueError):
     """A message that is not in the format (sizes, tags, shapes)."""
@@ -86,8 +69,11 @@ def _array_tag(value):
     return ["a", list(arr.shape), base64.b64encode(data).decode("ascii")]
 
 
-def encode(value, depth=0):
-    """Tagged plain form of a value (the notebook's side; may be hostile, so it is re-checked)."""
+def encode(value, passable=frozenset(), depth=0):
+    """Tagged plain form of a value; a function whose ``module:qualname`` is in `passable` is sent by name.
+
+    Used on both sides: the notebook's answers (which may be hostile, so they are re-checked) and the
+    arguments the grader's checks pass."""
     from ..mesh import QuadMesh
     from ..patches import Corner
 
@@ -112,10 +98,10 @@ def encode(value, depth=0):
         return ["mesh", _array_tag(value.points), _array_tag(value.quads)]
     if _is_plot(value):
         return _lines_tag(value)
-    if callable(value) and f"{getattr(value, '__module__', '')}:{getattr(value, '__qualname__', '')}" in PASSABLE:
+    if callable(value) and f"{getattr(value, '__module__', '')}:{getattr(value, '__qualname__', '')}" in passable:
         return ["fn", f"{value.__module__}:{value.__qualname__}"]
     if type(value) in (tuple, list):
-        return ["t" if type(value) is tuple else "l", [encode(item, depth + 1) for item in value[:100_000]]]
+        return ["t" if type(value) is tuple else "l", [encode(item, passable, depth + 1) for item in value[:100_000]]]
     return ["obj", f"a {type(value).__name__} object"]
 
 
@@ -161,9 +147,9 @@ def passable(name):
     """The pristine labkit function a ``["fn", name]`` stands for (the watch copies it before any cell runs)."""
     import importlib
 
-    if name not in PASSABLE:
-        raise ProtocolError(f"{name!r} is not a function the checks pass")
-    module, _, attribute = name.partition(":")
+    module, _, attribute = str(name).partition(":")
+    if not (module == "labkit" or module.startswith("labkit.")) or not attribute.isidentifier():
+        raise ProtocolError(f"{name!r} is not a labkit function the checks may pass")
     return getattr(importlib.import_module(module), attribute)
 
 

@@ -1,6 +1,6 @@
 """What a graded function may not reach, as the sandbox's watch recognises it (the grader's side).
 
-An exercise's part declares a :class:`labkit.checks.exercises.Refusal`:
+An exercise's part declares a :class:`labkit.exercises.model.Refusal`:
 whole modules (scipy's interpolation and spline modules, labkit's
 interpolation modules and the grader's own references), a few single
 functions, and the few functions the lab lets students reuse. This module

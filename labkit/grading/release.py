@@ -10,7 +10,7 @@ outputs are cleared. The markers and the stubs are nbgrader's.
 import json
 from pathlib import Path
 
-from ..notebooks import notebook_paths, read_notebook
+from ..execute import notebook_paths, read_notebook
 
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
 BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"

@@ -9,7 +9,7 @@ every process of the sandbox when it is done, stuck or misbehaving.
 function comes back as a :class:`Function` proxy that forwards each call
 into the sandbox, and data come back decoded as plain numbers
 (:func:`labkit.grading.protocol.decode`). So the checks of
-:mod:`labkit.checks` run unchanged on this side, never in the student's
+:mod:`labkit.exercises` run unchanged on this side, never in the student's
 process.
 
 A time limit is an exception of its own type, raised where it is detected:
@@ -69,9 +69,10 @@ class StudentError(Exception):
 class Notebook:
     """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest."""
 
-    def __init__(self, options=None, deadline=None, profiles=None):
+    def __init__(self, options=None, deadline=None, profiles=None, passables=()):
         self.options = options if options is not None else GradeOptions()
         self.deadline = deadline if deadline is not None else time.monotonic() + self.options.total_timeout
+        self.passables = frozenset(passables)  # functions the checks may hand to student code, by name
         self.stopped = None  # why the worker can no longer answer
         self.tampered = None  # what the notebook did that voids its answers
         self._buffer = b""
@@ -89,7 +90,7 @@ class Notebook:
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.process.stdout, selectors.EVENT_READ)
         self.request({"op": "setup", "profiles": profiles if profiles is not None else refusals.wire(()),
-                      "passables": sorted(protocol.PASSABLE)}, SETUP_TIMEOUT)
+                      "passables": sorted(self.passables)}, SETUP_TIMEOUT)
 
     def __enter__(self):
         return self
@@ -184,7 +185,7 @@ class Function:
         self.__name__ = name
 
     def __call__(self, *args):
-        tags = [protocol.encode(arg) for arg in args]
+        tags = [protocol.encode(arg, self.notebook.passables) for arg in args]
         request = {"op": "call", "name": self.name, "timeout": self.timeout, "args": tags,
                    "profile": self.refusal.name if self.refusal is not None else None,
                    "passables": sorted(protocol.function_names(tags))}
@@ -216,7 +217,7 @@ class Namespace:
     """The student's variables, read through the sandbox: the mapping the checks take.
 
     :meth:`refusing` sets what is switched off for the functions read after it
-    (each part of an exercise says its own, :func:`labkit.checks.exercises.grade`).
+    (each part of an exercise says its own, :meth:`labkit.exercises.registry.Registry.check`).
     """
 
     def __init__(self, notebook, timeout=None):

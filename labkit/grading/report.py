@@ -23,7 +23,6 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..checks.exercises import ANSWERS, EXERCISES
 from . import rubric as rubrics
 from .rubric import points_text
 
@@ -35,7 +34,7 @@ class SubmissionGrade:
     """The checks' results for one submission, and its grade under a rubric."""
 
     name: str
-    results: dict = field(default_factory=dict)  # exercise -> grade dict from labkit.checks.exercises.grade
+    results: dict = field(default_factory=dict)  # exercise -> grade dict from Registry.check
     problems: list = field(default_factory=list)  # what went wrong while running, per notebook
     seed: int = None
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
@@ -109,10 +108,11 @@ class SubmissionGrade:
 
     def _answer_lines(self):
         """The answers in words, for the instructor to read (no check scores them)."""
-        if not ANSWERS:
+        answers = self.rubric.registry.answers
+        if not answers:
             return []
         lines = ["", "For the instructor to read (answers in words, not scored by labkit):"]
-        for grade_id, (number, what) in ANSWERS.items():
+        for grade_id, (number, what) in answers.items():
             if number not in self.rubric.points:
                 continue
             text = str(self.answers.get(grade_id, "")).strip()
@@ -161,8 +161,9 @@ class SubmissionGrade:
                 grade.failure = str(grade.failure)
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
-        if not set(grade.results) <= set(EXERCISES):
-            raise ValueError(f"{source} grades exercises {sorted(grade.results)}, not {sorted(EXERCISES)}: "
+        known = grade.rubric.registry.exercises
+        if not set(grade.results) <= set(known):
+            raise ValueError(f"{source} grades exercises {sorted(grade.results)}, not {sorted(known)}: "
                              "it was written by another version of labkit.")
         return grade
 
@@ -210,9 +211,9 @@ def csv_cell(value):
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
 
 
-def read_columns(graded):
+def read_columns(graded, registry):
     """One empty column per answer in words of the graded exercises, for the instructor to fill in."""
-    return [f"to read: exercise {number}, {what}" for number, what in ANSWERS.values() if number in graded]
+    return [f"to read: exercise {number}, {what}" for number, what in registry.answers.values() if number in graded]
 
 
 def write_csv(path, grades):
@@ -222,7 +223,7 @@ def write_csv(path, grades):
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         graded = grades[0].rubric.graded if grades else []
-        to_read = read_columns(graded)
+        to_read = read_columns(graded, grades[0].rubric.registry if grades else None) if grades else []
         writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL + to_read)
         for g in grades:
             if not g.graded:

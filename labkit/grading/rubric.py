@@ -1,19 +1,23 @@
 """The rubric: how the exercises' results become a grade.
 
 A rubric is data (TOML, see ``rubric.toml`` next to this module, the lab's
-own): points per exercise, the exercises everyone does, alternative
-branches of which the best counts towards full credit while each other one
-is extra credit, and extra-credit exercises. :func:`load` reads and
-validates one; :meth:`Rubric.score` turns the fractions an exercise's parts
-earned (:func:`labkit.checks.exercises.grade`) into points, the branch that
-counted, the extra credit and the total.
+own): the exercises everyone does, alternative branches of which the best
+counts towards full credit while each other one is extra credit, and
+extra-credit exercises. An exercise's points are declared once, as the
+weights of its parts (:mod:`labkit.exercises`); a rubric may give an
+exercise other points in a ``[points]`` table, which scales its parts.
+``exercises = "module:attribute"`` names another course's exercises (the
+lab's by default). :func:`load` reads and validates one; :meth:`Rubric.score`
+turns the fractions an exercise's parts earned
+(:meth:`labkit.exercises.registry.Registry.check`) into points, the branch
+that counted, the extra credit and the total.
 """
 import functools
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..checks.exercises import EXERCISES
+from ..exercises.registry import LAB, Registry, load as load_registry
 
 DEFAULT = Path(__file__).with_name("rubric.toml")
 
@@ -53,6 +57,7 @@ class Rubric:
     branch_extra: float = 0.0
     extra_credit: tuple = ()
     source: str = field(default="the lab's rubric", compare=False)
+    registry: Registry = field(default=LAB, compare=False, repr=False)  # the exercises it grades
 
     @property
     def graded(self):
@@ -111,22 +116,22 @@ def _list(numbers):
     return ", ".join(map(str, numbers))
 
 
-def _exercise(value, where, source):
+def _exercise(value, where, source, registry):
     try:
         number = int(value)
     except (TypeError, ValueError):
         raise ValueError(f"{source}: {where} has {value!r}, which is not an exercise number.") from None
-    if str(value).strip() != str(number) or number not in EXERCISES:
-        known = ", ".join(map(str, sorted(EXERCISES)))
+    if str(value).strip() != str(number) or number not in registry.exercises:
+        known = ", ".join(map(str, sorted(registry.exercises)))
         raise ValueError(f"{source}: {where} names exercise {value!r}, which labkit does not grade "
                          f"(graded exercises: {known}; exercise 1 is not graded).")
     return number
 
 
-def _exercise_list(value, where, source):
+def _exercise_list(value, where, source, registry):
     if not isinstance(value, list):
         raise ValueError(f"{source}: {where} must be a list of exercise numbers, e.g. [2, 3, 4].")
-    numbers = [_exercise(v, where, source) for v in value]
+    numbers = [_exercise(v, where, source, registry) for v in value]
     if len(set(numbers)) != len(numbers):
         raise ValueError(f"{source}: {where} lists an exercise twice.")
     return tuple(numbers)
@@ -134,25 +139,33 @@ def _exercise_list(value, where, source):
 
 def from_dict(data, source="the rubric"):
     """A validated :class:`Rubric` from parsed TOML; ValueError says what is wrong and where."""
-    known = {"title", "required", "extra_credit", "points", "branches"}
+    known = {"title", "exercises", "required", "extra_credit", "points", "branches"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
-    raw_points = data.get("points")
-    if not isinstance(raw_points, dict) or not raw_points:
-        raise ValueError(f"{source}: needs a [points] table: one line `N = points` per graded exercise.")
+    named = data.get("exercises")
+    if named is not None and not isinstance(named, str):
+        raise ValueError(f"{source}: exercises must be text, module:attribute of a Registry.")
+    try:
+        registry = load_registry(named)
+    except ValueError as exc:
+        raise ValueError(f"{source}: {exc}") from None
+    raw_points = data.get("points", {})
+    if not isinstance(raw_points, dict):
+        raise ValueError(f"{source}: [points] must be a table of `N = points` lines (or left out: each exercise "
+                         "is then worth its parts' weights).")
     points = {}
     for key, value in raw_points.items():
-        number = _exercise(key, "[points]", source)
+        number = _exercise(key, "[points]", source, registry)
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
             raise ValueError(f"{source}: [points] gives exercise {number} {value!r}; points must be a number.")
         if value < 0:
             raise ValueError(f"{source}: [points] gives exercise {number} negative points ({value}); "
                              "use 0 to leave an exercise ungraded.")
         points[number] = float(value)
-    required = _exercise_list(data.get("required", []), "required", source)
-    extra_credit = _exercise_list(data.get("extra_credit", []), "extra_credit", source)
-    branches, branch_extra = _branches(data.get("branches"), source)
+    required = _exercise_list(data.get("required", []), "required", source, registry)
+    extra_credit = _exercise_list(data.get("extra_credit", []), "extra_credit", source, registry)
+    branches, branch_extra = _branches(data.get("branches"), source, registry)
     groups = [("required", required), ("extra_credit", extra_credit)]
     groups += [(f"branch {b.name!r}", b.exercises) for b in branches]
     seen = {}
@@ -162,8 +175,7 @@ def from_dict(data, source="the rubric"):
                 raise ValueError(f"{source}: exercise {number} is in {seen[number]} and in {group}; "
                                  "each exercise belongs to one group (branches may not overlap).")
             seen[number] = group
-            if number not in points:
-                raise ValueError(f"{source}: exercise {number} is in {group} but has no points in [points].")
+            points.setdefault(number, float(registry.points[number]))
     for number in points:
         if number not in seen:
             raise ValueError(f"{source}: exercise {number} has points but is in no group: add it to required, "
@@ -176,10 +188,13 @@ def from_dict(data, source="the rubric"):
     title = data.get("title", "rubric")
     if not isinstance(title, str):
         raise ValueError(f"{source}: title must be text.")
-    return Rubric(title, points, required, branches, branch_extra, extra_credit, source)
+    if not seen:
+        raise ValueError(f"{source}: grades nothing: list exercises in required, extra_credit or branches.")
+    points = {number: points[number] for number in sorted(points)}
+    return Rubric(title, points, required, branches, branch_extra, extra_credit, source, registry)
 
 
-def _branches(table, source):
+def _branches(table, source, registry):
     if table is None:
         return (), 0.0
     if not isinstance(table, dict):
@@ -198,7 +213,7 @@ def _branches(table, source):
         if not isinstance(choice, dict) or not isinstance(choice.get("name"), str) or "exercises" not in choice:
             raise ValueError(f"{source}: branch {index} needs a name and a list of exercises.")
         branches.append(Branch(choice["name"], _exercise_list(choice["exercises"], f"branch {choice['name']!r}",
-                                                              source)))
+                                                              source, registry)))
     if len({b.name for b in branches}) != len(branches):
         raise ValueError(f"{source}: two branches have the same name.")
     return tuple(branches), float(extra)

@@ -25,7 +25,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..checks.exercises import ANSWERS, EXERCISES, REFUSALS, grade as run_checks
+from ..exercises.registry import LAB
+from ..exercises.registry import load as load_registry
 from . import backends, refusals, remote, scan
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line
@@ -40,7 +41,7 @@ MAX_ANSWER = 4_000  # characters of one answer in words kept for the instructor
 HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
 
 
-def read_cells(path, answers=None):
+def read_cells(path, answers=None, registry=LAB):
     """(code sources, markdown sources) of a notebook file; ValueError says why it is not one.
 
     The size is checked before anything is read, and a link is never followed.
@@ -81,17 +82,17 @@ def read_cells(path, answers=None):
             markdown.append(source)
             meta = cell.get("metadata", {}).get("nbgrader", {}) if isinstance(cell.get("metadata"), dict) else {}
             grade_id = meta.get("grade_id") if isinstance(meta, dict) else None
-            if answers is not None and grade_id in ANSWERS and grade_id not in answers:
+            if answers is not None and grade_id in registry.answers and grade_id not in answers:
                 answers[grade_id] = source[:MAX_ANSWER]
     return code, markdown
 
 
-def exercises_in(markdown):
+def exercises_in(markdown, registry=LAB):
     """Graded exercises whose section heading ('## Exercise N') the markdown has."""
     if hasattr(markdown, "cells"):  # an nbformat notebook
         markdown = [cell.source for cell in markdown.cells if cell.cell_type == "markdown"]
     found = {int(n) for text in markdown for n in HEADING.findall(text) if len(n) < 4}
-    return sorted(found & set(EXERCISES))
+    return sorted(found & set(registry.exercises))
 
 
 def submission_notebooks(path):
@@ -152,10 +153,11 @@ def _own_code(check, findings):
                     "stay available."}
 
 
-def _rescore(verdict):
-    exercise = EXERCISES[verdict["exercise"]]
+def _rescore(verdict, registry):
+    exercise = registry.exercises[verdict["exercise"]]
     points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"])
-    verdict.update(points=points, passed=points == exercise.points, fraction=points / exercise.points)
+    verdict.update(points=points, passed=points == exercise.points,
+                   fraction=points / exercise.points if exercise.points else 1.0)
     return verdict
 
 
@@ -196,10 +198,10 @@ def _run_problems(name, ran):
     return problems
 
 
-def _profiles():
+def _profiles(registry):
     """The refusals of every exercise, computed once per grading process."""
-    if not hasattr(_profiles, "value"):
-        _profiles.value = refusals.wire(REFUSALS)
+    if getattr(_profiles, "source", None) != registry.source:
+        _profiles.value, _profiles.source = refusals.wire(registry.refusals), registry.source
     return _profiles.value
 
 
@@ -217,13 +219,14 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
     ({grade id: text}) when it is given."""
     options = GradeOptions.build(options, **single)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
-    profiles = profiles or _profiles()
+    registry = load_registry(options.exercises)
+    profiles = profiles or _profiles(registry)
     name = one_line(Path(path).name, 120)
     try:
-        code, markdown = read_cells(path, answers)
+        code, markdown = read_cells(path, answers, registry)
     except (ValueError, OSError) as exc:
         return {}, [f"{name}: {exc}" if name not in str(exc) else str(exc)]
-    numbers = [n for n in exercises_in(markdown) if n not in skip]
+    numbers = [n for n in exercises_in(markdown, registry) if n not in skip]
     if not numbers:
         return {}, []
     size = sum(len(source.encode("utf-8", "surrogatepass")) for source in code)
@@ -235,7 +238,7 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                     "by the notebooks before it."]
     problems, results = [], {}
     try:
-        notebook = remote.Notebook(options, deadline, _for_sandbox(profiles))
+        notebook = remote.Notebook(options, deadline, _for_sandbox(profiles), registry.passable)
     except remote.WorkerError as exc:
         return {}, [f"{name}: the sandbox could not start ({exc})."]
     with notebook:
@@ -255,14 +258,14 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
         if notebook.tampered:
             problems.append(f"{name}: {notebook.tampered}; none of its answers count.")
         for number in numbers:
-            exercise = EXERCISES[number]
+            exercise = registry.exercises[number]
             if notebook.tampered:
                 checks = [_failed_part({"weight": part.weight}, part.name, "the notebook's answers can be trusted",
                                        notebook.tampered, "remove what the message names and hand it in again.")
                           for part in exercise.parts]
-                results[number] = _rescore({"exercise": number, "defined": True, "checks": checks})
+                results[number] = _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
                 continue
-            verdict = run_checks(number, remote.Namespace(notebook), seed=options.seed)
+            verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed)
             for index, part in enumerate(exercise.parts):
                 if part.refused is None:
                     continue
@@ -275,7 +278,7 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                     continue
                 if findings:
                     verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
-            results[number] = _rescore(verdict)
+            results[number] = _rescore(verdict, registry)
         if notebook.stopped:
             problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")
     return results, problems

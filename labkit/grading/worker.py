@@ -492,6 +492,10 @@ def _warm():
 
     import labkit  # noqa: F401
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
+    # `import labkit` no longer loads scipy, but the watch learns the exact types of compiled routines
+    # (Cython's, f2py's) from the modules loaded when it is installed: scipy's must be among them
+    import scipy.linalg  # noqa: F401
+    import scipy.spatial  # noqa: F401
 
     config = Config()
     config.HistoryManager.enabled = False

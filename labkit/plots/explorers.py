@@ -44,10 +44,11 @@ class Painter:
 
     def draw(self):
         canvas = self.figure.canvas
-        if not hasattr(self.view, "dynamic"):
+        dynamic = tuple(self.view.dynamic()) if self.view is not None else ()
+        if not dynamic:  # a view that names no changing artists is drawn in full
             canvas.draw()
             return
-        dynamic, key = self.view.dynamic(), self.view.static_key()
+        key = self.view.static_key()
         if key != self.key or self.background is None:
             for artist in dynamic:
                 artist.set_animated(True)

@@ -46,7 +46,34 @@ def _fit(ax, x, y, margin=0.05):
         setter(low - pad, high + pad)
 
 
-class LimaconView:
+class View:
+    """What every view of the lab's figures is, and what the explorers rely on.
+
+    A view is made once with an axes (or makes its own) and draws its artists
+    there. ``update(...)`` puts new data into those same artists; its
+    keyword arguments are what an explorer's controls are named. For quicker
+    redraws while a slider moves, a view may name the artists that change
+    (``dynamic``) and a key of everything else (``static_key``): while the key
+    stays the same, :class:`labkit.plots.explorers.Painter` redraws only the
+    dynamic artists over a saved copy of the rest. The defaults (nothing
+    dynamic) make every picture a full draw.
+    """
+
+    ax = None
+
+    def update(self, **values):
+        raise NotImplementedError(f"{type(self).__name__} must define update(...), which changes its artists in place")
+
+    def dynamic(self):
+        """The artists that change on every update (none: every picture is drawn in full)."""
+        return ()
+
+    def static_key(self):
+        """A value that changes exactly when something outside :meth:`dynamic` changes."""
+        return None
+
+
+class LimaconView(View):
     """The limaçon r = r0 + cos t: exact curve, its interpolant from the sampled points, the data."""
 
     def __init__(self, ax=None):
@@ -91,7 +118,7 @@ class LimaconView:
         return self.ax.get_xlim(), self.ax.get_ylim(), self.curve.get_label(), self._r0
 
 
-class ErrorCurvesView:
+class ErrorCurvesView(View):
     """Pointwise error p - f of several interpolation methods from ndata equally spaced points."""
 
     def __init__(self, methods, ax=None, f=runge, interval=(0.0, 5.0)):
@@ -146,7 +173,7 @@ class ErrorCurvesView:
         return self.ax.get_xlim(), self.ax.get_ylim(), tuple(self._shown or ())
 
 
-class SplinePchipView:
+class SplinePchipView(View):
     """Data as circles, the not-a-knot spline and pchip through them, on 201 points."""
 
     def __init__(self, xdata, ax=None):
@@ -182,7 +209,7 @@ class SplinePchipView:
         return self.ax.get_xlim(), self.ax.get_ylim()
 
 
-class BilinearErrorView:
+class BilinearErrorView(View):
     """Colour map of I - f for bilinear interpolation from an ndata x ndata grid."""
 
     def __init__(self, ax=None, f=runge2d, square=(0.0, 5.0), ntest=201):
@@ -216,7 +243,7 @@ class BilinearErrorView:
         return self.ax.get_xlim(), self.ax.get_ylim()
 
 
-class PatchView:
+class PatchView(View):
     """A Coons patch's mesh, filled by element quality (folded elements red), with the worst in the title."""
 
     def __init__(self, ax=None, color_by_quality=True, colorbar=True):

@@ -83,8 +83,10 @@ def _parents(path, made):
     return args
 
 
-def command(argv, limits=Limits(), seccomp_fd=None):
-    """The bwrap command that runs `argv` in a new sandbox (pass `seccomp_fd` to the process with pass_fds)."""
+def command(argv, limits=None, seccomp_fd=None):
+    """The bwrap command that runs `argv` in a new sandbox bounded by `limits` (the defaults when None); pass
+    `seccomp_fd` to the process with pass_fds."""
+    limits = limits if limits is not None else Limits()
     args = [shutil.which("bwrap") or "bwrap", *_namespaces(), "--clearenv", "--cap-drop", "ALL"]
     if os.geteuid() == 0:
         args += ["--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID"]

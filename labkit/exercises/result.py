@@ -52,7 +52,7 @@ class CheckResult:
                 "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps]}
 
 
-class Checks(list):
+class Results(list):
     """Several check results shown together, such as the parts of one plot."""
 
     @property
@@ -131,33 +131,32 @@ def _where(exc):
     return f"in {function}, line {line}: `{source.strip()[:120]}`" if source.strip() else f"in {function}, line {line}"
 
 
-class _NotNumbers(Exception):
-    pass
+class NotNumbers(TypeError):
+    """A student's value that is not real numbers; the message says what it is instead."""
 
 
 def floats(value):
-    """``np.asarray(value, dtype=float)`` for a student's value, raising TypeError (never warning) for what is
-    not real numbers: complex values, strings, a sandboxed value that was not numbers."""
-    if getattr(value, "not_numbers", False) or isinstance(value, (str, bytes)):
-        raise TypeError("not numbers")
-    if np.iscomplexobj(value):
-        raise TypeError("complex numbers, not real ones")
-    try:
-        return np.asarray(value, dtype=float)
-    except OverflowError:
-        raise TypeError("numbers too large for a float") from None
+    """A student's value as a float ndarray: the one conversion every check uses.
 
-
-def _floats(value):
-    """A float ndarray, or _NotNumbers with what the value is instead."""
+    Raises :class:`NotNumbers` (a TypeError, never a warning) for what is not
+    real numbers, with a message that says what it is instead: complex values,
+    text, ragged lists, numbers too large for a float, or a value from a
+    sandboxed notebook that was not numbers.
+    """
     if getattr(value, "not_numbers", False):  # a value from a sandboxed notebook that was not numbers
-        raise _NotNumbers(str(value))
+        raise NotNumbers(str(value))
+    if isinstance(value, (str, bytes)):
+        raise NotNumbers(f"got {type(value).__name__}, not numbers")
     try:
         if np.iscomplexobj(value):
-            raise _NotNumbers("got complex numbers, not real ones")
+            raise NotNumbers("got complex numbers, not real ones")
         return np.asarray(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        raise _NotNumbers(f"got {type(value).__name__}, not numbers") from None
+    except NotNumbers:
+        raise
+    except OverflowError:
+        raise NotNumbers("got numbers too large for a float") from None
+    except (TypeError, ValueError):
+        raise NotNumbers(f"got {type(value).__name__}, not numbers") from None
 
 
 def several(value, count):
@@ -179,8 +178,8 @@ def several(value, count):
 def close(actual, expected, tol=TOLERANCE):
     """True if `actual` is a finite float array of `expected`'s shape and agrees to `tol`."""
     try:
-        actual = _floats(actual)
-    except _NotNumbers:
+        actual = floats(actual)
+    except NotNumbers:
         return False
     expected = np.asarray(expected, dtype=float)
     return (actual.shape == expected.shape and bool(np.all(np.isfinite(actual)))
@@ -190,8 +189,8 @@ def close(actual, expected, tol=TOLERANCE):
 def worst(actual, expected):
     """Why `actual` is not `expected`: what it is instead, or the largest difference."""
     try:
-        actual = _floats(actual)
-    except _NotNumbers as exc:
+        actual = floats(actual)
+    except NotNumbers as exc:
         return str(exc)
     expected = np.asarray(expected, dtype=float)
     if actual.shape != expected.shape:
@@ -204,8 +203,8 @@ def worst(actual, expected):
 def shown(value):
     """Short text of a student's value for a failure message (rounded numbers, or what it is)."""
     try:
-        values = _floats(value)
-    except _NotNumbers as exc:
+        values = floats(value)
+    except NotNumbers as exc:
         return str(exc)
     with np.errstate(all="ignore"):  # 1e308 rounds to inf: shown as such, with no warning
         finite = np.abs(values[np.isfinite(values)])

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import bilinear, convergence, functions, piecewise, splines
+from .model import EXPERIMENTS, Part
 from .result import CheckResult, call, case_rng, floats, shown
 
 DRIVER_TOLERANCE = 1e-6  # relative: the driver's error against the reference error
@@ -65,22 +66,42 @@ def scaled_runge2d(x, y):
 
 
 @dataclass(frozen=True)
-class Method:
-    """One convergence experiment of the lab."""
+class Experiment:
+    """One convergence experiment of the lab, as its exercise declares it.
 
-    key: str  # labkit.convergence_table's method, or "bilinear"
-    driver: str  # the student's function
-    table: str  # the student's error list
-    rate: str  # the student's rate answer
-    title: str
-    ndata: tuple
-    pieces: tuple = ()  # what the check hands the driver after ndata and f
+    ``key`` is the method (:func:`labkit.convergence_table`'s, or
+    ``"bilinear"``), whose title the library keeps; ``order`` is the order the
+    lab expects the table to show (tests check that labkit's own table shows
+    it). ``driver``, ``table`` and ``rate`` are the student's names, and
+    ``weights`` their parts' weights. ``pieces`` are what the check hands the
+    driver after ``ndata`` and ``f``.
+    """
+
+    key: str
+    order: int
+    driver: str
+    table: str
+    rate: str
+    weights: tuple = (1, 1, 1)
+    pieces: tuple = ()
+    ndata: tuple = convergence.DEFAULT_NDATA
     ntest: int = 4001
+
+    @property
+    def title(self):
+        if self.key == "bilinear":
+            return "Piecewise Bilinear"
+        return convergence.METHOD_TITLES[self.key]
 
     def f(self, scaled=False):
         if self.key == "bilinear":
             return scaled_runge2d if scaled else functions.runge2d
         return scaled_runge if scaled else functions.runge
+
+    @property
+    def passes(self):
+        """Every function the checks hand the driver: the pieces and both test functions."""
+        return tuple(self.pieces) + (self.f(), self.f(scaled=True))
 
     def reference(self, ndata, scaled=False, interval=(0.0, 5.0), ntest=None):
         """The relative errors labkit's experiment gives for `ndata` (a sequence of sizes)."""
@@ -93,9 +114,47 @@ class Method:
         return found.errors[: len(ndata)]
 
     @property
-    def order(self):
-        """The order the reference table shows (the lab's answer)."""
+    def observed_order(self):
+        """The order labkit's own table shows (the declared ``order`` must be it)."""
         return _reference_order(self)
+
+    def parts(self):
+        """The experiment's three parts: the driver, the table and the rate answer.
+
+        The table and the rate share one run of the student's driver at the
+        lab's sizes (:func:`check_experiment`): both are read from what the
+        driver returns, so neither is earned by numbers typed in from elsewhere.
+        """
+        driver, table, rate = self.weights
+        both = (self.table, self.rate, self.driver)
+        return (ExperimentPart(self.driver, driver, check_driver, reads=(self.driver,), seeded=True,
+                               refused=EXPERIMENTS, passes=self.passes, experiment=self),
+                ExperimentPart(self.table, table, check_experiment, reads=both, index=0, refused=EXPERIMENTS,
+                               functions=(self.table, self.driver), experiment=self),
+                ExperimentPart(self.rate, rate, check_experiment, reads=both, index=1, refused=EXPERIMENTS,
+                               functions=(self.rate, self.driver), experiment=self))
+
+    def names(self):
+        return (self.driver, self.table, self.rate)
+
+
+@dataclass(frozen=True)
+class ExperimentPart(Part):
+    """A part of a convergence experiment: its check takes the experiment first, and reads what is missing as
+    :data:`MISSING` (the table and the rate say which name is missing)."""
+
+    experiment: Experiment = None
+
+    @property
+    def self_check(self):
+        return {check_driver: "driver", check_experiment: ("table" if self.index == 0 else "rate")}[self.check]
+
+    def run(self, namespace, seed=None):
+        values = [namespace[name] if name in namespace or self.check is check_driver else MISSING
+                  for name in self.reads]
+        if self.check is check_driver:
+            return check_driver(self.experiment, *values, seed=seed)
+        return check_experiment(self.experiment, *values)
 
 
 @functools.lru_cache(maxsize=None)
@@ -104,27 +163,9 @@ def _reference_order(method):
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), method.reference(method.ndata)).order
 
 
-LAB_NDATA = convergence.DEFAULT_NDATA
-METHODS = {m.key: m for m in (
-    Method("pherm", "test_pherm_interpolate", "errors_pherm", "rate_pherm", "Piecewise Hermite Cubic", LAB_NDATA,
-           (piecewise.eval_pherm,)),
-    Method("complete", "test_ccspline_interpolate", "errors_complete", "rate_complete", "Complete Cubic Spline",
-           LAB_NDATA, (splines.ccspline,)),
-    Method("natural", "test_ncspline_interpolate", "errors_natural", "rate_natural", "Natural Cubic Spline",
-           LAB_NDATA, (splines.ncspline,)),
-    Method("notaknot", "test_spline_interpolate", "errors_notaknot", "rate_notaknot", "Not-A-Knot Cubic Spline",
-           LAB_NDATA),
-    Method("pchip", "test_pchip_interpolate", "errors_pchip", "rate_pchip", "Monotone Cubic Interpolation",
-           LAB_NDATA),
-    Method("bilinear", "test_pbilin_interpolate", "errors_bilinear", "rate_bilinear", "Piecewise Bilinear",
-           (11, 21, 41, 81, 161), (bilinear.eval_pbilin,), ntest=401),
-)}
-
-
-def _method(key):
-    if key not in METHODS:
-        raise ValueError(f"unknown experiment {key!r}; choose one of {', '.join(map(repr, METHODS))}.")
-    return METHODS[key]
+def _reference_error(key, ndata):
+    """labkit's relative error of method `key` on the Runge function at `ndata` points (a slip's signature)."""
+    return convergence.convergence_table(key, [ndata] * 2, functions.runge).errors[0]
 
 
 def _number(value):
@@ -188,8 +229,8 @@ def _other_methods(method, ndata):
         if other == method.key:
             continue
         advice = OTHER_METHOD_HINTS.get((method.key, other), f"build the {method.title.lower()} itself")
-        found.append((f"That is the {METHODS[other].title.lower()}'s error, not the {method.title.lower()}'s: "
-                      f"{advice}.", METHODS[other].reference([ndata])[0]))
+        found.append((f"That is the {convergence.METHOD_TITLES[other].lower()}'s error, not the {method.title.lower()}'s: "
+                      f"{advice}.", _reference_error(other, ndata)))
     if method.key == "complete":
         found += [(f"The end slopes look like {wrong}: the complete spline takes the derivatives f returns at "
                    "the first and the last data point, in that order.", _complete_error(ndata, ends))
@@ -226,21 +267,20 @@ def _arithmetic_mean_error(ndata):
     return _hermite_error(ndata, slopes)
 
 
-def driver(key, fn, seed=None):
-    """Check the driver of experiment `key`: ``fn(ndata, f, *pieces)`` is the relative max error.
+def check_driver(method, fn, seed=None):
+    """Check the driver of an :class:`Experiment`: ``fn(ndata, f, *pieces)`` is the relative max error.
 
     The driver gets labkit's Runge function as `f` (and labkit's interpolant
     or spline slopes where it takes them), then :func:`scaled_runge`, whose
     maximum is 3: an absolute error comes out three times too large, and a
     driver that ignores `f` gives the Runge function's error.
     """
-    method = _method(key)
     result = CheckResult(method.driver)
     sizes = method.ndata[:3]
     if seed is not None:  # the grader's fresh size: never one of the sizes checked anyway
         fresh = [n for n in range(6, 60) if n not in method.ndata]
-        sizes += (int(case_rng(seed, f"drivers.driver.{key}").choice(fresh)),)
-    where = (f"[0, 5]^2 with {method.ntest} x {method.ntest} test points" if key == "bilinear"
+        sizes += (int(case_rng(seed, f"drivers.driver.{method.key}").choice(fresh)),)
+    where = (f"[0, 5]^2 with {method.ntest} x {method.ntest} test points" if method.key == "bilinear"
              else f"[0, 5] with {method.ntest} test points")
     for ndata in sizes:
         ok, err = call(result, f"ndata = {ndata}", fn, ndata, method.f(), *method.pieces)
@@ -255,7 +295,7 @@ def driver(key, fn, seed=None):
                            "test points on [0, 5], and divide the largest error by max|f| there.")
             return result
     ndata = SHIFTED_PROBE
-    other = "3 / (1 + (x + y - 1)^2)" if key == "bilinear" else "3 / (1 + (x - 1)^2)"
+    other = "3 / (1 + (x + y - 1)^2)" if method.key == "bilinear" else "3 / (1 + (x - 1)^2)"
     ok, err = call(result, f"f = {other}", fn, ndata, method.f(scaled=True), *method.pieces)
     if not ok:
         return result
@@ -270,25 +310,24 @@ def driver(key, fn, seed=None):
     return result
 
 
-def observed_order(key, errors):
+def table_order(method, errors):
     """The order across a whole table: log(Err(first)/Err(last)) / log(h(first)/h(last)); None if not a table."""
-    method = _method(key)
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
         return None
     return float(np.log(values[0] / values[-1]) / np.log((method.ndata[-1] - 1) / (method.ndata[0] - 1)))
 
 
-def table(key, errors, fn):
-    """Check the error list of experiment `key` against what the student's driver `fn` returns
+def check_table(method, errors, fn):
+    """Check the error list of an experiment against what the student's driver `fn` returns
     (the notebook's self-check; see :func:`experiment`)."""
-    return experiment(key, errors, None, fn)[0]
+    return check_experiment(method, errors, MISSING, fn)[0]
 
 
-def rate(key, answer, errors, fn):
-    """Check the rate answer of experiment `key`: the exponent p with Err(n)/Err(2n-1) close to 2**p, read
+def check_rate(method, answer, errors, fn):
+    """Check the rate answer of an experiment: the exponent p with Err(n)/Err(2n-1) close to 2**p, read
     from the table `errors` of the student's driver `fn` (the notebook's self-check; see :func:`experiment`)."""
-    return experiment(key, errors, answer, fn)[1]
+    return check_experiment(method, errors, answer, fn)[1]
 
 
 def _no_experiment(method, values, whose="the", verdict="this table shows no experiment"):
@@ -321,8 +360,8 @@ def _own_errors(method, fn, result):
 MISSING = type("Missing", (), {"__repr__": lambda self: "not defined"})()  # a name the notebook does not define
 
 
-def experiment(key, errors, answer, fn):
-    """Check the table and the rate answer of experiment `key` against one run of the student's driver
+def check_experiment(method, errors, answer, fn):
+    """Check the table and the rate answer of an experiment against one run of the student's driver
     `fn` at the lab's sizes: ``[table result, rate result]``.
 
     The driver is called as the student would, ``fn(ndata)`` with its own
@@ -333,7 +372,6 @@ def experiment(key, errors, answer, fn):
     earns anything without a driver that runs: a table typed in from
     elsewhere, or a rate read off it, is not the student's experiment.
     """
-    method = _method(key)
     table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
     own = _own_errors(method, fn, table_result)
     if own is None:
@@ -364,7 +402,7 @@ def _table(method, errors, own, result):
         result.hint = (f"{rows} in your table {'is' if len(wrong) == 1 else 'are'} not what {method.driver} returns: "
                        f"fill the table by running your driver, [{method.driver}(n) for n in {list(method.ndata)}].")
         return result
-    order = observed_order(method.key, values)
+    order = table_order(method, values)
     if not result.step(f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across "
                        "the table)", order >= MIN_ORDER, _no_experiment(method, values)):
         result.hint = (f"{method.driver} must interpolate f from ndata points and measure the error at the test "
@@ -405,14 +443,13 @@ def _shown_errors(value):
     return "[" + ", ".join(f"{v:.3e}" for v in values) + "]"
 
 
-def supported_order(key, errors):
+def supported_order(method, errors):
     """The order a table of errors supports, as labkit estimates it; None if it is not a table that
     shows an experiment (errors that shrink with an observed order of at least MIN_ORDER)."""
-    method = _method(key)
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
         return None
-    if observed_order(key, values) < MIN_ORDER:
+    if table_order(method, values) < MIN_ORDER:
         return None
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
 
@@ -428,7 +465,7 @@ def _rate(method, answer, errors, own, result):
     if own is None:
         return result
     description = "the rate is the exponent p of the power of two 2**p that your table's ratios settle near"
-    if supported_order(method.key, own) is None:
+    if supported_order(method, own) is None:
         return result.fail(description, _no_experiment(method, own, f"{method.driver}'s",
                                                        "they show no experiment, so there is no rate to read"),
                            f"fix {method.driver} so that its errors shrink, refill {method.table}, then read the "
@@ -441,7 +478,7 @@ def _rate(method, answer, errors, own, result):
         return result.fail(description, f"{method.table} is not a table of {len(method.ndata)} positive errors, "
                                         "so there is nothing to read the rate from",
                            f"fill {method.table} from your driver first, then read the rate off its ratios.")
-    supported = supported_order(method.key, values)
+    supported = supported_order(method, values)
     if supported is None:
         return result.fail(description, _no_experiment(method, values, "your table's",
                                                        "this table shows no experiment, so it supports no rate"),

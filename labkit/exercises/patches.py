@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import patches
 from ..mesh import QuadMesh, quad_mesh
+from .model import OWN_PATCH, Exercise, Optional, Part, Together
 from .result import CheckResult, call, case_rng, close, worst
 
 # the grader's work on a student's meshes is bounded by the lab's sizes (600 and 1170 nodes): far larger is refused
@@ -18,7 +19,7 @@ def _identity_corners():
     return [patches.Corner(p, e1, e2) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
 
 
-def coons(fn, seed=None):
+def check_coons(fn, seed=None):
     """Check a student's ``coons(A, B, C, D, s, t) -> (x, y)`` (the script of exercise 5)."""
     result = CheckResult("coons")
     s, t = np.linspace(0, 1, 4), np.linspace(0, 1, 5)
@@ -65,7 +66,7 @@ def _corner_list(corners, result, label):
     return True
 
 
-def graded_corners(corners):
+def check_graded_corners(corners):
     """Exercise 6: the unit square with dx/ds 3 at A, D and 0.1 at B, C."""
     result = CheckResult("exercise 6 corners")
     if not _corner_list(corners, result, "four corners"):
@@ -85,7 +86,7 @@ def graded_corners(corners):
     return result
 
 
-def straight_corners(corners):
+def check_straight_corners(corners):
     """Exercise 7: A(-1,0), B(1,0), C(1,0.5), D(0,1); the patch must be the bilinear map."""
     result = CheckResult("exercise 7 corners")
     if not _corner_list(corners, result, "four corners"):
@@ -107,7 +108,7 @@ def straight_corners(corners):
     return result
 
 
-def circle_corners(corners):
+def check_circle_corners(corners):
     """Exercise 8: quarter-circle sides through the unit square's corners, two-fold symmetric."""
     result = CheckResult("exercise 8 corners")
     if not _corner_list(corners, result, "four corners"):
@@ -136,7 +137,7 @@ def circle_corners(corners):
     return result
 
 
-def two_patches(fn, corners):
+def check_two_patches(fn, corners):
     """Exercise 9: ``two_patches(A, B, C, D) -> (mesh1, mesh2)`` joins along BC / dc."""
     result = CheckResult("exercise 9 patches")
     if not _corner_list(corners, result, "corners of ABCD"):
@@ -199,7 +200,7 @@ def _folded(mesh):
     return int(np.sum(mesh.quality() <= 0))
 
 
-def combined_mesh(region, corners, two_patches=None):
+def check_combined_mesh(region, corners, two_patches=None):
     """Exercise 9(c): ``region`` is one conforming mesh of the two patches, judged from its data.
 
     The reference is the student's own two meshes (``two_patches`` called with
@@ -252,3 +253,23 @@ def combined_mesh(region, corners, two_patches=None):
                        f"{_folded(region)} folded elements, {_folded(reference)} in the two meshes joined"):
         result.hint = "the join turned elements over: keep each mesh's node order when you join them with +."
     return result
+
+
+CORNERS9 = Together(("A9", "B9", "C9", "D9"))
+
+EXERCISES = (
+    Exercise(5, ("coons",), (Part("coons", 12, check_coons, ("coons",), seeded=True, refused=OWN_PATCH),),
+             notebook="03_meshes.ipynb"),
+    Exercise(6, ("graded",), (Part("graded", 10, check_graded_corners, ("graded",)),), notebook="03_meshes.ipynb"),
+    Exercise(7, ("straight",), (Part("straight", 10, check_straight_corners, ("straight",)),),
+             notebook="03_meshes.ipynb",
+             answers=("why these corner data give straight, evenly divided sides",)),
+    Exercise(8, ("circle_sides",), (Part("circle_sides", 12, check_circle_corners, ("circle_sides",)),),
+             notebook="03_meshes.ipynb",
+             answers=("AB as parametric equations, and dx/ds, dy/ds at A and B",)),
+    Exercise(9, ("two_patches", "mirror", "region"),
+             (Part("two_patches", 10, check_two_patches, ("two_patches", CORNERS9)),
+              Part("region", 6, check_combined_mesh, ("region", CORNERS9, Optional("two_patches")))),
+             notebook="03_meshes.ipynb",
+             answers=("why the mirror image's corner data make the two patches match",)),
+)

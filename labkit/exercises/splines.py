@@ -8,6 +8,8 @@ must reproduce exactly.
 import numpy as np
 
 from .. import piecewise, splines
+from .experiments import Experiment
+from .model import INTERPOLANTS, Exercise, Optional, Part
 from .result import CheckResult, call, case_rng, close, floats, shown, worst
 
 SPLINE_CASES = [
@@ -43,7 +45,7 @@ def _matrix(AD):
     return A if A.ndim == 2 and np.all(np.isfinite(A)) else None
 
 
-def ccspline(fn, system=None, seed=None):
+def check_ccspline(fn, system=None, seed=None):
     """Check ``ccspline(xdata, ydata, y1p, ynp)``; with ``system(xdata, ydata, y1p, ynp) -> (A, D)``
     also the matrix (symmetric, diagonally dominant, equal to equations 11-12)."""
     result = CheckResult("ccspline")
@@ -123,7 +125,7 @@ def ccspline(fn, system=None, seed=None):
     return result
 
 
-def ncspline(fn, seed=None, system=None):
+def check_ncspline(fn, system=None, seed=None):
     """Check ``ncspline(xdata, ydata)``: the lab's linear case, zero end curvature, labkit's reference.
 
     `system` is the student's ``complete_system``, which the lab's ncspline
@@ -232,3 +234,27 @@ def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None):
     slopes[:-1] = -M[:-1] * h / 3 - M[1:] * h / 6 + secant
     slopes[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]
     return slopes
+
+
+COMPLETE = Experiment("complete", 4, "test_ccspline_interpolate", "errors_complete", "rate_complete",
+                      weights=(5, 2, 2), pieces=(splines.ccspline,))
+NATURAL = Experiment("natural", 2, "test_ncspline_interpolate", "errors_natural", "rate_natural",
+                     weights=(2, 2, 2), pieces=(splines.ncspline,))
+NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot",
+                      weights=(3, 2, 2))
+
+EXERCISES = (
+    Exercise(10, ("ccspline", "complete_system"),
+             (Part("ccspline", 15, check_ccspline, ("ccspline", Optional("complete_system")), seeded=True,
+                   refused=INTERPOLANTS, functions=("ccspline", "complete_system")),),
+             notebook="04_splines.ipynb"),
+    Exercise(11, COMPLETE.names(), COMPLETE.parts(), notebook="04_splines.ipynb",
+             answers=("the order, with f' used only at the ends",)),
+    Exercise(12, ("ncspline",) + NATURAL.names(),
+             (Part("ncspline", 9, check_ncspline, ("ncspline", Optional("complete_system")), seeded=True,
+                   refused=INTERPOLANTS),) + NATURAL.parts(),
+             notebook="04_splines.ipynb",
+             answers=("why the natural spline's order is lower",)),
+    Exercise(13, NOTAKNOT.names(), NOTAKNOT.parts(), notebook="04_splines.ipynb",
+             answers=("the three splines compared",)),
+)

@@ -1,6 +1,7 @@
 """Checks for exercises 2 to 4: the piecewise cubic Hermite interpolant, runge, the limaçon's slopes.
 
-Exercise 3's driver, table and rate are checked in :mod:`labkit.checks.drivers`.
+Exercise 3's driver, table and rate are checked in :mod:`labkit.exercises.experiments`; the
+exercises are declared at the end of this module.
 
 The maths is derived in ``notebooks/02_convergence.ipynb``. References are
 labkit's :func:`labkit.eval_pherm` and :func:`labkit.hermite_basis`, and the
@@ -9,6 +10,9 @@ polynomials a cubic Hermite interpolant must reproduce exactly.
 import numpy as np
 
 from .. import functions, piecewise
+from .experiments import Experiment
+from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part, Together
+from .plotted import check_limacon_plot
 from .result import CheckResult, call, case_rng, close, floats, several, shown, worst
 
 MONOMIAL_POINTS = np.array([-1.0, 0.5, 1.5, 3.0])
@@ -28,7 +32,7 @@ def _monomials(fn, interval, result, label):
     return wrong
 
 
-def eval_pherm(fn, seed=None):
+def check_eval_pherm(fn, seed=None):
     """Check a student's ``eval_pherm(xdata, ydata, ypdata, xval)`` (exercise 2).
 
     Steps: the four monomials on [0, 2] at x = -1, 0.5, 1.5, 3; if that fails,
@@ -145,7 +149,7 @@ def _constant_factor(got, want):
 
 # -- Exercise 3 ---------------------------------------------------------------
 
-def runge(fn, seed=None):
+def check_runge(fn, seed=None):
     """Check ``runge(x) -> (y, yprime)`` against 1/(1+x^2) and its derivative."""
     result = CheckResult("runge")
     x = np.linspace(-3.0, 3.0, 13)
@@ -184,7 +188,7 @@ def _sign_slip(got, want):
     return ""
 
 
-def limacon_derivatives(fn, seed=None):
+def check_limacon_derivatives(fn, seed=None):
     """Check ``limacon_derivatives(t, r0) -> (dxdt, dydt)`` of x = r cos t, y = r sin t, r = r0 + cos t."""
     result = CheckResult("limacon_derivatives")
     cases = [(np.linspace(0, 2 * np.pi, 21), 1.15)]
@@ -214,3 +218,23 @@ def limacon_derivatives(fn, seed=None):
                                "with the product rule, using dr/dt = -sin t; compare with a centred difference.")
                 return result
     return result
+
+
+PHERM = Experiment("pherm", 4, "test_pherm_interpolate", "errors_pherm", "rate_pherm", weights=(6, 3, 3),
+                   pieces=(piecewise.eval_pherm,))
+
+EXERCISES = (
+    Exercise(2, ("eval_pherm",), (Part("eval_pherm", 10, check_eval_pherm, ("eval_pherm",), seeded=True,
+                                       refused=INTERPOLANTS),),
+             notebook="02_convergence.ipynb"),
+    Exercise(3, ("runge",) + PHERM.names(),
+             (Part("runge", 3, check_runge, ("runge",), seeded=True, refused=OWN_FUNCTIONS),) + PHERM.parts(),
+             notebook="02_convergence.ipynb",
+             answers=("the order the table shows, against piecewise linear",)),
+    Exercise(4, ("limacon_derivatives", "ax4"),
+             (Part("limacon_derivatives", 8, check_limacon_derivatives, ("limacon_derivatives",), seeded=True,
+                   refused=OWN_FUNCTIONS),
+              Part("ax4", 7, check_limacon_plot,
+                   ("ax4", Together(("tdata", "xdata", "ydata", "xpdata", "ypdata"), required=False)))),
+             notebook="01_limacon.ipynb"),
+)

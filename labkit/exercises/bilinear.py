@@ -10,7 +10,9 @@ sandboxed notebook (:data:`labkit.grading.protocol.PASSABLE`).
 """
 import numpy as np
 
-from .. import functions
+from .. import bilinear, functions
+from .experiments import Experiment
+from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part
 from .result import CheckResult, call, case_rng, close, floats, worst
 
 
@@ -37,7 +39,7 @@ def product(x, y):
 BILINEAR_FUNCTIONS = (("1", one), ("x", x_only), ("y", y_only), ("xy", product))
 
 
-def runge2d(fn, seed=None):
+def check_runge2d(fn, seed=None):
     """Check ``runge2d(x, y)`` = 1/(1+(x+y)^2), on arrays."""
     result = CheckResult("runge2d")
     X, Y = np.meshgrid(np.linspace(-2, 2, 5), np.linspace(0, 3, 4), indexing="ij")
@@ -49,7 +51,7 @@ def runge2d(fn, seed=None):
     return result
 
 
-def eval_pbilin(fn, seed=None):
+def check_eval_pbilin(fn, seed=None):
     """Check ``eval_pbilin(f, xdata, ydata, xval, yval)``: one cell, then 1, x, y, xy on a grid."""
     result = CheckResult("eval_pbilin")
     unit = np.array([0.0, 1.0])
@@ -82,7 +84,7 @@ def eval_pbilin(fn, seed=None):
     return result
 
 
-def phi_table(table):
+def check_phi_table(table):
     """Exercise 16(a): the table of phi_m(P_n), rows P_1..P_4 and columns phi_1..phi_4.
 
     The reference is the definition: each phi_m evaluated at each corner of a
@@ -109,3 +111,19 @@ def phi_table(table):
             result.hint = ("evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
                            "on the side x = x1, so each phi_m vanishes at three corners.")
     return result
+
+
+BILINEAR = Experiment("bilinear", 2, "test_pbilin_interpolate", "errors_bilinear", "rate_bilinear",
+                      pieces=(bilinear.eval_pbilin,), ndata=(11, 21, 41, 81, 161), ntest=401)
+
+EXERCISES = (
+    Exercise(16, ("phi_table", "runge2d", "eval_pbilin") + BILINEAR.names(),
+             (Part("phi_table", 1, check_phi_table, ("phi_table",)),
+              Part("runge2d", 1, check_runge2d, ("runge2d",), seeded=True, refused=OWN_FUNCTIONS),
+              Part("eval_pbilin", 3, check_eval_pbilin, ("eval_pbilin",), seeded=True, refused=INTERPOLANTS,
+                   passes=(functions.runge2d,) + tuple(function for _, function in BILINEAR_FUNCTIONS)))
+             + BILINEAR.parts(),
+             notebook="06_bilinear.ipynb",
+             answers=("16(a): why the phi table makes I the bilinear interpolant",
+                      "the order, against piecewise linear in one dimension")),
+)

@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import functions, monotone, piecewise, splines
 from ..plotdata import NO_LINE, Line, line_of, lines_of  # noqa: F401 - Line and line_of for the checks' users
-from .result import CheckResult, Checks, floats
+from .result import CheckResult, Results, floats
 
 MIN_POINTS = 100
 # bounds on the grader's work for one plot, whatever the notebook drew: the long lines examined,
@@ -79,7 +79,7 @@ def _lab_hermite(r0=1.15, nintervals=20):
     return _hermite_curve(tdata, x, y, dx, dy)
 
 
-def limacon_plot(plot, own=None, r0=1.15):
+def check_limacon_plot(plot, own=None, r0=1.15):
     """Check Exercise 4's plot: the Hermite interpolant of the limaçon, drawn all the way round.
 
     The curve must be the piecewise cubic Hermite interpolant itself (to
@@ -169,14 +169,14 @@ def _matches(line, values):
     return bool(np.allclose(line.y, values, rtol=0, atol=1e-6))
 
 
-def boiling_plot(plot):
+def check_boiling_plot(plot):
     """Check Exercise 14's plot: data circles without lines, then the spline and pchip curves."""
     xdata, ydata = BOILING
-    results = Checks()
+    results = Results()
     lines = lines_of(plot)
     if lines is None:
         failed = _no_plot(CheckResult("ax14"), "ax14", plot)
-        return Checks([failed, failed, failed])
+        return Results([failed, failed, failed])
     lines = [ln for ln in lines if ln.x.size == ln.y.size and ln.x.size and np.all(np.isfinite(ln.x))
              and np.all(np.isfinite(ln.y))]
 

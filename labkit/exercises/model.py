@@ -1,0 +1,191 @@
+"""What an exercise is: the pieces every exercise declaration is made of.
+
+An exercise is declared once, in the topic module it belongs to
+(:mod:`~labkit.exercises.hermite`, :mod:`~labkit.exercises.patches`,
+:mod:`~labkit.exercises.splines`, :mod:`~labkit.exercises.bilinear`), as an
+:class:`Exercise` of :class:`Part` objects. A part says which of the
+notebook's names its check reads, the check itself (a ``check_...`` function,
+which the student calls as ``labkit.check....``), its weight, the functions the
+check hands to student code, and the references it switches off. Everything
+else (the grader's registry, the sandbox's list of functions that may cross,
+nbgrader's points, the notebooks' self-check names) is derived from the
+declarations by :class:`labkit.exercises.registry.Registry`.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+CHECK_PREFIX = "check_"
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """What a graded function may not reach while the grader calls it: whole modules, not names.
+
+    ``modules`` are module prefixes: every Python function, method and
+    compiled routine in them is switched off, private helpers included.
+    ``functions`` are single functions of other modules (numpy's linear
+    ``interp``). ``allowed`` are the few functions of those modules that the
+    lab lets students reuse. :mod:`labkit.grading.refusals` turns this into
+    what the sandbox recognises, and the source scan reads the same lists.
+    """
+
+    name: str
+    modules: tuple
+    functions: tuple = ()
+    allowed: tuple = ()
+
+
+# the lab's answers and the grader's own references: refused in every graded call that has a refusal
+GRADER = ("labkit.exercises",)
+INTERPOLANTS = Refusal(
+    "library interpolants",
+    modules=("scipy.interpolate", "scipy.ndimage", "scipy.signal._bsplines", "scipy.signal._spline",
+             "scipy.signal._spline_filters", "labkit.piecewise", "labkit.splines", "labkit.monotone",
+             "labkit.bilinear", "labkit.patches", "labkit.convergence", "labkit.functions") + GRADER,
+    functions=("numpy.lib._function_base_impl.interp", "numpy._core._multiarray_umath.interp",
+               "numpy._core._multiarray_umath.interp_complex"),
+    allowed=("labkit.piecewise.bracket",))
+OWN_FUNCTIONS = Refusal("the lab's functions", modules=("labkit.functions",) + GRADER)
+OWN_PATCH = Refusal("labkit's patch", modules=("labkit.patches",) + GRADER,
+                    allowed=("labkit.patches.Corner", "labkit.patches._vector"))
+EXPERIMENTS = Refusal("labkit's experiments", modules=("labkit.convergence",) + GRADER)
+
+
+@dataclass(frozen=True)
+class Optional:
+    """A name the check reads if the notebook defines it (None otherwise)."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Together:
+    """Several of the notebook's names handed to the check as one list.
+
+    When one is missing: the part fails as "not defined" (``required``), or
+    the check gets None and judges without them.
+    """
+
+    names: tuple
+    required: bool = True
+
+
+def read(namespace: Mapping, spec: str | Optional | Together) -> Any:
+    """The value a check gets for one of :attr:`Part.reads` (KeyError: a name the notebook lacks)."""
+    if isinstance(spec, Optional):
+        return namespace.get(spec.name)
+    if isinstance(spec, Together):
+        if not spec.required:
+            values = [namespace.get(name) for name in spec.names]
+            return None if any(value is None for value in values) else values
+        return [namespace[name] for name in spec.names]
+    return namespace[spec]
+
+
+def names_read(spec: str | Optional | Together) -> tuple:
+    """The notebook names one of :attr:`Part.reads` stands for."""
+    if isinstance(spec, Optional):
+        return (spec.name,)
+    if isinstance(spec, Together):
+        return tuple(spec.names)
+    return (spec,)
+
+
+def facade_name(check: Callable) -> str:
+    """The name a check has in :mod:`labkit.check`: its own name without ``check_``."""
+    name = check.__name__
+    if not name.startswith(CHECK_PREFIX):
+        raise ValueError(f"a part's check must be a function named {CHECK_PREFIX}<name>; got {name!r}.")
+    return name[len(CHECK_PREFIX):]
+
+
+@dataclass(frozen=True)
+class Part:
+    """One graded piece of an exercise: a check of some of the notebook's names, and its weight.
+
+    ``check(*values, seed=seed)`` (``seed`` only when ``seeded``) returns one
+    :class:`~labkit.exercises.result.CheckResult`, or, for parts that share
+    one check (``index`` set: the parts of one plot), a list of them, run once
+    for all. ``reads`` are the notebook's names passed to it, in order: a name,
+    an :class:`Optional` name, or names :class:`Together`. The weights of an
+    exercise's parts are its points; a rubric that gives the exercise other
+    points scales them (:mod:`labkit.grading.rubric`).
+
+    ``passes`` are labkit's functions the check hands to the student's code
+    (the only functions that may cross into the sandbox); ``refused`` is
+    what is switched off while the grader calls the student's functions for
+    this part; ``functions`` are the student's functions the part calls, when
+    not just the one named like it (the grader scans their source).
+    """
+
+    name: str
+    weight: int
+    check: Callable
+    reads: tuple = ()
+    seeded: bool = False
+    index: int | None = None
+    refused: Refusal | None = None
+    functions: tuple = ()
+    passes: tuple = ()
+
+    def __post_init__(self):
+        facade_name(self.check)
+        if int(self.weight) < 0:
+            raise ValueError(f"part {self.name!r} has a negative weight {self.weight}.")
+
+    @property
+    def scanned(self) -> tuple:
+        """The student's names whose source the grader reads for refused references."""
+        return self.functions or (self.name,)
+
+    @property
+    def self_check(self) -> str:
+        """The part's check as the notebook calls it: ``labkit.check.<self_check>``."""
+        return facade_name(self.check)
+
+    @property
+    def shared(self) -> tuple:
+        """Parts with the same key run their check once (with ``index`` picking each one's result)."""
+        return (self.check, self.reads)
+
+    def names(self) -> tuple:
+        """Every notebook name the part reads."""
+        return tuple(name for spec in self.reads for name in names_read(spec))
+
+    def run(self, namespace: Mapping, seed: int | None = None) -> Any:
+        values = [read(namespace, spec) for spec in self.reads]
+        return self.check(*values, seed=seed) if self.seeded else self.check(*values)
+
+
+@dataclass(frozen=True)
+class Exercise:
+    """One graded exercise.
+
+    ``names`` are what the student's notebook defines (any of them present
+    means the notebook is the exercise's own). ``parts`` are its checks with
+    their weights. ``answers`` are the remarks and explanations the student
+    writes in words: no check reads them, the feedback lists them for the
+    instructor, and ``grades.csv`` has an empty column for each.
+    ``notebook`` is the notebook the exercise is in.
+    """
+
+    number: int
+    names: tuple
+    parts: tuple
+    notebook: str
+    answers: tuple = ()
+    topic: str = field(default="", compare=False)
+
+    def __post_init__(self):
+        seen = [part.name for part in self.parts]
+        if len(set(seen)) != len(seen):
+            raise ValueError(f"exercise {self.number} has two parts with the same name.")
+        if not self.parts:
+            raise ValueError(f"exercise {self.number} has no parts: give it at least one checked part.")
+
+    @property
+    def points(self) -> int:
+        return sum(part.weight for part in self.parts)

@@ -1,0 +1,176 @@
+"""The graded exercises, gathered from their declarations, and everything derived from them.
+
+:data:`LAB` is the lab's registry: the exercises the topic modules declare.
+A course that adds an exercise declares it in a topic module and lists the
+module in :data:`TOPICS`; a toy course (the tests') builds its own
+:class:`Registry` from its own exercises and names it to the grader as
+``module:attribute``.
+
+The same registry serves a student's notebook and ``labkit grade``:
+:meth:`Registry.check` only reads names from a mapping, which is the notebook's
+own variables in the notebook and a proxy into the sandboxed notebook in the
+grader (:mod:`labkit.grading.remote`).
+"""
+from __future__ import annotations
+
+import importlib
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+from . import bilinear, hermite, monotone, patches, splines
+from .model import Exercise
+from .result import CheckResult
+
+TOPICS = (hermite, patches, splines, monotone, bilinear)  # in the order of the exercises they declare
+
+
+def function_name(function) -> str:
+    """How both sides of the sandbox name a function that may cross it: ``module:qualname``."""
+    return f"{function.__module__}:{function.__qualname__}"
+
+
+class Registry:
+    """A course's exercises by number, and what is derived from them.
+
+    Attributes
+    ----------
+    exercises : dict
+        :class:`~labkit.exercises.model.Exercise` by number.
+    points : dict
+        Each exercise's points: the sum of its parts' weights.
+    names : dict
+        What each exercise's notebook defines.
+    answers : dict
+        ``exerciseN-answer-K`` (nbgrader's grade id) -> (N, what the answer is about).
+    refusals : tuple
+        Every :class:`~labkit.exercises.model.Refusal` some part uses.
+    passable : frozenset
+        ``module:qualname`` of every function a check hands to student code:
+        the only functions that may cross into the sandbox.
+    self_checks : dict
+        ``labkit.check`` name -> the check function.
+    experiments : dict
+        The convergence experiments by key.
+    """
+
+    def __init__(self, exercises: Iterable[Exercise], source: str | None = None):
+        exercises = list(exercises)
+        numbers = [exercise.number for exercise in exercises]
+        duplicated = sorted({n for n in numbers if numbers.count(n) > 1})
+        if duplicated:
+            raise ValueError(f"exercise {duplicated[0]} is declared twice: give each exercise its own number.")
+        self.source = source
+        self.exercises = {exercise.number: exercise for exercise in sorted(exercises, key=lambda e: e.number)}
+        self.points = {n: e.points for n, e in self.exercises.items()}
+        self.names = {n: list(e.names) for n, e in self.exercises.items()}
+        self.answers = {f"exercise{e.number}-answer-{k}": (e.number, text)
+                        for e in self.exercises.values() for k, text in enumerate(e.answers, start=1)}
+        parts = [part for e in self.exercises.values() for part in e.parts]
+        self.refusals = tuple(sorted({p.refused for p in parts if p.refused}, key=lambda refusal: refusal.name))
+        self.passable = frozenset(function_name(f) for p in parts for f in p.passes)
+        self.experiments = {}
+        for part in parts:
+            experiment = getattr(part, "experiment", None)
+            if experiment is not None:
+                self.experiments.setdefault(experiment.key, experiment)
+        self.self_checks = {}
+        for part in parts:
+            if getattr(part, "experiment", None) is None:
+                self.self_checks.setdefault(part.self_check, part.check)
+
+    def __iter__(self):
+        return iter(self.exercises.values())
+
+    def __len__(self) -> int:
+        return len(self.exercises)
+
+    def notebooks(self) -> dict:
+        """Notebook file name -> the numbers of the exercises in it."""
+        found = {}
+        for exercise in self:
+            found.setdefault(exercise.notebook, []).append(exercise.number)
+        return found
+
+    def experiment(self, key: str):
+        """The convergence experiment `key`; ValueError naming the choices otherwise."""
+        if key not in self.experiments:
+            raise ValueError(f"unknown experiment {key!r}; choose one of {', '.join(map(repr, self.experiments))}.")
+        return self.experiments[key]
+
+    def parts_checked(self, number: int, function: str, first: str | None = None) -> list:
+        """The parts of exercise `number` that ``labkit.check.<function>(first, ...)`` checks.
+
+        For ``driver``, ``table`` and ``rate`` the first argument is the
+        experiment's key; otherwise the function's name is enough.
+        """
+        found = []
+        for part in self.exercises[number].parts:
+            experiment = getattr(part, "experiment", None)
+            if part.self_check == function and (experiment is None or experiment.key == first):
+                found.append(part)
+        return found
+
+    def check(self, number: int, namespace: Mapping, seed: int | None = None) -> dict:
+        """Run the checks of exercise `number` on a notebook's variables; a dict for the grader.
+
+        `namespace` is any mapping of names to the student's functions and
+        data. ``defined`` says whether the notebook defines any of the
+        exercise's names, so the grader can tell the exercise's own notebook
+        from one that only mentions it. Each check in ``checks`` carries its
+        part's ``weight``; ``fraction`` is the share of the weight that passed
+        and ``points`` the weights that passed. `seed` draws the random test
+        data afresh (see :func:`labkit.exercises.result.case_rng`).
+        """
+        exercise = self.exercises[number]
+        defined = any(name in namespace for name in exercise.names)
+        checks, shared = [], {}
+        refusing = getattr(namespace, "refusing", None)  # the grader's proxy switches references off per part
+        for part in exercise.parts:
+            if refusing is not None:
+                refusing(part.refused)
+            try:
+                if part.index is None:
+                    result = part.run(namespace, seed)
+                else:
+                    if part.shared not in shared:
+                        shared[part.shared] = part.run(namespace, seed)
+                    result = shared[part.shared][part.index]
+            except KeyError as exc:
+                result = _missing(str(exc).strip("'\""))
+                result.name = part.name
+            except Exception as exc:  # noqa: BLE001 - a fault of the check itself costs this part, not the others
+                result = CheckResult(part.name)
+                result.fail("the grader could check this part",
+                            f"the check failed inside labkit ({type(exc).__name__})",
+                            "this is a fault of the grader, not of your work: tell your instructor.")
+            checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # as the student names it
+        points = sum(check["weight"] for check in checks if check["passed"])
+        return {"exercise": number, "passed": points == exercise.points, "points": points,
+                "fraction": points / exercise.points if exercise.points else 1.0, "defined": defined,
+                "checks": checks}
+
+
+def _missing(name: str) -> CheckResult:
+    result = CheckResult(name)
+    return result.fail(f"{name} is defined", "not defined when the notebook finished",
+                       f"run the cell that defines {name} (and keep its name); a cell that raised stops it.")
+
+
+LAB = Registry((exercise for topic in TOPICS for exercise in topic.EXERCISES), source="labkit.exercises.registry:LAB")
+
+
+def load(source: str | None = None) -> Registry:
+    """The registry named ``module:attribute`` (the lab's when None); ValueError if it is not one."""
+    if source is None or source == LAB.source:
+        return LAB
+    module, _, attribute = str(source).partition(":")
+    try:
+        found: Any = getattr(importlib.import_module(module), attribute or "REGISTRY")
+    except (ImportError, AttributeError) as exc:
+        raise ValueError(f"cannot load the exercises {source!r} ({exc}); give module:attribute of a Registry, "
+                         "with the module importable.") from None
+    if not isinstance(found, Registry):
+        raise ValueError(f"{source!r} is a {type(found).__name__}, not a labkit Registry of exercises.")
+    if found.source is None:
+        found.source = source
+    return found
