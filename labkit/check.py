@@ -44,10 +44,15 @@ def rate(key, answer, errors, fn):
     return _experiments.check_rate(_LAB.experiment(key), answer, errors, fn)
 
 
-def grade(number, namespace, seed=None):
-    """Run every check of exercise `number` on a mapping of the notebook's names (what the grader runs)."""
+def exercise(number, namespace, seed=None):
+    """Run every check of exercise `number` on a mapping of the notebook's names (what the grader runs).
+
+    ``labkit.check.exercise(2, globals())`` checks Exercise 2 the way ``labkit grade`` does, except that
+    the grader also runs the notebook in a sandbox and draws fresh test data."""
     return _LAB.check(number, namespace, seed)
 
 
-__all__ = sorted(["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "driver", "grade",
+grade = exercise  # its name before 0.2; ``labkit.grading.grade`` is the grader's entry point
+
+__all__ = sorted(["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "driver", "exercise",
                   "rate", "table", *_LAB.self_checks])

@@ -93,7 +93,7 @@ def test_graded_corner_data(corners, passed):
 
 
 def test_grade_reports_missing_names_with_a_hint():
-    verdict = check.grade(16, {"runge2d": labkit.runge2d})
+    verdict = check.exercise(16, {"runge2d": labkit.runge2d})
     assert verdict["defined"] and not verdict["passed"]
     passed = [c["name"] for c in verdict["checks"] if c["passed"]]
     assert passed == ["runge2d"] and verdict["points"] == 1 and verdict["fraction"] == 1 / 8

@@ -29,13 +29,25 @@ def test_the_lab_rubric_is_its_branch_rule():
     assert lab.maximum == lab.full_credit + 10 + lab.points[16]
 
 
+P = {n: float(e.points) for n, e in EXERCISES.items()}  # the declared points: the totals below follow them
+REQUIRED, BRANCH = sum(P[n] for n in (2, 3, 4)), sum(P[n] for n in MESH)
+BONUS = 10  # the rubric's extra credit for a complete second branch
+
+
+def test_the_lab_branches_are_worth_the_same():
+    assert BRANCH == sum(P[n] for n in SPLINES)
+
+
 @pytest.mark.parametrize("done, total, branch, extra", [
-    (((2, 3, 4), SPLINES), 100, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
-    (((2, 3, 4), MESH), 100, "mesh generation", {"exercise 16": 0, "branch splines": 0}),
-    (((2, 3, 4), MESH, SPLINES), 110, "mesh generation", {"exercise 16": 0, "branch splines": 10}),
-    (((2, 3, 4), SPLINES, (16,)), 108, "splines", {"exercise 16": 8, "branch mesh generation": 0}),
-    (((2, 3, 4), MESH, SPLINES, (16,)), 118, "mesh generation", {"exercise 16": 8, "branch splines": 10}),
-    ((SPLINES,), 60, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
+    (((2, 3, 4), SPLINES), REQUIRED + BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
+    (((2, 3, 4), MESH), REQUIRED + BRANCH, "mesh generation", {"exercise 16": 0, "branch splines": 0}),
+    (((2, 3, 4), MESH, SPLINES), REQUIRED + BRANCH + BONUS, "mesh generation",
+     {"exercise 16": 0, "branch splines": BONUS}),
+    (((2, 3, 4), SPLINES, (16,)), REQUIRED + BRANCH + P[16], "splines",
+     {"exercise 16": P[16], "branch mesh generation": 0}),
+    (((2, 3, 4), MESH, SPLINES, (16,)), REQUIRED + BRANCH + BONUS + P[16], "mesh generation",
+     {"exercise 16": P[16], "branch splines": BONUS}),
+    ((SPLINES,), BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
     ((), 0, "none", {"exercise 16": 0, "branch splines": 0}),
 ])
 def test_the_better_branch_counts_and_the_other_is_extra_credit(done, total, branch, extra):
