@@ -244,6 +244,7 @@ CALLS = [
     ("ConvergenceTable.rates", lambda tmp: TABLE.rates),
     ("ConvergenceTable.order", lambda tmp: TABLE.order),
     ("ConvergenceTable.__str__", lambda tmp: str(TABLE)),
+    ("ready", lambda tmp: labkit.ready("0.1")),
 ]
 
 
