@@ -2,6 +2,7 @@
 
 Run: ``.venv/bin/python benchmarks/bench_2d.py``.
 """
+
 import time
 
 import numpy as np
@@ -48,9 +49,11 @@ def main():
 
     t_ours, z_ours = best_time(ours)
     t_scipy, z_scipy = best_time(scipy_rgi)
-    print(f"eval_pbilin 161^2 data on 2001^2: {t_ours:.3f} s, "
-          f"RegularGridInterpolator {t_scipy:.3f} s, ratio {t_ours / t_scipy:.3f}"
-          f" (max difference {np.max(np.abs(z_ours - z_scipy)):.1e})")
+    print(
+        f"eval_pbilin 161^2 data on 2001^2: {t_ours:.3f} s, "
+        f"RegularGridInterpolator {t_scipy:.3f} s, ratio {t_ours / t_scipy:.3f}"
+        f" (max difference {np.max(np.abs(z_ours - z_scipy)):.1e})"
+    )
 
 
 if __name__ == "__main__":

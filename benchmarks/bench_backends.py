@@ -16,6 +16,7 @@ key on each slider 12 times and prints the median and 90th percentile from key p
 picture: an ``<img>`` whose ``src`` changed, or for ipympl's canvas, image data arriving on the
 kernel's websocket.
 """
+
 import importlib.util
 import statistics
 import sys
@@ -117,8 +118,9 @@ def main():
                 page.locator(f"{scope} .noUi-handle").wait_for(timeout=30_000)
                 times = []
                 for _ in range(12):
-                    old = page.evaluate("s => { const i = document.querySelector(s + ' img'); return i ? i.src : null; }",
-                                        scope)
+                    old = page.evaluate(
+                        "s => { const i = document.querySelector(s + ' img'); return i ? i.src : null; }", scope
+                    )
                     before = frames(page)
                     page.locator(f"{scope} .noUi-handle").focus()
                     start = time.perf_counter()
@@ -127,8 +129,10 @@ def main():
                     times.append(1000 * (time.perf_counter() - start))
                     time.sleep(0.1)  # let a late second frame pass before the next press
                 ordered = sorted(times)
-                print(f"{way:<8} median {statistics.median(times):4.0f} ms, "
-                      f"90th percentile {ordered[int(0.9 * (len(ordered) - 1))]:4.0f} ms over {len(times)} key presses")
+                print(
+                    f"{way:<8} median {statistics.median(times):4.0f} ms, "
+                    f"90th percentile {ordered[int(0.9 * (len(ordered) - 1))]:4.0f} ms over {len(times)} key presses"
+                )
             browser.close()
 
 

@@ -7,14 +7,25 @@ Run All, 8 arrow-key presses per slider and, in the patch editor, an 8-step drag
 prints the median and 90th percentile per slider and exits non-zero if any median is above
 GOAL_MS. ``make test`` prints the same times but never fails on them.
 """
+
 import sys
 import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
-from jupyterlab_session import (CHROMIUM_FLAGS, COUNT_IMAGE_FRAMES, NOTEBOOKS, close_sessions, course_lab,  # noqa: E402
-                                drag_a_corner, latencies, move_every_slider, open_and_run, show_explorers)
+from jupyterlab_session import (  # noqa: E402
+    CHROMIUM_FLAGS,
+    COUNT_IMAGE_FRAMES,
+    NOTEBOOKS,
+    close_sessions,
+    course_lab,
+    drag_a_corner,
+    latencies,
+    move_every_slider,
+    open_and_run,
+    show_explorers,
+)
 
 CHROMIUM = Path("/usr/bin/chromium")
 GOAL_MS = 100  # median key press (or drag step) -> new picture, per slider

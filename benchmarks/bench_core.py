@@ -4,6 +4,7 @@ Run: ``.venv/bin/python benchmarks/bench_core.py [--n 1000000]``.
 Each entry is the best of a few repeats, so a busy moment on the machine
 does not decide a ratio.
 """
+
 import argparse
 import time
 
@@ -30,14 +31,20 @@ def cases(n, rng):
     shuffled = rng.permutation(xv)
     return [
         ("nakspline build", lambda: labkit.nakspline(x, y), lambda: CubicSpline(x, y)),
-        ("ccspline build", lambda: labkit.ccspline(x, y, 0.0, 1.0),
-         lambda: CubicSpline(x, y, bc_type=((1, 0.0), (1, 1.0)))),
+        (
+            "ccspline build",
+            lambda: labkit.ccspline(x, y, 0.0, 1.0),
+            lambda: CubicSpline(x, y, bc_type=((1, 0.0), (1, 1.0))),
+        ),
         ("ncspline build", lambda: labkit.ncspline(x, y), lambda: CubicSpline(x, y, bc_type="natural")),
         ("pchip build+eval", lambda: labkit.pchip(x, y, xv), lambda: PchipInterpolator(x, y)(xv)),
         ("eval_pherm", lambda: labkit.eval_pherm(x, y, yp, xv), lambda: CubicHermiteSpline(x, y, yp)(xv)),
         ("eval_plin vs np.interp", lambda: labkit.eval_plin(x, y, xv), lambda: np.interp(xv, x, y)),
-        ("eval_pherm, shuffled", lambda: labkit.eval_pherm(x, y, yp, shuffled),
-         lambda: CubicHermiteSpline(x, y, yp)(shuffled)),
+        (
+            "eval_pherm, shuffled",
+            lambda: labkit.eval_pherm(x, y, yp, shuffled),
+            lambda: CubicHermiteSpline(x, y, yp)(shuffled),
+        ),
         ("eval_plin, shuffled", lambda: labkit.eval_plin(x, y, shuffled), lambda: np.interp(shuffled, x, y)),
     ]
 
@@ -48,8 +55,10 @@ def main(argv=None):
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args(argv)
     rng = np.random.default_rng(0)
-    print(f"{args.n:,} unequally spaced knots, {args.n:,} evaluation points (sorted unless "
-          f"shuffled), best of {args.repeats}")
+    print(
+        f"{args.n:,} unequally spaced knots, {args.n:,} evaluation points (sorted unless "
+        f"shuffled), best of {args.repeats}"
+    )
     print(f"{'task':<24}{'labkit s':>10}{'scipy s':>10}{'ratio':>8}")
     for name, ours, theirs in cases(args.n, rng):
         t_ours, t_theirs = best_time(ours, args.repeats), best_time(theirs, args.repeats)

@@ -6,6 +6,7 @@ notebooks, half the student release. The sandbox's cost is the difference
 between the sandboxed and the unconfined single-submission times, measured
 in the same run.
 """
+
 import argparse
 import contextlib
 import io
@@ -50,14 +51,18 @@ def main():
         tmp = Path(tmp)
         submissions = _class(tmp, args.count)
         boxed, free = _single(submissions[0], True), _single(submissions[0], False)
-        print(f"one solved submission (6 notebooks), best of 3: sandboxed {boxed:.2f} s, unconfined {free:.2f} s, "
-              f"sandbox cost {boxed - free:+.2f} s per submission ({(boxed - free) / 6:+.3f} s per notebook)")
+        print(
+            f"one solved submission (6 notebooks), best of 3: sandboxed {boxed:.2f} s, unconfined {free:.2f} s, "
+            f"sandbox cost {boxed - free:+.2f} s per submission ({(boxed - free) / 6:+.3f} s per notebook)"
+        )
         start = time.perf_counter()
         grades = grading.grade(submissions, tmp / "out", jobs=args.jobs, progress=False, seed=1)
         elapsed = time.perf_counter() - start
     totals = sorted({g.total for g in grades})
-    print(f"class of {len(grades)} submissions, --jobs {args.jobs}, sandboxed: {elapsed:.1f} s "
-          f"({elapsed / len(grades):.2f} s each; before the sandbox: {BEFORE} s each); totals seen: {totals}")
+    print(
+        f"class of {len(grades)} submissions, --jobs {args.jobs}, sandboxed: {elapsed:.1f} s "
+        f"({elapsed / len(grades):.2f} s each; before the sandbox: {BEFORE} s each); totals seen: {totals}"
+    )
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ PNG at 100 dpi, as the inline backend does. "After" is what an explorer of
 render one PNG. The browser adds the trip to the page: see
 ``benchmarks/bench_browser_latency.py``.
 """
+
 import io
 import time
 
@@ -22,23 +23,52 @@ from labkit import plots  # noqa: E402
 
 def _graded(elements, dxds_bc):
     e2 = [0, 1]
-    return [labkit.Corner([0, 0], [3, 0], e2), labkit.Corner([1, 0], [dxds_bc, 0], e2),
-            labkit.Corner([1, 1], [dxds_bc, 0], e2), labkit.Corner([0, 1], [3, 0], e2)]
+    return [
+        labkit.Corner([0, 0], [3, 0], e2),
+        labkit.Corner([1, 0], [dxds_bc, 0], e2),
+        labkit.Corner([1, 1], [dxds_bc, 0], e2),
+        labkit.Corner([0, 1], [3, 0], e2),
+    ]
 
 
 # name -> (the old redraw for a value, explorer factory, control, two values to alternate)
 SLIDERS = {
-    "01 limacon intervals": (lambda v: plots.plot_limacon(v, 1.15, "pherm"), plots.limacon_explorer, "intervals", (40, 41)),
-    "02 convergence ndata": (lambda v: plots.plot_interpolation_error(["natural"], v), plots.convergence_explorer,
-                             "ndata", (40, 41)),
-    "03 mesh dx/ds B,C (11 x 11)": (lambda v: plots.plot_patch(_graded(10, v), 11, 11, color_by_quality=True),
-                                    plots.mesh_explorer, "dxds_BC", (0.1, 0.2)),
-    "03 mesh elements (40 x 40)": (lambda v: plots.plot_patch(_graded(v, 0.1), v + 1, v + 1, color_by_quality=True),
-                                   plots.mesh_explorer, "elements", (39, 40)),
-    "04 three spline errors": (lambda v: plots.plot_interpolation_error(["complete", "natural", "notaknot"], v),
-                               plots.spline_explorer, "ndata", (20, 21)),
-    "05 spline vs pchip": (lambda v: plots.plot_spline_vs_pchip(np.arange(5.0), np.array([0, v, 2, 2.4, 2])),
-                           plots.pchip_explorer, "y1", (1.0, 1.05)),
+    "01 limacon intervals": (
+        lambda v: plots.plot_limacon(v, 1.15, "pherm"),
+        plots.limacon_explorer,
+        "intervals",
+        (40, 41),
+    ),
+    "02 convergence ndata": (
+        lambda v: plots.plot_interpolation_error(["natural"], v),
+        plots.convergence_explorer,
+        "ndata",
+        (40, 41),
+    ),
+    "03 mesh dx/ds B,C (11 x 11)": (
+        lambda v: plots.plot_patch(_graded(10, v), 11, 11, color_by_quality=True),
+        plots.mesh_explorer,
+        "dxds_BC",
+        (0.1, 0.2),
+    ),
+    "03 mesh elements (40 x 40)": (
+        lambda v: plots.plot_patch(_graded(v, 0.1), v + 1, v + 1, color_by_quality=True),
+        plots.mesh_explorer,
+        "elements",
+        (39, 40),
+    ),
+    "04 three spline errors": (
+        lambda v: plots.plot_interpolation_error(["complete", "natural", "notaknot"], v),
+        plots.spline_explorer,
+        "ndata",
+        (20, 21),
+    ),
+    "05 spline vs pchip": (
+        lambda v: plots.plot_spline_vs_pchip(np.arange(5.0), np.array([0, v, 2, 2.4, 2])),
+        plots.pchip_explorer,
+        "y1",
+        (1.0, 1.05),
+    ),
     "06 bilinear ndata": (lambda v: plots.plot_bilinear_error(v), plots.bilinear_explorer, "ndata", (20, 21)),
 }
 
@@ -57,6 +87,7 @@ def _old(draw):
         ax = draw(value)
         ax.figure.savefig(io.BytesIO(), format="png", dpi=100)
         plt.close(ax.figure)
+
     return redraw
 
 
@@ -64,7 +95,7 @@ def main():
     print(f"{'slider':<30}{'before':>10}{'after':>10}")
     for name, (draw, factory, control, values) in SLIDERS.items():
         explorer = factory()
-        after = _median_ms(lambda v: setattr(explorer.controls[control], "value", v), values)
+        after = _median_ms(lambda v, e=explorer, c=control: setattr(e.controls[c], "value", v), values)
         print(f"{name:<30}{_median_ms(_old(draw), values):8.0f} ms{after:7.0f} ms")
     editor = plots.patch_editor()
     step = _median_ms(lambda v: setattr(editor.widget_, "drag", {"index": 1, "x": 1 + v, "y": 0.0}), (0.0, 0.05))

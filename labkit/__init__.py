@@ -7,6 +7,7 @@ Everything a notebook needs is importable from here, e.g.
 self-checks (:mod:`labkit.check`) and the figures (:mod:`labkit.plots`)
 load when first used, as ``labkit.check`` and ``labkit.plots``.
 """
+
 import importlib
 
 from .bilinear import eval_pbilin

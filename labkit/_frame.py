@@ -13,6 +13,7 @@ rise by 1 over an interval of 1e-320, a cubic evaluated far outside its
 data), :meth:`Frame.result` and :meth:`Frame.knot_slopes` raise a
 ValueError that says so, instead of returning inf or NaN.
 """
+
 import numpy as np
 
 LIMIT = 200  # binary exponents beyond +-LIMIT (about 1e+-60) are scaled
@@ -58,7 +59,8 @@ class Frame:
                 what = "value" if der == 0 else f"derivative of order {der}"
                 raise ValueError(
                     f"the interpolant's {what} at xval = {where:g} is beyond the float range; "
-                    "evaluate nearer to the data, or rescale xdata and ydata.")
+                    "evaluate nearer to the data, or rescale xdata and ydata."
+                )
         return values
 
     def knot_slopes(self, slopes, name):
@@ -71,5 +73,6 @@ class Frame:
             raise ValueError(
                 f"the {name} slopes are beyond the float range: the data change too fast for their spacing "
                 f"(the smallest interval is xdata[{k + 1}] - xdata[{k}] = {gaps[k]:g}). Rescale ydata, or "
-                "merge points that are this close.")
+                "merge points that are this close."
+            )
         return slopes

@@ -13,6 +13,7 @@ exact; only the speed depends on the spacing.
 The points are processed in blocks small enough to stay in the CPU cache,
 each block located and evaluated before the next one starts.
 """
+
 import numpy as np
 
 BLOCK = 1 << 17
@@ -35,9 +36,7 @@ class Locator:
         self.nbuckets = x.size
         with np.errstate(over="ignore", divide="ignore"):
             self.scale = self.nbuckets / (x[-1] - x[0])
-        self.use_buckets = (
-            x.size > 2 and 4 * npoints >= x.size and 0 < self.scale < np.inf
-        )
+        self.use_buckets = x.size > 2 and 4 * npoints >= x.size and 0 < self.scale < np.inf
         if self.use_buckets:
             self._count_knots_per_bucket()
             # knots[k] is the first interior knot a point with index k has
@@ -53,10 +52,10 @@ class Locator:
         # buckets: count them block by block into left[1:], then a prefix sum
         # makes left[b] the number of interior knots in buckets before b.
         for start in range(0, self.interior.size, BLOCK):
-            buckets = self._bucket(self.interior[start:start + BLOCK], inside=True)
+            buckets = self._bucket(self.interior[start : start + BLOCK], inside=True)
             first = buckets[0]
             counts = np.bincount(buckets - first)
-            self.left[first + 1:first + 1 + counts.size] += counts
+            self.left[first + 1 : first + 1 + counts.size] += counts
         # A bucket may straddle two blocks, so its occupancy is read here.
         most = int(self.left.max())
         np.cumsum(self.left, out=self.left)

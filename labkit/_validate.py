@@ -4,14 +4,14 @@ Each helper returns a float ndarray (never the caller's object when a copy
 is needed) and raises ``ValueError`` with a message that names the argument,
 says what is wrong and how to fix it.
 """
-import numpy as np
 
+import numpy as np
 
 _NOT_NUMBERS = {
     "c": "complex numbers (the imaginary parts would be lost): interpolate the real and imaginary parts "
-         "separately, e.g. with {name}.real and {name}.imag",
+    "separately, e.g. with {name}.real and {name}.imag",
     "b": "booleans (True/False), not numbers: if you mean 0 and 1, convert on purpose with "
-         "np.asarray({name}, dtype=float)",
+    "np.asarray({name}, dtype=float)",
     "U": "text, not numbers: convert it first, e.g. np.asarray({name}, dtype=float)",
     "S": "text, not numbers: convert it first, e.g. np.asarray({name}, dtype=float)",
     "M": "dates, not numbers: convert them to numbers first (e.g. seconds since a start time)",
@@ -34,8 +34,9 @@ def _check_object_item(item, name):
     try:
         float(item)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} holds a {type(item).__name__} object where a number should be; "
-                         "give real numbers only.") from None
+        raise ValueError(
+            f"{name} holds a {type(item).__name__} object where a number should be; give real numbers only."
+        ) from None
 
 
 def as_float_array(values, name):
@@ -81,9 +82,7 @@ def as_knots(xdata, name="xdata"):
             f"Pass a flat sequence such as np.ravel({name})."
         )
     if x.size < 2:
-        raise ValueError(
-            f"{name} needs at least 2 points to define an interval; got {x.size}."
-        )
+        raise ValueError(f"{name} needs at least 2 points to define an interval; got {x.size}.")
     # One comparison pass settles the common case: a NaN anywhere fails it,
     # and a strictly increasing array can only hold an infinity at its ends.
     if np.all(x[1:] > x[:-1]) and np.isfinite(x[0]) and np.isfinite(x[-1]):
@@ -101,14 +100,9 @@ def as_data(values, n, name, xname="xdata"):
     """Validate values attached to the n knots: 1-D, length n, finite."""
     v = as_float_array(values, name)
     if v.ndim != 1:
-        raise ValueError(
-            f"{name} must be a 1-D array; got an array of shape {v.shape}."
-        )
+        raise ValueError(f"{name} must be a 1-D array; got an array of shape {v.shape}.")
     if v.size != n:
-        raise ValueError(
-            f"{name} has {v.size} entries but {xname} has {n}; give one value per "
-            f"point of {xname}."
-        )
+        raise ValueError(f"{name} has {v.size} entries but {xname} has {n}; give one value per point of {xname}.")
     require_finite(v, name)
     return v
 

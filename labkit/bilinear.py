@@ -4,6 +4,7 @@ On each grid cell the interpolant is the unique function a + bx + cy + dxy
 that matches the four corner values; the derivation with the four cell
 basis functions is in ``notebooks/06_bilinear.ipynb``.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -11,8 +12,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import as_float_array, as_knots, require_finite
 from ._locate import locate
+from ._validate import as_float_array, as_knots, require_finite
 
 
 def eval_pbilin(

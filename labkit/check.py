@@ -17,10 +17,9 @@ name without ``check_``, and a convergence experiment's three checks take
 the experiment's key first: ``labkit.check.table("pherm", errors_pherm,
 test_pherm_interpolate)``.
 """
+
 from .exercises import experiments as _experiments
-from .exercises.model import Exercise
 from .exercises.registry import LAB as _LAB
-from .exercises.result import TOLERANCE, CheckResult
 
 EXERCISES = _LAB.exercises
 NAMES = _LAB.names
@@ -54,5 +53,18 @@ def exercise(number, namespace, seed=None):
 
 grade = exercise  # its name before 0.2; ``labkit.grading.grade`` is the grader's entry point
 
-__all__ = sorted(["CheckResult", "EXERCISES", "Exercise", "NAMES", "POINTS", "TOLERANCE", "driver", "exercise",
-                  "rate", "table", *_LAB.self_checks])
+__all__ = sorted(
+    [
+        "CheckResult",
+        "EXERCISES",
+        "Exercise",
+        "NAMES",
+        "POINTS",
+        "TOLERANCE",
+        "driver",
+        "exercise",
+        "rate",
+        "table",
+        *_LAB.self_checks,
+    ]
+)

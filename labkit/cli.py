@@ -7,6 +7,7 @@
 ``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
 ``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
 """
+
 import argparse
 import sys
 import time
@@ -22,8 +23,10 @@ def _notebooks(args):
     sources = paths()
     existing = [out / p.name for p in sources if (out / p.name).exists()]
     if existing and not args.force:
-        raise ValueError(f"{existing[0]} already exists (your work?); choose another folder, or --force to "
-                         "overwrite the notebooks there.")
+        raise ValueError(
+            f"{existing[0]} already exists (your work?); choose another folder, or --force to "
+            "overwrite the notebooks there."
+        )
     out.mkdir(parents=True, exist_ok=True)
     for source in sources:
         (out / source.name).write_bytes(source.read_bytes())
@@ -66,8 +69,10 @@ def _summary(grades, out, start, what):
 
     for g in grades:
         print(f"{one_line(g.name, 30):<30} {points_text(g.total) if g.graded else 'not graded':>10}")
-    print(f"{what} {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
-          f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/")
+    print(
+        f"{what} {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
+        f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/"
+    )
 
 
 def grade_options(args):
@@ -78,9 +83,15 @@ def grade_options(args):
     for name in ("jobs", "cell_timeout", "total_timeout", "memory", "grader_memory"):
         if getattr(args, name) < 1:
             raise ValueError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
-    return GradeOptions(cell_timeout=args.cell_timeout, total_timeout=args.total_timeout, seed=args.seed,
-                        backend=args.sandbox, rubric=args.rubric, grader_memory=args.grader_memory * MIB,
-                        limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE))
+    return GradeOptions(
+        cell_timeout=args.cell_timeout,
+        total_timeout=args.total_timeout,
+        seed=args.seed,
+        backend=args.sandbox,
+        rubric=args.rubric,
+        grader_memory=args.grader_memory * MIB,
+        limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE),
+    )
 
 
 def _grade(args):
@@ -99,15 +110,16 @@ def _grade(args):
     if not args.submissions:
         raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
     options = grade_options(args)
-    grades = grade(args.submissions, args.out, jobs=args.jobs, progress=not args.quiet, rubric=rubric,
-                   options=options)
+    grades = grade(args.submissions, args.out, jobs=args.jobs, progress=not args.quiet, rubric=rubric, options=options)
     _summary(grades, args.out, start, "graded")
-    print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} "
-          f"(repeat the run with --seed)")
+    print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} (repeat the run with --seed)")
     failed = report_failures(grades)
     if failed:
-        print(f"labkit grade: {failed} submission(s) could not be graded (see above and their feedback); "
-              "every other submission is in grades.csv.", file=sys.stderr)
+        print(
+            f"labkit grade: {failed} submission(s) could not be graded (see above and their feedback); "
+            "every other submission is in grades.csv.",
+            file=sys.stderr,
+        )
         return 1
     return 0
 
@@ -117,74 +129,131 @@ def build_parser():
     from .grading.options import DEFAULTS, MIB
 
     parser = argparse.ArgumentParser(
-        prog="labkit", description="Course kit tools for the higher-order interpolation lab.",
+        prog="labkit",
+        description="Course kit tools for the higher-order interpolation lab.",
         epilog="Grading runs every notebook in a sandbox (`labkit grade --help` lists them: the default has no "
-               "network, a read-only system, a private folder and resource limits) and checks it from outside; "
-               "see docs/instructors.md.")
+        "network, a read-only system, a private folder and resource limits) and checks it from outside; "
+        "see docs/instructors.md.",
+    )
     commands = parser.add_subparsers(dest="command", required=True)
 
-    nbs = commands.add_parser("notebooks", help="write the student notebooks shipped with labkit into a folder",
-                              description="Write the lab's six student notebooks (exercises to do, with their "
-                                          "self-checks) into DIR, e.g. for Colab, a JupyterHub or VS Code.")
+    nbs = commands.add_parser(
+        "notebooks",
+        help="write the student notebooks shipped with labkit into a folder",
+        description="Write the lab's six student notebooks (exercises to do, with their "
+        "self-checks) into DIR, e.g. for Colab, a JupyterHub or VS Code.",
+    )
     nbs.add_argument("out", type=Path, metavar="DIR", help="folder for the notebooks (created if needed)")
     nbs.add_argument("--force", action="store_true", help="overwrite notebooks of the same name in DIR")
     nbs.set_defaults(handler=_notebooks)
 
-    run = commands.add_parser("execute", help="re-execute every notebook in a fresh kernel and save it clean",
-                              description="Re-execute the notebooks top to bottom in a fresh python3 kernel and save "
-                                          "them without widget state: the reference outputs nbval compares against.")
+    run = commands.add_parser(
+        "execute",
+        help="re-execute every notebook in a fresh kernel and save it clean",
+        description="Re-execute the notebooks top to bottom in a fresh python3 kernel and save "
+        "them without widget state: the reference outputs nbval compares against.",
+    )
     run.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     run.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell (default 300)")
-    run.add_argument("--rubric", type=Path,
-                     help="TOML rubric whose points nbgrader's test cells get (default: the lab's)")
+    run.add_argument(
+        "--rubric", type=Path, help="TOML rubric whose points nbgrader's test cells get (default: the lab's)"
+    )
     run.set_defaults(handler=_execute)
 
-    rel = commands.add_parser("release", help="write the student version of the notebooks",
-                              description="Replace every '### BEGIN SOLUTION' ... '### END SOLUTION' region by a stub "
-                                          "that raises NotImplementedError, remove hidden tests, clear outputs.")
+    rel = commands.add_parser(
+        "release",
+        help="write the student version of the notebooks",
+        description="Replace every '### BEGIN SOLUTION' ... '### END SOLUTION' region by a stub "
+        "that raises NotImplementedError, remove hidden tests, clear outputs.",
+    )
     rel.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     rel.add_argument("--out", type=Path, required=True, help="folder for the student notebooks")
     rel.set_defaults(handler=_release)
 
     grd = commands.add_parser(
-        "grade", help="grade submitted notebooks",
+        "grade",
+        help="grade submitted notebooks",
         description="Run each submission (a notebook, or a folder with a student's notebooks) in a sandbox, "
-                    "check every exercise from outside it, and write grades.csv, feedback/<submission>.txt, "
-                    "results/<submission>.json and seed.txt. With --merge, combine earlier runs' results instead.")
+        "check every exercise from outside it, and write grades.csv, feedback/<submission>.txt, "
+        "results/<submission>.json and seed.txt. With --merge, combine earlier runs' results instead.",
+    )
     grd.add_argument("submissions", nargs="*", type=Path, help="notebooks or folders of notebooks, one per student")
     grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv, feedback/ and results/")
-    grd.add_argument("--merge", nargs="+", type=Path, metavar="DIR",
-                     help="combine the results/ of these earlier --out folders into one grades.csv")
+    grd.add_argument(
+        "--merge",
+        nargs="+",
+        type=Path,
+        metavar="DIR",
+        help="combine the results/ of these earlier --out folders into one grades.csv",
+    )
     grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
-    grd.add_argument("--cell-timeout", type=int, default=DEFAULTS.cell_timeout,
-                     help="seconds per cell, and per call of a graded function (default %(default)s)")
-    grd.add_argument("--total-timeout", type=int, default=DEFAULTS.total_timeout,
-                     help="seconds per submission in all, every notebook of it together (default %(default)s)")
-    grd.add_argument("--memory", type=int, default=DEFAULTS.limits.memory // MIB,
-                     help="MiB of memory for a notebook's sandbox, and of address space per process "
-                          "(default %(default)s)")
-    grd.add_argument("--grader-memory", type=int, default=DEFAULTS.grader_memory // MIB,
-                     help="MiB of memory for the grader's own work on one submission (default %(default)s)")
-    grd.add_argument("--seed", type=int, default=DEFAULTS.seed,
-                     help="seed of the random test data (default: a fresh one, saved in seed.txt)")
+    grd.add_argument(
+        "--cell-timeout",
+        type=int,
+        default=DEFAULTS.cell_timeout,
+        help="seconds per cell, and per call of a graded function (default %(default)s)",
+    )
+    grd.add_argument(
+        "--total-timeout",
+        type=int,
+        default=DEFAULTS.total_timeout,
+        help="seconds per submission in all, every notebook of it together (default %(default)s)",
+    )
+    grd.add_argument(
+        "--memory",
+        type=int,
+        default=DEFAULTS.limits.memory // MIB,
+        help="MiB of memory for a notebook's sandbox, and of address space per process (default %(default)s)",
+    )
+    grd.add_argument(
+        "--grader-memory",
+        type=int,
+        default=DEFAULTS.grader_memory // MIB,
+        help="MiB of memory for the grader's own work on one submission (default %(default)s)",
+    )
+    grd.add_argument(
+        "--seed",
+        type=int,
+        default=DEFAULTS.seed,
+        help="seed of the random test data (default: a fresh one, saved in seed.txt)",
+    )
     where = grd.add_mutually_exclusive_group()
-    where.add_argument("--sandbox", choices=backends.names(), default=DEFAULTS.backend, metavar="NAME",
-                       help="where student code runs: " + "; ".join(
-                           f"{name}{' (the default)' if name == DEFAULTS.backend else ''}: "
-                           f"{backends.backend_class(name).summary}" for name in backends.names()))
-    where.add_argument("--no-sandbox", dest="sandbox", action="store_const", const=backends.UNCONFINED,
-                       help=f"the old name of --sandbox {backends.UNCONFINED}: student code runs UNCONFINED, with "
-                            "your permissions (only for code you trust, or where each submission is already "
-                            "isolated)")
-    grd.add_argument("--rubric", type=Path, default=DEFAULTS.rubric,
-                     help="TOML rubric: points, required exercises, branches, extra credit "
-                          "(default: the lab's; `labkit rubric` prints it)")
+    where.add_argument(
+        "--sandbox",
+        choices=backends.names(),
+        default=DEFAULTS.backend,
+        metavar="NAME",
+        help="where student code runs: "
+        + "; ".join(
+            f"{name}{' (the default)' if name == DEFAULTS.backend else ''}: {backends.backend_class(name).summary}"
+            for name in backends.names()
+        ),
+    )
+    where.add_argument(
+        "--no-sandbox",
+        dest="sandbox",
+        action="store_const",
+        const=backends.UNCONFINED,
+        help=f"the old name of --sandbox {backends.UNCONFINED}: student code runs UNCONFINED, with "
+        "your permissions (only for code you trust, or where each submission is already "
+        "isolated)",
+    )
+    grd.add_argument(
+        "--rubric",
+        type=Path,
+        default=DEFAULTS.rubric,
+        help="TOML rubric: points, required exercises, branches, extra credit "
+        "(default: the lab's; `labkit rubric` prints it)",
+    )
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)
 
-    rub = commands.add_parser("rubric", help="print the lab's rubric (TOML) to copy and edit",
-                              description="Print the lab's own rubric. Save it, edit it and pass it to "
-                                          "`labkit grade --rubric FILE`; `--check FILE` validates an edited one.")
+    rub = commands.add_parser(
+        "rubric",
+        help="print the lab's rubric (TOML) to copy and edit",
+        description="Print the lab's own rubric. Save it, edit it and pass it to "
+        "`labkit grade --rubric FILE`; `--check FILE` validates an edited one.",
+    )
     rub.add_argument("--check", type=Path, metavar="FILE", help="validate this rubric and summarise it instead")
     rub.set_defaults(handler=_rubric)
     return parser
@@ -212,8 +281,11 @@ def main(argv=None):
     except ModuleNotFoundError as exc:
         if exc.name not in GRADE_EXTRA:
             raise
-        print(f"labkit {args.command}: needs {exc.name}, which comes with the instructor's extra: "
-              "pip install 'labkit[grade]'", file=sys.stderr)
+        print(
+            f"labkit {args.command}: needs {exc.name}, which comes with the instructor's extra: "
+            "pip install 'labkit[grade]'",
+            file=sys.stderr,
+        )
         return 2
 
 

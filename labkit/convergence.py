@@ -5,6 +5,7 @@ growing size and reports the relative maximum error, the ratios between
 successive errors and the order they imply. The tables the lab asks for are
 printed in ``notebooks/02_convergence.ipynb``.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -116,11 +117,15 @@ def ratio_table(title: str, ndata: ArrayLike, errors: ArrayLike) -> str:
     sizes = _sizes(ndata)
     values = as_float_array(errors, "errors")
     if values.shape != sizes.shape:
-        raise ValueError(f"errors has {values.size} entries but ndata has {sizes.size}; give one error per row "
-                         "(e.g. [test_pherm_interpolate(n) for n in ndata]).")
+        raise ValueError(
+            f"errors has {values.size} entries but ndata has {sizes.size}; give one error per row "
+            "(e.g. [test_pherm_interpolate(n) for n in ndata])."
+        )
     if not np.all(np.isfinite(values)) or np.any(values <= 0):
-        raise ValueError("every error must be a positive finite number; a zero or NaN error means the driver "
-                         "measured at the wrong points or failed.")
+        raise ValueError(
+            "every error must be a positive finite number; a zero or NaN error means the driver "
+            "measured at the wrong points or failed."
+        )
     return _rows(str(title), sizes, values)
 
 
@@ -164,17 +169,13 @@ def convergence_table(
     ndata = 11  Err( 11) =  1.252e-03  Err(  5)/Err( 11) =   28.446
     """
     if not isinstance(method, str) or method not in METHOD_TITLES:
-        raise ValueError(
-            f"unknown method {method!r}; choose one of {', '.join(map(repr, METHOD_TITLES))}."
-        )
+        raise ValueError(f"unknown method {method!r}; choose one of {', '.join(map(repr, METHOD_TITLES))}.")
     sizes = _sizes(ndata)
     a, b = _check_interval(interval)
     xtest = np.linspace(a, b, _count(ntest, "ntest"))
     exact, _ = _values_and_slopes(f, xtest, method)
     scale = np.max(np.abs(exact))
-    errors = np.array(
-        [np.max(np.abs(exact - _interpolate(method, f, a, b, n, xtest))) / scale for n in sizes]
-    )
+    errors = np.array([np.max(np.abs(exact - _interpolate(method, f, a, b, n, xtest))) / scale for n in sizes])
     name = "Runge function" if f is runge else getattr(f, "__name__", "f")
     return ConvergenceTable(f"{name}, {METHOD_TITLES[method]}", sizes, errors)
 
@@ -213,8 +214,7 @@ def _values_and_slopes(f, x, method):
         return np.asarray(out[0], dtype=float), np.asarray(out[1], dtype=float)
     if method in NEEDS_DERIVATIVE:
         raise ValueError(
-            f"method {method!r} needs derivatives: f must return (values, derivatives) "
-            "as labkit.runge does."
+            f"method {method!r} needs derivatives: f must return (values, derivatives) as labkit.runge does."
         )
     return np.asarray(out, dtype=float), None
 

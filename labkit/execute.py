@@ -4,6 +4,7 @@ Clean means: executed top to bottom in a fresh ``python3`` kernel, no widget
 state stored in the metadata (it churns on every run), no error outputs.
 Used by ``labkit execute`` and checked by tests/test_notebooks_clean.py.
 """
+
 import subprocess
 from pathlib import Path
 
@@ -30,7 +31,9 @@ def read_notebook(path):
     try:
         return nbformat.reads(text, as_version=4)
     except Exception as exc:  # nbformat raises several kinds for broken files
-        raise ValueError(f"{Path(path).name} is not a valid notebook ({type(exc).__name__}: {str(exc)[:200]}).") from None
+        raise ValueError(
+            f"{Path(path).name} is not a valid notebook ({type(exc).__name__}: {str(exc)[:200]})."
+        ) from None
 
 
 def execute(path, timeout=300, before_save=None):
@@ -43,9 +46,7 @@ def execute(path, timeout=300, before_save=None):
 
     path = Path(path)
     nb = nbformat.read(path, as_version=4)
-    client = NotebookClient(
-        nb, timeout=timeout, kernel_name=KERNEL, resources={"metadata": {"path": str(path.parent)}}
-    )
+    client = NotebookClient(nb, timeout=timeout, kernel_name=KERNEL, resources={"metadata": {"path": str(path.parent)}})
     client.execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # kernel log noise only
     clean(nb)
     if before_save is not None:

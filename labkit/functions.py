@@ -1,4 +1,5 @@
 """Test functions of the lab: the Runge function in one and two variables."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -5,6 +5,7 @@ nodes and counter-clockwise quadrilaterals; ``m1 + m2`` joins meshes that
 share an edge into one conforming mesh (exercise 9 of the lab). See
 ``notebooks/03_meshes.ipynb``.
 """
+
 from __future__ import annotations
 
 import os
@@ -122,10 +123,7 @@ class QuadMesh:
 
         path = Path(path)
         if path.suffix.lower() not in WRITERS:
-            raise ValueError(
-                f"cannot tell the mesh format from {path.name!r}; use one of "
-                + ", ".join(WRITERS) + "."
-            )
+            raise ValueError(f"cannot tell the mesh format from {path.name!r}; use one of " + ", ".join(WRITERS) + ".")
         file_format, options = WRITERS[path.suffix.lower()]
         points = self.points if self.dim == 3 else np.column_stack((self.points, np.zeros(len(self.points))))
         cell_data: dict[str, list[NDArray[Any]]] = {"quality": [self.quality()]}
@@ -159,8 +157,13 @@ class QuadMesh:
         polygons = self.points[self.quads][..., :2]
         style = {"edgecolor": "tab:blue", "linewidth": 0.8, **line_kw}
         if color_by_quality:
-            cells = PolyCollection(polygons, array=self.quality(), cmap="RdYlGn", clim=(-1, 1),  # type: ignore[arg-type]
-                                   **style)
+            cells = PolyCollection(
+                polygons,
+                array=self.quality(),
+                cmap="RdYlGn",
+                clim=(-1, 1),  # type: ignore[arg-type]
+                **style,
+            )
             ax.add_collection(cells)
             if colorbar:
                 ax.figure.colorbar(cells, ax=ax, label="quality (min scaled Jacobian)", shrink=0.8)
@@ -214,9 +217,7 @@ def quad_mesh(x: ArrayLike, y: ArrayLike, z: ArrayLike | None = None) -> QuadMes
     if ns < 2 or nt < 2:
         raise ValueError(f"a mesh needs at least 2 x 2 nodes; got {ns} x {nt}.")
     index = np.arange(ns * nt).reshape(ns, nt)
-    quads = np.stack(
-        (index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]), axis=-1
-    ).reshape(-1, 4)
+    quads = np.stack((index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]), axis=-1).reshape(-1, 4)
     return QuadMesh(np.stack([c.ravel() for c in coords], axis=1), quads)
 
 
@@ -251,8 +252,10 @@ def _merge_coincident(points, quads, tolerance):
     count = int(np.sum(counts.astype(np.int64) * (counts - 1) // 2))
     limit = max(10_000, 10 * len(points))
     if count > limit:
-        raise ValueError(f"{count:,} pairs of nodes coincide; meshes should meet only along their shared edges. "
-                         "Check that each mesh's nodes are distinct (no points piled on one spot).")
+        raise ValueError(
+            f"{count:,} pairs of nodes coincide; meshes should meet only along their shared edges. "
+            "Check that each mesh's nodes are distinct (no points piled on one spot)."
+        )
     from scipy.spatial import cKDTree  # loaded when meshes are joined: `import labkit` stays light
 
     pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")

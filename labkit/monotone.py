@@ -6,6 +6,7 @@ interpolant monotone on every interval where the data are; the choice below
 extremum, a clamped three-point formula at the ends) is the one MATLAB and
 scipy use. See ``notebooks/05_monotone.ipynb``.
 """
+
 from __future__ import annotations
 
 import numpy as np

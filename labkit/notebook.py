@@ -5,6 +5,7 @@ its comment, which holds the install command. When labkit is there,
 :func:`ready` checks what the notebook needs from the kernel and says how to
 fix it when something is missing.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -37,14 +38,19 @@ def ready(written_for: str) -> None:
     wanted = str(written_for).strip()
     parts = wanted.split(".")
     if len(parts) != 2 or not all(part.isdigit() for part in parts):
-        raise ValueError(f'give the labkit version the notebook was written for as "major.minor", e.g. "0.1"; '
-                         f"got {written_for!r}.")
+        raise ValueError(
+            f'give the labkit version the notebook was written for as "major.minor", e.g. "0.1"; got {written_for!r}.'
+        )
     have = _installed_version()
     if have != "0+unknown" and have.split(".")[:2] != parts:
-        raise ValueError(f"this notebook was written for labkit {wanted}, but the kernel has labkit {have}: "
-                         f"install the matching version in a cell,\n    {INSTALL}\nthen restart the kernel "
-                         "(Kernel > Restart) and run the notebook again.")
+        raise ValueError(
+            f"this notebook was written for labkit {wanted}, but the kernel has labkit {have}: "
+            f"install the matching version in a cell,\n    {INSTALL}\nthen restart the kernel "
+            "(Kernel > Restart) and run the notebook again."
+        )
     missing = [name for name in NEEDED if importlib.util.find_spec(name) is None]
     if missing:
-        raise ValueError(f"the kernel lacks {', '.join(missing)}, which the notebooks use: install labkit with "
-                         f"its dependencies in a cell,\n    {INSTALL}\nthen restart the kernel.")
+        raise ValueError(
+            f"the kernel lacks {', '.join(missing)}, which the notebooks use: install labkit with "
+            f"its dependencies in a cell,\n    {INSTALL}\nthen restart the kernel."
+        )

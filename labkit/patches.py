@@ -5,6 +5,7 @@ B (1, 0), C (1, 1) and D (0, 1): the point, the derivatives along s and t,
 and the cross derivative (twist). ``notebooks/03_meshes.ipynb`` builds the
 patch step by step and uses it to generate the lab's meshes.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -46,9 +47,7 @@ class Corner:
     def __init__(self, point: ArrayLike, ds: ArrayLike, dt: ArrayLike, dsdt: ArrayLike | None = None) -> None:
         where = _vector(point, "point")
         if where.size not in (2, 3):
-            raise ValueError(
-                f"Corner point must have 2 (plane) or 3 (space) coordinates; got {where.size}."
-            )
+            raise ValueError(f"Corner point must have 2 (plane) or 3 (space) coordinates; got {where.size}.")
         twist = np.zeros(where.size) if dsdt is None else dsdt
         object.__setattr__(self, "point", where)
         for name, value in (("ds", ds), ("dt", dt), ("dsdt", twist)):
@@ -77,9 +76,7 @@ def _vector(value, name):
 def _parameter(values, name):
     u = as_float_array(values, name)
     if u.ndim != 1 or u.size == 0:
-        raise ValueError(
-            f"{name} must be a non-empty 1-D array of parameter values in [0, 1]; got shape {u.shape}."
-        )
+        raise ValueError(f"{name} must be a non-empty 1-D array of parameter values in [0, 1]; got shape {u.shape}.")
     require_finite(u, name)
     if u.min() < 0.0 or u.max() > 1.0:
         raise ValueError(

@@ -4,6 +4,7 @@ The maths (the four Hermite basis cubics and why their combination is C1) is
 derived in ``notebooks/02_convergence.ipynb``; the parametric use of both
 interpolants is in ``notebooks/01_limacon.ipynb``.
 """
+
 from __future__ import annotations
 
 import numpy as np

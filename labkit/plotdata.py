@@ -10,6 +10,7 @@ the sandboxed notebook when it sends a plot to the grader
 from pixels. It holds no reference of the lab's: the grader's watch never
 refuses it.
 """
+
 from dataclasses import dataclass
 
 import numpy as np

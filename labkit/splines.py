@@ -9,6 +9,7 @@ matrix is nonsingular, is in ``notebooks/04_splines.ipynb``.
 The systems are solved in O(n) with LAPACK's tridiagonal solver; no dense
 matrix is ever formed.
 """
+
 from __future__ import annotations
 
 import numpy as np

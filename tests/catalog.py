@@ -12,15 +12,22 @@ A planted notebook reads its rates off its own tables (as a student who reads th
 so a slip in a function a table is built on is not charged again through the rate. The same code
 is in :func:`plant`.
 """
+
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import nbformat
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
-RATES = {"pherm": "errors_pherm", "complete": "errors_complete", "natural": "errors_natural",
-         "notaknot": "errors_notaknot", "pchip": "errors_pchip", "bilinear": "errors_bilinear"}
+RATES = {
+    "pherm": "errors_pherm",
+    "complete": "errors_complete",
+    "natural": "errors_natural",
+    "notaknot": "errors_notaknot",
+    "pchip": "errors_pchip",
+    "bilinear": "errors_bilinear",
+}
 
 
 @dataclass(frozen=True)
@@ -48,10 +55,13 @@ def plant(entry, folder):
             for cell in nb.cells:
                 if cell.cell_type == "code":
                     # the mean of the last three log2 ratios, rounded: how the printout is read
-                    cell.source = re.sub(rf"^rate_{key} = \d+$",
-                                         f"rate_{key} = int(np.rint(np.mean(np.log2(np.asarray({table}[-4:-1]) "
-                                         f"/ np.asarray({table}[-3:])))))",
-                                         cell.source, flags=re.MULTILINE)
+                    cell.source = re.sub(
+                        rf"^rate_{key} = \d+$",
+                        f"rate_{key} = int(np.rint(np.mean(np.log2(np.asarray({table}[-4:-1]) "
+                        f"/ np.asarray({table}[-3:])))))",
+                        cell.source,
+                        flags=re.MULTILINE,
+                    )
     path = Path(folder) / entry.notebook
     path.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, path)
@@ -61,11 +71,15 @@ def plant(entry, folder):
 H1 = "    h1 = (xval - xk1) ** 2 * (3 * xk - xk1 - 2 * xval) / (xk - xk1) ** 3\n"
 H2 = "    h2 = (xval - xk) * (xval - xk1) ** 2 / (xk - xk1) ** 2\n"
 COMBINATION = "    return ydata[k] * h1 + ypdata[k] * h2 + ydata[k + 1] * h3 + ypdata[k + 1] * h4\n"
-PHERM_BODY = ("    xdata, ydata, ypdata = (np.asarray(a, dtype=float) for a in (xdata, ydata, ypdata))\n"
-              "    xval = np.asarray(xval, dtype=float)\n    k = labkit.bracket(xdata, xval)\n"
-              "    xk, xk1 = xdata[k], xdata[k + 1]\n" + H1 + H2 +
-              "    h3 = (xval - xk) ** 2 * (3 * xk1 - xk - 2 * xval) / (xk1 - xk) ** 3\n"
-              "    h4 = (xval - xk1) * (xval - xk) ** 2 / (xk1 - xk) ** 2\n" + COMBINATION)
+PHERM_BODY = (
+    "    xdata, ydata, ypdata = (np.asarray(a, dtype=float) for a in (xdata, ydata, ypdata))\n"
+    "    xval = np.asarray(xval, dtype=float)\n    k = labkit.bracket(xdata, xval)\n"
+    "    xk, xk1 = xdata[k], xdata[k + 1]\n"
+    + H1
+    + H2
+    + "    h3 = (xval - xk) ** 2 * (3 * xk1 - xk - 2 * xval) / (xk1 - xk) ** 3\n"
+    "    h4 = (xval - xk1) * (xval - xk) ** 2 / (xk1 - xk) ** 2\n" + COMBINATION
+)
 PHERM_LOOPS = (  # MATLAB-style: one point at a time, a list out
     "    yval = []\n"
     "    for x in list(xval):\n"
@@ -76,17 +90,20 @@ PHERM_LOOPS = (  # MATLAB-style: one point at a time, a list out
     "        h3 = (x - xk) ** 2 * (3 * xk1 - xk - 2 * x) / (xk1 - xk) ** 3\n"
     "        h4 = (x - xk1) * (x - xk) ** 2 / (xk1 - xk) ** 2\n"
     "        yval.append(ydata[k] * h1 + ypdata[k] * h2 + ydata[k + 1] * h3 + ypdata[k + 1] * h4)\n"
-    "    return yval\n")
+    "    return yval\n"
+)
 PHERM_SEARCH = (  # vectorised with numpy's searchsorted instead of labkit.bracket
     "    xdata, ydata, ypdata, xval = (np.asarray(a, dtype=float) for a in (xdata, ydata, ypdata, xval))\n"
     "    k = np.clip(np.searchsorted(xdata, xval, side='right') - 1, 0, len(xdata) - 2)\n"
     "    xk, xk1 = xdata[k], xdata[k + 1]\n"
     "    h = xk1 - xk\n    s = (xval - xk) / h\n"
     "    return (ydata[k] * (1 + 2 * s) * (1 - s) ** 2 + ypdata[k] * h * s * (1 - s) ** 2\n"
-    "            + ydata[k + 1] * s ** 2 * (3 - 2 * s) + ypdata[k + 1] * h * s ** 2 * (s - 1))\n")
+    "            + ydata[k + 1] * s ** 2 * (3 - 2 * s) + ypdata[k + 1] * h * s ** 2 * (s - 1))\n"
+)
 PBILIN_BODY = (
     "    xdata, ydata, xval, yval = (np.asarray(a, dtype=float) for a in (xdata, ydata, xval, yval))\n"
-    "    i, j = labkit.bracket(xdata, xval), labkit.bracket(ydata, yval)\n")
+    "    i, j = labkit.bracket(xdata, xval), labkit.bracket(ydata, yval)\n"
+)
 PBILIN_LOOPS = (  # one row of xval at a time, a list of rows out
     "    xdata, ydata, yval = (np.asarray(a, dtype=float) for a in (xdata, ydata, yval))\n"
     "    j = labkit.bracket(ydata, yval)\n    y0, y1 = ydata[j], ydata[j + 1]\n    zval = []\n"
@@ -95,224 +112,674 @@ PBILIN_LOOPS = (  # one row of xval at a time, a list of rows out
     "        area = (x1 - x0) * (y1 - y0)\n"
     "        zval.append(list((f(x0, y0) * (x1 - x) * (y1 - yval) + f(x1, y0) * (x - x0) * (y1 - yval)\n"
     "                          + f(x1, y1) * (x - x0) * (yval - y0) + f(x0, y1) * (x1 - x) * (yval - y0)) / area))\n"
-    "    return zval\n")
+    "    return zval\n"
+)
 
 CORRECT = (
-    Planted("runge_returns_a_list", "02_convergence.ipynb", (("    return y, yprime\n", "    return [y, yprime]\n"),),
-            full=(2, 3)),
-    Planted("eval_pherm_with_loops_and_lists", "02_convergence.ipynb",
-            ((PHERM_BODY, PHERM_LOOPS),), full=(2, 3)),
+    Planted(
+        "runge_returns_a_list",
+        "02_convergence.ipynb",
+        (("    return y, yprime\n", "    return [y, yprime]\n"),),
+        full=(2, 3),
+    ),
+    Planted("eval_pherm_with_loops_and_lists", "02_convergence.ipynb", ((PHERM_BODY, PHERM_LOOPS),), full=(2, 3)),
     Planted("eval_pherm_with_searchsorted", "02_convergence.ipynb", ((PHERM_BODY, PHERM_SEARCH),), full=(2, 3)),
-    Planted("table_typed_from_the_printout", "02_convergence.ipynb",
-            (("errors_pherm = [test_pherm_interpolate(n) for n in ndata]",
-              "errors_pherm = [float(f'{e:.3e}') for e in [test_pherm_interpolate(n) for n in ndata]]"),),
-            full=(2, 3)),
-    Planted("rate_written_as_a_float", "02_convergence.ipynb", (("rate_pherm = 4\n", "rate_pherm = 4.0\n"),),
-            full=(2, 3), keep_rates=True),
-    Planted("limacon_derivatives_return_a_list", "01_limacon.ipynb",
-            (("    return dxdt, dydt\n", "    return [dxdt, dydt]\n"),), full=(4,)),
-    Planted("limacon_drawn_as_marks", "01_limacon.ipynb",
-            (("ax4.plot(xherm, yherm)", "ax4.scatter(xherm, yherm, s=4)"),), full=(4,)),
-    Planted("boiling_data_with_scatter", "05_monotone.ipynb",
-            (('ax14.plot(xdata, ydata, "o", color="k", label="data")',
-              'ax14.scatter(xdata, ydata, color="k", label="data")'),), full=(14, 15)),
-    Planted("boiling_data_with_stem", "05_monotone.ipynb",
-            (('ax14.plot(xdata, ydata, "o", color="k", label="data")', 'ax14.stem(xdata, ydata, label="data")'),),
-            full=(14, 15)),
-    Planted("boiling_data_with_errorbar", "05_monotone.ipynb",
-            (('ax14.plot(xdata, ydata, "o", color="k", label="data")',
-              'ax14.errorbar(xdata, ydata, yerr=0.05, fmt="o", color="k", label="data")'),), full=(14, 15)),
-    Planted("complete_system_returns_lists", "04_splines.ipynb",  # a student who works with lists of rows
-            (("    return A, D\n", "    return A.tolist(), list(D)\n"),
-             ("    A, D = complete_system(xdata, ydata, 0.0, 0.0)\n",
-              "    A, D = (np.array(v) for v in complete_system(xdata, ydata, 0.0, 0.0))\n"),
-             ("A, D = complete_system(xdata, np.exp(xdata), 0.0, 0.0)\n",
-              "A, D = (np.array(v) for v in complete_system(xdata, np.exp(xdata), 0.0, 0.0))\n")),
-            full=(10, 11, 12, 13)),
-    Planted("ccspline_with_the_inverse", "04_splines.ipynb",  # MATLAB's inv(A) * D
-            (("    M = np.linalg.solve(A, D)\n    h = np.diff(xdata)\n", "    M = np.linalg.inv(A) @ D\n    h = np.diff(xdata)\n"),),
-            full=(10, 11, 12, 13)),
-    Planted("ncspline_with_a_banded_solver", "04_splines.ipynb",
-            (("    M = np.linalg.solve(A, D)\n    h, secant", "    from scipy.linalg import solve_banded\n"
-              "    bands = np.zeros((3, len(D)))\n    bands[0, 1:], bands[1], bands[2, :-1] = np.diag(A, 1), "
-              "np.diag(A), np.diag(A, -1)\n    M = solve_banded((1, 1), bands, D)\n    h, secant"),),
-            full=(10, 11, 12, 13)),
-    Planted("eval_pbilin_row_by_row_in_lists", "06_bilinear.ipynb", ((PBILIN_BODY + (
-        "    x0, x1 = xdata[i][:, None], xdata[i + 1][:, None]  # cell corners, one row per xval\n"
-        "    y0, y1 = ydata[j][None, :], ydata[j + 1][None, :]  # one column per yval\n"
-        "    X, Y = xval[:, None], yval[None, :]\n    area = (x1 - x0) * (y1 - y0)\n"
-        "    return (f(x0, y0) * (x1 - X) * (y1 - Y) + f(x1, y0) * (X - x0) * (y1 - Y)\n"
-        "            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)) / area\n"),
-        PBILIN_LOOPS),), full=(16,)),
-    Planted("phi_table_as_nested_lists", "06_bilinear.ipynb",
-            (("phi_table = np.array([[phi_m(*P) for phi_m in phi] for P in corners])",
-              "phi_table = [[phi_m(*P) for phi_m in phi] for P in corners]"),), full=(16,)),
+    Planted(
+        "table_typed_from_the_printout",
+        "02_convergence.ipynb",
+        (
+            (
+                "errors_pherm = [test_pherm_interpolate(n) for n in ndata]",
+                "errors_pherm = [float(f'{e:.3e}') for e in [test_pherm_interpolate(n) for n in ndata]]",
+            ),
+        ),
+        full=(2, 3),
+    ),
+    Planted(
+        "rate_written_as_a_float",
+        "02_convergence.ipynb",
+        (("rate_pherm = 4\n", "rate_pherm = 4.0\n"),),
+        full=(2, 3),
+        keep_rates=True,
+    ),
+    Planted(
+        "limacon_derivatives_return_a_list",
+        "01_limacon.ipynb",
+        (("    return dxdt, dydt\n", "    return [dxdt, dydt]\n"),),
+        full=(4,),
+    ),
+    Planted(
+        "limacon_drawn_as_marks",
+        "01_limacon.ipynb",
+        (("ax4.plot(xherm, yherm)", "ax4.scatter(xherm, yherm, s=4)"),),
+        full=(4,),
+    ),
+    Planted(
+        "boiling_data_with_scatter",
+        "05_monotone.ipynb",
+        (
+            (
+                'ax14.plot(xdata, ydata, "o", color="k", label="data")',
+                'ax14.scatter(xdata, ydata, color="k", label="data")',
+            ),
+        ),
+        full=(14, 15),
+    ),
+    Planted(
+        "boiling_data_with_stem",
+        "05_monotone.ipynb",
+        (('ax14.plot(xdata, ydata, "o", color="k", label="data")', 'ax14.stem(xdata, ydata, label="data")'),),
+        full=(14, 15),
+    ),
+    Planted(
+        "boiling_data_with_errorbar",
+        "05_monotone.ipynb",
+        (
+            (
+                'ax14.plot(xdata, ydata, "o", color="k", label="data")',
+                'ax14.errorbar(xdata, ydata, yerr=0.05, fmt="o", color="k", label="data")',
+            ),
+        ),
+        full=(14, 15),
+    ),
+    Planted(
+        "complete_system_returns_lists",
+        "04_splines.ipynb",  # a student who works with lists of rows
+        (
+            ("    return A, D\n", "    return A.tolist(), list(D)\n"),
+            (
+                "    A, D = complete_system(xdata, ydata, 0.0, 0.0)\n",
+                "    A, D = (np.array(v) for v in complete_system(xdata, ydata, 0.0, 0.0))\n",
+            ),
+            (
+                "A, D = complete_system(xdata, np.exp(xdata), 0.0, 0.0)\n",
+                "A, D = (np.array(v) for v in complete_system(xdata, np.exp(xdata), 0.0, 0.0))\n",
+            ),
+        ),
+        full=(10, 11, 12, 13),
+    ),
+    Planted(
+        "ccspline_with_the_inverse",
+        "04_splines.ipynb",  # MATLAB's inv(A) * D
+        (
+            (
+                "    M = np.linalg.solve(A, D)\n    h = np.diff(xdata)\n",
+                "    M = np.linalg.inv(A) @ D\n    h = np.diff(xdata)\n",
+            ),
+        ),
+        full=(10, 11, 12, 13),
+    ),
+    Planted(
+        "ncspline_with_a_banded_solver",
+        "04_splines.ipynb",
+        (
+            (
+                "    M = np.linalg.solve(A, D)\n    h, secant",
+                "    from scipy.linalg import solve_banded\n"
+                "    bands = np.zeros((3, len(D)))\n    bands[0, 1:], bands[1], bands[2, :-1] = np.diag(A, 1), "
+                "np.diag(A), np.diag(A, -1)\n    M = solve_banded((1, 1), bands, D)\n    h, secant",
+            ),
+        ),
+        full=(10, 11, 12, 13),
+    ),
+    Planted(
+        "eval_pbilin_row_by_row_in_lists",
+        "06_bilinear.ipynb",
+        (
+            (
+                PBILIN_BODY
+                + (
+                    "    x0, x1 = xdata[i][:, None], xdata[i + 1][:, None]  # cell corners, one row per xval\n"
+                    "    y0, y1 = ydata[j][None, :], ydata[j + 1][None, :]  # one column per yval\n"
+                    "    X, Y = xval[:, None], yval[None, :]\n    area = (x1 - x0) * (y1 - y0)\n"
+                    "    return (f(x0, y0) * (x1 - X) * (y1 - Y) + f(x1, y0) * (X - x0) * (y1 - Y)\n"
+                    "            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)) / area\n"
+                ),
+                PBILIN_LOOPS,
+            ),
+        ),
+        full=(16,),
+    ),
+    Planted(
+        "phi_table_as_nested_lists",
+        "06_bilinear.ipynb",
+        (
+            (
+                "phi_table = np.array([[phi_m(*P) for phi_m in phi] for P in corners])",
+                "phi_table = [[phi_m(*P) for phi_m in phi] for P in corners]",
+            ),
+        ),
+        full=(16,),
+    ),
 )
 
 MISTAKES = (
     # Exercise 2: eval_pherm (its driver, table and rate use it by default)
-    Planted("wrong_denominator", "02_convergence.ipynb", ((H1, H1.replace("** 3\n", "** 2\n")),), 2, "eval_pherm",
-            "denominator", also=((3, "errors_pherm"), (3, "rate_pherm"))),
-    Planted("basis_with_the_wrong_sign", "02_convergence.ipynb", ((H2, H2.replace("h2 = (", "h2 = -(")),), 2,
-            "eval_pherm", "h2 has the wrong sign"),  # the table still shrinks (order 1): Exercise 3 keeps its points
-    Planted("values_and_slopes_swapped", "02_convergence.ipynb",
-            ((COMBINATION, "    return ypdata[k] * h1 + ydata[k] * h2 + ypdata[k + 1] * h3 + ydata[k + 1] * h4\n"),),
-            2, "eval_pherm", "values and the slopes are swapped", also=((3, "errors_pherm"), (3, "rate_pherm"))),
-    Planted("one_interval_for_every_point", "02_convergence.ipynb",
-            (("    k = labkit.bracket(xdata, xval)\n", "    k = np.zeros(xval.shape, dtype=int)\n"),), 2, "eval_pherm",
-            "one interval works but several do not", also=((3, "errors_pherm"), (3, "rate_pherm"))),
+    Planted(
+        "wrong_denominator",
+        "02_convergence.ipynb",
+        ((H1, H1.replace("** 3\n", "** 2\n")),),
+        2,
+        "eval_pherm",
+        "denominator",
+        also=((3, "errors_pherm"), (3, "rate_pherm")),
+    ),
+    Planted(
+        "basis_with_the_wrong_sign",
+        "02_convergence.ipynb",
+        ((H2, H2.replace("h2 = (", "h2 = -(")),),
+        2,
+        "eval_pherm",
+        "h2 has the wrong sign",
+    ),  # the table still shrinks (order 1): Exercise 3 keeps its points
+    Planted(
+        "values_and_slopes_swapped",
+        "02_convergence.ipynb",
+        ((COMBINATION, "    return ypdata[k] * h1 + ydata[k] * h2 + ypdata[k + 1] * h3 + ydata[k + 1] * h4\n"),),
+        2,
+        "eval_pherm",
+        "values and the slopes are swapped",
+        also=((3, "errors_pherm"), (3, "rate_pherm")),
+    ),
+    Planted(
+        "one_interval_for_every_point",
+        "02_convergence.ipynb",
+        (("    k = labkit.bracket(xdata, xval)\n", "    k = np.zeros(xval.shape, dtype=int)\n"),),
+        2,
+        "eval_pherm",
+        "one interval works but several do not",
+        also=((3, "errors_pherm"), (3, "rate_pherm")),
+    ),
     # Exercise 3: runge, the driver, the table, the rate
-    Planted("runge_derivative_sign", "02_convergence.ipynb",
-            (("yprime = -2.0 * x", "yprime = 2.0 * x"),), 3, "runge", "yprime has the wrong sign"),
-    Planted("driver_absolute_error", "02_convergence.ipynb",
-            (("interpolate(xdata, ydata, ypdata, xtest))) / np.max(np.abs(exact))",
-              "interpolate(xdata, ydata, ypdata, xtest)))"),), 3, "test_pherm_interpolate", "error is absolute"),
-    Planted("driver_on_the_wrong_interval", "02_convergence.ipynb",
-            (("    xdata = np.linspace(0, 5, ndata)\n    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)",
-              "    xdata = np.linspace(-5, 5, ndata)\n    ydata, ypdata = f(xdata)\n    xtest = np.linspace(-5, 5, 4001)"),),
-            3, "test_pherm_interpolate", "[-5, 5] instead of [0, 5]"),
-    Planted("driver_with_401_test_points", "02_convergence.ipynb",
-            (("    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)",
-              "    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 401)"),),
-            3, "test_pherm_interpolate", "401 test points instead of 4001"),
-    Planted("driver_ignores_f", "02_convergence.ipynb",
-            (("    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0]",
-              "    ydata, ypdata = runge(xdata)\n    xtest = np.linspace(0, 5, 4001)\n    exact = runge(xtest)[0]"),),
-            3, "test_pherm_interpolate", "passed in as `f`"),
-    Planted("driver_only_at_the_data", "02_convergence.ipynb",
-            (("    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)",
-              "    ydata, ypdata = f(xdata)\n    xtest = xdata"),),
-            3, "test_pherm_interpolate", "only at the data points", also=((3, "errors_pherm"), (3, "rate_pherm"))),
-    Planted("table_with_a_row_mistyped", "02_convergence.ipynb",
-            (("errors_pherm = [test_pherm_interpolate(n) for n in ndata]",
-              "errors_pherm = [test_pherm_interpolate(n) for n in ndata]\nerrors_pherm[3] *= 1.5"),),
-            3, "errors_pherm", "Err(41) in your table is not what test_pherm_interpolate returns"),
-    Planted("rate_as_the_ratio", "02_convergence.ipynb", (("rate_pherm = 4\n", "rate_pherm = 16\n"),), 3,
-            "rate_pherm", "the ratio Err(n)/Err(2n-1) itself", keep_rates=True),
-    Planted("rate_misread", "02_convergence.ipynb", (("rate_pherm = 4\n", "rate_pherm = 3\n"),), 3, "rate_pherm",
-            "take the ratios", keep_rates=True),
+    Planted(
+        "runge_derivative_sign",
+        "02_convergence.ipynb",
+        (("yprime = -2.0 * x", "yprime = 2.0 * x"),),
+        3,
+        "runge",
+        "yprime has the wrong sign",
+    ),
+    Planted(
+        "driver_absolute_error",
+        "02_convergence.ipynb",
+        (
+            (
+                "interpolate(xdata, ydata, ypdata, xtest))) / np.max(np.abs(exact))",
+                "interpolate(xdata, ydata, ypdata, xtest)))",
+            ),
+        ),
+        3,
+        "test_pherm_interpolate",
+        "error is absolute",
+    ),
+    Planted(
+        "driver_on_the_wrong_interval",
+        "02_convergence.ipynb",
+        (
+            (
+                "    xdata = np.linspace(0, 5, ndata)\n    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)",
+                "    xdata = np.linspace(-5, 5, ndata)\n    ydata, ypdata = f(xdata)\n    xtest = np.linspace(-5, 5, 4001)",
+            ),
+        ),
+        3,
+        "test_pherm_interpolate",
+        "[-5, 5] instead of [0, 5]",
+    ),
+    Planted(
+        "driver_with_401_test_points",
+        "02_convergence.ipynb",
+        (
+            (
+                "    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)",
+                "    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 401)",
+            ),
+        ),
+        3,
+        "test_pherm_interpolate",
+        "401 test points instead of 4001",
+    ),
+    Planted(
+        "driver_ignores_f",
+        "02_convergence.ipynb",
+        (
+            (
+                "    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0]",
+                "    ydata, ypdata = runge(xdata)\n    xtest = np.linspace(0, 5, 4001)\n    exact = runge(xtest)[0]",
+            ),
+        ),
+        3,
+        "test_pherm_interpolate",
+        "passed in as `f`",
+    ),
+    Planted(
+        "driver_only_at_the_data",
+        "02_convergence.ipynb",
+        (
+            (
+                "    ydata, ypdata = f(xdata)\n    xtest = np.linspace(0, 5, 4001)",
+                "    ydata, ypdata = f(xdata)\n    xtest = xdata",
+            ),
+        ),
+        3,
+        "test_pherm_interpolate",
+        "only at the data points",
+        also=((3, "errors_pherm"), (3, "rate_pherm")),
+    ),
+    Planted(
+        "table_with_a_row_mistyped",
+        "02_convergence.ipynb",
+        (
+            (
+                "errors_pherm = [test_pherm_interpolate(n) for n in ndata]",
+                "errors_pherm = [test_pherm_interpolate(n) for n in ndata]\nerrors_pherm[3] *= 1.5",
+            ),
+        ),
+        3,
+        "errors_pherm",
+        "Err(41) in your table is not what test_pherm_interpolate returns",
+    ),
+    Planted(
+        "rate_as_the_ratio",
+        "02_convergence.ipynb",
+        (("rate_pherm = 4\n", "rate_pherm = 16\n"),),
+        3,
+        "rate_pherm",
+        "the ratio Err(n)/Err(2n-1) itself",
+        keep_rates=True,
+    ),
+    Planted(
+        "rate_misread",
+        "02_convergence.ipynb",
+        (("rate_pherm = 4\n", "rate_pherm = 3\n"),),
+        3,
+        "rate_pherm",
+        "take the ratios",
+        keep_rates=True,
+    ),
     # Exercise 4
-    Planted("limacon_dydt_sign", "01_limacon.ipynb",
-            (("dydt = -np.sin(t) ** 2 + r * np.cos(t)", "dydt = np.sin(t) ** 2 - r * np.cos(t)"),), 4,
-            "limacon_derivatives", "dy/dt has the wrong sign"),
-    Planted("limacon_without_the_product_rule", "01_limacon.ipynb",
-            (("dxdt = -np.sin(t) * np.cos(t) - r * np.sin(t)", "dxdt = -r * np.sin(t)"),), 4, "limacon_derivatives",
-            "leaves out the product rule"),
-    Planted("limacon_drawn_with_straight_segments", "01_limacon.ipynb",
-            (("xherm = labkit.eval_pherm(tdata, xdata, xpdata, tval)\nyherm = labkit.eval_pherm(tdata, ydata, ypdata, tval)",
-              "xherm = labkit.eval_plin(tdata, xdata, tval)\nyherm = labkit.eval_plin(tdata, ydata, tval)"),), 4, "ax4",
-            "straight segments"),
-    Planted("limacon_drawn_exactly", "01_limacon.ipynb",
-            (("ax4.plot(xherm, yherm)", "ax4.plot((1.15 + np.cos(tval)) * np.cos(tval), (1.15 + np.cos(tval)) * np.sin(tval))"),),
-            4, "ax4", "exact limaçon"),
-    Planted("limacon_half_a_turn", "01_limacon.ipynb", (("ax4.plot(xherm, yherm)", "ax4.plot(xherm[:105], yherm[:105])"),),
-            4, "ax4", "whole turn"),
+    Planted(
+        "limacon_dydt_sign",
+        "01_limacon.ipynb",
+        (("dydt = -np.sin(t) ** 2 + r * np.cos(t)", "dydt = np.sin(t) ** 2 - r * np.cos(t)"),),
+        4,
+        "limacon_derivatives",
+        "dy/dt has the wrong sign",
+    ),
+    Planted(
+        "limacon_without_the_product_rule",
+        "01_limacon.ipynb",
+        (("dxdt = -np.sin(t) * np.cos(t) - r * np.sin(t)", "dxdt = -r * np.sin(t)"),),
+        4,
+        "limacon_derivatives",
+        "leaves out the product rule",
+    ),
+    Planted(
+        "limacon_drawn_with_straight_segments",
+        "01_limacon.ipynb",
+        (
+            (
+                "xherm = labkit.eval_pherm(tdata, xdata, xpdata, tval)\nyherm = labkit.eval_pherm(tdata, ydata, ypdata, tval)",
+                "xherm = labkit.eval_plin(tdata, xdata, tval)\nyherm = labkit.eval_plin(tdata, ydata, tval)",
+            ),
+        ),
+        4,
+        "ax4",
+        "straight segments",
+    ),
+    Planted(
+        "limacon_drawn_exactly",
+        "01_limacon.ipynb",
+        (
+            (
+                "ax4.plot(xherm, yherm)",
+                "ax4.plot((1.15 + np.cos(tval)) * np.cos(tval), (1.15 + np.cos(tval)) * np.sin(tval))",
+            ),
+        ),
+        4,
+        "ax4",
+        "exact limaçon",
+    ),
+    Planted(
+        "limacon_half_a_turn",
+        "01_limacon.ipynb",
+        (("ax4.plot(xherm, yherm)", "ax4.plot(xherm[:105], yherm[:105])"),),
+        4,
+        "ax4",
+        "whole turn",
+    ),
     # Exercises 5 to 9
-    Planted("coons_without_twists", "03_meshes.ipynb", (("[A.dsdt[c], B.dsdt[c]]", "[0.0, 0.0]"),), 5, "coons",
-            "ignores the twists"),
-    Planted("coons_transposed", "03_meshes.ipynb", (("    return xy[0], xy[1]\n", "    return xy[0].T, xy[1].T\n"),), 5,
-            "coons", "transposed"),
-    Planted("graded_the_wrong_way_round", "03_meshes.ipynb",
-            (("graded = [Corner(A.point, [3.0, 0.0], A.dt), Corner(B.point, [0.1, 0.0], B.dt),\n"
-              "          Corner(C.point, [0.1, 0.0], C.dt), Corner(D.point, [3.0, 0.0], D.dt)]",
-              "graded = [Corner(A.point, [0.1, 0.0], A.dt), Corner(B.point, [3.0, 0.0], B.dt),\n"
-              "          Corner(C.point, [3.0, 0.0], C.dt), Corner(D.point, [0.1, 0.0], D.dt)]"),), 6, "graded",
-            "A and D are on the left"),
-    Planted("straight_twist_sign", "03_meshes.ipynb", (("twist = PA - PB + PC - PD", "twist = PB - PA + PD - PC"),), 7,
-            "straight", "d2xdsdt = -1"),
-    Planted("straight_side_bent", "03_meshes.ipynb",
-            (("Corner(PD, PC - PD, PD - PA, twist)", "Corner(PD, PC - PD, PC - PB, twist)"),), 7, "straight",
-            "vector along that side"),
-    Planted("mirror_without_swapping", "03_meshes.ipynb",
-            (("corner.dt[::-1], corner.ds[::-1], corner.dsdt[::-1])", "corner.ds[::-1], corner.dt[::-1], corner.dsdt[::-1])"),),
-            9, "two_patches", "mirrored dt as ds"),
-    Planted("region_not_merged", "03_meshes.ipynb",
-            (("region = first + second", "region = labkit.QuadMesh(np.vstack((first.points, second.points)), "
-                                         "np.vstack((first.quads, second.quads + len(first.points))))"),),
-            9, "region", "appear once"),
-    Planted("circle_sides_with_unit_derivatives", "03_meshes.ipynb", (("q = np.pi / 4\n", "q = 1.0\n"),), 8,
-            "circle_sides", "both its direction and its length matter"),
-    Planted("circle_sides_pointing_along_the_chord", "03_meshes.ipynb",
-            (("circle_sides = [Corner([0, 0], [q, -q], [q, q])", "circle_sides = [Corner([0, 0], [q, 0.0], [q, q])"),),
-            8, "circle_sides", "both its direction and its length matter"),
+    Planted(
+        "coons_without_twists",
+        "03_meshes.ipynb",
+        (("[A.dsdt[c], B.dsdt[c]]", "[0.0, 0.0]"),),
+        5,
+        "coons",
+        "ignores the twists",
+    ),
+    Planted(
+        "coons_transposed",
+        "03_meshes.ipynb",
+        (("    return xy[0], xy[1]\n", "    return xy[0].T, xy[1].T\n"),),
+        5,
+        "coons",
+        "transposed",
+    ),
+    Planted(
+        "graded_the_wrong_way_round",
+        "03_meshes.ipynb",
+        (
+            (
+                "graded = [Corner(A.point, [3.0, 0.0], A.dt), Corner(B.point, [0.1, 0.0], B.dt),\n"
+                "          Corner(C.point, [0.1, 0.0], C.dt), Corner(D.point, [3.0, 0.0], D.dt)]",
+                "graded = [Corner(A.point, [0.1, 0.0], A.dt), Corner(B.point, [3.0, 0.0], B.dt),\n"
+                "          Corner(C.point, [3.0, 0.0], C.dt), Corner(D.point, [0.1, 0.0], D.dt)]",
+            ),
+        ),
+        6,
+        "graded",
+        "A and D are on the left",
+    ),
+    Planted(
+        "straight_twist_sign",
+        "03_meshes.ipynb",
+        (("twist = PA - PB + PC - PD", "twist = PB - PA + PD - PC"),),
+        7,
+        "straight",
+        "d2xdsdt = -1",
+    ),
+    Planted(
+        "straight_side_bent",
+        "03_meshes.ipynb",
+        (("Corner(PD, PC - PD, PD - PA, twist)", "Corner(PD, PC - PD, PC - PB, twist)"),),
+        7,
+        "straight",
+        "vector along that side",
+    ),
+    Planted(
+        "mirror_without_swapping",
+        "03_meshes.ipynb",
+        (
+            (
+                "corner.dt[::-1], corner.ds[::-1], corner.dsdt[::-1])",
+                "corner.ds[::-1], corner.dt[::-1], corner.dsdt[::-1])",
+            ),
+        ),
+        9,
+        "two_patches",
+        "mirrored dt as ds",
+    ),
+    Planted(
+        "region_not_merged",
+        "03_meshes.ipynb",
+        (
+            (
+                "region = first + second",
+                "region = labkit.QuadMesh(np.vstack((first.points, second.points)), "
+                "np.vstack((first.quads, second.quads + len(first.points))))",
+            ),
+        ),
+        9,
+        "region",
+        "appear once",
+    ),
+    Planted(
+        "circle_sides_with_unit_derivatives",
+        "03_meshes.ipynb",
+        (("q = np.pi / 4\n", "q = 1.0\n"),),
+        8,
+        "circle_sides",
+        "both its direction and its length matter",
+    ),
+    Planted(
+        "circle_sides_pointing_along_the_chord",
+        "03_meshes.ipynb",
+        (("circle_sides = [Corner([0, 0], [q, -q], [q, q])", "circle_sides = [Corner([0, 0], [q, 0.0], [q, q])"),),
+        8,
+        "circle_sides",
+        "both its direction and its length matter",
+    ),
     # Exercise 10: complete_system and ccspline
-    Planted("complete_with_natural_rows", "04_splines.ipynb",
-            (("    A[0, 0], A[0, 1], D[0] = h[0] / 3, h[0] / 6, secant[0] - y1p\n",
-              "    A[0, 0], A[0, 1], D[0] = 1.0, 0.0, 0.0\n"),
-             ("    A[n - 1, n - 2], A[n - 1, n - 1], D[n - 1] = h[n - 2] / 6, h[n - 2] / 3, ynp - secant[n - 2]\n",
-              "    A[n - 1, n - 2], A[n - 1, n - 1], D[n - 1] = 0.0, 1.0, 0.0\n")), 10, "ccspline",
-            "natural spline's (M1 = 0, Mn = 0)"),
-    Planted("complete_h_subscript", "04_splines.ipynb",
-            (("A[k, k - 1], A[k, k], A[k, k + 1] = h[k - 1] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6",
-              "A[k, k - 1], A[k, k], A[k, k + 1] = h[k] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6"),), 10, "ccspline",
-            "A(k, k-1) and A(k-1, k) must both be h(k-1)/6"),
-    Planted("complete_d_sign", "04_splines.ipynb", (("secant[0] - y1p\n", "y1p - secant[0]\n"),), 10, "ccspline",
-            "D's first entry has the wrong sign"),
-    Planted("complete_slopes_formula", "04_splines.ipynb",
-            (("sprime[:-1] = -M[:-1] * h / 3 - M[1:] * h / 6 + np.diff(ydata) / h",
-              "sprime[:-1] = -M[:-1] * h / 6 - M[1:] * h / 3 + np.diff(ydata) / h"),), 10, "ccspline",
-            "A and D are right, so what ccspline does with them is wrong"),
+    Planted(
+        "complete_with_natural_rows",
+        "04_splines.ipynb",
+        (
+            (
+                "    A[0, 0], A[0, 1], D[0] = h[0] / 3, h[0] / 6, secant[0] - y1p\n",
+                "    A[0, 0], A[0, 1], D[0] = 1.0, 0.0, 0.0\n",
+            ),
+            (
+                "    A[n - 1, n - 2], A[n - 1, n - 1], D[n - 1] = h[n - 2] / 6, h[n - 2] / 3, ynp - secant[n - 2]\n",
+                "    A[n - 1, n - 2], A[n - 1, n - 1], D[n - 1] = 0.0, 1.0, 0.0\n",
+            ),
+        ),
+        10,
+        "ccspline",
+        "natural spline's (M1 = 0, Mn = 0)",
+    ),
+    Planted(
+        "complete_h_subscript",
+        "04_splines.ipynb",
+        (
+            (
+                "A[k, k - 1], A[k, k], A[k, k + 1] = h[k - 1] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6",
+                "A[k, k - 1], A[k, k], A[k, k + 1] = h[k] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6",
+            ),
+        ),
+        10,
+        "ccspline",
+        "A(k, k-1) and A(k-1, k) must both be h(k-1)/6",
+    ),
+    Planted(
+        "complete_d_sign",
+        "04_splines.ipynb",
+        (("secant[0] - y1p\n", "y1p - secant[0]\n"),),
+        10,
+        "ccspline",
+        "D's first entry has the wrong sign",
+    ),
+    Planted(
+        "complete_slopes_formula",
+        "04_splines.ipynb",
+        (
+            (
+                "sprime[:-1] = -M[:-1] * h / 3 - M[1:] * h / 6 + np.diff(ydata) / h",
+                "sprime[:-1] = -M[:-1] * h / 6 - M[1:] * h / 3 + np.diff(ydata) / h",
+            ),
+        ),
+        10,
+        "ccspline",
+        "A and D are right, so what ccspline does with them is wrong",
+    ),
     # Exercise 12: ncspline
-    Planted("natural_rows_in_a_only", "04_splines.ipynb",
-            (("    A[0, 0], A[-1, -1] = 1.0, 1.0\n    D[0], D[-1] = 0.0, 0.0\n    M = np.linalg.solve(A, D)\n    h, secant",
-              "    A[0, 0], A[-1, -1] = 1.0, 1.0\n    M = np.linalg.solve(A, D)\n    h, secant"),), 12, "ncspline",
-            "D's first and last entries are still"),
-    Planted("natural_rows_unchanged", "04_splines.ipynb",
-            (("    A[0, :], A[-1, :] = 0.0, 0.0\n    A[0, 0], A[-1, -1] = 1.0, 1.0\n    D[0], D[-1] = 0.0, 0.0\n"
-              "    M = np.linalg.solve(A, D)\n    h, secant", "    M = np.linalg.solve(A, D)\n    h, secant"),), 12,
-            "ncspline", "still the complete spline's rows"),
-    Planted("natural_last_slope", "04_splines.ipynb",
-            (("sprime[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]", "sprime[-1] = secant[-1]"),), 12,
-            "ncspline", "every slope but the last is right"),
+    Planted(
+        "natural_rows_in_a_only",
+        "04_splines.ipynb",
+        (
+            (
+                "    A[0, 0], A[-1, -1] = 1.0, 1.0\n    D[0], D[-1] = 0.0, 0.0\n    M = np.linalg.solve(A, D)\n    h, secant",
+                "    A[0, 0], A[-1, -1] = 1.0, 1.0\n    M = np.linalg.solve(A, D)\n    h, secant",
+            ),
+        ),
+        12,
+        "ncspline",
+        "D's first and last entries are still",
+    ),
+    Planted(
+        "natural_rows_unchanged",
+        "04_splines.ipynb",
+        (
+            (
+                "    A[0, :], A[-1, :] = 0.0, 0.0\n    A[0, 0], A[-1, -1] = 1.0, 1.0\n    D[0], D[-1] = 0.0, 0.0\n"
+                "    M = np.linalg.solve(A, D)\n    h, secant",
+                "    M = np.linalg.solve(A, D)\n    h, secant",
+            ),
+        ),
+        12,
+        "ncspline",
+        "still the complete spline's rows",
+    ),
+    Planted(
+        "natural_last_slope",
+        "04_splines.ipynb",
+        (("sprime[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]", "sprime[-1] = secant[-1]"),),
+        12,
+        "ncspline",
+        "every slope but the last is right",
+    ),
     # Exercises 11 and 13: drivers
-    Planted("complete_driver_with_zero_end_slopes", "04_splines.ipynb",
-            (("sprime = slopes(xdata, ydata, ypdata[0], ypdata[-1])", "sprime = slopes(xdata, ydata, 0.0, 0.0)"),),
-            11, "test_ccspline_interpolate", "end slopes look like 0 and 0"),
-    Planted("complete_driver_with_the_ends_swapped", "04_splines.ipynb",
-            (("sprime = slopes(xdata, ydata, ypdata[0], ypdata[-1])",
-              "sprime = slopes(xdata, ydata, ypdata[-1], ypdata[0])"),),
-            11, "test_ccspline_interpolate", "the last and the first (swapped)"),
-    Planted("natural_driver_builds_the_complete_spline", "04_splines.ipynb",
-            (("labkit.eval_pherm(xdata, ydata, slopes(xdata, ydata), xtest)",
-              "labkit.eval_pherm(xdata, ydata, labkit.ccspline(xdata, ydata, f(xdata)[1][0], f(xdata)[1][-1]), xtest)"),),
-            12, "test_ncspline_interpolate", "complete cubic spline's error"),
-    Planted("notaknot_driver_builds_the_complete_spline", "04_splines.ipynb",
-            (("labkit.spline(xdata, f(xdata)[0], xtest)",
-              "labkit.spline(xdata, np.concatenate(([f(xdata)[1][0]], f(xdata)[0], [f(xdata)[1][-1]])), xtest)"),),
-            13, "test_spline_interpolate", "complete cubic spline's error"),
+    Planted(
+        "complete_driver_with_zero_end_slopes",
+        "04_splines.ipynb",
+        (("sprime = slopes(xdata, ydata, ypdata[0], ypdata[-1])", "sprime = slopes(xdata, ydata, 0.0, 0.0)"),),
+        11,
+        "test_ccspline_interpolate",
+        "end slopes look like 0 and 0",
+    ),
+    Planted(
+        "complete_driver_with_the_ends_swapped",
+        "04_splines.ipynb",
+        (
+            (
+                "sprime = slopes(xdata, ydata, ypdata[0], ypdata[-1])",
+                "sprime = slopes(xdata, ydata, ypdata[-1], ypdata[0])",
+            ),
+        ),
+        11,
+        "test_ccspline_interpolate",
+        "the last and the first (swapped)",
+    ),
+    Planted(
+        "natural_driver_builds_the_complete_spline",
+        "04_splines.ipynb",
+        (
+            (
+                "labkit.eval_pherm(xdata, ydata, slopes(xdata, ydata), xtest)",
+                "labkit.eval_pherm(xdata, ydata, labkit.ccspline(xdata, ydata, f(xdata)[1][0], f(xdata)[1][-1]), xtest)",
+            ),
+        ),
+        12,
+        "test_ncspline_interpolate",
+        "complete cubic spline's error",
+    ),
+    Planted(
+        "notaknot_driver_builds_the_complete_spline",
+        "04_splines.ipynb",
+        (
+            (
+                "labkit.spline(xdata, f(xdata)[0], xtest)",
+                "labkit.spline(xdata, np.concatenate(([f(xdata)[1][0]], f(xdata)[0], [f(xdata)[1][-1]])), xtest)",
+            ),
+        ),
+        13,
+        "test_spline_interpolate",
+        "complete cubic spline's error",
+    ),
     # Exercises 14 and 15
-    Planted("boiling_data_joined", "05_monotone.ipynb",
-            (('ax14.plot(xdata, ydata, "o", color="k", label="data")', 'ax14.plot(xdata, ydata, "o-", color="k", label="data")'),),
-            14, "ax14: the data", "linestyle 'none'"),
-    Planted("boiling_spline_at_20_points", "05_monotone.ipynb",
-            (("ax14.plot(xval, labkit.spline(xdata, ydata, xval)", "ax14.plot(xval[::10], labkit.spline(xdata, ydata, xval[::10])"),),
-            14, "ax14: the not-a-knot spline", "at least 100 points"),
-    Planted("pchip_driver_builds_the_spline", "05_monotone.ipynb",
-            (("labkit.pchip(xdata, f(xdata)[0], xtest)", "labkit.spline(xdata, f(xdata)[0], xtest)"),), 15,
-            "test_pchip_interpolate", "not-a-knot cubic spline's error"),
-    Planted("pchip_with_arithmetic_means", "05_monotone.ipynb",
-            (("    return np.max(np.abs(exact - labkit.pchip(xdata, f(xdata)[0], xtest))) / np.max(np.abs(exact))\n",
-              "    y = f(xdata)[0]\n    d = np.diff(y) / np.diff(xdata)\n"
-              "    slopes = np.concatenate(([d[0]], (d[:-1] + d[1:]) / 2, [d[-1]]))\n"
-              "    return np.max(np.abs(exact - labkit.eval_pherm(xdata, y, slopes, xtest))) / np.max(np.abs(exact))\n"),),
-            15, "test_pchip_interpolate", "arithmetic means"),
-    Planted("pchip_driver_that_raises", "05_monotone.ipynb",
-            (("    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0]\n    return np.max(np.abs(exact - labkit.pchip(",
-              "    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0] + xtest[4001]\n"
-              "    return np.max(np.abs(exact - labkit.pchip("),), 15, "test_pchip_interpolate", "xtest[4001]",
-            also=((15, "errors_pchip"), (15, "rate_pchip"))),
+    Planted(
+        "boiling_data_joined",
+        "05_monotone.ipynb",
+        (
+            (
+                'ax14.plot(xdata, ydata, "o", color="k", label="data")',
+                'ax14.plot(xdata, ydata, "o-", color="k", label="data")',
+            ),
+        ),
+        14,
+        "ax14: the data",
+        "linestyle 'none'",
+    ),
+    Planted(
+        "boiling_spline_at_20_points",
+        "05_monotone.ipynb",
+        (
+            (
+                "ax14.plot(xval, labkit.spline(xdata, ydata, xval)",
+                "ax14.plot(xval[::10], labkit.spline(xdata, ydata, xval[::10])",
+            ),
+        ),
+        14,
+        "ax14: the not-a-knot spline",
+        "at least 100 points",
+    ),
+    Planted(
+        "pchip_driver_builds_the_spline",
+        "05_monotone.ipynb",
+        (("labkit.pchip(xdata, f(xdata)[0], xtest)", "labkit.spline(xdata, f(xdata)[0], xtest)"),),
+        15,
+        "test_pchip_interpolate",
+        "not-a-knot cubic spline's error",
+    ),
+    Planted(
+        "pchip_with_arithmetic_means",
+        "05_monotone.ipynb",
+        (
+            (
+                "    return np.max(np.abs(exact - labkit.pchip(xdata, f(xdata)[0], xtest))) / np.max(np.abs(exact))\n",
+                "    y = f(xdata)[0]\n    d = np.diff(y) / np.diff(xdata)\n"
+                "    slopes = np.concatenate(([d[0]], (d[:-1] + d[1:]) / 2, [d[-1]]))\n"
+                "    return np.max(np.abs(exact - labkit.eval_pherm(xdata, y, slopes, xtest))) / np.max(np.abs(exact))\n",
+            ),
+        ),
+        15,
+        "test_pchip_interpolate",
+        "arithmetic means",
+    ),
+    Planted(
+        "pchip_driver_that_raises",
+        "05_monotone.ipynb",
+        (
+            (
+                "    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0]\n    return np.max(np.abs(exact - labkit.pchip(",
+                "    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0] + xtest[4001]\n"
+                "    return np.max(np.abs(exact - labkit.pchip(",
+            ),
+        ),
+        15,
+        "test_pchip_interpolate",
+        "xtest[4001]",
+        also=((15, "errors_pchip"), (15, "rate_pchip")),
+    ),
     # Exercise 16
-    Planted("phi_corners_numbered_clockwise", "06_bilinear.ipynb",
-            (("corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]", "corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]"),),
-            16, "phi_table", "numbered in another order"),
-    Planted("runge2d_with_a_product", "06_bilinear.ipynb",
-            (("(np.asarray(x, dtype=float) + np.asarray(y, dtype=float)) ** 2", "(np.asarray(x, dtype=float) * np.asarray(y, dtype=float)) ** 2"),),
-            16, "runge2d", "1 / (1 + (x + y)**2)"),
-    Planted("pbilin_transposed", "06_bilinear.ipynb",
-            (("            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)) / area\n",
-              "            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)).T / area.T\n"),), 16,
-            "eval_pbilin", "transposed"),
-    Planted("bilinear_driver_with_101_test_points", "06_bilinear.ipynb",
-            (("    test = np.linspace(0, 5, 401)\n", "    test = np.linspace(0, 5, 101)\n"),), 16,
-            "test_pbilin_interpolate", "101 test points instead of 401"),
+    Planted(
+        "phi_corners_numbered_clockwise",
+        "06_bilinear.ipynb",
+        (("corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]", "corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]"),),
+        16,
+        "phi_table",
+        "numbered in another order",
+    ),
+    Planted(
+        "runge2d_with_a_product",
+        "06_bilinear.ipynb",
+        (
+            (
+                "(np.asarray(x, dtype=float) + np.asarray(y, dtype=float)) ** 2",
+                "(np.asarray(x, dtype=float) * np.asarray(y, dtype=float)) ** 2",
+            ),
+        ),
+        16,
+        "runge2d",
+        "1 / (1 + (x + y)**2)",
+    ),
+    Planted(
+        "pbilin_transposed",
+        "06_bilinear.ipynb",
+        (
+            (
+                "            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)) / area\n",
+                "            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)).T / area.T\n",
+            ),
+        ),
+        16,
+        "eval_pbilin",
+        "transposed",
+    ),
+    Planted(
+        "bilinear_driver_with_101_test_points",
+        "06_bilinear.ipynb",
+        (("    test = np.linspace(0, 5, 401)\n", "    test = np.linspace(0, 5, 101)\n"),),
+        16,
+        "test_pbilin_interpolate",
+        "101 test points instead of 401",
+    ),
 )

@@ -34,10 +34,13 @@ def pytest_terminal_summary(terminalreporter):
         terminalreporter.write_line(
             f"{run.get('submissions')} submissions in {run.get('seconds')} s with --jobs {run.get('jobs')}; "
             f"{run.get('not graded')} not graded; grader peak "
-            + (f"{peak / 1024**2:.0f} MiB" if peak else "not measured (no memory cgroup)"))
+            + (f"{peak / 1024**2:.0f} MiB" if peak else "not measured (no memory cgroup)")
+        )
     module = sys.modules.get("test_jupyterlab")
     latencies = getattr(module, "LATENCIES", {})
     if latencies:
         terminalreporter.section("JupyterLab: key press or drag step -> new picture")
         for name, (median, p90, moves) in latencies.items():
-            terminalreporter.write_line(f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)")
+            terminalreporter.write_line(
+                f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)"
+            )

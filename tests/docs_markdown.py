@@ -2,6 +2,7 @@
 
 Imported by the tests as ``from docs_markdown import ...`` (like ``helpers``).
 """
+
 import re
 from pathlib import Path
 from urllib.parse import unquote
@@ -110,7 +111,7 @@ def exercise_table(path=DOCS / "students.md"):
     header, separator = _cells(lines[start]), _cells(lines[start + 1])
     assert all(re.fullmatch(r":?-{3,}:?", cell) for cell in separator), "a markdown table must follow the marker"
     rows = []
-    for line in lines[start + 2:]:
+    for line in lines[start + 2 :]:
         if not line.startswith("|"):
             break
         cells = _cells(line)

@@ -1,4 +1,5 @@
 """Data generators shared by the tests (imported as ``from helpers import ...``)."""
+
 import numpy as np
 from hypothesis import strategies as st
 
@@ -11,8 +12,6 @@ def unequal_knots(rng, n, start=-2.0):
 @st.composite
 def knots(draw, min_size=2, max_size=25):
     """Hypothesis strategy: strictly increasing, well-separated abscissae."""
-    gaps = draw(
-        st.lists(st.floats(0.05, 5.0), min_size=min_size - 1, max_size=max_size - 1)
-    )
+    gaps = draw(st.lists(st.floats(0.05, 5.0), min_size=min_size - 1, max_size=max_size - 1))
     start = draw(st.floats(-10.0, 10.0))
     return start + np.concatenate(([0.0], np.cumsum(gaps)))

@@ -1,5 +1,6 @@
 """Sandbox backends behind one interface: the registry, the CLI's switch, a backend that is only a subclass,
 and no knowledge of one backend's tool anywhere else."""
+
 import inspect
 import io
 import json
@@ -115,14 +116,23 @@ def test_no_sandbox_is_the_old_name_of_sandbox_none_with_its_warning(argv):
 
 
 def test_the_cli_offers_the_registry_and_refuses_other_names():
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "x.ipynb", "--out", "o", "--sandbox",
-                          "docker"], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "grade", "x.ipynb", "--out", "o", "--sandbox", "docker"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 2 and "invalid choice: 'docker' (choose from 'bwrap', 'none')" in run.stderr
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "x.ipynb", "--out", "o", "--sandbox",
-                          "bwrap", "--no-sandbox"], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "grade", "x.ipynb", "--out", "o", "--sandbox", "bwrap", "--no-sandbox"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 2 and "not allowed with" in run.stderr
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "--help"], capture_output=True, text=True,
-                         timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "grade", "--help"], capture_output=True, text=True, timeout=120
+    )
     help_text = " ".join(run.stdout.split())
     assert "--sandbox NAME" in help_text and "--no-sandbox" in help_text
     for name in backends.BUILTIN:
@@ -144,8 +154,9 @@ def test_a_backend_defined_in_a_test_module_is_all_grading_needs(tmp_path, monke
     record = tmp_path / "record.jsonl"
     monkeypatch.setenv(RECORD, str(record))
     options = GradeOptions(backend="recording", limits=Limits(memory=3 * 1024**3))
-    [grade] = grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", jobs=1, progress=False, seed=7,
-                            options=options)
+    [grade] = grading.grade(
+        [NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", jobs=1, progress=False, seed=7, options=options
+    )
     assert grade.graded and grade.total == 8, grade.feedback()
     assert "recording backend: student code runs unconfined" in capsys.readouterr().err
     entries = [json.loads(line) for line in record.read_text().splitlines()]
@@ -176,7 +187,7 @@ def test_the_bwrap_backend_gives_the_worker_its_uid_and_hands_over_the_seccomp_d
     worker = [sys.executable, "-I", "-m", "labkit.grading.worker"]
     box = backends.get_backend("bwrap").box(worker, Limits())
     try:
-        assert box.argv[-len(worker) - 2:] == ["--", *worker, str(bwrap.sandbox_uid())]
+        assert box.argv[-len(worker) - 2 :] == ["--", *worker, str(bwrap.sandbox_uid())]
         assert list(inspect.signature(bwrap.command).parameters) == ["argv", "limits", "seccomp_fd"]  # no uid
         for fd in box.pass_fds:
             assert f"--seccomp {fd}" in " ".join(box.argv)

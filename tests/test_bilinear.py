@@ -1,13 +1,14 @@
 import numpy as np
 import pytest
+from helpers import unequal_knots
 from scipy.interpolate import RegularGridInterpolator
 
 from labkit import bilinear_convergence, eval_pbilin, runge2d
-from helpers import unequal_knots
 
 
 @pytest.mark.parametrize(
-    "f", [lambda x, y: np.ones_like(x), lambda x, y: x, lambda x, y: y, lambda x, y: x * y],
+    "f",
+    [lambda x, y: np.ones_like(x), lambda x, y: x, lambda x, y: y, lambda x, y: x * y],
     ids=["1", "x", "y", "xy"],
 )
 def test_bilinear_functions_are_reproduced(rng, f):

@@ -1,17 +1,17 @@
 """Grades are right in both directions: every correct variation earns full marks, every typical slip costs
 exactly its part and is named (the catalogs are in tests/catalog.py), all graded in one sandboxed run."""
+
 import json
 import os
 from pathlib import Path
 
 import pytest
+from catalog import CORRECT, MISTAKES, plant
+from conftest import sandbox_or_skip
 
 from labkit import grading
 from labkit.check import EXERCISES
 from labkit.grading.rubric import default
-
-from catalog import CORRECT, MISTAKES, plant
-from conftest import sandbox_or_skip
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 RUBRIC = default()

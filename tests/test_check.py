@@ -1,4 +1,5 @@
 """labkit.check: passes the reference implementations, and narrows real mistakes down."""
+
 import numpy as np
 import pytest
 
@@ -22,6 +23,7 @@ def _hermite(combine):
         k = labkit.bracket(xdata, xval)
         h = labkit.hermite_basis(xdata[k], xdata[k + 1], xval)
         return combine(ydata, ypdata, k, h)
+
     return eval_pherm
 
 
@@ -68,7 +70,9 @@ def test_ccspline_subscript_mistake_is_located_by_the_equal_interval_case():
 
 def test_ccspline_asymmetric_matrix_is_reported():
     def system(xdata, ydata, y1p, ynp):
-        A, D = labkit.exercises.splines._reference_complete_system(np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp)
+        A, D = labkit.exercises.splines._reference_complete_system(
+            np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp
+        )
         A[1, 0] *= 2
         return A, D
 
@@ -81,13 +85,30 @@ def test_eval_pbilin_transposed_output_fails_at_the_single_cell():
     assert not result.passed
 
 
-@pytest.mark.parametrize("corners, passed", [
-    ([labkit.Corner([0, 0], [3, 0], [0, 1]), labkit.Corner([1, 0], [0.1, 0], [0, 1]),
-      labkit.Corner([1, 1], [0.1, 0], [0, 1]), labkit.Corner([0, 1], [3, 0], [0, 1])], True),
-    ([labkit.Corner([0, 0], [0.1, 0], [0, 1]), labkit.Corner([1, 0], [3, 0], [0, 1]),
-      labkit.Corner([1, 1], [3, 0], [0, 1]), labkit.Corner([0, 1], [0.1, 0], [0, 1])], False),
-    ("not corners", False),
-])
+@pytest.mark.parametrize(
+    "corners, passed",
+    [
+        (
+            [
+                labkit.Corner([0, 0], [3, 0], [0, 1]),
+                labkit.Corner([1, 0], [0.1, 0], [0, 1]),
+                labkit.Corner([1, 1], [0.1, 0], [0, 1]),
+                labkit.Corner([0, 1], [3, 0], [0, 1]),
+            ],
+            True,
+        ),
+        (
+            [
+                labkit.Corner([0, 0], [0.1, 0], [0, 1]),
+                labkit.Corner([1, 0], [3, 0], [0, 1]),
+                labkit.Corner([1, 1], [3, 0], [0, 1]),
+                labkit.Corner([0, 1], [0.1, 0], [0, 1]),
+            ],
+            False,
+        ),
+        ("not corners", False),
+    ],
+)
 def test_graded_corner_data(corners, passed):
     assert check.graded_corners(corners).passed is passed
 
@@ -105,6 +126,7 @@ def _recording(calls):
     def eval_pherm(xdata, ydata, ypdata, xval):
         calls.append(np.asarray(xdata, float).copy())
         return labkit.eval_pherm(xdata, ydata, ypdata, xval)
+
     return eval_pherm
 
 
@@ -155,7 +177,7 @@ def _system_with_h_subscript_slip(xdata, ydata, y1p, ynp):
     A, D = np.zeros((n, n)), np.zeros(n)
     A[0, :2], D[0] = [h[0] / 3, h[0] / 6], secant[0] - y1p
     for k in range(1, n - 1):
-        A[k, k - 1:k + 2], D[k] = [h[k] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6], secant[k] - secant[k - 1]
+        A[k, k - 1 : k + 2], D[k] = [h[k] / 6, (h[k - 1] + h[k]) / 3, h[k] / 6], secant[k] - secant[k - 1]
     A[-1, -2:], D[-1] = [h[-1] / 6, h[-1] / 3], ynp - secant[-1]
     return A, D
 
@@ -170,6 +192,7 @@ def _natural_from(system):
         h, secant = np.diff(x), np.diff(y) / np.diff(x)
         slopes = np.append(-M[:-1] * h / 3 - M[1:] * h / 6 + secant, M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1])
         return slopes
+
     return ncspline
 
 
@@ -184,7 +207,9 @@ def test_ncspline_built_on_a_wrong_complete_system_is_not_charged_twice(seed):
     ours = spline_checks.check_ncspline(ncspline, seed=seed, system=_system_with_h_subscript_slip)
     assert ours.passed and "your own complete_system" in repr(ours)
     # ... but a slip of its own next to the wrong system still costs ncspline
-    slipped = spline_checks.check_ncspline(lambda x, y: ncspline(x, y) * 1.01, seed=seed, system=_system_with_h_subscript_slip)
+    slipped = spline_checks.check_ncspline(
+        lambda x, y: ncspline(x, y) * 1.01, seed=seed, system=_system_with_h_subscript_slip
+    )
     assert not slipped.passed
     # and the right natural spline next to the wrong system passes the usual way
     assert spline_checks.check_ncspline(labkit.ncspline, seed=seed, system=_system_with_h_subscript_slip).passed

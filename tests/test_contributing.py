@@ -1,5 +1,6 @@
 """CONTRIBUTING.md's walkthrough, run as written: a toy exercise declared in a registry of its own, its
 notebook marked for nbgrader with the rubric's points, released, and a right and a wrong answer graded."""
+
 import csv
 import os
 import re
@@ -9,7 +10,6 @@ from pathlib import Path
 
 import nbformat
 import pytest
-
 from conftest import sandbox_or_skip
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -22,7 +22,7 @@ def _walkthrough():
     for _, body in BLOCK.findall((ROOT / "CONTRIBUTING.md").read_text(encoding="utf-8")):
         first, _, rest = body.partition("\n")
         if first.startswith("# file: "):
-            files[first[len("# file: "):].strip()] = rest
+            files[first[len("# file: ") :].strip()] = rest
         elif first.strip() == "# cell: code":
             cells.append(nbformat.v4.new_code_cell(rest.rstrip("\n")))
         elif first.strip() == "<!-- cell: markdown -->":
@@ -53,8 +53,9 @@ def course(tmp_path_factory):
 
 
 def _labkit(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "labkit.cli", *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "labkit.cli", *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=600
+    )
 
 
 def test_the_toy_exercise_is_declared_once_and_everything_follows(course):
@@ -70,14 +71,20 @@ def test_the_toy_exercise_is_declared_once_and_everything_follows(course):
     assert rubric.registry is registry and rubric.points == {17: 5.0} and rubric.full_credit == 5
     # nbgrader's points are the rubric's in force: the declared weight, or the rubric's own
     nb = nbformat.read(course / "notebooks" / "07_secants.ipynb", as_version=4)
-    tests = [c for c in mark(nb, "07_secants.ipynb", rubric).cells if c.metadata["nbgrader"]["grade"]
-             and c.cell_type == "code"]
+    tests = [
+        c
+        for c in mark(nb, "07_secants.ipynb", rubric).cells
+        if c.metadata["nbgrader"]["grade"] and c.cell_type == "code"
+    ]
     assert [c.metadata["nbgrader"]["points"] for c in tests] == [5]
     doubled = (course / "toy.toml").read_text() + "\n[points]\n17 = 10\n"
     (course / "doubled.toml").write_text(doubled)
     marked = mark(nb, "07_secants.ipynb", rubrics.load(course / "doubled.toml"))
-    assert [c.metadata["nbgrader"]["points"] for c in marked.cells if c.metadata["nbgrader"]["grade"]
-            and c.cell_type == "code"] == [10]
+    assert [
+        c.metadata["nbgrader"]["points"]
+        for c in marked.cells
+        if c.metadata["nbgrader"]["grade"] and c.cell_type == "code"
+    ] == [10]
     # a right and a wrong answer, checked in this process as a student's self-check would
     assert toy_lab.check_secants(lambda x, y: (y[1:] - y[:-1]) / (x[1:] - x[:-1])).passed
     slip = toy_lab.check_secants(lambda x, y: y[1:] - y[:-1])
@@ -105,8 +112,18 @@ def test_the_toy_exercise_is_executed_released_and_graded_right_and_wrong(course
         (folder / "07_secants.ipynb").write_text(source)
     (submissions / "bare").mkdir()
     (submissions / "bare" / "07_secants.ipynb").write_text(student)
-    graded = _labkit("grade", "--rubric", "toy.toml", "--seed", "5", "--quiet", "--out", "graded",
-                     *(submissions / n for n in ("right", "wrong", "bare")), cwd=course)
+    graded = _labkit(
+        "grade",
+        "--rubric",
+        "toy.toml",
+        "--seed",
+        "5",
+        "--quiet",
+        "--out",
+        "graded",
+        *(submissions / n for n in ("right", "wrong", "bare")),
+        cwd=course,
+    )
     assert graded.returncode == 0, graded.stderr
     with open(course / "graded" / "grades.csv", newline="") as handle:
         rows = {row["submission"]: row for row in csv.DictReader(handle)}

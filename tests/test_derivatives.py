@@ -1,4 +1,5 @@
 """Derivatives of every interpolant: against scipy's, and against the mathematics of each method."""
+
 import numpy as np
 import pytest
 from helpers import unequal_knots
@@ -71,8 +72,9 @@ def _jumps(x, y, slopes, der):
     h = np.diff(x)
     right = labkit.eval_pherm(x, y, slopes, x[1:-1], der=der)  # at a knot: the piece to its right
     # the left piece's value at its right end, from its own cubic evaluated on one interval
-    left = np.array([labkit.eval_pherm(x[k:k + 2], y[k:k + 2], slopes[k:k + 2], x[k + 1], der=der)
-                     for k in range(len(h) - 1)])
+    left = np.array(
+        [labkit.eval_pherm(x[k : k + 2], y[k : k + 2], slopes[k : k + 2], x[k + 1], der=der) for k in range(len(h) - 1)]
+    )
     return right - left
 
 
@@ -97,13 +99,16 @@ def test_hermite_basis_derivatives_are_the_derivatives_of_the_basis():
             np.testing.assert_allclose(got, (a - b) / (2 * step), rtol=1e-6, atol=1e-6)
 
 
-@pytest.mark.parametrize("call, highest", [
-    (lambda der: labkit.eval_plin([0, 1], [0, 1], 0.5, der=der), 1),
-    (lambda der: labkit.eval_pherm([0, 1], [0, 1], [0, 0], 0.5, der=der), 3),
-    (lambda der: labkit.spline([0, 1, 2], [0, 1, 0], 0.5, der=der), 3),
-    (lambda der: labkit.pchip([0, 1, 2], [0, 1, 0], 0.5, der=der), 3),
-    (lambda der: labkit.hermite_basis(0.0, 1.0, 0.5, der=der), 3),
-])
+@pytest.mark.parametrize(
+    "call, highest",
+    [
+        (lambda der: labkit.eval_plin([0, 1], [0, 1], 0.5, der=der), 1),
+        (lambda der: labkit.eval_pherm([0, 1], [0, 1], [0, 0], 0.5, der=der), 3),
+        (lambda der: labkit.spline([0, 1, 2], [0, 1, 0], 0.5, der=der), 3),
+        (lambda der: labkit.pchip([0, 1, 2], [0, 1, 0], 0.5, der=der), 3),
+        (lambda der: labkit.hermite_basis(0.0, 1.0, 0.5, der=der), 3),
+    ],
+)
 @pytest.mark.parametrize("offset", [1, 2])
 def test_derivative_order_out_of_range_is_refused(call, highest, offset):
     with pytest.raises(ValueError, match=f"der must be a whole number from 0 .* to {highest}"):

@@ -1,10 +1,19 @@
 """The documentation: every relative link reaches a file (and a heading), the README stays short."""
+
 import re
 
 import pytest
-
-from docs_markdown import (DOCS, EXERCISE_TABLE_MARKER, ROOT, anchors, broken_links, exercise_table,
-                           links, markdown_files, slug)
+from docs_markdown import (
+    DOCS,
+    EXERCISE_TABLE_MARKER,
+    ROOT,
+    anchors,
+    broken_links,
+    exercise_table,
+    links,
+    markdown_files,
+    slug,
+)
 
 # Linked on purpose before they exist, with who writes them. Once such a file exists its links are
 # checked like any other; then remove it from here.
@@ -15,8 +24,16 @@ FILES = markdown_files()
 
 def test_the_expected_documents_exist():
     names = {p.relative_to(ROOT).as_posix() for p in FILES}
-    assert {"README.md", "CHANGELOG.md", "docs/students.md", "docs/instructors.md", "docs/library.md",
-            "docs/performance.md", "docs/errata.md", "docs/grading-security.md"} <= names
+    assert {
+        "README.md",
+        "CHANGELOG.md",
+        "docs/students.md",
+        "docs/instructors.md",
+        "docs/library.md",
+        "docs/performance.md",
+        "docs/errata.md",
+        "docs/grading-security.md",
+    } <= names
 
 
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.relative_to(ROOT).as_posix())
@@ -26,8 +43,12 @@ def test_every_relative_link_reaches_a_file_and_its_heading(path):
 
 @pytest.mark.parametrize("name", sorted(PENDING))
 def test_pending_documents_are_linked_and_reported(name):
-    linked = any((p.parent / target.partition("#")[0]).resolve() == (ROOT / name).resolve()
-                 for p in FILES for _, target in links(p.read_text()) if target and "://" not in target)
+    linked = any(
+        (p.parent / target.partition("#")[0]).resolve() == (ROOT / name).resolve()
+        for p in FILES
+        for _, target in links(p.read_text())
+        if target and "://" not in target
+    )
     assert linked, f"{name} is in PENDING but nothing links to it: remove it from PENDING"
     if not (ROOT / name).exists():
         pytest.skip(f"{name} is linked but not written yet: {PENDING[name]}")
@@ -73,6 +94,7 @@ def test_the_exercise_table_lists_each_exercise_once_with_its_notebook_and_point
 
 # The checker itself: it must catch what it is there to catch.
 
+
 def test_slugs_are_githubs():
     assert slug("The notebooks and the lab's 16 exercises") == "the-notebooks-and-the-labs-16-exercises"
     assert slug("Changing a notebook, and what `make test` checks") == "changing-a-notebook-and-what-make-test-checks"
@@ -84,11 +106,13 @@ def test_slugs_are_githubs():
 def test_the_checker_finds_a_missing_file_and_a_missing_anchor(tmp_path):
     (tmp_path / "other.md").write_text("# Present heading\n")
     page = tmp_path / "page.md"
-    page.write_text("[ok](other.md#present-heading) [self](#top)\n\n# Top\n"
-                    "[gone](missing.md) [bad anchor](other.md#absent) [bad self](#nowhere)\n"
-                    "`[in code](missing-too.md)`\n```\n[fenced](missing-as-well.md)\n```\n"
-                    "[web](https://example.org/x.md) [ref]: ./also-missing.md\n"
-                    "[def]: ./missing-by-reference.md\n")
+    page.write_text(
+        "[ok](other.md#present-heading) [self](#top)\n\n# Top\n"
+        "[gone](missing.md) [bad anchor](other.md#absent) [bad self](#nowhere)\n"
+        "`[in code](missing-too.md)`\n```\n[fenced](missing-as-well.md)\n```\n"
+        "[web](https://example.org/x.md) [ref]: ./also-missing.md\n"
+        "[def]: ./missing-by-reference.md\n"
+    )
     problems = broken_links(page)
     assert len(problems) == 4, problems
     assert any("missing.md" in p and "no such file" in p for p in problems)

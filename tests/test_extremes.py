@@ -6,6 +6,7 @@ the answer scipy gives (or, where scipy overflows, the answer of the same
 problem scaled to ordinary numbers, scaled back). Where the answer itself is
 beyond the float range, a ValueError says so. No RuntimeWarning escapes.
 """
+
 import warnings
 
 import numpy as np
@@ -64,7 +65,9 @@ def test_knots_spanning_both_signs_of_huge_numbers():
 @pytest.mark.parametrize("name", sorted(SLOPES))
 def test_subnormal_spacing_raises_instead_of_overflowing(name):
     x = np.array([0.0, 5e-324, 1e-323, 1.0])
-    with pytest.raises(ValueError, match="slopes are beyond the float range.*smallest interval is xdata\\[1\\] - xdata\\[0\\]"):
+    with pytest.raises(
+        ValueError, match="slopes are beyond the float range.*smallest interval is xdata\\[1\\] - xdata\\[0\\]"
+    ):
         SLOPES[name](x, np.array([0.0, 1.0, 2.0, 3.0]))
 
 
@@ -148,8 +151,13 @@ BAD = {
     "bool": lambda good: np.asarray(good, dtype=float) > 0.5,
     "str": lambda good: np.asarray(good, dtype=float).astype(str),
 }
-MESSAGE = {"complex": "complex numbers", "None": "None", "object": "object where a number should be",
-           "bool": "booleans", "str": "text, not numbers"}
+MESSAGE = {
+    "complex": "complex numbers",
+    "None": "None",
+    "object": "object where a number should be",
+    "bool": "booleans",
+    "str": "text, not numbers",
+}
 # every public function of the library and the arguments that take numbers, with good values
 CALLS = {
     "bracket": (labkit.bracket, {"xdata": X3, "xval": 0.5}),
@@ -162,8 +170,7 @@ CALLS = {
     "spline": (labkit.spline, {"xdata": X3, "ydata": Y3, "xval": 0.5}),
     "pchip": (labkit.pchip, {"xdata": X3, "ydata": Y3, "xval": 0.5}),
     "pchip_slopes": (labkit.pchip_slopes, {"xdata": X3, "ydata": Y3}),
-    "eval_pbilin": (labkit.eval_pbilin, {"f": np.ones((3, 3)), "xdata": X3, "ydata": X3, "xval": 0.5,
-                                         "yval": 0.5}),
+    "eval_pbilin": (labkit.eval_pbilin, {"f": np.ones((3, 3)), "xdata": X3, "ydata": X3, "xval": 0.5, "yval": 0.5}),
     "runge": (labkit.runge, {"x": 0.5}),
     "runge2d": (labkit.runge2d, {"x": 0.5, "y": 0.5}),
     "limacon": (labkit.limacon, {"t": 0.5, "r0": 1.15}),
@@ -171,10 +178,14 @@ CALLS = {
     "quad_mesh": (labkit.quad_mesh, {"x": np.zeros((2, 2)) + [[0, 0], [1, 1]], "y": np.zeros((2, 2)) + [0, 1]}),
     "QuadMesh": (labkit.QuadMesh, {"points": [[0, 0], [1, 0], [1, 1], [0, 1]], "quads": [[0, 1, 2, 3]]}),
     "patch": (lambda s, t: labkit.patch(*SQUARE, s, t), {"s": [0.0, 0.5, 1.0], "t": [0.0, 1.0]}),
-    "convergence_table": (lambda **kw: labkit.convergence_table("plin", **kw),
-                          {"ndata": [5, 11], "interval": [0.0, 5.0], "ntest": 101}),
-    "ratio_table": (lambda ndata, errors: labkit.ratio_table("t", ndata, errors),
-                    {"ndata": [5, 11], "errors": [0.1, 0.01]}),
+    "convergence_table": (
+        lambda **kw: labkit.convergence_table("plin", **kw),
+        {"ndata": [5, 11], "interval": [0.0, 5.0], "ntest": 101},
+    ),
+    "ratio_table": (
+        lambda ndata, errors: labkit.ratio_table("t", ndata, errors),
+        {"ndata": [5, 11], "errors": [0.1, 0.01]},
+    ),
     "bilinear_convergence": (labkit.bilinear_convergence, {"ndata": [5, 9], "square": [0.0, 5.0], "ntest": 11}),
 }
 # public names that take no numbers from a user, and why: everything else in labkit.__all__ must be in CALLS
@@ -190,8 +201,13 @@ def test_every_public_function_has_its_bad_input_cases():
     assert not set(CALLS) & set(NO_NUMBERS)
 
 
-CASES = [(name, arg, bad) for name, (_, kwargs) in CALLS.items() for arg in kwargs for bad in BAD
-         if not (arg == "dsdt" and bad == "None")]  # a Corner without a twist is allowed: dsdt=None means 0
+CASES = [
+    (name, arg, bad)
+    for name, (_, kwargs) in CALLS.items()
+    for arg in kwargs
+    for bad in BAD
+    if not (arg == "dsdt" and bad == "None")
+]  # a Corner without a twist is allowed: dsdt=None means 0
 
 
 @pytest.mark.parametrize("name, arg, bad", CASES, ids=[f"{n}-{a}-{b}" for n, a, b in CASES])
@@ -203,12 +219,15 @@ def test_every_argument_refuses_what_is_not_real_numbers(name, arg, bad):
         function(**kwargs)
 
 
-@pytest.mark.parametrize("call, message", [
-    (lambda: labkit.convergence_table(np.array(["plin"], dtype=object)), "unknown method"),
-    (lambda: labkit.convergence_table("plin", ndata=[5, 10.5]), "whole numbers"),
-    (lambda: labkit.convergence_table("plin", ntest=2.5), "whole number of test points"),
-    (lambda: labkit.bilinear_convergence(ntest=True), "booleans"),
-])
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: labkit.convergence_table(np.array(["plin"], dtype=object)), "unknown method"),
+        (lambda: labkit.convergence_table("plin", ndata=[5, 10.5]), "whole numbers"),
+        (lambda: labkit.convergence_table("plin", ntest=2.5), "whole number of test points"),
+        (lambda: labkit.bilinear_convergence(ntest=True), "booleans"),
+    ],
+)
 def test_tables_refuse_what_is_not_a_count(call, message):
     with pytest.raises(ValueError, match=message):
         call()

@@ -1,6 +1,7 @@
 """Student release and grading: instructor = full marks and all extra credit, release = zero,
 the lab's branch rubric, planted mistakes lose exactly their part with the matching hint,
 broken submissions never stop the run."""
+
 import csv
 import json
 import shutil
@@ -27,17 +28,23 @@ EVERYTHING = RUBRIC.maximum
 
 
 def test_strip_solutions_keeps_signature_indentation_and_drops_hidden_tests():
-    source = "def f(x):\n    '''doc'''\n    ### BEGIN SOLUTION\n    return x\n    ### END SOLUTION\n" \
-             "### BEGIN HIDDEN TESTS\nassert f(1) == 1\n### END HIDDEN TESTS\nprint('kept')"
+    source = (
+        "def f(x):\n    '''doc'''\n    ### BEGIN SOLUTION\n    return x\n    ### END SOLUTION\n"
+        "### BEGIN HIDDEN TESTS\nassert f(1) == 1\n### END HIDDEN TESTS\nprint('kept')"
+    )
     assert grading.strip_solutions(source) == (
-        "def f(x):\n    '''doc'''\n    # YOUR CODE HERE\n    raise NotImplementedError()\nprint('kept')")
+        "def f(x):\n    '''doc'''\n    # YOUR CODE HERE\n    raise NotImplementedError()\nprint('kept')"
+    )
 
 
-@pytest.mark.parametrize("source, message", [
-    ("### BEGIN SOLUTION\nx = 1", "never closed"),
-    ("x = 1\n### END SOLUTION", "without a matching"),
-    ("### BEGIN SOLUTION\n### BEGIN HIDDEN TESTS", "inside an open"),
-])
+@pytest.mark.parametrize(
+    "source, message",
+    [
+        ("### BEGIN SOLUTION\nx = 1", "never closed"),
+        ("x = 1\n### END SOLUTION", "without a matching"),
+        ("### BEGIN SOLUTION\n### BEGIN HIDDEN TESTS", "inside an open"),
+    ],
+)
 def test_unbalanced_markers_are_reported_with_their_place(source, message):
     with pytest.raises(ValueError, match=message):
         grading.strip_solutions(source, "nb.ipynb, cell 3")
@@ -75,18 +82,46 @@ def test_release_is_deterministic_and_keeps_everything_but_solutions(released, t
 
 
 def test_required_student_code_sits_in_solution_regions_with_signatures_outside():
-    sources = [c.source for p in sorted(NOTEBOOKS.glob("*.ipynb"))
-               for c in nbformat.read(p, as_version=4).cells if c.cell_type == "code"]
+    sources = [
+        c.source
+        for p in sorted(NOTEBOOKS.glob("*.ipynb"))
+        for c in nbformat.read(p, as_version=4).cells
+        if c.cell_type == "code"
+    ]
     stripped = "\n".join(grading.strip_solutions(source) for source in sources)
-    for name in ("eval_pherm", "runge", "test_pherm_interpolate", "limacon_derivatives", "coons", "mirror",
-                 "two_patches", "complete_system", "ccspline", "ncspline", "test_ccspline_interpolate",
-                 "test_ncspline_interpolate", "test_spline_interpolate", "test_pchip_interpolate", "eval_pbilin",
-                 "runge2d", "test_pbilin_interpolate"):
+    for name in (
+        "eval_pherm",
+        "runge",
+        "test_pherm_interpolate",
+        "limacon_derivatives",
+        "coons",
+        "mirror",
+        "two_patches",
+        "complete_system",
+        "ccspline",
+        "ncspline",
+        "test_ccspline_interpolate",
+        "test_ncspline_interpolate",
+        "test_spline_interpolate",
+        "test_pchip_interpolate",
+        "eval_pbilin",
+        "runge2d",
+        "test_pbilin_interpolate",
+    ):
         body = stripped.split(f"def {name}(", 1)[1].split("\ndef ", 1)[0]
         assert '"""' in body.split("# YOUR CODE HERE")[0], f"{name} keeps its docstring"
         assert "raise NotImplementedError()" in body and "\n    return" not in body, name
-    data = ["graded =", "straight =", "circle_sides =", "A = Corner(", "region =", "phi_table =",
-            "xdata = r * np.cos(tdata)", "ax14.plot(", "ax4.plot("]
+    data = [
+        "graded =",
+        "straight =",
+        "circle_sides =",
+        "A = Corner(",
+        "region =",
+        "phi_table =",
+        "xdata = r * np.cos(tdata)",
+        "ax14.plot(",
+        "ax4.plot(",
+    ]
     for key in ("pherm", "complete", "natural", "notaknot", "pchip", "bilinear"):
         data += [f"errors_{key} =", f"rate_{key} ="]
     for line in data:
@@ -124,19 +159,51 @@ def _plant(tmp_path, name, notebook, old, new):
 
 # planted mistakes of the lab's student work: (name, notebook, old text, new text, exercise, part, hint)
 PLANTED = [
-    ("wrong_sign_dydt", "01_limacon.ipynb", "dydt = -np.sin(t) ** 2 + r * np.cos(t)",
-     "dydt = np.sin(t) ** 2 - r * np.cos(t)", 4, "limacon_derivatives", "dy/dt has the wrong sign"),
-    ("absolute_error", "04_splines.ipynb",
-     "labkit.eval_pherm(xdata, ydata, sprime, xtest))) / np.max(np.abs(exact))",
-     "labkit.eval_pherm(xdata, ydata, sprime, xtest)))", 11, "test_ccspline_interpolate",
-     "the error is absolute, not relative to max|f|"),
-    ("rate_eight", "04_splines.ipynb", "rate_complete = 4", "rate_complete = 8", 11, "rate_complete",
-     "take the ratios"),
-    ("data_joined", "05_monotone.ipynb", 'ax14.plot(xdata, ydata, "o", color="k"',
-     'ax14.plot(xdata, ydata, "o-", color="k"', 14, "ax14: the data", "linestyle 'none'"),
-    ("spline_20_points", "05_monotone.ipynb", "ax14.plot(xval, labkit.spline(xdata, ydata, xval)",
-     "ax14.plot(xval[::10], labkit.spline(xdata, ydata, xval[::10])", 14, "ax14: the not-a-knot spline",
-     "at least 100 points"),
+    (
+        "wrong_sign_dydt",
+        "01_limacon.ipynb",
+        "dydt = -np.sin(t) ** 2 + r * np.cos(t)",
+        "dydt = np.sin(t) ** 2 - r * np.cos(t)",
+        4,
+        "limacon_derivatives",
+        "dy/dt has the wrong sign",
+    ),
+    (
+        "absolute_error",
+        "04_splines.ipynb",
+        "labkit.eval_pherm(xdata, ydata, sprime, xtest))) / np.max(np.abs(exact))",
+        "labkit.eval_pherm(xdata, ydata, sprime, xtest)))",
+        11,
+        "test_ccspline_interpolate",
+        "the error is absolute, not relative to max|f|",
+    ),
+    (
+        "rate_eight",
+        "04_splines.ipynb",
+        "rate_complete = 4",
+        "rate_complete = 8",
+        11,
+        "rate_complete",
+        "take the ratios",
+    ),
+    (
+        "data_joined",
+        "05_monotone.ipynb",
+        'ax14.plot(xdata, ydata, "o", color="k"',
+        'ax14.plot(xdata, ydata, "o-", color="k"',
+        14,
+        "ax14: the data",
+        "linestyle 'none'",
+    ),
+    (
+        "spline_20_points",
+        "05_monotone.ipynb",
+        "ax14.plot(xval, labkit.spline(xdata, ydata, xval)",
+        "ax14.plot(xval[::10], labkit.spline(xdata, ydata, xval[::10])",
+        14,
+        "ax14: the not-a-knot spline",
+        "at least 100 points",
+    ),
 ]
 
 
@@ -157,20 +224,26 @@ def graded(tmp_path_factory, released):
     subs = {
         "instructor": NOTEBOOKS,
         "student_release": released,
-        "wrong_denominator": _plant(tmp, "wrong_denominator", "02_convergence.ipynb",
-                                    "/ (xk - xk1) ** 3", "/ (xk - xk1) ** 2"),
-        "natural_rows": _plant(tmp, "natural_rows", "04_splines.ipynb",
-                               "    A[0, :], A[-1, :] = 0.0, 0.0\n    A[0, 0], A[-1, -1] = 1.0, 1.0\n    D[0], D[-1] = 0.0, 0.0\n", ""),
-        "missing_twist": _plant(tmp, "missing_twist", "03_meshes.ipynb",
-                                "[A.dsdt[c], B.dsdt[c]]", "[0.0, 0.0]"),
+        "wrong_denominator": _plant(
+            tmp, "wrong_denominator", "02_convergence.ipynb", "/ (xk - xk1) ** 3", "/ (xk - xk1) ** 2"
+        ),
+        "natural_rows": _plant(
+            tmp,
+            "natural_rows",
+            "04_splines.ipynb",
+            "    A[0, :], A[-1, :] = 0.0, 0.0\n    A[0, 0], A[-1, -1] = 1.0, 1.0\n    D[0], D[-1] = 0.0, 0.0\n",
+            "",
+        ),
+        "missing_twist": _plant(tmp, "missing_twist", "03_meshes.ipynb", "[A.dsdt[c], B.dsdt[c]]", "[0.0, 0.0]"),
         "raises": _broken(tmp, "raises", "raise RuntimeError('student bug')"),
         "loops_forever": _broken(tmp, "loops_forever", "while True:\n    pass"),
         "syntax_error": _broken(tmp, "syntax_error", "def broken(:\n    pass"),
         "prints_megabytes": _broken(tmp, "prints_megabytes", "for _ in range(50):\n    print('x' * 1_000_000)"),
         "deletes_files": _broken(tmp, "deletes_files", "import os\nfor f in os.listdir('.'):\n    os.remove(f)"),
         # the lab's rubric: exercises 1-4 and one branch is full credit, the other branch extra
-        "spline_branch_only": _partly_done(tmp, "spline_branch_only", released,
-                                           ("03_meshes.ipynb", "06_bilinear.ipynb")),
+        "spline_branch_only": _partly_done(
+            tmp, "spline_branch_only", released, ("03_meshes.ipynb", "06_bilinear.ipynb")
+        ),
         "both_branches": _partly_done(tmp, "both_branches", released, ("06_bilinear.ipynb",)),
     }
     for name, notebook, old, new, *_ in PLANTED:
@@ -194,16 +267,18 @@ def test_instructor_notebooks_score_full_marks_and_all_extra_credit(graded):
 def test_spline_branch_alone_is_full_credit_without_extra(graded):
     results, *_ = graded
     score = results["spline_branch_only"].score
-    assert score.total == FULL and score.branch == "splines" and score.extra_total == 0, \
-        results["spline_branch_only"].feedback()
+    assert score.total == FULL and score.branch == "splines" and score.extra_total == 0, results[
+        "spline_branch_only"
+    ].feedback()
     assert "Branch that counts: splines, 60 / 60" in results["spline_branch_only"].feedback()
 
 
 def test_the_second_branch_is_ten_points_of_extra_credit(graded):
     results, *_ = graded
     score = results["both_branches"].score
-    assert score.total == FULL + 10 and score.extra == {"exercise 16": 0, "branch splines": 10.0}, \
-        results["both_branches"].feedback()
+    assert score.total == FULL + 10 and score.extra == {"exercise 16": 0, "branch splines": 10.0}, results[
+        "both_branches"
+    ].feedback()
     assert "Extra credit, branch splines: 10" in results["both_branches"].feedback()
 
 
@@ -213,12 +288,16 @@ def test_planted_mistake_loses_exactly_its_part_with_the_matching_hint(graded, n
     grade, instructor = results[name], results["instructor"]
     failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
     assert failed == [(exercise, part)], grade.feedback()
-    lost = RUBRIC.points[exercise] * next(p.weight for p in EXERCISES[exercise].parts if p.name == part) \
+    lost = (
+        RUBRIC.points[exercise]
+        * next(p.weight for p in EXERCISES[exercise].parts if p.name == part)
         / EXERCISES[exercise].points
+    )
     assert grade.points[exercise] == pytest.approx(RUBRIC.points[exercise] - lost, abs=0.01), grade.feedback()
     assert grade.total < EVERYTHING
-    assert {n: p for n, p in grade.points.items() if n != exercise} == \
-        {n: p for n, p in instructor.points.items() if n != exercise}
+    assert {n: p for n, p in grade.points.items() if n != exercise} == {
+        n: p for n, p in instructor.points.items() if n != exercise
+    }
     section = grade.feedback().split(f"Exercise {exercise}:")[1].split("\nExercise ")[0]
     assert hint in section, section
 
@@ -229,11 +308,14 @@ def test_student_release_scores_zero_without_crashing(graded):
     assert "not implemented yet" in results["student_release"].feedback()
 
 
-@pytest.mark.parametrize("name, exercise, part, hint", [
-    ("wrong_denominator", 2, "eval_pherm", "denominators"),
-    ("natural_rows", 12, "ncspline", "M1 = 0 and Mn = 0"),
-    ("missing_twist", 5, "coons", "ignores the twists"),
-])
+@pytest.mark.parametrize(
+    "name, exercise, part, hint",
+    [
+        ("wrong_denominator", 2, "eval_pherm", "denominators"),
+        ("natural_rows", 12, "ncspline", "M1 = 0 and Mn = 0"),
+        ("missing_twist", 5, "coons", "ignores the twists"),
+    ],
+)
 def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, name, exercise, part, hint):
     results, *_ = graded
     grade = results[name]
@@ -242,13 +324,15 @@ def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, n
     # The one exception: a table whose errors do not shrink shows no experiment and earns nothing, nor
     # does its rate (a wrong Hermite denominator makes the student's own driver's errors stall at 1); and a
     # rate is read from the student's own table, so the planted copy's unchanged answer no longer fits it
-    also = {"wrong_denominator": [(3, "errors_pherm"), (3, "rate_pherm")],
-            "natural_rows": [(12, "rate_natural")]}.get(name, [])
+    also = {"wrong_denominator": [(3, "errors_pherm"), (3, "rate_pherm")], "natural_rows": [(12, "rate_natural")]}.get(
+        name, []
+    )
     failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
     assert failed == [(exercise, part)] + also, grade.feedback()
     changed = {exercise} | {n for n, _ in also}
-    assert {n: p for n, p in grade.points.items() if n not in changed} == \
-        {n: p for n, p in results["instructor"].points.items() if n not in changed}, grade.feedback()
+    assert {n: p for n, p in grade.points.items() if n not in changed} == {
+        n: p for n, p in results["instructor"].points.items() if n not in changed
+    }, grade.feedback()
     if name == "wrong_denominator":
         assert "shows no experiment" in grade.feedback()
     feedback = grade.feedback()
@@ -256,13 +340,16 @@ def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, n
     assert hint in section
 
 
-@pytest.mark.parametrize("name, problem", [
-    ("raises", "raised an error"),
-    ("loops_forever", "raised an error"),
-    ("syntax_error", "raised an error"),
-    ("prints_megabytes", None),
-    ("deletes_files", None),
-])
+@pytest.mark.parametrize(
+    "name, problem",
+    [
+        ("raises", "raised an error"),
+        ("loops_forever", "raised an error"),
+        ("syntax_error", "raised an error"),
+        ("prints_megabytes", None),
+        ("deletes_files", None),
+    ],
+)
 def test_broken_submissions_are_graded_as_far_as_they_get(graded, name, problem):
     results, *_ = graded
     grade = results[name]
@@ -300,18 +387,26 @@ def test_grades_csv_and_feedback_files(graded):
     results, out, _, subs = graded
     with open(out / "grades.csv", newline="") as handle:
         rows = list(csv.reader(handle))
-    assert rows[0][:len(EXERCISES) + 8] == ["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + [
-        "required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
+    assert rows[0][: len(EXERCISES) + 8] == ["submission"] + [f"exercise {n}" for n in sorted(EXERCISES)] + [
+        "required",
+        "branch",
+        "branch points",
+        "extra credit",
+        "total",
+        "full credit",
+        "status",
+    ]
     # then one empty column per answer in words, for the instructor to fill in after reading it
-    assert rows[0][len(EXERCISES) + 8:] == [f"to read: exercise {n}, {what}" for n, what in ANSWERS.values()]
-    assert all(row[len(EXERCISES) + 8:] == [""] * len(ANSWERS) for row in rows[1:])
+    assert rows[0][len(EXERCISES) + 8 :] == [f"to read: exercise {n}, {what}" for n, what in ANSWERS.values()]
+    assert all(row[len(EXERCISES) + 8 :] == [""] * len(ANSWERS) for row in rows[1:])
     assert [row[0] for row in rows[1:]] == [results[name].name for name in subs]
     column = {name: i for i, name in enumerate(rows[0])}
     for row in rows[1:]:
         value = {name: row[i] for name, i in column.items()}
         assert float(value["required"]) == sum(float(value[f"exercise {n}"]) for n in (2, 3, 4))
         assert float(value["total"]) == pytest.approx(
-            float(value["required"]) + float(value["branch points"]) + float(value["extra credit"]))
+            float(value["required"]) + float(value["branch points"]) + float(value["extra credit"])
+        )
         assert value["full credit"] == "100"
     row = next(r for r in rows if r[0] == "spline_branch_only")
     assert row[column["branch"]] == "splines" and row[column["total"]] == "100"
@@ -342,7 +437,7 @@ def test_cli_rejects_bad_paths_and_non_notebooks(tmp_path):
 def test_every_submission_gets_a_result_file_and_the_seed_is_saved(graded):
     results, out, _, subs = graded
     seed = int((out / "seed.txt").read_text())
-    for name, grade in results.items():
+    for grade in results.values():
         data = json.loads((out / "results" / f"{grading.report.safe_name(grade.name)}.json").read_text())
         assert data["total"] == grade.total and data["seed"] == seed
         assert {int(n): v for n, v in data["points"].items()} == grade.points
@@ -372,8 +467,9 @@ def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
     assert rows["alice"][total] == "8" and rows["bob"][total] == "0"
     for grade in graded_apart:
         assert float(rows[grade.name][total]) == grade.total
-        assert (tmp / "merged" / "feedback" / f"{grading.report.safe_name(grade.name)}.txt").read_text() \
-            == grade.feedback()
+        assert (
+            tmp / "merged" / "feedback" / f"{grading.report.safe_name(grade.name)}.txt"
+        ).read_text() == grade.feedback()
     assert (tmp / "merged" / "seed.txt").read_text() == "4242\n"
 
 
@@ -393,13 +489,22 @@ def test_merge_scores_with_the_rubric_it_is_given(two_runs, tmp_path):
     tmp, *_ = two_runs
     rubric = tmp_path / "rubric.toml"
     rubric.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n')
-    run = _cli("grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"),
-               "--rubric", str(rubric))
+    run = _cli(
+        "grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"), "--rubric", str(rubric)
+    )
     assert run.returncode == 0, run.stderr
     with open(tmp_path / "m" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}
-    assert rows["submission"][1:9] == ["exercise 16", "required", "branch", "branch points", "extra credit",
-                                       "total", "full credit", "status"]
+    assert rows["submission"][1:9] == [
+        "exercise 16",
+        "required",
+        "branch",
+        "branch points",
+        "extra credit",
+        "total",
+        "full credit",
+        "status",
+    ]
     assert [c.split(",")[0] for c in rows["submission"][9:]] == ["to read: exercise 16"] * 2
     assert rows["alice"][1:9] == ["20", "20", "", "0", "0", "20", "20", "graded"] and rows["bob"][6] == "0"
     feedback = tmp_path / "m" / "feedback" / f"{grading.report.safe_name('alice')}.txt"
@@ -425,8 +530,9 @@ def test_grading_without_bwrap_stops_and_says_how_to_install_it(tmp_path, monkey
 
 @pytest.mark.parametrize("switch", [["--no-sandbox"], ["--sandbox", "none"]])
 def test_no_sandbox_warns_loudly_and_still_grades(tmp_path, switch):
-    run = _cli("grade", str(NOTEBOOKS / "06_bilinear.ipynb"), "--out", str(tmp_path / "g"), *switch,
-               "--quiet", "--seed", "5")
+    run = _cli(
+        "grade", str(NOTEBOOKS / "06_bilinear.ipynb"), "--out", str(tmp_path / "g"), *switch, "--quiet", "--seed", "5"
+    )
     assert run.returncode == 0, run.stderr
     assert "student code runs UNCONFINED" in run.stderr and "random test data from seed 5" in run.stdout
     assert f"06_bilinear{' ' * 20}" in run.stdout and run.stdout.split("06_bilinear")[1].split()[0] == "8"

@@ -9,6 +9,7 @@ grader's own memory stays under a bound, ``grades.csv`` has every student
 once, and the feedback names what happened, as data (no control character
 reaches a file or a terminal).
 """
+
 import csv
 import hashlib
 import json
@@ -23,13 +24,12 @@ from pathlib import Path
 
 import nbformat
 import pytest
+from conftest import sandbox_or_skip
 
 from labkit import grading
 from labkit.grading import remote
 from labkit.grading.report import safe_name
 from labkit.grading.rubric import default
-
-from conftest import sandbox_or_skip
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -90,185 +90,271 @@ def _notebook(folder, name, cells, base="02_convergence.ipynb", replace=None):
 
 # the cells of each attack; <OUT>, <LABKIT>, <PORT> and <REPO> are filled in by _fill
 ATTACKS = {
-    "patched_check": ["import labkit.check as c\nreal = c.grade\n"
-                      "c.grade = lambda n, ns, seed=None: {**real(n, ns), 'passed': True, 'points': c.POINTS[n]}\n"
-                      "import labkit.exercises.registry as e\ne.LAB.check = c.grade\n"
-                      "for name in dir(c):\n    obj = getattr(c, name)\n"
-                      "    if callable(obj) and not isinstance(obj, type): setattr(c, name, lambda *a, **k: True)"],
-    "patched_numpy": ["import numpy as np, numpy.testing\n"
-                      "np.allclose = lambda *a, **k: True\nnp.isclose = lambda *a, **k: True\n"
-                      "np.array_equal = lambda *a, **k: True\nnumpy.testing.assert_allclose = lambda *a, **k: None\n"
-                      "import builtins\nbuiltins.all = lambda *a: True\nbuiltins.abs = lambda x: 0"],
-    "always_equal": ["class Liar:\n    def __eq__(self, other): return True\n    __ne__ = lambda s, o: False\n"
-                     "    __lt__ = __le__ = __gt__ = __ge__ = __eq__\n    def __array__(self, *a, **k): raise TypeError\n"
-                     "    def __float__(self): return 1.0\n"
-                     "def eval_pherm(xdata, ydata, ypdata, xval):\n    return Liar()\n"
-                     "def runge(x):\n    return Liar(), Liar()"],
-    "always_equal_array": ["import numpy as np\nclass Yes(np.ndarray):\n"
-                           "    def __eq__(self, other): return np.ones(np.shape(other), bool).view(Yes)\n"
-                           "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                           "    return np.zeros(np.shape(xval)).view(Yes)"],
-    "fake_result_line": ["import json\nfor n in (2, 3, 11, 12):\n"
-                         "    print('LABKIT-GRADE-0000:' + json.dumps({'exercise': n, 'passed': True, 'points': 10, "
-                         "'defined': True, 'checks': []}))\n"
-                         "import os\nline = json.dumps({'id': '0', 'value': ['f', 1.0]}).encode() + b'\\n'\n"
-                         "for fd in range(1, 40):\n    try: os.write(fd, line)\n    except OSError: pass"],
-    "writes_outside": ["import os\nseen = []\n"
-                       "for path in ['/tmp/" + MARK + "', '<OUT>/" + MARK + "', '<LABKIT>/" + MARK + ".py', "
-                       "'<LABKIT>/__init__.py', '<REPO>/" + MARK + "']:\n"
-                       "    try:\n        open(path, 'a').write('owned')\n        seen.append(f'wrote {path}')\n"
-                       "    except OSError as exc:\n        seen.append(f'{path}: {exc.strerror}')\n"
-                       "raise RuntimeError('; '.join(seen))"],
-    "background_process": ["import subprocess, os\n"
-                           "subprocess.Popen(['sleep', '7777'], start_new_session=True)\n"
-                           "if os.fork() == 0:\n    os.setsid()\n    os.execvp('sleep', ['sleep', '7777'])\n"
-                           "raise RuntimeError('left sleep 7777 running')"],
-    "fork_loop": ["import os, time\nchildren = 0\n"
-                  "for _ in range(400):\n    pid = os.fork()\n"
-                  "    if pid == 0:\n        time.sleep(120)\n        os._exit(0)\n    children += 1"],
+    "patched_check": [
+        "import labkit.check as c\nreal = c.grade\n"
+        "c.grade = lambda n, ns, seed=None: {**real(n, ns), 'passed': True, 'points': c.POINTS[n]}\n"
+        "import labkit.exercises.registry as e\ne.LAB.check = c.grade\n"
+        "for name in dir(c):\n    obj = getattr(c, name)\n"
+        "    if callable(obj) and not isinstance(obj, type): setattr(c, name, lambda *a, **k: True)"
+    ],
+    "patched_numpy": [
+        "import numpy as np, numpy.testing\n"
+        "np.allclose = lambda *a, **k: True\nnp.isclose = lambda *a, **k: True\n"
+        "np.array_equal = lambda *a, **k: True\nnumpy.testing.assert_allclose = lambda *a, **k: None\n"
+        "import builtins\nbuiltins.all = lambda *a: True\nbuiltins.abs = lambda x: 0"
+    ],
+    "always_equal": [
+        "class Liar:\n    def __eq__(self, other): return True\n    __ne__ = lambda s, o: False\n"
+        "    __lt__ = __le__ = __gt__ = __ge__ = __eq__\n    def __array__(self, *a, **k): raise TypeError\n"
+        "    def __float__(self): return 1.0\n"
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n    return Liar()\n"
+        "def runge(x):\n    return Liar(), Liar()"
+    ],
+    "always_equal_array": [
+        "import numpy as np\nclass Yes(np.ndarray):\n"
+        "    def __eq__(self, other): return np.ones(np.shape(other), bool).view(Yes)\n"
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+        "    return np.zeros(np.shape(xval)).view(Yes)"
+    ],
+    "fake_result_line": [
+        "import json\nfor n in (2, 3, 11, 12):\n"
+        "    print('LABKIT-GRADE-0000:' + json.dumps({'exercise': n, 'passed': True, 'points': 10, "
+        "'defined': True, 'checks': []}))\n"
+        "import os\nline = json.dumps({'id': '0', 'value': ['f', 1.0]}).encode() + b'\\n'\n"
+        "for fd in range(1, 40):\n    try: os.write(fd, line)\n    except OSError: pass"
+    ],
+    "writes_outside": [
+        "import os\nseen = []\n"
+        "for path in ['/tmp/" + MARK + "', '<OUT>/" + MARK + "', '<LABKIT>/" + MARK + ".py', "
+        "'<LABKIT>/__init__.py', '<REPO>/" + MARK + "']:\n"
+        "    try:\n        open(path, 'a').write('owned')\n        seen.append(f'wrote {path}')\n"
+        "    except OSError as exc:\n        seen.append(f'{path}: {exc.strerror}')\n"
+        "raise RuntimeError('; '.join(seen))"
+    ],
+    "background_process": [
+        "import subprocess, os\n"
+        "subprocess.Popen(['sleep', '7777'], start_new_session=True)\n"
+        "if os.fork() == 0:\n    os.setsid()\n    os.execvp('sleep', ['sleep', '7777'])\n"
+        "raise RuntimeError('left sleep 7777 running')"
+    ],
+    "fork_loop": [
+        "import os, time\nchildren = 0\n"
+        "for _ in range(400):\n    pid = os.fork()\n"
+        "    if pid == 0:\n        time.sleep(120)\n        os._exit(0)\n    children += 1"
+    ],
     "memory_grab": ["block = bytearray(6 * 1024**3)"],
-    "connects_out": ["import socket\ns = socket.create_connection(('127.0.0.1', <PORT>), timeout=5)\n"
-                     "s.sendall(b'" + MARK + "')"],
-    "reads_solutions": ["source = open('<REPO>/notebooks/02_convergence.ipynb').read()\n"
-                        "import json\ncells = json.loads(source)['cells']\n"
-                        "exec(''.join(cells[5]['source']))"],
+    "connects_out": [
+        "import socket\ns = socket.create_connection(('127.0.0.1', <PORT>), timeout=5)\ns.sendall(b'" + MARK + "')"
+    ],
+    "reads_solutions": [
+        "source = open('<REPO>/notebooks/02_convergence.ipynb').read()\n"
+        "import json\ncells = json.loads(source)['cells']\n"
+        "exec(''.join(cells[5]['source']))"
+    ],
     "infinite_loop": ["while True:\n    pass"],
     "sys_exit": ["import sys\nsys.exit(1)"],
     "os_exit": ["import os\nos._exit(3)"],
-    "prints_100_mb": ["import sys\nfor _ in range(100):\n    print('x' * 1_000_000)\n"
-                      "    sys.__stdout__.write('y' * 100)"],
+    "prints_100_mb": [
+        "import sys\nfor _ in range(100):\n    print('x' * 1_000_000)\n    sys.__stdout__.write('y' * 100)"
+    ],
     # the answer-pipe bomb: one 256 MiB line of nested empty lists to every descriptor it can find
-    "answer_pipe_bomb": ["import os\nbomb = b'[' * (128 * 1024**2) + b']' * (128 * 1024**2) + b'\\n'\n"
-                         "for fd in range(3, 12):\n    try:\n        os.write(fd, bomb)\n    except OSError:\n"
-                         "        pass"],
+    "answer_pipe_bomb": [
+        "import os\nbomb = b'[' * (128 * 1024**2) + b']' * (128 * 1024**2) + b'\\n'\n"
+        "for fd in range(3, 12):\n    try:\n        os.write(fd, bomb)\n    except OSError:\n"
+        "        pass"
+    ],
     # a chain of 1,100 folders and a big file in the private folder, and in /tmp
-    "deep_folders": ["import os\nfull = []\nfor top in (os.path.expanduser('~'), '/tmp'):\n    os.chdir(top)\n"
-                     "    for _ in range(1100):\n        os.mkdir('d')\n        os.chdir('d')\n"
-                     "    try:\n        for i in range(6):\n            open(f'big{i}', 'wb').write(b'x' * 60 * 1024**2)\n"
-                     "    except OSError as exc:\n        full.append(str(exc))\n"
-                     "os.chdir(os.path.expanduser('~'))\nraise RuntimeError('; '.join(full))"],
+    "deep_folders": [
+        "import os\nfull = []\nfor top in (os.path.expanduser('~'), '/tmp'):\n    os.chdir(top)\n"
+        "    for _ in range(1100):\n        os.mkdir('d')\n        os.chdir('d')\n"
+        "    try:\n        for i in range(6):\n            open(f'big{i}', 'wb').write(b'x' * 60 * 1024**2)\n"
+        "    except OSError as exc:\n        full.append(str(exc))\n"
+        "os.chdir(os.path.expanduser('~'))\nraise RuntimeError('; '.join(full))"
+    ],
     # memory the address-space limit does not count, and a kernel key for the next submission to find
     "memfd": ["import os\nos.memfd_create('hoard')"],
-    "keyring": ["import ctypes\nlibc = ctypes.CDLL(None, use_errno=True)\n"
-                "key = libc.syscall(248, b'user', b'" + MARK + "', b'secret', 6, -4)\n"
-                "raise RuntimeError(f'add_key: {key} errno {ctypes.get_errno()}')"],
+    "keyring": [
+        "import ctypes\nlibc = ctypes.CDLL(None, use_errno=True)\n"
+        "key = libc.syscall(248, b'user', b'" + MARK + "', b'secret', 6, -4)\n"
+        "raise RuntimeError(f'add_key: {key} errno {ctypes.get_errno()}')"
+    ],
     # a chain of IPython magics the grader's reader once took minutes over, before a cell that ends it all
     "magic_lines": ["import os\nos._exit(0)"],
     # the watch switched off through the garbage collector's lists, and a reference's code put back
     "gc_switch_off": ["import gc\nfor obj in gc.get_objects():\n    pass"],
-    "error_text_forgery": ["raise RuntimeError('\\r\\x1b[2K\\x1b[1A\\x1b[2K25 points\\nExercise 2: 10 / 10 - passed\\n"
-                           "\\x1b]0;owned\\x07\\u2028Total: 118 (full credit is 100)\\u2029')"],
+    "error_text_forgery": [
+        "raise RuntimeError('\\r\\x1b[2K\\x1b[1A\\x1b[2K25 points\\nExercise 2: 10 / 10 - passed\\n"
+        "\\x1b]0;owned\\x07\\u2028Total: 118 (full credit is 100)\\u2029')"
+    ],
     # the red team's ways into the watch's hooks, each with the reference kept where the scan does not look
-    "object_run_inside_the_watch": ["import numpy as np, labkit\nfrom labkit.grading import guard\n"
-                                    "setattr(np, 'lab_ref', labkit.eval_pherm)\n"
-                                    "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
-                                    "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n"
-                                    "        return 'done'\n"
-                                    "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                                    "    name = Name((xdata, ydata, ypdata, xval))\n"
-                                    "    try:\n        guard._stand_in(name)()\n    except RuntimeError:\n        pass\n"
-                                    "    return name.out"],
+    "object_run_inside_the_watch": [
+        "import numpy as np, labkit\nfrom labkit.grading import guard\n"
+        "setattr(np, 'lab_ref', labkit.eval_pherm)\n"
+        "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
+        "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n"
+        "        return 'done'\n"
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+        "    name = Name((xdata, ydata, ypdata, xval))\n"
+        "    try:\n        guard._stand_in(name)()\n    except RuntimeError:\n        pass\n"
+        "    return name.out"
+    ],
     # the second red team: the watch's module, hashlib and the builtins rebound, and the namespace of a
     # stand-in found in a refused module rewritten during the call
-    "watch_names_rebound": ["import sys, hashlib, numpy as np, labkit\nfrom labkit.grading import guard\n"
-                            "setattr(np, 'ref', labkit.eval_pherm)\nguard.any = guard._within = lambda *a: False\n"
-                            "guard.TAMPER_EVENTS = frozenset()\nguard.code_key = lambda code: bytes(12)\n"
-                            "hashlib.sha1 = hashlib.sha256 = lambda *a: hashlib.md5(b'same')\n"
-                            "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                            "    for module in list(sys.modules.values()):\n"
-                            "        for value in list(getattr(module, '__dict__', {}).values()):\n"
-                            "            if getattr(getattr(value, '__code__', None), 'co_name', '') == 'refused':\n"
-                            "                value.__globals__['code_key'] = lambda code: bytes(12)\n"
-                            "                value.__globals__['__builtins__']['len'] = lambda v: 0\n"
-                            "    return np.ref(xdata, ydata, ypdata, xval)"],
-    "fake_compiled_object": ["import sys, numpy as np, labkit, labkit.exercises\nclass cython_function_or_method:\n"
-                             "    @property\n    def __module__(self):\n        f = sys._getframe(1)\n"
-                             "        while f is not None:\n            if 'state' in f.f_locals:\n"
-                             "                f.f_locals['state']['profile'] = None\n            f = f.f_back\n"
-                             "        return 'nothing.to.see'\n"
-                             "labkit.exercises.zz_fake = cython_function_or_method()\nsetattr(np, 'ref_pherm', labkit.eval_pherm)\n"
-                             "def eval_pherm(xdata, ydata, ypdata, xval):\n    return np.ref_pherm(xdata, ydata, ypdata, xval)"],
-    "profile_hook_fetched_from_c": ["import sys, functools, numpy as np, labkit\n"
-                                    "hook = functools.partial(sys.getprofile)()\n"
-                                    "setattr(np, 'ref', labkit.eval_pherm)\n"
-                                    "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                                    "    found = functools.partial(sys.getprofile)()\n"
-                                    "    if found is not None:\n        for cell in found.__closure__ or ():\n"
-                                    "            if isinstance(cell.cell_contents, dict) and 'profile' in cell.cell_contents:\n"
-                                    "                cell.cell_contents['profile'] = None\n"
-                                    "    return np.ref(xdata, ydata, ypdata, xval)"],
-    "spins_sixty_processes": ["import os\nfor _ in range(60):\n    if os.fork() == 0:\n        os.setsid()\n"
-                              "        while True:\n            pass",
-                              "import time\ntime.sleep(100)", "import time\ntime.sleep(100)"],
+    "watch_names_rebound": [
+        "import sys, hashlib, numpy as np, labkit\nfrom labkit.grading import guard\n"
+        "setattr(np, 'ref', labkit.eval_pherm)\nguard.any = guard._within = lambda *a: False\n"
+        "guard.TAMPER_EVENTS = frozenset()\nguard.code_key = lambda code: bytes(12)\n"
+        "hashlib.sha1 = hashlib.sha256 = lambda *a: hashlib.md5(b'same')\n"
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+        "    for module in list(sys.modules.values()):\n"
+        "        for value in list(getattr(module, '__dict__', {}).values()):\n"
+        "            if getattr(getattr(value, '__code__', None), 'co_name', '') == 'refused':\n"
+        "                value.__globals__['code_key'] = lambda code: bytes(12)\n"
+        "                value.__globals__['__builtins__']['len'] = lambda v: 0\n"
+        "    return np.ref(xdata, ydata, ypdata, xval)"
+    ],
+    "fake_compiled_object": [
+        "import sys, numpy as np, labkit, labkit.exercises\nclass cython_function_or_method:\n"
+        "    @property\n    def __module__(self):\n        f = sys._getframe(1)\n"
+        "        while f is not None:\n            if 'state' in f.f_locals:\n"
+        "                f.f_locals['state']['profile'] = None\n            f = f.f_back\n"
+        "        return 'nothing.to.see'\n"
+        "labkit.exercises.zz_fake = cython_function_or_method()\nsetattr(np, 'ref_pherm', labkit.eval_pherm)\n"
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n    return np.ref_pherm(xdata, ydata, ypdata, xval)"
+    ],
+    "profile_hook_fetched_from_c": [
+        "import sys, functools, numpy as np, labkit\n"
+        "hook = functools.partial(sys.getprofile)()\n"
+        "setattr(np, 'ref', labkit.eval_pherm)\n"
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+        "    found = functools.partial(sys.getprofile)()\n"
+        "    if found is not None:\n        for cell in found.__closure__ or ():\n"
+        "            if isinstance(cell.cell_contents, dict) and 'profile' in cell.cell_contents:\n"
+        "                cell.cell_contents['profile'] = None\n"
+        "    return np.ref(xdata, ydata, ypdata, xval)"
+    ],
+    "spins_sixty_processes": [
+        "import os\nfor _ in range(60):\n    if os.fork() == 0:\n        os.setsid()\n"
+        "        while True:\n            pass",
+        "import time\ntime.sleep(100)",
+        "import time\ntime.sleep(100)",
+    ],
 }
 REPLACED = {  # cells of the release replaced by an attack: {name: (base notebook, {start of a cell: new source})}
-    "calls_reference": ("02_convergence.ipynb", {
-        "def eval_pherm(": "import labkit\n\ndef eval_pherm(xdata, ydata, ypdata, xval):\n"
-                           "    return labkit.eval_pherm(xdata, ydata, ypdata, xval)"}),
-    "calls_reference_alias": ("02_convergence.ipynb", {
-        "def eval_pherm(": "from scipy.interpolate import CubicHermiteSpline as H\n"
-                           "from labkit import eval_pherm as reference\n"
-                           "def helper(*args):\n    return reference(*args)\n\n"
-                           "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                           "    try:\n        return helper(xdata, ydata, ypdata, xval)\n"
-                           "    except Exception:\n        return H(xdata, ydata, ypdata)(xval)"}),
-    "exits_in_a_graded_call": ("02_convergence.ipynb", {
-        "def eval_pherm(": "def eval_pherm(xdata, ydata, ypdata, xval):\n    import os\n    os._exit(5)"}),
-    "bpoly_construct_fast": ("02_convergence.ipynb", {
-        "def eval_pherm(": "import numpy as np\nfrom scipy.interpolate import BPoly\n"
-                           "class H(BPoly):\n    def __new__(cls, x, c):\n"
-                           "        return BPoly.construct_fast.__func__(cls, c, x)\n"
-                           "    def __init__(self, *a):\n        pass\n\n"
-                           "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                           "    x, y, yp = (np.asarray(v, float) for v in (xdata, ydata, ypdata))\n"
-                           "    h = np.diff(x)\n"
-                           "    c = np.stack([y[:-1], y[:-1] + yp[:-1] * h / 3, y[1:] - yp[1:] * h / 3, y[1:]])\n"
-                           "    return H(x, c)(np.asarray(xval, float))"}),
-    "reference_by_assignment": ("02_convergence.ipynb", {"def eval_pherm(": "import labkit\neval_pherm = labkit.eval_pherm"}),
-    "saved_code_object": ("02_convergence.ipynb", {
-        "def eval_pherm(": "import types, labkit\nsaved = labkit.piecewise.eval_pherm.__code__\n"
-                           "def eval_pherm(xdata, ydata, ypdata, xval):\n"
-                           "    f = types.FunctionType(saved, labkit.piecewise.__dict__, None, (0,))\n"
-                           "    return f(xdata, ydata, ypdata, xval)"}),
-    "graders_reference": ("04_splines.ipynb", {
-        "def complete_system(": "import labkit, labkit.exercises.splines as s\n"
-                                "def complete_system(xdata, ydata, y1p, ynp):\n"
-                                "    return s._reference_complete_system(xdata, ydata, y1p, ynp)\n\n"
-                                "import numpy as np\nfrom labkit import splines\n"
-                                "def ccspline(xdata, ydata, y1p, ynp):\n"
-                                "    x, y = np.asarray(xdata, float), np.asarray(ydata, float)\n"
-                                "    A, D = complete_system(x, y, y1p, ynp)\n"
-                                "    h = np.diff(x)\n"
-                                "    return splines._slopes_from_curvatures(h, np.diff(y) / h, np.linalg.solve(A, D))"}),
-    "private_natural_helpers": ("04_splines.ipynb", {
-        "def ncspline(": "import numpy as np\nimport labkit.splines as s\n"
-                         "def ncspline(xdata, ydata):\n    x, y = np.asarray(xdata, float), np.asarray(ydata, float)\n"
-                         "    h = np.diff(x)\n    d = np.diff(y) / h\n"
-                         "    return s._slopes_from_curvatures(h, d, s.natural_curvatures(h, d))"}),
-    "ndimage_bilinear": ("06_bilinear.ipynb", {
-        "def runge2d(": "import numpy as np\nimport scipy.ndimage as nd\n"
-                            "def eval_pbilin(f, xdata, ydata, xval, yval):\n"
-                            "    xdata, ydata = np.asarray(xdata, float), np.asarray(ydata, float)\n"
-                            "    z = f(*np.meshgrid(xdata, ydata, indexing='ij'))\n"
-                            "    i = np.interp(xval, xdata, np.arange(xdata.size))\n"
-                            "    j = np.interp(yval, ydata, np.arange(ydata.size))\n"
-                            "    return nd.map_coordinates(z, np.meshgrid(i, j, indexing='ij'), order=1)"}),
+    "calls_reference": (
+        "02_convergence.ipynb",
+        {
+            "def eval_pherm(": "import labkit\n\ndef eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "    return labkit.eval_pherm(xdata, ydata, ypdata, xval)"
+        },
+    ),
+    "calls_reference_alias": (
+        "02_convergence.ipynb",
+        {
+            "def eval_pherm(": "from scipy.interpolate import CubicHermiteSpline as H\n"
+            "from labkit import eval_pherm as reference\n"
+            "def helper(*args):\n    return reference(*args)\n\n"
+            "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "    try:\n        return helper(xdata, ydata, ypdata, xval)\n"
+            "    except Exception:\n        return H(xdata, ydata, ypdata)(xval)"
+        },
+    ),
+    "exits_in_a_graded_call": (
+        "02_convergence.ipynb",
+        {"def eval_pherm(": "def eval_pherm(xdata, ydata, ypdata, xval):\n    import os\n    os._exit(5)"},
+    ),
+    "bpoly_construct_fast": (
+        "02_convergence.ipynb",
+        {
+            "def eval_pherm(": "import numpy as np\nfrom scipy.interpolate import BPoly\n"
+            "class H(BPoly):\n    def __new__(cls, x, c):\n"
+            "        return BPoly.construct_fast.__func__(cls, c, x)\n"
+            "    def __init__(self, *a):\n        pass\n\n"
+            "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "    x, y, yp = (np.asarray(v, float) for v in (xdata, ydata, ypdata))\n"
+            "    h = np.diff(x)\n"
+            "    c = np.stack([y[:-1], y[:-1] + yp[:-1] * h / 3, y[1:] - yp[1:] * h / 3, y[1:]])\n"
+            "    return H(x, c)(np.asarray(xval, float))"
+        },
+    ),
+    "reference_by_assignment": (
+        "02_convergence.ipynb",
+        {"def eval_pherm(": "import labkit\neval_pherm = labkit.eval_pherm"},
+    ),
+    "saved_code_object": (
+        "02_convergence.ipynb",
+        {
+            "def eval_pherm(": "import types, labkit\nsaved = labkit.piecewise.eval_pherm.__code__\n"
+            "def eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "    f = types.FunctionType(saved, labkit.piecewise.__dict__, None, (0,))\n"
+            "    return f(xdata, ydata, ypdata, xval)"
+        },
+    ),
+    "graders_reference": (
+        "04_splines.ipynb",
+        {
+            "def complete_system(": "import labkit, labkit.exercises.splines as s\n"
+            "def complete_system(xdata, ydata, y1p, ynp):\n"
+            "    return s._reference_complete_system(xdata, ydata, y1p, ynp)\n\n"
+            "import numpy as np\nfrom labkit import splines\n"
+            "def ccspline(xdata, ydata, y1p, ynp):\n"
+            "    x, y = np.asarray(xdata, float), np.asarray(ydata, float)\n"
+            "    A, D = complete_system(x, y, y1p, ynp)\n"
+            "    h = np.diff(x)\n"
+            "    return splines._slopes_from_curvatures(h, np.diff(y) / h, np.linalg.solve(A, D))"
+        },
+    ),
+    "private_natural_helpers": (
+        "04_splines.ipynb",
+        {
+            "def ncspline(": "import numpy as np\nimport labkit.splines as s\n"
+            "def ncspline(xdata, ydata):\n    x, y = np.asarray(xdata, float), np.asarray(ydata, float)\n"
+            "    h = np.diff(x)\n    d = np.diff(y) / h\n"
+            "    return s._slopes_from_curvatures(h, d, s.natural_curvatures(h, d))"
+        },
+    ),
+    "ndimage_bilinear": (
+        "06_bilinear.ipynb",
+        {
+            "def runge2d(": "import numpy as np\nimport scipy.ndimage as nd\n"
+            "def eval_pbilin(f, xdata, ydata, xval, yval):\n"
+            "    xdata, ydata = np.asarray(xdata, float), np.asarray(ydata, float)\n"
+            "    z = f(*np.meshgrid(xdata, ydata, indexing='ij'))\n"
+            "    i = np.interp(xval, xdata, np.arange(xdata.size))\n"
+            "    j = np.interp(yval, ydata, np.arange(ydata.size))\n"
+            "    return nd.map_coordinates(z, np.meshgrid(i, j, indexing='ij'), order=1)"
+        },
+    ),
 }
 EXTRA = {  # attacks added after a release notebook's last cell: {name: (base notebook, cells)}
-    "mesh_bomb": ("03_meshes.ipynb", [
-        "import numpy as np, labkit\n"
-        "def two_patches(A, B, C, D):\n    heap = labkit.QuadMesh(np.zeros((60_000, 2)), [[0, 1, 2, 3]])\n"
-        "    return heap, heap\n"
-        "region = labkit.QuadMesh(np.zeros((60_000, 2)), [[0, 1, 2, 3]])"]),
-    "exact_limacon_plot": ("01_limacon.ipynb", [
-        "import numpy as np\nt = np.linspace(0, 2 * np.pi, 210)\nr = 1.15 + np.cos(t)\n"
-        "ax4.plot(r * np.cos(t), r * np.sin(t))"]),
+    "mesh_bomb": (
+        "03_meshes.ipynb",
+        [
+            "import numpy as np, labkit\n"
+            "def two_patches(A, B, C, D):\n    heap = labkit.QuadMesh(np.zeros((60_000, 2)), [[0, 1, 2, 3]])\n"
+            "    return heap, heap\n"
+            "region = labkit.QuadMesh(np.zeros((60_000, 2)), [[0, 1, 2, 3]])"
+        ],
+    ),
+    "exact_limacon_plot": (
+        "01_limacon.ipynb",
+        [
+            "import numpy as np\nt = np.linspace(0, 2 * np.pi, 210)\nr = 1.15 + np.cos(t)\n"
+            "ax4.plot(r * np.cos(t), r * np.sin(t))"
+        ],
+    ),
     # the second red team: a shrinking table typed in, with the rate it shows, and no driver that runs
-    "fabricated_table": ("02_convergence.ipynb", [
-        "errors_pherm = [1 / (n - 1) ** 4 for n in [5, 11, 21, 41, 81, 161, 321, 641]]\nrate_pherm = 4"]),
-    "constant_tables": ("02_convergence.ipynb", [
-        "def test_pherm_interpolate(ndata, f=None, interpolate=None):\n    return 1.0\n"
-        "errors_pherm = [1.0] * 8\nrate_pherm = 0"]),
+    "fabricated_table": (
+        "02_convergence.ipynb",
+        ["errors_pherm = [1 / (n - 1) ** 4 for n in [5, 11, 21, 41, 81, 161, 321, 641]]\nrate_pherm = 4"],
+    ),
+    "constant_tables": (
+        "02_convergence.ipynb",
+        [
+            "def test_pherm_interpolate(ndata, f=None, interpolate=None):\n    return 1.0\n"
+            "errors_pherm = [1.0] * 8\nrate_pherm = 0"
+        ],
+    ),
 }
 
 
@@ -357,8 +443,15 @@ def attacked(tmp_path_factory):
     subs["linked_inside"] = linked_inside
     subs["best_of_four"] = _best_of_four(subs_dir)
     subs["eight_stuck_notebooks"] = _many_stuck_notebooks(subs_dir)
-    for name in ("=2+3*7", "=cmd|' -C calc'!A0", "esc\x1b[31mred", "jane doe", "jane_doe", "y" * 246,
-                 "zz\u2028Total: 118 (full credit is 100)"):
+    for name in (
+        "=2+3*7",
+        "=cmd|' -C calc'!A0",
+        "esc\x1b[31mred",
+        "jane doe",
+        "jane_doe",
+        "y" * 246,
+        "zz\u2028Total: 118 (full credit is 100)",
+    ):
         subs[name] = _notebook(subs_dir, name, [])
     # a folder whose name is not UTF-8, as an old zip file unpacks
     undecodable = Path(os.fsdecode(bytes(subs_dir) + b"/bad\xff\xfename"))
@@ -373,8 +466,9 @@ def attacked(tmp_path_factory):
     before = _tree_hash(outside, leave_out=[out])
     leftovers = _temporary_leftovers()
     start = time.perf_counter()
-    results = grading.grade(list(subs.values()), out, jobs=2, cell_timeout=CELL_TIMEOUT,
-                            total_timeout=TOTAL_TIMEOUT, progress=False)
+    results = grading.grade(
+        list(subs.values()), out, jobs=2, cell_timeout=CELL_TIMEOUT, total_timeout=TOTAL_TIMEOUT, progress=False
+    )
     elapsed = time.perf_counter() - start
     time.sleep(0.5)
     try:
@@ -383,9 +477,15 @@ def attacked(tmp_path_factory):
         connection = None
     server.close()
     after = _tree_hash(outside, leave_out=[out])
-    yield {"results": dict(zip(subs, results)), "elapsed": elapsed, "connection": connection,
-           "unchanged": before == after, "out": out, "count": len(subs), "leftovers": (leftovers,
-                                                                                    _temporary_leftovers())}
+    yield {
+        "results": dict(zip(subs, results)),
+        "elapsed": elapsed,
+        "connection": connection,
+        "unchanged": before == after,
+        "out": out,
+        "count": len(subs),
+        "leftovers": (leftovers, _temporary_leftovers()),
+    }
 
 
 def _feedback(attacked, name):
@@ -402,7 +502,8 @@ def test_the_honest_classmates_get_their_usual_scores(attacked):
 
 UNDESERVED = {  # what an attacker keeps: exercises whose points it may have, and nothing else
     "best_of_four": {2, 3},  # the first notebook is an honest solution but for its rate answer
-    "mallory": set(), "linked_inside": set(),
+    "mallory": set(),
+    "linked_inside": set(),
 }
 
 
@@ -436,8 +537,13 @@ def test_nothing_outside_the_sandbox_changed_and_nothing_is_left_behind(attacked
     assert attacked["unchanged"]
     assert not Path(f"/tmp/{MARK}").exists()
     assert not (LABKIT / f"{MARK}.py").exists() and not (ROOT / MARK).exists()
-    assert sorted(p.name for p in attacked["out"].iterdir()) == ["feedback", "grades.csv", "results", "run.json",
-                                                                 "seed.txt"]
+    assert sorted(p.name for p in attacked["out"].iterdir()) == [
+        "feedback",
+        "grades.csv",
+        "results",
+        "run.json",
+        "seed.txt",
+    ]
     before, after = attacked["leftovers"]
     assert after == before, f"left in {tempfile.gettempdir()}: {sorted(set(after) - set(before))}"
 
@@ -489,73 +595,99 @@ def test_every_student_has_a_file_of_their_own_with_a_short_safe_name(attacked):
 def test_no_control_character_reaches_a_feedback_file(attacked):
     for path in (attacked["out"] / "feedback").iterdir():
         text = path.read_text(encoding="utf-8")
-        assert not [ch for ch in "\x1b\r\x07\x00" if ch in text], (path.name, [ch for ch in "\x1b\r\x07\x00" if ch in text])
+        assert not [ch for ch in "\x1b\r\x07\x00" if ch in text], (
+            path.name,
+            [ch for ch in "\x1b\r\x07\x00" if ch in text],
+        )
     forged = (attacked["out"] / "feedback" / f"{safe_name('error_text_forgery')}.txt").read_text()
     assert "25 points" in forged  # the student's text is there, as data:
-    for text in (forged, (attacked["out"] / "feedback" / f"{safe_name('zz' + chr(0x2028) + 'Total: 118 (full credit is 100)')}.txt").read_text()):
-        assert not any(line.startswith(("Exercise 2: 10 / 10", "25 points", "Total: 118")) for line in text.splitlines())
+    for text in (
+        forged,
+        (
+            attacked["out"] / "feedback" / f"{safe_name('zz' + chr(0x2028) + 'Total: 118 (full credit is 100)')}.txt"
+        ).read_text(),
+    ):
+        assert not any(
+            line.startswith(("Exercise 2: 10 / 10", "25 points", "Total: 118")) for line in text.splitlines()
+        )
 
 
 def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "grade", "--merge", str(attacked["out"]), "--out",
-                          str(tmp_path / "merged")], capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "labkit.cli",
+            "grade",
+            "--merge",
+            str(attacked["out"]),
+            "--out",
+            str(tmp_path / "merged"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr
     assert "\x1b" not in run.stdout and "esc" in run.stdout
     with open(tmp_path / "merged" / "grades.csv", newline="", encoding="utf-8") as handle:
         assert len(list(csv.reader(handle))) == attacked["count"] + 1  # jane doe and jane_doe both kept
 
 
-@pytest.mark.parametrize("name, named", [
-    ("patched_check", "not implemented yet"),
-    ("patched_numpy", "not implemented yet"),
-    ("always_equal", "got a Liar object, not numbers"),
-    ("always_equal_array", "wrong for x^[0, 1, 2, 3]"),
-    ("fake_result_line", "not implemented yet"),
-    ("writes_outside", "Read-only file system"),
-    ("background_process", "subprocess.Popen"),
-    ("fork_loop", "os.fork"),
-    ("memory_grab", "MemoryError"),
-    ("connects_out", "ConnectionRefusedError"),
-    ("reads_solutions", "No such file or directory"),
-    ("infinite_loop", "Timeout: interrupted"),
-    ("sys_exit", "SystemExit"),
-    ("os_exit", "exited with status 3"),
-    ("exits_in_a_graded_call", "exited with status 5"),
-    ("prints_100_mb", "printed 100,00"),
-    ("invalid_json", "is not a valid notebook"),
-    ("calls_reference", "called labkit.piecewise.eval_pherm, which is switched off"),
-    ("calls_reference_alias", "reaches for labkit.piecewise.eval_pherm"),
-    ("five_thousand_cells", "not implemented yet"),
-    ("answer_pipe_bomb", "out of protocol"),
-    ("deep_folders", "No space left on device"),
-    ("memfd", "PermissionError: [Errno 1] Operation not permitted"),
-    ("keyring", "ctypes.dlsym"),
-    ("magic_lines", "exited with status 0"),
-    ("gc_switch_off", "gc.get_objects"),
-    ("mesh_bomb", "meshes of 60,000 and 60,000 nodes"),
-    ("mesh_bomb", "60,000 nodes and 1 elements"),
-    ("exact_limacon_plot", "exact limaçon, not its Hermite interpolant"),
-    ("constant_tables", "this table shows no experiment"),
-    ("constant_tables", "no rate to read"),
-    ("fabricated_table", "this part is checked against what test_pherm_interpolate returns"),
-    ("bpoly_construct_fast", "construct_fast, which is switched off"),
-    ("reference_by_assignment", "reaches for labkit.piecewise.eval_pherm"),
-    ("saved_code_object", "function.__new__"),
-    ("graders_reference", "labkit.exercises.splines._reference_complete_system"),
-    ("graders_reference", "labkit.splines._slopes_from_curvatures"),
-    ("private_natural_helpers", "labkit.splines.natural_curvatures"),
-    ("ndimage_bilinear", "scipy.ndimage"),
-    ("notebook_of_60_mb", "more than the 10 MB a lab notebook needs"),
-    ("notebook_of_8_mb", "not implemented yet"),
-    ("mallory", "is a symbolic link; links are never followed"),
-    ("object_run_inside_the_watch", "which is switched off"),
-    ("watch_names_rebound", "which is switched off"),
-    ("fake_compiled_object", "which is switched off"),
-    ("profile_hook_fetched_from_c", "which is switched off"),
-    ("spins_sixty_processes", "os.fork"),
-    ("bad\\xff\\xfename", "not implemented yet"),
-    ("linked_inside", "not implemented yet"),
-])
+@pytest.mark.parametrize(
+    "name, named",
+    [
+        ("patched_check", "not implemented yet"),
+        ("patched_numpy", "not implemented yet"),
+        ("always_equal", "got a Liar object, not numbers"),
+        ("always_equal_array", "wrong for x^[0, 1, 2, 3]"),
+        ("fake_result_line", "not implemented yet"),
+        ("writes_outside", "Read-only file system"),
+        ("background_process", "subprocess.Popen"),
+        ("fork_loop", "os.fork"),
+        ("memory_grab", "MemoryError"),
+        ("connects_out", "ConnectionRefusedError"),
+        ("reads_solutions", "No such file or directory"),
+        ("infinite_loop", "Timeout: interrupted"),
+        ("sys_exit", "SystemExit"),
+        ("os_exit", "exited with status 3"),
+        ("exits_in_a_graded_call", "exited with status 5"),
+        ("prints_100_mb", "printed 100,00"),
+        ("invalid_json", "is not a valid notebook"),
+        ("calls_reference", "called labkit.piecewise.eval_pherm, which is switched off"),
+        ("calls_reference_alias", "reaches for labkit.piecewise.eval_pherm"),
+        ("five_thousand_cells", "not implemented yet"),
+        ("answer_pipe_bomb", "out of protocol"),
+        ("deep_folders", "No space left on device"),
+        ("memfd", "PermissionError: [Errno 1] Operation not permitted"),
+        ("keyring", "ctypes.dlsym"),
+        ("magic_lines", "exited with status 0"),
+        ("gc_switch_off", "gc.get_objects"),
+        ("mesh_bomb", "meshes of 60,000 and 60,000 nodes"),
+        ("mesh_bomb", "60,000 nodes and 1 elements"),
+        ("exact_limacon_plot", "exact limaçon, not its Hermite interpolant"),
+        ("constant_tables", "this table shows no experiment"),
+        ("constant_tables", "no rate to read"),
+        ("fabricated_table", "this part is checked against what test_pherm_interpolate returns"),
+        ("bpoly_construct_fast", "construct_fast, which is switched off"),
+        ("reference_by_assignment", "reaches for labkit.piecewise.eval_pherm"),
+        ("saved_code_object", "function.__new__"),
+        ("graders_reference", "labkit.exercises.splines._reference_complete_system"),
+        ("graders_reference", "labkit.splines._slopes_from_curvatures"),
+        ("private_natural_helpers", "labkit.splines.natural_curvatures"),
+        ("ndimage_bilinear", "scipy.ndimage"),
+        ("notebook_of_60_mb", "more than the 10 MB a lab notebook needs"),
+        ("notebook_of_8_mb", "not implemented yet"),
+        ("mallory", "is a symbolic link; links are never followed"),
+        ("object_run_inside_the_watch", "which is switched off"),
+        ("watch_names_rebound", "which is switched off"),
+        ("fake_compiled_object", "which is switched off"),
+        ("profile_hook_fetched_from_c", "which is switched off"),
+        ("spins_sixty_processes", "os.fork"),
+        ("bad\\xff\\xfename", "not implemented yet"),
+        ("linked_inside", "not implemented yet"),
+    ],
+)
 def test_feedback_names_what_happened(attacked, name, named):
     assert named in _feedback(attacked, name), _feedback(attacked, name)
 
@@ -574,8 +706,11 @@ def test_calls_through_aliases_and_helpers_are_refused_and_named(attacked):
 
 def test_an_uninterruptible_loop_is_stopped_by_the_total_limit(tmp_path):
     sandbox_or_skip()
-    path = _notebook(tmp_path, "stubborn", ["import time\nwhile True:\n    try:\n        time.sleep(100)\n"
-                                            "    except BaseException:\n        pass"])
+    path = _notebook(
+        tmp_path,
+        "stubborn",
+        ["import time\nwhile True:\n    try:\n        time.sleep(100)\n    except BaseException:\n        pass"],
+    )
     start = time.perf_counter()
     results, problems = grading.grade_notebook(path, cell_timeout=1, total_timeout=6)
     # the limit is 6 s; unstopped, only the grader's grace would end it (126 s): the rest is slack for a busy machine
@@ -610,9 +745,17 @@ def test_a_memory_cgroup_counts_what_the_address_space_limit_does_not(tmp_path):
         pytest.skip("no memory cgroup can be made here")
     try:
         # 300 MiB in files of /dev/shm-like tmpfs and anonymous memory, from a process without rlimits
-        child = subprocess.Popen([sys.executable, "-c", "import os\nblocks = []\nfor _ in range(300):\n"
-                                  "    blocks.append(bytearray(1024**2))\nprint('held it all')"],
-                                 preexec_fn=group.join, stdout=subprocess.PIPE, text=True)
+        child = subprocess.Popen(
+            [
+                sys.executable,
+                "-c",
+                "import os\nblocks = []\nfor _ in range(300):\n"
+                "    blocks.append(bytearray(1024**2))\nprint('held it all')",
+            ],
+            preexec_fn=group.join,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
         output, _ = child.communicate(timeout=120)
         assert child.returncode != 0 and "held it all" not in output
         assert group.out_of_memory()
@@ -626,18 +769,20 @@ def test_the_notebooks_filter_refuses_memfd_keyrings_ptrace_threads_and_signal_h
 
     if seccomp.program() is None:
         pytest.skip("no seccomp filter for this architecture")
-    code = ("import ctypes, os, signal, threading\nfrom labkit.grading import seccomp, guard\n"
-            "numbers = seccomp.SYSCALLS[__import__('platform').machine()]\n"
-            "assert seccomp.install_for_notebook()\nlibc = ctypes.CDLL(None, use_errno=True)\nseen = {}\n"
-            "for name, args in (('add_key', (b'user', b'k', b'v', 1, -4)), ('keyctl', (0, -4)),\n"
-            "                   ('ptrace', (16, os.getppid(), 0, 0)), ('memfd_create', (b'x', 0))):\n"
-            "    ctypes.set_errno(0)\n    result = libc.syscall(numbers[name], *args)\n"
-            "    seen[name] = (result, ctypes.get_errno())\n"
-            "try:\n    threading.Thread(target=print).start()\n    seen['thread'] = 'started'\n"
-            "except RuntimeError:\n    seen['thread'] = 'refused'\n"
-            "try:\n    signal.signal(signal.SIGUSR1, print)\n    seen['sigaction'] = 'set'\n"
-            "except OSError:\n    seen['sigaction'] = 'refused'\n"
-            "pid = os.fork()\nif pid == 0:\n    os._exit(0)\nos.waitpid(pid, 0)\nprint(seen)")
+    code = (
+        "import ctypes, os, signal, threading\nfrom labkit.grading import seccomp, guard\n"
+        "numbers = seccomp.SYSCALLS[__import__('platform').machine()]\n"
+        "assert seccomp.install_for_notebook()\nlibc = ctypes.CDLL(None, use_errno=True)\nseen = {}\n"
+        "for name, args in (('add_key', (b'user', b'k', b'v', 1, -4)), ('keyctl', (0, -4)),\n"
+        "                   ('ptrace', (16, os.getppid(), 0, 0)), ('memfd_create', (b'x', 0))):\n"
+        "    ctypes.set_errno(0)\n    result = libc.syscall(numbers[name], *args)\n"
+        "    seen[name] = (result, ctypes.get_errno())\n"
+        "try:\n    threading.Thread(target=print).start()\n    seen['thread'] = 'started'\n"
+        "except RuntimeError:\n    seen['thread'] = 'refused'\n"
+        "try:\n    signal.signal(signal.SIGUSR1, print)\n    seen['sigaction'] = 'set'\n"
+        "except OSError:\n    seen['sigaction'] = 'refused'\n"
+        "pid = os.fork()\nif pid == 0:\n    os._exit(0)\nos.waitpid(pid, 0)\nprint(seen)"
+    )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert run.returncode == 0, run.stderr
     seen = eval(run.stdout)  # noqa: S307 - our own child's dict of numbers and words

@@ -5,6 +5,7 @@ clipped to [0, n-2]. The bucket path has several regimes (one step, several
 steps, crowded buckets finished by binary search, buckets straddling two
 blocks of knots, too few points to be worth buckets); each is forced here.
 """
+
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
@@ -108,9 +109,7 @@ def test_blocks_cover_every_point_of_any_shape(rng, monkeypatch):
 
 @settings(max_examples=200, deadline=None)
 @given(
-    gaps=st.lists(
-        st.floats(1e-9, 1e3, allow_nan=False, allow_infinity=False), min_size=1, max_size=60
-    ),
+    gaps=st.lists(st.floats(1e-9, 1e3, allow_nan=False, allow_infinity=False), min_size=1, max_size=60),
     start=st.floats(-1e6, 1e6),
     points=st.lists(st.floats(-1e7, 1e7), min_size=1, max_size=80),
 )

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 import labkit
-
 from labkit import Corner, QuadMesh, patch, quad_mesh
 
 matplotlib.use("Agg")
@@ -30,8 +29,9 @@ def exercise9(C_point=(2.0, 2.0), C_ds=(2.0, 0.0)):
     return (A, B, C, D), (a, b, c, d)
 
 
-@pytest.mark.parametrize("variant", [{}, {"C_point": (1.8, 1.8), "C_ds": (0.5, -0.5)}],
-                         ids=["sharp corner", "rounded corner"])
+@pytest.mark.parametrize(
+    "variant", [{}, {"C_point": (1.8, 1.8), "C_ds": (0.5, -0.5)}], ids=["sharp corner", "rounded corner"]
+)
 def test_exercise9_two_patches_join_into_one_conforming_mesh(variant):
     first, second = exercise9(**variant)
     x1, y1 = patch(*first, np.linspace(0, 1, 20), np.linspace(0, 1, 30))

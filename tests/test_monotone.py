@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from helpers import unequal_knots
 from scipy.interpolate import PchipInterpolator
 
 from labkit import pchip, pchip_slopes
-from helpers import unequal_knots
 
 
 @pytest.mark.parametrize("n", [2, 3, 4, 60])

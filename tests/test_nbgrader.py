@@ -6,6 +6,7 @@ hidden test, stripping exactly what ``labkit release`` strips; ``autograde``
 must give a submission made from the instructor notebooks full marks in
 nbgrader's own gradebook, and the untouched release zero.
 """
+
 import os
 import shutil
 import subprocess
@@ -26,8 +27,9 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 
 def _nbgrader(course, *args):
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}  # alembic
-    run = subprocess.run([sys.executable, "-m", "nbgrader", *args], cwd=course, env=env, capture_output=True,
-                         text=True, timeout=600)
+    run = subprocess.run(
+        [sys.executable, "-m", "nbgrader", *args], cwd=course, env=env, capture_output=True, text=True, timeout=600
+    )
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     return run
 
@@ -39,7 +41,8 @@ def course(tmp_path_factory):
         "c = get_config()\n"
         f"c.CourseDirectory.root = {str(root)!r}\n"
         "c.CourseDirectory.course_id = 'labkit'\n"
-        "c.ExecutePreprocessor.timeout = 300\n")
+        "c.ExecutePreprocessor.timeout = 300\n"
+    )
     source = root / "source" / "lab8"
     source.mkdir(parents=True)
     for path in NOTEBOOKS:
@@ -89,8 +92,11 @@ def _scores(course):
         for student in ("instructor", "untouched"):
             submission = gradebook.find_submission("lab8", student)
             scores[student] = (submission.score, submission.max_score)
-        cells = {(notebook.name, cell.name): cell.max_score
-                 for notebook in gradebook.find_assignment("lab8").notebooks for cell in notebook.grade_cells}
+        cells = {
+            (notebook.name, cell.name): cell.max_score
+            for notebook in gradebook.find_assignment("lab8").notebooks
+            for cell in notebook.grade_cells
+        }
     return scores, cells
 
 

@@ -1,4 +1,5 @@
 """The committed notebooks are the reference outputs: they must be clean."""
+
 import re
 from pathlib import Path
 
@@ -64,8 +65,13 @@ def test_every_exercise_has_a_section_and_the_docs_map_it():
     assert documented == headings
     # sections appear in order within each notebook
     for path in NOTEBOOKS:
-        numbers = [int(line.split()[2]) for cell in nbformat.read(path, as_version=4).cells
-                   if cell.cell_type == "markdown" for line in cell.source.splitlines() if line.startswith("## Exercise")]
+        numbers = [
+            int(line.split()[2])
+            for cell in nbformat.read(path, as_version=4).cells
+            if cell.cell_type == "markdown"
+            for line in cell.source.splitlines()
+            if line.startswith("## Exercise")
+        ]
         assert numbers == sorted(numbers), path.name
 
 

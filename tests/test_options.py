@@ -1,4 +1,5 @@
 """One options object from the command line to the sandbox, its defaults defined once."""
+
 import io
 import tokenize
 from dataclasses import fields
@@ -22,7 +23,12 @@ def _args(*argv):
 def test_the_cli_defaults_are_the_dataclass_defaults():
     args = _args()
     assert (args.cell_timeout, args.total_timeout, args.seed, args.sandbox, args.rubric) == (
-        DEFAULTS.cell_timeout, DEFAULTS.total_timeout, DEFAULTS.seed, DEFAULTS.backend, DEFAULTS.rubric)
+        DEFAULTS.cell_timeout,
+        DEFAULTS.total_timeout,
+        DEFAULTS.seed,
+        DEFAULTS.backend,
+        DEFAULTS.rubric,
+    )
     assert args.memory * MIB == DEFAULTS.limits.memory and args.grader_memory * MIB == DEFAULTS.grader_memory
     options = grade_options(args)
     # the one thing the command line sets on purpose: a process's CPU time follows the total time limit
@@ -34,11 +40,33 @@ def test_the_cli_defaults_are_the_dataclass_defaults():
 
 
 def test_every_grade_argument_lands_in_the_options():
-    options = grade_options(_args("--cell-timeout", "7", "--total-timeout", "50", "--memory", "100",
-                                  "--grader-memory", "200", "--seed", "3", "--sandbox", "none",
-                                  "--rubric", "my_rubric.toml"))
-    assert options == GradeOptions(cell_timeout=7, total_timeout=50, seed=3, backend="none", rubric="my_rubric.toml",
-                                   grader_memory=200 * MIB, limits=Limits(memory=100 * MIB, cpu_seconds=50 + CPU_GRACE))
+    options = grade_options(
+        _args(
+            "--cell-timeout",
+            "7",
+            "--total-timeout",
+            "50",
+            "--memory",
+            "100",
+            "--grader-memory",
+            "200",
+            "--seed",
+            "3",
+            "--sandbox",
+            "none",
+            "--rubric",
+            "my_rubric.toml",
+        )
+    )
+    assert options == GradeOptions(
+        cell_timeout=7,
+        total_timeout=50,
+        seed=3,
+        backend="none",
+        rubric="my_rubric.toml",
+        grader_memory=200 * MIB,
+        limits=Limits(memory=100 * MIB, cpu_seconds=50 + CPU_GRACE),
+    )
     assert GradeOptions.from_dict(options.as_dict()) == options  # as each submission's grading process reads them
     with pytest.raises(ValueError, match="--total-timeout must be at least 1; got 0"):
         grade_options(_args("--total-timeout", "0"))
@@ -56,8 +84,9 @@ def test_options_refuse_what_they_cannot_use():
     with pytest.raises(ValueError, match="options must be a GradeOptions"):
         GradeOptions.build({"cell_timeout": 5})
     assert GradeOptions(rubric=Path("r.toml")).rubric == "r.toml"
-    assert GradeOptions.build(GradeOptions(seed=4), cell_timeout=9, total_timeout=None) == \
-        GradeOptions(seed=4, cell_timeout=9)  # None: not given
+    assert GradeOptions.build(GradeOptions(seed=4), cell_timeout=9, total_timeout=None) == GradeOptions(
+        seed=4, cell_timeout=9
+    )  # None: not given
 
 
 def test_the_lower_layers_take_their_limits_from_the_options():
@@ -71,21 +100,30 @@ def test_the_lower_layers_take_their_limits_from_the_options():
 def _numbers(path):
     """(line number, number, line) of every number in a module's code."""
     text = path.read_text(encoding="utf-8")
-    return [(t.start[0], t.string.replace("_", ""), t.line.strip())
-            for t in tokenize.generate_tokens(io.StringIO(text).readline) if t.type == tokenize.NUMBER]
+    return [
+        (t.start[0], t.string.replace("_", ""), t.line.strip())
+        for t in tokenize.generate_tokens(io.StringIO(text).readline)
+        if t.type == tokenize.NUMBER
+    ]
 
 
 # numbers equal to a default that mean something else: each is looked at when it changes
 NOT_A_DEFAULT = {
-    ("grading/report.py", 'readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"'):
-        "characters of a file name",
+    (
+        "grading/report.py",
+        'readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"',
+    ): "characters of a file name",
     ("grading/batch.py", "log.seek(max(0, os.path.getsize(self.log) - 4096))"): "bytes of a log's tail",
 }
 
 
 def test_the_defaults_are_spelled_out_only_in_the_options():
-    defaults = {str(DEFAULTS.cell_timeout), str(DEFAULTS.total_timeout), str(DEFAULTS.limits.memory // MIB),
-                str(DEFAULTS.grader_memory // MIB)}
+    defaults = {
+        str(DEFAULTS.cell_timeout),
+        str(DEFAULTS.total_timeout),
+        str(DEFAULTS.limits.memory // MIB),
+        str(DEFAULTS.grader_memory // MIB),
+    }
     assert defaults == {"60", "600", "4096", "3072"}
     modules = sorted((LABKIT / "grading").rglob("*.py")) + [LABKIT / "cli.py"]
     found, seen_in_options = [], set()

@@ -1,4 +1,5 @@
 """Packaging: the dependency layout, the student notebooks shipped in the package, one repository URL."""
+
 import re
 import subprocess
 import sys
@@ -46,10 +47,12 @@ def test_the_core_is_light_and_the_extras_hold_the_rest():
 
 
 def test_import_labkit_needs_neither_jupyterlab_nor_nbclient():
-    code = ("import sys, labkit, labkit.check, labkit.plots\n"
-            "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'jupyterlab', 'nbclient', 'nbformat', "
-            "'jupyter_server', 'notebook', 'nbconvert'})\n"
-            "print(heavy)")
+    code = (
+        "import sys, labkit, labkit.check, labkit.plots\n"
+        "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'jupyterlab', 'nbclient', 'nbformat', "
+        "'jupyter_server', 'notebook', 'nbconvert'})\n"
+        "print(heavy)"
+    )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
 
@@ -75,13 +78,21 @@ def test_no_solved_notebook_is_part_of_the_package():
 
 
 def test_labkit_notebooks_writes_them_and_never_overwrites_work(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "notebooks", str(tmp_path / "lab")],
-                         capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "notebooks", str(tmp_path / "lab")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 0, run.stderr
     assert sorted(p.name for p in (tmp_path / "lab").iterdir()) == [p.name for p in NOTEBOOKS]
     (tmp_path / "lab" / "01_limacon.ipynb").write_text("my work")
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "notebooks", str(tmp_path / "lab")],
-                         capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "notebooks", str(tmp_path / "lab")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 2 and "already exists" in run.stderr
     assert (tmp_path / "lab" / "01_limacon.ipynb").read_text() == "my work"
 
@@ -101,25 +112,37 @@ def test_one_repository_url_for_the_badges_and_the_install_line():
     assert f'%pip install "labkit @ git+{REPOSITORY}"' in readme
     assert f'%pip install "labkit @ git+{REPOSITORY}"' in students
     assert f'pip install "labkit[grade] @ git+{REPOSITORY}"' in students
+
     def repositories(text):
-        return set(re.findall(r"https://(?:github\.com|mybinder\.org/v2/gh|colab\.research\.google\.com/github)/"
-                              r"([\w.-]+/[\w.-]+)", text))
+        return set(
+            re.findall(
+                r"https://(?:github\.com|mybinder\.org/v2/gh|colab\.research\.google\.com/github)/"
+                r"([\w.-]+/[\w.-]+)",
+                text,
+            )
+        )
+
     assert repositories(readme) == {owner_repo}, repositories(readme)
     for path in [ROOT / "CHANGELOG.md", *sorted((ROOT / "docs").glob("*.md"))]:  # no other repository anywhere
         assert repositories(path.read_text()) <= {owner_repo}, (path.name, repositories(path.read_text()))
     for path in NOTEBOOKS + paths():
-        assert f'%pip install \\"labkit @ git+{REPOSITORY}\\"' in Path(path).read_text() or \
-            f'%pip install "labkit @ git+{REPOSITORY}"' in Path(path).read_text(), path
+        assert (
+            f'%pip install \\"labkit @ git+{REPOSITORY}\\"' in Path(path).read_text()
+            or f'%pip install "labkit @ git+{REPOSITORY}"' in Path(path).read_text()
+        ), path
 
 
 def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
     # every notebook starts a worker: what it imports is paid once per notebook graded
-    code = ("import sys, labkit.grading.worker\n"
-            "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.batch', "
-            "'labkit.grading.scoring', 'labkit.grading.report', 'concurrent.futures.process'}))")
+    code = (
+        "import sys, labkit.grading.worker\n"
+        "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.batch', "
+        "'labkit.grading.scoring', 'labkit.grading.report', 'concurrent.futures.process'}))"
+    )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
     from labkit import grading
+
     assert callable(grading.release) and callable(grading.grade) and grading.report.safe_name("a b").startswith("a_b-")
 
 

@@ -48,8 +48,10 @@ def test_exercise7_straight_quadrilateral_is_the_bilinear_map():
     s, t = np.linspace(0, 1, 20), np.linspace(0, 1, 15)
     S, T = np.meshgrid(s, t, indexing="ij")
     bilinear = (
-        np.multiply.outer(A, (1 - S) * (1 - T)) + np.multiply.outer(B, S * (1 - T))
-        + np.multiply.outer(C, S * T) + np.multiply.outer(D, (1 - S) * T)
+        np.multiply.outer(A, (1 - S) * (1 - T))
+        + np.multiply.outer(B, S * (1 - T))
+        + np.multiply.outer(C, S * T)
+        + np.multiply.outer(D, (1 - S) * T)
     )
     xy = patch(*corners, s, t)
     np.testing.assert_allclose(xy, bilinear, atol=1e-14)
@@ -59,8 +61,11 @@ def test_exercise7_straight_quadrilateral_is_the_bilinear_map():
 
 
 def test_exercise6_graded_mesh_shrinks_towards_the_right():
-    x, y = patch(*unit_square(A_ds=[3.0, 0.0], D_ds=[3.0, 0.0], B_ds=[0.1, 0.0], C_ds=[0.1, 0.0]),
-                 np.linspace(0, 1, 11), np.linspace(0, 1, 16))
+    x, y = patch(
+        *unit_square(A_ds=[3.0, 0.0], D_ds=[3.0, 0.0], B_ds=[0.1, 0.0], C_ds=[0.1, 0.0]),
+        np.linspace(0, 1, 11),
+        np.linspace(0, 1, 16),
+    )
     widths = np.diff(x, axis=0)
     assert np.all(widths > 0)
     assert np.all(np.diff(widths, axis=0) < 0)
@@ -82,12 +87,14 @@ def test_patch_equals_the_tensor_form_on_random_data(rng):
     Ht = P @ np.vander(t, 4, increasing=True).T
     # geometry matrix: rows (A-side value, A-side s-slope, B-side value, B-side s-slope)
     # of the t-data (bottom value, bottom t-slope, top value, top t-slope)
-    G = np.array([
-        [A.point, A.dt, D.point, D.dt],
-        [A.ds, A.dsdt, D.ds, D.dsdt],
-        [B.point, B.dt, C.point, C.dt],
-        [B.ds, B.dsdt, C.ds, C.dsdt],
-    ])  # (4, 4, dim)
+    G = np.array(
+        [
+            [A.point, A.dt, D.point, D.dt],
+            [A.ds, A.dsdt, D.ds, D.dsdt],
+            [B.point, B.dt, C.point, C.dt],
+            [B.ds, B.dsdt, C.ds, C.dsdt],
+        ]
+    )  # (4, 4, dim)
     expected = np.einsum("is,ijd,jt->dst", Hs, G, Ht)
     np.testing.assert_allclose(patch(A, B, C, D, s, t), expected, atol=1e-12)
 

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from helpers import unequal_knots
 from scipy.interpolate import CubicHermiteSpline
 
 from labkit import bracket, eval_pherm, eval_plin, hermite_basis
-from helpers import unequal_knots
 
 
 def test_bracket_finds_the_interval_and_clips_to_the_ends():

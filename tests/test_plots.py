@@ -1,4 +1,5 @@
 """Each figure of the notebooks: labelled, titled, and drawing the right data."""
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -82,7 +83,9 @@ def test_bilinear_error_map_is_interpolant_minus_function():
     _labelled(ax)
     test = np.linspace(0, 5, 21)
     X, Y = np.meshgrid(test, test, indexing="ij")
-    expected = labkit.eval_pbilin(labkit.runge2d, np.linspace(0, 5, 5), np.linspace(0, 5, 5), test, test) - labkit.runge2d(X, Y)
+    expected = labkit.eval_pbilin(
+        labkit.runge2d, np.linspace(0, 5, 5), np.linspace(0, 5, 5), test, test
+    ) - labkit.runge2d(X, Y)
     image = ax.images[0]
     np.testing.assert_allclose(image.get_array(), expected.T)  # row j is y = test[j], from the bottom
     assert image.origin == "lower" and image.get_extent()[0] < 0 < 5 < image.get_extent()[1]
@@ -90,8 +93,12 @@ def test_bilinear_error_map_is_interpolant_minus_function():
 
 def test_plot_patch_titles_with_the_worst_quality_and_colours_folds():
     e1, e2 = [1, 0], [0, 1]
-    corners = [labkit.Corner([0, 0], e1, e2), labkit.Corner([1, 0], [-1.5, 0], e2),
-               labkit.Corner([1, 1], [-1.5, 0], e2), labkit.Corner([0, 1], e1, e2)]
+    corners = [
+        labkit.Corner([0, 0], e1, e2),
+        labkit.Corner([1, 0], [-1.5, 0], e2),
+        labkit.Corner([1, 1], [-1.5, 0], e2),
+        labkit.Corner([0, 1], e1, e2),
+    ]
     ax = plots.plot_patch(corners, ns=11, nt=3, color_by_quality=True)
     _labelled(ax)
     assert "worst quality -" in ax.get_title()
@@ -99,6 +106,7 @@ def test_plot_patch_titles_with_the_worst_quality_and_colours_folds():
 
 
 # -- views updated in place, explorers, the patch editor -----------------------------------------
+
 
 def test_a_view_updates_its_own_artists_instead_of_drawing_new_ones():
     view = plots.LimaconView()
@@ -149,14 +157,17 @@ def _png_size(data):
     return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
 
 
-@pytest.mark.parametrize("factory, control, value", [
-    (plots.limacon_explorer, "intervals", 7),
-    (plots.convergence_explorer, "ndata", 21),
-    (plots.mesh_explorer, "dxds_BC", -1.0),
-    (plots.spline_explorer, "natural", False),
-    (plots.pchip_explorer, "y3", 2.5),
-    (plots.bilinear_explorer, "ndata", 5),
-])
+@pytest.mark.parametrize(
+    "factory, control, value",
+    [
+        (plots.limacon_explorer, "intervals", 7),
+        (plots.convergence_explorer, "ndata", 21),
+        (plots.mesh_explorer, "dxds_BC", -1.0),
+        (plots.spline_explorer, "natural", False),
+        (plots.pchip_explorer, "y3", 2.5),
+        (plots.bilinear_explorer, "ndata", 5),
+    ],
+)
 def test_every_explorer_redraws_while_dragged_and_sends_a_new_picture(factory, control, value):
     explorer = factory()
     sliders = [c for c in explorer.controls.values() if hasattr(c, "continuous_update")]
@@ -256,15 +267,18 @@ def test_the_editor_refuses_what_it_cannot_edit():
         plots.patch_editor([labkit.Corner([0, 0, 0], [1, 0, 0], [0, 1, 0])] * 4)
 
 
-@pytest.mark.parametrize("factory, control, value", [
-    (plots.mesh_explorer, "dxds_BC", 0.6),
-    (plots.mesh_explorer, "twist", 1.2),
-    (plots.limacon_explorer, "intervals", 9),
-    (plots.bilinear_explorer, "ndata", 5),
-    (plots.spline_explorer, "ndata", 12),
-    (plots.convergence_explorer, "ndata", 12),
-    (plots.pchip_explorer, "y1", 1.05),
-])
+@pytest.mark.parametrize(
+    "factory, control, value",
+    [
+        (plots.mesh_explorer, "dxds_BC", 0.6),
+        (plots.mesh_explorer, "twist", 1.2),
+        (plots.limacon_explorer, "intervals", 9),
+        (plots.bilinear_explorer, "ndata", 5),
+        (plots.spline_explorer, "ndata", 12),
+        (plots.convergence_explorer, "ndata", 12),
+        (plots.pchip_explorer, "y1", 1.05),
+    ],
+)
 def test_a_blitted_picture_is_the_full_drawing_pixel_for_pixel(factory, control, value):
     import io
 
@@ -304,8 +318,9 @@ def test_second_derivative_plot_shows_hermite_jumps_and_c2_splines():
     assert abs(s2[0]) < 1e-12 and abs(s2[-1]) < 1e-12
     x = np.linspace(0, 5, 7)
     y, _ = labkit.runge(x)
-    np.testing.assert_allclose(notaknot.get_ydata()[:40],
-                               labkit.spline(x, y, np.linspace(x[0], x[1], 40), der=2), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        notaknot.get_ydata()[:40], labkit.spline(x, y, np.linspace(x[0], x[1], 40), der=2), rtol=1e-12, atol=1e-12
+    )
 
 
 def test_every_view_follows_the_written_view_interface_and_a_new_one_needs_only_update():
@@ -315,8 +330,11 @@ def test_every_view_follows_the_written_view_interface_and_a_new_one_needs_only_
 
     from labkit.plots import explorers, figures
 
-    views = [cls for _, cls in inspect.getmembers(figures, inspect.isclass)
-             if issubclass(cls, figures.View) and cls is not figures.View]
+    views = [
+        cls
+        for _, cls in inspect.getmembers(figures, inspect.isclass)
+        if issubclass(cls, figures.View) and cls is not figures.View
+    ]
     assert len(views) >= 5
     for cls in views:
         assert cls.update is not figures.View.update, cls  # each view changes its own artists
@@ -324,7 +342,7 @@ def test_every_view_follows_the_written_view_interface_and_a_new_one_needs_only_
     class Sine(figures.View):  # a newcomer's view: update only, no blitting
         def __init__(self, ax):
             self.ax = ax
-            self.line, = ax.plot([], [])
+            (self.line,) = ax.plot([], [])
             ax.set_xlim(0, 1)
             ax.set_ylim(-1, 1)
 

@@ -1,9 +1,11 @@
 """Property tests: reproduction of polynomials and shape preservation."""
+
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from helpers import knots
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from labkit import ccspline, eval_pherm, eval_plin, nakspline, ncspline, pchip, spline
-from helpers import knots
 
 coefficient = st.floats(-5.0, 5.0)
 settings.register_profile("labkit", max_examples=60, deadline=None)

@@ -1,4 +1,5 @@
 """What crosses from a sandboxed notebook: plain numbers only, everything else refused or marked."""
+
 import json
 
 import numpy as np
@@ -32,13 +33,16 @@ def test_corners_and_meshes_are_rebuilt_by_their_constructors():
     assert isinstance(mesh, labkit.QuadMesh) and mesh.quads.tolist() == labkit.quad_mesh(x, y).quads.tolist()
 
 
-@pytest.mark.parametrize("value, says", [
-    (np.array([1 + 2j]), "complex numbers"),
-    (np.array(["a"]), "an array of <U1"),
-    (object(), "a object object"),
-    ({"a": 1}, "a dict object"),
-    (lambda x: x, "a function object"),
-])
+@pytest.mark.parametrize(
+    "value, says",
+    [
+        (np.array([1 + 2j]), "complex numbers"),
+        (np.array(["a"]), "an array of <U1"),
+        (object(), "a object object"),
+        ({"a": 1}, "a dict object"),
+        (lambda x: x, "a function object"),
+    ],
+)
 def test_anything_but_numbers_arrives_as_not_numbers(value, says):
     got = _roundtrip(value)
     assert isinstance(got, protocol.NotNumbers) and says in str(got)
@@ -56,22 +60,26 @@ def test_values_that_compare_equal_to_everything_fail():
 
 
 def test_invalid_corners_and_meshes_are_not_numbers():
-    assert isinstance(protocol.decode(["corner", ["a", [1], "AAAAAAAAAAA="]] * 1 + [["obj", "x"]] * 3),
-                      protocol.NotNumbers)
+    assert isinstance(
+        protocol.decode(["corner", ["a", [1], "AAAAAAAAAAA="]] * 1 + [["obj", "x"]] * 3), protocol.NotNumbers
+    )
     bad_quads = protocol.encode(np.array([[0, 1, 2, 9]]))
     points = protocol.encode(np.zeros((4, 2)))
     assert "invalid QuadMesh" in str(protocol.decode(["mesh", points, bad_quads]))
 
 
-@pytest.mark.parametrize("tag, message", [
-    (["a", [3], "AAAA"], "does not match its shape"),
-    (["a", [-1], ""], "malformed array shape"),
-    (["a", [1], "!!!!!!!!!!!="], "not base64"),
-    (["zzz"], "unknown value tag"),
-    ("text", "malformed value"),
-    (["f", "1.0"], "unknown value tag"),
-    (["fn", "labkit.piecewise:eval_pherm"], "unknown value tag"),  # the grader never takes functions
-])
+@pytest.mark.parametrize(
+    "tag, message",
+    [
+        (["a", [3], "AAAA"], "does not match its shape"),
+        (["a", [-1], ""], "malformed array shape"),
+        (["a", [1], "!!!!!!!!!!!="], "not base64"),
+        (["zzz"], "unknown value tag"),
+        ("text", "malformed value"),
+        (["f", "1.0"], "unknown value tag"),
+        (["fn", "labkit.piecewise:eval_pherm"], "unknown value tag"),  # the grader never takes functions
+    ],
+)
 def test_malformed_values_are_protocol_errors(tag, message):
     with pytest.raises(protocol.ProtocolError, match=message):
         protocol.decode(tag)
@@ -110,8 +118,13 @@ def test_functions_cross_only_by_name_and_only_the_listed_ones():
 def test_a_corner_is_rebuilt_checked_without_running_its_class_code():
     corner = protocol.decode(protocol.encode(labkit.Corner([0, 1], [1, 0], [0, 2])))
     assert isinstance(corner, labkit.Corner) and corner.dsdt.tolist() == [0.0, 0.0] and corner.dim == 2
-    mismatched = ["corner", protocol.encode(np.zeros(2)), protocol.encode(np.zeros(3)), protocol.encode(np.zeros(2)),
-                  protocol.encode(np.zeros(2))]
+    mismatched = [
+        "corner",
+        protocol.encode(np.zeros(2)),
+        protocol.encode(np.zeros(3)),
+        protocol.encode(np.zeros(2)),
+        protocol.encode(np.zeros(2)),
+    ]
     assert "same size" in str(protocol.decode(mismatched))
     infinite = ["corner"] + [protocol.encode(np.array([np.inf, 0.0]))] * 4
     assert "NaN or infinite" in str(protocol.decode(infinite))

@@ -5,13 +5,14 @@ run without bubblewrap; the hostile suite repeats the important attacks in
 the sandbox): each attack is a notebook's cells, and the grader's proxy
 calls the student's function with a part's refusal, as grading does.
 """
+
 import numpy as np
 import pytest
 
 import labkit
 from labkit.exercises import hermite
-from labkit.exercises.registry import LAB
 from labkit.exercises.model import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN_PATCH
+from labkit.exercises.registry import LAB
 
 REFUSALS = LAB.refusals
 from labkit.grading import guard, refusals, remote, scoring
@@ -66,9 +67,9 @@ def test_an_honest_function_built_on_the_allowed_helpers_passes_the_check_under_
 ATTACKS = {
     "the reference itself": "def eval_pherm(*a):\n    return labkit.eval_pherm(*a)",
     "an alias taken before grading": "from labkit.piecewise import eval_pherm as ref\n"
-                                     "def eval_pherm(*a):\n    return ref(*a)",
+    "def eval_pherm(*a):\n    return ref(*a)",
     "a private helper": "def eval_pherm(x, y, yp, xv):\n"
-                        "    return labkit.piecewise._hermite_eval(*map(np.asarray, (x, y, yp, xv)))",
+    "    return labkit.piecewise._hermite_eval(*map(np.asarray, (x, y, yp, xv)))",
     "BPoly through a subclass and construct_fast": (
         "from scipy.interpolate import BPoly\n"
         "class H(BPoly):\n"
@@ -78,20 +79,24 @@ ATTACKS = {
         "    x, y, yp = map(np.asarray, (x, y, yp))\n"
         "    h = np.diff(x)\n"
         "    c = np.stack([y[:-1], y[:-1] + yp[:-1] * h / 3, y[1:] - yp[1:] * h / 3, y[1:]])\n"
-        "    return H(x, c)(xv)"),
+        "    return H(x, c)(xv)"
+    ),
     "a saved code object put back under a new function": (
         "import types\nsaved = labkit.piecewise.eval_pherm.__code__\n"
-        "def eval_pherm(*a):\n    return types.FunctionType(saved, labkit.piecewise.__dict__, None, (0,))(*a)"),
+        "def eval_pherm(*a):\n    return types.FunctionType(saved, labkit.piecewise.__dict__, None, (0,))(*a)"
+    ),
     "labkit's code pasted into the notebook": (
-        "import inspect\nexec(inspect.getsource(labkit.piecewise).replace('from ._', 'from labkit._'), globals())"),
+        "import inspect\nexec(inspect.getsource(labkit.piecewise).replace('from ._', 'from labkit._'), globals())"
+    ),
     "scipy's CubicHermiteSpline": "import scipy.interpolate as si\n"
-                                  "def eval_pherm(x, y, yp, xv):\n    return si.CubicHermiteSpline(x, y, yp)(xv)",
+    "def eval_pherm(x, y, yp, xv):\n    return si.CubicHermiteSpline(x, y, yp)(xv)",
     "a compiled routine of scipy.interpolate": (
         "from scipy.interpolate import _ppoly\n"
         "def eval_pherm(x, y, yp, xv):\n"
         "    f = getattr(__import__('scipy.interpolate._ppoly').interpolate._ppoly, 'evaluate')\n"
         "    return f(np.zeros((4, 1, 1)), np.asarray(x, float)[:2], np.asarray(xv, float), 0, True,\n"
-        "             np.empty((len(xv), 1)))[:, 0]"),
+        "             np.empty((len(xv), 1)))[:, 0]"
+    ),
 }
 
 
@@ -107,24 +112,31 @@ def test_every_path_to_a_library_interpolant_is_refused(open_notebooks, name):
 
 def test_private_spline_helpers_and_ndimage_are_refused_like_the_public_functions(open_notebooks):
     notebook = _notebook(
-        open_notebooks, "import numpy as np, labkit\nfrom labkit import splines\nimport scipy.ndimage",
+        open_notebooks,
+        "import numpy as np, labkit\nfrom labkit import splines\nimport scipy.ndimage",
         "def ncspline(x, y):\n    x, y = np.asarray(x, float), np.asarray(y, float)\n    h = np.diff(x)\n"
         "    s = np.diff(y) / h\n    return splines._slopes_from_curvatures(h, s, splines.natural_curvatures(h, s))",
         "def eval_pbilin(f, xd, yd, xv, yv):\n    z = f(*np.meshgrid(xd, yd, indexing='ij'))\n"
         "    i = np.interp(xv, xd, np.arange(len(xd)))\n    j = np.interp(yv, yd, np.arange(len(yd)))\n"
         "    I, J = np.meshgrid(i, j, indexing='ij')\n"
-        "    return scipy.ndimage.map_coordinates(z, [I, J], order=1)")
-    for name, args, reference in (("ncspline", (X, Y), "labkit.splines"),
-                                  ("eval_pbilin", (labkit.runge2d, X, X, XV, XV), "interp")):
+        "    return scipy.ndimage.map_coordinates(z, [I, J], order=1)",
+    )
+    for name, args, reference in (
+        ("ncspline", (X, Y), "labkit.splines"),
+        ("eval_pbilin", (labkit.runge2d, X, X, XV, XV), "interp"),
+    ):
         with pytest.raises(remote.StudentError, match="switched off") as refused:
             _call(notebook, name, INTERPOLANTS, *args)
         assert reference in str(refused.value)
 
 
 def test_a_handed_over_function_is_trusted_only_in_the_call_it_was_handed_to(open_notebooks):
-    notebook = _notebook(open_notebooks, "import numpy as np\nkept = []",
-                         "def driver(n, f):\n    kept.append(f)\n    return float(np.max(f(np.linspace(0, 5, n))[0]))",
-                         "def runge(x):\n    return kept[0](x)")
+    notebook = _notebook(
+        open_notebooks,
+        "import numpy as np\nkept = []",
+        "def driver(n, f):\n    kept.append(f)\n    return float(np.max(f(np.linspace(0, 5, n))[0]))",
+        "def runge(x):\n    return kept[0](x)",
+    )
     # the driver may use the labkit runge the check hands it (labkit.functions is refused in its part too)
     assert _call(notebook, "driver", OWN_FUNCTIONS, 11, labkit.runge) == pytest.approx(1.0)
     # but a student who kept it cannot use it for the part that asks for their own runge
@@ -133,21 +145,27 @@ def test_a_handed_over_function_is_trusted_only_in_the_call_it_was_handed_to(ope
 
 
 def test_a_handed_over_function_gets_plain_numbers_whatever_it_is_given(open_notebooks):
-    notebook = _notebook(open_notebooks, "import numpy as np, labkit",
-                         "class Sly:\n    def __array__(self, *a, **k):\n"
-                         "        return labkit.convergence_table('pherm').errors[:1]\n"
-                         "def driver(n, f):\n    return float(f(Sly())[0][0])")
+    notebook = _notebook(
+        open_notebooks,
+        "import numpy as np, labkit",
+        "class Sly:\n    def __array__(self, *a, **k):\n"
+        "        return labkit.convergence_table('pherm').errors[:1]\n"
+        "def driver(n, f):\n    return float(f(Sly())[0][0])",
+    )
     # the student's hook runs before the trusted copy does, so its refused call is seen
     with pytest.raises(remote.StudentError, match="labkit.convergence"):
         _call(notebook, "driver", EXPERIMENTS, 11, labkit.runge)
 
 
 def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
-    notebook = _notebook(open_notebooks, "import numpy as np, labkit",
-                         "def coons(A, B, C, D, s, t):\n    assert A.dim == 2\n"
-                         "    x = labkit.eval_pherm([0, 1], [A.point[0], B.point[0]], [A.ds[0], B.ds[0]], s)\n"
-                         "    return np.add.outer(x, 0 * np.asarray(t)), np.add.outer(0 * x, np.asarray(t))",
-                         "def cheat(A, B, C, D, s, t):\n    return labkit.patch(A, B, C, D, s, t)")
+    notebook = _notebook(
+        open_notebooks,
+        "import numpy as np, labkit",
+        "def coons(A, B, C, D, s, t):\n    assert A.dim == 2\n"
+        "    x = labkit.eval_pherm([0, 1], [A.point[0], B.point[0]], [A.ds[0], B.ds[0]], s)\n"
+        "    return np.add.outer(x, 0 * np.asarray(t)), np.add.outer(0 * x, np.asarray(t))",
+        "def cheat(A, B, C, D, s, t):\n    return labkit.patch(A, B, C, D, s, t)",
+    )
     corners = [labkit.Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
     x, y = _call(notebook, "coons", OWN_PATCH, *corners, np.linspace(0, 1, 4), np.linspace(0, 1, 5))
     assert x.shape == (4, 5)
@@ -155,71 +173,118 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
         _call(notebook, "cheat", OWN_PATCH, *corners, np.linspace(0, 1, 4), np.linspace(0, 1, 5))
 
 
-@pytest.mark.parametrize("cells, says", [
-    (["import gc\ndef eval_pherm(*a):\n    gc.get_objects()\n    return 0.0"], "gc.get_objects"),
-    (["import gc, functools\nfunctools.partial(gc.get_referrers, labkit)()"], "gc.get_referrers"),  # from C code
-    (["import sys\ndef eval_pherm(*a):\n    sys.setprofile(None)\n    return labkit.eval_pherm(*a)"],
-     "sys.setprofile"),
-    (["import ctypes\nctypes.c_char.from_address(id(labkit))"], "ctypes.cdata"),
-    (["import types\nf = types.FunctionType(labkit.piecewise.eval_pherm.__code__, {})"], "function.__new__"),
-    # the red team's ways into the watch's own hooks (now nothing of the student's runs inside them):
-    # a stand-in made with a name of the student's own, whose formatting calls the reference
-    (["import numpy as np\nfrom labkit.grading import guard\nnp.lab_ref = labkit.eval_pherm\n"
-      "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
-      "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n        return 'x'\n"
-      "def eval_pherm(x, y, yp, xv):\n    name = Name((x, y, yp, xv))\n    try:\n        guard._stand_in(name)()\n"
-      "    except RuntimeError:\n        pass\n    return name.out"], "switched off"),
-    # the second red team: every name the watch's module, hashlib and the builtins hold, rebound
-    (["import builtins, hashlib, numpy as np\nfrom labkit.grading import guard\nnp.ref = labkit.eval_pherm\n"
-      "guard.any = guard._within = lambda *a: False\nguard.TAMPER_EVENTS = frozenset()\n"
-      "guard.code_key = lambda code: bytes(12)\nguard._sha1 = guard._sha256 = lambda *a: hashlib.md5(b'same')\n"
-      "hashlib.sha1 = hashlib.sha256 = guard._sha1\nguard.sign = lambda *a: ''\n"
-      "guard.attestation_text = lambda r, p, pa, s, d: (r, p or '', ','.join(sorted(pa)), 'clean', d)\n"
-      "def eval_pherm(*a):\n    return np.ref(*a)"], "switched off"),
-    # ... and the watch's names reached through the globals of a stand-in found in a refused module
-    (["import sys, numpy as np\nnp.ref = labkit.eval_pherm\n"
-      "def eval_pherm(*a):\n    found = 0\n    for module in list(sys.modules.values()):\n"
-      "        for value in list(getattr(module, '__dict__', {}).values()):\n"
-      "            code = getattr(value, '__code__', None)\n"
-      "            if getattr(code, 'co_name', '') == 'refused':\n                g = value.__globals__\n"
-      "                g['code_key'] = lambda code: bytes(12)\n                g['TAMPER_EVENTS'] = frozenset()\n"
-      "                g['__builtins__']['len'] = lambda v: 0\n                found += 1\n"
-      "    assert found, 'no stand-in found'\n    return np.ref(*a)"], "switched off"),
-    (["import sys, numpy as np, labkit.exercises.splines\nclass cython_function_or_method:\n"
-      "    @property\n    def __module__(self):\n        raise SystemExit('inside the watch')\n"
-      "labkit.exercises.zz_fake = cython_function_or_method()\nnp.ref_pherm = labkit.eval_pherm\n"
-      "def eval_pherm(*a):\n    return np.ref_pherm(*a)"], "switched off"),
-    (["import sys, functools, numpy as np\nhook = functools.partial(sys.getprofile)()\nassert hook is None\n"
-      "np.ref = labkit.eval_pherm\ndef eval_pherm(*a):\n    assert functools.partial(sys.getprofile)() is None\n"
-      "    return np.ref(*a)"], "switched off"),
-    (["from labkit.grading import protocol\nseen, decode, encode = [], protocol.decode, protocol.encode\n"
-      "def peek(tag, *a, **k):\n    value = decode(tag, *a, **k)\n    seen.append(value)\n    return value\n"
-      "def answer(value, *a):\n    return encode(labkit.eval_pherm(*seen[-4:]) if len(seen) >= 4 else value, *a)\n"
-      "protocol.decode, protocol.encode = peek, answer"],  # the worker's own helpers, rewritten
-     "switched off"),
-    (["import labkit.grading.protocol as p, json\nreal = p.loads\nstash = {}\n"
-      "def peek(line):\n    request = real(line)\n    if request.get('op') == 'call':\n"
-      "        stash['answer'] = labkit.eval_pherm(X, Y, YP, XV)\n    return request\np.loads = peek"],
-     "switched off"),
-    (["import sys\ndef eval_pherm(*a):\n    sys.audit('labkit.end', b'{}')\n    return labkit.eval_pherm(*a)"],
-     "labkit.end raised by the notebook"),
-])
+@pytest.mark.parametrize(
+    "cells, says",
+    [
+        (["import gc\ndef eval_pherm(*a):\n    gc.get_objects()\n    return 0.0"], "gc.get_objects"),
+        (["import gc, functools\nfunctools.partial(gc.get_referrers, labkit)()"], "gc.get_referrers"),  # from C code
+        (
+            ["import sys\ndef eval_pherm(*a):\n    sys.setprofile(None)\n    return labkit.eval_pherm(*a)"],
+            "sys.setprofile",
+        ),
+        (["import ctypes\nctypes.c_char.from_address(id(labkit))"], "ctypes.cdata"),
+        (["import types\nf = types.FunctionType(labkit.piecewise.eval_pherm.__code__, {})"], "function.__new__"),
+        # the red team's ways into the watch's own hooks (now nothing of the student's runs inside them):
+        # a stand-in made with a name of the student's own, whose formatting calls the reference
+        (
+            [
+                "import numpy as np\nfrom labkit.grading import guard\nnp.lab_ref = labkit.eval_pherm\n"
+                "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
+                "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n        return 'x'\n"
+                "def eval_pherm(x, y, yp, xv):\n    name = Name((x, y, yp, xv))\n    try:\n        guard._stand_in(name)()\n"
+                "    except RuntimeError:\n        pass\n    return name.out"
+            ],
+            "switched off",
+        ),
+        # the second red team: every name the watch's module, hashlib and the builtins hold, rebound
+        (
+            [
+                "import builtins, hashlib, numpy as np\nfrom labkit.grading import guard\nnp.ref = labkit.eval_pherm\n"
+                "guard.any = guard._within = lambda *a: False\nguard.TAMPER_EVENTS = frozenset()\n"
+                "guard.code_key = lambda code: bytes(12)\nguard._sha1 = guard._sha256 = lambda *a: hashlib.md5(b'same')\n"
+                "hashlib.sha1 = hashlib.sha256 = guard._sha1\nguard.sign = lambda *a: ''\n"
+                "guard.attestation_text = lambda r, p, pa, s, d: (r, p or '', ','.join(sorted(pa)), 'clean', d)\n"
+                "def eval_pherm(*a):\n    return np.ref(*a)"
+            ],
+            "switched off",
+        ),
+        # ... and the watch's names reached through the globals of a stand-in found in a refused module
+        (
+            [
+                "import sys, numpy as np\nnp.ref = labkit.eval_pherm\n"
+                "def eval_pherm(*a):\n    found = 0\n    for module in list(sys.modules.values()):\n"
+                "        for value in list(getattr(module, '__dict__', {}).values()):\n"
+                "            code = getattr(value, '__code__', None)\n"
+                "            if getattr(code, 'co_name', '') == 'refused':\n                g = value.__globals__\n"
+                "                g['code_key'] = lambda code: bytes(12)\n                g['TAMPER_EVENTS'] = frozenset()\n"
+                "                g['__builtins__']['len'] = lambda v: 0\n                found += 1\n"
+                "    assert found, 'no stand-in found'\n    return np.ref(*a)"
+            ],
+            "switched off",
+        ),
+        (
+            [
+                "import sys, numpy as np, labkit.exercises.splines\nclass cython_function_or_method:\n"
+                "    @property\n    def __module__(self):\n        raise SystemExit('inside the watch')\n"
+                "labkit.exercises.zz_fake = cython_function_or_method()\nnp.ref_pherm = labkit.eval_pherm\n"
+                "def eval_pherm(*a):\n    return np.ref_pherm(*a)"
+            ],
+            "switched off",
+        ),
+        (
+            [
+                "import sys, functools, numpy as np\nhook = functools.partial(sys.getprofile)()\nassert hook is None\n"
+                "np.ref = labkit.eval_pherm\ndef eval_pherm(*a):\n    assert functools.partial(sys.getprofile)() is None\n"
+                "    return np.ref(*a)"
+            ],
+            "switched off",
+        ),
+        (
+            [
+                "from labkit.grading import protocol\nseen, decode, encode = [], protocol.decode, protocol.encode\n"
+                "def peek(tag, *a, **k):\n    value = decode(tag, *a, **k)\n    seen.append(value)\n    return value\n"
+                "def answer(value, *a):\n    return encode(labkit.eval_pherm(*seen[-4:]) if len(seen) >= 4 else value, *a)\n"
+                "protocol.decode, protocol.encode = peek, answer"
+            ],  # the worker's own helpers, rewritten
+            "switched off",
+        ),
+        (
+            [
+                "import labkit.grading.protocol as p, json\nreal = p.loads\nstash = {}\n"
+                "def peek(line):\n    request = real(line)\n    if request.get('op') == 'call':\n"
+                "        stash['answer'] = labkit.eval_pherm(X, Y, YP, XV)\n    return request\np.loads = peek"
+            ],
+            "switched off",
+        ),
+        (
+            ["import sys\ndef eval_pherm(*a):\n    sys.audit('labkit.end', b'{}')\n    return labkit.eval_pherm(*a)"],
+            "labkit.end raised by the notebook",
+        ),
+    ],
+)
 def test_switching_the_watch_off_or_going_round_it_voids_the_answer(open_notebooks, cells, says):
-    notebook = _notebook(open_notebooks, "import numpy as np, labkit\nX, Y, YP, XV = "
-                         "np.array([0., 1, 3]), np.array([1., -1, 2]), np.array([0., 2, -1]), np.linspace(-.5, 3.5, 9)",
-                         HONEST_PHERM, *cells, clean=False)
+    notebook = _notebook(
+        open_notebooks,
+        "import numpy as np, labkit\nX, Y, YP, XV = "
+        "np.array([0., 1, 3]), np.array([1., -1, 2]), np.array([0., 2, -1]), np.linspace(-.5, 3.5, 9)",
+        HONEST_PHERM,
+        *cells,
+        clean=False,
+    )
     with pytest.raises(remote.StudentError) as voided:
         _call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV)
     assert says in str(voided.value), str(voided.value)
 
 
-@pytest.mark.parametrize("cell, error", [
-    ("import threading\nthreading.Thread(target=print).start()", "can't start new thread"),
-    ("import signal\nsignal.signal(signal.SIGALRM, lambda *a: None)", "Operation not permitted"),
-    ("import os\nos.memfd_create('hoard')", "Operation not permitted"),
-])
-def test_threads_signal_handlers_and_anonymous_memory_are_refused_even_without_the_sandbox(open_notebooks, cell,
-                                                                                            error):
+@pytest.mark.parametrize(
+    "cell, error",
+    [
+        ("import threading\nthreading.Thread(target=print).start()", "can't start new thread"),
+        ("import signal\nsignal.signal(signal.SIGALRM, lambda *a: None)", "Operation not permitted"),
+        ("import os\nos.memfd_create('hoard')", "Operation not permitted"),
+    ],
+)
+def test_threads_signal_handlers_and_anonymous_memory_are_refused_even_without_the_sandbox(open_notebooks, cell, error):
     notebook = remote.Notebook(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": [cell], "cell_timeout": 30}, 120)
@@ -227,24 +292,30 @@ def test_threads_signal_handlers_and_anonymous_memory_are_refused_even_without_t
 
 
 def test_a_forged_answer_line_never_reaches_the_grader(open_notebooks):
-    notebook = _notebook(open_notebooks, HONEST_PHERM,
-                         "import os, json\nfor fd in range(3, 40):\n    try:\n"
-                         "        os.write(fd, (json.dumps({'id': 'x', 'value': ['f', 1.0]}) + '\\n').encode())\n"
-                         "    except OSError:\n        pass")
+    notebook = _notebook(
+        open_notebooks,
+        HONEST_PHERM,
+        "import os, json\nfor fd in range(3, 40):\n    try:\n"
+        "        os.write(fd, (json.dumps({'id': 'x', 'value': ['f', 1.0]}) + '\\n').encode())\n"
+        "    except OSError:\n        pass",
+    )
     assert np.allclose(_call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV), labkit.eval_pherm(X, Y, YP, XV))
 
 
 def test_an_attestation_the_notebook_writes_for_its_own_request_voids_the_answer(open_notebooks):
     # the request's id is found on the worker's frames, and a line for it written to every descriptor
-    notebook = _notebook(open_notebooks, "import sys, os, numpy as np, labkit\nnp.ref = labkit.eval_pherm",
-                         "def eval_pherm(*a):\n    frame, rid = sys._getframe(), None\n"
-                         "    while frame is not None and rid is None:\n"
-                         "        request = frame.f_locals.get('request')\n"
-                         "        rid = request.get('id') if isinstance(request, dict) else None\n"
-                         "        frame = frame.f_back\n    assert rid, 'no request id found'\n"
-                         "    line = '\\t'.join([str(rid), 'interpolants', '', 'clean', '0' * 64, '0' * 64]) + '\\n'\n"
-                         "    for fd in range(3, 40):\n        try:\n            os.write(fd, line.encode())\n"
-                         "        except OSError:\n            pass\n    return np.ref(*a)")
+    notebook = _notebook(
+        open_notebooks,
+        "import sys, os, numpy as np, labkit\nnp.ref = labkit.eval_pherm",
+        "def eval_pherm(*a):\n    frame, rid = sys._getframe(), None\n"
+        "    while frame is not None and rid is None:\n"
+        "        request = frame.f_locals.get('request')\n"
+        "        rid = request.get('id') if isinstance(request, dict) else None\n"
+        "        frame = frame.f_back\n    assert rid, 'no request id found'\n"
+        "    line = '\\t'.join([str(rid), 'interpolants', '', 'clean', '0' * 64, '0' * 64]) + '\\n'\n"
+        "    for fd in range(3, 40):\n        try:\n            os.write(fd, line.encode())\n"
+        "        except OSError:\n            pass\n    return np.ref(*a)",
+    )
     with pytest.raises(remote.StudentError, match="wrote to the grader's watch"):
         _call(notebook, "eval_pherm", INTERPOLANTS, X, Y, YP, XV)
 
@@ -281,9 +352,14 @@ def test_a_call_that_ends_the_process_costs_only_that_call(open_notebooks):
 def test_the_grader_computes_the_digests_from_the_library_files():
     names, modules, c_names = refusals.recognised(INTERPOLANTS)
     recognised = set(names.values())
-    assert {"labkit.piecewise.eval_pherm", "labkit.piecewise._hermite_eval", "labkit.splines._slopes_from_curvatures",
-            "scipy.interpolate._interpolate._PPolyBase.construct_fast", "labkit.exercises.splines._reference_complete_system",
-            "numpy.lib._function_base_impl.interp"} <= recognised
+    assert {
+        "labkit.piecewise.eval_pherm",
+        "labkit.piecewise._hermite_eval",
+        "labkit.splines._slopes_from_curvatures",
+        "scipy.interpolate._interpolate._PPolyBase.construct_fast",
+        "labkit.exercises.splines._reference_complete_system",
+        "numpy.lib._function_base_impl.interp",
+    } <= recognised
     assert "labkit.piecewise.bracket" not in recognised  # the lab lets students use it
     # what the sandbox recognises is the live code's digest
     assert names[guard.code_key(labkit.eval_pherm.__code__)] == "labkit.piecewise.eval_pherm"
@@ -323,18 +399,31 @@ def test_scan_names_references_through_aliases_helpers_and_magics():
     assert _scan(sources, ["runge"], OWN_FUNCTIONS) == [("runge", 2, "labkit.functions.runge (as labkit.runge)")]
 
 
-@pytest.mark.parametrize("sources, what", [
-    (["import labkit\nref = labkit.eval_pherm", "def eval_pherm(*a):\n    return ref(*a)"], "labkit.eval_pherm"),
-    (["import labkit\neval_pherm = labkit.eval_pherm"], "labkit.eval_pherm"),
-    (["from scipy.interpolate import CubicHermiteSpline\nclass H(CubicHermiteSpline):\n    pass",
-      "def eval_pherm(x, y, yp, xv):\n    return H(x, y, yp)(xv)"], "CubicHermiteSpline"),
-    (["import numpy as np\ndef eval_pherm(x, y, yp, xv):\n    return np.interp(xv, x, y)"], "interp"),
-    (["def eval_pherm(*a):\n    m = __import__('lab' + 'kit')\n    return m.eval_pherm(*a)"], "__import__"),
-    (["import importlib\nm = importlib.import_module('labkit')", "def eval_pherm(*a):\n    return m.eval_pherm(*a)"],
-     "importlib"),
-    (["def eval_pherm(*a):\n    return getattr(__builtins__, 'ev' + 'al')('1')"], "getattr with a computed name"),
-    (["import types, labkit\nc = labkit.eval_pherm.__code__\ndef eval_pherm(*a):\n    return 0"], None),
-])
+@pytest.mark.parametrize(
+    "sources, what",
+    [
+        (["import labkit\nref = labkit.eval_pherm", "def eval_pherm(*a):\n    return ref(*a)"], "labkit.eval_pherm"),
+        (["import labkit\neval_pherm = labkit.eval_pherm"], "labkit.eval_pherm"),
+        (
+            [
+                "from scipy.interpolate import CubicHermiteSpline\nclass H(CubicHermiteSpline):\n    pass",
+                "def eval_pherm(x, y, yp, xv):\n    return H(x, y, yp)(xv)",
+            ],
+            "CubicHermiteSpline",
+        ),
+        (["import numpy as np\ndef eval_pherm(x, y, yp, xv):\n    return np.interp(xv, x, y)"], "interp"),
+        (["def eval_pherm(*a):\n    m = __import__('lab' + 'kit')\n    return m.eval_pherm(*a)"], "__import__"),
+        (
+            [
+                "import importlib\nm = importlib.import_module('labkit')",
+                "def eval_pherm(*a):\n    return m.eval_pherm(*a)",
+            ],
+            "importlib",
+        ),
+        (["def eval_pherm(*a):\n    return getattr(__builtins__, 'ev' + 'al')('1')"], "getattr with a computed name"),
+        (["import types, labkit\nc = labkit.eval_pherm.__code__\ndef eval_pherm(*a):\n    return 0"], None),
+    ],
+)
 def test_scan_follows_module_level_names_classes_and_dynamic_access(sources, what):
     found = _scan(sources, ["eval_pherm"], INTERPOLANTS)
     if what is None:  # a name the graded function never reaches is none of its business
@@ -344,9 +433,11 @@ def test_scan_follows_module_level_names_classes_and_dynamic_access(sources, wha
 
 
 def test_scan_leaves_honest_code_alone():
-    sources = ["from labkit import eval_pherm\nimport numpy as np\nM = 3\nydata = np.zeros(3)",
-               "def eval_pherm(xdata, ydata, ypdata, xval):\n    M = len(xdata)\n"
-               "    return 0 * xval if M > 2 else eval_pherm(xdata[:2], ydata, ypdata, xval)"]
+    sources = [
+        "from labkit import eval_pherm\nimport numpy as np\nM = 3\nydata = np.zeros(3)",
+        "def eval_pherm(xdata, ydata, ypdata, xval):\n    M = len(xdata)\n"
+        "    return 0 * xval if M > 2 else eval_pherm(xdata[:2], ydata, ypdata, xval)",
+    ]
     assert _scan(sources, ["eval_pherm"], INTERPOLANTS) == []
     assert scan(sources, ["eval_pherm"], None) == []
 

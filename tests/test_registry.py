@@ -5,6 +5,7 @@ self-check facade, the functions that may cross into the sandbox, the rubric's
 points, nbgrader's points in the committed notebooks, the notebooks' own
 sections, names and self-check calls, and the exercise table in the docs.
 """
+
 import ast
 import inspect
 import re
@@ -77,11 +78,17 @@ def test_each_notebook_holds_its_exercises_defines_their_names_and_self_checks_e
     headings = {int(n) for text in _cells(exercise.notebook, "markdown") for n in HEADING.findall(text)}
     assert exercise.number in headings
     code = _cells(exercise.notebook)
-    missing = [name for part in exercise.parts for name in part.names() + part.scanned
-               if name.split(":")[0] not in _defined_names(code)]
+    missing = [
+        name
+        for part in exercise.parts
+        for name in part.names() + part.scanned
+        if name.split(":")[0] not in _defined_names(code)
+    ]
     assert not missing, f"the notebook does not define {missing}"
     calls = [(function, key) for source in code for function, key in CHECK_CALL.findall(source)]
-    checked = {part.name for function, key in calls for part in LAB.parts_checked(exercise.number, function, key or None)}
+    checked = {
+        part.name for function, key in calls for part in LAB.parts_checked(exercise.number, function, key or None)
+    }
     assert checked == {part.name for part in exercise.parts}, "parts the notebook never self-checks"
 
 
@@ -162,8 +169,13 @@ def test_a_declaration_refuses_what_would_break_the_derivations():
 
 def test_the_self_check_facade_keeps_the_notebooks_names():
     # the names the committed notebooks call, each a function of the facade
-    called = {function for path in NOTEBOOKS.values() for cell in nbformat.read(path, as_version=4).cells
-              if cell.cell_type == "code" for function, _ in CHECK_CALL.findall(cell.source)}
+    called = {
+        function
+        for path in NOTEBOOKS.values()
+        for cell in nbformat.read(path, as_version=4).cells
+        if cell.cell_type == "code"
+        for function, _ in CHECK_CALL.findall(cell.source)
+    }
     assert called <= set(labkit.check.__all__)
     for name in called:
         assert inspect.isfunction(getattr(labkit.check, name)), name

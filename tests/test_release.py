@@ -4,6 +4,7 @@ Whatever the lab asks a student to find or explain stays in the instructor noteb
 solution regions: code the student writes, and answers in words (markdown solution cells, which
 the release turns into ``YOUR ANSWER HERE`` and nbgrader's metadata marks for manual grading).
 """
+
 import re
 from pathlib import Path
 
@@ -14,17 +15,19 @@ from labkit.check import EXERCISES
 from labkit.exercises.registry import LAB
 
 ANSWERS = LAB.answers
-from labkit.grading.release import strip_solutions
 from labkit.grading.nbgrader import answer_ids, mark
-from labkit.grading.release import BEGIN_SOLUTION, END_SOLUTION
+from labkit.grading.release import BEGIN_SOLUTION, END_SOLUTION, strip_solutions
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 STUDENT = ROOT / "labkit" / "student_notebooks"
 
-STATED_ORDER = re.compile(r"\b(first|second|third|fourth|fifth|[1-5](st|nd|rd|th))[- ]order\b"
-                          r"|\border\s+(of\s+(convergence\s+)?)?(is\s+)?\d|Estimated order|\.order\b"
-                          r"|\brate_\w+\s*=\s*\d|\bfourfold\b|\bsixteenfold\b", re.IGNORECASE)
+STATED_ORDER = re.compile(
+    r"\b(first|second|third|fourth|fifth|[1-5](st|nd|rd|th))[- ]order\b"
+    r"|\border\s+(of\s+(convergence\s+)?)?(is\s+)?\d|Estimated order|\.order\b"
+    r"|\brate_\w+\s*=\s*\d|\bfourfold\b|\bsixteenfold\b",
+    re.IGNORECASE,
+)
 
 
 def _student(path):
@@ -53,8 +56,9 @@ def test_the_release_states_no_order_and_no_rate(path):
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
 def test_no_worked_answer_is_left_in_the_release(path):
     teacher = nbformat.read(path, as_version=4)
-    given = {line.strip() for cell in teacher.cells
-             for line in strip_solutions(cell.source).split("\n")}  # what the student is meant to see
+    given = {
+        line.strip() for cell in teacher.cells for line in strip_solutions(cell.source).split("\n")
+    }  # what the student is meant to see
     student_text = "\n".join(cell.source for cell in _student(path).cells)
     for cell in teacher.cells:
         for line in _solution_lines(cell.source):
@@ -81,8 +85,11 @@ def test_every_answer_in_words_is_a_stub_marked_for_manual_grading_and_listed_in
         student = _student(path)
         ids = answer_ids(teacher)
         found += ids
-        answers = [(t, s) for t, s in zip(teacher.cells, student.cells)
-                   if t.cell_type == "markdown" and BEGIN_SOLUTION in t.source]
+        answers = [
+            (t, s)
+            for t, s in zip(teacher.cells, student.cells)
+            if t.cell_type == "markdown" and BEGIN_SOLUTION in t.source
+        ]
         assert len(answers) == len(ids)
         for (t, s), grade_id in zip(answers, ids):
             assert s.source == "YOUR ANSWER HERE"

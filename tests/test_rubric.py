@@ -1,4 +1,5 @@
 """The rubric: the lab's branch rule as data, its scoring, and clear errors for a bad file."""
+
 import subprocess
 import sys
 import tomllib
@@ -23,8 +24,9 @@ def test_the_lab_rubric_is_its_branch_rule():
     assert lab.branch_extra == 10
     # the points are the declared parts' weights, kept nowhere else
     assert lab.points == {n: exercise.points for n, exercise in EXERCISES.items()}
-    assert "[points]" not in "".join(line for line in rubrics.DEFAULT.read_text().splitlines()
-                                     if not line.startswith("#"))
+    assert "[points]" not in "".join(
+        line for line in rubrics.DEFAULT.read_text().splitlines() if not line.startswith("#")
+    )
     assert lab.full_credit == sum(lab.points[n] for n in (2, 3, 4) + MESH)
     assert lab.maximum == lab.full_credit + 10 + lab.points[16]
 
@@ -38,18 +40,33 @@ def test_the_lab_branches_are_worth_the_same():
     assert BRANCH == sum(P[n] for n in SPLINES)
 
 
-@pytest.mark.parametrize("done, total, branch, extra", [
-    (((2, 3, 4), SPLINES), REQUIRED + BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
-    (((2, 3, 4), MESH), REQUIRED + BRANCH, "mesh generation", {"exercise 16": 0, "branch splines": 0}),
-    (((2, 3, 4), MESH, SPLINES), REQUIRED + BRANCH + BONUS, "mesh generation",
-     {"exercise 16": 0, "branch splines": BONUS}),
-    (((2, 3, 4), SPLINES, (16,)), REQUIRED + BRANCH + P[16], "splines",
-     {"exercise 16": P[16], "branch mesh generation": 0}),
-    (((2, 3, 4), MESH, SPLINES, (16,)), REQUIRED + BRANCH + BONUS + P[16], "mesh generation",
-     {"exercise 16": P[16], "branch splines": BONUS}),
-    ((SPLINES,), BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
-    ((), 0, "none", {"exercise 16": 0, "branch splines": 0}),
-])
+@pytest.mark.parametrize(
+    "done, total, branch, extra",
+    [
+        (((2, 3, 4), SPLINES), REQUIRED + BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
+        (((2, 3, 4), MESH), REQUIRED + BRANCH, "mesh generation", {"exercise 16": 0, "branch splines": 0}),
+        (
+            ((2, 3, 4), MESH, SPLINES),
+            REQUIRED + BRANCH + BONUS,
+            "mesh generation",
+            {"exercise 16": 0, "branch splines": BONUS},
+        ),
+        (
+            ((2, 3, 4), SPLINES, (16,)),
+            REQUIRED + BRANCH + P[16],
+            "splines",
+            {"exercise 16": P[16], "branch mesh generation": 0},
+        ),
+        (
+            ((2, 3, 4), MESH, SPLINES, (16,)),
+            REQUIRED + BRANCH + BONUS + P[16],
+            "mesh generation",
+            {"exercise 16": P[16], "branch splines": BONUS},
+        ),
+        ((SPLINES,), BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
+        ((), 0, "none", {"exercise 16": 0, "branch splines": 0}),
+    ],
+)
 def test_the_better_branch_counts_and_the_other_is_extra_credit(done, total, branch, extra):
     score = rubrics.default().score(_fractions(*done))
     assert (score.total, score.branch, score.extra) == (total, branch, extra)
@@ -76,8 +93,17 @@ def test_parts_scale_with_the_points_an_edited_rubric_gives():
 
 def test_the_feedback_explains_the_rubric_and_where_the_points_came_from():
     lab = rubrics.default()
-    results = {n: {"exercise": n, "passed": True, "points": EXERCISES[n].points, "fraction": 1.0,
-                   "defined": True, "checks": []} for n in (2, 3, 4) + SPLINES}
+    results = {
+        n: {
+            "exercise": n,
+            "passed": True,
+            "points": EXERCISES[n].points,
+            "fraction": 1.0,
+            "defined": True,
+            "checks": [],
+        }
+        for n in (2, 3, 4) + SPLINES
+    }
     text = SubmissionGrade("ada", results, [], None, lab).feedback()
     assert "Feedback for ada: 100 points (100 / 100)" in text
     assert "plus one branch: mesh generation (5, 6, 7, 8, 9) or splines (10, 11, 12, 13, 14, 15)" in text
@@ -99,30 +125,43 @@ required = [2, 3]
 """
 
 
-@pytest.mark.parametrize("text, message", [
-    ("[points]\n17 = 5\n", "names exercise '17', which labkit does not grade"),
-    ("required = [1]\n[points]\n1 = 5\n", "exercise 1 is not graded"),
-    ("required = [2]\n[points]\n2 = -5\n", "negative points"),
-    ("required = [2]\n[points]\n2 = 'ten'\n", "points must be a number"),
-    ("[points]\n2 = 5\n5 = 5\n10 = 5\n[branches]\nextra_credit = 1\n[[branches.choice]]\nname = 'a'\nexercises = [5, 2]\n"
-     "[[branches.choice]]\nname = 'b'\nexercises = [10, 2]\n", "branches may not overlap"),
-    ("required = [2]\n[points]\n2 = 5\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
-     "[[branches.choice]]\nname = 'b'\nexercises = [2]\n", "branches may not overlap"),
-    ("[points]\n5 = 5\n10 = 6\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
-     "[[branches.choice]]\nname = 'b'\nexercises = [10]\n", "must be worth the same points"),
-    ("[points]\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n", "at least two"),
-    ("title = 'x'\n", "grades nothing"),
-    ("exercises = 'no_such_module:REGISTRY'\nrequired = [2]\n", "cannot load the exercises"),
-    ("exercises = 'labkit.exercises.model:Part'\nrequired = [2]\n", "not a labkit Registry"),
-    ("points = 3\nrequired = [2]\n", "must be a table"),
-    ("required = [2]\n[points]\n2 = 5\n3 = 5\n", "exercise 3 has points but is in no group"),
-    ("required = [2]\nbonus = [3]\n[points]\n2 = 5\n", "unknown key(s) bonus"),
-    ("required = 2\n[points]\n2 = 5\n", "must be a list of exercise numbers"),
-    ("required = [2\n", "is not valid TOML"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("[points]\n17 = 5\n", "names exercise '17', which labkit does not grade"),
+        ("required = [1]\n[points]\n1 = 5\n", "exercise 1 is not graded"),
+        ("required = [2]\n[points]\n2 = -5\n", "negative points"),
+        ("required = [2]\n[points]\n2 = 'ten'\n", "points must be a number"),
+        (
+            "[points]\n2 = 5\n5 = 5\n10 = 5\n[branches]\nextra_credit = 1\n[[branches.choice]]\nname = 'a'\nexercises = [5, 2]\n"
+            "[[branches.choice]]\nname = 'b'\nexercises = [10, 2]\n",
+            "branches may not overlap",
+        ),
+        (
+            "required = [2]\n[points]\n2 = 5\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
+            "[[branches.choice]]\nname = 'b'\nexercises = [2]\n",
+            "branches may not overlap",
+        ),
+        (
+            "[points]\n5 = 5\n10 = 6\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n"
+            "[[branches.choice]]\nname = 'b'\nexercises = [10]\n",
+            "must be worth the same points",
+        ),
+        ("[points]\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n", "at least two"),
+        ("title = 'x'\n", "grades nothing"),
+        ("exercises = 'no_such_module:REGISTRY'\nrequired = [2]\n", "cannot load the exercises"),
+        ("exercises = 'labkit.exercises.model:Part'\nrequired = [2]\n", "not a labkit Registry"),
+        ("points = 3\nrequired = [2]\n", "must be a table"),
+        ("required = [2]\n[points]\n2 = 5\n3 = 5\n", "exercise 3 has points but is in no group"),
+        ("required = [2]\nbonus = [3]\n[points]\n2 = 5\n", "unknown key(s) bonus"),
+        ("required = 2\n[points]\n2 = 5\n", "must be a list of exercise numbers"),
+        ("required = [2\n", "is not valid TOML"),
+    ],
+)
 def test_rubric_errors_are_clear(tmp_path, text, message):
-    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[")
-                       .replace("]", r"\]")):
+    with pytest.raises(
+        ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[").replace("]", r"\]")
+    ):
         rubrics.load(_write(tmp_path, text))
 
 
@@ -141,6 +180,7 @@ def test_cli_prints_the_lab_rubric_and_checks_an_edited_one(tmp_path):
     run = subprocess.run([sys.executable, "-m", "labkit.cli", "rubric"], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0 and rubrics.from_dict(tomllib.loads(run.stdout)) == rubrics.default()
     path = _write(tmp_path, run.stdout.replace("[branches]", "[points]\n16 = -8\n\n[branches]"))
-    run = subprocess.run([sys.executable, "-m", "labkit.cli", "rubric", "--check", str(path)], capture_output=True,
-                         text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "rubric", "--check", str(path)], capture_output=True, text=True, timeout=60
+    )
     assert run.returncode == 2 and "negative points" in run.stderr

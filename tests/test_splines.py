@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
+from helpers import unequal_knots
 from scipy.interpolate import CubicSpline
 
 from labkit import ccspline, eval_pherm, nakspline, ncspline, spline
 from labkit.splines import natural_curvatures
-from helpers import unequal_knots
 
 
 @pytest.fixture
@@ -72,7 +72,7 @@ def _second_derivative_jumps(x, y, slopes):
     """s'' from the left and the right of every interior knot, from the Hermite form."""
     h = np.diff(x)
     d = np.diff(y) / h
-    left_end = (6 * d - 4 * slopes[:-1] - 2 * slopes[1:]) / h   # s'' at x_k on [x_k, x_k+1]
+    left_end = (6 * d - 4 * slopes[:-1] - 2 * slopes[1:]) / h  # s'' at x_k on [x_k, x_k+1]
     right_end = (-6 * d + 2 * slopes[:-1] + 4 * slopes[1:]) / h  # s'' at x_k+1 on [x_k, x_k+1]
     return right_end[:-1], left_end[1:], left_end[0], right_end[-1]
 

@@ -5,6 +5,7 @@ References are labkit's experiments (which test_convergence.py compares with sci
 mathematics; every mistake below is one a student makes, and each must fail its own check with
 its own hint while the right answer passes.
 """
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -16,7 +17,6 @@ import labkit  # noqa: E402
 from labkit import check  # noqa: E402
 from labkit.exercises import experiments, plotted  # noqa: E402
 from labkit.exercises.registry import LAB  # noqa: E402
-from labkit.check import EXERCISES  # noqa: E402
 from labkit.grading import protocol  # noqa: E402
 
 # -- drivers ---------------------------------------------------------------------
@@ -24,6 +24,7 @@ from labkit.grading import protocol  # noqa: E402
 
 def _driver_1d(method, interval=(0.0, 5.0), ntest=4001, relative=True):
     """A student's driver for `method`, written independently of labkit's experiment."""
+
     def driver(ndata, f=labkit.runge, piece=None):
         x = np.linspace(*interval, ndata)
         xtest = np.linspace(*interval, ntest)
@@ -41,6 +42,7 @@ def _driver_1d(method, interval=(0.0, 5.0), ntest=4001, relative=True):
             value = labkit.pchip(x, y, xtest)
         error = np.max(np.abs(exact - value))
         return error / np.max(np.abs(exact)) if relative else error
+
     return driver
 
 
@@ -67,12 +69,17 @@ def test_a_correct_bilinear_driver_passes():
 def test_the_reference_matches_scipy():
     # the drivers are judged against labkit's experiment; here it is against scipy's interpolants
     from scipy.interpolate import CubicHermiteSpline, CubicSpline, PchipInterpolator
+
     x, xtest = np.linspace(0, 5, 21), np.linspace(0, 5, 4001)
     y, yp = labkit.runge(x)
     exact = labkit.runge(xtest)[0]
-    for key, interpolant in (("pherm", CubicHermiteSpline(x, y, yp)), ("complete", CubicSpline(x, y, bc_type=((1, yp[0]), (1, yp[-1])))),
-                             ("natural", CubicSpline(x, y, bc_type="natural")), ("notaknot", CubicSpline(x, y)),
-                             ("pchip", PchipInterpolator(x, y))):
+    for key, interpolant in (
+        ("pherm", CubicHermiteSpline(x, y, yp)),
+        ("complete", CubicSpline(x, y, bc_type=((1, yp[0]), (1, yp[-1])))),
+        ("natural", CubicSpline(x, y, bc_type="natural")),
+        ("notaknot", CubicSpline(x, y)),
+        ("pchip", PchipInterpolator(x, y)),
+    ):
         expected = np.max(np.abs(interpolant(xtest) - exact)) / np.max(np.abs(exact))
         assert LAB.experiment(key).reference([21])[0] == pytest.approx(expected, rel=1e-9), key
 
@@ -86,12 +93,15 @@ def test_an_absolute_error_is_named_although_runge_hides_it(method):
     assert "the error is absolute, not relative to max|f|" in result.hint
 
 
-@pytest.mark.parametrize("slip, kwargs, hint", [
-    ("interval", {"interval": (-5.0, 5.0)}, "measured on [-5, 5] instead of [0, 5]"),
-    ("test points", {"ntest": 401}, "measured at 401 test points instead of 4001"),
-    ("data points", {"ntest": 5}, "measured only at the data points"),
-    ("something else", {"interval": (0.0, 3.0)}, None),
-])
+@pytest.mark.parametrize(
+    "slip, kwargs, hint",
+    [
+        ("interval", {"interval": (-5.0, 5.0)}, "measured on [-5, 5] instead of [0, 5]"),
+        ("test points", {"ntest": 401}, "measured at 401 test points instead of 4001"),
+        ("data points", {"ntest": 5}, "measured only at the data points"),
+        ("something else", {"interval": (0.0, 3.0)}, None),
+    ],
+)
 def test_the_usual_slips_are_told_apart(slip, kwargs, hint):
     result = check.driver("complete", _driver_1d("complete", **kwargs))
     assert not result.passed
@@ -106,12 +116,14 @@ def test_a_driver_measured_only_at_the_data_points_is_told_so():
         x = np.linspace(0, 5, ndata)
         y, yp = f(x)
         return np.max(np.abs(labkit.eval_pherm(x, y, slopes(x, y, yp[0], yp[-1]), x) - y)) / np.max(np.abs(y))
+
     assert "measured only at the data points" in check.driver("complete", at_data).hint
 
 
 def test_a_driver_that_ignores_f_is_caught():
     def ignores_f(ndata, f=labkit.runge, slopes=labkit.ccspline):
         return _driver_1d("complete")(ndata)
+
     result = check.driver("complete", ignores_f)
     assert not result.passed and "compute f from the function passed in" in result.hint
 
@@ -122,6 +134,7 @@ def test_unknown_experiment_is_a_clear_value_error():
 
 
 # -- tables ---------------------------------------------------------------------------
+
 
 def test_a_table_is_what_the_students_own_driver_gives():
     driver = _driver_1d("natural")
@@ -135,15 +148,22 @@ def test_a_table_is_what_the_students_own_driver_gives():
     assert not result.passed and "fill the table by running your driver" in result.hint
 
 
-@pytest.mark.parametrize("errors, detail", [
-    ([0.1, 0.01], "got"), ("eight numbers", "got"), ([1.0] * 7 + [np.nan], "got"), (None, "got"),
-])
+@pytest.mark.parametrize(
+    "errors, detail",
+    [
+        ([0.1, 0.01], "got"),
+        ("eight numbers", "got"),
+        ([1.0] * 7 + [np.nan], "got"),
+        (None, "got"),
+    ],
+)
 def test_a_table_that_is_not_eight_errors_says_what_to_give(errors, detail):
     result = check.table("pherm", errors, _driver_1d("pherm"))
     assert not result.passed and "make errors_pherm a list of 8 positive errors" in result.hint
 
 
 # -- rate answers ---------------------------------------------------------------------
+
 
 def _returning(errors, ndata=labkit.convergence.DEFAULT_NDATA):
     """A driver that returns the given errors for the lab's sizes (as a fabricated one would)."""
@@ -154,8 +174,9 @@ def _table_of(driver, key):
     return [driver(n) for n in LAB.experiment(key).ndata]
 
 
-@pytest.mark.parametrize("method, order", [("pherm", 4), ("complete", 4), ("natural", 2), ("notaknot", 4),
-                                           ("pchip", 2), ("bilinear", 2)])
+@pytest.mark.parametrize(
+    "method, order", [("pherm", 4), ("complete", 4), ("natural", 2), ("notaknot", 4), ("pchip", 2), ("bilinear", 2)]
+)
 def test_the_true_order_is_right_and_its_ratio_or_a_neighbour_is_not(method, order):
     assert LAB.experiment(method).order == order  # what the exercise declares ...
     assert LAB.experiment(method).observed_order == order  # ... is what labkit's own table shows
@@ -163,7 +184,7 @@ def test_the_true_order_is_right_and_its_ratio_or_a_neighbour_is_not(method, ord
     table = _table_of(driver, method)
     assert check.rate(method, order, table, driver).passed
     assert check.rate(method, float(order), tuple(table), driver).passed
-    ratio = check.rate(method, 2 ** order, table, driver)
+    ratio = check.rate(method, 2**order, table, driver)
     assert not ratio.passed and "the ratio Err(n)/Err(2n-1) itself" in repr(ratio)
     assert not check.rate(method, order + 1, table, driver).passed
     # without a driver, or without a table, there is nothing to read the rate from, even for the right answer
@@ -244,11 +265,13 @@ def test_a_rate_that_is_not_a_whole_number_says_so(answer):
 
 # -- Exercise 4: derivatives and plot ------------------------------------------------
 
+
 def _derivatives(sign_y=1.0):
     def limacon_derivatives(t, r0=1.15):
         t = np.asarray(t, dtype=float)
         r = r0 + np.cos(t)
-        return -np.sin(t) * np.cos(t) - r * np.sin(t), sign_y * (-np.sin(t) ** 2 + r * np.cos(t))
+        return -np.sin(t) * np.cos(t) - r * np.sin(t), sign_y * (-(np.sin(t) ** 2) + r * np.cos(t))
+
     return limacon_derivatives
 
 
@@ -313,6 +336,7 @@ def test_something_that_is_not_a_plot_is_told_to_draw_on_the_axes():
 
 # -- Exercise 14: the boiling-water plot ---------------------------------------------
 
+
 def _boiling(data="o", spline_points=201, pchip_points=201, spline_style="-"):
     xdata, ydata = plotted.BOILING
     fig, ax = plt.subplots()
@@ -332,13 +356,16 @@ def test_the_boiling_plot_passes_when_right():
     assert np.max(np.abs(labkit.spline(*plotted.BOILING, x) - labkit.pchip(*plotted.BOILING, x))) > 0.05
 
 
-@pytest.mark.parametrize("kwargs, failing, hint", [
-    ({"data": "o-"}, 0, "linestyle 'none'"),
-    ({"data": "s"}, 0, "marker 'o'"),
-    ({"spline_points": 20}, 1, "at least 100 points"),
-    ({"pchip_points": 5}, 2, "evaluate pchip of the data at many points"),
-    ({"spline_style": "."}, 1, "as a line"),
-])
+@pytest.mark.parametrize(
+    "kwargs, failing, hint",
+    [
+        ({"data": "o-"}, 0, "linestyle 'none'"),
+        ({"data": "s"}, 0, "marker 'o'"),
+        ({"spline_points": 20}, 1, "at least 100 points"),
+        ({"pchip_points": 5}, 2, "evaluate pchip of the data at many points"),
+        ({"spline_style": "."}, 1, "as a line"),
+    ],
+)
 def test_each_plot_mistake_fails_only_its_part(kwargs, failing, hint):
     results = check.boiling_plot(_boiling(**kwargs))
     assert [r.passed for r in results] == [i != failing for i in range(3)]
@@ -370,6 +397,7 @@ def test_plots_cross_to_the_grader_as_their_lines():
 
 # -- Exercise 16(a) and Exercise 9(c) ---------------------------------------------------
 
+
 def test_the_phi_table_is_checked_against_the_definition():
     assert check.phi_table(np.eye(4)).passed
     assert check.phi_table([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]).passed
@@ -383,18 +411,25 @@ def test_the_phi_table_is_checked_against_the_definition():
 
 def _corners9():
     r2 = np.sqrt(2) / 2
-    return [labkit.Corner([0, 1], [np.pi / 4, 0], [0, 1]),
-            labkit.Corner([r2, r2], [r2 * np.pi / 4, -r2 * np.pi / 4], [2 - r2, 2 - r2]),
-            labkit.Corner([2, 2], [2, 0], [2 - r2, 2 - r2]), labkit.Corner([0, 2], [2, 0], [0, 1])]
+    return [
+        labkit.Corner([0, 1], [np.pi / 4, 0], [0, 1]),
+        labkit.Corner([r2, r2], [r2 * np.pi / 4, -r2 * np.pi / 4], [2 - r2, 2 - r2]),
+        labkit.Corner([2, 2], [2, 0], [2 - r2, 2 - r2]),
+        labkit.Corner([0, 2], [2, 0], [0, 1]),
+    ]
 
 
 def _patch_meshes(corners, mirror_ds_dt=True):
     A, B, C, D = corners
     first = labkit.quad_mesh(*labkit.patch(A, B, C, D, np.linspace(0, 1, 20), np.linspace(0, 1, 30)))
-    swap = (lambda c: labkit.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1])) if mirror_ds_dt else \
-        (lambda c: labkit.Corner(c.point[::-1], c.ds[::-1], c.dt[::-1], c.dsdt[::-1]))
-    second = labkit.quad_mesh(*labkit.patch(swap(A), swap(D), swap(C), swap(B), np.linspace(0, 1, 30),
-                                            np.linspace(0, 1, 20)))
+    swap = (
+        (lambda c: labkit.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]))
+        if mirror_ds_dt
+        else (lambda c: labkit.Corner(c.point[::-1], c.ds[::-1], c.dt[::-1], c.dsdt[::-1]))
+    )
+    second = labkit.quad_mesh(
+        *labkit.patch(swap(A), swap(D), swap(C), swap(B), np.linspace(0, 1, 30), np.linspace(0, 1, 20))
+    )
     return first, second
 
 
@@ -406,8 +441,9 @@ def test_the_combined_mesh_is_judged_from_its_data():
     # the shared edge: 20 x 30 + 30 x 20 nodes less the 30 it has
     assert len(region.points) == 1170
     # two meshes side by side without merging: a crack along the shared edge
-    cracked = labkit.QuadMesh(np.vstack((first.points, second.points)),
-                              np.vstack((first.quads, second.quads + len(first.points))))
+    cracked = labkit.QuadMesh(
+        np.vstack((first.points, second.points)), np.vstack((first.quads, second.quads + len(first.points)))
+    )
     result = check.combined_mesh(cracked, corners)
     assert not result.passed and "appear once" in result.hint
     assert not check.combined_mesh(first, corners).passed

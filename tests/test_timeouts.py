@@ -4,6 +4,7 @@ The real workers here run with the none backend (no sandbox needed); the
 end-to-end messages a student sees are tested in test_grading.py and
 test_hostile.py ("the submission's time limit of N s").
 """
+
 import time
 
 import nbformat
@@ -53,8 +54,10 @@ def test_a_request_past_the_submissions_deadline_is_a_notebook_timeout(worker):
 
 def test_a_call_past_its_limit_is_a_cell_timeout_and_a_students_own_timeout_is_not(worker):
     notebook = worker()
-    cells = ["import time\ndef slow():\n    time.sleep(60)\n",
-             "class Timeout(Exception):\n    pass\ndef mine():\n    raise Timeout('my own')\n"]
+    cells = [
+        "import time\ndef slow():\n    time.sleep(60)\n",
+        "class Timeout(Exception):\n    pass\ndef mine():\n    raise Timeout('my own')\n",
+    ]
     ran = notebook.request({"op": "run", "cells": cells, "cell_timeout": 30}, 60)
     assert ran["errors"] == []
     with pytest.raises(remote.CellTimeout) as stopped:
@@ -104,9 +107,11 @@ def stubbed(tmp_path, monkeypatch):
 def test_scoring_tells_timeouts_apart_by_type_not_by_their_words(stubbed):
     # the student sees the same sentences as before, whatever words the exception carries
     assert stubbed(remote.NotebookTimeout("anything")) == [
-        "work.ipynb: stopped after the submission's time limit of 321 s."]
+        "work.ipynb: stopped after the submission's time limit of 321 s."
+    ]
     assert stubbed(remote.CellTimeout("stopped after the time limit: the notebook did not answer in time")) == [
-        "work.ipynb: stopped after the time limit: the notebook did not answer in time."]
+        "work.ipynb: stopped after the time limit: the notebook did not answer in time."
+    ]
     # a grading error whose words merely read like a timeout is not one
     words = "stopped after the total time limit: the notebook did not answer in time"
     assert stubbed(remote.WorkerError(words)) == [f"work.ipynb: {words} while running its cells."]

@@ -1,4 +1,5 @@
 """Bad input gets a ValueError that says what is wrong, never a wrong answer."""
+
 import numpy as np
 import pytest
 

@@ -7,6 +7,7 @@ to the end, ``import labkit`` pulls in nothing of JupyterLab's, and the
 instructor's commands say which extra they need, then work once it is there.
 The notebooks are driven by nbclient from this test's own environment.
 """
+
 import os
 import subprocess
 import sys
@@ -42,12 +43,19 @@ def fresh(tmp_path_factory):
     installed = _run(python, "-m", "pip", "install", "--quiet", wheel)
     seconds = time.perf_counter() - start
     assert installed.returncode == 0, installed.stderr[-3000:]
-    print(f"\nwheel {wheel.name}: {wheel.stat().st_size / 1024:.0f} KiB; core install into a fresh venv {seconds:.1f} s")
+    print(
+        f"\nwheel {wheel.name}: {wheel.stat().st_size / 1024:.0f} KiB; core install into a fresh venv {seconds:.1f} s"
+    )
     kernels = tmp / "kernels"
     spec = _run(python, "-m", "ipykernel", "install", "--prefix", kernels, "--name", KERNEL)
     assert spec.returncode == 0, spec.stderr
-    return {"tmp": tmp, "wheel": wheel, "python": python, "bin": venv / "bin",
-            "jupyter_path": kernels / "share" / "jupyter"}
+    return {
+        "tmp": tmp,
+        "wheel": wheel,
+        "python": python,
+        "bin": venv / "bin",
+        "jupyter_path": kernels / "share" / "jupyter",
+    }
 
 
 def test_the_wheel_ships_the_student_notebooks_and_no_solved_one(fresh):
@@ -66,8 +74,10 @@ def test_the_wheel_ships_the_student_notebooks_and_no_solved_one(fresh):
 def test_the_core_install_has_no_jupyterlab_and_import_labkit_pulls_none_in(fresh):
     for package in ("jupyterlab", "nbclient", "notebook", "jupyter_server"):
         assert _run(fresh["python"], "-c", f"import {package}").returncode != 0, f"{package} came with the core"
-    code = ("import sys, labkit, labkit.check, labkit.plots\n"
-            "print(sorted({m.split('.')[0] for m in sys.modules} & {'jupyterlab', 'nbclient', 'nbformat'}))")
+    code = (
+        "import sys, labkit, labkit.check, labkit.plots\n"
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'jupyterlab', 'nbclient', 'nbformat'}))"
+    )
     run = _run(fresh["python"], "-c", code)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stderr
 
@@ -96,9 +106,10 @@ def test_each_student_notebook_runs_up_to_its_first_stub(fresh, student_folder, 
     # it stopped in the first stub, or in the first cell that calls a stubbed function
     stop = next(i for i, c in enumerate(code) if any(o.output_type == "error" for o in c.outputs))
     assert stop >= first_stub and [o.ename for o in code[stop].outputs if o.output_type == "error"] == [
-        "NotImplementedError"]
-    assert all(c.execution_count for c in code[:stop + 1])
-    assert all(c.execution_count is None for c in code[stop + 1:])
+        "NotImplementedError"
+    ]
+    assert all(c.execution_count for c in code[: stop + 1])
+    assert all(c.execution_count is None for c in code[stop + 1 :])
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)

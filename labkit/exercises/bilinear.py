@@ -8,6 +8,7 @@ The functions handed to the student's ``eval_pbilin`` are module-level
 functions (not lambdas), so that ``labkit grade`` can name them to the
 sandboxed notebook (:data:`labkit.grading.protocol.PASSABLE`).
 """
+
 import numpy as np
 
 from .. import bilinear, functions
@@ -46,7 +47,9 @@ def check_runge2d(fn, seed=None):
     if seed is not None:
         X, Y = case_rng(seed, "bilinear.runge2d").uniform(-3, 3, (2, 5, 4))
     ok, out = call(result, "runge2d on a grid", fn, X, Y)
-    if ok and not result.step("1/(1+(x+y)^2) on arrays", close(out, functions.runge2d(X, Y)), worst(out, functions.runge2d(X, Y))):
+    if ok and not result.step(
+        "1/(1+(x+y)^2) on arrays", close(out, functions.runge2d(X, Y)), worst(out, functions.runge2d(X, Y))
+    ):
         result.hint = "use componentwise operations: 1 / (1 + (x + y)**2)."
     return result
 
@@ -59,8 +62,11 @@ def check_eval_pbilin(fn, seed=None):
     if not ok:
         return result
     X, Y = np.meshgrid(unit, unit, indexing="ij")
-    if not result.step("returns runge2d at the four corners of [0, 1]^2", close(z, functions.runge2d(X, Y)),
-                       worst(z, functions.runge2d(X, Y))):
+    if not result.step(
+        "returns runge2d at the four corners of [0, 1]^2",
+        close(z, functions.runge2d(X, Y)),
+        worst(z, functions.runge2d(X, Y)),
+    ):
         result.hint = "zval(k, l) is I(xval(k), yval(l)): check the order of the indices and the four basis functions."
         return result
     xdata, ydata = np.array([0.0, 0.5, 2.0, 3.0]), np.array([-1.0, 0.0, 2.5])
@@ -75,11 +81,15 @@ def check_eval_pbilin(fn, seed=None):
             return result
         if not result.step(f"reproduces f = {name} on an unequal grid", close(z, f(XV, YV)), worst(z, f(XV, YV))):
             if close(z, f(XV, YV).T):
-                result.hint = ("zval is transposed: zval[k, l] is I(xval[k], yval[l]), one row per value of xval "
-                               f"(shape ({len(xval)}, {len(yval)})).")
+                result.hint = (
+                    "zval is transposed: zval[k, l] is I(xval[k], yval[l]), one row per value of xval "
+                    f"(shape ({len(xval)}, {len(yval)}))."
+                )
             else:
-                result.hint = ("one cell works but a grid does not: use bracket on xval and on yval to find the cell "
-                               "and that cell's corners in the basis functions.")
+                result.hint = (
+                    "one cell works but a grid does not: use bracket on xval and on yval to find the cell "
+                    "and that cell's corners in the basis functions."
+                )
             return result
     return result
 
@@ -95,35 +105,65 @@ def check_phi_table(table):
     area = (x1 - x0) * (y1 - y0)
     P = np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
     x, y = P[:, 0], P[:, 1]
-    expected = np.stack(((x1 - x) * (y1 - y), (x - x0) * (y1 - y), (x - x0) * (y - y0), (x1 - x) * (y - y0)),
-                        axis=1) / area  # expected[n, m] = phi_m(P_n)
+    expected = (
+        np.stack(((x1 - x) * (y1 - y), (x - x0) * (y1 - y), (x - x0) * (y - y0), (x1 - x) * (y - y0)), axis=1) / area
+    )  # expected[n, m] = phi_m(P_n)
     if not result.step("a 4 x 4 table of phi_m(P_n)", close(table, expected), worst(table, expected)):
         try:
             values = floats(table)
-            permutation = (values.shape == (4, 4) and np.allclose(np.sort(values, axis=1), [[0, 0, 0, 1]] * 4)
-                           and np.allclose(values.sum(axis=0), 1))
+            permutation = (
+                values.shape == (4, 4)
+                and np.allclose(np.sort(values, axis=1), [[0, 0, 0, 1]] * 4)
+                and np.allclose(values.sum(axis=0), 1)
+            )
         except (TypeError, ValueError):
             permutation = False
         if permutation:
-            result.hint = ("your corners are numbered in another order: P_1 = (x0, y0), P_2 = (x1, y0), "
-                           "P_3 = (x1, y1), P_4 = (x0, y1), counter-clockwise; row n is P_n, column m is phi_m.")
+            result.hint = (
+                "your corners are numbered in another order: P_1 = (x0, y0), P_2 = (x1, y0), "
+                "P_3 = (x1, y1), P_4 = (x0, y1), counter-clockwise; row n is P_n, column m is phi_m."
+            )
         else:
-            result.hint = ("evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
-                           "on the side x = x1, so each phi_m vanishes at three corners.")
+            result.hint = (
+                "evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
+                "on the side x = x1, so each phi_m vanishes at three corners."
+            )
     return result
 
 
-BILINEAR = Experiment("bilinear", 2, "test_pbilin_interpolate", "errors_bilinear", "rate_bilinear",
-                      pieces=(bilinear.eval_pbilin,), ndata=(11, 21, 41, 81, 161), ntest=401)
+BILINEAR = Experiment(
+    "bilinear",
+    2,
+    "test_pbilin_interpolate",
+    "errors_bilinear",
+    "rate_bilinear",
+    pieces=(bilinear.eval_pbilin,),
+    ndata=(11, 21, 41, 81, 161),
+    ntest=401,
+)
 
 EXERCISES = (
-    Exercise(16, ("phi_table", "runge2d", "eval_pbilin") + BILINEAR.names(),
-             (Part("phi_table", 1, check_phi_table, ("phi_table",)),
-              Part("runge2d", 1, check_runge2d, ("runge2d",), seeded=True, refused=OWN_FUNCTIONS),
-              Part("eval_pbilin", 3, check_eval_pbilin, ("eval_pbilin",), seeded=True, refused=INTERPOLANTS,
-                   passes=(functions.runge2d,) + tuple(function for _, function in BILINEAR_FUNCTIONS)))
-             + BILINEAR.parts(),
-             notebook="06_bilinear.ipynb",
-             answers=("16(a): why the phi table makes I the bilinear interpolant",
-                      "the order, against piecewise linear in one dimension")),
+    Exercise(
+        16,
+        ("phi_table", "runge2d", "eval_pbilin") + BILINEAR.names(),
+        (
+            Part("phi_table", 1, check_phi_table, ("phi_table",)),
+            Part("runge2d", 1, check_runge2d, ("runge2d",), seeded=True, refused=OWN_FUNCTIONS),
+            Part(
+                "eval_pbilin",
+                3,
+                check_eval_pbilin,
+                ("eval_pbilin",),
+                seeded=True,
+                refused=INTERPOLANTS,
+                passes=(functions.runge2d,) + tuple(function for _, function in BILINEAR_FUNCTIONS),
+            ),
+        )
+        + BILINEAR.parts(),
+        notebook="06_bilinear.ipynb",
+        answers=(
+            "16(a): why the phi table makes I the bilinear interpolant",
+            "the order, against piecewise linear in one dimension",
+        ),
+    ),
 )

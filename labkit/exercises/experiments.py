@@ -29,12 +29,13 @@ an earlier exercise is not counted again here. The functions handed over are
 module-level functions, so ``labkit grade`` can name them to the sandboxed
 notebook (:data:`labkit.grading.protocol.PASSABLE`).
 """
+
 import functools
 from dataclasses import dataclass
 
 import numpy as np
 
-from .. import bilinear, convergence, functions, piecewise, splines
+from .. import convergence, functions, piecewise, splines
 from .model import EXPERIMENTS, Part
 from .result import CheckResult, call, case_rng, floats, shown
 
@@ -127,12 +128,38 @@ class Experiment:
         """
         driver, table, rate = self.weights
         both = (self.table, self.rate, self.driver)
-        return (ExperimentPart(self.driver, driver, check_driver, reads=(self.driver,), seeded=True,
-                               refused=EXPERIMENTS, passes=self.passes, experiment=self),
-                ExperimentPart(self.table, table, check_experiment, reads=both, index=0, refused=EXPERIMENTS,
-                               functions=(self.table, self.driver), experiment=self),
-                ExperimentPart(self.rate, rate, check_experiment, reads=both, index=1, refused=EXPERIMENTS,
-                               functions=(self.rate, self.driver), experiment=self))
+        return (
+            ExperimentPart(
+                self.driver,
+                driver,
+                check_driver,
+                reads=(self.driver,),
+                seeded=True,
+                refused=EXPERIMENTS,
+                passes=self.passes,
+                experiment=self,
+            ),
+            ExperimentPart(
+                self.table,
+                table,
+                check_experiment,
+                reads=both,
+                index=0,
+                refused=EXPERIMENTS,
+                functions=(self.table, self.driver),
+                experiment=self,
+            ),
+            ExperimentPart(
+                self.rate,
+                rate,
+                check_experiment,
+                reads=both,
+                index=1,
+                refused=EXPERIMENTS,
+                functions=(self.rate, self.driver),
+                experiment=self,
+            ),
+        )
 
     def names(self):
         return (self.driver, self.table, self.rate)
@@ -150,14 +177,15 @@ class ExperimentPart(Part):
         return {check_driver: "driver", check_experiment: ("table" if self.index == 0 else "rate")}[self.check]
 
     def run(self, namespace, seed=None):
-        values = [namespace[name] if name in namespace or self.check is check_driver else MISSING
-                  for name in self.reads]
+        values = [
+            namespace[name] if name in namespace or self.check is check_driver else MISSING for name in self.reads
+        ]
         if self.check is check_driver:
             return check_driver(self.experiment, *values, seed=seed)
         return check_experiment(self.experiment, *values)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _reference_order(method):
     """Computed once per experiment: a grading run asks for it once per submission."""
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), method.reference(method.ndata)).order
@@ -190,13 +218,18 @@ def _diagnosis(method, got, ndata):
     if number is None:
         return None
     if abs(number) < 1e-14:
-        return ("The error is 0: it looks measured only at the data points, where every interpolant is exact; "
-                f"use {method.ntest} equally spaced test points.")
+        return (
+            "The error is 0: it looks measured only at the data points, where every interpolant is exact; "
+            f"use {method.ntest} equally spaced test points."
+        )
     other_points = (4000, 401, 1001, 1000, 201, 101, 100, 40001) if method.ntest == 4001 else (400, 4001, 101, 100, 201)
-    slips = [(f"The error looks measured on [{a:g}, {b:g}] instead of [0, 5].", {"interval": (a, b)})
-             for a, b in ((-5.0, 5.0), (0.0, 1.0), (-1.0, 1.0), (0.0, 10.0), (1.0, 5.0))]
-    slips += [(f"The error looks measured at {n} test points instead of {method.ntest}.", {"ntest": n})
-              for n in other_points]
+    slips = [
+        (f"The error looks measured on [{a:g}, {b:g}] instead of [0, 5].", {"interval": (a, b)})
+        for a, b in ((-5.0, 5.0), (0.0, 1.0), (-1.0, 1.0), (0.0, 10.0), (1.0, 5.0))
+    ]
+    slips += [
+        (f"The error looks measured at {n} test points instead of {method.ntest}.", {"ntest": n}) for n in other_points
+    ]
     for description, options in slips:
         try:
             expected = method.reference([ndata], **options)[0]
@@ -212,7 +245,7 @@ def _diagnosis(method, got, ndata):
 
 OTHER_METHOD_HINTS = {
     ("notaknot", "complete"): "spline(xdata, ydata, xval) with ydata alone gives the not-a-knot spline; with the "
-                              "end slopes added to ydata it gives the complete one",
+    "end slopes added to ydata it gives the complete one",
     ("natural", "complete"): "use the slopes function passed in (your ncspline), not ccspline",
     ("complete", "natural"): "use the slopes function passed in (your ccspline) with the end slopes f'(0), f'(5)",
     ("pchip", "notaknot"): "use pchip, not spline",
@@ -229,17 +262,33 @@ def _other_methods(method, ndata):
         if other == method.key:
             continue
         advice = OTHER_METHOD_HINTS.get((method.key, other), f"build the {method.title.lower()} itself")
-        found.append((f"That is the {convergence.METHOD_TITLES[other].lower()}'s error, not the {method.title.lower()}'s: "
-                      f"{advice}.", _reference_error(other, ndata)))
+        found.append(
+            (
+                f"That is the {convergence.METHOD_TITLES[other].lower()}'s error, not the {method.title.lower()}'s: "
+                f"{advice}.",
+                _reference_error(other, ndata),
+            )
+        )
     if method.key == "complete":
-        found += [(f"The end slopes look like {wrong}: the complete spline takes the derivatives f returns at "
-                   "the first and the last data point, in that order.", _complete_error(ndata, ends))
-                  for wrong, ends in (("0 and 0", lambda yp: (0.0, 0.0)),
-                                      ("the last and the first (swapped)", lambda yp: (yp[-1], yp[0])))]
+        found += [
+            (
+                f"The end slopes look like {wrong}: the complete spline takes the derivatives f returns at "
+                "the first and the last data point, in that order.",
+                _complete_error(ndata, ends),
+            )
+            for wrong, ends in (
+                ("0 and 0", lambda yp: (0.0, 0.0)),
+                ("the last and the first (swapped)", lambda yp: (yp[-1], yp[0])),
+            )
+        ]
     if method.key == "pchip":
-        found.append(("The slopes look like arithmetic means of neighbouring secants: pchip takes their harmonic "
-                      "mean (and 0 where the data turn), which keeps the interpolant monotone.",
-                      _arithmetic_mean_error(ndata)))
+        found.append(
+            (
+                "The slopes look like arithmetic means of neighbouring secants: pchip takes their harmonic "
+                "mean (and 0 where the data turn), which keeps the interpolant monotone.",
+                _arithmetic_mean_error(ndata),
+            )
+        )
     return found
 
 
@@ -260,6 +309,7 @@ def _complete_error(ndata, ends):
 
 def _arithmetic_mean_error(ndata):
     """Arithmetic means of the neighbouring secants as slopes (a pchip slip)."""
+
     def slopes(x, y, yp):
         secants = np.diff(y) / np.diff(x)
         return np.concatenate(([secants[0]], (secants[:-1] + secants[1:]) / 2, [secants[-1]]))
@@ -280,19 +330,28 @@ def check_driver(method, fn, seed=None):
     if seed is not None:  # the grader's fresh size: never one of the sizes checked anyway
         fresh = [n for n in range(6, 60) if n not in method.ndata]
         sizes += (int(case_rng(seed, f"drivers.driver.{method.key}").choice(fresh)),)
-    where = (f"[0, 5]^2 with {method.ntest} x {method.ntest} test points" if method.key == "bilinear"
-             else f"[0, 5] with {method.ntest} test points")
+    where = (
+        f"[0, 5]^2 with {method.ntest} x {method.ntest} test points"
+        if method.key == "bilinear"
+        else f"[0, 5] with {method.ntest} test points"
+    )
     for ndata in sizes:
         ok, err = call(result, f"ndata = {ndata}", fn, ndata, method.f(), *method.pieces)
         if not ok:
             return result
         expected = method.reference([ndata])[0]
-        if not result.step(f"Err({ndata}) = max|f - p| / max|f| on {where}",
-                           _agrees(err, expected), f"got {shown(err)}, expected {expected:.6e}"):
+        if not result.step(
+            f"Err({ndata}) = max|f - p| / max|f| on {where}",
+            _agrees(err, expected),
+            f"got {shown(err)}, expected {expected:.6e}",
+        ):
             slip = _diagnosis(method, err, ndata)
-            result.hint = (slip if slip else
-                           f"use ndata equally spaced data points on [0, 5] from f, {method.ntest} equally spaced "
-                           "test points on [0, 5], and divide the largest error by max|f| there.")
+            result.hint = (
+                slip
+                if slip
+                else f"use ndata equally spaced data points on [0, 5] from f, {method.ntest} equally spaced "
+                "test points on [0, 5], and divide the largest error by max|f| there."
+            )
             return result
     ndata = SHIFTED_PROBE
     other = "3 / (1 + (x + y - 1)^2)" if method.key == "bilinear" else "3 / (1 + (x - 1)^2)"
@@ -300,13 +359,19 @@ def check_driver(method, fn, seed=None):
     if not ok:
         return result
     expected = method.reference([ndata], scaled=True)[0]
-    if not result.step(f"the error is relative to max|f|, for f = {other} too",
-                       _agrees(err, expected), f"got {shown(err)}, expected {expected:.6e}"):
+    if not result.step(
+        f"the error is relative to max|f|, for f = {other} too",
+        _agrees(err, expected),
+        f"got {shown(err)}, expected {expected:.6e}",
+    ):
         number = _number(err)
         tripled = number is not None and abs(number - 3 * expected) <= DRIVER_TOLERANCE * 3 * expected
-        result.hint = ("the error is absolute, not relative to max|f|: divide the largest error by max|f| over "
-                       "the test points (for the Runge function on [0, 5] that is 1, which hides the slip)."
-                       if tripled else "compute f from the function passed in as `f`, not from runge itself.")
+        result.hint = (
+            "the error is absolute, not relative to max|f|: divide the largest error by max|f| over "
+            "the test points (for the Runge function on [0, 5] that is 1, which hides the slip)."
+            if tripled
+            else "compute f from the function passed in as `f`, not from runge itself."
+        )
     return result
 
 
@@ -331,16 +396,21 @@ def check_rate(method, answer, errors, fn):
 
 
 def _no_experiment(method, values, whose="the", verdict="this table shows no experiment"):
-    return (f"{whose} errors do not shrink as ndata grows (Err({method.ndata[0]}) = {values[0]:.3e}, "
-            f"Err({method.ndata[-1]}) = {values[-1]:.3e}): {verdict}")
+    return (
+        f"{whose} errors do not shrink as ndata grows (Err({method.ndata[0]}) = {values[0]:.3e}, "
+        f"Err({method.ndata[-1]}) = {values[-1]:.3e}): {verdict}"
+    )
 
 
 def _own_errors(method, fn, result):
     """What the student's driver returns for each of the lab's sizes, called as the student would
     (``fn(ndata)``, its own defaults); None, with a failed step in `result`, if it does not run."""
     if fn is None or fn is MISSING:
-        result.fail(f"{method.driver} is defined", "not defined when the notebook finished",
-                    f"this part is read from what {method.driver} returns: define it first.")
+        result.fail(
+            f"{method.driver} is defined",
+            "not defined when the notebook finished",
+            f"this part is read from what {method.driver} returns: define it first.",
+        )
         return None
     own = []
     for ndata in method.ndata:
@@ -350,9 +420,11 @@ def _own_errors(method, fn, result):
             return None
         own.append(_number(err))
     if None in own or _numbers(own) is None:
-        result.fail(f"{method.driver} returns one positive error per ndata",
-                    f"got {_shown_errors([np.nan if v is None else v for v in own])}",
-                    f"make {method.driver}(ndata) return the relative max error as one positive number.")
+        result.fail(
+            f"{method.driver} returns one positive error per ndata",
+            f"got {_shown_errors([np.nan if v is None else v for v in own])}",
+            f"make {method.driver}(ndata) return the relative max error as one positive number.",
+        )
         return None
     return np.array(own)
 
@@ -385,28 +457,47 @@ def _table(method, errors, own, result):
     sizes = ", ".join(map(str, method.ndata))
     description = f"one error per ndata = {sizes}"
     if errors is MISSING:
-        return result.fail(f"{method.table} is defined", "not defined when the notebook finished",
-                           f"run the cell that fills {method.table} (and keep its name).")
+        return result.fail(
+            f"{method.table} is defined",
+            "not defined when the notebook finished",
+            f"run the cell that fills {method.table} (and keep its name).",
+        )
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
-        return result.fail(description, f"got {_shown_errors(errors)}",
-                           f"make {method.table} a list of {len(method.ndata)} positive errors: "
-                           f"[{method.driver}(n) for n in {list(method.ndata)}].")
+        return result.fail(
+            description,
+            f"got {_shown_errors(errors)}",
+            f"make {method.table} a list of {len(method.ndata)} positive errors: "
+            f"[{method.driver}(n) for n in {list(method.ndata)}].",
+        )
     result.step(description, True)
     agree = bool(np.allclose(values, own, rtol=PRINTED, atol=0))
-    if not result.step(f"the errors are what {method.driver} returns for each ndata (to 4 significant digits)",
-                       agree, f"got {np.array2string(values, precision=3)}"):
-        wrong = [n for n, mine, theirs in zip(method.ndata, values, own)
-                 if not np.isclose(mine, theirs, rtol=PRINTED, atol=0)]
+    if not result.step(
+        f"the errors are what {method.driver} returns for each ndata (to 4 significant digits)",
+        agree,
+        f"got {np.array2string(values, precision=3)}",
+    ):
+        wrong = [
+            n
+            for n, mine, theirs in zip(method.ndata, values, own)
+            if not np.isclose(mine, theirs, rtol=PRINTED, atol=0)
+        ]
         rows = ", ".join(f"Err({n})" for n in wrong[:3]) + (" and more" if len(wrong) > 3 else "")
-        result.hint = (f"{rows} in your table {'is' if len(wrong) == 1 else 'are'} not what {method.driver} returns: "
-                       f"fill the table by running your driver, [{method.driver}(n) for n in {list(method.ndata)}].")
+        result.hint = (
+            f"{rows} in your table {'is' if len(wrong) == 1 else 'are'} not what {method.driver} returns: "
+            f"fill the table by running your driver, [{method.driver}(n) for n in {list(method.ndata)}]."
+        )
         return result
     order = table_order(method, values)
-    if not result.step(f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across "
-                       "the table)", order >= MIN_ORDER, _no_experiment(method, values)):
-        result.hint = (f"{method.driver} must interpolate f from ndata points and measure the error at the test "
-                       "points; with more points the error gets smaller.")
+    if not result.step(
+        f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across the table)",
+        order >= MIN_ORDER,
+        _no_experiment(method, values),
+    ):
+        result.hint = (
+            f"{method.driver} must interpolate f from ndata points and measure the error at the test "
+            "points; with more points the error gets smaller."
+        )
     return result
 
 
@@ -466,36 +557,53 @@ def _rate(method, answer, errors, own, result):
         return result
     description = "the rate is the exponent p of the power of two 2**p that your table's ratios settle near"
     if supported_order(method, own) is None:
-        return result.fail(description, _no_experiment(method, own, f"{method.driver}'s",
-                                                       "they show no experiment, so there is no rate to read"),
-                           f"fix {method.driver} so that its errors shrink, refill {method.table}, then read the "
-                           "rate off the ratios.")
+        return result.fail(
+            description,
+            _no_experiment(method, own, f"{method.driver}'s", "they show no experiment, so there is no rate to read"),
+            f"fix {method.driver} so that its errors shrink, refill {method.table}, then read the rate off the ratios.",
+        )
     if answer is MISSING:
-        return result.fail(f"{method.rate} is defined", "not defined when the notebook finished",
-                           f"run the cell that sets {method.rate} (and keep its name).")
+        return result.fail(
+            f"{method.rate} is defined",
+            "not defined when the notebook finished",
+            f"run the cell that sets {method.rate} (and keep its name).",
+        )
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
-        return result.fail(description, f"{method.table} is not a table of {len(method.ndata)} positive errors, "
-                                        "so there is nothing to read the rate from",
-                           f"fill {method.table} from your driver first, then read the rate off its ratios.")
+        return result.fail(
+            description,
+            f"{method.table} is not a table of {len(method.ndata)} positive errors, "
+            "so there is nothing to read the rate from",
+            f"fill {method.table} from your driver first, then read the rate off its ratios.",
+        )
     supported = supported_order(method, values)
     if supported is None:
-        return result.fail(description, _no_experiment(method, values, "your table's",
-                                                       "this table shows no experiment, so it supports no rate"),
-                           f"fill {method.table} by running {method.driver}, then read the rate off the ratios.")
+        return result.fail(
+            description,
+            _no_experiment(method, values, "your table's", "this table shows no experiment, so it supports no rate"),
+            f"fill {method.table} by running {method.driver}, then read the rate off the ratios.",
+        )
     number = _number(answer)
     if number is None or number != round(number):
-        return result.fail(description, f"got {shown(answer)}",
-                           f"set {method.rate} to a whole number p: the ratios Err(41)/Err(81), ... are close to 2**p.")
+        return result.fail(
+            description,
+            f"got {shown(answer)}",
+            f"set {method.rate} to a whole number p: the ratios Err(41)/Err(81), ... are close to 2**p.",
+        )
     p = int(round(number))
     if p == supported:
         result.step(description, True)
         return result
     exponent = p.bit_length() - 1 if p > 1 else None
-    if exponent is not None and p == 2 ** exponent and exponent == supported:
-        return result.fail(description, f"got {p}, which is the ratio Err(n)/Err(2n-1) itself",
-                           f"the rate is the exponent p that gives {p} = 2**p.")
-    return result.fail(description, f"got {p}, which is not the exponent of the power of two your table's "
-                                    "ratios settle near",
-                       "take the ratios Err(41)/Err(81), Err(81)/Err(161), ... of your table; they settle near a "
-                       "power of two 2**p, and p is the rate.")
+    if exponent is not None and p == 2**exponent and exponent == supported:
+        return result.fail(
+            description,
+            f"got {p}, which is the ratio Err(n)/Err(2n-1) itself",
+            f"the rate is the exponent p that gives {p} = 2**p.",
+        )
+    return result.fail(
+        description,
+        f"got {p}, which is not the exponent of the power of two your table's ratios settle near",
+        "take the ratios Err(41)/Err(81), Err(81)/Err(161), ... of your table; they settle near a "
+        "power of two 2**p, and p is the rate.",
+    )

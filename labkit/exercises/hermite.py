@@ -7,6 +7,7 @@ The maths is derived in ``notebooks/02_convergence.ipynb``. References are
 labkit's :func:`labkit.eval_pherm` and :func:`labkit.hermite_basis`, and the
 polynomials a cubic Hermite interpolant must reproduce exactly.
 """
+
 import numpy as np
 
 from .. import functions, piecewise
@@ -44,19 +45,24 @@ def check_eval_pherm(fn, seed=None):
     wrong = _monomials(fn, [0.0, 2.0], result, "[0, 2]")
     if wrong is None:
         return result
-    if not result.step("reproduces 1, x, x^2, x^3 on [0, 2] at x = -1, 0.5, 1.5, 3", not wrong,
-                       f"wrong for x^{wrong}" if wrong else ""):
+    if not result.step(
+        "reproduces 1, x, x^2, x^3 on [0, 2] at x = -1, 0.5, 1.5, 3", not wrong, f"wrong for x^{wrong}" if wrong else ""
+    ):
         return _narrow_pherm(fn, result)
     rng = case_rng(seed, "hermite.eval_pherm")
     xdata = np.cumsum(rng.uniform(0.2, 1.5, 8))
     ydata, ypdata = rng.normal(size=8), rng.normal(size=8)
     xval = np.linspace(xdata[0] - 0.5, xdata[-1] + 0.5, 57)
     ok, yval = call(result, "several unequal intervals", fn, xdata, ydata, ypdata, xval)
-    if ok and not result.step("several unequal intervals agree with labkit.eval_pherm",
-                              close(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval)),
-                              worst(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval))):
-        result.hint = ("one interval works but several do not: use bracket(xdata, xval) to pick the "
-                       "interval k of each point, and x_k, x_{k+1} of that interval in h1..h4.")
+    if ok and not result.step(
+        "several unequal intervals agree with labkit.eval_pherm",
+        close(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval)),
+        worst(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval)),
+    ):
+        result.hint = (
+            "one interval works but several do not: use bracket(xdata, xval) to pick the "
+            "interval k of each point, and x_k, x_{k+1} of that interval in h1..h4."
+        )
     return result
 
 
@@ -65,8 +71,9 @@ def _narrow_pherm(fn, result):
     wrong_unit = _monomials(fn, [0.0, 1.0], result, "[0, 1]")
     if wrong_unit is None:
         return result
-    unit_ok = result.step("monomials on [0, 1] (interval length 1)", not wrong_unit,
-                          f"wrong for x^{wrong_unit}" if wrong_unit else "")
+    unit_ok = result.step(
+        "monomials on [0, 1] (interval length 1)", not wrong_unit, f"wrong for x^{wrong_unit}" if wrong_unit else ""
+    )
     # on [0, 1] every denominator is 1; on [0, 2] they are not
     interval = [0.0, 1.0] if not unit_ok else [0.0, 2.0]
     bad = _basis_failures(fn, interval, result)
@@ -75,8 +82,10 @@ def _narrow_pherm(fn, result):
     label = f"each Hermite basis function alone on [{interval[0]:g}, {interval[1]:g}]"
     if not bad:
         result.step(label, True)
-        result.hint = ("each basis function is right, so the combination is wrong: "
-                       "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
+        result.hint = (
+            "each basis function is right, so the combination is wrong: "
+            "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4)."
+        )
         return result
     name, factor, other = bad[0]
     if factor == -1 and not unit_ok:
@@ -89,29 +98,41 @@ def _narrow_pherm(fn, result):
             factor, interval, unit_ok = factor2, [0.0, 2.0], True
             label = "each Hermite basis function alone on [0, 2]"
     if other is not None and {name, other} in ({"h1", "h2"}, {"h3", "h4"}):
-        hint = (f"with only the data of {name} set, your interpolant gives {other}: the values and the slopes are "
-                "swapped in the combination. The value y_k goes with h1 and the slope y'_k with h2 "
-                "(y_{k+1} with h3, y'_{k+1} with h4), equation (4).")
+        hint = (
+            f"with only the data of {name} set, your interpolant gives {other}: the values and the slopes are "
+            "swapped in the combination. The value y_k goes with h1 and the slope y'_k with h2 "
+            "(y_{k+1} with h3, y'_{k+1} with h4), equation (4)."
+        )
     elif other is not None and {name, other} in ({"h1", "h3"}, {"h2", "h4"}):
-        hint = (f"with only the data of {name} set, your interpolant gives {other}: the two ends of the interval "
-                "are swapped in the combination. The data at x_k (y_k, y'_k) go with h1 and h2, the data at "
-                "x_{k+1} with h3 and h4, equation (4).")
+        hint = (
+            f"with only the data of {name} set, your interpolant gives {other}: the two ends of the interval "
+            "are swapped in the combination. The data at x_k (y_k, y'_k) go with h1 and h2, the data at "
+            "x_{k+1} with h3 and h4, equation (4)."
+        )
     elif other is not None:
-        hint = (f"with only the data of {name} set, your interpolant gives {other}: the combination pairs the data "
-                "with the wrong basis functions. p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4).")
+        hint = (
+            f"with only the data of {name} set, your interpolant gives {other}: the combination pairs the data "
+            "with the wrong basis functions. p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4)."
+        )
     elif factor == -1:
-        hint = (f"{name} has the wrong sign: compare its factors with the lab's definition, a minus sign at a time "
-                "(x - x_{k+1} and x_k - x_{k+1} are not the same).")
+        hint = (
+            f"{name} has the wrong sign: compare its factors with the lab's definition, a minus sign at a time "
+            "(x - x_{k+1} and x_k - x_{k+1} are not the same)."
+        )
     elif factor is not None or unit_ok:
         times = f" times {factor:g}" if factor is not None else ""
-        hint = (f"{name} is the right polynomial{times} on [{interval[0]:g}, {interval[1]:g}]: its denominator is wrong "
-                "(the denominators are (x_k - x_{k+1})^3 for h1, (x_k - x_{k+1})^2 for h2, "
-                "(x_{k+1} - x_k)^3 for h3 and (x_{k+1} - x_k)^2 for h4).")
+        hint = (
+            f"{name} is the right polynomial{times} on [{interval[0]:g}, {interval[1]:g}]: its denominator is wrong "
+            "(the denominators are (x_k - x_{k+1})^3 for h1, (x_k - x_{k+1})^2 for h2, "
+            "(x_{k+1} - x_k)^3 for h3 and (x_{k+1} - x_k)^2 for h4)."
+        )
         if factor is None:
             hint = hint.replace(" is the right polynomial on", " is right on [0, 1] but not on")
     else:
-        hint = (f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
-                "polynomials, factor by factor.")
+        hint = (
+            f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
+            "polynomials, factor by factor."
+        )
     result.fail(label, f"wrong: {', '.join(n for n, _, _ in bad)}", hint)
     return result
 
@@ -149,6 +170,7 @@ def _constant_factor(got, want):
 
 # -- Exercise 3 ---------------------------------------------------------------
 
+
 def check_runge(fn, seed=None):
     """Check ``runge(x) -> (y, yprime)`` against 1/(1+x^2) and its derivative."""
     result = CheckResult("runge")
@@ -160,22 +182,28 @@ def check_runge(fn, seed=None):
         return result
     out = several(got, 2)
     if out is None:
-        return result.fail("runge(x) returns (y, yprime)", f"got {shown(got)}",
-                           "return both values: `return y, yprime`.")
+        return result.fail(
+            "runge(x) returns (y, yprime)", f"got {shown(got)}", "return both values: `return y, yprime`."
+        )
     y, yprime = functions.runge(x)
     if not result.step("y = 1/(1+x^2)", close(out[0], y), "" if close(out[0], y) else worst(out[0], y)):
         result.hint = "use componentwise operations: 1 / (1 + x**2)."
         return result
     if _sign_slip(out[1], yprime):
-        return result.fail("yprime = -2x/(1+x^2)^2", "yprime has the wrong sign",
-                           "yprime has the wrong sign: the derivative of 1/(1+x^2) is -2x/(1+x^2)^2 (chain rule).")
-    if not result.step("yprime = -2x/(1+x^2)^2", close(out[1], yprime),
-                       "" if close(out[1], yprime) else worst(out[1], yprime)):
+        return result.fail(
+            "yprime = -2x/(1+x^2)^2",
+            "yprime has the wrong sign",
+            "yprime has the wrong sign: the derivative of 1/(1+x^2) is -2x/(1+x^2)^2 (chain rule).",
+        )
+    if not result.step(
+        "yprime = -2x/(1+x^2)^2", close(out[1], yprime), "" if close(out[1], yprime) else worst(out[1], yprime)
+    ):
         result.hint = "differentiate 1/(1+x^2) with the chain rule: -2x/(1+x^2)^2."
     return result
 
 
 # -- Exercise 4 ---------------------------------------------------------------
+
 
 def _sign_slip(got, want):
     """'has the wrong sign' if got == -want (and want is not zero), else ''."""
@@ -203,38 +231,73 @@ def check_limacon_derivatives(fn, seed=None):
         if out is None:
             return result.fail(label, f"got {shown(got)}", "return both derivatives: `return dxdt, dydt`.")
         _, _, dxdt, dydt = functions.limacon(t, r0=r0)
-        for name, got, want, formula in (("dx/dt", out[0], dxdt, "-sin t cos t - r sin t"),
-                                         ("dy/dt", out[1], dydt, "-sin^2 t + r cos t")):
+        for name, got, want, formula in (
+            ("dx/dt", out[0], dxdt, "-sin t cos t - r sin t"),
+            ("dy/dt", out[1], dydt, "-sin^2 t + r cos t"),
+        ):
             if not result.step(f"{label}: {name} = {formula}", close(got, want), worst(got, want)):
                 r = r0 + np.cos(t)
                 no_product_rule = -r * np.sin(t) if name == "dx/dt" else r * np.cos(t)
                 if close(got, no_product_rule):
-                    result.hint = (f"{name} leaves out the product rule: r = r0 + cos t depends on t too, so it "
-                                   "has a second term with dr/dt = -sin t.")
+                    result.hint = (
+                        f"{name} leaves out the product rule: r = r0 + cos t depends on t too, so it "
+                        "has a second term with dr/dt = -sin t."
+                    )
                     return result
                 slip = _sign_slip(got, want)
-                result.hint = (f"{name} {slip}: differentiate with the product rule, r' = -sin t."
-                               if slip else f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "
-                               "with the product rule, using dr/dt = -sin t; compare with a centred difference.")
+                result.hint = (
+                    f"{name} {slip}: differentiate with the product rule, r' = -sin t."
+                    if slip
+                    else f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "
+                    "with the product rule, using dr/dt = -sin t; compare with a centred difference."
+                )
                 return result
     return result
 
 
-PHERM = Experiment("pherm", 4, "test_pherm_interpolate", "errors_pherm", "rate_pherm", weights=(6, 3, 3),
-                   pieces=(piecewise.eval_pherm,))
+PHERM = Experiment(
+    "pherm",
+    4,
+    "test_pherm_interpolate",
+    "errors_pherm",
+    "rate_pherm",
+    weights=(6, 3, 3),
+    pieces=(piecewise.eval_pherm,),
+)
 
 EXERCISES = (
-    Exercise(2, ("eval_pherm",), (Part("eval_pherm", 10, check_eval_pherm, ("eval_pherm",), seeded=True,
-                                       refused=INTERPOLANTS),),
-             notebook="02_convergence.ipynb"),
-    Exercise(3, ("runge",) + PHERM.names(),
-             (Part("runge", 3, check_runge, ("runge",), seeded=True, refused=OWN_FUNCTIONS),) + PHERM.parts(),
-             notebook="02_convergence.ipynb",
-             answers=("the order the table shows, against piecewise linear",)),
-    Exercise(4, ("limacon_derivatives", "ax4"),
-             (Part("limacon_derivatives", 8, check_limacon_derivatives, ("limacon_derivatives",), seeded=True,
-                   refused=OWN_FUNCTIONS),
-              Part("ax4", 7, check_limacon_plot,
-                   ("ax4", Together(("tdata", "xdata", "ydata", "xpdata", "ypdata"), required=False)))),
-             notebook="01_limacon.ipynb"),
+    Exercise(
+        2,
+        ("eval_pherm",),
+        (Part("eval_pherm", 10, check_eval_pherm, ("eval_pherm",), seeded=True, refused=INTERPOLANTS),),
+        notebook="02_convergence.ipynb",
+    ),
+    Exercise(
+        3,
+        ("runge",) + PHERM.names(),
+        (Part("runge", 3, check_runge, ("runge",), seeded=True, refused=OWN_FUNCTIONS),) + PHERM.parts(),
+        notebook="02_convergence.ipynb",
+        answers=("the order the table shows, against piecewise linear",),
+    ),
+    Exercise(
+        4,
+        ("limacon_derivatives", "ax4"),
+        (
+            Part(
+                "limacon_derivatives",
+                8,
+                check_limacon_derivatives,
+                ("limacon_derivatives",),
+                seeded=True,
+                refused=OWN_FUNCTIONS,
+            ),
+            Part(
+                "ax4",
+                7,
+                check_limacon_plot,
+                ("ax4", Together(("tdata", "xdata", "ydata", "xpdata", "ypdata"), required=False)),
+            ),
+        ),
+        notebook="01_limacon.ipynb",
+    ),
 )

@@ -11,6 +11,7 @@ else (the grader's registry, the sandbox's list of functions that may cross,
 nbgrader's points, the notebooks' self-check names) is derived from the
 declarations by :class:`labkit.exercises.registry.Registry`.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
@@ -42,15 +43,32 @@ class Refusal:
 GRADER = ("labkit.exercises",)
 INTERPOLANTS = Refusal(
     "library interpolants",
-    modules=("scipy.interpolate", "scipy.ndimage", "scipy.signal._bsplines", "scipy.signal._spline",
-             "scipy.signal._spline_filters", "labkit.piecewise", "labkit.splines", "labkit.monotone",
-             "labkit.bilinear", "labkit.patches", "labkit.convergence", "labkit.functions") + GRADER,
-    functions=("numpy.lib._function_base_impl.interp", "numpy._core._multiarray_umath.interp",
-               "numpy._core._multiarray_umath.interp_complex"),
-    allowed=("labkit.piecewise.bracket",))
+    modules=(
+        "scipy.interpolate",
+        "scipy.ndimage",
+        "scipy.signal._bsplines",
+        "scipy.signal._spline",
+        "scipy.signal._spline_filters",
+        "labkit.piecewise",
+        "labkit.splines",
+        "labkit.monotone",
+        "labkit.bilinear",
+        "labkit.patches",
+        "labkit.convergence",
+        "labkit.functions",
+    )
+    + GRADER,
+    functions=(
+        "numpy.lib._function_base_impl.interp",
+        "numpy._core._multiarray_umath.interp",
+        "numpy._core._multiarray_umath.interp_complex",
+    ),
+    allowed=("labkit.piecewise.bracket",),
+)
 OWN_FUNCTIONS = Refusal("the lab's functions", modules=("labkit.functions",) + GRADER)
-OWN_PATCH = Refusal("labkit's patch", modules=("labkit.patches",) + GRADER,
-                    allowed=("labkit.patches.Corner", "labkit.patches._vector"))
+OWN_PATCH = Refusal(
+    "labkit's patch", modules=("labkit.patches",) + GRADER, allowed=("labkit.patches.Corner", "labkit.patches._vector")
+)
 EXPERIMENTS = Refusal("labkit's experiments", modules=("labkit.convergence",) + GRADER)
 
 
@@ -99,7 +117,7 @@ def facade_name(check: Callable) -> str:
     name = check.__name__
     if not name.startswith(CHECK_PREFIX):
         raise ValueError(f"a part's check must be a function named {CHECK_PREFIX}<name>; got {name!r}.")
-    return name[len(CHECK_PREFIX):]
+    return name[len(CHECK_PREFIX) :]
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,7 @@
 The plot is checked in :mod:`~labkit.exercises.plotted` and the experiment in
 :mod:`~labkit.exercises.experiments`; this module declares the exercises.
 """
+
 from .experiments import Experiment
 from .model import Exercise, Part
 from .plotted import check_boiling_plot
@@ -10,10 +11,20 @@ from .plotted import check_boiling_plot
 PCHIP = Experiment("pchip", 2, "test_pchip_interpolate", "errors_pchip", "rate_pchip", weights=(4, 2, 2))
 
 EXERCISES = (
-    Exercise(14, ("ax14",), tuple(Part(name, 2, check_boiling_plot, ("ax14",), index=i)
-                                  for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline",
-                                                            "ax14: pchip"))),
-             notebook="05_monotone.ipynb"),
-    Exercise(15, PCHIP.names(), PCHIP.parts(), notebook="05_monotone.ipynb",
-             answers=("pchip's order against the spline's, and when to choose pchip",)),
+    Exercise(
+        14,
+        ("ax14",),
+        tuple(
+            Part(name, 2, check_boiling_plot, ("ax14",), index=i)
+            for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline", "ax14: pchip"))
+        ),
+        notebook="05_monotone.ipynb",
+    ),
+    Exercise(
+        15,
+        PCHIP.names(),
+        PCHIP.parts(),
+        notebook="05_monotone.ipynb",
+        answers=("pchip's order against the spline's, and when to choose pchip",),
+    ),
 )

@@ -4,6 +4,7 @@ The maths is derived in ``notebooks/03_meshes.ipynb``. References are
 :func:`labkit.patch` and the geometry each exercise asks for (the bilinear
 map of a straight quadrilateral, quarter circles, a conforming join).
 """
+
 import numpy as np
 
 from .. import patches
@@ -13,6 +14,7 @@ from .result import CheckResult, call, case_rng, close, worst
 
 # the grader's work on a student's meshes is bounded by the lab's sizes (600 and 1170 nodes): far larger is refused
 MAX_NODES = 20_000
+
 
 def _identity_corners():
     e1, e2 = [1.0, 0.0], [0.0, 1.0]
@@ -27,41 +29,60 @@ def check_coons(fn, seed=None):
     if not ok:
         return result
     S, T = np.meshgrid(s, t, indexing="ij")
-    if not result.step("the unit square with the identity data gives the 4 x 5 grid", close(out, [S, T]),
-                       "" if close(out, [S, T]) else worst(out, [S, T])):
+    if not result.step(
+        "the unit square with the identity data gives the 4 x 5 grid",
+        close(out, [S, T]),
+        "" if close(out, [S, T]) else worst(out, [S, T]),
+    ):
         if close(out, [S.T, T.T]):
-            result.hint = ("x and y are transposed: x[i, j] belongs to s[i] and t[j], so they have one row per "
-                           "value of s (shape (len(s), len(t))).")
+            result.hint = (
+                "x and y are transposed: x[i, j] belongs to s[i] and t[j], so they have one row per "
+                "value of s (shape (len(s), len(t)))."
+            )
         else:
-            result.hint = ("start with the outline: x along AB is eval_pherm([0, 1], [xA, xB], [dxdsA, dxdsB], s); "
-                           "DC uses D and C; then join them in t for every s.")
+            result.hint = (
+                "start with the outline: x along AB is eval_pherm([0, 1], [xA, xB], [dxdsA, dxdsB], s); "
+                "DC uses D and C; then join them in t for every s."
+            )
         return result
     rng = case_rng(seed, "patches.coons")
     corners = [patches.Corner(*rng.normal(size=(4, 2))) for _ in range(4)]
     expected = patches.patch(*corners, s, t)
     ok, out = call(result, "random corner data with twists", fn, *corners, s, t)
-    if not ok or result.step("random corner data with twists agree with labkit.patch", close(out, expected),
-                             "" if close(out, expected) else worst(out, expected)):
+    if not ok or result.step(
+        "random corner data with twists agree with labkit.patch",
+        close(out, expected),
+        "" if close(out, expected) else worst(out, expected),
+    ):
         return result
     for edge, untwist in (("AB and DC", "ABCD"), ("AB", "AB"), ("DC", "DC")):
-        candidate = [patches.Corner(c.point, c.ds, c.dt) if label in untwist else c
-                     for label, c in zip("ABCD", corners)]
+        candidate = [
+            patches.Corner(c.point, c.ds, c.dt) if label in untwist else c for label, c in zip("ABCD", corners)
+        ]
         if close(out, patches.patch(*candidate, s, t)):
-            result.hint = (f"your patch ignores the twists along {edge}: the t-derivative along an edge "
-                           "(dxdtAB, dxdtDC) is a Hermite cubic in s with values dx/dt and slopes d2x/dsdt "
-                           "at its corners (likewise for y).")
+            result.hint = (
+                f"your patch ignores the twists along {edge}: the t-derivative along an edge "
+                "(dxdtAB, dxdtDC) is a Hermite cubic in s with values dx/dt and slopes d2x/dsdt "
+                "at its corners (likewise for y)."
+            )
             break
     else:
-        result.hint = ("compare the four edge curves one at a time with labkit.patch: values along AB and DC, "
-                       "then the t-derivatives along them, then the join in t.")
+        result.hint = (
+            "compare the four edge curves one at a time with labkit.patch: values along AB and DC, "
+            "then the t-derivatives along them, then the join in t."
+        )
     return result
 
 
 def _corner_list(corners, result, label):
-    if not (isinstance(corners, (list, tuple)) and len(corners) == 4
-            and all(isinstance(c, patches.Corner) for c in corners)):
-        result.fail(label, "expected a list of four labkit.Corner objects A, B, C, D",
-                    "build them with Corner(point, ds, dt, dsdt).")
+    if not (
+        isinstance(corners, (list, tuple)) and len(corners) == 4 and all(isinstance(c, patches.Corner) for c in corners)
+    ):
+        result.fail(
+            label,
+            "expected a list of four labkit.Corner objects A, B, C, D",
+            "build them with Corner(point, ds, dt, dsdt).",
+        )
         return False
     return True
 
@@ -72,13 +93,14 @@ def check_graded_corners(corners):
     if not _corner_list(corners, result, "four corners"):
         return result
     x, y = patches.patch(*corners, np.linspace(0, 1, 11), np.linspace(0, 1, 16))
-    outline = close([x[0], x[-1]], [np.zeros(16), np.ones(16)]) and close([y[:, 0], y[:, -1]], [np.zeros(11), np.ones(11)])
+    outline = close([x[0], x[-1]], [np.zeros(16), np.ones(16)]) and close(
+        [y[:, 0], y[:, -1]], [np.zeros(11), np.ones(11)]
+    )
     if not result.step("outline is still the unit square", outline):
         result.hint = "only dx/ds changes; every other value stays as in exercise 5."
         return result
     dxds = [c.ds[0] for c in corners]
-    if not result.step("dx/ds is 3 at A and D and 0.1 at B and C", close(dxds, [3.0, 0.1, 0.1, 3.0]),
-                       f"got {dxds}"):
+    if not result.step("dx/ds is 3 at A and D and 0.1 at B and C", close(dxds, [3.0, 0.1, 0.1, 3.0]), f"got {dxds}"):
         result.hint = "A and D are on the left (s = 0), B and C on the right (s = 1)."
         return result
     widths = np.diff(x, axis=0)
@@ -103,8 +125,10 @@ def check_straight_corners(corners):
     bilinear_map = [(1 - S) * (1 - T) * A[i] + S * (1 - T) * B[i] + S * T * C[i] + (1 - S) * T * D[i] for i in (0, 1)]
     got = patches.patch(*corners, s, t)
     if not result.step("mesh lines straight and evenly spaced", close(got, bilinear_map), worst(got, bilinear_map)):
-        result.hint = ("along a straight side with even spacing the derivative is the vector along that side: "
-                       "d/ds = B - A on AB and C - D on DC, d/dt = D - A on AD and C - B on BC.")
+        result.hint = (
+            "along a straight side with even spacing the derivative is the vector along that side: "
+            "d/ds = B - A on AB and C - D on DC, d/dt = D - A on AD and C - B on BC."
+        )
     return result
 
 
@@ -115,21 +139,29 @@ def check_circle_corners(corners):
         return result
     u = np.linspace(0, 1, 25)
     x, y = patches.patch(*corners, u, u)
-    if not result.step("corners at the unit square's corners",
-                       close([c.point for c in corners], [[0, 0], [1, 0], [1, 1], [0, 1]])):
+    if not result.step(
+        "corners at the unit square's corners", close([c.point for c in corners], [[0, 0], [1, 0], [1, 1], [0, 1]])
+    ):
         result.hint = "A = (0, 0), B = (1, 0), C = (1, 1), D = (0, 1) as in exercise 5."
         return result
     radius = np.sqrt(2) / 2
     bound = np.sqrt(2) * radius * (np.pi / 2) ** 4 / 384
-    sides = {"AB": (x[:, 0], y[:, 0], [(0.5, 0.5), (0.5, -0.5)]), "DC": (x[:, -1], y[:, -1], [(0.5, 0.5), (0.5, 1.5)]),
-             "AD": (x[0], y[0], [(0.5, 0.5), (-0.5, 0.5)]), "BC": (x[-1], y[-1], [(0.5, 0.5), (1.5, 0.5)])}
+    sides = {
+        "AB": (x[:, 0], y[:, 0], [(0.5, 0.5), (0.5, -0.5)]),
+        "DC": (x[:, -1], y[:, -1], [(0.5, 0.5), (0.5, 1.5)]),
+        "AD": (x[0], y[0], [(0.5, 0.5), (-0.5, 0.5)]),
+        "BC": (x[-1], y[-1], [(0.5, 0.5), (1.5, 0.5)]),
+    }
     for name, (xs, ys, centres) in sides.items():
         near = min(np.max(np.abs(np.hypot(xs - cx, ys - cy) - radius)) for cx, cy in centres)
-        if not result.step(f"side {name} close to a quarter circle of radius sqrt(2)/2", near < bound,
-                           f"off by {near:.3f}"):
-            result.hint = ("write the side as an arc with its angle growing by pi/2 as s goes from 0 to 1, "
-                           "differentiate it, and give each corner that derivative at s = 0 or s = 1: both its "
-                           "direction and its length matter.")
+        if not result.step(
+            f"side {name} close to a quarter circle of radius sqrt(2)/2", near < bound, f"off by {near:.3f}"
+        ):
+            result.hint = (
+                "write the side as an arc with its angle growing by pi/2 as s goes from 0 to 1, "
+                "differentiate it, and give each corner that derivative at s = 0 or s = 1: both its "
+                "direction and its length matter."
+            )
             return result
     symmetric = close(x + x[::-1], np.ones_like(x)) and close(y + y[:, ::-1], np.ones_like(y))
     if not result.step("left-right and top-bottom symmetric", symmetric):
@@ -142,8 +174,10 @@ def check_two_patches(fn, corners):
     result = CheckResult("exercise 9 patches")
     if not _corner_list(corners, result, "corners of ABCD"):
         return result
-    for label, ABCD in (("sharp corner", corners),
-                        ("rounded corner", [*corners[:2], patches.Corner([1.8, 1.8], [0.5, -0.5], corners[2].dt), corners[3]])):
+    for label, ABCD in (
+        ("sharp corner", corners),
+        ("rounded corner", [*corners[:2], patches.Corner([1.8, 1.8], [0.5, -0.5], corners[2].dt), corners[3]]),
+    ):
         ok, out = call(result, label, fn, *ABCD)
         if not ok:
             return result
@@ -151,21 +185,35 @@ def check_two_patches(fn, corners):
             first, second = out
             sizes = [len(first.points), len(second.points), len(first.quads), len(second.quads)]
         except Exception:  # noqa: BLE001
-            return result.fail(label, f"got {getattr(out, 'description', type(out).__name__)}",
-                               "return the two QuadMesh objects: `return first, second`.")
+            return result.fail(
+                label,
+                f"got {getattr(out, 'description', type(out).__name__)}",
+                "return the two QuadMesh objects: `return first, second`.",
+            )
         if max(sizes) > MAX_NODES:
-            return result.fail(label, f"meshes of {sizes[0]:,} and {sizes[1]:,} nodes",
-                               "each patch is meshed with 20 x 30 points (600 nodes); keep to the lab's sizes.")
+            return result.fail(
+                label,
+                f"meshes of {sizes[0]:,} and {sizes[1]:,} nodes",
+                "each patch is meshed with 20 x 30 points (600 nodes); keep to the lab's sizes.",
+            )
         try:
             merged = first + second
         except Exception as exc:  # noqa: BLE001
-            return result.fail(label, f"could not join the two meshes ({exc})",
-                               "return the two QuadMesh objects: `return first, second`.")
+            return result.fail(
+                label,
+                f"could not join the two meshes ({exc})",
+                "return the two QuadMesh objects: `return first, second`.",
+            )
         expected_nodes = len(first.points) + len(second.points) - 30
-        if not result.step(f"{label}: the 30 nodes of the shared edge merge", len(merged.points) == expected_nodes,
-                           f"{len(first.points)} + {len(second.points)} nodes gave {len(merged.points)}"):
-            result.hint = ("abcd is ABCD mirrored in y = x with s and t swapped: give each corner the mirrored "
-                           "dt as ds and the mirrored ds as dt, and use 30 points along dc.")
+        if not result.step(
+            f"{label}: the 30 nodes of the shared edge merge",
+            len(merged.points) == expected_nodes,
+            f"{len(first.points)} + {len(second.points)} nodes gave {len(merged.points)}",
+        ):
+            result.hint = (
+                "abcd is ABCD mirrored in y = x with s and t swapped: give each corner the mirrored "
+                "dt as ds and the mirrored ds as dt, and use 30 points along dc."
+            )
             return result
         if not result.step(f"{label}: every element positively oriented", merged.quality().min() > 0):
             result.hint = "a folded element means a corner derivative of abcd points the wrong way."
@@ -213,11 +261,17 @@ def check_combined_mesh(region, corners, two_patches=None):
     """
     result = CheckResult("region")
     if not isinstance(region, QuadMesh):
-        return result.fail("region is a QuadMesh", f"got {getattr(region, 'description', type(region).__name__)}",
-                           "join the two patch meshes with +: region = first + second.")
+        return result.fail(
+            "region is a QuadMesh",
+            f"got {getattr(region, 'description', type(region).__name__)}",
+            "join the two patch meshes with +: region = first + second.",
+        )
     if max(len(region.points), len(region.quads)) > MAX_NODES:
-        return result.fail("region has the lab's size", f"{len(region.points):,} nodes and {len(region.quads):,} "
-                           "elements", "mesh the two patches with 20 x 30 points each and join them with +.")
+        return result.fail(
+            "region has the lab's size",
+            f"{len(region.points):,} nodes and {len(region.quads):,} elements",
+            "mesh the two patches with 20 x 30 points each and join them with +.",
+        )
     own = _own_meshes(two_patches, corners)
     if own is not None:
         whose = "your two_patches meshes"
@@ -232,25 +286,37 @@ def check_combined_mesh(region, corners, two_patches=None):
         mirrored = [patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]) for c in (A, D, C, B)]
         second = quad_mesh(*patches.patch(*mirrored, np.linspace(0, 1, 30), np.linspace(0, 1, 20)))
         reference = first + second
-    if not result.step(f"{len(reference.points)} nodes and {len(reference.quads)} elements, as {whose} joined",
-                       len(region.points) == len(reference.points) and len(region.quads) == len(reference.quads),
-                       f"got {len(region.points)} nodes and {len(region.quads)} elements"):
-        result.hint = ("the shared edge's 30 nodes appear once in a conforming mesh: join the two meshes with "
-                       "+, which merges them (20 x 30 + 30 x 20 - 30 nodes).")
+    if not result.step(
+        f"{len(reference.points)} nodes and {len(reference.quads)} elements, as {whose} joined",
+        len(region.points) == len(reference.points) and len(region.quads) == len(reference.quads),
+        f"got {len(region.points)} nodes and {len(region.quads)} elements",
+    ):
+        result.hint = (
+            "the shared edge's 30 nodes appear once in a conforming mesh: join the two meshes with "
+            "+, which merges them (20 x 30 + 30 x 20 - 30 nodes)."
+        )
         return result
     order = np.lexsort(np.round(region.points, 9).T[::-1])
     expected = np.lexsort(np.round(reference.points, 9).T[::-1])
-    if not result.step(f"the nodes are those of {whose}", close(region.points[order], reference.points[expected], 1e-7),
-                       worst(region.points[order], reference.points[expected])):
+    if not result.step(
+        f"the nodes are those of {whose}",
+        close(region.points[order], reference.points[expected], 1e-7),
+        worst(region.points[order], reference.points[expected]),
+    ):
         result.hint = "make region from the two meshes two_patches returns: region = first + second."
         return result
-    if not result.step("conforming: no crack along the shared edge",
-                       _boundary_edges(region) == _boundary_edges(reference),
-                       f"{_boundary_edges(region)} boundary edges, {_boundary_edges(reference)} expected"):
+    if not result.step(
+        "conforming: no crack along the shared edge",
+        _boundary_edges(region) == _boundary_edges(reference),
+        f"{_boundary_edges(region)} boundary edges, {_boundary_edges(reference)} expected",
+    ):
         result.hint = "elements on both sides of the shared edge must use the same nodes: join the meshes with +."
         return result
-    if not result.step("no element folded by the join", _folded(region) <= _folded(reference),
-                       f"{_folded(region)} folded elements, {_folded(reference)} in the two meshes joined"):
+    if not result.step(
+        "no element folded by the join",
+        _folded(region) <= _folded(reference),
+        f"{_folded(region)} folded elements, {_folded(reference)} in the two meshes joined",
+    ):
         result.hint = "the join turned elements over: keep each mesh's node order when you join them with +."
     return result
 
@@ -258,18 +324,35 @@ def check_combined_mesh(region, corners, two_patches=None):
 CORNERS9 = Together(("A9", "B9", "C9", "D9"))
 
 EXERCISES = (
-    Exercise(5, ("coons",), (Part("coons", 12, check_coons, ("coons",), seeded=True, refused=OWN_PATCH),),
-             notebook="03_meshes.ipynb"),
+    Exercise(
+        5,
+        ("coons",),
+        (Part("coons", 12, check_coons, ("coons",), seeded=True, refused=OWN_PATCH),),
+        notebook="03_meshes.ipynb",
+    ),
     Exercise(6, ("graded",), (Part("graded", 10, check_graded_corners, ("graded",)),), notebook="03_meshes.ipynb"),
-    Exercise(7, ("straight",), (Part("straight", 10, check_straight_corners, ("straight",)),),
-             notebook="03_meshes.ipynb",
-             answers=("why these corner data give straight, evenly divided sides",)),
-    Exercise(8, ("circle_sides",), (Part("circle_sides", 12, check_circle_corners, ("circle_sides",)),),
-             notebook="03_meshes.ipynb",
-             answers=("AB as parametric equations, and dx/ds, dy/ds at A and B",)),
-    Exercise(9, ("two_patches", "mirror", "region"),
-             (Part("two_patches", 10, check_two_patches, ("two_patches", CORNERS9)),
-              Part("region", 6, check_combined_mesh, ("region", CORNERS9, Optional("two_patches")))),
-             notebook="03_meshes.ipynb",
-             answers=("why the mirror image's corner data make the two patches match",)),
+    Exercise(
+        7,
+        ("straight",),
+        (Part("straight", 10, check_straight_corners, ("straight",)),),
+        notebook="03_meshes.ipynb",
+        answers=("why these corner data give straight, evenly divided sides",),
+    ),
+    Exercise(
+        8,
+        ("circle_sides",),
+        (Part("circle_sides", 12, check_circle_corners, ("circle_sides",)),),
+        notebook="03_meshes.ipynb",
+        answers=("AB as parametric equations, and dx/ds, dy/ds at A and B",),
+    ),
+    Exercise(
+        9,
+        ("two_patches", "mirror", "region"),
+        (
+            Part("two_patches", 10, check_two_patches, ("two_patches", CORNERS9)),
+            Part("region", 6, check_combined_mesh, ("region", CORNERS9, Optional("two_patches"))),
+        ),
+        notebook="03_meshes.ipynb",
+        answers=("why the mirror image's corner data make the two patches match",),
+    ),
 )

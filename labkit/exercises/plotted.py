@@ -14,6 +14,7 @@ here, on the grader's side.
   the not-a-knot spline and pchip each as a curve of at least 100 points
   over the whole data range.
 """
+
 import numpy as np
 
 from .. import functions, monotone, piecewise, splines
@@ -32,11 +33,15 @@ CIRCLE = "o"
 
 def _no_plot(result, name, plot):
     what = getattr(plot, "description", None) or type(plot).__name__
-    return result.fail(f"{name} is a plot", f"got {what}",
-                       f"draw on the Axes `{name}` the cell gives you (e.g. `{name}.plot(x, y)`), and keep the name.")
+    return result.fail(
+        f"{name} is a plot",
+        f"got {what}",
+        f"draw on the Axes `{name}` the cell gives you (e.g. `{name}.plot(x, y)`), and keep the name.",
+    )
 
 
 # -- Exercise 4 ---------------------------------------------------------------
+
 
 def _distances(points, curve, bound):
     """For each of `points` (2, n) its distance to the polyline `curve` (2, m), or inf beyond `bound`.
@@ -94,10 +99,12 @@ def check_limacon_plot(plot, own=None, r0=1.15):
     if lines is None:
         return _no_plot(result, "ax4", plot)
     long = [line for line in lines if line.x.size >= MIN_POINTS and line.x.size == line.y.size]
-    if not result.step(f"a curve of at least {MIN_POINTS} points", bool(long),
-                       f"the longest line has {max((line.x.size for line in lines), default=0)} points"):
-        result.hint = ("plot the Hermite interpolant at the 10*(nintervals+1) values of tval, not only the data "
-                       "points.")
+    if not result.step(
+        f"a curve of at least {MIN_POINTS} points",
+        bool(long),
+        f"the longest line has {max((line.x.size for line in lines), default=0)} points",
+    ):
+        result.hint = "plot the Hermite interpolant at the 10*(nintervals+1) values of tval, not only the data points."
         return result
     long = long[:MAX_CURVES]
     curves = [("the Hermite interpolant of the lab's data", _lab_hermite(r0))]
@@ -106,7 +113,7 @@ def check_limacon_plot(plot, own=None, r0=1.15):
         curves.insert(0, ("the Hermite interpolant of your tdata, xdata, ydata, xpdata, ypdata", own_curve))
     best = None
     for line in long:
-        points = np.stack((line.x, line.y))[:, ::-(-line.x.size // SAMPLE)]
+        points = np.stack((line.x, line.y))[:, :: -(-line.x.size // SAMPLE)]
         if not np.all(np.isfinite(points)):
             continue
         for name, curve in curves:
@@ -116,29 +123,48 @@ def check_limacon_plot(plot, own=None, r0=1.15):
             if best is None or (far, cover) < best[:2]:
                 best = (far, cover, name)
     if best is None:
-        return result.fail("the curve is the Hermite interpolant", "every long line has NaN or infinite points",
-                           "plot xherm, yherm from eval_pherm.")
+        return result.fail(
+            "the curve is the Hermite interpolant",
+            "every long line has NaN or infinite points",
+            "plot xherm, yherm from eval_pherm.",
+        )
     far, cover, name = best
     exact = _limacon_curve(r0)
-    on_exact = all(float(_distances(np.stack((ln.x, ln.y))[:, ::-(-ln.x.size // SAMPLE)], exact,
-                                    10 * HERMITE_LIMACON).max()) <= ON_CURVE for ln in long
-                   if np.all(np.isfinite(ln.x)) and np.all(np.isfinite(ln.y)))
-    ok = result.step(f"the curve is {name} (within {ON_CURVE:g})", far <= ON_CURVE,
-                     f"a point is {far:.2e} away from it" if np.isfinite(far) else
-                     f"points are more than {10 * HERMITE_LIMACON:g} away from it")
+    on_exact = all(
+        float(_distances(np.stack((ln.x, ln.y))[:, :: -(-ln.x.size // SAMPLE)], exact, 10 * HERMITE_LIMACON).max())
+        <= ON_CURVE
+        for ln in long
+        if np.all(np.isfinite(ln.x)) and np.all(np.isfinite(ln.y))
+    )
+    ok = result.step(
+        f"the curve is {name} (within {ON_CURVE:g})",
+        far <= ON_CURVE,
+        f"a point is {far:.2e} away from it"
+        if np.isfinite(far)
+        else f"points are more than {10 * HERMITE_LIMACON:g} away from it",
+    )
     if not ok:
         if on_exact:
-            result.hint = ("that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
-                           "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm.")
+            result.hint = (
+                "that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
+                "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm."
+            )
         elif far <= HERMITE_LIMACON:
-            result.hint = ("close to the curve but not the interpolant of your data: plot eval_pherm of tdata, "
-                           "xdata, xpdata and of tdata, ydata, ypdata at tval.")
+            result.hint = (
+                "close to the curve but not the interpolant of your data: plot eval_pherm of tdata, "
+                "xdata, xpdata and of tdata, ydata, ypdata at tval."
+            )
         else:
-            result.hint = ("corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
-                           "bends the curve away; use eval_pherm with the derivatives of Exercise 4.")
+            result.hint = (
+                "corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
+                "bends the curve away; use eval_pherm with the derivatives of Exercise 4."
+            )
         return result
-    if not result.step("the curve goes all the way round", cover <= 0.1,
-                       f"part of the curve is {min(cover, 1.0):.2f} or more away from every plotted point"):
+    if not result.step(
+        "the curve goes all the way round",
+        cover <= 0.1,
+        f"part of the curve is {min(cover, 1.0):.2f} or more away from every plotted point",
+    ):
         result.hint = "interpolate over the whole turn: tval from 0 to 2*pi."
     return result
 
@@ -177,18 +203,30 @@ def check_boiling_plot(plot):
     if lines is None:
         failed = _no_plot(CheckResult("ax14"), "ax14", plot)
         return Results([failed, failed, failed])
-    lines = [ln for ln in lines if ln.x.size == ln.y.size and ln.x.size and np.all(np.isfinite(ln.x))
-             and np.all(np.isfinite(ln.y))]
+    lines = [
+        ln
+        for ln in lines
+        if ln.x.size == ln.y.size and ln.x.size and np.all(np.isfinite(ln.x)) and np.all(np.isfinite(ln.y))
+    ]
 
     data = CheckResult("ax14: the data")
-    at_data = [ln for ln in lines if ln.x.size == xdata.size and np.allclose(np.sort(ln.x), xdata)
-               and _matches(ln, np.interp(ln.x, xdata, ydata))]
+    at_data = [
+        ln
+        for ln in lines
+        if ln.x.size == xdata.size and np.allclose(np.sort(ln.x), xdata) and _matches(ln, np.interp(ln.x, xdata, ydata))
+    ]
     if not data.step("a line at the five data points", bool(at_data), "no line has exactly the data's points"):
         data.hint = "plot xdata, ydata themselves: ax14.plot(xdata, ydata, 'o')."
-    elif data.step("drawn as circles", any(ln.marker == CIRCLE for ln in at_data),
-                   f"markers {sorted({ln.marker for ln in at_data})}"):
-        if not data.step("with no lines between them", any(ln.marker == CIRCLE and not ln.joined for ln in at_data),
-                         "the circles are joined by lines"):
+    elif data.step(
+        "drawn as circles",
+        any(ln.marker == CIRCLE for ln in at_data),
+        f"markers {sorted({ln.marker for ln in at_data})}",
+    ):
+        if not data.step(
+            "with no lines between them",
+            any(ln.marker == CIRCLE and not ln.joined for ln in at_data),
+            "the circles are joined by lines",
+        ):
             data.hint = "circles only: marker 'o' with linestyle 'none' (the format string 'o')."
     else:
         data.hint = "use the marker 'o'."
@@ -197,19 +235,28 @@ def check_boiling_plot(plot):
     curves = [ln for ln in lines if all(ln is not d for d in at_data)]
     for name, interpolant in (("the not-a-knot spline", splines.spline), ("pchip", monotone.pchip)):
         check = CheckResult(f"ax14: {name}")
-        matching = [ln for ln in curves if _matches(ln, interpolant(xdata, ydata, ln.x))
-                    and not _matches(ln, _other(interpolant)(xdata, ydata, ln.x))]
-        if not check.step(f"a curve that is {name}", bool(matching),
-                          f"none of the {len(curves)} other line(s) follows it"):
-            check.hint = (f"evaluate {name} of the data at many points xval and plot them: "
-                          f"ax14.plot(xval, {'labkit.spline' if 'spline' in name else 'labkit.pchip'}(xdata, ydata, xval)).")
+        matching = [
+            ln
+            for ln in curves
+            if _matches(ln, interpolant(xdata, ydata, ln.x))
+            and not _matches(ln, _other(interpolant)(xdata, ydata, ln.x))
+        ]
+        if not check.step(
+            f"a curve that is {name}", bool(matching), f"none of the {len(curves)} other line(s) follows it"
+        ):
+            check.hint = (
+                f"evaluate {name} of the data at many points xval and plot them: "
+                f"ax14.plot(xval, {'labkit.spline' if 'spline' in name else 'labkit.pchip'}(xdata, ydata, xval))."
+            )
         else:
             most = max(matching, key=lambda ln: ln.x.size)
-            if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS,
-                              f"only {most.x.size} points"):
+            if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS, f"only {most.x.size} points"):
                 check.hint = f"use at least {MIN_POINTS} points, e.g. xval = np.linspace(0, 4, 201)."
-            elif not check.step("over the whole data range [0, 4]", most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
-                                f"from {most.x.min():.3g} to {most.x.max():.3g}"):
+            elif not check.step(
+                "over the whole data range [0, 4]",
+                most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
+                f"from {most.x.min():.3g} to {most.x.max():.3g}",
+            ):
                 check.hint = "let xval run from the first data point to the last: np.linspace(0, 4, 201)."
             elif not check.step("drawn as a line", most.joined, "drawn as separate markers"):
                 check.hint = "draw the curve as a line (format string '-')."

@@ -11,6 +11,7 @@ The same registry serves a student's notebook and ``labkit grade``:
 own variables in the notebook and a proxy into the sandboxed notebook in the
 grader (:mod:`labkit.grading.remote`).
 """
+
 from __future__ import annotations
 
 import importlib
@@ -63,8 +64,11 @@ class Registry:
         self.exercises = {exercise.number: exercise for exercise in sorted(exercises, key=lambda e: e.number)}
         self.points = {n: e.points for n, e in self.exercises.items()}
         self.names = {n: list(e.names) for n, e in self.exercises.items()}
-        self.answers = {f"exercise{e.number}-answer-{k}": (e.number, text)
-                        for e in self.exercises.values() for k, text in enumerate(e.answers, start=1)}
+        self.answers = {
+            f"exercise{e.number}-answer-{k}": (e.number, text)
+            for e in self.exercises.values()
+            for k, text in enumerate(e.answers, start=1)
+        }
         parts = [part for e in self.exercises.values() for part in e.parts]
         self.refusals = tuple(sorted({p.refused for p in parts if p.refused}, key=lambda refusal: refusal.name))
         self.passable = frozenset(function_name(f) for p in parts for f in p.passes)
@@ -140,20 +144,30 @@ class Registry:
                 result.name = part.name
             except Exception as exc:  # noqa: BLE001 - a fault of the check itself costs this part, not the others
                 result = CheckResult(part.name)
-                result.fail("the grader could check this part",
-                            f"the check failed inside labkit ({type(exc).__name__})",
-                            "this is a fault of the grader, not of your work: tell your instructor.")
+                result.fail(
+                    "the grader could check this part",
+                    f"the check failed inside labkit ({type(exc).__name__})",
+                    "this is a fault of the grader, not of your work: tell your instructor.",
+                )
             checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # as the student names it
         points = sum(check["weight"] for check in checks if check["passed"])
-        return {"exercise": number, "passed": points == exercise.points, "points": points,
-                "fraction": points / exercise.points if exercise.points else 1.0, "defined": defined,
-                "checks": checks}
+        return {
+            "exercise": number,
+            "passed": points == exercise.points,
+            "points": points,
+            "fraction": points / exercise.points if exercise.points else 1.0,
+            "defined": defined,
+            "checks": checks,
+        }
 
 
 def _missing(name: str) -> CheckResult:
     result = CheckResult(name)
-    return result.fail(f"{name} is defined", "not defined when the notebook finished",
-                       f"run the cell that defines {name} (and keep its name); a cell that raised stops it.")
+    return result.fail(
+        f"{name} is defined",
+        "not defined when the notebook finished",
+        f"run the cell that defines {name} (and keep its name); a cell that raised stops it.",
+    )
 
 
 LAB = Registry((exercise for topic in TOPICS for exercise in topic.EXERCISES), source="labkit.exercises.registry:LAB")
@@ -167,8 +181,10 @@ def load(source: str | None = None) -> Registry:
     try:
         found: Any = getattr(importlib.import_module(module), attribute or "REGISTRY")
     except (ImportError, AttributeError) as exc:
-        raise ValueError(f"cannot load the exercises {source!r} ({exc}); give module:attribute of a Registry, "
-                         "with the module importable.") from None
+        raise ValueError(
+            f"cannot load the exercises {source!r} ({exc}); give module:attribute of a Registry, "
+            "with the module importable."
+        ) from None
     if not isinstance(found, Registry):
         raise ValueError(f"{source!r} is a {type(found).__name__}, not a labkit Registry of exercises.")
     if found.source is None:

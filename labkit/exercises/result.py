@@ -8,6 +8,7 @@ hint, never an exception. The same check runs in a student's notebook, on
 the real function, and in ``labkit grade``, on a proxy that forwards the call
 into the sandboxed notebook: see :mod:`labkit.grading.remote`.
 """
+
 import hashlib
 from dataclasses import dataclass, field
 
@@ -48,8 +49,12 @@ class CheckResult:
         return "\n".join(lines)
 
     def as_dict(self):
-        return {"name": self.name, "passed": self.passed, "hint": self.hint,
-                "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps]}
+        return {
+            "name": self.name,
+            "passed": self.passed,
+            "hint": self.hint,
+            "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps],
+        }
 
 
 class Results(list):
@@ -92,15 +97,22 @@ def call(result, description, fn, *args):
         kind = getattr(exc, "kind", type(exc).__name__)
         refused = getattr(exc, "refused", None)
         if refused:
-            result.fail(description, f"called {refused}, which is switched off while this exercise is graded",
-                        f"the exercise asks you to write this yourself: do not call {refused}.")
+            result.fail(
+                description,
+                f"called {refused}, which is switched off while this exercise is graded",
+                f"the exercise asks you to write this yourself: do not call {refused}.",
+            )
         elif kind in ("Tampered", "Timeout", "WorkerError"):
             result.fail(description, _text(exc), "see what the feedback says about the notebook above.")
         else:
             where = _where(exc)
-            result.fail(description, f"raised {kind}: {_text(exc)}" + (f" ({where})" if where else ""),
-                        f"the error happened {where}: look at that line." if where else
-                        "run the cell with the error on its own: the traceback shows where it happened.")
+            result.fail(
+                description,
+                f"raised {kind}: {_text(exc)}" + (f" ({where})" if where else ""),
+                f"the error happened {where}: look at that line."
+                if where
+                else "run the cell with the error on its own: the traceback shows where it happened.",
+            )
     return False, None
 
 
@@ -182,8 +194,11 @@ def close(actual, expected, tol=TOLERANCE):
     except NotNumbers:
         return False
     expected = np.asarray(expected, dtype=float)
-    return (actual.shape == expected.shape and bool(np.all(np.isfinite(actual)))
-            and bool(np.allclose(actual, expected, rtol=tol, atol=tol)))
+    return (
+        actual.shape == expected.shape
+        and bool(np.all(np.isfinite(actual)))
+        and bool(np.allclose(actual, expected, rtol=tol, atol=tol))
+    )
 
 
 def worst(actual, expected):

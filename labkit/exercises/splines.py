@@ -5,6 +5,7 @@ labkit's splines (:func:`labkit.ccspline`, :func:`labkit.ncspline`), the
 lab's equations (11)-(12) for the matrix, and cubics the complete spline
 must reproduce exactly.
 """
+
 import numpy as np
 
 from .. import piecewise, splines
@@ -54,8 +55,11 @@ def check_ccspline(fn, system=None, seed=None):
     if not ok:
         return result
     expected = 3 * np.array(x) ** 2
-    if result.step(f"{name}: slopes [0 3 12 48]", close(sprime, expected),
-                   "" if close(sprime, expected) else f"got {shown(sprime)}"):
+    if result.step(
+        f"{name}: slopes [0 3 12 48]",
+        close(sprime, expected),
+        "" if close(sprime, expected) else f"got {shown(sprime)}",
+    ):
         rng = case_rng(seed, "splines.ccspline")
         xr = np.cumsum(rng.uniform(0.2, 1.5, 9))
         yr = rng.normal(size=9)
@@ -71,14 +75,20 @@ def check_ccspline(fn, system=None, seed=None):
             return result
         A = _matrix(AD)
         if A is None:
-            return result.fail("the matrix A", "complete_system must return (A, D) with A a matrix of numbers",
-                               "end the function with `return A, D`.")
+            return result.fail(
+                "the matrix A",
+                "complete_system must return (A, D) with A a matrix of numbers",
+                "end the function with `return A, D`.",
+            )
         natural_rows = A.shape == (4, 4) and np.allclose(A[0], [1, 0, 0, 0]) and np.allclose(A[-1], [0, 0, 0, 1])
         if natural_rows:
-            return result.fail("the first and last rows of A", "they say M1 = 0 and Mn = 0",
-                               "the first and last rows of A are the natural spline's (M1 = 0, Mn = 0); the complete "
-                               "spline's first row is h1/3, h1/6 and its last h(n-1)/6, h(n-1)/3 (equation 11), with "
-                               "y1p and ynp in D.")
+            return result.fail(
+                "the first and last rows of A",
+                "they say M1 = 0 and Mn = 0",
+                "the first and last rows of A are the natural spline's (M1 = 0, Mn = 0); the complete "
+                "spline's first row is h1/3, h1/6 and its last h(n-1)/6, h(n-1)/3 (equation 11), with "
+                "y1p and ynp in D.",
+            )
         if not result.step("A is symmetric", A.shape == (4, 4) and np.allclose(A, A.T)):
             result.hint = "A(k, k-1) and A(k-1, k) must both be h(k-1)/6."
             return result
@@ -91,8 +101,10 @@ def check_ccspline(fn, system=None, seed=None):
     if not ok:
         return result
     if result.step(name2, close(sprime2, 3 * np.array(x2) ** 2), f"got {shown(sprime2)}"):
-        result.hint = ("equal intervals work and unequal ones do not: a subscript of h is off "
-                       "(h(k) = x(k+1) - x(k); row k uses h(k-1) and h(k)).")
+        result.hint = (
+            "equal intervals work and unequal ones do not: a subscript of h is off "
+            "(h(k) = x(k+1) - x(k); row k uses h(k-1) and h(k))."
+        )
         return result
     name3, x3, y3, a3, b3 = SPLINE_CASES[2]
     if system is not None:
@@ -101,8 +113,11 @@ def check_ccspline(fn, system=None, seed=None):
             return result
         A_ref, D_ref = _reference_complete_system(np.array(x3), np.array(y3), a3, b3)
         if _matrix(AD) is None:
-            return result.fail("A and D for [0 1 3]", "complete_system must return (A, D) with A a matrix of numbers",
-                               "end the function with `return A, D`.")
+            return result.fail(
+                "A and D for [0 1 3]",
+                "complete_system must return (A, D) with A a matrix of numbers",
+                "end the function with `return A, D`.",
+            )
         if not result.step("A for xdata = [0 1 3] matches equation (11)", close(AD[0], A_ref), worst(AD[0], A_ref)):
             result.hint = "compute the 3 x 3 matrix by hand from (11) and compare entry by entry."
             return result
@@ -116,12 +131,16 @@ def check_ccspline(fn, system=None, seed=None):
             else:
                 result.hint = "compute D by hand from (12): first and last entries use y1p and ynp."
             return result
-        result.hint = ("your complete_system's A and D are right, so what ccspline does with them is wrong: it must "
-                       "solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
-                       "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp.")
+        result.hint = (
+            "your complete_system's A and D are right, so what ccspline does with them is wrong: it must "
+            "solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
+            "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp."
+        )
         return result
-    result.hint = ("the slopes are wrong for equal intervals too: check A and D against equations (11) and (12) "
-                   "(define complete_system so the grader can check them too), then the slopes against (8).")
+    result.hint = (
+        "the slopes are wrong for equal intervals too: check A and D against equations (11) and (12) "
+        "(define complete_system so the grader can check them too), then the slopes against (8)."
+    )
     return result
 
 
@@ -135,14 +154,22 @@ def check_ncspline(fn, system=None, seed=None):
     result = CheckResult("ncspline")
     own = _own_natural(fn, system, seed)
     if own is not None:
-        result.step("slopes are the natural spline of your own complete_system (its mistake is marked in "
-                    "Exercise 10, not again here)", True)
+        result.step(
+            "slopes are the natural spline of your own complete_system (its mistake is marked in "
+            "Exercise 10, not again here)",
+            True,
+        )
         return result
-    ok, sprime = call(result, "linear data [0 2 4 6]", fn, np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 2.0, 4.0, 6.0]))
+    ok, sprime = call(
+        result, "linear data [0 2 4 6]", fn, np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 2.0, 4.0, 6.0])
+    )
     if not ok:
         return result
-    linear_ok = result.step("linear data y = 2x give slopes 2", close(sprime, [2.0] * 4),
-                            "" if close(sprime, [2.0] * 4) else f"got {shown(sprime)}")
+    linear_ok = result.step(
+        "linear data y = 2x give slopes 2",
+        close(sprime, [2.0] * 4),
+        "" if close(sprime, [2.0] * 4) else f"got {shown(sprime)}",
+    )
     x, y = _ncspline_data(seed)
     ok, slopes = call(result, "a nonlinear function", fn, x, y)
     if not ok:
@@ -158,28 +185,44 @@ def check_ncspline(fn, system=None, seed=None):
     except (TypeError, ValueError):
         return result.fail("slopes for six knots", f"got {shown(slopes)}", "return one slope per knot.")
     if got.shape == want.shape and np.allclose(got[:-1], want[:-1]) and not np.allclose(got[-1], want[-1]):
-        return result.fail("every slope from the system", "all but the last agree with labkit.ncspline",
-                           "every slope but the last is right: equation (8) gives the slope at the left end of a "
-                           "piece, and the last knot is a right end, which needs (9).")
-    if not result.step("second derivative zero at both ends (M1 = Mn = 0)", close(ends, [0.0, 0.0]), f"s'' = {np.round(ends, 6)}"):
+        return result.fail(
+            "every slope from the system",
+            "all but the last agree with labkit.ncspline",
+            "every slope but the last is right: equation (8) gives the slope at the left end of a "
+            "piece, and the last knot is a right end, which needs (9).",
+        )
+    if not result.step(
+        "second derivative zero at both ends (M1 = Mn = 0)", close(ends, [0.0, 0.0]), f"s'' = {np.round(ends, 6)}"
+    ):
         if close(slopes, _natural_slopes(x, y, rows_in_d=False)):
-            result.hint = ("A's first and last rows say M1 = 0 and Mn = 0, but D's first and last entries are still "
-                           "the complete spline's: set them to 0 too.")
+            result.hint = (
+                "A's first and last rows say M1 = 0 and Mn = 0, but D's first and last entries are still "
+                "the complete spline's: set them to 0 too."
+            )
         elif close(slopes, _natural_slopes(x, y, rows_in_a=False, rows_in_d=False)):
-            result.hint = ("the first and last rows of A must say M1 = 0 and Mn = 0 (1 on the diagonal, 0 elsewhere, "
-                           "0 in D): they are still the complete spline's rows.")
+            result.hint = (
+                "the first and last rows of A must say M1 = 0 and Mn = 0 (1 on the diagonal, 0 elsewhere, "
+                "0 in D): they are still the complete spline's rows."
+            )
         else:
-            result.hint = ("the second derivative is not 0 at the ends: the first and last equations of the system "
-                           "must say M1 = 0 and Mn = 0.")
+            result.hint = (
+                "the second derivative is not 0 at the ends: the first and last equations of the system "
+                "must say M1 = 0 and Mn = 0."
+            )
         return result
     if not result.step("slopes agree with labkit.ncspline", close(slopes, want), worst(slopes, want)) or not linear_ok:
-        result.hint = "the ends are right, so check the interior rows and the slopes from (8) and, at the last knot, (9)."
+        result.hint = (
+            "the ends are right, so check the interior rows and the slopes from (8) and, at the last knot, (9)."
+        )
     return result
 
 
 def _ncspline_data(seed):
-    x = (np.array([0.0, 0.7, 1.5, 2.0, 3.2, 4.0]) if seed is None
-         else np.cumsum(case_rng(seed, "splines.ncspline").uniform(0.2, 1.5, 6)))
+    x = (
+        np.array([0.0, 0.7, 1.5, 2.0, 3.2, 4.0])
+        if seed is None
+        else np.cumsum(case_rng(seed, "splines.ncspline").uniform(0.2, 1.5, 6))
+    )
     return x, np.exp(x / 2)
 
 
@@ -215,8 +258,11 @@ def _flipped_ends(D, D_ref):
         return []
     if values.shape != D_ref.shape:
         return []
-    return [which for i, which in ((0, "first"), (-1, "last"))
-            if abs(D_ref[i]) > 1e-12 and np.isclose(values[i], -D_ref[i]) and np.allclose(values[1:-1], D_ref[1:-1])]
+    return [
+        which
+        for i, which in ((0, "first"), (-1, "last"))
+        if abs(D_ref[i]) > 1e-12 and np.isclose(values[i], -D_ref[i]) and np.allclose(values[1:-1], D_ref[1:-1])
+    ]
 
 
 def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None):
@@ -236,25 +282,68 @@ def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None):
     return slopes
 
 
-COMPLETE = Experiment("complete", 4, "test_ccspline_interpolate", "errors_complete", "rate_complete",
-                      weights=(5, 2, 2), pieces=(splines.ccspline,))
-NATURAL = Experiment("natural", 2, "test_ncspline_interpolate", "errors_natural", "rate_natural",
-                     weights=(2, 2, 2), pieces=(splines.ncspline,))
-NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot",
-                      weights=(3, 2, 2))
+COMPLETE = Experiment(
+    "complete",
+    4,
+    "test_ccspline_interpolate",
+    "errors_complete",
+    "rate_complete",
+    weights=(5, 2, 2),
+    pieces=(splines.ccspline,),
+)
+NATURAL = Experiment(
+    "natural",
+    2,
+    "test_ncspline_interpolate",
+    "errors_natural",
+    "rate_natural",
+    weights=(2, 2, 2),
+    pieces=(splines.ncspline,),
+)
+NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot", weights=(3, 2, 2))
 
 EXERCISES = (
-    Exercise(10, ("ccspline", "complete_system"),
-             (Part("ccspline", 15, check_ccspline, ("ccspline", Optional("complete_system")), seeded=True,
-                   refused=INTERPOLANTS, functions=("ccspline", "complete_system")),),
-             notebook="04_splines.ipynb"),
-    Exercise(11, COMPLETE.names(), COMPLETE.parts(), notebook="04_splines.ipynb",
-             answers=("the order, with f' used only at the ends",)),
-    Exercise(12, ("ncspline",) + NATURAL.names(),
-             (Part("ncspline", 9, check_ncspline, ("ncspline", Optional("complete_system")), seeded=True,
-                   refused=INTERPOLANTS),) + NATURAL.parts(),
-             notebook="04_splines.ipynb",
-             answers=("why the natural spline's order is lower",)),
-    Exercise(13, NOTAKNOT.names(), NOTAKNOT.parts(), notebook="04_splines.ipynb",
-             answers=("the three splines compared",)),
+    Exercise(
+        10,
+        ("ccspline", "complete_system"),
+        (
+            Part(
+                "ccspline",
+                15,
+                check_ccspline,
+                ("ccspline", Optional("complete_system")),
+                seeded=True,
+                refused=INTERPOLANTS,
+                functions=("ccspline", "complete_system"),
+            ),
+        ),
+        notebook="04_splines.ipynb",
+    ),
+    Exercise(
+        11,
+        COMPLETE.names(),
+        COMPLETE.parts(),
+        notebook="04_splines.ipynb",
+        answers=("the order, with f' used only at the ends",),
+    ),
+    Exercise(
+        12,
+        ("ncspline",) + NATURAL.names(),
+        (
+            Part(
+                "ncspline",
+                9,
+                check_ncspline,
+                ("ncspline", Optional("complete_system")),
+                seeded=True,
+                refused=INTERPOLANTS,
+            ),
+        )
+        + NATURAL.parts(),
+        notebook="04_splines.ipynb",
+        answers=("why the natural spline's order is lower",),
+    ),
+    Exercise(
+        13, NOTAKNOT.names(), NOTAKNOT.parts(), notebook="04_splines.ipynb", answers=("the three splines compared",)
+    ),
 )

@@ -20,18 +20,44 @@ One module per concern:
 
 Student code never runs in the grading process: see docs/instructors.md.
 """
+
 import importlib
 
 from .release import release, release_notebook, strip_solutions  # light: nbformat is imported when used
 
 # Names are imported on first use (PEP 562), so that the sandboxed worker, started as
 # ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
-_EXPORTS = {"grade": "batch", "SubmissionGrade": "report", "merge": "report", "Rubric": "rubric",
-            "load_rubric": "rubric", "exercises_in": "scoring", "grade_notebook": "scoring",
-            "grade_submission": "scoring", "submission_notebooks": "scoring", "GradeOptions": "options",
-            "get_backend": "backends"}
-_MODULES = {"backends", "batch", "cgroup", "guard", "nbgrader", "options", "protocol", "refusals", "release", "remote",
-            "report", "rubric", "scan", "scoring", "seccomp", "worker"}
+_EXPORTS = {
+    "grade": "batch",
+    "SubmissionGrade": "report",
+    "merge": "report",
+    "Rubric": "rubric",
+    "load_rubric": "rubric",
+    "exercises_in": "scoring",
+    "grade_notebook": "scoring",
+    "grade_submission": "scoring",
+    "submission_notebooks": "scoring",
+    "GradeOptions": "options",
+    "get_backend": "backends",
+}
+_MODULES = {
+    "backends",
+    "batch",
+    "cgroup",
+    "guard",
+    "nbgrader",
+    "options",
+    "protocol",
+    "refusals",
+    "release",
+    "remote",
+    "report",
+    "rubric",
+    "scan",
+    "scoring",
+    "seccomp",
+    "worker",
+}
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]
 

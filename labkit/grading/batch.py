@@ -18,6 +18,7 @@ says so, rather than grading students into zeros. The output folder
 submission once, and ``run.json`` says how the run went (its seed, how many
 could not be graded, its time, the grader's peak memory for one submission).
 """
+
 import json
 import os
 import resource
@@ -60,8 +61,10 @@ def _low_space(out):
         except OSError:
             continue
         if free < MIN_FREE:
-            return (f"only {free / 1024**2:.0f} MiB free in {folder} (grading needs {MIN_FREE // 1024**2} MiB); "
-                    "free some space and grade these submissions again, then combine the runs with --merge")
+            return (
+                f"only {free / 1024**2:.0f} MiB free in {folder} (grading needs {MIN_FREE // 1024**2} MiB); "
+                "free some space and grade these submissions again, then combine the runs with --merge"
+            )
     return None
 
 
@@ -78,10 +81,19 @@ class _Job:
         self.result = self.work / f"{safe_name(self.name)}-{self.attempt}.json"
         spec = self.work / f"{safe_name(self.name)}-{self.attempt}.spec.json"
         origin = None if self.options.backend in backends.BUILTIN else backends.origin(self.options.backend)
-        spec.write_text(json.dumps({"submission": str(self.path), "name": self.name, "result": str(self.result),
-                                    "profiles": str(self.profiles_file), "options": self.options.as_dict(),
-                                    "backend_origin": origin}),
-                        encoding="utf-8")
+        spec.write_text(
+            json.dumps(
+                {
+                    "submission": str(self.path),
+                    "name": self.name,
+                    "result": str(self.result),
+                    "profiles": str(self.profiles_file),
+                    "options": self.options.as_dict(),
+                    "backend_origin": origin,
+                }
+            ),
+            encoding="utf-8",
+        )
         memory = self.options.grader_memory
         self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
         group = self.cgroup
@@ -96,9 +108,15 @@ class _Job:
             environment.update(group.sibling_environment())
         self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
         with open(self.log, "wb") as log:
-            self.process = subprocess.Popen([sys.executable, "-m", "labkit.grading.scoring", str(spec)],
-                                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log,
-                                            start_new_session=True, preexec_fn=prepare, env=environment)
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "labkit.grading.scoring", str(spec)],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=log,
+                start_new_session=True,
+                preexec_fn=prepare,
+                env=environment,
+            )
         self.started = time.monotonic()
 
     @property
@@ -138,14 +156,18 @@ class _Job:
         """(SubmissionGrade, None) from the result file, or (None, why the grading process failed)."""
         code = self.process.returncode
         if timed_out:
-            return None, (f"its grading took longer than {self.limit} s (the submission's time limit plus "
-                          f"{self.options.grader_grace} s for the checks) and was stopped")
+            return None, (
+                f"its grading took longer than {self.limit} s (the submission's time limit plus "
+                f"{self.options.grader_grace} s for the checks) and was stopped"
+            )
         if code != 0 or not self.result.exists():
             if getattr(self, "out_of_memory", False) or code in (-signal.SIGKILL, -signal.SIGSEGV):
-                return None, ("its grading ran out of memory (the grader's limit of "
-                              f"{self.options.grader_memory // 1024**2} MiB) and was stopped"
-                              if getattr(self, "out_of_memory", False) or code == -signal.SIGKILL
-                              else f"its grading process crashed ({signal.Signals(-code).name})")
+                return None, (
+                    "its grading ran out of memory (the grader's limit of "
+                    f"{self.options.grader_memory // 1024**2} MiB) and was stopped"
+                    if getattr(self, "out_of_memory", False) or code == -signal.SIGKILL
+                    else f"its grading process crashed ({signal.Signals(-code).name})"
+                )
             if code is not None and code < 0:
                 name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else str(-code)
                 return None, f"its grading process was killed by {name}"
@@ -161,8 +183,19 @@ class _Job:
         return grade, None
 
 
-def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, progress=True, seed=None,
-          sandboxed=None, limits=None, rubric=None, options=None):
+def grade(
+    submissions,
+    out_dir,
+    jobs=2,
+    cell_timeout=None,
+    total_timeout=None,
+    progress=True,
+    seed=None,
+    sandboxed=None,
+    limits=None,
+    rubric=None,
+    options=None,
+):
     """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
 
     `options` (a :class:`labkit.grading.options.GradeOptions`, the defaults
@@ -185,8 +218,9 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     names = [submission_name(p) for p in submissions]
     if len(set(names)) != len(names):
         raise ValueError("two submissions have the same name; their feedback files would collide.")
-    options = GradeOptions.build(options, cell_timeout=cell_timeout, total_timeout=total_timeout, limits=limits,
-                                 seed=seed, sandboxed=sandboxed)
+    options = GradeOptions.build(
+        options, cell_timeout=cell_timeout, total_timeout=total_timeout, limits=limits, seed=seed, sandboxed=sandboxed
+    )
     if rubric is not None and not isinstance(rubric, Rubric):
         options = GradeOptions.build(options, rubric=rubric)
     if not isinstance(rubric, Rubric):
@@ -212,16 +246,27 @@ def grade(submissions, out_dir, jobs=2, cell_timeout=None, total_timeout=None, p
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
-        grades = _schedule(submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out,
-                           progress, peaks)
+        grades = _schedule(
+            submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out, progress, peaks
+        )
     finally:
         shutil.rmtree(work, ignore_errors=True)
     ordered = [grades[p] for p in submissions]
     write_report(out, ordered)
-    (out / "run.json").write_text(json.dumps({
-        "seed": seed, "submissions": len(ordered), "not graded": sum(not g.graded for g in ordered),
-        "seconds": round(time.monotonic() - start, 1), "jobs": int(jobs),
-        "grader peak bytes": max((p for p in peaks if p), default=None)}, indent=1), encoding="utf-8")
+    (out / "run.json").write_text(
+        json.dumps(
+            {
+                "seed": seed,
+                "submissions": len(ordered),
+                "not graded": sum(not g.graded for g in ordered),
+                "seconds": round(time.monotonic() - start, 1),
+                "jobs": int(jobs),
+                "grader peak bytes": max((p for p in peaks if p), default=None),
+            },
+            indent=1,
+        ),
+        encoding="utf-8",
+    )
     return ordered
 
 
@@ -239,8 +284,7 @@ def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, ou
                 running.append(job)
         if stopped is not None and not running:
             for job in pending:
-                grades[job.path] = SubmissionGrade(job.name, seed=options.seed, rubric=rubric,
-                                                   failure=stopped)
+                grades[job.path] = SubmissionGrade(job.name, seed=options.seed, rubric=rubric, failure=stopped)
             pending = []
             break
         time.sleep(0.05)
@@ -259,8 +303,9 @@ def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, ou
             if result is None and job.attempt < ATTEMPTS:
                 pending.append(job)  # once more, in a fresh process
                 continue
-            grades[job.path] = result or SubmissionGrade(job.name, seed=options.seed, rubric=rubric,
-                                                         failure=f"{why} (tried {job.attempt} times)")
+            grades[job.path] = result or SubmissionGrade(
+                job.name, seed=options.seed, rubric=rubric, failure=f"{why} (tried {job.attempt} times)"
+            )
             if progress:
                 _progress(len(grades), len(submissions))
     return grades

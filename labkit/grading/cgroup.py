@@ -16,6 +16,7 @@ Where no cgroup can be made (not root, no delegation, no cgroup file
 system) :func:`create` returns None and the sandbox relies on its other
 limits; the instructors' documentation says what that leaves open.
 """
+
 import os
 import signal
 import time

@@ -39,6 +39,7 @@ makes threads and new signal handlers impossible (:mod:`labkit.grading.seccomp`)
 so nothing interrupts them either. A refused call is allowed to run and its
 answer is voided afterwards: neither hook raises.
 """
+
 import _hashlib
 import builtins
 import gc
@@ -52,18 +53,42 @@ import types
 _sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
 _write, _getframe, _modules = os.write, sys._getframe, sys.modules
 _gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
-_ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (types.ModuleType, types.CodeType, types.FunctionType,
-                                                                types.BuiltinFunctionType)
+_ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
+    types.ModuleType,
+    types.CodeType,
+    types.FunctionType,
+    types.BuiltinFunctionType,
+)
 
 SMALL_CODE = 64  # bytes of bytecode below which a function is only recognised with its name and place
 RUN = "run"  # the profile of the request that runs the cells: nothing is refused, tampering is noted
 BEGIN, CHOSEN, END = "labkit.begin", "labkit.chosen", "labkit.end"  # the worker's sentinels
 # audit events that void the notebook's answers: what reaches the watch's state or goes round it
-TAMPER_EVENTS = frozenset({
-    "sys.setprofile", "sys.settrace", "sys._current_frames", "sys.addaudithook", "gc.get_objects",
-    "gc.get_referrers", "gc.get_referents", "gc.freeze", "os.fork", "os.forkpty", "os.posix_spawn", "os.exec",
-    "os.spawn", "os.system", "subprocess.Popen", "code.__new__", "function.__new__", "_thread.start_new_thread",
-    "cpython._PySys_ClearAuditHooks", "cpython.run_interactivehook", "sys.monitoring.register_callback"})
+TAMPER_EVENTS = frozenset(
+    {
+        "sys.setprofile",
+        "sys.settrace",
+        "sys._current_frames",
+        "sys.addaudithook",
+        "gc.get_objects",
+        "gc.get_referrers",
+        "gc.get_referents",
+        "gc.freeze",
+        "os.fork",
+        "os.forkpty",
+        "os.posix_spawn",
+        "os.exec",
+        "os.spawn",
+        "os.system",
+        "subprocess.Popen",
+        "code.__new__",
+        "function.__new__",
+        "_thread.start_new_thread",
+        "cpython._PySys_ClearAuditHooks",
+        "cpython.run_interactivehook",
+        "sys.monitoring.register_callback",
+    }
+)
 TAMPER_PREFIXES = ("ctypes.",)  # but ctypes.dlopen: scipy's own imports open libraries, which is no harm alone
 HARMLESS = frozenset({"ctypes.dlopen"})
 GUARDED_ATTRIBUTES = frozenset({"__code__"})  # libraries set __defaults__ and the like when imported
@@ -108,9 +133,11 @@ def _stand_in(name):
     """A function that stands in for a refused compiled function or class while a graded request runs.
 
     The watch recognises a call of one by its code, and reads the name from its frame (a plain string only)."""
+
     def refused(*args, **kwargs):
-        raise RuntimeError(f"{name} is switched off while this exercise is graded: "
-                           "the exercise asks you to write it yourself")
+        raise RuntimeError(
+            f"{name} is switched off while this exercise is graded: the exercise asks you to write it yourself"
+        )
 
     return refused
 
@@ -189,8 +216,9 @@ def install(secret, verdict_fd, profiles, passables, chain):
     for name, value in list(private.items()):
         if type(value) is _FunctionType and value.__globals__ is globals():
             home = exposed if name in EXPOSED else private
-            home[name] = private[name] = _FunctionType(value.__code__, home, value.__name__, value.__defaults__,
-                                                       value.__closure__)
+            home[name] = private[name] = _FunctionType(
+                value.__code__, home, value.__name__, value.__defaults__, value.__closure__
+            )
     private["_install"](secret, verdict_fd, profiles, passables, chain)
 
 
@@ -203,11 +231,11 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     key_of, signed, fields, within, modules = code_key, sign, attestation_text, _within, _modules
     refused_call, make_stand_in = _stand_in("").__code__, _stand_in
     handed_code = _handed_over(lambda: None).__code__
-    compiled_types, module_type, str_type, bytes_type, dict_type = (_compiled_types(), _ModuleType, str,
-                                                                    bytes, dict)
+    compiled_types, module_type, str_type, bytes_type, dict_type = (_compiled_types(), _ModuleType, str, bytes, dict)
     heap_type = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
-    profiles = {name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in
-                profiles.items()}
+    profiles = {
+        name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in profiles.items()
+    }
     union = ({}, set(), set())
     for names, mods, c_names in profiles.values():
         union[0].update(names)
@@ -217,13 +245,23 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     copies = {}
     for name, function in passables.items():
         code = function.__code__.replace()  # equal, but another object: trusted by identity
-        copy = _FunctionType(code, function.__globals__, function.__name__, function.__defaults__,
-                             function.__closure__)
+        copy = _FunctionType(code, function.__globals__, function.__name__, function.__defaults__, function.__closure__)
         copy.__kwdefaults__, copy.__qualname__ = function.__kwdefaults__, function.__qualname__
         copies[name] = (code, _handed_over(copy))
     # mode: "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
-    state = {"mode": "idle", "rid": None, "name": None, "profile": None, "passables": (), "refused": None,
-             "tampered": None, "live": frozenset(), "stubbed": [], "busy": False, "gc": True}
+    state = {
+        "mode": "idle",
+        "rid": None,
+        "name": None,
+        "profile": None,
+        "passables": (),
+        "refused": None,
+        "tampered": None,
+        "live": frozenset(),
+        "stubbed": [],
+        "busy": False,
+        "gc": True,
+    }
     cache = {}  # id(code) -> (code, key)
 
     def note_tampering(what):
@@ -287,8 +325,9 @@ def _install(secret, verdict_fd, profiles, passables, chain):
                 name = name if type(name) is str_type and name else "a switched-off function"
             else:
                 name = profile[0].get(key(code)) if profile is not None else None
-            if name is not None and not (code in state["live"] and frame.f_back is not None
-                                         and frame.f_back.f_code is handed_code):
+            if name is not None and not (
+                code in state["live"] and frame.f_back is not None and frame.f_back.f_code is handed_code
+            ):
                 state["refused"] = str(name)
         except BaseException:  # noqa: BLE001 - the hook never raises (its traceback would expose the watch)
             state["tampered"] = state["tampered"] or "an error inside the grader's watch"
@@ -306,8 +345,9 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             return
         state["gc"] = gc_isenabled()
         gc_disable()  # no finalizer of the student's runs while a request is watched
-        state.update(mode="reading", rid=None, name=None, profile=strictest, passables=(), refused=None,
-                     live=frozenset())
+        state.update(
+            mode="reading", rid=None, name=None, profile=strictest, passables=(), refused=None, live=frozenset()
+        )
         set_profile(hook_address, None)  # sys.getprofile() stays None: nothing to fetch
 
     def choose(args):
@@ -315,9 +355,14 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             note_tampering("a grading request chosen twice")
             return
         rid, name, wanted, handoff = args
-        if (type(rid) is not str_type or (name is not None and type(name) is not str_type)
-                or type(wanted) not in (list, tuple) or any(type(w) is not str_type for w in wanted)
-                or type(handoff) is not dict_type or handoff):
+        if (
+            type(rid) is not str_type
+            or (name is not None and type(name) is not str_type)
+            or type(wanted) not in (list, tuple)
+            or any(type(w) is not str_type for w in wanted)
+            or type(handoff) is not dict_type
+            or handoff
+        ):
             note_tampering("a grading request with what no grader sends")
             return
         live = set()
@@ -327,8 +372,14 @@ def _install(secret, verdict_fd, profiles, passables, chain):
                 handoff[passable] = handed
                 live.add(code)
         profile = None if name in (None, RUN) else profiles.get(name, strictest)
-        state.update(rid=rid, name=name, profile=profile, passables=tuple(wanted), live=frozenset(live),
-                     mode=RUN if name == RUN else "graded")
+        state.update(
+            rid=rid,
+            name=name,
+            profile=profile,
+            passables=tuple(wanted),
+            live=frozenset(live),
+            mode=RUN if name == RUN else "graded",
+        )
         if name == RUN:
             set_profile(None, None)  # the cells run unwatched but for tampering, and at full speed
             if state["gc"]:
@@ -342,8 +393,13 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             return
         set_profile(None, None)
         unstub()
-        status = (f"tampered:{state['tampered']}" if state["tampered"] else
-                  f"refused:{state['refused']}" if state["refused"] else "clean")
+        status = (
+            f"tampered:{state['tampered']}"
+            if state["tampered"]
+            else f"refused:{state['refused']}"
+            if state["refused"]
+            else "clean"
+        )
         parts = fields(state["rid"], state["name"], state["passables"], status, sha256(args[0]).hexdigest())
         state.update(mode="idle", rid=None, name=None, profile=None, passables=(), live=frozenset())
         if state["gc"]:
@@ -394,6 +450,11 @@ def _install(secret, verdict_fd, profiles, passables, chain):
 
 def unwire(profiles):
     """The profiles the grader sent (:func:`labkit.grading.refusals.wire`) as :func:`install` takes them."""
-    return {name: ({bytes.fromhex(key): text for key, text in profile["names"].items()},
-                   tuple(profile["modules"]), frozenset(tuple(pair) for pair in profile["c_names"]))
-            for name, profile in profiles.items()}
+    return {
+        name: (
+            {bytes.fromhex(key): text for key, text in profile["names"].items()},
+            tuple(profile["modules"]),
+            frozenset(tuple(pair) for pair in profile["c_names"]),
+        )
+        for name, profile in profiles.items()
+    }

@@ -20,6 +20,7 @@ folder. nbgrader reads what each cell is from ``cell.metadata["nbgrader"]``:
 notebooks; ``labkit execute`` applies it before saving. The keys and their
 meaning follow nbgrader's ``nbgrader/nbgraderformat/v3.json``.
 """
+
 import re
 
 from . import rubric as rubrics
@@ -52,12 +53,17 @@ def test_points(source, where="a test cell", rubric=None):
         raise ValueError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
     number = int(found.group(1))
     exercise = registry.exercises[number]
-    checked = {part.name for function, key in CHECK_CALL.findall(_hidden_region(source))
-               for part in registry.parts_checked(number, function, key or None)}
+    checked = {
+        part.name
+        for function, key in CHECK_CALL.findall(_hidden_region(source))
+        for part in registry.parts_checked(number, function, key or None)
+    }
     weights = sum(part.weight for part in exercise.parts if part.name in checked)
     if not weights:
-        raise ValueError(f"{where} tests exercise {number} but checks none of its parts "
-                         f"({', '.join(p.name for p in exercise.parts)}).")
+        raise ValueError(
+            f"{where} tests exercise {number} but checks none of its parts "
+            f"({', '.join(p.name for p in exercise.parts)})."
+        )
     scale = rubric.points.get(number, exercise.points) / exercise.points if exercise.points else 0
     points = weights * scale
     return number, int(points) if points == int(points) else round(points, 2)

@@ -6,6 +6,7 @@ submission's grading process (:mod:`labkit.grading.scoring`) and into the
 sandbox (:class:`labkit.grading.remote.Notebook`). No other module spells out
 a default of its own: they take the options object, or values from it.
 """
+
 import os
 from dataclasses import asdict, dataclass, field, fields, replace
 
@@ -37,8 +38,9 @@ class GradeOptions:
         backends.backend_class(self.backend)  # ValueError naming the choices
         if self.rubric is not None:
             if not isinstance(self.rubric, (str, os.PathLike)):
-                raise ValueError(f"rubric must be the path of a TOML rubric (or None for the lab's own); got "
-                                 f"{self.rubric!r}.")
+                raise ValueError(
+                    f"rubric must be the path of a TOML rubric (or None for the lab's own); got {self.rubric!r}."
+                )
             object.__setattr__(self, "rubric", os.fspath(self.rubric))
         if not isinstance(self.limits, Limits):
             raise ValueError(f"limits must be a labkit.grading.backends.base.Limits; got {self.limits!r}.")
@@ -54,14 +56,18 @@ class GradeOptions:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(given) - known)
         if unknown:
-            raise ValueError(f"unknown grading option(s) {', '.join(unknown)}; the options are "
-                             f"{', '.join(sorted(known))} (and sandboxed=False, the old name of "
-                             f"backend={backends.UNCONFINED!r}).")
+            raise ValueError(
+                f"unknown grading option(s) {', '.join(unknown)}; the options are "
+                f"{', '.join(sorted(known))} (and sandboxed=False, the old name of "
+                f"backend={backends.UNCONFINED!r})."
+            )
         given = {key: value for key, value in given.items() if value is not None}
         if sandboxed is False or confined is False:
             if given.get("backend", backends.UNCONFINED) != backends.UNCONFINED:
-                raise ValueError(f"sandboxed=False means backend={backends.UNCONFINED!r}, but "
-                                 f"backend={given['backend']!r} was given too; give one or the other.")
+                raise ValueError(
+                    f"sandboxed=False means backend={backends.UNCONFINED!r}, but "
+                    f"backend={given['backend']!r} was given too; give one or the other."
+                )
             given["backend"] = backends.UNCONFINED
         return replace(options if options is not None else cls(), **given)
 

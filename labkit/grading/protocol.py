@@ -25,6 +25,7 @@ float, and anything else becomes a :class:`NotNumbers` that fails every
 comparison with a message saying what it was. Nothing is unpickled or
 evaluated. The notebook side encodes with :func:`encode`.
 """
+
 import base64
 import json
 import math
@@ -37,6 +38,7 @@ MAX_TEXT = 2_000
 MAX_LINE = 48 * 1024 * 1024  # bytes in one message: enforced while reading, before any parsing
 MAX_CONTAINERS = 250_000  # JSON lists and objects in one message: bounds what parsing it allocates
 MAX_LINES = 1_000  # Line2D objects of one plot
+
 
 class ProtocolError(ValueError):
     """A message that is not in the format (sizes, tags, shapes)."""
@@ -57,6 +59,7 @@ class NotNumbers:
 
 
 # -- the notebook's side --------------------------------------------------------
+
 
 def _array_tag(value):
     arr = np.asarray(value)
@@ -110,8 +113,12 @@ def _is_plot(value):
     import sys
 
     module = sys.modules.get("matplotlib.artist")
-    return module is not None and isinstance(value, module.Artist) and hasattr(value, "get_children") and (
-        hasattr(value, "get_lines") or isinstance(getattr(value, "axes", None), list))
+    return (
+        module is not None
+        and isinstance(value, module.Artist)
+        and hasattr(value, "get_children")
+        and (hasattr(value, "get_lines") or isinstance(getattr(value, "axes", None), list))
+    )
 
 
 def _lines_tag(plot):
@@ -121,8 +128,10 @@ def _lines_tag(plot):
         lines = lines_of(plot)
     except Exception as exc:  # noqa: BLE001 - a hostile artist
         return ["obj", f"a plot whose lines cannot be read ({type(exc).__name__})"]
-    return ["lines", [[_array_tag(line.x), _array_tag(line.y), line.marker[:20], line.linestyle[:20]]
-                      for line in lines[:MAX_LINES]]]
+    return [
+        "lines",
+        [[_array_tag(line.x), _array_tag(line.y), line.marker[:20], line.linestyle[:20]] for line in lines[:MAX_LINES]],
+    ]
 
 
 def function_names(tags):
@@ -154,6 +163,7 @@ def passable(name):
 
 
 # -- the grader's side -----------------------------------------------------------
+
 
 def loads(line):
     """Parse one message line; anything but a JSON object of bounded size and structure is a ProtocolError.
@@ -197,8 +207,12 @@ def _array(tag):
 def _line(item):
     from ..plotdata import Line
 
-    if not (isinstance(item, list) and len(item) == 4 and all(isinstance(part, list) for part in item[:2])
-            and all(isinstance(part, str) for part in item[2:])):
+    if not (
+        isinstance(item, list)
+        and len(item) == 4
+        and all(isinstance(part, list) for part in item[:2])
+        and all(isinstance(part, str) for part in item[2:])
+    ):
         raise ProtocolError("malformed plotted line")
     x, y = _array(item[0]).ravel(), _array(item[1]).ravel()
     return Line(x, y, item[2][:20], item[3][:20])

@@ -20,6 +20,7 @@ spelling of the allowed ones. Everything is computed once per grading run
 (:func:`wire`) and sent to the sandbox before the notebook's first cell
 runs.
 """
+
 import functools
 import importlib
 import importlib.util
@@ -54,7 +55,7 @@ def _module_files(prefix):
     return []  # a compiled module: its routines are refused by the module's name
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _compiled_codes(path):
     """Every code object of one source file, compiled as the import system does."""
     source = Path(path).read_bytes()
@@ -65,7 +66,7 @@ def _inside(qualname, names):
     return any(qualname == name or qualname.startswith(name + ".") for name in names)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def recognised(refusal):
     """``(names, modules, c_names)`` for the sandbox: {digest: readable name}, module prefixes, compiled functions."""
     allowed = {}
@@ -117,7 +118,7 @@ def _within(module, prefixes):
     return any(module == p or module.startswith(p + ".") for p in prefixes)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def spellings(refusal):
     """({spelling: the refused object's own name}, [spellings of allowed objects]) in labkit, scipy and numpy."""
     for prefix in refusal.modules:
@@ -126,8 +127,11 @@ def spellings(refusal):
                 importlib.import_module(prefix)
             except ImportError:
                 pass
-    libraries = [(name, module) for name, module in list(sys.modules.items())
-                 if module is not None and name.split(".")[0] in LIBRARIES]
+    libraries = [
+        (name, module)
+        for name, module in list(sys.modules.items())
+        if module is not None and name.split(".")[0] in LIBRARIES
+    ]
     allowed = {id(value): value for value in map(_resolve, refusal.allowed) if value is not None}
     refused = {}
     for name, module in libraries:
@@ -137,8 +141,7 @@ def spellings(refusal):
             if isinstance(value, types.ModuleType) or id(value) in allowed:
                 continue
             home = getattr(value, "__module__", None)
-            if isinstance(home, str) and _within(home, refusal.modules) and (
-                    id(value) not in refused or home == name):
+            if isinstance(home, str) and _within(home, refusal.modules) and (id(value) not in refused or home == name):
                 refused[id(value)] = (value, f"{name}.{attribute}")
     for dotted in refusal.functions:
         value = _resolve(dotted)
@@ -161,7 +164,11 @@ def wire(refusals):
     for refusal in refusals:
         names, modules, c_names = recognised(refusal)
         spelled, allowed = spellings(refusal)
-        profiles[refusal.name] = {"names": {key.hex(): name for key, name in names.items()},
-                                  "modules": list(modules), "c_names": sorted(map(list, c_names)),
-                                  "spellings": spelled, "allowed": allowed}
+        profiles[refusal.name] = {
+            "names": {key.hex(): name for key, name in names.items()},
+            "modules": list(modules),
+            "c_names": sorted(map(list, c_names)),
+            "spellings": spelled,
+            "allowed": allowed,
+        }
     return profiles

@@ -7,6 +7,7 @@ HERE``, for the student to write and the instructor to read. Hidden tests
 between ``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS`` disappear,
 outputs are cleared. The markers and the stubs are nbgrader's.
 """
+
 import json
 from pathlib import Path
 

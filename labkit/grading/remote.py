@@ -17,6 +17,7 @@ A time limit is an exception of its own type, raised where it is detected:
 :class:`CellTimeout` when a cell, a request or one call of a student's
 function ran past its own limit. Callers tell them apart by type.
 """
+
 import os
 import secrets
 import selectors
@@ -89,8 +90,14 @@ class Notebook:
             raise
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.process.stdout, selectors.EVENT_READ)
-        self.request({"op": "setup", "profiles": profiles if profiles is not None else refusals.wire(()),
-                      "passables": sorted(self.passables)}, SETUP_TIMEOUT)
+        self.request(
+            {
+                "op": "setup",
+                "profiles": profiles if profiles is not None else refusals.wire(()),
+                "passables": sorted(self.passables),
+            },
+            SETUP_TIMEOUT,
+        )
 
     def __enter__(self):
         return self
@@ -158,8 +165,9 @@ class Notebook:
             remaining = until - time.monotonic()
             if remaining <= 0:
                 if until >= self.deadline:
-                    self._stop("stopped after the total time limit: the notebook did not answer in time",
-                               NotebookTimeout)
+                    self._stop(
+                        "stopped after the total time limit: the notebook did not answer in time", NotebookTimeout
+                    )
                 self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
             if not self._selector.select(remaining):
                 continue
@@ -186,9 +194,14 @@ class Function:
 
     def __call__(self, *args):
         tags = [protocol.encode(arg, self.notebook.passables) for arg in args]
-        request = {"op": "call", "name": self.name, "timeout": self.timeout, "args": tags,
-                   "profile": self.refusal.name if self.refusal is not None else None,
-                   "passables": sorted(protocol.function_names(tags))}
+        request = {
+            "op": "call",
+            "name": self.name,
+            "timeout": self.timeout,
+            "args": tags,
+            "profile": self.refusal.name if self.refusal is not None else None,
+            "passables": sorted(protocol.function_names(tags)),
+        }
         answer = self.notebook.request(request, self.timeout + 5)
         return _value(answer)
 
@@ -205,8 +218,9 @@ def _value(answer):
             raise CellTimeout(message)
         if kind == "NotImplementedError" and not refused:
             raise NotImplementedError(message)
-        raise StudentError(kind, message, str(refused)[:200] if refused else None,
-                           str(error.get("traceback", ""))[:2000])
+        raise StudentError(
+            kind, message, str(refused)[:200] if refused else None, str(error.get("traceback", ""))[:2000]
+        )
     try:
         return protocol.decode(answer.get("value"))
     except protocol.ProtocolError as exc:
@@ -233,8 +247,9 @@ class Namespace:
         if name not in self._kinds:
             try:
                 answer = self.notebook.request({"op": "names", "names": [name]}, self.timeout)
-                kind = answer.get("names", {}).get(name, "missing") if isinstance(answer.get("names"), dict) \
-                    else "missing"
+                kind = (
+                    answer.get("names", {}).get(name, "missing") if isinstance(answer.get("names"), dict) else "missing"
+                )
             except WorkerError:
                 kind = "function"  # every call on it then says why the notebook cannot answer
             self._kinds[name] = kind if kind in ("function", "data") else "missing"
@@ -250,8 +265,7 @@ class Namespace:
         if kind == "function":
             return Function(self.notebook, name, self.refusal, self.timeout)
         try:
-            return _value(self.notebook.request({"op": "get", "name": name, "timeout": self.timeout},
-                                                self.timeout + 5))
+            return _value(self.notebook.request({"op": "get", "name": name, "timeout": self.timeout}, self.timeout + 5))
         except (StudentError, WorkerError) as exc:
             return protocol.NotNumbers(f"nothing readable ({exc})")
 

@@ -16,6 +16,7 @@ of control characters (:func:`printable`) before it reaches a file or a
 terminal, and every CSV cell that a spreadsheet would run as a formula is
 neutralised (:func:`csv_cell`).
 """
+
 import csv
 import hashlib
 import json
@@ -64,13 +65,18 @@ class SubmissionGrade:
 
     def feedback(self):
         if not self.graded:
-            return printable(f"Feedback for {one_line(self.name)}: not graded\n\n! could not be graded: "
-                             f"{one_line(self.failure, 500)}\n"
-                             "Your instructor has been told; nothing of this submission was scored.\n")
+            return printable(
+                f"Feedback for {one_line(self.name)}: not graded\n\n! could not be graded: "
+                f"{one_line(self.failure, 500)}\n"
+                "Your instructor has been told; nothing of this submission was scored.\n"
+            )
         score, rubric = self.score, self.rubric
         extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
-        lines = [f"Feedback for {one_line(self.name)}: {points_text(score.total)} points "
-                 f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})", ""]
+        lines = [
+            f"Feedback for {one_line(self.name)}: {points_text(score.total)} points "
+            f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})",
+            "",
+        ]
         # a problem's first line is the grader's; what follows (a traceback) is indented, so no line can pose
         # as one of the grader's own
         lines += [line for problem in self.problems for line in _problem_lines(problem)]
@@ -89,8 +95,10 @@ class SubmissionGrade:
         points = self.rubric.points[number]
         verdict = self.results.get(number)
         if verdict is None:
-            return [f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
-                    f"('## Exercise {number}') or it never ran."]
+            return [
+                f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
+                f"('## Exercise {number}') or it never ran."
+            ]
         status = "passed" if verdict["passed"] else "FAILED"
         lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(points)} - {status}"]
         total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
@@ -101,7 +109,9 @@ class SubmissionGrade:
             for step in check["steps"]:
                 mark = "ok  " if step["passed"] else "FAIL"
                 detail = f": {one_line(step['detail'], 1000)}" if step["detail"] else ""
-                lines.append(f"    [{mark}] {one_line(check['name'], 100)}{worth}: {one_line(step['step'], 300)}{detail}")
+                lines.append(
+                    f"    [{mark}] {one_line(check['name'], 100)}{worth}: {one_line(step['step'], 300)}{detail}"
+                )
             if check["hint"] and not check["passed"]:
                 lines.append(f"    hint: {one_line(check['hint'], 1000)}")
         return lines
@@ -124,14 +134,18 @@ class SubmissionGrade:
 
     def _summary(self):
         score, rubric = self.score, self.rubric
-        lines = [f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
-                 f"{points_text(sum(rubric.points[n] for n in rubric.required))}"]
+        lines = [
+            f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
+            f"{points_text(sum(rubric.points[n] for n in rubric.required))}"
+        ]
         if score.branch == "none":
             lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
         elif score.branch:
             full = sum(rubric.points[n] for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
-            lines.append(f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
-                         "(the better of the branches)")
+            lines.append(
+                f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
+                "(the better of the branches)"
+            )
         for what, value in score.extra.items():
             lines.append(f"Extra credit, {what}: {points_text(value)}")
         lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
@@ -139,11 +153,20 @@ class SubmissionGrade:
 
     def as_dict(self):
         score = self.score
-        return {"format": FORMAT, "name": self.name, "seed": self.seed, "problems": list(self.problems),
-                "failure": self.failure, "answers": dict(self.answers),
-                "results": {str(n): v for n, v in self.results.items()},
-                "rubric": self.rubric.title, "points": {str(n): v for n, v in score.points.items()},
-                "branch": score.branch, "extra_credit": score.extra, "total": score.total}
+        return {
+            "format": FORMAT,
+            "name": self.name,
+            "seed": self.seed,
+            "problems": list(self.problems),
+            "failure": self.failure,
+            "answers": dict(self.answers),
+            "results": {str(n): v for n, v in self.results.items()},
+            "rubric": self.rubric.title,
+            "points": {str(n): v for n, v in score.points.items()},
+            "branch": score.branch,
+            "extra_credit": score.extra,
+            "total": score.total,
+        }
 
     @classmethod
     def from_dict(cls, data, source="a result file", rubric=None):
@@ -154,25 +177,34 @@ class SubmissionGrade:
             results = {int(n): v for n, v in data["results"].items()}
             for verdict in results.values():
                 float(verdict["fraction"])
-            grade = cls(str(data["name"]), results, [str(p) for p in data["problems"]], data.get("seed"),
-                        rubric or rubrics.default(), data.get("failure"),
-                        {str(k): str(v)[:4000] for k, v in dict(data.get("answers") or {}).items()})
+            grade = cls(
+                str(data["name"]),
+                results,
+                [str(p) for p in data["problems"]],
+                data.get("seed"),
+                rubric or rubrics.default(),
+                data.get("failure"),
+                {str(k): str(v)[:4000] for k, v in dict(data.get("answers") or {}).items()},
+            )
             if grade.failure is not None:
                 grade.failure = str(grade.failure)
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
         known = grade.rubric.registry.exercises
         if not set(grade.results) <= set(known):
-            raise ValueError(f"{source} grades exercises {sorted(grade.results)}, not {sorted(known)}: "
-                             "it was written by another version of labkit.")
+            raise ValueError(
+                f"{source} grades exercises {sorted(grade.results)}, not {sorted(known)}: "
+                "it was written by another version of labkit."
+            )
         return grade
 
 
 def _problem_lines(problem):
     first, *rest = str(problem).split("\n") or [""]
-    return [f"! {one_line(first, 1000)}"] + ["    " + printable(line).replace("\t", " ")[:1000]
-                                               if line.startswith(" ") else "    | " + one_line(line, 1000)
-                                               for line in rest[:40]]
+    return [f"! {one_line(first, 1000)}"] + [
+        "    " + printable(line).replace("\t", " ")[:1000] if line.startswith(" ") else "    | " + one_line(line, 1000)
+        for line in rest[:40]
+    ]
 
 
 # control characters, and the invisible ones that break or reorder lines (line and paragraph separators, bidi marks)
@@ -227,14 +259,28 @@ def write_csv(path, grades):
         writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL + to_read)
         for g in grades:
             if not g.graded:
-                writer.writerow([csv_cell(g.name)] + [""] * (len(graded) + len(CSV_TAIL) - 1)
-                                + [csv_cell(f"not graded: {g.failure}")] + [""] * len(to_read))
+                writer.writerow(
+                    [csv_cell(g.name)]
+                    + [""] * (len(graded) + len(CSV_TAIL) - 1)
+                    + [csv_cell(f"not graded: {g.failure}")]
+                    + [""] * len(to_read)
+                )
                 continue
             s = g.score
-            writer.writerow([csv_cell(g.name)] + [points_text(s.points[n]) for n in graded]
-                            + [points_text(s.required), csv_cell(s.branch), points_text(s.counted),
-                               points_text(s.extra_total), points_text(s.total), points_text(s.full_credit),
-                               "graded"] + [""] * len(to_read))
+            writer.writerow(
+                [csv_cell(g.name)]
+                + [points_text(s.points[n]) for n in graded]
+                + [
+                    points_text(s.required),
+                    csv_cell(s.branch),
+                    points_text(s.counted),
+                    points_text(s.extra_total),
+                    points_text(s.total),
+                    points_text(s.full_credit),
+                    "graded",
+                ]
+                + [""] * len(to_read)
+            )
 
 
 def write_result(out_dir, grade):
@@ -242,8 +288,9 @@ def write_result(out_dir, grade):
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
-    (out / "results" / f"{safe_name(grade.name)}.json").write_text(json.dumps(grade.as_dict(), indent=1),
-                                                                     encoding="utf-8")
+    (out / "results" / f"{safe_name(grade.name)}.json").write_text(
+        json.dumps(grade.as_dict(), indent=1), encoding="utf-8"
+    )
     (out / "feedback" / f"{safe_name(grade.name)}.txt").write_text(grade.feedback(), encoding="utf-8")
 
 
@@ -262,7 +309,9 @@ def read_results(folders, rubric=None):
     for folder in map(Path, folders):
         files = sorted((folder / "results").glob("*.json"))
         if not files:
-            raise ValueError(f"{folder} holds no results/*.json: give the --out folders of earlier `labkit grade` runs.")
+            raise ValueError(
+                f"{folder} holds no results/*.json: give the --out folders of earlier `labkit grade` runs."
+            )
         for path in files:
             try:
                 data = json.loads(path.read_text(encoding="utf-8"))

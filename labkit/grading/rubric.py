@@ -12,12 +12,14 @@ turns the fractions an exercise's parts earned
 (:meth:`labkit.exercises.registry.Registry.check`) into points, the branch
 that counted, the extra credit and the total.
 """
+
 import functools
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..exercises.registry import LAB, Registry, load as load_registry
+from ..exercises.registry import LAB, Registry
+from ..exercises.registry import load as load_registry
 
 DEFAULT = Path(__file__).with_name("rubric.toml")
 
@@ -72,8 +74,11 @@ class Rubric:
     @property
     def maximum(self):
         """Full credit plus every extra credit."""
-        return self.full_credit + self.branch_extra * max(len(self.branches) - 1, 0) + sum(
-            self.points[n] for n in self.extra_credit)
+        return (
+            self.full_credit
+            + self.branch_extra * max(len(self.branches) - 1, 0)
+            + sum(self.points[n] for n in self.extra_credit)
+        )
 
     def score(self, fractions):
         """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1)."""
@@ -94,8 +99,10 @@ class Rubric:
 
     def describe(self):
         """The rubric in a few lines, for the feedback."""
-        lines = [f"Rubric: {self.title}",
-                 f"  full credit {points_text(self.full_credit)}: exercises {_list(self.required)} for everyone"]
+        lines = [
+            f"Rubric: {self.title}",
+            f"  full credit {points_text(self.full_credit)}: exercises {_list(self.required)} for everyone",
+        ]
         if self.branches:
             names = " or ".join(f"{b.name} ({_list(b.exercises)})" for b in self.branches)
             lines[-1] += f", plus one branch: {names}; the better branch counts"
@@ -123,8 +130,10 @@ def _exercise(value, where, source, registry):
         raise ValueError(f"{source}: {where} has {value!r}, which is not an exercise number.") from None
     if str(value).strip() != str(number) or number not in registry.exercises:
         known = ", ".join(map(str, sorted(registry.exercises)))
-        raise ValueError(f"{source}: {where} names exercise {value!r}, which labkit does not grade "
-                         f"(graded exercises: {known}; exercise 1 is not graded).")
+        raise ValueError(
+            f"{source}: {where} names exercise {value!r}, which labkit does not grade "
+            f"(graded exercises: {known}; exercise 1 is not graded)."
+        )
     return number
 
 
@@ -152,16 +161,20 @@ def from_dict(data, source="the rubric"):
         raise ValueError(f"{source}: {exc}") from None
     raw_points = data.get("points", {})
     if not isinstance(raw_points, dict):
-        raise ValueError(f"{source}: [points] must be a table of `N = points` lines (or left out: each exercise "
-                         "is then worth its parts' weights).")
+        raise ValueError(
+            f"{source}: [points] must be a table of `N = points` lines (or left out: each exercise "
+            "is then worth its parts' weights)."
+        )
     points = {}
     for key, value in raw_points.items():
         number = _exercise(key, "[points]", source, registry)
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
             raise ValueError(f"{source}: [points] gives exercise {number} {value!r}; points must be a number.")
         if value < 0:
-            raise ValueError(f"{source}: [points] gives exercise {number} negative points ({value}); "
-                             "use 0 to leave an exercise ungraded.")
+            raise ValueError(
+                f"{source}: [points] gives exercise {number} negative points ({value}); "
+                "use 0 to leave an exercise ungraded."
+            )
         points[number] = float(value)
     required = _exercise_list(data.get("required", []), "required", source, registry)
     extra_credit = _exercise_list(data.get("extra_credit", []), "extra_credit", source, registry)
@@ -172,19 +185,25 @@ def from_dict(data, source="the rubric"):
     for group, numbers in groups:
         for number in numbers:
             if number in seen:
-                raise ValueError(f"{source}: exercise {number} is in {seen[number]} and in {group}; "
-                                 "each exercise belongs to one group (branches may not overlap).")
+                raise ValueError(
+                    f"{source}: exercise {number} is in {seen[number]} and in {group}; "
+                    "each exercise belongs to one group (branches may not overlap)."
+                )
             seen[number] = group
             points.setdefault(number, float(registry.points[number]))
     for number in points:
         if number not in seen:
-            raise ValueError(f"{source}: exercise {number} has points but is in no group: add it to required, "
-                             "extra_credit or a branch, or remove its points.")
+            raise ValueError(
+                f"{source}: exercise {number} has points but is in no group: add it to required, "
+                "extra_credit or a branch, or remove its points."
+            )
     totals = {b.name: sum(points[n] for n in b.exercises) for b in branches}
     if len(set(totals.values())) > 1:
         shown = ", ".join(f"{name} {points_text(total)}" for name, total in totals.items())
-        raise ValueError(f"{source}: the branches must be worth the same points, since either one gives full "
-                         f"credit; they are worth {shown}.")
+        raise ValueError(
+            f"{source}: the branches must be worth the same points, since either one gives full "
+            f"credit; they are worth {shown}."
+        )
     title = data.get("title", "rubric")
     if not isinstance(title, str):
         raise ValueError(f"{source}: title must be text.")
@@ -201,7 +220,9 @@ def _branches(table, source, registry):
         raise ValueError(f"{source}: [branches] must be a table with extra_credit and [[branches.choice]] entries.")
     unknown = sorted(set(table) - {"extra_credit", "choice"})
     if unknown:
-        raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)} in [branches]; it has extra_credit and choice.")
+        raise ValueError(
+            f"{source}: unknown key(s) {', '.join(unknown)} in [branches]; it has extra_credit and choice."
+        )
     extra = table.get("extra_credit", 0)
     if isinstance(extra, bool) or not isinstance(extra, (int, float)) or extra < 0:
         raise ValueError(f"{source}: [branches] extra_credit must be a number of points, at least 0; got {extra!r}.")
@@ -212,14 +233,15 @@ def _branches(table, source, registry):
     for index, choice in enumerate(choices, start=1):
         if not isinstance(choice, dict) or not isinstance(choice.get("name"), str) or "exercises" not in choice:
             raise ValueError(f"{source}: branch {index} needs a name and a list of exercises.")
-        branches.append(Branch(choice["name"], _exercise_list(choice["exercises"], f"branch {choice['name']!r}",
-                                                              source, registry)))
+        branches.append(
+            Branch(choice["name"], _exercise_list(choice["exercises"], f"branch {choice['name']!r}", source, registry))
+        )
     if len({b.name for b in branches}) != len(branches):
         raise ValueError(f"{source}: two branches have the same name.")
     return tuple(branches), float(extra)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def default():
     """The lab's own rubric (:data:`DEFAULT`)."""
     return load(DEFAULT)

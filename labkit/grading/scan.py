@@ -20,6 +20,7 @@ The scan is bounded: a notebook's code cells may hold at most
 that run Python (``%%time``, ``%%capture``) are read as Python; other cells
 that IPython would hand to another program are skipped.
 """
+
 import ast
 import re
 import time
@@ -29,20 +30,95 @@ TIME_BUDGET = 20.0  # seconds to read one notebook's code
 
 PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
 # modules a graded function may reach without the scan asking what they are
-KNOWN = {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator",
-         "collections", "numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings",
-         "bisect", "heapq", "copy", "enum", "abc"}
-DYNAMIC_NAMES = {"__import__": "__import__", "eval": "eval", "exec": "exec", "compile": "compile",
-                 "globals": "globals()", "vars": "vars()", "locals": "locals()", "setattr": "setattr",
-                 "delattr": "delattr", "breakpoint": "breakpoint"}
-DYNAMIC_ATTRIBUTES = {"__code__", "__closure__", "__globals__", "__builtins__", "__dict__", "__subclasses__",
-                      "__func__", "f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame", "__wrapped__"}
-DYNAMIC_MODULES = {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill", "builtins",
-                   "imp", "pkgutil", "runpy", "code", "codeop", "threading", "_thread", "multiprocessing",
-                   "subprocess", "signal"}
-DYNAMIC_DOTTED = {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace",
-                  "sys.gettrace", "sys._current_frames", "types.FunctionType", "types.CodeType", "os.system",
-                  "os.fork", "os.popen", "os.exec", "os.spawn"}
+KNOWN = {
+    "numpy",
+    "scipy",
+    "math",
+    "cmath",
+    "labkit",
+    "matplotlib",
+    "functools",
+    "itertools",
+    "operator",
+    "collections",
+    "numbers",
+    "fractions",
+    "decimal",
+    "statistics",
+    "typing",
+    "dataclasses",
+    "warnings",
+    "bisect",
+    "heapq",
+    "copy",
+    "enum",
+    "abc",
+}
+DYNAMIC_NAMES = {
+    "__import__": "__import__",
+    "eval": "eval",
+    "exec": "exec",
+    "compile": "compile",
+    "globals": "globals()",
+    "vars": "vars()",
+    "locals": "locals()",
+    "setattr": "setattr",
+    "delattr": "delattr",
+    "breakpoint": "breakpoint",
+}
+DYNAMIC_ATTRIBUTES = {
+    "__code__",
+    "__closure__",
+    "__globals__",
+    "__builtins__",
+    "__dict__",
+    "__subclasses__",
+    "__func__",
+    "f_back",
+    "f_locals",
+    "f_globals",
+    "gi_frame",
+    "tb_frame",
+    "cr_frame",
+    "__wrapped__",
+}
+DYNAMIC_MODULES = {
+    "importlib",
+    "ctypes",
+    "cffi",
+    "gc",
+    "inspect",
+    "marshal",
+    "pickle",
+    "dill",
+    "builtins",
+    "imp",
+    "pkgutil",
+    "runpy",
+    "code",
+    "codeop",
+    "threading",
+    "_thread",
+    "multiprocessing",
+    "subprocess",
+    "signal",
+}
+DYNAMIC_DOTTED = {
+    "sys.modules",
+    "sys._getframe",
+    "sys.setprofile",
+    "sys.getprofile",
+    "sys.settrace",
+    "sys.gettrace",
+    "sys._current_frames",
+    "types.FunctionType",
+    "types.CodeType",
+    "os.system",
+    "os.fork",
+    "os.popen",
+    "os.exec",
+    "os.spawn",
+}
 
 
 class Unreadable(ValueError):
@@ -126,8 +202,13 @@ class _Reader:
             found.append((current, node, local))
             for inner in ast.walk(node):
                 self._tick()
-                if (isinstance(inner, ast.Name) and isinstance(inner.ctx, ast.Load) and inner.id in self.definitions
-                        and inner.id not in seen and inner.id not in local):
+                if (
+                    isinstance(inner, ast.Name)
+                    and isinstance(inner.ctx, ast.Load)
+                    and inner.id in self.definitions
+                    and inner.id not in seen
+                    and inner.id not in local
+                ):
                     todo.append(inner.id)
         return found
 
@@ -140,8 +221,9 @@ def _locals(node):
     for inner in ast.walk(node):
         if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
             arguments = inner.args
-            for arg in arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg,
-                                                                                        arguments.kwarg]:
+            for arg in (
+                arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg, arguments.kwarg]
+            ):
                 if arg is not None:
                     bound.add(arg.arg)
             if inner is not node and not isinstance(inner, ast.Lambda):
@@ -207,8 +289,13 @@ def _dynamic(node, aliases):
         return DYNAMIC_NAMES[node.id]
     if isinstance(node, ast.Attribute) and node.attr in DYNAMIC_ATTRIBUTES:
         return node.attr
-    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "getattr" \
-            and len(node.args) >= 2 and not isinstance(node.args[1], ast.Constant):
+    if (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id == "getattr"
+        and len(node.args) >= 2
+        and not isinstance(node.args[1], ast.Constant)
+    ):
         return "getattr with a computed name"
     if isinstance(node, (ast.Name, ast.Attribute)):
         dotted = _dotted(node, aliases)
@@ -247,8 +334,9 @@ def scan(sources, names, profile, deadline=None):
         return []
     size = sum(len(s.encode("utf-8", "surrogatepass")) for s in sources)
     if size > MAX_CODE_BYTES:
-        raise Unreadable(f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} "
-                         "a lab notebook needs")
+        raise Unreadable(
+            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
+        )
     deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
     reader = _reader(tuple(sources), deadline)
     refused = _Refused(profile)
@@ -262,8 +350,9 @@ def scan(sources, names, profile, deadline=None):
                 if isinstance(node, (ast.Import, ast.ImportFrom)):
                     for alias_name, dotted in _imported(node):
                         local[alias_name] = dotted
-                        why = refused.reason(dotted) or (dotted.split(".")[0] if dotted.split(".")[0]
-                                                         in DYNAMIC_MODULES else None)
+                        why = refused.reason(dotted) or (
+                            dotted.split(".")[0] if dotted.split(".")[0] in DYNAMIC_MODULES else None
+                        )
                         if why:
                             findings.add((owner, node.lineno - start + 1, why))
             for node in ast.walk(definition):
@@ -278,8 +367,9 @@ def scan(sources, names, profile, deadline=None):
                 if what:
                     findings.add((owner, getattr(node, "lineno", start) - start + 1, what))
     # an attribute chain reports itself and its prefixes: keep the longest on each line
-    return sorted(f for f in findings if not any(g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2])
-                                                  for g in findings))
+    return sorted(
+        f for f in findings if not any(g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2]) for g in findings)
+    )
 
 
 _READERS = {}

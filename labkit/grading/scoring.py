@@ -17,6 +17,7 @@ process of its own and writes its result file: :mod:`labkit.grading.batch`
 starts one per submission, so whatever one submission does to the grader's
 memory or time costs only its own grade.
 """
+
 import json
 import os
 import re
@@ -52,9 +53,11 @@ def read_cells(path, answers=None, registry=LAB):
     if stat.S_ISLNK(info.st_mode):
         raise ValueError(f"{path.name} is a symbolic link; links are never followed.")
     if info.st_size > MAX_NOTEBOOK_BYTES:
-        raise ValueError(f"{path.name} is {info.st_size / 1024**2:.1f} MB, more than the "
-                         f"{MAX_NOTEBOOK_BYTES // 1024**2} MB a lab notebook needs (clear its outputs and hand it in "
-                         "again); it was not graded.")
+        raise ValueError(
+            f"{path.name} is {info.st_size / 1024**2:.1f} MB, more than the "
+            f"{MAX_NOTEBOOK_BYTES // 1024**2} MB a lab notebook needs (clear its outputs and hand it in "
+            "again); it was not graded."
+        )
     fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
     with os.fdopen(fd, "rb") as handle:
         raw = handle.read(MAX_NOTEBOOK_BYTES + 1)
@@ -107,8 +110,10 @@ def submission_notebooks(path):
     except FileNotFoundError:
         raise ValueError(f"{path} does not exist.") from None
     if stat.S_ISLNK(info.st_mode):
-        raise ValueError(f"{path} is a symbolic link; links are never followed (grade the folder it points to "
-                         "by its own name if it is really a submission).")
+        raise ValueError(
+            f"{path} is a symbolic link; links are never followed (grade the folder it points to "
+            "by its own name if it is really a submission)."
+        )
     if stat.S_ISREG(info.st_mode):
         if path.suffix != ".ipynb":
             raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
@@ -138,26 +143,36 @@ def submission_notebooks(path):
 
 
 def _failed_part(check, name, step, detail, hint):
-    return {"name": name, "passed": False, "hint": hint, "weight": check.get("weight", 0),
-            "steps": [{"step": step, "passed": False, "detail": detail}]}
+    return {
+        "name": name,
+        "passed": False,
+        "hint": hint,
+        "weight": check.get("weight", 0),
+        "steps": [{"step": step, "passed": False, "detail": detail}],
+    }
 
 
 def _own_code(check, findings):
     """The part's check, failed: the graded function reaches for refused references (its other steps kept)."""
-    details = "; ".join(f"{function} (line {line} of its definition) reaches for {name}"
-                        for function, line, name in findings[:8])
-    return {**check, "passed": False,
-            "steps": list(check.get("steps", [])) + [{"step": "calls no reference implementation", "passed": False,
-                                                       "detail": details}],
-            "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names "
-                    "stay available."}
+    details = "; ".join(
+        f"{function} (line {line} of its definition) reaches for {name}" for function, line, name in findings[:8]
+    )
+    return {
+        **check,
+        "passed": False,
+        "steps": list(check.get("steps", []))
+        + [{"step": "calls no reference implementation", "passed": False, "detail": details}],
+        "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names "
+        "stay available.",
+    }
 
 
 def _rescore(verdict, registry):
     exercise = registry.exercises[verdict["exercise"]]
     points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"])
-    verdict.update(points=points, passed=points == exercise.points,
-                   fraction=points / exercise.points if exercise.points else 1.0)
+    verdict.update(
+        points=points, passed=points == exercise.points, fraction=points / exercise.points if exercise.points else 1.0
+    )
     return verdict
 
 
@@ -184,15 +199,20 @@ def _run_problems(name, ran):
         shown = []
         for error in errors[:SHOWN_ERRORS]:
             error = error if isinstance(error, dict) else {}
-            text = f"cell {int(error.get('cell', -1)) + 1} raised {one_line(error.get('kind'), 100)}: " \
-                   f"{one_line(error.get('message', ''), 300)}"
+            text = (
+                f"cell {int(error.get('cell', -1)) + 1} raised {one_line(error.get('kind'), 100)}: "
+                f"{one_line(error.get('message', ''), 300)}"
+            )
             tail = _student_frames(str(error.get("traceback", ""))[-4000:])
             if tail:
                 text += "\n" + "\n".join(f"      | {line}" for line in tail[-6:])
             shown.append(text)
         more = f"\n    and {len(errors) - SHOWN_ERRORS} more" if len(errors) > SHOWN_ERRORS else ""
-        problems.append(f"{name}: {len(errors)} cell(s) raised an error (graded as far as it got):\n    "
-                        + "\n    ".join(shown) + more)
+        problems.append(
+            f"{name}: {len(errors)} cell(s) raised an error (graded as far as it got):\n    "
+            + "\n    ".join(shown)
+            + more
+        )
     if int(ran.get("output_chars", 0) or 0) > OUTPUT_LIMIT:
         problems.append(f"{name}: printed {int(ran['output_chars']):,} characters of output (none of it is kept).")
     return problems
@@ -231,11 +251,15 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
         return {}, []
     size = sum(len(source.encode("utf-8", "surrogatepass")) for source in code)
     if size > scan.MAX_CODE_BYTES:
-        return {}, [f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
-                    "notebook needs; it was not graded."]
+        return {}, [
+            f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
+            "notebook needs; it was not graded."
+        ]
     if deadline - time.monotonic() <= 1:
-        return {}, [f"{name}: not run: the submission's time limit of {options.total_timeout} s was used up "
-                    "by the notebooks before it."]
+        return {}, [
+            f"{name}: not run: the submission's time limit of {options.total_timeout} s was used up "
+            "by the notebooks before it."
+        ]
     problems, results = [], {}
     try:
         notebook = remote.Notebook(options, deadline, _for_sandbox(profiles), registry.passable)
@@ -243,8 +267,9 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
         return {}, [f"{name}: the sandbox could not start ({exc})."]
     with notebook:
         try:
-            ran = notebook.request({"op": "run", "cells": code, "cell_timeout": options.cell_timeout},
-                                   options.total_timeout)
+            ran = notebook.request(
+                {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
+            )
         except remote.NotebookTimeout:
             return {}, [f"{name}: stopped after the submission's time limit of {options.total_timeout} s."]
         except remote.CellTimeout as exc:
@@ -260,9 +285,16 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
         for number in numbers:
             exercise = registry.exercises[number]
             if notebook.tampered:
-                checks = [_failed_part({"weight": part.weight}, part.name, "the notebook's answers can be trusted",
-                                       notebook.tampered, "remove what the message names and hand it in again.")
-                          for part in exercise.parts]
+                checks = [
+                    _failed_part(
+                        {"weight": part.weight},
+                        part.name,
+                        "the notebook's answers can be trusted",
+                        notebook.tampered,
+                        "remove what the message names and hand it in again.",
+                    )
+                    for part in exercise.parts
+                ]
                 results[number] = _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
                 continue
             verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed)
@@ -273,8 +305,12 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                     findings = scan.scan(code, part.scanned, profiles[part.refused.name])
                 except scan.Unreadable as exc:
                     verdict["checks"][index] = _failed_part(
-                        verdict["checks"][index], verdict["checks"][index]["name"], "its source can be read",
-                        str(exc), "keep the notebook's code to what the lab asks for.")
+                        verdict["checks"][index],
+                        verdict["checks"][index]["name"],
+                        "its source can be read",
+                        str(exc),
+                        "keep the notebook's code to what the lab asks for.",
+                    )
                     continue
                 if findings:
                     verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
@@ -315,8 +351,9 @@ def grade_submission(path, options=None, *, rubric=None, profiles=None, **single
         return grade
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
-        results, problems = grade_notebook(notebook, options=options, deadline=deadline, skip=claimed,
-                                           profiles=profiles, answers=grade.answers)
+        results, problems = grade_notebook(
+            notebook, options=options, deadline=deadline, skip=claimed, profiles=profiles, answers=grade.answers
+        )
         grade.problems.extend(problems)
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)

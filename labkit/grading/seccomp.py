@@ -24,6 +24,7 @@ System calls of another architecture (32-bit calls on a 64-bit machine)
 are refused too: they would reach the same functions under other numbers.
 The filters are classic BPF, a few dozen instructions each.
 """
+
 import errno
 import os
 import platform
@@ -31,15 +32,43 @@ import struct
 
 # numbers of the refused calls on the architectures the grader runs on
 SYSCALLS = {
-    "x86_64": {"memfd_create": 319, "memfd_secret": 447, "add_key": 248, "request_key": 249, "keyctl": 250,
-               "ptrace": 101, "process_vm_readv": 310, "process_vm_writev": 311, "clone": 56, "clone3": 435,
-               "rt_sigaction": 13},
-    "aarch64": {"memfd_create": 279, "memfd_secret": 447, "add_key": 217, "request_key": 218, "keyctl": 219,
-                "ptrace": 117, "process_vm_readv": 270, "process_vm_writev": 271, "clone": 220, "clone3": 435,
-                "rt_sigaction": 134},
+    "x86_64": {
+        "memfd_create": 319,
+        "memfd_secret": 447,
+        "add_key": 248,
+        "request_key": 249,
+        "keyctl": 250,
+        "ptrace": 101,
+        "process_vm_readv": 310,
+        "process_vm_writev": 311,
+        "clone": 56,
+        "clone3": 435,
+        "rt_sigaction": 13,
+    },
+    "aarch64": {
+        "memfd_create": 279,
+        "memfd_secret": 447,
+        "add_key": 217,
+        "request_key": 218,
+        "keyctl": 219,
+        "ptrace": 117,
+        "process_vm_readv": 270,
+        "process_vm_writev": 271,
+        "clone": 220,
+        "clone3": 435,
+        "rt_sigaction": 134,
+    },
 }
-SANDBOX = ("memfd_create", "memfd_secret", "add_key", "request_key", "keyctl", "ptrace", "process_vm_readv",
-           "process_vm_writev")
+SANDBOX = (
+    "memfd_create",
+    "memfd_secret",
+    "add_key",
+    "request_key",
+    "keyctl",
+    "ptrace",
+    "process_vm_readv",
+    "process_vm_writev",
+)
 AUDIT_ARCH = {"x86_64": 0xC000003E, "aarch64": 0xC00000B7}
 X32_BIT = 0x40000000  # x86_64's x32 calls: the same functions under numbers with this bit
 CLONE_THREAD = 0x00010000
@@ -68,10 +97,12 @@ def program(machine=None, deny=SANDBOX, threads=True):
         body.append((_JGE_K, "deny", 0, X32_BIT))
     body += [(_JEQ_K, "deny", 0, numbers[name]) for name in deny]
     if threads:  # last: the flags check leaves the accumulator holding the flags, not the number
-        body += [(_JEQ_K, "nosys", 0, numbers["clone3"]),
-                 (_JEQ_K, 0, 2, numbers["clone"]),
-                 (_LD_W_ABS, 0, 0, _ARG0),
-                 (_JSET_K, "deny", 0, CLONE_THREAD)]
+        body += [
+            (_JEQ_K, "nosys", 0, numbers["clone3"]),
+            (_JEQ_K, 0, 2, numbers["clone"]),
+            (_LD_W_ABS, 0, 0, _ARG0),
+            (_JSET_K, "deny", 0, CLONE_THREAD),
+        ]
     body += [(_RET_K, 0, 0, _ALLOW), (_RET_K, 0, 0, _ERRNO | errno.EPERM), (_RET_K, 0, 0, _ERRNO | errno.ENOSYS)]
     targets = {"allow": len(body) - 3, "deny": len(body) - 2, "nosys": len(body) - 1}
 

@@ -32,6 +32,7 @@ crash, a time limit), the next request starts a new one that runs the cells
 again, so one bad call costs only its own part. Everything said here is
 still only evidence: the grader checks it and computes every score itself.
 """
+
 import hashlib
 import hmac
 import io
@@ -142,6 +143,7 @@ class _Lines:
 
 # -- the notebook's process -----------------------------------------------------
 
+
 class Notebook:
     """The student's namespace in an IPython shell, and the answers to the grader's requests about it."""
 
@@ -177,8 +179,12 @@ class Notebook:
                 kind, text = _describe(failure)
                 errors.append({"cell": index, "kind": kind, "message": text, "traceback": _tail(failure)})
             plt.close("all")  # as the inline backend does after each cell
-        return {"errors": errors, "cells": len(cells), "output_chars": self.output.chars,
-                "seconds": time.perf_counter() - start}
+        return {
+            "errors": errors,
+            "cells": len(cells),
+            "output_chars": self.output.chars,
+            "seconds": time.perf_counter() - start,
+        }
 
     def names(self, names):
         namespace, kinds = self.shell.user_ns, {}
@@ -228,7 +234,7 @@ def _serve_one(notebook, reader, answers):
     sys.audit(guard.END, payload)
     view = memoryview(payload)
     while view:
-        view = view[os.write(answers, view):]
+        view = view[os.write(answers, view) :]
     return True
 
 
@@ -247,13 +253,19 @@ def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles,
     signal.signal(signal.SIGALRM, _alarm)
     seccomp.install_for_notebook()
     passables = {name: protocol.passable(name) for name in passable_names}
-    guard.install(os.read(key_fd, 32), verdict_fd, guard.unwire(profiles), passables,
-                  chain=(_serve_one.__code__, _serve.__code__, _notebook_main.__code__))
+    guard.install(
+        os.read(key_fd, 32),
+        verdict_fd,
+        guard.unwire(profiles),
+        passables,
+        chain=(_serve_one.__code__, _serve.__code__, _notebook_main.__code__),
+    )
     os.close(key_fd)
     _serve(Notebook(shell, output), _Lines(requests_fd), answers_fd)
 
 
 # -- the supervisor -------------------------------------------------------------
+
 
 class Supervisor:
     """Holds the grader's pipes, forks and watches the notebook's process, forwards attested answers."""
@@ -268,7 +280,7 @@ class Supervisor:
         data = protocol.dumps(message)
         view = memoryview(data)
         while view:
-            view = view[os.write(self.answers, view):]
+            view = view[os.write(self.answers, view) :]
 
     def serve(self):
         while True:
@@ -299,8 +311,15 @@ class Supervisor:
                 os.close(self.answers)
                 for name, (read, write) in pipes.items():
                     os.close(write if name in ("key", "requests") else read)
-                _notebook_main(self.shell, pipes["key"][0], pipes["verdict"][1], pipes["requests"][0],
-                               pipes["answers"][1], self.setup["profiles"], self.setup["passables"])
+                _notebook_main(
+                    self.shell,
+                    pipes["key"][0],
+                    pipes["verdict"][1],
+                    pipes["requests"][0],
+                    pipes["answers"][1],
+                    self.setup["profiles"],
+                    self.setup["passables"],
+                )
             finally:
                 os._exit(0)
         for name, (read, write) in pipes.items():
@@ -308,8 +327,12 @@ class Supervisor:
         self.secret = os.urandom(32)  # made after the fork: it never existed in the notebook's memory
         os.write(pipes["key"][1], self.secret)
         os.close(pipes["key"][1])
-        self.child = {"pid": pid, "requests": pipes["requests"][1], "answers": _Lines(pipes["answers"][0]),
-                      "verdicts": _Lines(pipes["verdict"][0], 1 << 16)}
+        self.child = {
+            "pid": pid,
+            "requests": pipes["requests"][1],
+            "answers": _Lines(pipes["answers"][0]),
+            "verdicts": _Lines(pipes["verdict"][0], 1 << 16),
+        }
 
     def stop(self, why=None):
         if self.child is None:
@@ -367,7 +390,7 @@ class Supervisor:
             data = protocol.dumps(message)
             view = memoryview(data)
             while view:
-                view = view[os.write(self.child["requests"], view):]
+                view = view[os.write(self.child["requests"], view) :]
         except OSError:
             self.stop()
             return _error("WorkerError", self.ended)
@@ -409,9 +432,11 @@ class Supervisor:
         return self._verified(answer, line + b"\n", rid, profile, passables)
 
     def _tamper_text(self):
-        return (f"the notebook used {self.tampered}, so the grader cannot vouch for its answers (threads, "
-                "processes, ctypes, profilers, debuggers and the garbage collector's lists are not allowed while "
-                "a notebook is graded)")
+        return (
+            f"the notebook used {self.tampered}, so the grader cannot vouch for its answers (threads, "
+            "processes, ctypes, profilers, debuggers and the garbage collector's lists are not allowed while "
+            "a notebook is graded)"
+        )
 
     def _read_verdicts(self):
         """File what the watch wrote: tampering (sticky, True when there is some) and attestations."""
@@ -434,22 +459,31 @@ class Supervisor:
         # that does not verify, means the notebook found the request's id and wrote to the watch's pipe
         mine = [text.split("\t") for text in pending if text.split("\t", 1)[0] == expected[0]]
         if len(mine) != 1:
-            return _error("Tampered", "the answer came without the grader's watch (it was switched off, or the "
-                                      "answer was forged)" if not mine else
-                          "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers")
+            return _error(
+                "Tampered",
+                "the answer came without the grader's watch (it was switched off, or the answer was forged)"
+                if not mine
+                else "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers",
+            )
         parts = mine[0]
         *fields, signature = parts if len(parts) == 6 else ([""] * 6)
-        if ((fields[0], fields[1], fields[2], fields[4]) != (expected[0], expected[1], expected[2], expected[4])
-                or not hmac.compare_digest(signature, guard.sign(self.secret, *fields))):
-            return _error("Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for "
-                                      "its answers")
+        if (fields[0], fields[1], fields[2], fields[4]) != (
+            expected[0],
+            expected[1],
+            expected[2],
+            expected[4],
+        ) or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
+            return _error(
+                "Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers"
+            )
         status = fields[3]
         if status == "clean":
             return answer
         what, _, detail = status.partition(":")
         if what == "refused":
-            return _error("RefusedReference", f"called {detail}, which is switched off while this part is graded",
-                          detail)
+            return _error(
+                "RefusedReference", f"called {detail}, which is switched off while this part is graded", detail
+            )
         self.tampered = self.tampered or detail
         return _error("Tampered", self._tamper_text())
 
@@ -487,15 +521,16 @@ def _warm():
     matplotlib.use("Agg")
     import matplotlib.pyplot  # noqa: F401
     import numpy  # noqa: F401
+
+    # `import labkit` no longer loads scipy, but the watch learns the exact types of compiled routines
+    # (Cython's, f2py's) from the modules loaded when it is installed: scipy's must be among them
+    import scipy.linalg  # noqa: F401
+    import scipy.spatial  # noqa: F401
     from IPython.core.interactiveshell import InteractiveShell
     from traitlets.config import Config
 
     import labkit  # noqa: F401
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
-    # `import labkit` no longer loads scipy, but the watch learns the exact types of compiled routines
-    # (Cython's, f2py's) from the modules loaded when it is installed: scipy's must be among them
-    import scipy.linalg  # noqa: F401
-    import scipy.spatial  # noqa: F401
 
     config = Config()
     config.HistoryManager.enabled = False

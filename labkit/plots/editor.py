@@ -13,6 +13,7 @@ The handles' logic is plain Python, tested without a browser
 :func:`move_handle`, :func:`corner_code`. The browser side is
 ``editor.js`` beside this file, an anywidget module.
 """
+
 import pathlib
 
 import numpy as np
@@ -73,8 +74,10 @@ def _numbers(vector):
 
 def corner_code(corners):
     """The corner data as the Corner(...) lines an exercise cell uses, rounded to 3 decimals."""
-    return "\n".join(f"{name} = Corner({_numbers(c.point)}, ds={_numbers(c.ds)}, dt={_numbers(c.dt)}, "
-                     f"dsdt={_numbers(c.dsdt)})" for name, c in zip(NAMES, corners))
+    return "\n".join(
+        f"{name} = Corner({_numbers(c.point)}, ds={_numbers(c.ds)}, dt={_numbers(c.dt)}, dsdt={_numbers(c.dsdt)})"
+        for name, c in zip(NAMES, corners)
+    )
 
 
 def _editor_class():
@@ -106,8 +109,14 @@ class Editor:
         self.figure, self.ax = new_figure((5, 5))
         self.view = PatchView(self.ax, colorbar=False)
         self.elements = _size_slider(elements)
-        self.twist = widgets.FloatSlider(value=float(np.mean([c.dsdt[0] for c in self.corners])), min=-3.0,
-                                         max=3.0, step=0.1, description="twist", continuous_update=True)
+        self.twist = widgets.FloatSlider(
+            value=float(np.mean([c.dsdt[0] for c in self.corners])),
+            min=-3.0,
+            max=3.0,
+            step=0.1,
+            description="twist",
+            continuous_update=True,
+        )
         self.widget_ = _editor_class()()
         self.limits = limits or self._fit_limits()
         self.redraws = 0
@@ -158,8 +167,9 @@ class Editor:
         self.widget_.frame = self._frame()
         self.widget_.handles = handle_positions(self.corners).round(6).tolist()
         folded = int(np.sum(self.view.mesh.quality() <= 0))
-        self.widget_.readout = (f"worst quality {worst:.2f}" + (f", {folded} folded" if folded else "")
-                                + "\n" + corner_code(self.corners))
+        self.widget_.readout = (
+            f"worst quality {worst:.2f}" + (f", {folded} folded" if folded else "") + "\n" + corner_code(self.corners)
+        )
         self.widget_.worst = worst
         self.widget_.image = picture
         self.redraws += 1
@@ -169,9 +179,18 @@ class Editor:
         width, height = self.figure.canvas.get_width_height()
         box = self.ax.get_window_extent()  # pixels, as drawn (after the equal aspect was applied)
         (x0, x1), (y0, y1) = self.ax.get_xlim(), self.ax.get_ylim()
-        return {"width": width, "height": height, "left": float(box.x0), "right": float(box.x1),
-                "top": float(height - box.y1), "bottom": float(height - box.y0),
-                "x0": float(x0), "x1": float(x1), "y0": float(y0), "y1": float(y1)}
+        return {
+            "width": width,
+            "height": height,
+            "left": float(box.x0),
+            "right": float(box.x1),
+            "top": float(height - box.y1),
+            "bottom": float(height - box.y0),
+            "x0": float(x0),
+            "x1": float(x1),
+            "y0": float(y0),
+            "y1": float(y1),
+        }
 
     def _repr_mimebundle_(self, **kwargs):
         return widget_with_picture(self.widget, self.widget_.image, self.widget_.readout, **kwargs)

@@ -12,6 +12,7 @@ picture, so a static copy of the notebook still shows the figure.
 One function per notebook builds its explorer, so a notebook's Explore cell
 is one line, e.g. ``plots.limacon_explorer()``.
 """
+
 import base64
 import io
 
@@ -69,7 +70,8 @@ def png(figure, painter=None):
     (painter or Painter(figure)).draw()
     buffer = io.BytesIO()
     Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).save(
-        buffer, format="png", compress_level=1)
+        buffer, format="png", compress_level=1
+    )
     return buffer.getvalue()
 
 
@@ -122,8 +124,9 @@ class Explorer:
         return png(self.figure, self.painter)
 
     def _repr_mimebundle_(self, **kwargs):
-        return widget_with_picture(self.widget, self.png(), f"<{type(self).__name__}: {', '.join(self.controls)}>",
-                                   **kwargs)
+        return widget_with_picture(
+            self.widget, self.png(), f"<{type(self).__name__}: {', '.join(self.controls)}>", **kwargs
+        )
 
 
 def widget_with_picture(widget, picture, text, **kwargs):
@@ -151,12 +154,18 @@ def limacon_explorer():
 
     figure, ax = new_figure((5, 5))
     view = LimaconView(ax)
-    return Explorer(figure, lambda intervals, r0, method: view.update(intervals, r0, method), view=view, controls={
-        "intervals": _slider(int, 20, 3, 60, description="intervals"),
-        "r0": _slider(float, 1.15, 0.5, 2.0, 0.05, "r0"),
-        "method": widgets.Dropdown(options=[("Hermite", "pherm"), ("linear", "plin")], value="pherm",
-                                   description="method"),
-    })
+    return Explorer(
+        figure,
+        lambda intervals, r0, method: view.update(intervals, r0, method),
+        view=view,
+        controls={
+            "intervals": _slider(int, 20, 3, 60, description="intervals"),
+            "r0": _slider(float, 1.15, 0.5, 2.0, 0.05, "r0"),
+            "method": widgets.Dropdown(
+                options=[("Hermite", "pherm"), ("linear", "plin")], value="pherm", description="method"
+            ),
+        },
+    )
 
 
 def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notaknot", "pchip")):
@@ -167,11 +176,19 @@ def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notak
 
     figure, ax = new_figure((6, 4))
     view = ErrorCurvesView(methods, ax)
-    return Explorer(figure, lambda method, ndata: view.update([method], ndata), view=view, controls={
-        "method": widgets.Dropdown(options=[(METHOD_TITLES[m], m) for m in methods],
-                                   value="natural" if "natural" in methods else methods[0], description="method"),
-        "ndata": _slider(int, 11, 3, 81, description="ndata"),
-    })
+    return Explorer(
+        figure,
+        lambda method, ndata: view.update([method], ndata),
+        view=view,
+        controls={
+            "method": widgets.Dropdown(
+                options=[(METHOD_TITLES[m], m) for m in methods],
+                value="natural" if "natural" in methods else methods[0],
+                description="method",
+            ),
+            "ndata": _slider(int, 11, 3, 81, description="ndata"),
+        },
+    )
 
 
 def mesh_explorer():
@@ -180,16 +197,25 @@ def mesh_explorer():
     view = PatchView(ax)
 
     def update(dxds_AD, dxds_BC, twist, elements):
-        corners = [Corner([0, 0], [dxds_AD, 0], [0, 1], [twist, 0]), Corner([1, 0], [dxds_BC, 0], [0, 1], [twist, 0]),
-                   Corner([1, 1], [dxds_BC, 0], [0, 1], [twist, 0]), Corner([0, 1], [dxds_AD, 0], [0, 1], [twist, 0])]
+        corners = [
+            Corner([0, 0], [dxds_AD, 0], [0, 1], [twist, 0]),
+            Corner([1, 0], [dxds_BC, 0], [0, 1], [twist, 0]),
+            Corner([1, 1], [dxds_BC, 0], [0, 1], [twist, 0]),
+            Corner([0, 1], [dxds_AD, 0], [0, 1], [twist, 0]),
+        ]
         view.update(corners, elements + 1, elements + 1)
 
-    return Explorer(figure, update, view=view, controls={
-        "dxds_AD": _slider(float, 3.0, -2.0, 5.0, 0.1, "dx/ds A,D"),
-        "dxds_BC": _slider(float, 0.1, -2.0, 5.0, 0.1, "dx/ds B,C"),
-        "twist": _slider(float, 0.0, -3.0, 3.0, 0.1, "twist"),
-        "elements": _slider(int, 10, 2, 40, description="elements"),
-    })
+    return Explorer(
+        figure,
+        update,
+        view=view,
+        controls={
+            "dxds_AD": _slider(float, 3.0, -2.0, 5.0, 0.1, "dx/ds A,D"),
+            "dxds_BC": _slider(float, 0.1, -2.0, 5.0, 0.1, "dx/ds B,C"),
+            "twist": _slider(float, 0.0, -3.0, 3.0, 0.1, "twist"),
+            "elements": _slider(int, 10, 2, 40, description="elements"),
+        },
+    )
 
 
 def spline_explorer():
@@ -213,10 +239,15 @@ def pchip_explorer(xdata=(0.0, 1.0, 2.0, 3.0, 4.0)):
     """05: move two data values and watch the spline overshoot while pchip keeps the shape."""
     figure, ax = new_figure((6, 4))
     view = SplinePchipView(np.asarray(xdata, dtype=float), ax)
-    return Explorer(figure, lambda y1, y3: view.update([0.0, y1, 2.0, y3, 2.0]), view=view, controls={
-        "y1": _slider(float, 1.0, 0.0, 2.5, 0.05, "y at t=1"),
-        "y3": _slider(float, 2.0, 0.5, 3.0, 0.05, "y at t=3"),
-    })
+    return Explorer(
+        figure,
+        lambda y1, y3: view.update([0.0, y1, 2.0, y3, 2.0]),
+        view=view,
+        controls={
+            "y1": _slider(float, 1.0, 0.0, 2.5, 0.05, "y at t=1"),
+            "y3": _slider(float, 2.0, 0.5, 3.0, 0.05, "y at t=3"),
+        },
+    )
 
 
 def bilinear_explorer():

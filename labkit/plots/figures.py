@@ -7,6 +7,7 @@ The sliders of :mod:`labkit.plots.explorers` call ``update`` on every move;
 the ``plot_*`` functions are a view updated once, for a static figure.
 Every function labels its axes, sets a title and returns the axes.
 """
+
 import numpy as np
 
 from ..bilinear import eval_pbilin
@@ -78,9 +79,9 @@ class LimaconView(View):
 
     def __init__(self, ax=None):
         self.ax = new_axes(ax)
-        self.exact, = self.ax.plot([], [], color="0.75", lw=3, label="exact")
-        self.curve, = self.ax.plot([], [], color="tab:blue", label="interpolant")
-        self.data, = self.ax.plot([], [], "o", color="tab:red", ms=4, label="data")
+        (self.exact,) = self.ax.plot([], [], color="0.75", lw=3, label="exact")
+        (self.curve,) = self.ax.plot([], [], color="tab:blue", label="interpolant")
+        (self.data,) = self.ax.plot([], [], "o", color="tab:red", ms=4, label="data")
         self._r0 = None
         self.ax.set_aspect("equal")
         _label(self.ax, "x", "y", "")
@@ -109,7 +110,6 @@ class LimaconView(View):
         self.ax.set_title(f"limaçon r = {r0:g} + cos t, {nintervals} intervals")
         return self.ax
 
-
     def dynamic(self):
         """The artists a move of the interval count changes (see PatchView.dynamic)."""
         return [self.curve, self.data, self.ax.title]
@@ -128,7 +128,7 @@ class ErrorCurvesView(View):
         self.exact = f(self.x)[0]
         self._errors, self._shown = {}, None
         self.lines = {m: self.ax.plot(self.x, 0 * self.x, label=METHOD_TITLES[m])[0] for m in methods}
-        self.points, = self.ax.plot([], [], "k.", ms=4, label="data points")
+        (self.points,) = self.ax.plot([], [], "k.", ms=4, label="data points")
         self.ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
         _label(self.ax, "x", "p(x) - f(x)", "")
 
@@ -164,7 +164,6 @@ class ErrorCurvesView(View):
         self.ax.set_title(f"Interpolation error, {ndata} equally spaced points")
         return self.ax
 
-
     def dynamic(self):
         """The curves, the data points and the title: see PatchView.dynamic."""
         return [*self.lines.values(), self.points, self.ax.title]
@@ -180,9 +179,9 @@ class SplinePchipView(View):
         self.ax = new_axes(ax, size=(6, 4))
         self.xdata = np.asarray(xdata, dtype=float)
         self.xv = np.linspace(self.xdata[0], self.xdata[-1], 201)
-        self.spline, = self.ax.plot(self.xv, 0 * self.xv, label="not-a-knot spline")
-        self.pchip, = self.ax.plot(self.xv, 0 * self.xv, label="pchip")
-        self.data, = self.ax.plot(self.xdata, 0 * self.xdata, "o", mfc="none", color="k", label="data")
+        (self.spline,) = self.ax.plot(self.xv, 0 * self.xv, label="not-a-knot spline")
+        (self.pchip,) = self.ax.plot(self.xv, 0 * self.xv, label="pchip")
+        (self.data,) = self.ax.plot(self.xdata, 0 * self.xdata, "o", mfc="none", color="k", label="data")
         self._fitted = False
         self.ax.legend(fontsize="small")
         _label(self.ax, "time", "temperature", "Spline overshoots, pchip keeps the data's shape")
@@ -220,8 +219,9 @@ class BilinearErrorView(View):
         self.exact = f(X, Y)
         step = (self.b - self.a) / (ntest - 1)  # one pixel per test point, centred on it
         extent = (self.a - step / 2, self.b + step / 2, self.a - step / 2, self.b + step / 2)
-        self.image = self.ax.imshow(0 * self.exact.T, origin="lower", extent=extent, cmap="coolwarm",
-                                    interpolation="nearest")
+        self.image = self.ax.imshow(
+            0 * self.exact.T, origin="lower", extent=extent, cmap="coolwarm", interpolation="nearest"
+        )
         self.colorbar = self.ax.figure.colorbar(self.image, ax=self.ax, label="I(x, y) - f(x, y)")
         self.ax.set_aspect("equal")
         _label(self.ax, "x", "y", "")
@@ -268,7 +268,6 @@ class PatchView(View):
             self.ax.set_title(title)
         _fit(self.ax, self.mesh.points[:, 0], self.mesh.points[:, 1])
         return self.ax
-
 
     def dynamic(self):
         """The artists a move changes (the rest is drawn once and copied: see Explorer)."""
@@ -331,8 +330,12 @@ def plot_second_derivatives(ndata=7, ax=None, f=runge, interval=(0.0, 5.0)):
     x = np.concatenate([np.append(piece, np.nan) for piece in pieces])
 
     def curve(slopes):
-        return np.concatenate([np.append(eval_pherm(xdata[k:k + 2], y[k:k + 2], slopes[k:k + 2], piece, der=2), np.nan)
-                               for k, piece in enumerate(pieces)])
+        return np.concatenate(
+            [
+                np.append(eval_pherm(xdata[k : k + 2], y[k : k + 2], slopes[k : k + 2], piece, der=2), np.nan)
+                for k, piece in enumerate(pieces)
+            ]
+        )
 
     ax.plot(x, curve(yp), color="0.5", lw=2.5, label="Hermite (true slopes): s'' jumps")
     ax.plot(x, curve(ccspline(xdata, y, yp[0], yp[-1])), label="complete spline")

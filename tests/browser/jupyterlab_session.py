@@ -4,6 +4,7 @@ benchmarks/bench_backends.py and benchmarks/bench_browser_latency.py.
 The server runs on 127.0.0.1 with a token, with every Jupyter/IPython/matplotlib folder in a
 temporary directory, news, update checks and autosave off.
 """
+
 import contextlib
 import json
 import os
@@ -21,8 +22,13 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 MOVES = 8  # key presses per slider, mouse steps per drag
 TOKEN = "labkit-browser-test"
 CHROMIUM_FLAGS = [
-    "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
 ]
 LAB_SETTINGS = {
     "@jupyterlab/apputils-extension/notification.jupyterlab-settings": {"fetchNews": "false", "checkForUpdates": False},
@@ -59,10 +65,19 @@ def jupyterlab(home, served):
     env["JUPYTERLAB_WORKSPACES_DIR"] = str(home / "workspaces")
     port = _free_port()
     command = [
-        sys.executable, "-m", "jupyterlab", "--no-browser", "--ip=127.0.0.1", f"--port={port}",
-        "--ServerApp.port_retries=0", f"--IdentityProvider.token={TOKEN}", f"--ServerApp.root_dir={served}",
-        "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate", "--LabApp.extension_manager=readonly",
-        "--LabApp.expose_app_in_browser=True", "--allow-root",
+        sys.executable,
+        "-m",
+        "jupyterlab",
+        "--no-browser",
+        "--ip=127.0.0.1",
+        f"--port={port}",
+        "--ServerApp.port_retries=0",
+        f"--IdentityProvider.token={TOKEN}",
+        f"--ServerApp.root_dir={served}",
+        "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+        "--LabApp.extension_manager=readonly",
+        "--LabApp.expose_app_in_browser=True",
+        "--allow-root",
     ]
     log = open(home / "server.log", "w")
     server = subprocess.Popen(command, env=env, stdout=log, stderr=subprocess.STDOUT)
@@ -75,7 +90,9 @@ def jupyterlab(home, served):
                 break
             except OSError:
                 if server.poll() is not None or time.monotonic() > deadline:
-                    raise RuntimeError(f"JupyterLab did not start: {(home / 'server.log').read_text()[-2000:]}")
+                    raise RuntimeError(
+                        f"JupyterLab did not start: {(home / 'server.log').read_text()[-2000:]}"
+                    ) from None
                 time.sleep(0.3)
         yield base
     finally:
@@ -100,8 +117,9 @@ def course_lab(home):
 def close_sessions(base):
     """Shut down every notebook's kernel, so the next notebook runs alone."""
     for session in api(base, "/api/sessions"):
-        request = urllib.request.Request(f"{base}/api/sessions/{session['id']}", method="DELETE",
-                                         headers={"Authorization": f"token {TOKEN}"})
+        request = urllib.request.Request(
+            f"{base}/api/sessions/{session['id']}", method="DELETE", headers={"Authorization": f"token {TOKEN}"}
+        )
         urllib.request.urlopen(request, timeout=10).close()
 
 
@@ -125,14 +143,18 @@ CELL_SUMMARY = """() => {
 
 
 def run_all(page, base, expected_cells):
-    page.wait_for_function("() => window.jupyterapp && window.jupyterapp.shell.currentWidget"
-                           " && window.jupyterapp.shell.currentWidget.sessionContext"
-                           " && window.jupyterapp.shell.currentWidget.sessionContext.session")
+    page.wait_for_function(
+        "() => window.jupyterapp && window.jupyterapp.shell.currentWidget"
+        " && window.jupyterapp.shell.currentWidget.sessionContext"
+        " && window.jupyterapp.shell.currentWidget.sessionContext.session"
+    )
     wait_for_idle_kernel(base)
     page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
     page.wait_for_function(
         f"() => {{ const cells = ({CELL_SUMMARY})(); return cells.length === {expected_cells}"
-        " && cells.every(c => c.count !== null && c.count > 0); }", timeout=120_000)
+        " && cells.every(c => c.count !== null && c.count > 0); }",
+        timeout=120_000,
+    )
     wait_for_idle_kernel(base)
 
 
@@ -190,9 +212,12 @@ NEW_PICTURE_NTH = """([e, old, framesBefore]) => {
 
 
 def _picture_src_nth(page, e):
-    return page.evaluate("e => { const n = window.jupyterapp.shell.currentWidget.node"
-                         ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')[e];"
-                         " const img = n && n.querySelector('img'); return img ? img.src : null; }", e)
+    return page.evaluate(
+        "e => { const n = window.jupyterapp.shell.currentWidget.node"
+        ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')[e];"
+        " const img = n && n.querySelector('img'); return img ? img.src : null; }",
+        e,
+    )
 
 
 def move_every_slider(page, panel, name):
@@ -218,8 +243,11 @@ def move_every_slider(page, panel, name):
                 start = time.perf_counter()
                 page.keyboard.press(key)
                 try:
-                    page.wait_for_function("([node, old]) => node.innerText !== old",
-                                           arg=[readout.element_handle(), old_readout], timeout=2_000)
+                    page.wait_for_function(
+                        "([node, old]) => node.innerText !== old",
+                        arg=[readout.element_handle(), old_readout],
+                        timeout=2_000,
+                    )
                 except PlaywrightTimeout:  # at the end of its range: go back
                     key = "ArrowLeft" if key == "ArrowRight" else "ArrowRight"
                     continue
@@ -233,9 +261,11 @@ def move_every_slider(page, panel, name):
 def drag_a_corner(page, panel):
     """Drag corner B of the patch editor in steps and let go; (seconds per step, readout before, readout after)."""
     editor = panel.locator(".labkit-patch-editor").first
-    e = page.evaluate("() => [...window.jupyterapp.shell.currentWidget.node"
-                      ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')]"
-                      ".findIndex(n => n.classList.contains('labkit-patch-editor'))")
+    e = page.evaluate(
+        "() => [...window.jupyterapp.shell.currentWidget.node"
+        ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')]"
+        ".findIndex(n => n.classList.contains('labkit-patch-editor'))"
+    )
     corner = editor.locator("circle[data-handle='1']")
     corner.scroll_into_view_if_needed()
     readout = editor.locator(".labkit-editor-readout")
@@ -252,8 +282,9 @@ def drag_a_corner(page, panel):
         page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
         steps.append(time.perf_counter() - start)
     page.mouse.up()
-    page.wait_for_function("([node, old]) => node.innerText !== old", arg=[readout.element_handle(), before_readout],
-                           timeout=10_000)
+    page.wait_for_function(
+        "([node, old]) => node.innerText !== old", arg=[readout.element_handle(), before_readout], timeout=10_000
+    )
     return steps, before_readout, readout.inner_text()
 
 
@@ -264,5 +295,7 @@ def percentile(values, fraction):
 
 def latencies(timings):
     """{slider: (median ms, 90th percentile ms, moves)} from move_every_slider's {slider: [seconds]}."""
-    return {label: (1000 * statistics.median(times), 1000 * percentile(times, 0.9), len(times))
-            for label, times in timings.items()}
+    return {
+        label: (1000 * statistics.median(times), 1000 * percentile(times, 0.9), len(times))
+        for label, times in timings.items()
+    }

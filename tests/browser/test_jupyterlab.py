@@ -10,12 +10,23 @@ limit is `make bench`'s (benchmarks/bench_browser_latency.py).
 
 Run alone: ``.venv/bin/python -m pytest tests/browser -s``.
 """
+
 from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
-from jupyterlab_session import (CHROMIUM_FLAGS, COUNT_IMAGE_FRAMES, NOTEBOOKS, close_sessions, course_lab,
-                                drag_a_corner, latencies, move_every_slider, open_and_run, show_explorers)
+from jupyterlab_session import (
+    CHROMIUM_FLAGS,
+    COUNT_IMAGE_FRAMES,
+    NOTEBOOKS,
+    close_sessions,
+    course_lab,
+    drag_a_corner,
+    latencies,
+    move_every_slider,
+    open_and_run,
+    show_explorers,
+)
 
 LATENCIES = {}  # slider -> (median ms, 90th percentile ms, moves), printed by tests/conftest.py's summary
 ROOT = Path(__file__).resolve().parents[2]
@@ -25,7 +36,9 @@ playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright i
 if not CHROMIUM.exists():
     pytest.skip(
         "!! BROWSER TEST SKIPPED: /usr/bin/chromium is missing (install Debian's chromium package; "
-        "`make test` does this when run as root)", allow_module_level=True)
+        "`make test` does this when run as root)",
+        allow_module_level=True,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -51,8 +64,9 @@ def _nudge_with_keys(page, panel, after_drag):
     """Check the keyboard fallback after a drag: the dragged handle stays selected, Tab moves on, arrows nudge."""
     readout = panel.locator(".labkit-patch-editor").first.locator(".labkit-editor-readout")
     changed = "([node, old]) => node.innerText !== old"
-    page.wait_for_function("() => document.activeElement && document.activeElement.classList.contains('labkit-editor')",
-                           timeout=5_000)
+    page.wait_for_function(
+        "() => document.activeElement && document.activeElement.classList.contains('labkit-editor')", timeout=5_000
+    )
     page.keyboard.press("ArrowUp")
     page.wait_for_function(changed, arg=[readout.element_handle(), after_drag], timeout=10_000)
     nudged = readout.inner_text()

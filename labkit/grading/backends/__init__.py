@@ -22,6 +22,7 @@ A backend registered from a module outside labkit (a test's, a site's own)
 works too: each grading process imports the module that registered it
 (:func:`origin`, :func:`import_origin`).
 """
+
 import importlib
 import importlib.util
 import sys
@@ -38,16 +39,21 @@ def register(cls):
     from .base import Backend
 
     if not (isinstance(cls, type) and issubclass(cls, Backend)):
-        raise ValueError(f"{cls!r} is not a subclass of labkit.grading.backends.base.Backend; only backends "
-                         "can be registered.")
+        raise ValueError(
+            f"{cls!r} is not a subclass of labkit.grading.backends.base.Backend; only backends can be registered."
+        )
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not name.isidentifier() or name != name.lower():
-        raise ValueError(f"{cls.__qualname__}.name is {name!r}; a backend needs a lower-case name that is a Python "
-                         "identifier, e.g. name = 'podman' (it is what `labkit grade --sandbox` takes).")
+        raise ValueError(
+            f"{cls.__qualname__}.name is {name!r}; a backend needs a lower-case name that is a Python "
+            "identifier, e.g. name = 'podman' (it is what `labkit grade --sandbox` takes)."
+        )
     known = _registered.get(name)
     if known is not None and (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
-        raise ValueError(f"a backend named {name!r} is already registered ({known.__module__}.{known.__qualname__}); "
-                         f"give {cls.__qualname__} another name.")
+        raise ValueError(
+            f"a backend named {name!r} is already registered ({known.__module__}.{known.__qualname__}); "
+            f"give {cls.__qualname__} another name."
+        )
     _registered[name] = cls
     return cls
 
@@ -62,8 +68,10 @@ def backend_class(name):
     if isinstance(name, str) and name in BUILTIN and name not in _registered:
         importlib.import_module(f"{__name__}.{name}")  # the module registers its backend
     if not isinstance(name, str) or name not in _registered:
-        raise ValueError(f"there is no sandbox backend called {name!r}; choose one of: {', '.join(names())} "
-                         f"(e.g. `labkit grade --sandbox {DEFAULT}`, the default).")
+        raise ValueError(
+            f"there is no sandbox backend called {name!r}; choose one of: {', '.join(names())} "
+            f"(e.g. `labkit grade --sandbox {DEFAULT}`, the default)."
+        )
     return _registered[name]
 
 
@@ -88,8 +96,10 @@ def import_origin(module, path=None):
         return
     except ImportError:
         if not path:
-            raise ValueError(f"cannot import {module!r}, which defines the sandbox backend; make it importable "
-                             "(on PYTHONPATH, or installed) in the grading processes.") from None
+            raise ValueError(
+                f"cannot import {module!r}, which defines the sandbox backend; make it importable "
+                "(on PYTHONPATH, or installed) in the grading processes."
+            ) from None
     spec = importlib.util.spec_from_file_location(module, path)
     if spec is None or spec.loader is None:
         raise ValueError(f"cannot import the sandbox backend's module {module!r} from {path}.")

@@ -20,6 +20,7 @@ in a memory cgroup of its own where one can be made
 (:func:`apply_limits`); a backend whose sandbox lives elsewhere (a
 container engine) overrides :meth:`Box.start` and :meth:`Box.stop`.
 """
+
 import abc
 import os
 import resource
@@ -51,6 +52,7 @@ class Limits:
 
 def apply_limits(limits, processes_base=0):
     """Set the rlimits of the calling process (a child about to exec the sandbox or the worker)."""
+
     def cap(kind, value):
         soft, hard = resource.getrlimit(kind)
         value = value if hard == resource.RLIM_INFINITY else min(value, hard)
@@ -81,8 +83,9 @@ def remove_tree(path):
     if not os.path.lexists(path):
         return
     subprocess.run(["chmod", "-R", "u+rwx", "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    subprocess.run(["rm", "-rf", "--one-file-system", "--", str(path)], stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL)
+    subprocess.run(
+        ["rm", "-rf", "--one-file-system", "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
 
 
 class Box:
@@ -113,8 +116,16 @@ class Box:
 
         try:
             self.process = subprocess.Popen(
-                self.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, cwd=self.cwd,
-                env=self.env, start_new_session=True, preexec_fn=prepare, pass_fds=self.pass_fds)
+                self.argv,
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL,
+                cwd=self.cwd,
+                env=self.env,
+                start_new_session=True,
+                preexec_fn=prepare,
+                pass_fds=self.pass_fds,
+            )
         finally:
             self._close_passed()
         return self.process

@@ -27,6 +27,7 @@ cgroup around the whole sandbox where it can (:mod:`labkit.grading.cgroup`)
 and sets the rlimits in the child before ``bwrap`` starts
 (:func:`~.base.apply_limits`); they are inherited by everything inside.
 """
+
 import os
 import shutil
 import subprocess
@@ -38,16 +39,26 @@ from . import register
 from .base import Backend, Box, Limits, SandboxUnavailable, processes_of_this_user
 
 HOME = "/home/student"
-INSTALL_HINT = ("install bubblewrap (Debian/Ubuntu: `sudo apt-get install bubblewrap`; Fedora: `sudo dnf install "
-                "bubblewrap`) on a Linux machine that allows user namespaces, or grade inside a container that "
-                "allows them; where each submission is already isolated (a pod or container of its own), "
-                "`labkit grade --sandbox none` runs student code without a sandbox of labkit's own")
+INSTALL_HINT = (
+    "install bubblewrap (Debian/Ubuntu: `sudo apt-get install bubblewrap`; Fedora: `sudo dnf install "
+    "bubblewrap`) on a Linux machine that allows user namespaces, or grade inside a container that "
+    "allows them; where each submission is already isolated (a pod or container of its own), "
+    "`labkit grade --sandbox none` runs student code without a sandbox of labkit's own"
+)
 
 
 def _namespaces():
     user = [] if os.geteuid() == 0 else ["--unshare-user"]
-    return [*user, "--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts", "--unshare-cgroup-try",
-            "--die-with-parent", "--new-session"]
+    return [
+        *user,
+        "--unshare-pid",
+        "--unshare-net",
+        "--unshare-ipc",
+        "--unshare-uts",
+        "--unshare-cgroup-try",
+        "--die-with-parent",
+        "--new-session",
+    ]
 
 
 def sandbox_uid():
@@ -93,8 +104,20 @@ def command(argv, limits=None, seccomp_fd=None):
     if seccomp_fd is not None:
         args += ["--seccomp", str(seccomp_fd)]
     # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
-    args += ["--proc", "/proc", "--remount-ro", "/proc", "--dev", "/dev",
-             "--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
+    args += [
+        "--proc",
+        "/proc",
+        "--remount-ro",
+        "/proc",
+        "--dev",
+        "/dev",
+        "--perms",
+        "1777",
+        "--size",
+        str(limits.tmp_size),
+        "--tmpfs",
+        "/tmp",
+    ]
     for name in ("usr", "etc"):
         args += ["--ro-bind", f"/{name}", f"/{name}"]
     for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
@@ -106,11 +129,28 @@ def command(argv, limits=None, seccomp_fd=None):
     made = {Path("/tmp")}
     for path in _read_only_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
-    args += [*_parents(HOME, made), "--perms", "1777", "--size", str(limits.home_size), "--tmpfs", HOME,
-             "--chdir", HOME]
-    environment = {"HOME": HOME, "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin", "LANG": "C.UTF-8",
-                   "MPLBACKEND": "Agg", "MPLCONFIGDIR": f"{HOME}/.matplotlib", "PYTHONDONTWRITEBYTECODE": "1",
-                   "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+    args += [
+        *_parents(HOME, made),
+        "--perms",
+        "1777",
+        "--size",
+        str(limits.home_size),
+        "--tmpfs",
+        HOME,
+        "--chdir",
+        HOME,
+    ]
+    environment = {
+        "HOME": HOME,
+        "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin",
+        "LANG": "C.UTF-8",
+        "MPLBACKEND": "Agg",
+        "MPLCONFIGDIR": f"{HOME}/.matplotlib",
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "OMP_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+    }
     for name in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE"):  # set on some machines for correct results
         if name in os.environ:
             environment[name] = os.environ[name]
@@ -124,19 +164,26 @@ class Bubblewrap(Backend):
     """Each notebook in a bubblewrap sandbox of its own on this machine (see the module's description)."""
 
     name = "bwrap"
-    summary = ("bubblewrap on this machine: no network, a read-only system, private folders, a seccomp filter "
-               "and resource limits")
+    summary = (
+        "bubblewrap on this machine: no network, a read-only system, private folders, a seccomp filter "
+        "and resource limits"
+    )
 
     def available(self):
         """Raise SandboxUnavailable with what to do if bwrap cannot run a sandbox here; bwrap's path otherwise."""
         bwrap = shutil.which("bwrap")
         if bwrap is None:
             raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
-        probe = subprocess.run([bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev",
-                                "true"], capture_output=True, text=True, timeout=30)
+        probe = subprocess.run(
+            [bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev", "true"],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
         if probe.returncode != 0:
-            raise SandboxUnavailable(f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): "
-                                     f"{INSTALL_HINT}.")
+            raise SandboxUnavailable(
+                f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): {INSTALL_HINT}."
+            )
         return bwrap
 
     def box(self, argv, limits):

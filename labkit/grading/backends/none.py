@@ -13,6 +13,7 @@ and the grader's watch) hold too. Everything else is open: student code
 runs with the grader's permissions, so every run starts with
 :data:`WARNING` on stderr.
 """
+
 import os
 import tempfile
 
@@ -31,8 +32,10 @@ class Unconfined(Backend):
     """The worker as a plain process with a private folder: only where the submission is isolated already."""
 
     name = "none"
-    summary = ("no sandbox of labkit's own, for when each submission already has a container of its own "
-               "(a pod, a batch job's container); student code runs with your permissions")
+    summary = (
+        "no sandbox of labkit's own, for when each submission already has a container of its own "
+        "(a pod, a batch job's container); student code runs with your permissions"
+    )
 
     def available(self):
         return None  # a process can always be started
@@ -43,5 +46,11 @@ class Unconfined(Backend):
     def box(self, argv, limits):
         folder = tempfile.mkdtemp(prefix="labkit-grade-")
         env = {**os.environ, "HOME": folder, "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1"}
-        return Box(argv, limits, cwd=folder, env=env, processes_base=processes_of_this_user(),
-                   cleanup=lambda: remove_tree(folder))
+        return Box(
+            argv,
+            limits,
+            cwd=folder,
+            env=env,
+            processes_base=processes_of_this_user(),
+            cleanup=lambda: remove_tree(folder),
+        )
