@@ -237,3 +237,25 @@ def test_the_grading_modules_reach_a_sandbox_only_through_the_interface():
     for name in ("remote.py", "batch.py", "scoring.py", "worker.py", "options.py", "../cli.py"):
         code, _ = _code_and_text(LABKIT / "grading" / name)
         assert not re.search(r"backends \. (bwrap|none)\b|backends import (bwrap|none)\b", code), name
+
+
+def test_a_new_backend_is_one_new_module_in_the_package(tmp_path):
+    """Dropping backends/<name>.py in is all it takes: the registry, the CLI's choices and grading find it."""
+    module = BACKENDS / "zzexample.py"
+    module.write_text(
+        "from . import register\nfrom .none import Unconfined\n\n\n@register\nclass Example(Unconfined):\n"
+        '    name = "zzexample"\n    summary = "a test\'s copy of the none backend"\n',
+        encoding="utf-8",
+    )
+    try:
+        code = (
+            "from labkit.grading import backends\nfrom labkit.cli import build_parser\n"
+            "print(backends.BUILTIN)\nprint(type(backends.get_backend('zzexample')).__name__)\n"
+            "print(build_parser().parse_args(['grade', '--sandbox', 'zzexample', 'x', '--out', 'o']).sandbox)\n"
+        )
+        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    finally:
+        module.unlink()
+    assert run.returncode == 0, run.stderr
+    builtin, found, chosen = run.stdout.splitlines()
+    assert builtin == "('bwrap', 'none', 'zzexample')" and found == "Example" and chosen == "zzexample"

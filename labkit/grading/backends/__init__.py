@@ -15,8 +15,8 @@ backend knows about its own tool lives in its own module, named after it:
 
 A Docker or podman backend must be one new module: ``backends/<name>.py``
 with a :class:`~.base.Backend` subclass whose ``name`` is ``<name>``,
-decorated with :func:`register`, and ``<name>`` added to :data:`BUILTIN`.
-Nothing else in labkit changes: ``labkit grade --sandbox <name>`` and
+decorated with :func:`register`. :data:`BUILTIN` is read from the package's
+modules, so nothing else in labkit changes: ``labkit grade --sandbox <name>`` and
 :class:`labkit.grading.options.GradeOptions` take their choices from here.
 A backend registered from a module outside labkit (a test's, a site's own)
 works too: each grading process imports the module that registered it
@@ -25,10 +25,16 @@ works too: each grading process imports the module that registered it
 
 import importlib
 import importlib.util
+import pkgutil
 import sys
 
-BUILTIN = ("bwrap", "none")  # one module each, backends/<name>.py; the first is the default
-DEFAULT = BUILTIN[0]
+DEFAULT = "bwrap"
+# one module each, backends/<name>.py, found in this package (the default first)
+BUILTIN = tuple(
+    sorted(
+        (m.name for m in pkgutil.iter_modules(__path__) if m.name != "base"), key=lambda name: (name != DEFAULT, name)
+    )
+)
 UNCONFINED = "none"  # the backend the old switches (--no-sandbox, sandboxed=False, confined=False) stand for
 
 _registered = {}  # name -> Backend subclass
