@@ -9,13 +9,14 @@ fix it when something is missing.
 from __future__ import annotations
 
 import importlib.util
-from importlib.metadata import PackageNotFoundError, version
 
 INSTALL = '%pip install "labkit @ git+https://github.com/labkit-course/labkit"'
 NEEDED = ("numpy", "scipy", "matplotlib", "ipywidgets", "anywidget")
 
 
 def _installed_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version  # only when a notebook starts
+
     try:
         return version("labkit")
     except PackageNotFoundError:  # run from a source tree that was never installed
