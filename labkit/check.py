@@ -19,7 +19,9 @@ test_pherm_interpolate)``.
 """
 
 from .exercises import experiments as _experiments
+from .exercises.model import Exercise  # noqa: F401 - part of the facade (__all__)
 from .exercises.registry import LAB as _LAB
+from .exercises.result import TOLERANCE, CheckResult  # noqa: F401 - part of the facade (__all__)
 
 EXERCISES = _LAB.exercises
 NAMES = _LAB.names

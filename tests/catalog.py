@@ -783,3 +783,35 @@ MISTAKES = (
         "101 test points instead of 401",
     ),
 )
+
+
+def plant_class(folder):
+    """The catalog class in `folder`: one submission per entry, and one complete MATLAB-style solution set
+    (loops, lists, a dense solve, scatter plots, typed-in tables: every correct variation of a notebook
+    applied together). {submission name: its folder}, in a fixed order."""
+    import json
+
+    folder = Path(folder)
+    folders = {}
+    for entry in CORRECT + MISTAKES:
+        plant(entry, folder / entry.name)
+        folders[entry.name] = folder / entry.name
+    matlab = folder / "matlab_style"
+    for entry in CORRECT:
+        if not (matlab / entry.notebook).exists():
+            plant(entry, matlab)
+    by_notebook = {}
+    for entry in CORRECT:
+        by_notebook.setdefault(entry.notebook, []).append(entry)
+    for notebook, entries in by_notebook.items():
+        path = matlab / notebook
+        text = path.read_text()
+        for entry in entries[1:]:
+            for old, new in entry.replace:
+                encoded_old, encoded_new = json.dumps(old)[1:-1], json.dumps(new)[1:-1]
+                if encoded_old in text:
+                    text = text.replace(encoded_old, encoded_new)
+        path.write_text(text)
+    plant(Planted("the meshes as they are", "03_meshes.ipynb", ()), matlab)
+    folders["matlab_style"] = matlab
+    return folders

@@ -1,12 +1,11 @@
 """Grades are right in both directions: every correct variation earns full marks, every typical slip costs
 exactly its part and is named (the catalogs are in tests/catalog.py), all graded in one sandboxed run."""
 
-import json
 import os
 from pathlib import Path
 
 import pytest
-from catalog import CORRECT, MISTAKES, plant
+from catalog import CORRECT, MISTAKES, plant_class
 from conftest import sandbox_or_skip
 
 from labkit import grading
@@ -26,29 +25,7 @@ RUN = {}
 def graded(tmp_path_factory):
     sandbox_or_skip()
     tmp = tmp_path_factory.mktemp("catalog")
-    folders = {}
-    for entry in CORRECT + MISTAKES:
-        plant(entry, tmp / entry.name)
-        folders[entry.name] = tmp / entry.name
-    # one complete MATLAB-style solution set: loops, lists, a dense solve, scatter plots, typed-in tables
-    matlab = tmp / "matlab_style"
-    for entry in CORRECT:
-        if not (matlab / entry.notebook).exists():
-            plant(entry, matlab)
-    by_notebook = {}
-    for entry in CORRECT:
-        by_notebook.setdefault(entry.notebook, []).append(entry)
-    for notebook, entries in by_notebook.items():  # apply every variation of a notebook together
-        path = matlab / notebook
-        text = path.read_text()
-        for entry in entries[1:]:
-            for old, new in entry.replace:
-                encoded_old, encoded_new = json.dumps(old)[1:-1], json.dumps(new)[1:-1]
-                if encoded_old in text:
-                    text = text.replace(encoded_old, encoded_new)
-        path.write_text(text)
-    plant(CORRECT[0].__class__("the meshes as they are", "03_meshes.ipynb", ()), matlab)
-    folders["matlab_style"] = matlab
+    folders = plant_class(tmp)
     results = grading.grade(list(folders.values()), tmp / "out", jobs=2, progress=False, seed=SEED)
     RUN["out"] = tmp / "out"
     return dict(zip(folders, results))

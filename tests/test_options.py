@@ -144,3 +144,13 @@ def test_the_defaults_are_spelled_out_only_in_the_options():
     assert found == [], "defaults spelled out outside labkit/grading/options.py:\n" + "\n".join(found)
     assert seen_in_options == {"60", "600"}  # the scan does see them where they are defined
     assert len(modules) > 15
+
+
+def test_exercises_that_disagree_with_the_rubric_are_refused_before_anything_is_graded(tmp_path):
+    from labkit import grading
+
+    notebook = Path(__file__).resolve().parents[1] / "notebooks" / "01_limacon.ipynb"
+    options = GradeOptions(exercises="some_course:REGISTRY", backend="none")
+    with pytest.raises(ValueError, match="name the course's exercises in its rubric"):
+        grading.grade([notebook], tmp_path / "out", options=options, progress=False)
+    assert not (tmp_path / "out" / "grades.csv").exists()

@@ -6,6 +6,9 @@ the sandbox): each attack is a notebook's cells, and the grader's proxy
 calls the student's function with a part's refusal, as grading does.
 """
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -457,3 +460,23 @@ def test_every_refusal_of_every_part_is_wired():
     assert {part.refused for part in parts} == set(REFUSALS)
     for refusal in REFUSALS:
         assert refusals.recognised(refusal)[0], refusal.name
+
+
+def test_the_scan_names_the_self_checks_in_a_grading_process_that_never_imported_them():
+    """The grader's process loads labkit.check only because the refusals name it: the scan must not depend on
+    what happened to be imported (``import labkit`` no longer loads the checks)."""
+    code = (
+        "import sys\nfrom labkit.exercises.registry import LAB\nfrom labkit.grading import refusals, scan\n"
+        "assert 'labkit.check' not in sys.modules\n"
+        "wired = refusals.wire(LAB.refusals)\n"
+        "sources = ['import labkit.check\\nfrom labkit.check import runge as r\\n"
+        "def runge(x):\\n    return labkit.check.driver, r\\n"
+        "def runge2(x):\\n    return labkit.exercises.hermite.check_runge\\n']\n"
+        "for names in (('runge',), ('runge2',)):\n"
+        '    print(sorted({found[2] for found in scan.scan(sources, names, wired["the lab\'s functions"])}))\n'
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    first, second = run.stdout.splitlines()
+    assert "labkit.check.driver" in first and "labkit.check.runge" in first, first
+    assert "labkit.exercises.hermite.check_runge" in second, second

@@ -165,6 +165,73 @@ def test_a_declaration_refuses_what_would_break_the_derivations():
         load("no.such.module:REGISTRY")
     with pytest.raises(ValueError, match="unknown experiment 'akima'"):
         LAB.experiment("akima")
+    with pytest.raises(ValueError, match="worth no points"):
+        model.Exercise(41, ("thing",), (model.Part("thing", 0, check_thing, ("thing",)),), notebook="x.ipynb")
+
+
+def check_table(value):  # named like a function the facade defines itself
+    return value
+
+
+def check_elsewhere(value):
+    return value
+
+
+@pytest.mark.parametrize(
+    "part, message",
+    [
+        (lambda: model.Part("p", 1, check_elsewhere, ("p",), passes=(lambda x: x,)), "only module-level functions"),
+        (lambda: model.Part("p", 1, check_elsewhere, ("p",), passes=(np_sin(),)), "only module-level functions"),
+        (lambda: model.Part("p", 1, check_elsewhere, ("p",), passes=(check_elsewhere,)), "only module-level functions"),
+        (lambda: model.Part("p", 1, check_elsewhere, ("p",), passes=(grading_grade(),)), "only module-level functions"),
+        (lambda: model.Part("p", 1, check_table, ("p",)), "labkit.check.table is taken by labkit itself"),
+        (
+            lambda: model.Part(
+                "eval_pherm",
+                1,
+                check_elsewhere,
+                ("eval_pherm",),
+                refused=model.Refusal(model.INTERPOLANTS.name, ("numpy",)),
+            ),
+            "two different refusals",
+        ),
+    ],
+)
+def test_the_registry_refuses_what_the_sandbox_or_the_facade_could_not_honour(part, message):
+    with pytest.raises(ValueError, match=message):
+        Registry([*LAB, model.Exercise(40, ("p",), (part(),), notebook="x.ipynb")])
+
+
+def np_sin():
+    import numpy as np
+
+    return np.sin
+
+
+def grading_grade():
+    from labkit.grading import grade
+
+    return grade
+
+
+def test_a_second_check_under_an_existing_name_is_refused():
+    from labkit.exercises.hermite import check_runge
+
+    def check_runge_again(fn, seed=None):
+        return check_runge(fn, seed)
+
+    check_runge_again.__name__ = "check_runge"
+    part = model.Part("runge", 1, check_runge_again, ("runge",))
+    with pytest.raises(ValueError, match="two different checks would both be labkit.check.runge"):
+        Registry([*LAB, model.Exercise(40, ("runge",), (part,), notebook="x.ipynb")])
+
+
+def test_every_name_the_facade_exports_exists_and_the_checks_keep_their_signatures():
+    namespace = {}
+    exec("from labkit.check import *", namespace)
+    assert set(labkit.check.__all__) <= set(namespace)
+    # the second positional argument of the ncspline check is still the seed, as before
+    assert list(inspect.signature(labkit.check.ncspline).parameters) == ["fn", "seed", "system"]
 
 
 def test_the_self_check_facade_keeps_the_notebooks_names():

@@ -6,7 +6,7 @@ interpolant reproduces exactly on any grid.
 
 The functions handed to the student's ``eval_pbilin`` are module-level
 functions (not lambdas), so that ``labkit grade`` can name them to the
-sandboxed notebook (:data:`labkit.grading.protocol.PASSABLE`).
+sandboxed notebook: the declaration lists them (``passes``).
 """
 
 import numpy as np

@@ -27,7 +27,7 @@ The pieces a driver builds on (the Runge function, the interpolant or the
 spline's slopes) are handed to it by the check, from labkit, so a mistake in
 an earlier exercise is not counted again here. The functions handed over are
 module-level functions, so ``labkit grade`` can name them to the sandboxed
-notebook (:data:`labkit.grading.protocol.PASSABLE`).
+notebook: the declaration lists them (:attr:`Experiment.passes`).
 """
 
 import functools

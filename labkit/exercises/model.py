@@ -2,7 +2,8 @@
 
 An exercise is declared once, in the topic module it belongs to
 (:mod:`~labkit.exercises.hermite`, :mod:`~labkit.exercises.patches`,
-:mod:`~labkit.exercises.splines`, :mod:`~labkit.exercises.bilinear`), as an
+:mod:`~labkit.exercises.splines`, :mod:`~labkit.exercises.monotone`,
+:mod:`~labkit.exercises.bilinear`), as an
 :class:`Exercise` of :class:`Part` objects. A part says which of the
 notebook's names its check reads, the check itself (a ``check_...`` function,
 which the student calls as ``labkit.check....``), its weight, the functions the
@@ -40,7 +41,7 @@ class Refusal:
 
 
 # the lab's answers and the grader's own references: refused in every graded call that has a refusal
-GRADER = ("labkit.exercises",)
+GRADER = ("labkit.exercises", "labkit.check")
 INTERPOLANTS = Refusal(
     "library interpolants",
     modules=(
@@ -148,6 +149,7 @@ class Part:
     refused: Refusal | None = None
     functions: tuple = ()
     passes: tuple = ()
+    keywords: tuple = ()  # (keyword, spec) pairs: notebook names handed to the check by keyword
 
     def __post_init__(self):
         facade_name(self.check)
@@ -171,11 +173,15 @@ class Part:
 
     def names(self) -> tuple:
         """Every notebook name the part reads."""
-        return tuple(name for spec in self.reads for name in names_read(spec))
+        specs = tuple(self.reads) + tuple(spec for _, spec in self.keywords)
+        return tuple(name for spec in specs for name in names_read(spec))
 
     def run(self, namespace: Mapping, seed: int | None = None) -> Any:
         values = [read(namespace, spec) for spec in self.reads]
-        return self.check(*values, seed=seed) if self.seeded else self.check(*values)
+        keywords = {keyword: read(namespace, spec) for keyword, spec in self.keywords}
+        if self.seeded:
+            keywords["seed"] = seed
+        return self.check(*values, **keywords)
 
 
 @dataclass(frozen=True)
@@ -203,6 +209,8 @@ class Exercise:
             raise ValueError(f"exercise {self.number} has two parts with the same name.")
         if not self.parts:
             raise ValueError(f"exercise {self.number} has no parts: give it at least one checked part.")
+        if self.points <= 0:
+            raise ValueError(f"exercise {self.number} is worth no points: give its parts positive weights.")
 
     @property
     def points(self) -> int:

@@ -15,6 +15,7 @@ grader (:mod:`labkit.grading.remote`).
 from __future__ import annotations
 
 import importlib
+import types
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -23,6 +24,20 @@ from .model import Exercise
 from .result import CheckResult
 
 TOPICS = (hermite, patches, splines, monotone, bilinear)  # in the order of the exercises they declare
+# names labkit.check defines itself: no part's check may take one
+FACADE = (
+    "CheckResult",
+    "EXERCISES",
+    "Exercise",
+    "NAMES",
+    "POINTS",
+    "TOLERANCE",
+    "driver",
+    "exercise",
+    "grade",
+    "rate",
+    "table",
+)
 
 
 def function_name(function) -> str:
@@ -71,6 +86,15 @@ class Registry:
         }
         parts = [part for e in self.exercises.values() for part in e.parts]
         self.refusals = tuple(sorted({p.refused for p in parts if p.refused}, key=lambda refusal: refusal.name))
+        names = [refusal.name for refusal in self.refusals]
+        if len(set(names)) != len(names):
+            raise ValueError(
+                f"two different refusals are named {sorted(n for n in names if names.count(n) > 1)[0]!r}: "
+                "give each Refusal a name of its own (the sandbox knows them by name)."
+            )
+        for part in parts:
+            for function in part.passes:
+                _check_passable(function, part.name)
         self.passable = frozenset(function_name(f) for p in parts for f in p.passes)
         self.experiments = {}
         for part in parts:
@@ -79,8 +103,16 @@ class Registry:
                 self.experiments.setdefault(experiment.key, experiment)
         self.self_checks = {}
         for part in parts:
-            if getattr(part, "experiment", None) is None:
-                self.self_checks.setdefault(part.self_check, part.check)
+            if getattr(part, "experiment", None) is not None:
+                continue
+            name = part.self_check
+            if name in FACADE:
+                raise ValueError(
+                    f"part {part.name!r}: labkit.check.{name} is taken by labkit itself; name the check "
+                    f"check_<something else>."
+                )
+            if self.self_checks.setdefault(name, part.check) is not part.check:
+                raise ValueError(f"two different checks would both be labkit.check.{name}: give one another name.")
 
     def __iter__(self):
         return iter(self.exercises.values())
@@ -159,6 +191,24 @@ class Registry:
             "defined": defined,
             "checks": checks,
         }
+
+
+def _check_passable(function, part: str) -> None:
+    """A function a check hands to student code must be one the sandbox can find by name: a module-level function
+    of labkit's own (not of the grader), as its module has it."""
+    module, qualname = getattr(function, "__module__", None), getattr(function, "__qualname__", None)
+    ok = isinstance(function, types.FunctionType) and isinstance(module, str) and isinstance(qualname, str)
+    ok = ok and module.startswith("labkit.") and not module.startswith("labkit.grading") and qualname.isidentifier()
+    if ok:
+        try:
+            ok = getattr(importlib.import_module(module), qualname, None) is function
+        except ImportError:
+            ok = False
+    if not ok:
+        raise ValueError(
+            f"part {part!r} passes {function!r} to student code: only module-level functions of labkit's "
+            "own modules (outside labkit.grading) can be handed into the sandbox, by their name."
+        )
 
 
 def _missing(name: str) -> CheckResult:

@@ -144,7 +144,7 @@ def check_ccspline(fn, system=None, seed=None):
     return result
 
 
-def check_ncspline(fn, system=None, seed=None):
+def check_ncspline(fn, seed=None, system=None):
     """Check ``ncspline(xdata, ydata)``: the lab's linear case, zero end curvature, labkit's reference.
 
     `system` is the student's ``complete_system``, which the lab's ncspline
@@ -334,7 +334,8 @@ EXERCISES = (
                 "ncspline",
                 9,
                 check_ncspline,
-                ("ncspline", Optional("complete_system")),
+                ("ncspline",),
+                keywords=(("system", Optional("complete_system")),),
                 seeded=True,
                 refused=INTERPOLANTS,
             ),

@@ -237,6 +237,11 @@ def grade(
 
     seed = secrets.randbits(63) if options.seed is None else int(options.seed)
     options = replace(options, seed=seed)
+    if options.exercises not in (None, rubric.registry.source):
+        raise ValueError(
+            f"the options grade the exercises {options.exercises!r} but the rubric grades {rubric.registry.source!r}: "
+            'name the course\'s exercises in its rubric (exercises = "module:attribute") and leave the option out.'
+        )
     options = replace(options, exercises=rubric.registry.source)  # the workers load the rubric's exercises
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -155,11 +155,15 @@ def dumps(message):
 def passable(name):
     """The pristine labkit function a ``["fn", name]`` stands for (the watch copies it before any cell runs)."""
     import importlib
+    import types
 
     module, _, attribute = str(name).partition(":")
-    if not (module == "labkit" or module.startswith("labkit.")) or not attribute.isidentifier():
+    if not module.startswith("labkit.") or module.startswith("labkit.grading") or not attribute.isidentifier():
         raise ProtocolError(f"{name!r} is not a labkit function the checks may pass")
-    return getattr(importlib.import_module(module), attribute)
+    found = getattr(importlib.import_module(module), attribute, None)
+    if type(found) is not types.FunctionType or (found.__module__, found.__qualname__) != (module, attribute):
+        raise ProtocolError(f"{name!r} is not a module-level labkit function the checks may pass")
+    return found
 
 
 # -- the grader's side -----------------------------------------------------------
