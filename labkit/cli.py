@@ -6,6 +6,7 @@
 ``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
 ``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
 ``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
+``labkit export DIR --canvas FILE ...``    the totals into the course's Canvas gradebook (or --moodle)
 """
 
 import argparse
@@ -122,6 +123,40 @@ def _grade(args):
         )
         return 1
     return 0
+
+
+def _export(args):
+    from .grading import lms
+    from .grading.report import read_results
+    from .grading.rubric import load
+
+    if args.canvas is not None and args.feedback:
+        raise ValueError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
+    grades = read_results([args.results], load(args.rubric))
+    if args.canvas is not None:
+        export = lms.to_canvas(
+            grades,
+            args.canvas,
+            args.roster,
+            args.out or lms.default_file(args.results, "canvas"),
+            column=args.column,
+            key=args.key or "ID",
+            force=args.force,
+        )
+    else:
+        export = lms.to_moodle(
+            grades,
+            args.roster,
+            args.out or lms.default_file(args.results, "moodle"),
+            key=args.key or "idnumber",
+            column=args.column,
+            feedback=args.feedback,
+            force=args.force,
+        )
+    for line in export.problems():
+        print(f"labkit export: {line}", file=sys.stderr)
+    print(export.summary())
+    return 1 if export.listed else 0
 
 
 def build_parser():
@@ -247,6 +282,62 @@ def build_parser():
     )
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)
+
+    exp = commands.add_parser(
+        "export",
+        help="put the grades into the course's Canvas gradebook or a Moodle grade import file",
+        description="Write each student's total under the rubric for the LMS to import: into the Canvas gradebook "
+        "export GRADEBOOK.csv (one assignment column filled in or added, everything else kept), or a CSV for "
+        "Moodle's 'Import grades from CSV'. A roster joins submissions to the LMS's students. Submissions that "
+        "could not be graded, and students who do not match, are listed and get nothing (never a zero). Exit "
+        "status: 0 when every submission and roster entry matched, 1 when the file was written with students "
+        "listed, 2 for bad input (then nothing is written).",
+    )
+    exp.add_argument(
+        "results", type=Path, metavar="OUT", help="the --out folder of `labkit grade` (or of `labkit grade --merge`)"
+    )
+    lms_choice = exp.add_mutually_exclusive_group(required=True)
+    lms_choice.add_argument(
+        "--canvas",
+        type=Path,
+        metavar="GRADEBOOK.csv",
+        help="the course's gradebook as Canvas exports it (Grades > Export); it is read, never changed",
+    )
+    lms_choice.add_argument("--moodle", action="store_true", help="write a CSV for Moodle's 'Import grades from CSV'")
+    exp.add_argument(
+        "--roster",
+        type=Path,
+        required=True,
+        metavar="ROSTER.csv",
+        help="CSV with the columns submission (the names in grades.csv) and id (the student's id in the LMS)",
+    )
+    exp.add_argument(
+        "--key",
+        help="what the roster's ids are: for Canvas the gradebook column 'ID' (the default), 'SIS User ID' or "
+        "'SIS Login ID'; for Moodle 'idnumber' (the default) or 'email'",
+    )
+    exp.add_argument(
+        "--column",
+        default="labkit",
+        metavar="NAME",
+        help="the assignment: Canvas's column of that title is filled, or added if there is none; Moodle's "
+        "grade item column (default %(default)s)",
+    )
+    exp.add_argument("--feedback", action="store_true", help="Moodle: add a Feedback column (the points in words)")
+    exp.add_argument(
+        "--out",
+        type=Path,
+        metavar="FILE",
+        help="the file to write (default: OUT-canvas.csv or OUT-moodle.csv next to OUT); a summary CSV "
+        "(FILE-summary.csv) goes beside it",
+    )
+    exp.add_argument(
+        "--force", action="store_true", help="replace FILE and its summary if they exist (never an input file)"
+    )
+    exp.add_argument(
+        "--rubric", type=Path, help="TOML rubric to score the results with (default: the lab's), as for --merge"
+    )
+    exp.set_defaults(handler=_export)
 
     rub = commands.add_parser(
         "rubric",

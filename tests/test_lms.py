@@ -1,0 +1,431 @@
+"""Grades into the LMS: a Canvas gradebook export filled in, a Moodle grade import file, and bad input refused."""
+
+import csv
+import io
+import subprocess
+import sys
+
+import pytest
+
+from labkit.grading import lms
+from labkit.grading.report import SubmissionGrade, read_results, write_report
+from labkit.grading.rubric import default
+
+LAB = default()
+SPLINES = (10, 11, 12, 13, 14, 15)
+HOSTILE = '=HYPERLINK("http://evil.example","click")'
+ESCAPE = "mal\x1b[2Jory"  # an escape sequence that would clear a terminal
+
+
+def _results(fractions):
+    return {
+        n: {"exercise": n, "passed": f == 1.0, "points": LAB.points[n], "fraction": f, "defined": True, "checks": []}
+        for n, f in fractions.items()
+    }
+
+
+def _grades():
+    full = {n: 1.0 for n in (2, 3, 4, *SPLINES)}
+    return [
+        SubmissionGrade("ada", _results({**full, 16: 0.5}), rubric=LAB),  # 100 + 4 extra credit
+        SubmissionGrade("bob", _results({2: 1.0, 3: 0.5}), rubric=LAB),  # 10 + 7.5
+        SubmissionGrade("carl", rubric=LAB, failure="its grading crashed twice"),
+        SubmissionGrade("dora", _results(full), rubric=LAB),  # 100, but not on the roster
+        SubmissionGrade(HOSTILE, _results({2: 1.0}), rubric=LAB),  # 10
+        SubmissionGrade(ESCAPE, _results({2: 0.5}), rubric=LAB),  # 5, not on the roster
+    ]
+
+
+@pytest.fixture(scope="module")
+def out(tmp_path_factory):
+    """A grading run's output folder, written as `labkit grade` writes it (no sandbox needed)."""
+    folder = tmp_path_factory.mktemp("run") / "grades"
+    write_report(folder, _grades())
+    return folder
+
+
+ROSTER = f'''name,submission,id
+Ada Lovelace,ada,1001
+Bob Babbage,bob,1002
+Carl Gauss,carl,1003
+Eve Noether,eve,1005
+"Mallory Formula","{HOSTILE.replace('"', '""')}",1006
+Gus Riemann,gus,1007
+'''
+
+# Canvas's layout (see labkit/grading/lms.py): the student columns, closed by Section; assignments titled
+# "Title (number)"; read-only totals; a Muted row, the Points Possible row, then the students. Exported with a
+# byte-order mark. Frank has no roster entry; "Student, Test" is Canvas's test student.
+CANVAS = (
+    "\ufeffStudent,ID,SIS User ID,SIS Login ID,Section,Quiz 1 (501),Lab 8 (777),Current Score,Final Score\n"
+    ",,,,,,Muted,,\n"
+    "    Points Possible,,,,,10,100,(read only),(read only)\n"
+    '"Lovelace, Ada",1001,S1001,ada@uni.example,Section A,9,,90,90\n'
+    '"Babbage, Bob",1002,S1002,bob@uni.example,Section A,7.5,,75,75\n'
+    '"Gauss, Carl",1003,S1003,carl@uni.example,Section B,8,55,80,80\n'
+    '"Noether, Eve",1005,S1005,eve@uni.example,Section B,10,,100,100\n'
+    "\"=cmd|' /C calc'!A0\",1006,S1006,mallory@uni.example,Section B,6,,60,60\n"
+    '"Fourier, Frank",1004,S1004,frank@uni.example,Section A,,,,\n'
+    '"Student, Test",9999,,,Section A,,,,\n'
+)
+
+
+def _write(path, text, encoding="utf-8"):
+    path.write_bytes(text.encode(encoding))
+    return path
+
+
+@pytest.fixture
+def inputs(tmp_path):
+    return _write(tmp_path / "gradebook.csv", CANVAS), _write(tmp_path / "roster.csv", ROSTER)
+
+
+def _rows(path, delimiter=","):
+    return list(csv.reader(io.StringIO(path.read_bytes().decode("utf-8-sig"), newline=""), delimiter=delimiter))
+
+
+def _snapshot(folder):
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def test_a_new_canvas_column_holds_the_totals_and_everything_else_is_kept(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    target = tmp_path / "import.csv"
+    export = lms.to_canvas(read_results([out]), gradebook, roster, target, column="Interpolation lab")
+    before, after = _rows(gradebook), _rows(target)
+    # every row and column as exported, one column added at the end
+    assert [row[:-1] for row in after] == before
+    assert after[0][-1] == "Interpolation lab"
+    column = {row[1] or row[0].strip(): row[-1] for row in after[1:]}
+    assert column == {
+        "": "",  # the Muted row
+        "Points Possible": "100",  # the rubric's full credit: Canvas makes the new assignment worth it
+        "1001": "104",  # ada: 100 + 4 extra credit
+        "1002": "17.5",
+        "1003": "",  # carl could not be graded: no number, never 0
+        "1005": "",  # eve submitted nothing
+        "1006": "10",  # the submission with the formula name, matched through the roster
+        "1004": "",  # frank has no roster entry
+        "9999": "",
+    }
+    # the file is Canvas's own encoding: the byte-order mark and line endings kept, the input untouched
+    assert target.read_bytes().startswith(b"\xef\xbb\xbfStudent,ID,") and b"\r\n" not in target.read_bytes()
+    assert gradebook.read_text(encoding="utf-8") == CANVAS
+    assert export.exported == {"ada": ("1001", 104.0), "bob": ("1002", 17.5), HOSTILE: ("1006", 10.0)}
+
+
+def test_canvas_lists_everyone_who_got_nothing(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    assert export.not_graded == {"carl": "its grading crashed twice"}
+    assert sorted(export.not_in_roster) == sorted(["dora", ESCAPE])
+    assert export.no_submission == [("eve", "1005"), ("gus", "1007")]
+    assert export.not_in_lms == []  # gus has no submission, which is said first
+    assert export.lms_only == [("Fourier, Frank", "1004"), ("Student, Test", "9999")]
+    assert export.listed == 7
+    lines = export.problems()
+    assert "not graded, no points exported: carl (its grading crashed twice)" in lines
+    assert "in the Canvas gradebook, not in the roster: Fourier, Frank (id 1004)" in lines
+    assert all("\x1b" not in line for line in lines) and any("mal\ufffd[2Jory" in line for line in lines)
+
+
+def test_the_summary_has_every_student_once_and_neutralises_formula_names(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    assert export.summary_path == tmp_path / "import-summary.csv"
+    rows = _rows(export.summary_path)
+    assert rows[0] == ["submission", "id", "points", "status"]
+    status = {row[0] or row[1]: row[1:] for row in rows[1:]}
+    assert status["ada"] == ["1001", "104", "exported"]
+    assert status["carl"] == ["1003", "", "not graded: its grading crashed twice"]
+    assert status["dora"] == ["", "100", "no roster entry"]  # the total, for entering by hand
+    assert status["eve"] == ["1005", "", "no submission (in the roster)"]
+    assert status["1004"] == ["1004", "", "in the Canvas gradebook (Fourier, Frank), not in the roster"]
+    # a name that a spreadsheet would run as a formula is shown as text, and no control character is left
+    assert "'" + HOSTILE in status and HOSTILE not in status
+    assert all("\x1b" not in cell for row in rows for cell in row)
+    assert len(rows) == 1 + 6 + 2 + 2  # six submissions, two roster entries without one, two Canvas rows
+
+
+def test_an_existing_canvas_column_is_filled_and_a_cell_without_a_grade_is_left_as_exported(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    target = tmp_path / "import.csv"
+    export = lms.to_canvas(read_results([out]), gradebook, roster, target, column="Lab 8")
+    before, after = _rows(gradebook), _rows(target)
+    assert after[0] == before[0] and export.column == "Lab 8 (777)"
+    at = before[0].index("Lab 8 (777)")
+    for old, new in zip(before, after):
+        assert old[:at] + old[at + 1 :] == new[:at] + new[at + 1 :]  # nothing else changed
+    assert {row[1]: row[at] for row in after[3:]} == {
+        "1001": "104",
+        "1002": "17.5",
+        "1003": "55",  # carl was not graded: the grade Canvas holds stays
+        "1005": "",
+        "1006": "10",
+        "1004": "",
+        "9999": "",
+    }
+    assert after[1][at] == "Muted" and after[2][at] == "100"
+    # the full header, with Canvas's number, names the same column
+    again = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "again.csv", column="Lab 8 (777)")
+    assert _rows(tmp_path / "again.csv") == after and again.column == "Lab 8 (777)"
+
+
+def test_the_roster_can_match_canvas_on_sis_ids(out, tmp_path):
+    gradebook = _write(tmp_path / "gradebook.csv", CANVAS)
+    roster = _write(
+        tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\ndora,dora@uni.example\n"
+    )
+    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", key="SIS Login ID")
+    rows = {row[1]: row[-1] for row in _rows(tmp_path / "import.csv")[3:]}
+    assert rows["1001"] == "104" and rows["1002"] == "17.5" and rows["1003"] == ""
+    # dora was graded, but no row of the gradebook has her login: listed, and her total is in the summary
+    assert export.not_in_lms == [("dora", "dora@uni.example")] and "dora" not in export.exported
+    assert "in the roster, not in the Canvas gradebook: dora (id dora@uni.example)" in export.problems()
+    summary = {row[0]: row[1:] for row in _rows(export.summary_path)}
+    assert summary["dora"] == ["dora@uni.example", "100", "not in the Canvas gradebook"]
+    # the test student has no login: listed without an id
+    assert ("Student, Test", "") in export.lms_only
+
+
+def test_a_semicolon_export_keeps_its_separator_and_decimal_commas(out, tmp_path):
+    text = (
+        "Student;ID;SIS Login ID;Section;Quiz 1 (501)\r\n"
+        "    Points Possible;;;;7,5\r\n"
+        "Lovelace Ada;1001;ada;Section A;7,5\r\n"
+        "Babbage Bob;1002;bob;Section A;6\r\n"
+    )
+    gradebook = _write(tmp_path / "gradebook.csv", text)
+    roster = _write(tmp_path / "roster.csv", "submission;id\nada;1001\nbob;1002\n")
+    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    written = (tmp_path / "import.csv").read_bytes().decode("utf-8")
+    assert not written.startswith("\ufeff")  # no byte-order mark where the export had none
+    assert written == (
+        "Student;ID;SIS Login ID;Section;Quiz 1 (501);labkit\r\n"
+        "    Points Possible;;;;7,5;100\r\n"
+        "Lovelace Ada;1001;ada;Section A;7,5;104\r\n"
+        "Babbage Bob;1002;bob;Section A;6;17,5\r\n"
+    )
+
+
+@pytest.mark.parametrize(
+    "key, roster, header",
+    [
+        ("idnumber", "submission,id\nada,S1001\nbob,S1002\ncarl,S1003\neve,S1005\n", "ID number"),
+        ("email", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\ncarl,carl@uni.example\n", "Email address"),
+    ],
+)
+def test_moodle_gets_one_row_per_graded_student_keyed_as_asked(out, tmp_path, key, roster, header):
+    path = _write(tmp_path / "roster.csv", roster)
+    export = lms.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", key=key, column="Lab 8")
+    ids = dict(line.split(",") for line in roster.splitlines()[1:])
+    # carl could not be graded: left out, so Moodle keeps what it has (an empty cell would mean "no grade")
+    assert _rows(tmp_path / "moodle.csv") == [[header, "Lab 8"], [ids["ada"], "104"], [ids["bob"], "17.5"]]
+    assert export.not_graded == {"carl": "its grading crashed twice"}
+    assert sorted(export.not_in_roster) == sorted(["dora", ESCAPE, HOSTILE])
+    assert [name for name, _ in export.no_submission] == (["eve"] if key == "idnumber" else [])
+    assert any("above full credit" in note and "104" in note for note in export.notes)
+
+
+def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
+    path = _write(tmp_path / "roster.csv", "submission,id\nada,S1001\nbob,S1002\n")
+    lms.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", feedback=True)
+    rows = _rows(tmp_path / "moodle.csv")
+    assert rows[0] == ["ID number", "labkit", "Feedback"]
+    assert rows[1][2] == "104 points: 100 of 100 for full credit, and 4 of extra credit (labkit grade)"
+    assert rows[2][2] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"
+
+
+def test_a_rubric_given_rescores_the_results(out, inputs, tmp_path):
+    rubric = tmp_path / "rubric.toml"
+    rubric.write_text("required = [2, 3]\n[points]\n2 = 50\n3 = 50\n")
+    from labkit.grading.rubric import load
+
+    gradebook, roster = inputs
+    lms.to_canvas(read_results([out], load(rubric)), gradebook, roster, tmp_path / "import.csv")
+    rows = {row[1] or row[0].strip(): row[-1] for row in _rows(tmp_path / "import.csv")[1:]}
+    assert rows["Points Possible"] == "100" and rows["1001"] == "100" and rows["1002"] == "75"
+
+
+# --- bad input: a clear error, and nothing written or changed ---------------------------------------------------
+
+
+def _refused(tmp_path, call, *messages):
+    before = _snapshot(tmp_path)
+    with pytest.raises(ValueError) as caught:
+        call()
+    for message in messages:
+        assert message in str(caught.value), str(caught.value)
+    assert _snapshot(tmp_path) == before  # nothing written, no input changed
+    return str(caught.value)
+
+
+@pytest.mark.parametrize(
+    "roster, messages",
+    [
+        ("submission,id\nada,1001\nbob,1001\n", ["gives the id '1001' to two submissions", "rows 2 and 3"]),
+        ("submission,id\nada,1001\nada,1002\n", ["names the submission 'ada' twice", "rows 2 and 3"]),
+        ("name,student\nada,1001\n", ["needs a header row with the columns 'submission'", "'name', 'student'"]),
+        ("submission,id\nada,\n", ["row 2: the id is empty"]),
+        ("submission,id\n\n", ["has a header but no student"]),
+        ("submission,id,id\nada,1,2\n", ["has two 'id' columns"]),
+    ],
+)
+def test_a_bad_roster_is_refused(out, tmp_path, roster, messages):
+    gradebook = _write(tmp_path / "gradebook.csv", CANVAS)
+    path = _write(tmp_path / "roster.csv", roster)
+    _refused(tmp_path, lambda: lms.to_canvas(read_results([out]), gradebook, path, tmp_path / "x.csv"), *messages)
+    _refused(tmp_path, lambda: lms.to_moodle(read_results([out]), path, tmp_path / "x.csv"), *messages)
+
+
+@pytest.mark.parametrize(
+    "content, messages",
+    [
+        ("Name,Points\nada,3\n", ["is not a Canvas gradebook export", "'Student' and 'ID'", "'Name', 'Points'"]),
+        ("Student,ID,Quiz (1)\nAda,1001,3\n", ["no 'Section' column"]),
+        ("Student,ID,Section,Quiz (1)\nAda,1001,A,3,4\n", ["row 2 has 5 cells but the header only 4"]),
+        ('Student,ID,Section,Quiz (1)\n"Ada,1001,A,3\n', ["is not valid CSV"]),
+    ],
+)
+def test_a_file_that_is_not_a_canvas_export_is_refused(out, tmp_path, content, messages):
+    gradebook = _write(tmp_path / "gradebook.csv", content)
+    roster = _write(tmp_path / "roster.csv", ROSTER)
+    _refused(tmp_path, lambda: lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "x.csv"), *messages)
+
+
+def test_a_canvas_export_that_is_not_utf8_or_is_a_workbook_is_refused(out, tmp_path):
+    roster = _write(tmp_path / "roster.csv", ROSTER)
+    latin = _write(tmp_path / "latin.csv", CANVAS.replace("\ufeff", "").replace("Ada", "Adà"), "latin-1")
+    _refused(
+        tmp_path,
+        lambda: lms.to_canvas(read_results([out]), latin, roster, tmp_path / "x.csv"),
+        "is not UTF-8 text",
+        "CSV UTF-8",
+    )
+    workbook = tmp_path / "gradebook.xlsx"
+    workbook.write_bytes(b"PK\x03\x04" + bytes(range(256)))
+    _refused(
+        tmp_path,
+        lambda: lms.to_canvas(read_results([out]), workbook, roster, tmp_path / "x.csv"),
+        "is an Excel workbook, not CSV",
+    )
+
+
+def test_canvas_columns_and_ids_that_cannot_be_filled_are_refused(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    grades = read_results([out])
+
+    def refused(*messages, book=gradebook, **options):
+        return _refused(tmp_path, lambda: lms.to_canvas(grades, book, roster, tmp_path / "x.csv", **options), *messages)
+
+    refused("as a student column or a total", column="Current Score")
+    refused("as a student column or a total", column="Section")
+    refused("starts like a spreadsheet formula", column="=1+1")
+    refused("must be one line", column="Lab\n8")
+    refused("--key for Canvas is one of", key="email")
+    ambiguous = _write(tmp_path / "two.csv", CANVAS.replace("Quiz 1 (501)", "Lab 8 (778)"))
+    refused("has 2 assignment columns named 'Lab 8'", "--column 'Lab 8 (778)'", book=ambiguous, column="Lab 8")
+    readonly = _write(tmp_path / "ro.csv", CANVAS.replace(",10,100,", ",(read only),100,"))
+    refused("is read-only in Canvas", book=readonly, column="Quiz 1")
+    no_sis = _write(
+        tmp_path / "nosis.csv", "Student,ID,SIS Login ID,Section,Quiz (1)\n    Points Possible,,,,5\nAda,1001,ada,A,3\n"
+    )
+    refused("has no 'SIS User ID' column", book=no_sis, key="SIS User ID")
+    twice = _write(tmp_path / "twice.csv", CANVAS.replace('"Fourier, Frank",1004', '"Fourier, Frank",1001'))
+    refused("has two rows with ID '1001' (rows 4 and 9)", book=twice)
+    refused("no submission of the results matched a row", key="SIS User ID")  # the roster holds Canvas IDs
+
+
+def test_an_output_is_never_an_input_nor_an_existing_file_unless_forced(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    grades = read_results([out])
+    for target in (gradebook, roster):
+        message = _refused(tmp_path, lambda t=target: lms.to_canvas(grades, gradebook, roster, t, force=True))
+        assert "is an input of this export; it is never overwritten" in message
+    target = _write(tmp_path / "import.csv", "my earlier export")
+    _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, target), "already exists", "--force")
+    _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "no" / "x.csv"), "does not exist")
+    lms.to_canvas(grades, gradebook, roster, target, force=True)
+    assert _rows(target)[0][-1] == "labkit" and gradebook.read_text(encoding="utf-8") == CANVAS
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "gradebook.csv",
+        "import-summary.csv",
+        "import.csv",
+        "roster.csv",
+    ]  # no temporary file left
+
+
+def test_moodle_refuses_ids_that_are_not_what_the_key_says(out, tmp_path):
+    grades = read_results([out])
+    roster = _write(tmp_path / "roster.csv", "submission,id\nada,S1001\n")
+    _refused(
+        tmp_path, lambda: lms.to_moodle(grades, roster, tmp_path / "m.csv", key="email"), "is not an email address"
+    )
+    formula = _write(tmp_path / "roster.csv", "submission,id\nada,=1+1\n")
+    _refused(tmp_path, lambda: lms.to_moodle(grades, formula, tmp_path / "m.csv"), "starts like a spreadsheet formula")
+    nobody = _write(tmp_path / "roster.csv", "submission,id\ncarl,S1003\n")  # only a student who was not graded
+    _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv"), "no graded submission")
+    _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv", key="ID"), "idnumber or email")
+
+
+# --- the command ------------------------------------------------------------------------------------------------
+
+
+def _cli(*args, cwd=None):
+    return subprocess.run(
+        [sys.executable, "-m", "labkit.cli", "export", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=cwd,
+    )
+
+
+def test_labkit_export_canvas_writes_next_to_out_and_lists_on_stderr(out, tmp_path):
+    run_dir = tmp_path / "grades"
+    write_report(run_dir, _grades())
+    gradebook = _write(tmp_path / "gradebook.csv", CANVAS)
+    roster = _write(tmp_path / "roster.csv", ROSTER)
+    run = _cli(run_dir, "--canvas", gradebook, "--roster", roster, "--column", "Lab 8")
+    assert run.returncode == 1, run.stderr  # written, with students listed
+    target = tmp_path / "grades-canvas.csv"
+    assert _rows(target)[3][6] == "104" and (tmp_path / "grades-canvas-summary.csv").exists()
+    assert f"wrote {target}" in run.stdout and "7 student(s) got nothing from this file" in run.stdout
+    assert "labkit export: not graded, no points exported: carl (its grading crashed twice)" in run.stderr
+    assert "labkit export: no roster entry, nothing exported: dora" in run.stderr
+    assert "labkit export: in the roster, no submission: eve (id 1005)" in run.stderr
+    assert "\x1b" not in run.stderr + run.stdout and "mal\ufffd[2Jory" in run.stderr
+    # a second run refuses to replace the file
+    again = _cli(run_dir, "--canvas", gradebook, "--roster", roster)
+    assert again.returncode == 2 and "already exists" in again.stderr and again.stdout == ""
+
+
+def test_labkit_export_moodle_exits_0_when_everyone_matched(tmp_path):
+    run_dir = tmp_path / "grades"
+    write_report(run_dir, _grades()[:2])
+    roster = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
+    target = tmp_path / "for-moodle.csv"
+    run = _cli(run_dir, "--moodle", "--roster", roster, "--key", "email", "--out", target)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr == "" and "every submission and roster entry matched" in run.stdout
+    assert _rows(target) == [["Email address", "labkit"], ["ada@uni.example", "104"], ["bob@uni.example", "17.5"]]
+
+
+def test_labkit_export_refuses_bad_input_with_status_2(tmp_path):
+    roster = _write(tmp_path / "roster.csv", ROSTER)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    run = _cli(empty, "--moodle", "--roster", roster)
+    assert run.returncode == 2 and "holds no results/*.json" in run.stderr
+    run = _cli(empty, "--canvas", tmp_path / "gradebook.csv", "--roster", roster, "--feedback")
+    assert run.returncode == 2 and "--feedback is for --moodle" in run.stderr
+    run = _cli(empty, "--roster", roster)
+    assert run.returncode == 2 and "one of the arguments --canvas --moodle is required" in run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "roster.csv"]
+
+
+def test_the_default_column_is_the_modules():
+    from labkit.cli import build_parser
+
+    args = build_parser().parse_args(["export", "grades", "--moodle", "--roster", "r.csv"])
+    assert args.column == lms.DEFAULT_COLUMN
