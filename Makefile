@@ -46,6 +46,7 @@ bench: $(STAMP) chromium
 	$(PY) benchmarks/bench_sliders.py
 	$(PY) benchmarks/bench_grading.py
 	$(PY) benchmarks/bench_browser_latency.py
+	$(PY) benchmarks/bench_report.py
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis

@@ -5,6 +5,7 @@
 ``labkit release DIR --out DIR``           write the student version of the instructor notebooks
 ``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
 ``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
+``labkit report OUT``                      write OUT/report.html: the class at a glance, from a grading run
 ``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
 ``labkit export DIR --canvas FILE ...``    the totals into the course's Canvas gradebook (or --moodle)
 """
@@ -159,8 +160,33 @@ def _export(args):
     return 1 if export.listed else 0
 
 
+def _report(args):
+    from .grading import class_report, similarity
+    from .grading.rubric import load
+
+    start = time.perf_counter()
+    threshold = args.similarity_threshold
+    if not 0.0 < threshold <= 1.0:
+        raise ValueError(f"--similarity-threshold is a similarity above 0 and at most 1; got {threshold}.")
+    rubric = load(args.rubric)
+    grades = class_report.read(args.out, rubric)
+    search = getattr(similarity, "similar_pairs", None)
+    if search is None:
+        pairs, note = None, "this version of labkit has no similarity search"
+    else:
+        pairs, note = search(grades, threshold), None
+    path = class_report.write(args.out, grades, pairs, threshold=threshold, similarity_note=note)
+    if not args.quiet:
+        similar = "similar code not computed" if pairs is None else f"{len(pairs)} similar pair(s)"
+        print(
+            f"wrote {path}: {len(grades)} submission(s), {similar}, in {time.perf_counter() - start:.1f} s "
+            "(open it in a browser; it needs no network)"
+        )
+    return 0
+
+
 def build_parser():
-    from .grading import backends
+    from .grading import backends, similarity
     from .grading.options import DEFAULTS, MIB
 
     parser = argparse.ArgumentParser(
@@ -338,6 +364,33 @@ def build_parser():
         "--rubric", type=Path, help="TOML rubric to score the results with (default: the lab's), as for --merge"
     )
     exp.set_defaults(handler=_export)
+
+    rep = commands.add_parser(
+        "report",
+        help="write OUT/report.html: totals, pass rates, slips, problems and similar code of a grading run",
+        description="Read the results/ of a `labkit grade` run (or of `labkit grade --merge`) in OUT and write "
+        "OUT/report.html, one self-contained page: the distribution of totals, each exercise's and part's "
+        "pass rate, the slips the checks named with who made them, the problems (time limits, crashes, "
+        "errors, refused references), the students with the most failed parts, and similar code side by "
+        "side. Nothing else in OUT is changed.",
+    )
+    rep.add_argument("out", type=Path, metavar="OUT", help="the --out folder of a `labkit grade` run")
+    rep.add_argument(
+        "--rubric",
+        type=Path,
+        default=DEFAULTS.rubric,
+        help="the TOML rubric the run was scored with (default: the lab's)",
+    )
+    rep.add_argument(
+        "--similarity-threshold",
+        type=float,
+        default=similarity.DEFAULT_THRESHOLD,
+        metavar="X",
+        help="show pairs of similar code from this similarity (0 to 1) up (default %(default)s); "
+        "similarity never changes a grade",
+    )
+    rep.add_argument("--quiet", action="store_true", help="print nothing when all goes well")
+    rep.set_defaults(handler=_report)
 
     rub = commands.add_parser(
         "rubric",

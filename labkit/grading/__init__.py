@@ -16,7 +16,8 @@ One module per concern:
 * :mod:`~labkit.grading.scoring` - grading one notebook and one submission (one process per submission);
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
 * :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own;
-* :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging.
+* :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
+* :mod:`~labkit.grading.class_report` - ``report.html``: the class at a glance (``labkit report OUT``);
 * :mod:`~labkit.grading.lms` - the grades into a Canvas gradebook or a Moodle grade import file.
 
 Student code never runs in the grading process: see docs/instructors.md.
@@ -45,6 +46,7 @@ _MODULES = {
     "backends",
     "batch",
     "cgroup",
+    "class_report",
     "guard",
     "lms",
     "nbgrader",

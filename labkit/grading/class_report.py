@@ -1,0 +1,1121 @@
+"""The class report: one self-contained HTML page about a grading run (``labkit report OUT``).
+
+:func:`read` reads a grading run's ``results/`` back (a merged run's too),
+:func:`summarise` counts what the class did, and :func:`write` writes
+``OUT/report.html``: the distribution of totals, each exercise's and part's
+pass rate, the slips the checks named (most frequent first, with who made
+them), the problems (time limits, crashes, cells that raised, refused
+references, ...), the students with the most failed parts, and pairs of
+similar code side by side (:mod:`labkit.grading.similarity`; similarity never
+changes a grade, it is for a person to judge).
+
+The page needs nothing but itself: its figures are inline PNG images drawn
+with matplotlib's Agg canvas (no pyplot state), its style and its one small
+script are inline, and it names no other resource. Everything a submission
+could have influenced (its name, a hint that quotes its values, a problem's
+text, its code) is data: made printable and bounded in length
+(:func:`labkit.grading.report.one_line`), then HTML-escaped.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import os
+import re
+import statistics
+import tempfile
+from collections import defaultdict
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .report import SubmissionGrade, one_line, printable, read_results
+from .rubric import Rubric, points_text
+from .rubric import default as default_rubric
+from .similarity import DEFAULT_THRESHOLD, Pair
+
+REPORT = "report.html"
+MAX_RESULT_BYTES = 32 * 1024**2  # one result file, as the grader accepts it (labkit.grading.batch.MAX_RESULT)
+MAX_SUBMISSIONS = 20_000  # result files in one folder
+MAX_NAME = 80  # characters of a submission's name shown
+MAX_TEXT = 300  # characters of a hint, a problem or a failed step shown
+MAX_NAMES = 300  # names listed under one slip or problem (then "and N more")
+MAX_ROWS = 200  # slips shown (the rarest are counted, not listed)
+MAX_TEXTS = 6  # problems shown per student and kind
+MOST_FAILED = 10  # students listed under "most failed parts"
+MAX_PAIRS = 50  # similar pairs shown side by side
+MAX_LINES = 200  # lines of each side of a pair shown
+MAX_LINE = 160  # characters of one line of code shown
+
+PASSED, SLIP, NOT_DONE = "passed", "slip", "not done"
+TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, NOT_GRADED, OTHER = (
+    "timeout",
+    "crash",
+    "raised",
+    "refused",
+    "tampered",
+    "not graded",
+    "other",
+)
+# the kinds of problem, in the order the page lists them: (heading, what it means)
+KINDS = {
+    TIMEOUT: ("Time limits", "A cell, a call of a graded function or the whole submission ran past its time limit"),
+    CRASH: (
+        "Crashes",
+        "The notebook's process died (killed, exited, out of memory) or stopped answering the grader",
+    ),
+    RAISED: ("Errors raised", "A cell of the notebook, or a graded function the grader called, raised an exception"),
+    REFUSED: (
+        "Refused references",
+        "A graded function called, or its source reached for, a reference implementation the exercise switches off",
+    ),
+    TAMPERED: ("Answers voided", "The notebook interfered with the grader's watch, so none of its answers count"),
+    NOT_GRADED: (
+        "Could not be graded",
+        "The grading itself failed twice; these submissions have no points (not zero) and no other row here",
+    ),
+    OTHER: (
+        "Other problems",
+        "A flood of output, a notebook too large to grade, a sandbox that could not start, a fault of a check",
+    ),
+}
+
+# How the grader words what went wrong (labkit.exercises.result.call, labkit.exercises.registry,
+# labkit.grading.scoring, labkit.grading.remote, labkit.grading.worker); tests/test_class_report.py
+# produces each wording with the grader's own functions, so a change of words fails there.
+NOT_DONE_DETAILS = ("not implemented yet", "not defined when the notebook finished")
+REFUSED_WORDS = ("switched off while this exercise is graded",)
+REFUSED_STEP = "calls no reference implementation"
+TAMPERED_STEP = "the notebook's answers can be trusted"
+TAMPERED_WORDS = ("none of its answers count",)
+TIMEOUT_WORDS = ("time limit",)
+CRASH_WORDS = (
+    "killed by",
+    "exited with status",
+    "ran out of memory",
+    "stopped answering",
+    "out of protocol",
+    "larger than the protocol allows",
+    "crashed",
+)
+GRADER_FAULT = "the check failed inside labkit"
+CELLS_RAISED = "cell(s) raised an error"
+CELL_LINE = re.compile(r"^    cell (\d+) raised ([^:\n]*): ?(.*)$")
+
+
+@dataclass(frozen=True)
+class ExerciseRate:
+    """How the class did on one exercise: of the graded submissions, how many attempted and passed it."""
+
+    exercise: int
+    graded: int  # graded submissions
+    found: int  # that have the exercise
+    attempted: int  # that have something other than stubs in it (a part passed, slipped or met a problem)
+    passed: int  # that passed every part
+
+    @property
+    def rate(self):
+        """The share of the submissions that attempted it which passed it (None when nobody attempted it)."""
+        return self.passed / self.attempted if self.attempted else None
+
+
+@dataclass(frozen=True)
+class PartRate:
+    """How the class did on one part: what became of it in each graded submission."""
+
+    exercise: int
+    part: str
+    weight: float
+    passed: int
+    slipped: int  # failed, with the check's hint
+    problem: int  # failed through a problem: a time limit, a crash, an error, a refused reference
+    not_done: int  # a stub left as released, or the name not defined
+    missing: int  # the submission has no notebook with the exercise
+
+    @property
+    def attempted(self):
+        return self.passed + self.slipped + self.problem
+
+    @property
+    def rate(self):
+        """The share of the submissions that attempted the part which passed it (None when nobody did)."""
+        return self.passed / self.attempted if self.attempted else None
+
+    @property
+    def label(self):
+        return f"{self.exercise} {self.part}"
+
+
+@dataclass(frozen=True)
+class Slip:
+    """One hint of one part, and the students whose work failed the part with it."""
+
+    exercise: int
+    part: str
+    hint: str
+    students: tuple
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What went wrong for one student, of one kind (its texts as the grader worded them)."""
+
+    kind: str
+    student: str
+    texts: tuple
+
+
+@dataclass(frozen=True)
+class Struggle:
+    """A student's failed parts (of the exercises the submission has)."""
+
+    student: str
+    total: float
+    failed: tuple  # "exercise part" labels of the parts attempted and failed (a slip or a problem)
+    not_done: int  # parts left as released or not defined, counted apart
+
+
+@dataclass
+class ClassSummary:
+    """Everything the page shows, counted from the grades (see :func:`summarise`)."""
+
+    rubric: Rubric
+    totals: dict  # graded submission -> total
+    not_graded: dict  # submission -> why
+    exercises: list  # ExerciseRate, in the rubric's order
+    parts: list  # PartRate, in the declarations' order
+    slips: list  # Slip, most frequent first
+    problems: dict  # kind -> [Problem], by student
+    most_failed: list  # Struggle, most failed parts first
+    seeds: list = field(default_factory=list)
+
+    @property
+    def submissions(self):
+        return len(self.totals) + len(self.not_graded)
+
+
+def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
+    """The grades of a grading run's output folder (``labkit grade ... --out OUT``, merged runs too).
+
+    Parameters
+    ----------
+    folder : str or Path
+        The ``--out`` folder of ``labkit grade`` (or of ``labkit grade --merge``).
+    rubric : Rubric, optional
+        The rubric the run was scored with (the lab's when None).
+
+    Returns
+    -------
+    list of SubmissionGrade
+        In name order.
+
+    Raises
+    ------
+    ValueError
+        If the folder does not exist or holds no results, a result file is not a regular file or is too
+        large, a result is not labkit's (another version wrote it, or it grades exercises the rubric's
+        course does not have), or the results were scored under another rubric than `rubric`.
+
+    Examples
+    --------
+    >>> read("no/such/folder")
+    Traceback (most recent call last):
+    ...
+    ValueError: no/such/folder is not a folder: give the --out folder of a `labkit grade` run.
+    """
+    rubric = rubric if rubric is not None else default_rubric()
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ValueError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
+    files = sorted((folder / "results").glob("*.json"))
+    if len(files) > MAX_SUBMISSIONS:
+        raise ValueError(
+            f"{folder / 'results'} holds {len(files):,} result files, more than the {MAX_SUBMISSIONS:,} "
+            "a class report shows: split the class and report on each part."
+        )
+    for path in files:
+        if not path.is_file() or path.is_symlink():
+            raise ValueError(f"{path} is not a regular file; a grading run writes its results as plain files.")
+        if path.stat().st_size > MAX_RESULT_BYTES:
+            raise ValueError(
+                f"{path} is larger than the {MAX_RESULT_BYTES:,} bytes a result can have: "
+                "it was not written by `labkit grade`; remove it."
+            )
+    grades = read_results([folder], rubric)  # ValueError for an empty folder, another format, a clash
+    for path in files:
+        title = json.loads(path.read_text(encoding="utf-8")).get("rubric")
+        if title is not None and title != rubric.title:
+            raise ValueError(
+                f"{path} was scored under the rubric {one_line(title, 100)!r}, not {rubric.title!r}: give "
+                "`labkit report --rubric FILE` the rubric of that run, so the report's totals are grades.csv's."
+            )
+    return grades
+
+
+def check_outcome(check: dict) -> str:
+    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"`` or a problem's kind.
+
+    Parameters
+    ----------
+    check : dict
+        One entry of an exercise's ``checks`` in a result: ``name``, ``passed``, ``hint``, ``steps``.
+
+    Returns
+    -------
+    str
+        ``"passed"``; ``"slip"`` (the check named what is wrong); ``"not done"`` (a stub or a missing
+        name); or one of the problem kinds ``"timeout"``, ``"crash"``, ``"raised"``, ``"refused"``,
+        ``"tampered"``, ``"other"`` (a fault of the check itself).
+
+    Examples
+    --------
+    >>> check_outcome({"passed": False, "hint": "h", "steps": [{"step": "s", "passed": False,
+    ...     "detail": "not implemented yet"}]})
+    'not done'
+    >>> check_outcome({"passed": False, "hint": "divide by the interval's length", "steps": [
+    ...     {"step": "the values at 5 points", "passed": False, "detail": "off by 0.3"}]})
+    'slip'
+    """
+    if not isinstance(check, dict):
+        raise ValueError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
+    if check.get("passed"):
+        return PASSED
+    failed = [s for s in _steps(check) if not s.get("passed")]
+    names = [str(s.get("step", "")) for s in failed]
+    details = [str(s.get("detail", "")) for s in failed]
+    text = " ".join(details)
+    if REFUSED_STEP in names or any(words in text for words in REFUSED_WORDS):
+        return REFUSED
+    if TAMPERED_STEP in names:
+        return TAMPERED
+    if any(words in text for words in TIMEOUT_WORDS):
+        return TIMEOUT
+    if any(words in text for words in CRASH_WORDS):
+        return CRASH
+    if any(detail.startswith("raised ") for detail in details):
+        return RAISED
+    if GRADER_FAULT in text:
+        return OTHER
+    if any(detail in NOT_DONE_DETAILS for detail in details):
+        return NOT_DONE
+    return SLIP
+
+
+def problem_kinds(text: str) -> list[tuple[str, str]]:
+    """The kinds of a problem the grader wrote for a submission, each with the words to show.
+
+    A notebook whose cells raised has one problem listing the cells; a cell stopped at its time limit
+    counts as a time limit, the others as errors raised.
+
+    Parameters
+    ----------
+    text : str
+        One of a submission's ``problems``.
+
+    Returns
+    -------
+    list of (str, str)
+        (kind, description) pairs; the description is one printable line, bounded.
+
+    Examples
+    --------
+    >>> problem_kinds("a.ipynb: stopped after the submission's time limit of 600 s.")
+    [('timeout', "a.ipynb: stopped after the submission's time limit of 600 s.")]
+    >>> problem_kinds("a.ipynb: 2 cell(s) raised an error (graded as far as it got):\\n"
+    ...     "    cell 3 raised ZeroDivisionError: division by zero\\n"
+    ...     "    cell 5 raised Timeout: interrupted: it ran longer than the time limit")
+    ... # doctest: +NORMALIZE_WHITESPACE
+    [('raised', 'a.ipynb: cell 3 raised ZeroDivisionError: division by zero'),
+     ('timeout', 'a.ipynb: cell 5 ran past its time limit')]
+    """
+    lines = str(text).split("\n")
+    first = lines[0]
+    if CELLS_RAISED in first:
+        notebook = first.split(": ")[0]
+        found = []
+        for line in lines[1:]:
+            match = CELL_LINE.match(line)
+            if not match:
+                continue
+            cell, kind, message = match.groups()
+            if kind == "Timeout":
+                found.append((TIMEOUT, one_line(f"{notebook}: cell {cell} ran past its time limit", MAX_TEXT)))
+            else:
+                found.append((RAISED, one_line(f"{notebook}: cell {cell} raised {kind}: {message}", MAX_TEXT)))
+        return found or [(RAISED, one_line(first, MAX_TEXT))]
+    if any(words in first for words in TAMPERED_WORDS):
+        kind = TAMPERED
+    elif any(words in first for words in TIMEOUT_WORDS):
+        kind = TIMEOUT
+    elif any(words in first for words in CRASH_WORDS):
+        kind = CRASH
+    else:
+        kind = OTHER
+    return [(kind, one_line(first, MAX_TEXT))]
+
+
+def _steps(check):
+    steps = check.get("steps", [])
+    return [s for s in steps if isinstance(s, dict)] if isinstance(steps, list) else []
+
+
+def _checks(grade, number):
+    verdict = grade.results.get(number)
+    if verdict is None:
+        return None
+    checks = verdict.get("checks") if isinstance(verdict, dict) else None
+    if not isinstance(checks, list) or not all(isinstance(c, dict) for c in checks):
+        raise ValueError(
+            f"the result of {one_line(grade.name, MAX_NAME)!r} for exercise {number} has no list of checks: "
+            "it was not written by `labkit grade`; grade the submission again."
+        )
+    return checks
+
+
+def _part_names(rubric, number, grades):
+    """The exercise's parts as declared, then any other part name the results hold, in order."""
+    exercise = rubric.registry.exercises.get(number)
+    names = [part.name for part in exercise.parts] if exercise is not None else []
+    for grade in grades:
+        for check in _checks(grade, number) or []:
+            name = one_line(check.get("name", "?"), MAX_TEXT)
+            if name not in names:
+                names.append(name)
+    return names
+
+
+def _weights(rubric, number):
+    exercise = rubric.registry.exercises.get(number)
+    if exercise is None:
+        return {}
+    total = sum(part.weight for part in exercise.parts) or 1
+    return {part.name: rubric.points.get(number, 0) * part.weight / total for part in exercise.parts}
+
+
+def _failed_text(check, number):
+    details = [
+        f"{one_line(s.get('step', ''), 100)}: {one_line(s.get('detail', ''), MAX_TEXT)}"
+        for s in _steps(check)
+        if not s.get("passed")
+    ]
+    return one_line(f"exercise {number}, {check.get('name', '?')}: " + ("; ".join(details) or "failed"), MAX_TEXT)
+
+
+def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
+    """Count what a class did: totals, pass rates, slips, problems and the most failed parts.
+
+    Parameters
+    ----------
+    grades : list of SubmissionGrade
+        One per submission, all scored under one rubric (:func:`read` gives them).
+
+    Returns
+    -------
+    ClassSummary
+
+    Raises
+    ------
+    ValueError
+        If `grades` is empty, holds something other than SubmissionGrade, or mixes rubrics.
+
+    Examples
+    --------
+    >>> from labkit.grading.report import SubmissionGrade
+    >>> summarise([SubmissionGrade("ann", {2: {"fraction": 1.0, "passed": True, "checks": [
+    ...     {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}]}})]).totals
+    {'ann': 10.0}
+    """
+    grades = list(grades)
+    if not grades:
+        raise ValueError("there are no submissions to report on: grade some first (`labkit grade`).")
+    for grade in grades:
+        if not isinstance(grade, SubmissionGrade):
+            raise ValueError(
+                f"a class report is made of SubmissionGrade objects (labkit.grading.report); got "
+                f"{type(grade).__name__}: read a run's results with labkit.grading.class_report.read."
+            )
+    rubric = grades[0].rubric
+    if any(grade.rubric != rubric for grade in grades):
+        raise ValueError("the grades are scored under different rubrics: read them all with one rubric.")
+    graded = [g for g in grades if g.graded]
+    exercises, parts = [], []
+    slips = defaultdict(list)
+    problems = defaultdict(list)  # (kind, student) -> texts
+    failed = {g.name: [] for g in graded}
+    not_done = defaultdict(int)
+    for number in rubric.graded:
+        names = _part_names(rubric, number, graded)
+        weights = _weights(rubric, number)
+        counts = {name: defaultdict(int) for name in names}
+        found = attempted = passed = 0
+        for grade in graded:
+            checks = _checks(grade, number)
+            if checks is None:
+                for name in names:
+                    counts[name]["missing"] += 1
+                continue
+            found += 1
+            by_name = {one_line(c.get("name", "?"), MAX_TEXT): c for c in checks}
+            outcomes = []
+            for name in names:
+                check = by_name.get(name)
+                outcome = check_outcome(check) if check is not None else NOT_DONE
+                outcomes.append(outcome)
+                counts[name][outcome] += 1
+                if outcome == PASSED:
+                    continue
+                if outcome == NOT_DONE:
+                    not_done[grade.name] += 1
+                    continue
+                failed[grade.name].append(f"{number} {name}")
+                if outcome == SLIP:
+                    hint = one_line(check.get("hint") or "", MAX_TEXT) or _failed_text(check, number)
+                    slips[(number, names.index(name), name, hint)].append(grade.name)
+                else:
+                    problems[(outcome, grade.name)].append(_failed_text(check, number))
+            attempted += any(outcome not in (NOT_DONE,) for outcome in outcomes)
+            passed += all(outcome == PASSED for outcome in outcomes) and bool(outcomes)
+        exercises.append(ExerciseRate(number, len(graded), found, attempted, passed))
+        for name in names:
+            c = counts[name]
+            problem = sum(c[kind] for kind in KINDS)
+            parts.append(
+                PartRate(number, name, weights.get(name, 0.0), c[PASSED], c[SLIP], problem, c[NOT_DONE], c["missing"])
+            )
+    for grade in grades:
+        if not grade.graded:
+            problems[(NOT_GRADED, grade.name)].append(one_line(grade.failure, MAX_TEXT))
+            continue
+        for text in grade.problems:
+            for kind, line in problem_kinds(text):
+                problems[(kind, grade.name)].append(line)
+    by_kind = {kind: [] for kind in KINDS}
+    for (kind, student), texts in sorted(problems.items(), key=lambda item: (item[0][0], item[0][1])):
+        by_kind[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))
+    ordered = sorted(slips.items(), key=lambda item: (-len(set(item[1])), item[0][0], item[0][1], item[0][3]))
+    slip_list = [
+        Slip(number, name, hint, tuple(sorted(set(students)))) for (number, _, name, hint), students in ordered
+    ]
+    totals = {g.name: g.total for g in graded}
+    struggles = sorted(
+        (Struggle(name, totals[name], tuple(labels), not_done[name]) for name, labels in failed.items() if labels),
+        key=lambda s: (-len(s.failed), s.total, s.student),
+    )
+    return ClassSummary(
+        rubric=rubric,
+        totals=totals,
+        not_graded={g.name: g.failure for g in grades if not g.graded},
+        exercises=exercises,
+        parts=parts,
+        slips=slip_list,
+        problems={kind: rows for kind, rows in by_kind.items() if rows},
+        most_failed=struggles[:MOST_FAILED],
+        seeds=sorted({g.seed for g in grades if isinstance(g.seed, int)}),
+    )
+
+
+# ---------------------------------------------------------------------------------------------- figures
+
+
+def _png(figure):
+    """A matplotlib Figure as a base64 PNG (no pyplot: the figure is garbage once drawn)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(figure)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
+    return base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def _bins(totals, maximum):
+    """Bin edges of a round width, about twenty bins from 0 to the largest possible total."""
+    import numpy as np
+
+    top = max([float(maximum), *map(float, totals), 1.0])
+    width = next(w for w in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 10**9) if top / w <= 25)
+    edges = np.arange(0.0, top + width, float(width))
+    if edges[-1] < top:
+        edges = np.append(edges, edges[-1] + width)
+    return edges
+
+
+def histogram_of_totals(summary: ClassSummary) -> tuple[str, str, list[tuple[float, float, int]]]:
+    """The histogram of the graded totals: (base64 PNG, alt text, [(low, high, count)]).
+
+    Parameters
+    ----------
+    summary : ClassSummary
+
+    Returns
+    -------
+    tuple
+        The picture, its alt text (the figures in words: how many, median, mean, range, full credit,
+        the largest bin) and the bins it shows.
+    """
+    import numpy as np
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
+
+    totals = list(summary.totals.values())
+    rubric = summary.rubric
+    edges = _bins(totals, rubric.maximum)
+    counts, _ = np.histogram(totals, bins=edges)
+    bins = [(float(lo), float(hi), int(n)) for lo, hi, n in zip(edges[:-1], edges[1:], counts)]
+    figure = Figure(figsize=(6.4, 2.8), layout="constrained")
+    axes = figure.subplots()
+    axes.hist(totals, bins=edges, color="#2b5797", edgecolor="white")
+    axes.axvline(rubric.full_credit, color="black", linestyle="--", linewidth=1.2)
+    axes.annotate(
+        f"full credit {points_text(rubric.full_credit)}",
+        (rubric.full_credit, 1.0),
+        xycoords=("data", "axes fraction"),
+        xytext=(0, 3),
+        textcoords="offset points",
+        ha="center",
+        va="bottom",
+        fontsize=9,
+    )
+    axes.set_xlabel("total points")
+    axes.set_ylabel("submissions")
+    axes.yaxis.set_major_locator(MaxNLocator(integer=True))
+    axes.set_xlim(edges[0], edges[-1])
+    image = _png(figure)
+    if totals:
+        low, high, count = max(bins, key=lambda b: (b[2], -b[0]))
+        full = sum(t >= rubric.full_credit for t in totals)
+        alt = (
+            f"Histogram of {len(totals)} totals: median {points_text(statistics.median(totals))}, "
+            f"mean {statistics.fmean(totals):.1f}, lowest {points_text(min(totals))}, "
+            f"highest {points_text(max(totals))}; {full} of {len(totals)} reach full credit "
+            f"({points_text(rubric.full_credit)} points). The largest bin, {points_text(low)} to "
+            f"{points_text(high)} points, holds {count}."
+        )
+    else:
+        alt = "Histogram of totals: empty, no submission could be graded."
+    return image, alt, bins
+
+
+def _rate_text(rate, attempted):
+    return "nobody attempted it" if rate is None else f"{rate:.0%} of {attempted}"
+
+
+def _bars(labels, rates, attempted):
+    from matplotlib.figure import Figure
+
+    height = 0.9 + 0.26 * len(labels)
+    figure = Figure(figsize=(7.5, height), layout="constrained")
+    axes = figure.subplots()
+    positions = list(range(len(labels)))
+    values = [100 * (r or 0.0) for r in rates]
+    axes.barh(positions, values, color="#2b5797", height=0.7)
+    for y, rate, n in zip(positions, rates, attempted):
+        axes.text(
+            (100 * rate if rate is not None else 0) + 1, y, _rate_text(rate, n), va="center", fontsize=8, color="black"
+        )
+    axes.set_yticks(positions, [one_line(label, 40) for label in labels], fontsize=8)
+    axes.invert_yaxis()
+    axes.set_xlim(0, 125)
+    axes.set_xticks([0, 25, 50, 75, 100], ["0%", "25%", "50%", "75%", "100%"])
+    axes.set_xlabel("passed, of the submissions that attempted it")
+    return _png(figure)
+
+
+def pass_rate_figures(summary: ClassSummary) -> list[tuple[str, str, str]]:
+    """Bar charts of the pass rates: [(base64 PNG, alt text, caption)], exercises then parts.
+
+    Parameters
+    ----------
+    summary : ClassSummary
+
+    Returns
+    -------
+    list of tuple
+        Each figure with an alt text that gives every rate in numbers.
+    """
+    exercises, parts = summary.exercises, summary.parts
+    exercise_alt = (
+        "Bar chart of the pass rate of each exercise among the submissions that attempted it: "
+        + "; ".join(f"exercise {e.exercise} {_rate_text(e.rate, e.attempted)}" for e in exercises)
+        + "."
+    )
+    part_alt = (
+        "Bar chart of the pass rate of each part among the submissions that attempted it: "
+        + "; ".join(f"exercise {p.label} {_rate_text(p.rate, p.attempted)}" for p in parts)
+        + "."
+    )
+    return [
+        (
+            _bars(
+                [f"exercise {e.exercise}" for e in exercises],
+                [e.rate for e in exercises],
+                [e.attempted for e in exercises],
+            ),
+            exercise_alt,
+            "Each exercise: passed (every part) of the submissions that attempted it.",
+        ),
+        (
+            _bars([p.label for p in parts], [p.rate for p in parts], [p.attempted for p in parts]),
+            part_alt,
+            "Each part, labelled with its exercise: passed of the submissions that attempted it.",
+        ),
+    ]
+
+
+# ---------------------------------------------------------------------------------------------- HTML
+
+
+def _e(value, limit=MAX_TEXT):
+    """A submission's (or the grader's) text as HTML: printable, one line, bounded, escaped."""
+    return html.escape(one_line(value, limit), quote=True)
+
+
+def _percent(rate):
+    return "&ndash;" if rate is None else f"{rate:.0%}"
+
+
+def _names(names, noun="students"):
+    names = list(names)
+    if len(names) <= 3:
+        return ", ".join(_e(name, MAX_NAME) for name in names)
+    shown = "".join(f"<li>{_e(name, MAX_NAME)}</li>" for name in names[:MAX_NAMES])
+    more = f"<li>and {len(names) - MAX_NAMES} more</li>" if len(names) > MAX_NAMES else ""
+    one = noun[:-1] if noun.endswith("s") else noun
+    return (
+        f"<details><summary>{len(names)} {one if len(names) == 1 else noun}</summary>"
+        f'<ul class="names">{shown}{more}</ul></details>'
+    )
+
+
+def _figure(image, alt, caption):
+    return (
+        f'<figure><img src="data:image/png;base64,{image}" alt="{html.escape(alt, quote=True)}">'
+        f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+    )
+
+
+def _totals_section(summary):
+    totals = list(summary.totals.values())
+    rubric = summary.rubric
+    parts = ['<section aria-labelledby="totals"><h2 id="totals">Totals</h2>']
+    if not totals:
+        parts.append("<p>No submission could be graded, so there are no totals.</p></section>")
+        return "".join(parts)
+    image, alt, bins = histogram_of_totals(summary)
+    parts.append('<div class="row">')
+    parts.append(_figure(image, alt, "The distribution of the graded submissions' totals under the rubric."))
+    quartiles = statistics.quantiles(totals, n=4, method="inclusive") if len(totals) > 1 else [totals[0]] * 3
+    rows = [
+        ("graded", str(len(totals))),
+        ("could not be graded", str(len(summary.not_graded))),
+        ("median", points_text(statistics.median(totals))),
+        ("mean", f"{statistics.fmean(totals):.1f}"),
+        ("lowest, highest", f"{points_text(min(totals))}, {points_text(max(totals))}"),
+        ("quartiles", ", ".join(points_text(q) for q in quartiles)),
+        (f"full credit ({points_text(rubric.full_credit)}) or more", str(sum(t >= rubric.full_credit for t in totals))),
+        ("the most possible, with extra credit", points_text(rubric.maximum)),
+    ]
+    parts.append('<table class="narrow"><caption>The totals in figures</caption><tbody>')
+    parts += [f'<tr><th scope="row">{html.escape(k)}</th><td class="num">{v}</td></tr>' for k, v in rows]
+    parts.append("</tbody></table></div>")
+    parts.append(
+        '<details><summary>The histogram as a table</summary><table class="narrow"><caption>Submissions per '
+        'range of totals</caption><thead><tr><th scope="col">total points</th><th scope="col">submissions</th>'
+        "</tr></thead><tbody>"
+    )
+    parts += [
+        f"<tr><td>{points_text(lo)} to {'under ' if i < len(bins) - 1 else ''}{points_text(hi)}</td>"
+        f'<td class="num">{n}</td></tr>'
+        for i, (lo, hi, n) in enumerate(bins)
+    ]
+    parts.append("</tbody></table></details></section>")
+    return "".join(parts)
+
+
+def _rates_section(summary):
+    out = ['<section aria-labelledby="pass-rates"><h2 id="pass-rates">Pass rates</h2>']
+    out.append(
+        "<p>A submission <em>attempted</em> an exercise or part when it holds more than the released stub: "
+        "the part passed, failed with a hint, or met a problem. Parts left as released or not defined are "
+        "counted as <em>not done</em>; exercises in no notebook of a submission as <em>not found</em>.</p>"
+    )
+    if summary.totals:
+        for image, alt, caption in pass_rate_figures(summary):
+            out.append(_figure(image, alt, caption))
+    out.append(
+        '<table><caption>Each exercise</caption><thead><tr><th scope="col">exercise</th>'
+        '<th scope="col">points</th><th scope="col">found</th><th scope="col">attempted</th>'
+        '<th scope="col">passed</th><th scope="col">pass rate (of attempted)</th>'
+        '<th scope="col">pass rate (of graded)</th></tr></thead><tbody>'
+    )
+    for e in summary.exercises:
+        of_graded = e.passed / e.graded if e.graded else None
+        out.append(
+            f'<tr><th scope="row">{e.exercise}</th><td class="num">'
+            f"{points_text(summary.rubric.points.get(e.exercise, 0))}</td>"
+            f'<td class="num">{e.found}</td><td class="num">{e.attempted}</td><td class="num">{e.passed}</td>'
+            f'<td class="num">{_percent(e.rate)}</td><td class="num">{_percent(of_graded)}</td></tr>'
+        )
+    out.append("</tbody></table>")
+    out.append(
+        '<table><caption>Each part</caption><thead><tr><th scope="col">exercise</th><th scope="col">part</th>'
+        '<th scope="col">points</th><th scope="col">passed</th><th scope="col">failed with a hint</th>'
+        '<th scope="col">problem</th><th scope="col">not done</th><th scope="col">not found</th>'
+        '<th scope="col">pass rate (of attempted)</th></tr></thead><tbody>'
+    )
+    for p in summary.parts:
+        out.append(
+            f'<tr><td class="num">{p.exercise}</td><th scope="row">{_e(p.part)}</th>'
+            f'<td class="num">{points_text(p.weight)}</td><td class="num">{p.passed}</td>'
+            f'<td class="num">{p.slipped}</td><td class="num">{p.problem}</td><td class="num">{p.not_done}</td>'
+            f'<td class="num">{p.missing}</td><td class="num">{_percent(p.rate)}</td></tr>'
+        )
+    out.append("</tbody></table></section>")
+    return "".join(out)
+
+
+def _slips_section(summary):
+    out = ['<section aria-labelledby="slips"><h2 id="slips">Slips the checks named</h2>']
+    slips = summary.slips
+    if not slips:
+        out.append("<p>No part failed with a hint.</p></section>")
+        return "".join(out)
+    out.append(
+        f"<p>{len(slips)} different hints, most frequent first. A slip is a failed part with the hint its check "
+        "gave; each student is counted once per slip.</p>"
+    )
+    out.append(
+        '<table><caption>Slips, most frequent first</caption><thead><tr><th scope="col">students</th>'
+        '<th scope="col">exercise</th><th scope="col">part</th><th scope="col">the hint</th>'
+        '<th scope="col">who</th></tr></thead><tbody>'
+    )
+    for slip in slips[:MAX_ROWS]:
+        count = len(slip.students)
+        out.append(
+            f'<tr><td class="num">{count}</td><td class="num">{slip.exercise}</td><th scope="row">{_e(slip.part)}</th>'
+            f"<td>{_e(slip.hint)}: <strong>{count} student{'' if count == 1 else 's'}</strong></td>"
+            f"<td>{_names(slip.students)}</td></tr>"
+        )
+    out.append("</tbody></table>")
+    if len(slips) > MAX_ROWS:
+        rest = slips[MAX_ROWS:]
+        out.append(
+            f"<p>{len(rest)} rarer slips ({sum(len(s.students) for s in rest)} failed parts) are not listed; "
+            "each student's feedback file names them.</p>"
+        )
+    out.append("</section>")
+    return "".join(out)
+
+
+def _problems_section(summary):
+    out = ['<section aria-labelledby="problems"><h2 id="problems">Problems</h2>']
+    if not summary.problems:
+        out.append("<p>No time limit, crash, error, refused reference or other problem.</p></section>")
+        return "".join(out)
+    out.append("<ul>")
+    for kind, rows in summary.problems.items():
+        heading, _ = KINDS[kind]
+        out.append(
+            f'<li><a href="#problem-{kind.replace(" ", "-")}">{heading}</a>: {len(rows)} '
+            f"student{'' if len(rows) == 1 else 's'}</li>"
+        )
+    out.append("</ul>")
+    for kind, rows in summary.problems.items():
+        heading, meaning = KINDS[kind]
+        anchor = f"problem-{kind.replace(' ', '-')}"
+        out.append(
+            f'<h3 id="{anchor}">{heading}: {len(rows)} student{"" if len(rows) == 1 else "s"}</h3>'
+            f"<p>{html.escape(meaning)}.</p>"
+        )
+        out.append(
+            f"<details{' open' if len(rows) <= 10 else ''}><summary>Who, and what happened ({len(rows)})</summary>"
+            f'<table><caption>{heading}</caption><thead><tr><th scope="col">student</th>'
+            '<th scope="col">what happened</th></tr></thead><tbody>'
+        )
+        for row in rows[:MAX_NAMES]:
+            texts = "".join(f"<li>{_e(text)}</li>" for text in row.texts[:MAX_TEXTS])
+            more = f"<li>and {len(row.texts) - MAX_TEXTS} more</li>" if len(row.texts) > MAX_TEXTS else ""
+            out.append(f'<tr><th scope="row">{_e(row.student, MAX_NAME)}</th><td><ul>{texts}{more}</ul></td></tr>')
+        out.append("</tbody></table>")
+        if len(rows) > MAX_NAMES:
+            out.append(f"<p>and {len(rows) - MAX_NAMES} more students.</p>")
+        out.append("</details>")
+    out.append("</section>")
+    return "".join(out)
+
+
+def _most_failed_section(summary):
+    out = ['<section aria-labelledby="most-failed"><h2 id="most-failed">The most failed parts</h2>']
+    if not summary.most_failed:
+        out.append("<p>No graded submission failed a part.</p></section>")
+        return "".join(out)
+    out.append(
+        f"<p>The {len(summary.most_failed)} students with the most failed parts: parts they attempted that "
+        "failed, with a hint or through a problem. Parts left as released or not defined (the other branch, "
+        "say) are counted apart, as <em>not done</em>.</p>"
+        '<table><caption>Students with the most failed parts</caption><thead><tr><th scope="col">student</th>'
+        '<th scope="col">failed parts</th><th scope="col">not done</th><th scope="col">total</th>'
+        '<th scope="col">the failed parts</th></tr></thead><tbody>'
+    )
+    for s in summary.most_failed:
+        labels = ", ".join(_e(label, 60) for label in s.failed[:60])
+        more = f", and {len(s.failed) - 60} more" if len(s.failed) > 60 else ""
+        out.append(
+            f'<tr><th scope="row">{_e(s.student, MAX_NAME)}</th><td class="num">{len(s.failed)}</td>'
+            f'<td class="num">{s.not_done}</td><td class="num">{points_text(s.total)}</td>'
+            f"<td>{labels}{more}</td></tr>"
+        )
+    out.append("</tbody></table></section>")
+    return "".join(out)
+
+
+def _code_side(name, lines, shared):
+    rows = []
+    width = len(str(min(len(lines), MAX_LINES)))
+    for number, line in enumerate(lines[:MAX_LINES]):
+        text = html.escape(printable(str(line)).replace("\t", "    ").replace("\n", " ")[:MAX_LINE])
+        gutter = (
+            f'<span class="gutter" aria-hidden="true">{number + 1:>{width}} {"=" if number in shared else " "} </span>'
+        )
+        rows.append(f"{gutter}<mark>{text}</mark>" if number in shared else f"{gutter}{text}")
+    if len(lines) > MAX_LINES:
+        rows.append(f"\u2026 and {len(lines) - MAX_LINES} more lines")
+    return f"<figure><figcaption>{_e(name, MAX_NAME)}</figcaption><pre>" + "\n".join(rows) + "</pre></figure>"
+
+
+def _similar_section(pairs, threshold, note):
+    out = ['<section aria-labelledby="similar"><h2 id="similar">Similar code</h2>']
+    out.append(
+        "<p><strong>Similarity never changes a grade.</strong> These pairs are for a person to judge: shared "
+        "code can be innocent (the lab's template, a formula everyone writes alike, work done together where "
+        "that is allowed).</p>"
+    )
+    if pairs is None:
+        why = f" ({_e(note)})" if note else ""
+        out.append(f"<p>Not computed{why}.</p></section>")
+        return "".join(out)
+    if not pairs:
+        out.append(f"<p>No pair of submissions is similar at the threshold {threshold:.2f} or above.</p></section>")
+        return "".join(out)
+    ordered = sorted(pairs, key=lambda p: (-p.score, p.function, p.first, p.second))
+    out.append(
+        f"<p>{len(pairs)} pair{'' if len(pairs) == 1 else 's'} of versions of one graded function at a similarity "
+        f"of {threshold:.2f} or above, most similar first. Shared lines are highlighted and marked "
+        "<code>=</code> after their line number.</p>"
+    )
+    for index, pair in enumerate(ordered[:MAX_PAIRS], 1):
+        shared_first = {i for i in pair.shared_first if isinstance(i, int) and 0 <= i < len(pair.first_lines)}
+        shared_second = {i for i in pair.shared_second if isinstance(i, int) and 0 <= i < len(pair.second_lines)}
+        out.append(
+            f'<article class="pair" aria-labelledby="pair-{index}"><h3 id="pair-{index}">'
+            f"<code>{_e(pair.function, 100)}</code>: {_e(pair.first, MAX_NAME)} and {_e(pair.second, MAX_NAME)}, "
+            f"similarity {pair.score:.2f}</h3>"
+            f"<p>{len(shared_first)} of {len(pair.first_lines)} lines of the first and {len(shared_second)} of "
+            f"{len(pair.second_lines)} of the second are shared.</p>"
+            '<div class="sides">'
+            + _code_side(pair.first, pair.first_lines, shared_first)
+            + _code_side(pair.second, pair.second_lines, shared_second)
+            + "</div></article>"
+        )
+    if len(pairs) > MAX_PAIRS:
+        out.append(f"<p>and {len(pairs) - MAX_PAIRS} less similar pairs, not shown.</p>")
+    out.append("</section>")
+    return "".join(out)
+
+
+STYLE = """
+:root { color: #1b1b1b; background: #fff; font-family: system-ui, sans-serif; line-height: 1.45; }
+body { max-width: 72rem; margin: 0 auto; padding: 0 1rem 3rem; }
+.skip { position: absolute; left: -100vw; top: 0.5rem; background: #fff; color: #0b3d91; padding: 0.5rem; }
+.skip:focus { left: 0.5rem; z-index: 1; }
+:focus-visible { outline: 3px solid #0b3d91; outline-offset: 2px; }
+a { color: #0b3d91; }
+h1 { font-size: 1.7rem; } h2 { margin-top: 2.5rem; border-bottom: 2px solid #1b1b1b; } h3 { margin-top: 1.5rem; }
+table { border-collapse: collapse; margin: 1rem 0; width: 100%; }
+table.narrow { width: auto; }
+caption { text-align: left; font-weight: bold; padding: 0.3rem 0; }
+th, td { border: 1px solid #8a8a8a; padding: 0.25rem 0.5rem; text-align: left; vertical-align: top; }
+thead th { background: #e8ecf3; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+figure { margin: 1rem 0; } figure img { max-width: 100%; height: auto; }
+figcaption { font-style: italic; }
+ul.names { columns: 14rem; margin: 0.3rem 0; }
+nav ul { display: flex; flex-wrap: wrap; gap: 0.3rem 1.5rem; list-style: none; padding: 0; }
+.row { display: flex; flex-wrap: wrap; gap: 0 2rem; align-items: flex-start; }
+.row figure { flex: 0 1 38rem; }
+details > summary { cursor: pointer; }
+.sides { display: grid; grid-template-columns: 1fr 1fr; gap: 1rem; }
+.sides figure { margin: 0; min-width: 0; }
+pre { white-space: pre-wrap; overflow-wrap: anywhere; background: #f6f6f6; border: 1px solid #8a8a8a;
+  padding: 0.5rem; font-size: 0.85rem; margin: 0; }
+mark { background: #ffe680; color: #000; font-weight: bold; }
+.gutter { color: #4a4a4a; user-select: none; }
+.pair { border-top: 1px solid #8a8a8a; margin-top: 1.5rem; }
+@media (max-width: 50rem) { .sides { grid-template-columns: 1fr; } }
+@media print {
+  :root { font-size: 10pt; }
+  body { max-width: none; padding: 0; }
+  .skip, nav { display: none; }
+  a { color: inherit; }
+  thead th, pre { background: none; }
+  mark { background: none; text-decoration: underline; }
+  details > summary { list-style: none; font-weight: bold; }
+  details::details-content { display: contents; content-visibility: visible; }
+  figure, tr, .pair h3 { break-inside: avoid; }
+  h2, h3 { break-after: avoid; }
+}
+"""
+
+# open every <details> while printing (and close again those that were closed): print shows every list
+SCRIPT = """
+addEventListener("beforeprint", () => { for (const d of document.querySelectorAll("details")) {
+  if (!d.open) { d.dataset.printed = "1"; d.open = true; } } });
+addEventListener("afterprint", () => { for (const d of document.querySelectorAll("details[data-printed]")) {
+  d.open = false; delete d.dataset.printed; } });
+"""
+
+
+def render(
+    summary: ClassSummary,
+    pairs: Iterable[Pair] | None = None,
+    *,
+    threshold: float = DEFAULT_THRESHOLD,
+    similarity_note: str | None = None,
+) -> str:
+    """The class report as one HTML document (a string), figures inline.
+
+    Parameters
+    ----------
+    summary : ClassSummary
+        From :func:`summarise`.
+    pairs : list of Pair, optional
+        Similar code to show side by side; None when the search was not made.
+    threshold : float
+        The similarity from which pairs were listed (said on the page).
+    similarity_note : str, optional
+        Why the pairs were not computed, when `pairs` is None.
+
+    Returns
+    -------
+    str
+    """
+    if not isinstance(summary, ClassSummary):
+        raise ValueError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
+    pairs = _check_pairs(pairs)
+    rubric = summary.rubric
+    seeds = ", ".join(str(s) for s in summary.seeds[:20]) or "not recorded"
+    sections = [
+        ("totals", "Totals"),
+        ("pass-rates", "Pass rates"),
+        ("slips", "Slips the checks named"),
+        ("problems", "Problems"),
+        ("most-failed", "The most failed parts"),
+        ("similar", "Similar code"),
+    ]
+    nav = "".join(f'<li><a href="#{anchor}">{title}</a></li>' for anchor, title in sections)
+    return (
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        f"<title>Class report: {_e(rubric.title, 200)}</title>\n<style>{STYLE}</style>\n"
+        f"<script>{SCRIPT}</script>\n</head>\n<body>\n"
+        '<a class="skip" href="#main">Skip to the report</a>\n'
+        f"<header><h1>Class report</h1><p>{_e(rubric.title, 200)}: {summary.submissions} submissions, "
+        f"{len(summary.totals)} graded, {len(summary.not_graded)} could not be graded. Random test data from "
+        f"seed {seeds}. Full credit is {points_text(rubric.full_credit)} points; with every extra credit "
+        f"{points_text(rubric.maximum)}.</p>\n"
+        f'<nav aria-label="Sections of the report"><ul>{nav}</ul></nav></header>\n'
+        '<main id="main" tabindex="-1">\n'
+        + "\n".join(
+            [
+                _totals_section(summary),
+                _rates_section(summary),
+                _slips_section(summary),
+                _problems_section(summary),
+                _most_failed_section(summary),
+                _similar_section(pairs, threshold, similarity_note),
+            ]
+        )
+        + "\n</main>\n<footer><p>Written by <code>labkit report</code> from the grading run's "
+        "<code>results/</code>; each student's feedback file has the details.</p></footer>\n</body>\n</html>\n"
+    )
+
+
+def _check_pairs(pairs):
+    if pairs is None:
+        return None
+    if isinstance(pairs, (str, bytes, dict)):
+        raise ValueError(
+            f"pairs must be a list of labkit.grading.similarity.Pair (or None); got {type(pairs).__name__}."
+        )
+    pairs = list(pairs)
+    for pair in pairs:
+        if not isinstance(pair, Pair):
+            raise ValueError(
+                f"pairs must be labkit.grading.similarity.Pair objects (similarity.similar_pairs gives them); "
+                f"got {type(pair).__name__}."
+            )
+        if not isinstance(pair.score, (int, float)) or not 0.0 <= float(pair.score) <= 1.0:
+            raise ValueError(f"a pair's score is a similarity from 0 to 1; got {pair.score!r} for {pair.function!r}.")
+    return pairs
+
+
+def write(
+    out_dir: str | Path,
+    grades: Iterable[SubmissionGrade],
+    pairs: Iterable[Pair] | None = None,
+    *,
+    threshold: float = DEFAULT_THRESHOLD,
+    similarity_note: str | None = None,
+) -> Path:
+    """Write ``report.html`` into a grading run's output folder; its path.
+
+    The folder's other files (grades.csv, feedback/, results/, ...) are neither read here nor touched:
+    the page is written to a temporary file in the folder, then renamed over an earlier report.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The run's ``--out`` folder (it must exist).
+    grades : list of SubmissionGrade
+        The class (:func:`read` reads them from `out_dir`).
+    pairs : list of Pair, optional
+        Similar code, shown side by side; None says "not computed".
+    threshold : float
+        The similarity from which `pairs` were listed, between 0 and 1.
+    similarity_note : str, optional
+        Why the pairs were not computed.
+
+    Returns
+    -------
+    Path
+        ``out_dir/report.html``.
+
+    Raises
+    ------
+    ValueError
+        For a folder that does not exist, a ``report.html`` that is not a file, no grades, a threshold
+        outside (0, 1], or pairs that are not :class:`~labkit.grading.similarity.Pair` objects.
+    """
+    out = Path(out_dir)
+    if not out.is_dir():
+        raise ValueError(f"{out} is not a folder: give the --out folder of a `labkit grade` run.")
+    if not isinstance(threshold, (int, float)) or not 0.0 < float(threshold) <= 1.0:
+        raise ValueError(f"the similarity threshold is a number above 0 and at most 1; got {threshold!r}.")
+    target = out / REPORT
+    if target.is_symlink() or (target.exists() and not target.is_file()):
+        raise ValueError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
+    page = render(summarise(grades), pairs, threshold=float(threshold), similarity_note=similarity_note)
+    handle = tempfile.NamedTemporaryFile(
+        "w", encoding="utf-8", dir=out, prefix=".report-", suffix=".html.tmp", delete=False
+    )
+    try:
+        with handle:
+            handle.write(page)
+        os.chmod(handle.name, 0o644)
+        os.replace(handle.name, target)
+    except BaseException:
+        Path(handle.name).unlink(missing_ok=True)
+        raise
+    return target

@@ -1,0 +1,594 @@
+"""The class report (`labkit report OUT`): what report.html says about a class, and what it never does.
+
+The class here is built from SubmissionGrade objects whose failed checks are made by the grader's own
+functions (labkit.exercises.result.call with the sandbox's exceptions, the registry's missing name, the
+scan's refusal, the run's problems), so the report's reading of them follows the grader's wording.
+The page in a real browser (no request leaves the machine, axe-core finds no serious violation) is
+tests/browser/test_class_report_browser.py.
+"""
+
+import hashlib
+import json
+import statistics
+import subprocess
+import sys
+import types
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from labkit.cli import main
+from labkit.exercises.registry import LAB, _missing
+from labkit.exercises.result import CheckResult, call
+from labkit.grading import class_report, remote, scoring, similarity
+from labkit.grading.report import SubmissionGrade, merge, write_report
+from labkit.grading.rubric import default, load
+from labkit.grading.similarity import Pair
+
+HOSTILE = "<script>alert(1)</script>"
+HTML_HINT = 'divide by <b>h</b><img src=x onerror="alert(2)"> & not by 2'
+ABSOLUTE = "absolute error instead of relative: divide by the maximum of |f|"
+DRIVER = "test_pherm_interpolate"
+
+
+# ------------------------------------------------------------------ checks as the grader records them
+
+
+def passed(part):
+    result = CheckResult(part)
+    result.step("the values at the lab's points", True)
+    return result.as_dict()
+
+
+def slip(part, hint):
+    return CheckResult(part).fail("the values at the lab's points", "off by 3.1e-01", hint).as_dict()
+
+
+def called(part, exception):
+    """The check of a part whose function raised `exception` when the grader called it."""
+
+    def student(*args):
+        raise exception
+
+    result = CheckResult(part)
+    call(result, f"{part}(...) runs", student)
+    return result.as_dict()
+
+
+def timed_out(part):
+    return called(part, remote.CellTimeout("interrupted: it ran longer than the time limit"))
+
+
+def raised(part):
+    trace = 'File "<cell>", line 4, in eval_pherm\n    d = 2 / (xk1 - xk)\n'
+    return called(part, remote.StudentError("ZeroDivisionError", "float division by zero", None, trace))
+
+
+def refused_call(part):
+    return called(part, remote.StudentError("Refused", "", "scipy.interpolate.CubicHermiteSpline"))
+
+
+def refused_scan(part):
+    return scoring._own_code(passed(part), [(part, 2, "labkit.piecewise.eval_pherm")])
+
+
+def crashed(part, why):
+    return called(part, remote.WorkerError(why))
+
+
+def ended(code, out_of_memory=False):
+    """The grader's words for a notebook process that ended (labkit.grading.remote.Notebook._ended)."""
+    fake = types.SimpleNamespace(
+        process=types.SimpleNamespace(poll=lambda: code), box=types.SimpleNamespace(out_of_memory=lambda: out_of_memory)
+    )
+    return remote.Notebook._ended(fake)
+
+
+def cells_raised(name, *errors, output_chars=0):
+    """The problems of a notebook whose cells raised (labkit.grading.scoring's wording)."""
+    ran = {
+        "errors": [{"cell": cell, "kind": kind, "message": message, "traceback": ""} for cell, kind, message in errors],
+        "output_chars": output_chars,
+    }
+    return scoring._run_problems(name, ran)
+
+
+def grade(name, checks=None, problems=(), failure=None, rubric=None):
+    """A submission: `checks` maps (exercise, part) to a check; the exercise's other parts pass."""
+    rubric = rubric or default()
+    results = {}
+    for number in sorted({n for n, _ in checks or {}}):
+        exercise = LAB.exercises[number]
+        parts = [
+            {**checks.get((number, part.name), passed(part.name)), "name": part.name, "weight": part.weight}
+            for part in exercise.parts
+        ]
+        points = sum(p["weight"] for p in parts if p["passed"])
+        results[number] = {
+            "exercise": number,
+            "passed": points == exercise.points,
+            "points": points,
+            "fraction": points / exercise.points,
+            "defined": True,
+            "checks": parts,
+        }
+    return SubmissionGrade(name, results, list(problems), 20261122, rubric, failure)
+
+
+def full(number):
+    return {(number, part.name): passed(part.name) for part in LAB.exercises[number].parts}
+
+
+@pytest.fixture
+def grades():
+    """Eight submissions: every kind of outcome once or more, one hostile name, one not graded."""
+    return [
+        grade("ann", {**full(2), **full(3), **full(4)}),
+        grade("ben", {**full(2), (3, DRIVER): slip(DRIVER, ABSOLUTE), **full(4)}),
+        grade("cleo", {(2, "eval_pherm"): raised("eval_pherm"), (3, DRIVER): slip(DRIVER, ABSOLUTE)}),
+        grade(
+            "dev",
+            {(2, "eval_pherm"): refused_call("eval_pherm"), (3, DRIVER): slip(DRIVER, ABSOLUTE)},
+            problems=cells_raised("02_convergence.ipynb", (2, "NameError", "name 'xk' is not defined")),
+        ),
+        grade(
+            "eve",
+            {
+                (2, "eval_pherm"): called("eval_pherm", NotImplementedError()),
+                (3, "runge"): _missing("runge").as_dict(),
+                (4, "limacon_derivatives"): timed_out("limacon_derivatives"),
+            },
+            problems=[
+                "01_limacon.ipynb: stopped after the submission's time limit of 600 s.",
+                *cells_raised("02_convergence.ipynb", (7, "Timeout", "interrupted: it ran longer than the time limit")),
+            ],
+        ),
+        grade(HOSTILE, {(2, "eval_pherm"): slip("eval_pherm", HTML_HINT)}),
+        grade("finn", failure="its grading ran out of memory (the grader's limit of 3072 MiB) and was stopped"),
+        grade(
+            "gus",
+            {(2, "eval_pherm"): refused_scan("eval_pherm"), (3, DRIVER): crashed(DRIVER, ended(-9))},
+            problems=[
+                f"03_meshes.ipynb: {ended(3)} while running its cells.",
+                *cells_raised("04_splines.ipynb", output_chars=250_000),
+            ],
+        ),
+    ]
+
+
+class Page(HTMLParser):
+    """What the report's HTML holds: every tag with its attributes, the text by section, the <pre> lines."""
+
+    def __init__(self, text):
+        super().__init__(convert_charrefs=True)
+        self.tags, self.text, self.marked, self.section = [], {}, [], None
+        self._in_mark = False
+        self.feed(text)
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        self.tags.append((tag, attrs))
+        if tag == "section":
+            self.section = attrs.get("aria-labelledby")
+        self._in_mark = self._in_mark or tag == "mark"
+
+    def handle_endtag(self, tag):
+        if tag == "mark":
+            self._in_mark = False
+
+    def handle_data(self, data):
+        self.text.setdefault(self.section, []).append(data)
+        if self._in_mark:
+            self.marked.append(data)
+
+    def words(self, section):
+        return " ".join(" ".join(self.text.get(section, [])).split())
+
+
+def page_of(grades, pairs=None, **options):
+    return class_report.render(class_report.summarise(grades), pairs, **options)
+
+
+# ------------------------------------------------------------------ reading the grader's words
+
+
+@pytest.mark.parametrize(
+    "check, outcome",
+    [
+        (passed("eval_pherm"), "passed"),
+        (slip("eval_pherm", ABSOLUTE), "slip"),
+        (called("eval_pherm", NotImplementedError()), "not done"),
+        (_missing("eval_pherm").as_dict(), "not done"),
+        (timed_out("eval_pherm"), "timeout"),
+        (raised("eval_pherm"), "raised"),
+        (called("eval_pherm", ValueError("shapes (4,) (5,)")), "raised"),
+        (refused_call("eval_pherm"), "refused"),
+        (refused_scan("eval_pherm"), "refused"),
+        (crashed("eval_pherm", ended(-9)), "crash"),
+        (crashed("eval_pherm", ended(1)), "crash"),
+        (crashed("eval_pherm", ended(None, out_of_memory=True)), "crash"),
+        (crashed("eval_pherm", ended(None)), "crash"),
+        (
+            scoring._failed_part(
+                {"weight": 10}, "eval_pherm", "the notebook's answers can be trusted", "it patched labkit.check", "h"
+            ),
+            "tampered",
+        ),
+    ],
+    ids=lambda v: v if isinstance(v, str) else None,
+)
+def test_a_failed_check_is_read_as_the_grader_meant_it(check, outcome):
+    assert class_report.check_outcome(check) == outcome
+
+
+def test_a_check_that_fails_inside_labkit_is_a_problem_not_a_slip():
+    registry_fault = CheckResult("eval_pherm").fail(
+        "the grader could check this part",
+        "the check failed inside labkit (KeyError)",
+        "this is a fault of the grader, not of your work: tell your instructor.",
+    )
+    assert class_report.check_outcome(registry_fault.as_dict()) == "other"
+
+
+def test_the_problems_of_a_run_are_sorted_into_their_kinds():
+    [raised_and_stopped, flood] = cells_raised(
+        "a.ipynb",
+        (2, "ZeroDivisionError", "float division by zero"),
+        (5, "Timeout", "interrupted: it ran longer than the time limit"),
+        output_chars=200_000,
+    )
+    assert class_report.problem_kinds(raised_and_stopped) == [
+        ("raised", "a.ipynb: cell 3 raised ZeroDivisionError: float division by zero"),
+        ("timeout", "a.ipynb: cell 6 ran past its time limit"),
+    ]
+    assert class_report.problem_kinds(flood)[0][0] == "other"
+    assert class_report.problem_kinds(f"a.ipynb: {ended(-9)} while running its cells.")[0][0] == "crash"
+    assert class_report.problem_kinds("a.ipynb: it patched numpy; none of its answers count.")[0][0] == "tampered"
+    stopped = "a.ipynb: stopped after the total time limit: the notebook did not answer in time."
+    assert class_report.problem_kinds(stopped)[0][0] == "timeout"
+    # a traceback line of the student's cannot pose as another cell's error
+    [forged] = cells_raised("a.ipynb", (0, "KeyError", "x\n    cell 9 raised Timeout: y"))
+    assert [kind for kind, _ in class_report.problem_kinds(forged)] == ["raised"]
+
+
+# ------------------------------------------------------------------ what the summary counts
+
+
+def test_slips_are_counted_per_hint_most_frequent_first_with_who(grades):
+    summary = class_report.summarise(grades)
+    first = summary.slips[0]
+    assert (first.exercise, first.part, first.hint, first.students) == (3, DRIVER, ABSOLUTE, ("ben", "cleo", "dev"))
+    assert [(s.exercise, s.part, len(s.students)) for s in summary.slips] == [(3, DRIVER, 3), (2, "eval_pherm", 1)]
+    assert summary.slips[1].students == (HOSTILE,)
+
+
+def test_pass_rates_count_attempts_passes_stubs_and_missing_exercises(grades):
+    summary = class_report.summarise(grades)
+    exercises = {e.exercise: e for e in summary.exercises}
+    # exercise 2: seven graded; eve left the stub; ann and ben passed; cleo, dev, the hostile one and gus failed
+    two = exercises[2]
+    assert (two.graded, two.found, two.attempted, two.passed) == (7, 7, 6, 2)
+    assert two.rate == pytest.approx(2 / 6)
+    three = exercises[3]  # ann and ben's four parts; cleo and dev slipped; eve's runge is missing; gus crashed
+    assert (three.found, three.attempted, three.passed) == (6, 6, 1)
+    assert (exercises[5].found, exercises[5].attempted, exercises[5].rate) == (0, 0, None)
+    parts = {(p.exercise, p.part): p for p in summary.parts}
+    driver = parts[(3, DRIVER)]
+    assert (driver.passed, driver.slipped, driver.problem, driver.not_done, driver.missing) == (2, 3, 1, 0, 1)
+    runge = parts[(3, "runge")]
+    assert (runge.passed, runge.not_done, runge.attempted) == (5, 1, 5)
+    assert [p.part for p in summary.parts if p.exercise == 14] == [part.name for part in LAB.exercises[14].parts]
+    assert sum(p.weight for p in summary.parts if p.exercise == 3) == pytest.approx(default().points[3])
+
+
+def test_problems_name_who_and_what_by_kind(grades):
+    problems = class_report.summarise(grades).problems
+    who = {kind: [row.student for row in rows] for kind, rows in problems.items()}
+    assert who == {
+        "timeout": ["eve"],
+        "crash": ["gus"],
+        "raised": ["cleo", "dev"],
+        "refused": ["dev", "gus"],
+        "not graded": ["finn"],
+        "other": ["gus"],
+    }
+    eve = problems["timeout"][0].texts
+    assert eve == (
+        "exercise 4, limacon_derivatives: limacon_derivatives(...) runs: "
+        "interrupted: it ran longer than the time limit",
+        "01_limacon.ipynb: stopped after the submission's time limit of 600 s.",
+        "02_convergence.ipynb: cell 8 ran past its time limit",
+    )
+    gus = {row.student: row.texts for row in problems["refused"]}["gus"]
+    assert "reaches for labkit.piecewise.eval_pherm" in gus[0]
+    assert any("killed by SIGKILL" in text for text in problems["crash"][0].texts)
+    assert any("exited with status 3" in text for text in problems["crash"][0].texts)
+    assert "250,000 characters" in problems["other"][0].texts[0]
+
+
+def test_the_most_failed_list_counts_failed_parts_and_keeps_stubs_apart(grades):
+    most = class_report.summarise(grades).most_failed
+    assert [(s.student, len(s.failed), s.not_done) for s in most] == [
+        ("cleo", 2, 0),  # two failed parts each, and 9 points each: by name
+        ("dev", 2, 0),
+        ("gus", 2, 0),
+        (HOSTILE, 1, 0),  # one failed part: the lowest total first
+        ("eve", 1, 2),
+        ("ben", 1, 0),
+    ]
+    assert most[2].failed == ("2 eval_pherm", f"3 {DRIVER}") and most[4].failed == ("4 limacon_derivatives",)
+    assert "ann" not in [s.student for s in most] and "finn" not in [s.student for s in most]
+
+
+# ------------------------------------------------------------------ the page
+
+
+def test_the_page_shows_the_slips_the_rates_the_problems_and_the_most_failed(grades):
+    html = page_of(grades)
+    page = Page(html)
+    slips = page.words("slips")
+    assert f"{ABSOLUTE}: 3 students" in slips and "ben, cleo, dev" in slips
+    rates = page.words("pass-rates")
+    assert "2 10 7 6 2 33% 29%" in rates  # exercise, points, found, attempted, passed, rate of attempted, of graded
+    assert f"{DRIVER} 6 2 3 1 0 1 33%" in rates  # points, passed, with a hint, problem, not done, not found, rate
+    problems = page.words("problems")
+    for heading in ("Time limits: 1 student", "Crashes: 1 student", "Errors raised: 2 students", "Could not be graded"):
+        assert heading in problems
+    assert "the grader's limit of 3072 MiB" in problems
+    assert page.words("most-failed").startswith("The most failed parts The 6 students")
+    assert "gus 2 0 9 2 eval_pherm, 3 test_pherm_interpolate" in page.words("most-failed")
+    assert "Not computed (no search here)" in page_of(grades, similarity_note="no search here")
+
+
+def test_names_hints_and_problems_are_escaped(grades):
+    html = page_of(grades)
+    assert HOSTILE not in html and "<img src=x" not in html and "<b>h</b>" not in html
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    assert "divide by &lt;b&gt;h&lt;/b&gt;&lt;img src=x onerror=&quot;alert(2)&quot;&gt; &amp; not by 2" in html
+    assert [tag for tag, _ in Page(html).tags].count("script") == 1  # the page's own, nothing of a student's
+    assert HOSTILE in Page(html).words("most-failed")  # the name is shown, as text
+
+
+def test_long_and_control_character_names_are_bounded_and_printable(grades):
+    grades[1].name = "x" * 10_000 + "\x1b[31m\u202e"
+    html = page_of(grades)
+    assert "x" * class_report.MAX_NAME not in html and "\x1b" not in html and "\u202e" not in html
+    assert "x" * (class_report.MAX_NAME - 1) + "\u2026" in html
+
+
+def test_every_figure_says_in_numbers_what_it_shows(grades):
+    page = Page(page_of(grades))
+    images = [attrs for tag, attrs in page.tags if tag == "img"]
+    assert len(images) == 3
+    for attrs in images:
+        assert attrs["src"].startswith("data:image/png;base64,") and attrs["alt"].strip()
+    totals = [g.total for g in grades if g.graded]
+    histogram, exercises, parts = (attrs["alt"] for attrs in images)
+    assert histogram.startswith(f"Histogram of 7 totals: median {statistics.median(totals):g}, ")
+    assert f"lowest {min(totals):g}, highest {max(totals):g}" in histogram
+    assert "exercise 2 33% of 6; exercise 3 17% of 6;" in exercises and "exercise 5 nobody attempted it" in exercises
+    assert f"exercise 3 {DRIVER} 33% of 6" in parts
+
+
+def test_the_page_asks_for_nothing_outside_itself(grades):
+    pairs = [Pair("eval_pherm", "ann", "ben", 0.9, ("a = 1",), ("a = 1",), frozenset({0}), frozenset({0}))]
+    html = page_of(grades, pairs)
+    page = Page(html)
+    for tag, attrs in page.tags:
+        for name in ("src", "href", "srcset", "data", "action", "poster"):
+            value = attrs.get(name)
+            if value is not None:
+                assert value.startswith(("#", "data:image/png;base64,")), (tag, name, value[:80])
+        assert tag not in ("link", "iframe", "object", "embed", "base", "form")
+    assert "http://" not in html and "https://" not in html and "url(" not in html and "@import" not in html
+    assert ("html", {"lang": "en"}) in page.tags
+
+
+def test_the_page_is_built_for_keyboards_screen_readers_and_print(grades):
+    page = Page(page_of(grades))
+    tags = page.tags
+    assert tags[0] == ("html", {"lang": "en"})
+    skip = next(attrs for tag, attrs in tags if tag == "a")
+    assert skip == {"class": "skip", "href": "#main"} and ("main", {"id": "main", "tabindex": "-1"}) in tags
+    headers = [attrs.get("scope") for tag, attrs in tags if tag == "th"]
+    assert headers and set(headers) <= {"col", "row"}
+    assert [tag for tag, _ in tags].count("h1") == 1
+    assert sum(tag == "details" for tag, _ in tags) >= 2
+    html = page_of(grades)
+    assert ":focus-visible" in html and "@media print" in html and "beforeprint" in html
+    assert all(attrs.get("tabindex", "-1") == "-1" for _, attrs in tags)  # nothing forced into the tab order
+
+
+def test_similar_code_is_shown_side_by_side_with_the_shared_lines_marked(grades):
+    first = ("def eval_pherm(x, y, yp, xv):", "    k = bracket(x, xv)", "    # mine < yours & theirs", "    return k")
+    second = ("def eval_pherm(x, y, yp, xv):", "    idx = bracket(x, xv)", "    # mine < yours & theirs")
+    pair = Pair("eval_pherm", "ann", HOSTILE, 0.91, first, second, frozenset({0, 2}), frozenset({0, 2}))
+    other = Pair("coons", "ben", "cleo", 0.85, ("a = 1",), ("a = 1",), frozenset({0}), frozenset({0}))
+    html = page_of(grades, [other, pair], threshold=0.8)
+    page = Page(html)
+    similar = page.words("similar")
+    assert "Similarity never changes a grade" in similar and "for a person to judge" in similar
+    assert similar.index("eval_pherm : ann and <script>alert(1)</script>, similarity 0.91") < similar.index(
+        "coons : ben and cleo, similarity 0.85"
+    )
+    assert "2 of 4 lines of the first and 2 of 3 of the second are shared" in similar
+    assert page.marked == [first[0], first[2], second[0], second[2], "a = 1", "a = 1"]
+    assert "&lt; yours &amp; theirs</mark>" in html and "k = bracket" in similar and "return k" in similar
+    assert sum(tag == "pre" for tag, _ in page.tags) == 4
+    assert "No pair of submissions is similar at the threshold 0.80" in page_of(grades, [])
+
+
+def test_similar_code_is_bounded(grades):
+    lines = tuple(f"line {i} " + "y" * 500 for i in range(1000))
+    pair = Pair("eval_pherm", "ann", "ben", 1.0, lines, lines, frozenset(range(1000)), frozenset({5, 2000, -1}))
+    html = page_of(grades, [pair] * (class_report.MAX_PAIRS + 3))
+    assert html.count('<article class="pair"') == class_report.MAX_PAIRS
+    assert "and 3 less similar pairs" in html and f"and {1000 - class_report.MAX_LINES} more lines" in html
+    assert "y" * (class_report.MAX_LINE + 1) not in html
+    assert "1000 of 1000 lines of the first and 1 of 1000 of the second" in html
+
+
+# ------------------------------------------------------------------ writing it, and bad input
+
+
+def snapshot(folder):
+    return {
+        p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def test_report_reads_a_real_results_folder_and_changes_nothing_else(grades, tmp_path, capsys, monkeypatch):
+    monkeypatch.delattr(similarity, "similar_pairs", raising=False)
+    write_report(tmp_path, grades)
+    (tmp_path / "seed.txt").write_text("20261122\n")
+    before = snapshot(tmp_path)
+    assert main(["report", str(tmp_path)]) == 0
+    assert "report.html: 8 submission(s)" in capsys.readouterr().out
+    after = snapshot(tmp_path)
+    assert {k: v for k, v in after.items() if k != "report.html"} == before and "report.html" in after
+    note = "this version of labkit has no similarity search"
+    assert (tmp_path / "report.html").read_text() == page_of(class_report.read(tmp_path), similarity_note=note)
+    assert main(["report", str(tmp_path), "--quiet"]) == 0 and capsys.readouterr().out == ""
+    assert sorted(snapshot(tmp_path)) == sorted(after)  # replaced, no temporary file left
+    read_back = class_report.summarise(class_report.read(tmp_path))
+    summary = class_report.summarise(grades)
+    assert read_back.slips == summary.slips and read_back.parts == summary.parts
+    assert read_back.totals == summary.totals and read_back.problems == summary.problems
+
+
+def test_report_reads_merged_runs(grades, tmp_path):
+    write_report(tmp_path / "job1", grades[:4])
+    write_report(tmp_path / "job2", grades[4:])
+    merge([tmp_path / "job1", tmp_path / "job2"], tmp_path / "merged")
+    assert main(["report", str(tmp_path / "merged"), "--quiet"]) == 0
+    html = (tmp_path / "merged" / "report.html").read_text()
+    assert "8 submissions, 7 graded, 1 could not be graded" in html
+    assert f"{ABSOLUTE}: <strong>3 students</strong>" in html
+
+
+def test_the_cli_uses_the_similarity_search_when_labkit_has_one(grades, tmp_path, monkeypatch):
+    write_report(tmp_path, grades)
+    asked = []
+
+    def search(found, threshold):
+        asked.append(([g.name for g in found], threshold))
+        return [Pair("coons", "ann", "ben", 0.97, ("x = 1",), ("x = 1",), frozenset({0}), frozenset({0}))]
+
+    monkeypatch.setattr(similarity, "similar_pairs", search, raising=False)
+    assert main(["report", str(tmp_path), "--similarity-threshold", "0.6", "--quiet"]) == 0
+    assert asked == [(sorted(g.name for g in grades), 0.6)]
+    assert "coons</code>: ann and ben, similarity 0.97" in (tmp_path / "report.html").read_text()
+    monkeypatch.delattr(similarity, "similar_pairs")
+    assert main(["report", str(tmp_path), "--quiet"]) == 0
+    assert "Not computed (this version of labkit has no similarity search)" in (tmp_path / "report.html").read_text()
+
+
+@pytest.mark.parametrize("threshold", ["0", "-0.5", "1.5", "nan"])
+def test_the_cli_refuses_a_threshold_outside_0_to_1(grades, tmp_path, capsys, threshold):
+    write_report(tmp_path, grades)
+    assert main(["report", str(tmp_path), "--similarity-threshold", threshold]) == 2
+    assert "--similarity-threshold is a similarity above 0 and at most 1" in capsys.readouterr().err
+    assert not (tmp_path / "report.html").exists()
+
+
+def test_the_cli_refuses_a_missing_or_empty_folder(tmp_path, capsys):
+    assert main(["report", str(tmp_path / "nowhere")]) == 2
+    assert "nowhere is not a folder: give the --out folder of a `labkit grade` run" in capsys.readouterr().err
+    assert main(["report", str(tmp_path)]) == 2
+    assert "holds no results/*.json" in capsys.readouterr().err
+    assert not (tmp_path / "report.html").exists() and not (tmp_path / "nowhere").exists()
+
+
+def _cli(*args):
+    return subprocess.run(
+        [sys.executable, "-m", "labkit.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=Path(__file__).parent,
+    )
+
+
+def test_results_of_another_labkit_version_or_course_are_refused_without_a_traceback(grades, tmp_path):
+    write_report(tmp_path, grades)
+    path = sorted((tmp_path / "results").glob("*.json"))[0]
+    original = path.read_bytes()
+    data = json.loads(original)
+    before = snapshot(tmp_path)
+    path.write_text(json.dumps({**data, "format": "labkit-grade/1"}))
+    run = _cli("report", str(tmp_path))
+    assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
+    assert "is not a labkit grade result (format is 'labkit-grade/1'" in run.stderr
+    path.write_text(json.dumps({**data, "results": {**data["results"], "17": {"fraction": 1.0, "checks": []}}}))
+    run = _cli("report", str(tmp_path))
+    assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
+    assert "grades exercises [2, 3, 4, 17]" in run.stderr and "written by another version of labkit" in run.stderr
+    path.write_bytes(original)
+    assert snapshot(tmp_path) == before and not (tmp_path / "report.html").exists()
+
+
+def test_results_of_another_rubric_need_that_rubric(grades, tmp_path, capsys):
+    text = 'title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n'
+    (tmp_path / "bilinear.toml").write_text(text)
+    rubric = load(tmp_path / "bilinear.toml")
+    out = tmp_path / "out"
+    write_report(
+        out, [grade(g.name, {**full(16), (16, "runge2d"): slip("runge2d", "h")}, rubric=rubric) for g in grades[:3]]
+    )
+    assert main(["report", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "was scored under the rubric 'bilinear only'" in err and "--rubric FILE" in err
+    assert main(["report", str(out), "--rubric", str(tmp_path / "bilinear.toml"), "--quiet"]) == 0
+    html = (out / "report.html").read_text()
+    assert "Class report: bilinear only" in html and "Full credit is 20 points" in html
+
+
+def test_bad_input_to_the_module_says_what_to_fix(grades, tmp_path):
+    with pytest.raises(ValueError, match="no submissions to report on"):
+        class_report.summarise([])
+    with pytest.raises(ValueError, match="SubmissionGrade objects"):
+        class_report.summarise([{"name": "ann"}])
+    with pytest.raises(ValueError, match="Pair objects"):
+        class_report.write(tmp_path, grades, [("ann", "ben", 0.9)])
+    bad = Pair("f", "a", "b", 1.5, (), (), frozenset(), frozenset())
+    with pytest.raises(ValueError, match="from 0 to 1"):
+        class_report.write(tmp_path, grades, [bad])
+    with pytest.raises(ValueError, match="threshold"):
+        class_report.write(tmp_path, grades, None, threshold=0)
+    with pytest.raises(ValueError, match="is not a folder"):
+        class_report.write(tmp_path / "nowhere", grades)
+    (tmp_path / "report.html").mkdir()
+    (tmp_path / "report.html" / "keep.txt").write_text("mine")
+    with pytest.raises(ValueError, match="is not a plain file: move it away"):
+        class_report.write(tmp_path, grades)
+    assert (tmp_path / "report.html" / "keep.txt").read_text() == "mine"
+    broken = grade("zed", full(2))
+    broken.results[2]["checks"] = "none"
+    with pytest.raises(ValueError, match="'zed' for exercise 2 has no list of checks"):
+        class_report.summarise([broken])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.html"]  # no temporary file left
+
+
+def test_result_files_that_are_not_plain_files_or_too_large_are_refused(grades, tmp_path, monkeypatch):
+    write_report(tmp_path, grades)
+    fifo = tmp_path / "results" / "zz.json"
+    import os
+
+    os.mkfifo(fifo)  # reading it would wait forever
+    with pytest.raises(ValueError, match="zz.json is not a regular file"):
+        class_report.read(tmp_path)
+    fifo.unlink()
+    monkeypatch.setattr(class_report, "MAX_RESULT_BYTES", 100)
+    with pytest.raises(ValueError, match="larger than the 100 bytes a result can have"):
+        class_report.read(tmp_path)
+
+
+def test_the_cli_help_names_the_options_and_their_defaults(capsys):
+    with pytest.raises(SystemExit) as exit:
+        main(["report", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert exit.value.code == 0 and "usage: labkit report" in text
+    assert f"(default {similarity.DEFAULT_THRESHOLD})" in text and "--rubric" in text and "--quiet" in text
