@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-GRADE_EXTRA = ("nbformat", "nbclient")
+GRADE_EXTRA = ("nbformat", "nbclient", "rich")
 
 
 def _notebooks(args):
@@ -70,11 +70,67 @@ def _summary(grades, out, start, what):
     from .grading.rubric import points_text
 
     for g in grades:
-        print(f"{one_line(g.name, 30):<30} {points_text(g.total) if g.graded else 'not graded':>10}")
+        lateness = g.lateness
+        late = f"  ({points_text(lateness.penalty)} off for late work)" if lateness and lateness.penalty else ""
+        print(f"{one_line(g.name, 30):<30} {points_text(g.total) if g.graded else 'not graded':>10}{late}")
     print(
         f"{what} {len(grades)} submission(s) in {time.perf_counter() - start:.1f} s; "
         f"wrote {out / 'grades.csv'}, {out / 'feedback'}/ and {out / 'results'}/"
     )
+
+
+def _replaced(replaced):
+    """Say which results a later folder's replaced in a merge."""
+    from .grading.report import one_line
+
+    if not replaced:
+        return
+    print(f"{len(replaced)} result(s) replaced by a later folder's (the later one counts; see merge.json):")
+    for r in replaced:
+        kept = "; its submission time kept from the earlier result" if r.time_kept else ""
+        print(f"  {one_line(r.name, 60)}: {one_line(r.earlier, 200)} -> {one_line(r.later, 200)}{kept}")
+
+
+def _times_notes(grades, rubric, times):
+    """Tell the instructor about the submission times: times that cost nothing or match no submission, and
+    each submission a deadline applies to whose time is unknown. The number of times that could not be read."""
+    from .grading.late import unknown_times
+    from .grading.report import one_line
+
+    def names(found):
+        shown = ", ".join(repr(one_line(name, 40)) for name in sorted(found)[:5])
+        return shown + (f" and {len(found) - 5} more" if len(found) > 5 else "")
+
+    graded = {g.name for g in grades}
+    if times and rubric.late is None:
+        print(
+            "labkit grade: the rubric has no [late] table, so the times cost nothing; they are saved with the "
+            "results for a --merge with a rubric that has one.",
+            file=sys.stderr,
+        )
+    stray = set(times or ()) - graded
+    if stray:
+        print(f"labkit grade: the times file names submission(s) not in this run: {names(stray)}.", file=sys.stderr)
+    extended = {name for name, _ in rubric.late.extensions} - graded if rubric.late else set()
+    if extended:
+        print(
+            f"labkit grade: the rubric's [late.extensions] name submission(s) not in this run: {names(extended)}.",
+            file=sys.stderr,
+        )
+    unknown = unknown_times(grades)
+    for name, note, error in unknown:
+        print(
+            f"{'time unreadable' if error else 'no time'} for {one_line(name, 80)}: {one_line(note, 300)}",
+            file=sys.stderr,
+        )
+    if unknown:
+        print(
+            f"labkit grade: {len(unknown)} submission(s) have no known time, so no late penalty; give their times "
+            "in --times TIMES.csv (submission,time) and merge again (labkit grade --merge DIR --times TIMES.csv "
+            "--out NEW).",
+            file=sys.stderr,
+        )
+    return sum(error for *_, error in unknown)
 
 
 def grade_options(args):
@@ -99,23 +155,44 @@ def grade_options(args):
 def _grade(args):
     from .grading import grade, merge
     from .grading.batch import report_failures
+    from .grading.late import read_times
     from .grading.rubric import load
 
     start = time.perf_counter()
     rubric = load(args.rubric)
+    times = read_times(args.times) if args.times else None
     if args.merge:
         if args.submissions:
             raise ValueError("--merge takes output folders of earlier runs, not submissions; give one or the other.")
-        grades = merge(args.merge, args.out, rubric)
+        if args.times_from_mtime:
+            raise ValueError(
+                "--times-from-mtime reads the submissions' files, which --merge does not have: give the times in "
+                "--times TIMES.csv (the results keep the times they were graded with)."
+            )
+        grades = merge(args.merge, args.out, rubric, times=times, progress=not args.quiet)
         _summary(grades, args.out, start, "merged")
-        return 1 if report_failures(grades) else 0
+        _replaced(grades.replaced)
+        unreadable = _times_notes(grades, rubric, times)
+        return 1 if report_failures(grades) or unreadable else 0
     if not args.submissions:
         raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
     options = grade_options(args)
-    grades = grade(args.submissions, args.out, jobs=args.jobs, progress=not args.quiet, rubric=rubric, options=options)
+    grades = grade(
+        args.submissions,
+        args.out,
+        jobs=args.jobs,
+        progress=not args.quiet,
+        rubric=rubric,
+        options=options,
+        times=times,
+        times_from_mtime=args.times_from_mtime,
+    )
     _summary(grades, args.out, start, "graded")
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} (repeat the run with --seed)")
+    unreadable = _times_notes(grades, rubric, times)
     failed = report_failures(grades)
+    if unreadable and not failed:
+        return 1
     if failed:
         print(
             f"labkit grade: {failed} submission(s) could not be graded (see above and their feedback); "
@@ -245,7 +322,8 @@ def build_parser():
         nargs="+",
         type=Path,
         metavar="DIR",
-        help="combine the results/ of these earlier --out folders into one grades.csv",
+        help="combine the results/ of these earlier --out folders into one grades.csv; a later folder's result "
+        "replaces an earlier one's for the same submission (a regrade goes last)",
     )
     grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
     grd.add_argument(
@@ -303,8 +381,21 @@ def build_parser():
         "--rubric",
         type=Path,
         default=DEFAULTS.rubric,
-        help="TOML rubric: points, required exercises, branches, extra credit "
+        help="TOML rubric: points, required exercises, branches, extra credit, a deadline ([late]) "
         "(default: the lab's; `labkit rubric` prints it)",
+    )
+    grd.add_argument(
+        "--times",
+        type=Path,
+        metavar="TIMES.csv",
+        help="submission times for the rubric's [late] table: a CSV with the columns submission and time "
+        "(ISO 8601 with a UTC offset); a time listed there comes before nbgrader's timestamp.txt",
+    )
+    grd.add_argument(
+        "--times-from-mtime",
+        action="store_true",
+        help="a submission with no other time gets its notebooks' newest modification time (never without "
+        "this option: copying or unpacking a file changes it)",
     )
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)
@@ -410,6 +501,9 @@ def _rubric(args):
         rubric = load(args.check)
         print(rubric.describe())
         print("  points: " + ", ".join(f"exercise {n} {points_text(p)}" for n, p in rubric.points.items()))
+        if rubric.late is not None and rubric.late.extensions:
+            print(f"  extensions: {len(rubric.late.extensions)} student(s) have a deadline of their own")
+        print(f"  digest: {rubric.digest} (results of runs with the same digest can be merged)")
     else:
         print(DEFAULT.read_text(encoding="utf-8"), end="")
     return 0

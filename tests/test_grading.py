@@ -473,10 +473,14 @@ def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
     assert (tmp / "merged" / "seed.txt").read_text() == "4242\n"
 
 
-def test_merge_refuses_a_submission_graded_twice_and_folders_without_results(two_runs, tmp_path):
+def test_merge_keeps_a_later_folders_result_and_refuses_folders_without_results(two_runs, tmp_path):
     tmp, *_ = two_runs
-    with pytest.raises(ValueError, match="graded twice"):
-        grading.merge([tmp / "job1", tmp / "job3"], tmp_path / "m")
+    merged = grading.merge([tmp / "job1", tmp / "job3"], tmp_path / "m0")
+    result = f"{grading.report.safe_name('alice')}.json"
+    assert [g.name for g in merged] == ["alice"]
+    assert [(r.name, r.earlier, r.later) for r in merged.replaced] == [
+        ("alice", tmp / "job1" / "results" / result, tmp / "job3" / "results" / result)
+    ]
     with pytest.raises(ValueError, match="holds no results"):
         grading.merge([tmp_path], tmp_path / "m")
     (tmp_path / "results").mkdir()

@@ -15,6 +15,8 @@ One module per concern:
 * :mod:`~labkit.grading.scan` - reading a notebook's source for refused references;
 * :mod:`~labkit.grading.scoring` - grading one notebook and one submission (one process per submission);
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
+* :mod:`~labkit.grading.late` - the rubric's deadline, submission times, the late penalty;
+* :mod:`~labkit.grading.progress` - a progress bar with an ETA, on a terminal only;
 * :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own;
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
 * :mod:`~labkit.grading.class_report` - ``report.html``: the class at a glance (``labkit report OUT``);
@@ -48,9 +50,11 @@ _MODULES = {
     "cgroup",
     "class_report",
     "guard",
+    "late",
     "lms",
     "nbgrader",
     "options",
+    "progress",
     "protocol",
     "refusals",
     "release",

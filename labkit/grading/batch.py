@@ -17,6 +17,11 @@ says so, rather than grading students into zeros. The output folder
 (:mod:`labkit.grading.report`) always gets a ``grades.csv`` with every
 submission once, and ``run.json`` says how the run went (its seed, how many
 could not be graded, its time, the grader's peak memory for one submission).
+
+Each submission's time (for a rubric's ``[late]`` table) is read here, on the
+grader's side (:func:`labkit.grading.late.submission_time`), and saved with
+its result, so that ``--merge`` can apply a late rule later. A progress bar
+with an ETA is drawn on a terminal (:mod:`labkit.grading.progress`).
 """
 
 import json
@@ -33,24 +38,18 @@ from pathlib import Path
 
 from . import backends, cgroup, refusals
 from .backends.base import SandboxUnavailable
+from .late import submission_time
 from .options import GradeOptions
+from .progress import Progress
 from .report import SubmissionGrade, one_line, safe_name, write_report
 from .rubric import Rubric
 from .rubric import default as default_rubric
 from .rubric import load as load_rubric
-from .scoring import submission_name
+from .scoring import submission_name, submission_notebooks
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
 MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file
-
-
-def _progress(done, total, width=30):
-    filled = int(width * done / total)
-    sys.stderr.write(f"\rgrading [{'#' * filled}{'.' * (width - filled)}] {done}/{total}")
-    if done == total:
-        sys.stderr.write("\n")
-    sys.stderr.flush()
 
 
 def _low_space(out):
@@ -195,6 +194,8 @@ def grade(
     limits=None,
     rubric=None,
     options=None,
+    times=None,
+    times_from_mtime=False,
 ):
     """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
 
@@ -205,9 +206,14 @@ def grade(
     backend is the sandbox (``sandboxed=False``, the old switch, means
     ``backend="none"``: student code runs unconfined, after a warning on
     stderr). `rubric` (a :class:`Rubric`, or a TOML file; else the options'
-    rubric, else the lab's) turns the checks' results into grades. Returns
-    the grades in the order given; those with ``graded`` False could not be
-    graded (their ``failure`` says why).
+    rubric, else the lab's) turns the checks' results into grades. Each
+    submission's time comes from `times` ({name: datetime}, the instructor's
+    ``--times`` file), else from nbgrader's ``timestamp.txt`` in its folder,
+    else, only with `times_from_mtime`, from its notebooks' modification
+    time (:func:`labkit.grading.late.submission_time`). `progress` draws a
+    bar with an ETA on a terminal. Returns the grades in the order given;
+    those with ``graded`` False could not be graded (their ``failure`` says
+    why).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:
@@ -243,6 +249,11 @@ def grade(
             'name the course\'s exercises in its rubric (exercises = "module:attribute") and leave the option out.'
         )
     options = replace(options, exercises=rubric.registry.source)  # the workers load the rubric's exercises
+    # read before any student code runs, as collected
+    handed_in = [
+        submission_time(path, name, times, _notebooks(path) if times_from_mtime else None, times_from_mtime)
+        for path, name in zip(submissions, names)
+    ]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
@@ -251,12 +262,15 @@ def grade(
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
-        grades = _schedule(
-            submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out, progress, peaks
-        )
+        with Progress(len(submissions), "grading", enabled=progress) as bar:
+            grades = _schedule(
+                submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out, bar, peaks
+            )
     finally:
         shutil.rmtree(work, ignore_errors=True)
     ordered = [grades[p] for p in submissions]
+    for grade, time_handed_in in zip(ordered, handed_in):
+        grade.time = time_handed_in
     write_report(out, ordered)
     (out / "run.json").write_text(
         json.dumps(
@@ -275,7 +289,15 @@ def grade(
     return ordered
 
 
-def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, out, progress, peaks):
+def _notebooks(path):
+    """The submission's notebooks, or none when it has none to offer."""
+    try:
+        return submission_notebooks(path)
+    except ValueError:
+        return []
+
+
+def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, out, bar, peaks):
     """Run the grading processes, `jobs` at a time; {path: SubmissionGrade} for every submission."""
     pending = [_Job(path, name, work, options, profiles_file) for path, name in zip(submissions, names)]
     pending.reverse()
@@ -290,6 +312,7 @@ def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, ou
         if stopped is not None and not running:
             for job in pending:
                 grades[job.path] = SubmissionGrade(job.name, seed=options.seed, rubric=rubric, failure=stopped)
+                bar.advance()
             pending = []
             break
         time.sleep(0.05)
@@ -311,8 +334,7 @@ def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, ou
             grades[job.path] = result or SubmissionGrade(
                 job.name, seed=options.seed, rubric=rubric, failure=f"{why} (tried {job.attempt} times)"
             )
-            if progress:
-                _progress(len(grades), len(submissions))
+            bar.advance()
     return grades
 
 

@@ -3,10 +3,12 @@
 Layout of an output folder::
 
     grades.csv               one row per submission: points per exercise, the branch that
-                             counted, the extra credit, the total (under the rubric)
+                             counted, the extra credit, the total (under the rubric); with a
+                             [late] table also the raw total, the time, the lateness and penalty
     feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
     results/<name>.json      the same grade as data: merged by ``labkit grade --merge``
     seed.txt                 the seed of the run's random test data
+    merge.json               (--merge only) the folders merged and the results a later one replaced
 
 Every file here is written by the grader from its own results; nothing in
 it comes from a student's process but plain numbers and short texts, and
@@ -18,6 +20,7 @@ neutralised (:func:`csv_cell`).
 """
 
 import csv
+import functools
 import hashlib
 import json
 import re
@@ -25,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import rubric as rubrics
+from .late import FROM_CSV, SubmissionTime, time_text
 from .rubric import points_text
 
 FORMAT = "labkit-grade/2"
@@ -41,6 +45,7 @@ class SubmissionGrade:
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
     failure: str = None  # why the submission could not be graded at all (then it has no points, not zero)
     answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
+    time: SubmissionTime = None  # when it was handed in (labkit.grading.late), None when no source had a time
 
     @property
     def graded(self):
@@ -60,8 +65,23 @@ class SubmissionGrade:
         return self.score.points
 
     @property
-    def total(self):
+    def lateness(self):
+        """What the rubric's late rule makes of this submission (:class:`labkit.grading.late.Lateness`), or None
+        when the rubric has no ``[late]`` table or the submission could not be graded."""
+        if self.rubric.late is None or not self.graded:
+            return None
+        return self.rubric.late.assess(self.name, self.time, self.score.total)
+
+    @property
+    def raw_total(self):
+        """The points under the rubric before any late penalty."""
         return self.score.total
+
+    @property
+    def total(self):
+        """The points under the rubric, less the late penalty when the rubric has a ``[late]`` table."""
+        lateness = self.lateness
+        return self.score.total if lateness is None else lateness.total
 
     def feedback(self):
         if not self.graded:
@@ -70,10 +90,12 @@ class SubmissionGrade:
                 f"{one_line(self.failure, 500)}\n"
                 "Your instructor has been told; nothing of this submission was scored.\n"
             )
-        score, rubric = self.score, self.rubric
+        score, rubric, lateness = self.score, self.rubric, self.lateness
         extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
+        if lateness is not None and lateness.penalty:
+            extra += f", {points_text(lateness.penalty)} off for late work"
         lines = [
-            f"Feedback for {one_line(self.name)}: {points_text(score.total)} points "
+            f"Feedback for {one_line(self.name)}: {points_text(self.total)} points "
             f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})",
             "",
         ]
@@ -148,13 +170,28 @@ class SubmissionGrade:
             )
         for what, value in score.extra.items():
             lines.append(f"Extra credit, {what}: {points_text(value)}")
+        lateness = self.lateness
+        if lateness is not None:
+            lines += rubric.late.feedback(lateness)
+            if lateness.penalty:
+                lines.append(
+                    f"Total: {points_text(lateness.total)} ({points_text(score.total)} less "
+                    f"{points_text(lateness.penalty)} for late work; full credit is {points_text(score.full_credit)})"
+                )
+                return "\n".join(lines)
         lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
         return "\n".join(lines)
 
     def as_dict(self):
         score = self.score
+        late = {}
+        if self.lateness is not None:
+            late = {"raw total": score.total, "late": self.lateness.note, "penalty": self.lateness.penalty}
         return {
             "format": FORMAT,
+            "labkit": labkit_version(),
+            "rubric digest": self.rubric.digest,
+            "submitted": None if self.time is None else self.time.as_dict(),
             "name": self.name,
             "seed": self.seed,
             "problems": list(self.problems),
@@ -165,7 +202,8 @@ class SubmissionGrade:
             "points": {str(n): v for n, v in score.points.items()},
             "branch": score.branch,
             "extra_credit": score.extra,
-            "total": score.total,
+            **late,
+            "total": self.total,
         }
 
     @classmethod
@@ -188,8 +226,16 @@ class SubmissionGrade:
             )
             if grade.failure is not None:
                 grade.failure = str(grade.failure)
+            grade.time = SubmissionTime.from_dict(data.get("submitted"))
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
+        if data.get("labkit") != labkit_version():
+            written = f"labkit {one_line(data['labkit'], 40)}" if data.get("labkit") else "a labkit that did not say"
+            raise ValueError(
+                f"{source} was written by {written}, and this is labkit {labkit_version()}: results of another "
+                "version are not mixed in (its checks may grade differently); grade those submissions again "
+                "with this version."
+            )
         known = grade.rubric.registry.exercises
         if not set(grade.results) <= set(known):
             raise ValueError(
@@ -241,6 +287,34 @@ def csv_cell(value):
 
 
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
+# with a [late] table, between "extra credit" and "total" (which is then the total after the penalty)
+CSV_LATE = ["raw total", "submitted", "deadline", "hours late", "lateness", "penalty"]
+
+
+@functools.cache
+def labkit_version():
+    """The installed labkit's version, recorded in every result file ("0+unknown" in a tree never installed)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("labkit")
+    except PackageNotFoundError:
+        return "0+unknown"
+
+
+def _late_cells(grade, lateness):
+    """The cells of CSV_LATE for one graded submission."""
+    zone = grade.rubric.late.deadline.tzinfo
+    when = lateness.time.when if lateness.known else None
+    hours = max(lateness.late_by.total_seconds() / 3600, 0.0) if lateness.known else None
+    return [
+        points_text(lateness.raw_total),
+        "" if when is None else time_text(when, zone),
+        time_text(lateness.deadline, zone),
+        "" if hours is None else f"{hours:.2f}",
+        csv_cell(lateness.note),
+        points_text(lateness.penalty),
+    ]
 
 
 def read_columns(graded, registry):
@@ -256,29 +330,26 @@ def write_csv(path, grades):
         writer = csv.writer(handle)
         graded = grades[0].rubric.graded if grades else []
         to_read = read_columns(graded, grades[0].rubric.registry if grades else None) if grades else []
-        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + CSV_TAIL + to_read)
+        late = bool(grades) and grades[0].rubric.late is not None
+        tail = CSV_TAIL[:4] + CSV_LATE + CSV_TAIL[4:] if late else CSV_TAIL
+        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + tail + to_read)
         for g in grades:
             if not g.graded:
                 writer.writerow(
                     [csv_cell(g.name)]
-                    + [""] * (len(graded) + len(CSV_TAIL) - 1)
+                    + [""] * (len(graded) + len(tail) - 1)
                     + [csv_cell(f"not graded: {g.failure}")]
                     + [""] * len(to_read)
                 )
                 continue
             s = g.score
+            lateness = g.lateness
             writer.writerow(
                 [csv_cell(g.name)]
                 + [points_text(s.points[n]) for n in graded]
-                + [
-                    points_text(s.required),
-                    csv_cell(s.branch),
-                    points_text(s.counted),
-                    points_text(s.extra_total),
-                    points_text(s.total),
-                    points_text(s.full_credit),
-                    "graded",
-                ]
+                + [points_text(s.required), csv_cell(s.branch), points_text(s.counted), points_text(s.extra_total)]
+                + (_late_cells(g, lateness) if lateness is not None else [])
+                + [points_text(g.total), points_text(s.full_credit), "graded"]
                 + [""] * len(to_read)
             )
 
@@ -303,32 +374,135 @@ def write_report(out_dir, grades):
     write_csv(out / "grades.csv", grades)
 
 
-def read_results(folders, rubric=None):
-    """Every results/*.json of the given output folders, in name order; ValueError on a clash."""
-    grades = {}
+@dataclass(frozen=True)
+class Replaced:
+    """A submission's result that a later folder's result replaced in a merge.
+
+    Attributes
+    ----------
+    name : str
+        The submission.
+    earlier, later : pathlib.Path
+        The result file replaced, and the one that counts.
+    time_kept : bool
+        Whether the later result had no submission time and kept the earlier one's.
+    """
+
+    name: str
+    earlier: Path
+    later: Path
+    time_kept: bool = False
+
+
+class Merged(list):
+    """The grades of a merge, in name order, with the results that were replaced (:attr:`replaced`)."""
+
+    def __init__(self, grades, replaced=()):
+        super().__init__(grades)
+        self.replaced = tuple(replaced)
+
+
+def read_results(folders, rubric=None, replaced=None):
+    """Every results/*.json of the given output folders, in name order, scored with `rubric` (the lab's when None).
+
+    A submission with a result in several folders counts from the last of them, in the order given (a
+    regrade replaces the class's result); a later result without a submission time keeps the earlier one's.
+    Each replacement is appended to `replaced` (a list) when it is given. ValueError when a folder has no
+    results, is given twice, holds one submission twice, or when the results come from another labkit version
+    or from different rubrics (exercises, groups or points: the ``[late]`` table may differ)."""
+    grades, files, first, given = {}, {}, None, set()
     for folder in map(Path, folders):
-        files = sorted((folder / "results").glob("*.json"))
-        if not files:
+        if folder.resolve() in given:
+            raise ValueError(f"{folder} is given twice; give each folder once.")
+        given.add(folder.resolve())
+        files_here = sorted((folder / "results").glob("*.json"))
+        if not files_here:
             raise ValueError(
                 f"{folder} holds no results/*.json: give the --out folders of earlier `labkit grade` runs."
             )
-        for path in files:
+        here = {}
+        for path in files_here:
             try:
                 data = json.loads(path.read_text(encoding="utf-8"))
             except (UnicodeDecodeError, ValueError) as exc:
                 raise ValueError(f"{path} is not JSON ({exc}).") from None
             grade = SubmissionGrade.from_dict(data, str(path), rubric)
-            if grade.name in grades:
-                raise ValueError(f"submission {grade.name!r} is graded twice ({path}); keep one of the two results.")
-            grades[grade.name] = grade
+            digest, title = data.get("rubric digest"), one_line(data.get("rubric"), 80)
+            if first is None:
+                first = (digest, title, path)
+            elif digest != first[0]:
+                raise ValueError(
+                    f"{path} was graded under the rubric {title!r} ({digest}) and {first[2]} under {first[1]!r} "
+                    f"({first[0]}): results of different rubrics (their exercises, groups or points) are not "
+                    "merged. Grade again with the --rubric of the class's run; the [late] table may differ, as "
+                    "--merge applies the one it is given."
+                )
+            if grade.name in here:
+                raise ValueError(
+                    f"submission {one_line(grade.name, 80)!r} is graded twice in {folder} ({here[grade.name]} and "
+                    f"{path}); keep one of the two results."
+                )
+            here[grade.name] = path
+            earlier = grades.get(grade.name)
+            if earlier is not None:
+                kept = grade.time is None and earlier.time is not None
+                if kept:
+                    grade.time = earlier.time
+                if replaced is not None:
+                    replaced.append(Replaced(grade.name, files[grade.name], path, kept))
+            grades[grade.name], files[grade.name] = grade, path
     return [grades[name] for name in sorted(grades)]
 
 
-def merge(folders, out_dir, rubric=None):
-    """Combine the results of several grading runs (e.g. one per batch job) into one grades.csv,
-    scored with `rubric` (the lab's when None)."""
-    grades = read_results(folders, rubric)
-    write_report(out_dir, grades)
+def merge(folders, out_dir, rubric=None, times=None, progress=False):
+    """Combine the results of several grading runs (e.g. one per batch job, or a class's run and a regrade)
+    into one output folder, scored with `rubric` (the lab's when None).
+
+    Parameters
+    ----------
+    folders : list of path-like
+        The ``--out`` folders of earlier runs. A submission in several of them counts from the last one
+        (:func:`read_results`).
+    out_dir : path-like
+        The merged output folder (not one of `folders`).
+    rubric : Rubric, optional
+        Scores every result, and its ``[late]`` table applies to the submission times they carry.
+    times : dict, optional
+        {submission name: datetime} (:func:`labkit.grading.late.read_times`): these times replace the
+        stored ones of the submissions they name.
+    progress : bool
+        Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).
+
+    Returns
+    -------
+    Merged
+        The grades in name order; its ``replaced`` lists the results a later folder replaced, which
+        ``merge.json`` in `out_dir` records as well.
+    """
+    from .progress import Progress
+
+    out = Path(out_dir)
+    if out.resolve() in {Path(folder).resolve() for folder in folders}:
+        raise ValueError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
+    replaced = []
+    grades = read_results(folders, rubric, replaced)
+    for grade in grades:
+        if times and grade.name in times:
+            grade.time = SubmissionTime(times[grade.name], FROM_CSV)
+    out.mkdir(parents=True, exist_ok=True)
+    with Progress(len(grades), "merging", enabled=progress) as bar:
+        for grade in grades:
+            write_result(out, grade)
+            bar.advance()
+    write_csv(out / "grades.csv", grades)
     seeds = sorted({g.seed for g in grades if g.seed is not None})
-    (Path(out_dir) / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")
-    return grades
+    (out / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")
+    record = {
+        "folders": [str(folder) for folder in folders],
+        "replaced": [
+            {"submission": r.name, "earlier": str(r.earlier), "later": str(r.later), "time kept": r.time_kept}
+            for r in replaced
+        ],
+    }
+    (out / "merge.json").write_text(json.dumps(record, indent=1), encoding="utf-8")
+    return Merged(grades, replaced)

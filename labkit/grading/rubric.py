@@ -7,19 +7,23 @@ extra-credit exercises. An exercise's points are declared once, as the
 weights of its parts (:mod:`labkit.exercises`); a rubric may give an
 exercise other points in a ``[points]`` table, which scales its parts.
 ``exercises = "module:attribute"`` names another course's exercises (the
-lab's by default). :func:`load` reads and validates one; :meth:`Rubric.score`
+lab's by default). An optional ``[late]`` table sets a deadline and what
+lateness costs (:mod:`labkit.grading.late`). :func:`load` reads and validates one; :meth:`Rubric.score`
 turns the fractions an exercise's parts earned
 (:meth:`labkit.exercises.registry.Registry.check`) into points, the branch
 that counted, the extra credit and the total.
 """
 
 import functools
+import hashlib
+import json
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..exercises.registry import LAB, Registry
 from ..exercises.registry import load as load_registry
+from . import late as lateness
 
 DEFAULT = Path(__file__).with_name("rubric.toml")
 
@@ -60,6 +64,7 @@ class Rubric:
     extra_credit: tuple = ()
     source: str = field(default="the lab's rubric", compare=False)
     registry: Registry = field(default=LAB, compare=False, repr=False)  # the exercises it grades
+    late: lateness.Late = None  # the deadline and what lateness costs, when the rubric has a [late] table
 
     @property
     def graded(self):
@@ -79,6 +84,25 @@ class Rubric:
             + self.branch_extra * max(len(self.branches) - 1, 0)
             + sum(self.points[n] for n in self.extra_credit)
         )
+
+    @property
+    def digest(self):
+        """A fingerprint of what the rubric grades and how: its title, exercises, groups and points.
+
+        Results graded under different rubrics are not merged (:func:`labkit.grading.report.read_results`).
+        The ``[late]`` table is left out: ``--merge`` applies the late rule of the rubric it is given to the
+        submission times the results carry.
+        """
+        described = {
+            "title": self.title,
+            "exercises": self.registry.source,
+            "points": {str(n): p for n, p in self.points.items()},
+            "required": list(self.required),
+            "branches": [[b.name, list(b.exercises)] for b in self.branches],
+            "branch_extra": self.branch_extra,
+            "extra_credit": list(self.extra_credit),
+        }
+        return hashlib.sha256(json.dumps(described, sort_keys=True).encode("utf-8")).hexdigest()[:16]
 
     def score(self, fractions):
         """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1)."""
@@ -110,6 +134,8 @@ class Rubric:
         if self.extra_credit:
             extra = ", ".join(f"exercise {n} ({points_text(self.points[n])})" for n in self.extra_credit)
             lines.append(("  " if not self.branches else "  and ") + f"extra credit: {extra}")
+        if self.late is not None:
+            lines.append(f"  {self.late.describe()}")
         return "\n".join(lines)
 
 
@@ -148,7 +174,7 @@ def _exercise_list(value, where, source, registry):
 
 def from_dict(data, source="the rubric"):
     """A validated :class:`Rubric` from parsed TOML; ValueError says what is wrong and where."""
-    known = {"title", "exercises", "required", "extra_credit", "points", "branches"}
+    known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
@@ -210,7 +236,8 @@ def from_dict(data, source="the rubric"):
     if not seen:
         raise ValueError(f"{source}: grades nothing: list exercises in required, extra_credit or branches.")
     points = {number: points[number] for number in sorted(points)}
-    return Rubric(title, points, required, branches, branch_extra, extra_credit, source, registry)
+    late = lateness.from_dict(data["late"], source) if "late" in data else None
+    return Rubric(title, points, required, branches, branch_extra, extra_credit, source, registry, late)
 
 
 def _branches(table, source, registry):

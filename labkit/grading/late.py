@@ -1,0 +1,659 @@
+"""Late work: the rubric's ``[late]`` table, when each submission was handed in, and the penalty.
+
+A rubric may say when the work was due and what lateness costs::
+
+    [late]
+    deadline = "2026-12-01T23:59:00+01:00"  # ISO 8601 with its UTC offset
+    per = "day"                             # the penalty counts started days ("day") or hours ("hour")
+    percent = 10                            # percent of the submission's points lost per started day
+    cap = 50                                # the most it can lose, in percent
+    grace = 15                              # minutes after a deadline that still count as on time (optional)
+
+    [late.extensions]                       # optional: a student's own deadline
+    alice = "2026-12-03T23:59:00+01:00"     # a new deadline
+    bob = 48                                # or hours added to the deadline
+
+The penalty is a share of the submission's own points (its total under the
+rubric, extra credit included): ``min(percent * started units, cap)`` percent
+of it. Lateness is counted from the student's deadline; the grace decides
+only whether a submission is late at all, so one 20 minutes late with 15
+minutes' grace is one started hour (or day) late.
+
+A submission's time (:class:`SubmissionTime`) comes, in this order of
+precedence, from the instructor's ``--times TIMES.csv`` (columns
+``submission`` and ``time``), from nbgrader's ``timestamp.txt`` at the top of
+the submission's folder (:func:`parse_timestamp` reads every format nbgrader
+writes with a UTC offset or UTC itself), and, only when the instructor asks for
+it (``--times-from-mtime``), from the newest modification time of its
+notebooks. A submission with no time while a deadline is set is graded and
+not penalised, and the grades and the feedback say so; an unreadable
+``timestamp.txt`` is reported the same way, with the reason, for the
+instructor to give that time in ``--times``.
+"""
+
+import csv
+import math
+import os
+import re
+import stat
+from dataclasses import dataclass, field
+from datetime import UTC, datetime, timedelta, timezone, tzinfo
+from pathlib import Path
+
+UNITS = {"day": 86400, "hour": 3600}
+TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
+MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
+MAX_TIMES = 10 * 1024**2  # bytes of a --times file
+FORMAT = "ISO 8601 with a UTC offset, e.g. 2026-12-01T23:59:00+01:00 (or ...T22:59:00Z)"
+FROM_CSV, FROM_NBGRADER, FROM_MTIME = "the --times file", "nbgrader's timestamp.txt", "file modification time"
+KEYS = {"deadline", "per", "percent", "cap", "grace", "extensions"}
+SHOWN = 80  # characters of a name or a bad value quoted in a message
+MINUTE = timedelta(minutes=1)
+
+_ISO = re.compile(r"\d{4}-\d{2}-\d{2}[T ]\d{2}:\d{2}(?::\d{2}(?:\.\d{1,6})?)?(?:Z|[+-]\d{2}:\d{2})")
+# nbgrader: "%Y-%m-%d %H:%M:%S.%f %Z" (older: without .%f), or an ISO time (what `zip_collect` writes)
+_NBGRADER = re.compile(
+    r"(?P<date>\d{4}-\d{2}-\d{2})[T ](?P<time>\d{2}:\d{2}(?::\d{2}(?:[.,]\d{1,9})?)?)"
+    r"\s*(?P<zone>Z|UTC|GMT|[+-]\d{2}:?\d{2}|[A-Za-z][A-Za-z0-9/_+-]{0,40})?"
+)
+
+
+def parse_deadline(value: str | datetime, where: str = "the deadline") -> datetime:
+    """A deadline as a timezone-aware datetime: ISO 8601 text with a UTC offset, or a TOML offset date-time.
+
+    Parameters
+    ----------
+    value : str or datetime.datetime
+        ``"2026-12-01T23:59:00+01:00"`` (``Z`` stands for ``+00:00``; the seconds may be left out), or
+        an offset date-time as TOML reads an unquoted one.
+    where : str
+        What the value is, for the error message.
+
+    Returns
+    -------
+    datetime.datetime
+        The moment, with its offset.
+
+    Raises
+    ------
+    ValueError
+        If the value has no UTC offset or is not in that format.
+
+    Examples
+    --------
+    >>> parse_deadline("2026-12-01T23:59:00+01:00").isoformat()
+    '2026-12-01T23:59:00+01:00'
+    >>> parse_deadline("2026-12-01T23:59")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: the deadline is '2026-12-01T23:59', which has no UTC offset: write it as ISO 8601 with a UTC offset...
+    """
+    if isinstance(value, datetime):
+        if value.tzinfo is None or value.utcoffset() is None:
+            raise ValueError(f"{where} is {value.isoformat()}, which has no UTC offset: write it as {FORMAT}.")
+        return value
+    if not isinstance(value, str):
+        raise ValueError(f"{where} is {value!r}, not a time: write it as {FORMAT}.")
+    text = value.strip()
+    if not _ISO.fullmatch(text):
+        plain = re.fullmatch(r"\d{4}-\d{2}-\d{2}(?:[T ]\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?)?", text)
+        why = "which has no UTC offset" if plain else "which is not in that format"
+        raise ValueError(f"{where} is {value[:SHOWN]!r}, {why}: write it as {FORMAT}.")
+    try:
+        return datetime.fromisoformat(text.replace("Z", "+00:00"))
+    except ValueError as exc:
+        raise ValueError(f"{where} is {value!r}, which is not a real time ({exc}): write it as {FORMAT}.") from None
+
+
+def parse_timestamp(text: str) -> datetime:
+    """The time nbgrader wrote in a ``timestamp.txt``, as a timezone-aware datetime.
+
+    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` in its configured timezone
+    (``2026-12-01 23:59:59.123456 UTC``), older versions the same without the
+    fraction, and ``nbgrader zip_collect`` an ISO time with an offset. All of
+    these are read, as is a numeric offset after the time. A time without any
+    zone, or with a zone name other than UTC or GMT (``CET`` names several),
+    is refused: which moment it means cannot be known.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+
+    Returns
+    -------
+    datetime.datetime
+        The moment, with its offset.
+
+    Raises
+    ------
+    ValueError
+        Saying what is wrong with the text (shown to the instructor with the submission's name).
+
+    Examples
+    --------
+    >>> parse_timestamp("2026-12-01 23:59:59.123456 UTC\\n").isoformat()
+    '2026-12-01T23:59:59.123456+00:00'
+    >>> parse_timestamp("2026-12-02 00:30:00+0100").isoformat()
+    '2026-12-02T00:30:00+01:00'
+    """
+    line = str(text).strip().lstrip("\ufeff").strip()
+    match = _NBGRADER.fullmatch(line)
+    if not match:
+        shown = line[:SHOWN] + ("..." if len(line) > SHOWN else "")
+        raise ValueError(f"{shown!r} is not a time as nbgrader writes it (e.g. 2026-12-01 23:59:59.123456 UTC)")
+    zone = match["zone"]
+    if zone is None:
+        raise ValueError(f"{line!r} has no time zone, so the moment it means is unknown")
+    if zone in ("Z", "UTC", "GMT"):
+        offset = UTC
+    elif zone[0] in "+-":
+        digits = zone[1:].replace(":", "")
+        if int(digits[:2]) > 23 or int(digits[2:]) > 59:
+            raise ValueError(f"{line!r} has the offset {zone}, which no time zone has")
+        offset = timezone((1 if zone[0] == "+" else -1) * timedelta(hours=int(digits[:2]), minutes=int(digits[2:])))
+    else:
+        raise ValueError(
+            f"{line!r} names the time zone {zone!r}, which labkit cannot place (only UTC, GMT and numeric "
+            "offsets are unambiguous)"
+        )
+    clock = match["time"].replace(",", ".")
+    if "." in clock:
+        whole, fraction = clock.split(".")
+        clock = f"{whole}.{fraction[:6].ljust(6, '0')}"
+    try:
+        naive = datetime.fromisoformat(f"{match['date']}T{clock}")
+    except ValueError as exc:
+        raise ValueError(f"{line!r} is not a real time ({exc})") from None
+    return naive.replace(tzinfo=offset)
+
+
+def time_text(moment: datetime, zone: tzinfo | None = None) -> str:
+    """A moment as ISO 8601 text to the second, in the offset of `zone` (a tzinfo) when given.
+
+    Examples
+    --------
+    >>> time_text(parse_deadline("2026-12-01T22:59:00Z"), parse_deadline("2026-12-01T00:00+01:00").tzinfo)
+    '2026-12-01T23:59:00+01:00'
+    """
+    return (moment.astimezone(zone) if zone is not None else moment).isoformat(timespec="seconds")
+
+
+def duration_text(delta: timedelta) -> str:
+    """A positive duration in days, hours and minutes (seconds below one minute).
+
+    Examples
+    --------
+    >>> duration_text(timedelta(days=1, hours=2, minutes=5, seconds=30))
+    '1 day 2 h 5 min'
+    >>> duration_text(timedelta(seconds=42))
+    '42 s'
+    """
+    if delta < MINUTE:
+        return f"{int(delta.total_seconds())} s"
+    days, rest = divmod(int(delta.total_seconds()), UNITS["day"])
+    hours, rest = divmod(rest, UNITS["hour"])
+    minutes = rest // int(MINUTE.total_seconds())
+    parts = [f"{days} day{'s' if days != 1 else ''}"] if days else []
+    parts += [f"{hours} h"] if hours else []
+    parts += [f"{minutes} min"] if minutes else []
+    return " ".join(parts)
+
+
+@dataclass(frozen=True)
+class SubmissionTime:
+    """When a submission was handed in, where that came from, or why it is not known.
+
+    Attributes
+    ----------
+    when : datetime.datetime or None
+        The moment (timezone-aware), None when unknown.
+    source : str or None
+        Where it came from: :data:`FROM_CSV`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`.
+    problem : str or None
+        Why the time could not be read (an unreadable ``timestamp.txt``), when it could not.
+    """
+
+    when: datetime = None
+    source: str = None
+    problem: str = None
+
+    def as_dict(self) -> dict:
+        """The time as JSON data (UTC, ISO 8601), for a result file."""
+        return {
+            "time": None if self.when is None else self.when.astimezone(UTC).isoformat(),
+            "source": self.source,
+            "problem": self.problem,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict | None) -> "SubmissionTime | None":
+        """Read back :meth:`as_dict`'s data (None gives None); ValueError if it is not that."""
+        if data is None:
+            return None
+        if not isinstance(data, dict) or set(data) - {"time", "source", "problem"}:
+            raise ValueError("its submission time is not a time, source and problem")
+        when = data.get("time")
+        if when is not None:
+            when = parse_deadline(when, "its submission time")
+        source, problem = data.get("source"), data.get("problem")
+        if not all(v is None or isinstance(v, str) for v in (source, problem)):
+            raise ValueError("its submission time's source and problem must be text")
+        return cls(when, source, problem)
+
+
+@dataclass(frozen=True)
+class Lateness:
+    """What the late rule made of one submission.
+
+    Attributes
+    ----------
+    deadline : datetime.datetime
+        The student's deadline (the rubric's, or their extension).
+    extended : bool
+        Whether that deadline is an extension.
+    time : SubmissionTime or None
+        When the work was handed in (None, or without a moment, when unknown).
+    late_by : datetime.timedelta or None
+        How long after the deadline it came (zero or less: on time); None when the time is unknown.
+    units : int
+        Started days or hours counted for the penalty (0 when on time, within the grace, or unknown).
+    percent : float
+        The penalty in percent of the raw total (the cap applied).
+    raw_total : float
+        The points before the penalty.
+    penalty : float
+        The points taken off (rounded to 0.01).
+    note : str
+        One line saying what happened, for ``grades.csv``.
+    """
+
+    deadline: datetime
+    extended: bool
+    time: SubmissionTime
+    late_by: timedelta
+    units: int
+    percent: float
+    raw_total: float
+    penalty: float
+    note: str
+
+    @property
+    def total(self) -> float:
+        """The points after the penalty."""
+        return round(self.raw_total - self.penalty, 2)
+
+    @property
+    def known(self) -> bool:
+        """Whether the submission's time is known."""
+        return self.late_by is not None
+
+
+@dataclass(frozen=True)
+class Late:
+    """The rubric's late rule (see the module's documentation for the table it is read from).
+
+    Attributes
+    ----------
+    deadline : datetime.datetime
+        When the work is due (timezone-aware).
+    per : str
+        ``"day"`` or ``"hour"``: the unit whose started ones are counted.
+    percent : float
+        Percent of the raw total lost per started unit.
+    cap : float
+        The largest penalty, in percent.
+    grace : float
+        Minutes after a deadline that still count as on time.
+    extensions : tuple
+        ``(name, deadline)`` pairs: a student's own deadline.
+    """
+
+    deadline: datetime
+    per: str
+    percent: float
+    cap: float
+    grace: float = 0.0
+    extensions: tuple = field(default=())
+
+    def deadline_for(self, name: str) -> tuple[datetime, bool]:
+        """(the deadline of submission `name`, whether it is an extension)."""
+        for student, deadline in self.extensions:
+            if student == name:
+                return deadline, True
+        return self.deadline, False
+
+    def assess(self, name: str, time: SubmissionTime | None, raw_total: float) -> Lateness:
+        """The :class:`Lateness` of submission `name`, handed in at `time` (a :class:`SubmissionTime` or
+        None), whose points before the penalty are `raw_total`.
+
+        Examples
+        --------
+        >>> rule = from_dict({"deadline": "2026-12-01T23:59:00+01:00", "per": "day", "percent": 10, "cap": 50})
+        >>> handed_in = SubmissionTime(parse_deadline("2026-12-03T08:00:00+01:00"), FROM_CSV)
+        >>> late = rule.assess("ada", handed_in, 80)
+        >>> late.units, late.percent, late.penalty, late.total
+        (2, 20.0, 16.0, 64.0)
+        """
+        deadline, extended = self.deadline_for(name)
+        if time is None or time.when is None:
+            why = f"its submission time could not be read ({time.problem})" if time and time.problem else None
+            note = f"{why or 'no submission time'}: not penalised"
+            return Lateness(deadline, extended, time, None, 0, 0.0, raw_total, 0.0, note)
+        late_by = time.when - deadline
+        grace = timedelta(minutes=self.grace)
+        if late_by <= timedelta(0) or late_by <= grace:
+            note = "on time" if late_by <= timedelta(0) else f"on time (within the {_minutes(self.grace)} grace)"
+            return Lateness(deadline, extended, time, late_by, 0, 0.0, raw_total, 0.0, note)
+        units = math.ceil(late_by.total_seconds() / UNITS[self.per])
+        percent = min(units * self.percent, self.cap)
+        penalty = round(raw_total * percent / 100, 2)
+        capped = " (the cap)" if units * self.percent > self.cap else ""
+        note = (
+            f"late by {duration_text(late_by)}: {units} started {self.per}{'s' if units != 1 else ''}, "
+            f"{_number(percent)}% off{capped}"
+        )
+        if extended:
+            note += " (after an extension)"
+        return Lateness(deadline, extended, time, late_by, units, float(percent), raw_total, penalty, note)
+
+    def describe(self) -> str:
+        """The rule in one line, for the feedback: it names no student (extensions are private)."""
+        grace = f", with {_number(self.grace)} minute{'s' if self.grace != 1 else ''} of grace" if self.grace else ""
+        return (
+            f"late work: due {time_text(self.deadline)}{grace}; {_number(self.percent)}% of the points "
+            f"off per started {self.per} late, at most {_number(self.cap)}%"
+        )
+
+    def feedback(self, lateness: Lateness) -> list[str]:
+        """The lines of one submission's feedback about its lateness."""
+        zone = self.deadline.tzinfo
+        due = f"{time_text(lateness.deadline, zone)}{' (your extension)' if lateness.extended else ''}"
+        if not lateness.known:
+            return [
+                f"Late work: due {due}; this submission's time is not known, so no late penalty was applied.",
+            ]
+        handed_in = f"handed in {time_text(lateness.time.when, zone)} ({lateness.time.source})"
+        if not lateness.units:
+            return [f"Late work: due {due}; {handed_in}: {lateness.note}."]
+        from .rubric import points_text
+
+        return [
+            f"Late work: due {due}; {handed_in}: {lateness.note}: "
+            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points.",
+        ]
+
+
+def _number(value):
+    return f"{int(value)}" if float(value) == int(value) else f"{value:g}"
+
+
+def _minutes(value):
+    return f"{_number(value)}-minute" if value != 1 else "1-minute"
+
+
+def _amount(table, key, source, low=0.0, high=None, unit=""):
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{source}: [late] {key} must be a number{unit}; got {value!r}.")
+    if value < low or (high is not None and value > high):
+        bound = f"between {_number(low)} and {_number(high)}" if high is not None else f"at least {_number(low)}"
+        raise ValueError(f"{source}: [late] {key} must be {bound}{unit}; got {value!r}.")
+    return float(value)
+
+
+def from_dict(table: dict, source: str = "the rubric") -> Late:
+    """A validated :class:`Late` from the rubric's parsed ``[late]`` table.
+
+    Parameters
+    ----------
+    table : dict
+        The table: ``deadline``, ``per``, ``percent`` and ``cap`` (all required), ``grace`` and
+        ``extensions`` (optional).
+    source : str
+        The rubric's name, for error messages.
+
+    Returns
+    -------
+    Late
+        The rule.
+
+    Raises
+    ------
+    ValueError
+        Saying which key is wrong and what it must be.
+    """
+    if not isinstance(table, dict):
+        raise ValueError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
+    unknown = sorted(map(str, set(table) - KEYS))
+    if unknown:
+        raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)} in [late]; it has {', '.join(sorted(KEYS))}.")
+    missing = [key for key in ("deadline", "per", "percent", "cap") if key not in table]
+    if missing:
+        raise ValueError(
+            f'{source}: [late] needs {", ".join(missing)} (e.g. deadline = "2026-12-01T23:59:00+01:00", '
+            'per = "day", percent = 10, cap = 50).'
+        )
+    deadline = parse_deadline(table["deadline"], f"{source}: [late] deadline")
+    per = table["per"]
+    if per not in UNITS:
+        raise ValueError(
+            f'{source}: [late] per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.'
+        )
+    percent = _amount(table, "percent", source, 0, 100, " (percent of the points per started unit)")
+    cap = _amount(table, "cap", source, 0, 100, " (the largest penalty, in percent)")
+    grace = _amount(table, "grace", source, 0, unit=" of minutes") if "grace" in table else 0.0
+    extensions = table.get("extensions", {})
+    if not isinstance(extensions, dict):
+        raise ValueError(
+            f'{source}: [late.extensions] must be a table of `name = "new deadline"` or `name = hours` lines.'
+        )
+    granted = []
+    for name, value in extensions.items():
+        if not isinstance(name, str) or not name.strip():
+            raise ValueError(
+                f"{source}: [late.extensions] has the name {name!r}; a name is a submission's name, as text."
+            )
+        where = f"{source}: [late.extensions] {name[:SHOWN]!r}"
+        if isinstance(value, (str, datetime)):
+            new = parse_deadline(value, where)
+        elif isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+            if value <= 0:
+                raise ValueError(f"{where} gives {value!r} hours; an extension adds more than 0 hours.")
+            new = deadline + timedelta(hours=value)
+        else:
+            raise ValueError(f"{where} is {value!r}: give a new deadline ({FORMAT}) or a number of hours.")
+        if new <= deadline:
+            raise ValueError(
+                f"{where} is {time_text(new, deadline.tzinfo)}, not after the deadline {time_text(deadline)}; "
+                "an extension gives more time."
+            )
+        granted.append((name, new))
+    return Late(deadline, per, percent, cap, grace, tuple(granted))
+
+
+def _read_small(path, limit):
+    """The bytes of regular file `path`, never following a link nor waiting on a pipe; ValueError says why not."""
+    if stat.S_ISLNK(os.lstat(path).st_mode):
+        raise ValueError(f"{path.name} is a symbolic link; links are never followed")
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise ValueError(f"{path.name} is not a file")
+        if info.st_size > limit:
+            raise ValueError(f"{path.name} is {info.st_size:,} bytes, more than the {limit:,} it can be")
+        chunks, size = [], 0
+        while size < limit:
+            chunk = os.read(fd, limit - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
+    """The time in nbgrader's ``timestamp.txt`` at the top of a submission's folder.
+
+    Parameters
+    ----------
+    submission : path-like
+        A submission: a folder (a single notebook has no ``timestamp.txt``).
+
+    Returns
+    -------
+    SubmissionTime or None
+        None when there is no such file; a time whose ``problem`` says why when the file cannot be read.
+    """
+    path = Path(submission) / TIMESTAMP
+    try:
+        if not stat.S_ISDIR(os.lstat(submission).st_mode):
+            return None
+        os.lstat(path)
+    except OSError:
+        return None
+    try:
+        raw = _read_small(path, MAX_TIMESTAMP)
+        return SubmissionTime(parse_timestamp(raw.decode("utf-8")), FROM_NBGRADER)
+    except UnicodeDecodeError:
+        return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP} is not text")
+    except (OSError, ValueError) as exc:
+        return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP}: {exc}")
+
+
+def modification_time(notebooks: list) -> SubmissionTime | None:
+    """The newest modification time of a submission's notebooks (only on the instructor's explicit request).
+
+    Parameters
+    ----------
+    notebooks : list of path-like
+        The submission's notebook files.
+
+    Returns
+    -------
+    SubmissionTime or None
+        None when there are none.
+    """
+    times = []
+    for path in notebooks:
+        try:
+            times.append(os.lstat(path).st_mtime)
+        except OSError:
+            continue
+    if not times:
+        return None
+    return SubmissionTime(datetime.fromtimestamp(max(times), UTC), FROM_MTIME)
+
+
+def read_times(path: str | os.PathLike) -> dict[str, datetime]:
+    """The submission times in a CSV file with the columns ``submission`` and ``time`` (others are ignored).
+
+    Parameters
+    ----------
+    path : path-like
+        The file. A time is ISO 8601 with a UTC offset, or as nbgrader writes it
+        (``2026-12-01 23:59:59 UTC``).
+
+    Returns
+    -------
+    dict
+        {submission name: datetime}.
+
+    Raises
+    ------
+    ValueError
+        When the file cannot be read, lacks a column, names a submission twice or has a bad time (naming the line).
+    """
+    path = Path(path)
+    try:
+        raw = _read_small(path, MAX_TIMES)
+        text = raw.decode("utf-8-sig")
+    except FileNotFoundError:
+        raise ValueError(f"the times file {path} does not exist.") from None
+    except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError
+        raise ValueError(f"cannot read the times file {path}: {exc}.") from None
+    rows = csv.reader(text.splitlines())
+    header = [cell.strip().lower() for cell in next(rows, [])]
+    if "submission" not in header or "time" not in header:
+        raise ValueError(
+            f"{path} needs a header row with the columns submission and time "
+            "(e.g. `submission,time` then `alice,2026-12-01T23:10:00+01:00`)."
+        )
+    who, when = header.index("submission"), header.index("time")
+    times = {}
+    for line, row in enumerate(rows, start=2):
+        if not any(cell.strip() for cell in row):
+            continue
+        if len(row) <= max(who, when):
+            raise ValueError(f"{path}, line {line}: it has {len(row)} cell(s), fewer than the header's columns.")
+        name = row[who].strip()
+        if not name:
+            raise ValueError(f"{path}, line {line}: the submission's name is empty.")
+        if name in times:
+            raise ValueError(f"{path}, line {line}: {name[:SHOWN]!r} is listed twice; keep one time per submission.")
+        try:
+            times[name] = parse_timestamp(row[when])
+        except ValueError as exc:
+            raise ValueError(f"{path}, line {line} ({name[:SHOWN]!r}): {exc}; write it as {FORMAT}.") from None
+    return times
+
+
+def submission_time(
+    submission: str | os.PathLike,
+    name: str,
+    times: dict | None = None,
+    notebooks: list | None = None,
+    from_mtime: bool = False,
+) -> SubmissionTime | None:
+    """The time of one submission, by the precedence the module's documentation gives.
+
+    Parameters
+    ----------
+    submission : path-like
+        The submission (a folder or a notebook).
+    name : str
+        Its name (what the ``--times`` file lists).
+    times : dict, optional
+        {name: datetime} from :func:`read_times`.
+    notebooks : list of path-like, optional
+        Its notebooks, for `from_mtime`.
+    from_mtime : bool
+        Fall back on the notebooks' modification time (never unless the instructor asks).
+
+    Returns
+    -------
+    SubmissionTime or None
+        None when no source has a time.
+    """
+    if times and name in times:
+        return SubmissionTime(times[name], FROM_CSV)
+    found = read_timestamp(submission)
+    if found is not None:
+        return found
+    if from_mtime:
+        return modification_time(notebooks if notebooks is not None else [submission])
+    return None
+
+
+def unknown_times(grades: list) -> list[tuple[str, str, bool]]:
+    """The graded submissions that a rubric's deadline applies to but whose time is unknown, with the reason.
+
+    Parameters
+    ----------
+    grades : list of SubmissionGrade
+        A run's grades.
+
+    Returns
+    -------
+    list of tuple
+        (name, note, is an error) per such submission: an error is a time that could not be read.
+    """
+    found = []
+    for grade in grades:
+        lateness = grade.lateness
+        if grade.graded and lateness is not None and not lateness.known:
+            found.append((grade.name, lateness.note, bool(lateness.time and lateness.time.problem)))
+    return found
