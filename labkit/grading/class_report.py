@@ -49,6 +49,8 @@ MOST_FAILED = 10  # students listed under "most failed parts"
 MAX_PAIRS = 50  # similar pairs shown side by side
 MAX_LINES = 200  # lines of each side of a pair shown
 MAX_LINE = 160  # characters of one line of code shown
+MAX_LABEL = 64  # characters of a part's label in the list of a student's failed parts
+MAX_FAILED_SHOWN = 50  # failed parts listed per student
 
 PASSED, SLIP, NOT_DONE = "passed", "slip", "not done"
 TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, NOT_GRADED, OTHER = (
@@ -860,8 +862,9 @@ def _most_failed_section(summary):
         '<th scope="col">the failed parts</th></tr></thead><tbody>'
     )
     for s in summary.most_failed:
-        labels = ", ".join(_e(label, 60) for label in s.failed[:60])
-        more = f", and {len(s.failed) - 60} more" if len(s.failed) > 60 else ""
+        labels = ", ".join(_e(label, MAX_LABEL) for label in s.failed[:MAX_FAILED_SHOWN])
+        extra = len(s.failed) - MAX_FAILED_SHOWN
+        more = f", and {extra} more" if extra > 0 else ""
         out.append(
             f'<tr><th scope="row">{_e(s.student, MAX_NAME)}</th><td class="num">{len(s.failed)}</td>'
             f'<td class="num">{s.not_done}</td><td class="num">{points_text(s.total)}</td>'
