@@ -26,6 +26,7 @@ from pathlib import Path
 
 from . import rubric as rubrics
 from .rubric import points_text
+from .scan import MAX_SOURCE_CHARS
 
 FORMAT = "labkit-grade/2"
 
@@ -41,6 +42,9 @@ class SubmissionGrade:
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
     failure: str = None  # why the submission could not be graded at all (then it has no points, not zero)
     answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
+    # graded function -> the source of its definition (printable, at most MAX_SOURCE_CHARS), for the similarity
+    # search (labkit.grading.similarity); never part of the grade
+    sources: dict = field(default_factory=dict)
 
     @property
     def graded(self):
@@ -160,6 +164,7 @@ class SubmissionGrade:
             "problems": list(self.problems),
             "failure": self.failure,
             "answers": dict(self.answers),
+            "sources": dict(self.sources),
             "results": {str(n): v for n, v in self.results.items()},
             "rubric": self.rubric.title,
             "points": {str(n): v for n, v in score.points.items()},
@@ -185,6 +190,7 @@ class SubmissionGrade:
                 rubric or rubrics.default(),
                 data.get("failure"),
                 {str(k): str(v)[:4000] for k, v in dict(data.get("answers") or {}).items()},
+                _sources(data.get("sources") or {}),  # results written before the grade kept sources have none
             )
             if grade.failure is not None:
                 grade.failure = str(grade.failure)
@@ -197,6 +203,14 @@ class SubmissionGrade:
                 "it was written by another version of labkit."
             )
         return grade
+
+
+def _sources(value):
+    """A result file's sources, bounded and printable; TypeError when they are not names and texts."""
+    sources = dict(value)
+    if not all(isinstance(k, str) and isinstance(v, str) for k, v in sources.items()):
+        raise TypeError("its sources are not function names and source texts")
+    return {printable(k)[:200]: printable(v)[:MAX_SOURCE_CHARS] for k, v in sources.items()}
 
 
 def _problem_lines(problem):
