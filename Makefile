@@ -45,6 +45,7 @@ bench: $(STAMP) chromium
 	$(PY) benchmarks/bench_2d.py
 	$(PY) benchmarks/bench_sliders.py
 	$(PY) benchmarks/bench_grading.py
+	$(PY) benchmarks/bench_similarity.py
 	$(PY) benchmarks/bench_browser_latency.py
 	$(PY) benchmarks/bench_report.py
 

@@ -239,6 +239,7 @@ def _export(args):
 
 def _report(args):
     from .grading import class_report, similarity
+    from .grading.progress import Progress
     from .grading.rubric import load
 
     start = time.perf_counter()
@@ -247,11 +248,9 @@ def _report(args):
         raise ValueError(f"--similarity-threshold is a similarity above 0 and at most 1; got {threshold}.")
     rubric = load(args.rubric)
     grades = class_report.read(args.out, rubric)
-    search = getattr(similarity, "similar_pairs", None)
-    if search is None:
-        pairs, note = None, "this version of labkit has no similarity search"
-    else:
-        pairs, note = search(grades, threshold), None
+    functions = {function for grade in grades for function in grade.sources}
+    with Progress(len(functions), "comparing code", enabled=not args.quiet) as bar:
+        pairs, note = similarity.similar_pairs(grades, threshold, progress=bar), None
     path = class_report.write(args.out, grades, pairs, threshold=threshold, similarity_note=note)
     if not args.quiet:
         similar = "similar code not computed" if pairs is None else f"{len(pairs)} similar pair(s)"

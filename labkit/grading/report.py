@@ -30,6 +30,7 @@ from pathlib import Path
 from . import rubric as rubrics
 from .late import FROM_CSV, SubmissionTime, time_text
 from .rubric import points_text
+from .scan import MAX_SOURCE_CHARS
 
 FORMAT = "labkit-grade/2"
 
@@ -46,6 +47,9 @@ class SubmissionGrade:
     failure: str = None  # why the submission could not be graded at all (then it has no points, not zero)
     answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
     time: SubmissionTime = None  # when it was handed in (labkit.grading.late), None when no source had a time
+    # graded function -> the source of its definition (printable, at most MAX_SOURCE_CHARS), for the similarity
+    # search (labkit.grading.similarity); never part of the grade
+    sources: dict = field(default_factory=dict)
 
     @property
     def graded(self):
@@ -197,6 +201,7 @@ class SubmissionGrade:
             "problems": list(self.problems),
             "failure": self.failure,
             "answers": dict(self.answers),
+            "sources": dict(self.sources),
             "results": {str(n): v for n, v in self.results.items()},
             "rubric": self.rubric.title,
             "points": {str(n): v for n, v in score.points.items()},
@@ -223,6 +228,7 @@ class SubmissionGrade:
                 rubric or rubrics.default(),
                 data.get("failure"),
                 {str(k): str(v)[:4000] for k, v in dict(data.get("answers") or {}).items()},
+                sources=_sources(data.get("sources") or {}),  # results written before sources were kept have none
             )
             if grade.failure is not None:
                 grade.failure = str(grade.failure)
@@ -243,6 +249,14 @@ class SubmissionGrade:
                 "it was written by another version of labkit."
             )
         return grade
+
+
+def _sources(value):
+    """A result file's sources, bounded and printable; TypeError when they are not names and texts."""
+    sources = dict(value)
+    if not all(isinstance(k, str) and isinstance(v, str) for k, v in sources.items()):
+        raise TypeError("its sources are not function names and source texts")
+    return {printable(k)[:200]: printable(v)[:MAX_SOURCE_CHARS] for k, v in sources.items()}
 
 
 def _problem_lines(problem):

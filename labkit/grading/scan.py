@@ -19,6 +19,10 @@ The scan is bounded: a notebook's code cells may hold at most
 :data:`TIME_BUDGET` seconds (:class:`Unreadable` otherwise). Cell magics
 that run Python (``%%time``, ``%%capture``) are read as Python; other cells
 that IPython would hand to another program are skipped.
+
+:func:`function_sources` reads the same cells for the text of the graded
+functions' definitions, which the grade keeps for the similarity search
+(:mod:`labkit.grading.similarity`).
 """
 
 import ast
@@ -27,6 +31,7 @@ import time
 
 MAX_CODE_BYTES = 512 * 1024  # a lab notebook's code is a few tens of kilobytes
 TIME_BUDGET = 20.0  # seconds to read one notebook's code
+MAX_SOURCE_CHARS = 20_000  # characters kept of one graded function's source (a lab function is a few hundred)
 
 PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
 # modules a graded function may reach without the scan asking what they are
@@ -382,3 +387,91 @@ def _reader(sources, deadline):
         found = _READERS[sources] = _Reader(sources, deadline)
     found.deadline = deadline
     return found
+
+
+def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
+    """The source text of the last top-level definition of each of `names` in a notebook's code cells.
+
+    The cells are parsed with :mod:`ast`, never run. A definition counts
+    where the cells, run in order, would leave it bound to its name: at the
+    top level of a cell (or inside a top-level ``if``, ``for``, ``while``,
+    ``with`` or ``try``); a later assignment or import of the name drops it
+    (the graded object is then not a function written here). A cell that
+    does not parse defines nothing, as when IPython runs it.
+
+    Parameters
+    ----------
+    sources : sequence of str
+        The notebook's code cells, in order.
+    names : iterable of str
+        The function names wanted.
+    limit : int, optional
+        Characters kept of one definition (whole lines while they fit).
+
+    Returns
+    -------
+    dict
+        ``{name: source}`` for each of `names` the cells define with ``def``;
+        a source runs from its first decorator to its last line. Nothing at
+        all when the cells hold more than :data:`MAX_CODE_BYTES`.
+
+    Examples
+    --------
+    >>> cells = ["import numpy as np", "def f(x):\\n    return 2 * x\\n\\nf(1)", "def g(:"]
+    >>> function_sources(cells, ["f", "g", "h"])
+    {'f': 'def f(x):\\n    return 2 * x'}
+    """
+    wanted = set(names)
+    size = sum(len(str(s).encode("utf-8", "surrogatepass")) for s in sources)
+    if not wanted or size > MAX_CODE_BYTES:
+        return {}
+    found = {}
+    for cell in sources:
+        lines = str(cell).replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        text = python_source("\n".join(lines))
+        if text is None:
+            continue
+        try:
+            nodes = list(_top_level(ast.parse(text).body))
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            continue
+        for node in nodes:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                if node.name in wanted:
+                    first = min([node.lineno] + [d.lineno for d in node.decorator_list])
+                    found[node.name] = _clip("\n".join(lines[first - 1 : node.end_lineno]), limit)
+            else:
+                for bound in _bound_names(node):
+                    found.pop(bound, None)
+    return found
+
+
+def _top_level(body):
+    """The statements a cell runs at its top level, those inside top-level compound statements included."""
+    for node in body:
+        yield node
+        if isinstance(node, (ast.If, ast.For, ast.AsyncFor, ast.While, ast.With, ast.AsyncWith, ast.Try)):
+            inner = [node.body, getattr(node, "orelse", []), getattr(node, "finalbody", [])]
+            inner += [handler.body for handler in getattr(node, "handlers", [])]
+            for block in inner:
+                yield from _top_level(block)
+
+
+def _bound_names(node):
+    """The names a top-level statement other than a function definition binds."""
+    if isinstance(node, (ast.Import, ast.ImportFrom)):
+        return [local for local, _ in _imported(node)]
+    if isinstance(node, ast.ClassDef):
+        return [node.name]
+    if isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+        return [n.id for target in targets for n in ast.walk(target) if isinstance(n, ast.Name)]
+    return []
+
+
+def _clip(text, limit):
+    """At most `limit` characters of `text`: whole lines while they fit."""
+    if len(text) <= limit:
+        return text
+    cut = text[:limit]
+    return cut[: cut.rindex("\n")] if "\n" in cut else cut

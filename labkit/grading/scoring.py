@@ -30,7 +30,7 @@ from ..exercises.registry import LAB
 from ..exercises.registry import load as load_registry
 from . import backends, refusals, remote, scan
 from .options import GradeOptions
-from .report import SubmissionGrade, one_line
+from .report import SubmissionGrade, one_line, printable
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -229,14 +229,23 @@ def _for_sandbox(profiles):
     return {name: {key: profile[key] for key in ("names", "modules", "c_names")} for name, profile in profiles.items()}
 
 
-def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, **single):
+def graded_functions(exercise):
+    """The names of an exercise whose source the grade keeps, if the notebook defines them with ``def``:
+    its names and the names its parts scan, in order."""
+    names = list(exercise.names) + [name for part in exercise.parts for name in part.scanned]
+    return [name for name in dict.fromkeys(names) if name.isidentifier()]
+
+
+def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None, **single):
     """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
 
     `options` (a :class:`GradeOptions`, the defaults when None) bound it, with
     any single option given as a keyword (``cell_timeout=10``) in its place;
     `deadline` (monotonic) is the submission's; exercises in `skip` are not
     checked here. The notebook's answers in words go into `answers`
-    ({grade id: text}) when it is given."""
+    ({grade id: text}) when it is given, and the source of each graded
+    function it defines (read with ``ast``, never run) into `sources`
+    ({function name: text}), unless an earlier notebook gave it."""
     options = GradeOptions.build(options, **single)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     registry = load_registry(options.exercises)
@@ -255,6 +264,10 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
             f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
             "notebook needs; it was not graded."
         ]
+    if sources is not None:
+        wanted = [n for number in numbers for n in graded_functions(registry.exercises[number]) if n not in sources]
+        for function, text in scan.function_sources(code, wanted).items():
+            sources[function] = printable(text)[: scan.MAX_SOURCE_CHARS]
     if deadline - time.monotonic() <= 1:
         return {}, [
             f"{name}: not run: the submission's time limit of {options.total_timeout} s was used up "
@@ -352,7 +365,13 @@ def grade_submission(path, options=None, *, rubric=None, profiles=None, **single
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
         results, problems = grade_notebook(
-            notebook, options=options, deadline=deadline, skip=claimed, profiles=profiles, answers=grade.answers
+            notebook,
+            options=options,
+            deadline=deadline,
+            skip=claimed,
+            profiles=profiles,
+            answers=grade.answers,
+            sources=grade.sources,
         )
         grade.problems.extend(problems)
         for number, verdict in results.items():
