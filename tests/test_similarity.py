@@ -359,3 +359,17 @@ def test_graded_results_carry_the_sources_and_a_copy_costs_no_points(tmp_path):
     assert flagged["runge"].score == 1.0  # the rest of the notebook is the same
     write_csv(out / "again.csv", grades)  # after the search: the same grades.csv
     assert (out / "again.csv").read_bytes() == csv_before
+
+
+def test_what_much_of_the_class_writes_alike_is_not_evidence_but_a_copy_among_them_still_is():
+    # 30 students write the obvious runge alike (independently); two of them also share a renamed copy of a
+    # longer eval_pherm, and the rest write that one their own way
+    obvious = "def runge(x):\n    y = 1 / (1 + x**2)\n    return y, -2 * x * y**2\n"
+    grades = [SubmissionGrade(f"s{k:02d}", sources={"runge": obvious}) for k in range(30)]
+    grades[0].sources["eval_pherm"], grades[1].sources["eval_pherm"] = ORIGINAL, COPY
+    grades[2].sources["eval_pherm"] = LOOP
+    pairs = similar_pairs(grades)
+    assert [(p.function, p.first, p.second) for p in pairs] == [("eval_pherm", "s00", "s01")]
+    # in a small group the same runge is still shown: it is the class's common code that is set aside
+    few = similar_pairs(grades[:4])
+    assert {p.function for p in few} == {"runge", "eval_pherm"}

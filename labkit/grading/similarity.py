@@ -15,7 +15,10 @@ fingerprint. What the student release gives everyone (the stubs, the lab's
 given code) is boilerplate: a fingerprint that occurs anywhere in it is
 dropped. A pair's score, for each side, is the share of that side's
 fingerprinted code that the other side shares; the pair's score is the larger
-of the two.
+of the two. Code that a large part of the class wrote alike (a fingerprint in
+more than :data:`COMMON_SHARE` of a function's versions, and in more than
+:data:`COMMON_MIN` of them) is set aside too, as a person reading the pairs
+would: the obvious way to write a short function is no evidence.
 
 The work is bounded: each source is at most
 :data:`~labkit.grading.scan.MAX_SOURCE_CHARS` characters, tokenised (never
@@ -43,6 +46,11 @@ DEFAULT_THRESHOLD = 0.8  # similarity (0..1) from which a pair is shown
 NOISE = 25  # normalised characters hashed into one fingerprint (copydetect's noise threshold): shorter runs never count
 GUARANTEE = 30  # a shared run of this many normalised characters always shares a fingerprint (copydetect's default)
 SLACK = 1e-9  # the vectorised scores and copydetect's may differ by rounding
+# code most of a class writes alike is no evidence of copying (a two-line runge comes out the same from
+# everyone): a fingerprint found in more than this share of a function's versions, and in more than
+# COMMON_MIN of them, is set aside like the release's boilerplate
+COMMON_SHARE = 0.2
+COMMON_MIN = 5
 
 
 @dataclass(frozen=True)
@@ -252,9 +260,15 @@ def _fingerprint(text, hashes):
     ``boilerplate`` argument, which also drops a fingerprint that occurs
     twice in the source (its set intersection assumes unique hashes)."""
     from copydetect import CodeFingerprint
-    from copydetect.utils import get_token_coverage
 
     fingerprint = CodeFingerprint("source.py", NOISE, GUARANTEE - NOISE + 1, fp=io.StringIO(text), language="python")
+    return _without(fingerprint, hashes)
+
+
+def _without(fingerprint, hashes):
+    """The fingerprint with `hashes` taken out and its coverage recomputed (None: nothing of its own left)."""
+    from copydetect.utils import get_token_coverage
+
     fingerprint.hash_idx = {
         int(h): list(map(int, where)) for h, where in fingerprint.hash_idx.items() if int(h) not in hashes
     }
@@ -320,6 +334,15 @@ def _function_pairs(function, versions, given, threshold):
 
     kept = [(name, text, _fingerprint(text, given.hashes)) for name, text in versions]
     kept = [version for version in kept if version[2] is not None]
+    counts = {}
+    for _, _, fingerprint in kept:
+        for h in fingerprint.hashes:
+            counts[h] = counts.get(h, 0) + 1
+    limit = max(COMMON_MIN, COMMON_SHARE * len(kept))
+    common = {h for h, count in counts.items() if count > limit}
+    if common:
+        kept = [(name, text, _without(fingerprint, common)) for name, text, fingerprint in kept]
+        kept = [version for version in kept if version[2] is not None]
     if len(kept) < 2:
         return []
     scores = shares([fingerprint for _, _, fingerprint in kept])
