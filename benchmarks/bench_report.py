@@ -23,7 +23,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from class_results import pair_of, synthetic_class, synthetic_sources  # noqa: E402
+from bench_similarity import synthetic_class as similarity_class  # noqa: E402
+from class_results import pair_of, synthetic_class  # noqa: E402
 
 from labkit.cli import main as cli  # noqa: E402
 from labkit.grading import class_report, similarity  # noqa: E402
@@ -51,9 +52,15 @@ def main():
 
     grades = synthetic_class(args.count, seed=1)
     graded = [g for g in grades if g.graded]
-    sources, copied = synthetic_sources([g.name for g in graded], seed=1, copies=args.copies)
-    for grade in graded:
-        grade.sources = {function: texts[grade.name] for function, texts in sources.items()}
+    # the sources of bench_similarity.py: independent variants of 15 functions, and planted copies
+    with_sources, planted_by_index = similarity_class(len(graded), 15, 2 * args.copies, 21)
+    rename = {own.name: grade.name for own, grade in zip(with_sources, graded)}
+    sources = {}
+    for own, grade in zip(with_sources, graded):
+        grade.sources = dict(own.sources)
+        for function, text in own.sources.items():
+            sources.setdefault(function, {})[grade.name] = text
+    copied = [(f, rename[a], rename[b]) for f, a, b in planted_by_index]
     lines = statistics.mean(len(text.splitlines()) for texts in sources.values() for text in texts.values())
     print(
         f"a class of {len(grades)} submissions ({len(graded)} graded), {len(sources)} graded functions with a "
