@@ -15,6 +15,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
 from jupyterlab_session import (  # noqa: E402
+    CHROMIUM,
     CHROMIUM_FLAGS,
     COUNT_IMAGE_FRAMES,
     NOTEBOOKS,
@@ -27,7 +28,6 @@ from jupyterlab_session import (  # noqa: E402
     show_explorers,
 )
 
-CHROMIUM = Path("/usr/bin/chromium")
 GOAL_MS = 100  # median key press (or drag step) -> new picture, per slider
 
 

@@ -373,13 +373,13 @@ def test_nothing_outside_the_temporary_folders_is_touched(graded):
 def test_total_time_limit_stops_a_slow_notebook(tmp_path):
     nb = nbformat.v4.new_notebook()
     nb.cells = [nbformat.v4.new_markdown_cell("## Exercise 16")]
-    nb.cells += [nbformat.v4.new_code_cell("import time\ntime.sleep(1)") for _ in range(60)]
+    nb.cells += [nbformat.v4.new_code_cell("import time\ntime.sleep(1)") for _ in range(150)]
     path = tmp_path / "slow.ipynb"
     nbformat.write(nb, path)
     start = time.perf_counter()
     results, problems = grading.grade_notebook(path, cell_timeout=60, total_timeout=3)
-    # unstopped, the cells take 60 s; the limit is 3 s, and the rest is slack for a busy machine
-    assert time.perf_counter() - start < 40
+    # unstopped, the cells take 150 s; the limit is 3 s, and the rest is slack for a busy machine
+    assert time.perf_counter() - start < 90
     assert results == {} and "the submission's time limit of 3 s" in problems[0]
 
 

@@ -714,7 +714,7 @@ def test_an_uninterruptible_loop_is_stopped_by_the_total_limit(tmp_path):
     start = time.perf_counter()
     results, problems = grading.grade_notebook(path, cell_timeout=1, total_timeout=6)
     # the limit is 6 s; unstopped, only the grader's grace would end it (126 s): the rest is slack for a busy machine
-    assert time.perf_counter() - start < 60
+    assert time.perf_counter() - start < 100
     assert results == {} and "the submission's time limit of 6 s" in problems[0]
     assert _processes_with("labkit.grading.worker") == []
 

@@ -18,6 +18,21 @@ import urllib.request
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+CHROMIUM = Path("/usr/bin/chromium")  # Debian's: Playwright never downloads a browser of its own
+
+
+def skip_without_chromium():
+    """Skip the calling test module, saying so loudly, when /usr/bin/chromium is missing."""
+    if not CHROMIUM.exists():
+        import pytest
+
+        pytest.skip(
+            "!! BROWSER TEST SKIPPED: /usr/bin/chromium is missing (install Debian's chromium package; "
+            "`make test` does this when run as root)",
+            allow_module_level=True,
+        )
+
+
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 MOVES = 8  # key presses per slider, mouse steps per drag
 TOKEN = "labkit-browser-test"

@@ -10,24 +10,16 @@ summary is printed (``-s``).
 Run alone: ``.venv/bin/python -m pytest tests/browser/test_class_report_browser.py -s``.
 """
 
-from pathlib import Path
-
 import pytest
 from class_results import class_with_pairs
-from jupyterlab_session import CHROMIUM_FLAGS
+from jupyterlab_session import CHROMIUM, CHROMIUM_FLAGS, skip_without_chromium
 
 from labkit.grading import class_report
 
-CHROMIUM = Path("/usr/bin/chromium")
 HOSTILE = "<script>alert(1)</script>"
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 axe_playwright = pytest.importorskip("axe_playwright_python.sync_playwright", reason="axe-playwright-python is missing")
-if not CHROMIUM.exists():
-    pytest.skip(
-        "!! BROWSER TEST SKIPPED: /usr/bin/chromium is missing (install Debian's chromium package; "
-        "`make test` does this when run as root)",
-        allow_module_level=True,
-    )
+skip_without_chromium()
 
 
 @pytest.fixture(scope="module")

@@ -16,6 +16,7 @@ from urllib.parse import urlparse
 
 import pytest
 from jupyterlab_session import (
+    CHROMIUM,
     CHROMIUM_FLAGS,
     COUNT_IMAGE_FRAMES,
     NOTEBOOKS,
@@ -26,19 +27,14 @@ from jupyterlab_session import (
     move_every_slider,
     open_and_run,
     show_explorers,
+    skip_without_chromium,
 )
 
 LATENCIES = {}  # slider -> (median ms, 90th percentile ms, moves), printed by tests/conftest.py's summary
 ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM = Path("/usr/bin/chromium")
 SCREENSHOTS = ROOT / "build" / "screenshots"
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
-if not CHROMIUM.exists():
-    pytest.skip(
-        "!! BROWSER TEST SKIPPED: /usr/bin/chromium is missing (install Debian's chromium package; "
-        "`make test` does this when run as root)",
-        allow_module_level=True,
-    )
+skip_without_chromium()
 
 
 @pytest.fixture(scope="module")
