@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._alt import describe, num
 from ._validate import as_float_array, require_finite
 
 if TYPE_CHECKING:  # matplotlib is imported only when a mesh is drawn
@@ -22,6 +23,11 @@ if TYPE_CHECKING:  # matplotlib is imported only when a mesh is drawn
 
 WRITERS = {".vtu": ("vtu", {}), ".vtk": ("vtk", {}), ".msh": ("gmsh22", {"binary": True})}
 MERGE_TOLERANCE = 1e-6  # relative to the shortest edge of the meshes being joined
+# the quality map reads for colour-blind readers too (cividis: dark blue to yellow, lightness rising
+# throughout); folded elements are hatched and outlined as well, so no reading rests on colour alone
+QUALITY_CMAP = "cividis"
+FOLDED_STYLE = {"facecolor": "none", "edgecolor": "white", "hatch": "////", "linewidth": 1.5}
+FOLDED_LABEL = "folded or inverted (quality ≤ 0): hatched, outlined"
 
 
 class QuadMesh:
@@ -145,26 +151,44 @@ class QuadMesh:
         """Draw the element edges (x and y) with matplotlib; return the axes.
 
         With ``color_by_quality`` the elements are filled by their quality
-        (red: folded or inverted, green: square), with a colour bar unless
-        ``colorbar=False``. ``labkit.plots`` builds its mesh figures on this.
+        on the cividis map (dark blue: folded or inverted, yellow: square),
+        with a colour bar unless ``colorbar=False``; folded or inverted
+        elements (quality <= 0) are also hatched and outlined in white, and a
+        legend below the axes says so. ``labkit.plots`` builds its mesh
+        figures on this. The axes' alternative text (the ``alt`` of the
+        picture in a notebook) gives the mesh's size, extent and quality.
         """
         import matplotlib.pyplot as plt
         from matplotlib.collections import PolyCollection
+        from matplotlib.patches import Patch
 
         if ax is None:
             _, ax = plt.subplots(figsize=(5, 5))
         # shape (M, 4, 2): PolyCollection takes an array, though matplotlib's stubs type it as a Sequence
         polygons = self.points[self.quads][..., :2]
         style = {"edgecolor": "tab:blue", "linewidth": 0.8, **line_kw}
+        quality = self.quality()
         if color_by_quality:
             cells = PolyCollection(
                 polygons,
-                array=self.quality(),
-                cmap="RdYlGn",
+                array=quality,
+                cmap=QUALITY_CMAP,
                 clim=(-1, 1),  # type: ignore[arg-type]
+                gid="quality",
                 **style,
             )
             ax.add_collection(cells)
+            folded = PolyCollection(polygons[quality <= 0], gid="folded", **FOLDED_STYLE)  # type: ignore[arg-type]
+            ax.add_collection(folded)
+            sample = Patch(label=FOLDED_LABEL, **{**FOLDED_STYLE, "facecolor": cells.cmap(0.25)})
+            ax.legend(
+                handles=[sample],
+                loc="upper center",
+                bbox_to_anchor=(0.5, -0.13),
+                fontsize="small",
+                frameon=False,
+                handleheight=1.5,
+            )
             if colorbar:
                 ax.figure.colorbar(cells, ax=ax, label="quality (min scaled Jacobian)", shrink=0.8)
         else:
@@ -174,7 +198,32 @@ class QuadMesh:
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         ax.set_title(title or f"{len(self.quads)} quadrilaterals")
+        describe(ax, self.describe())
         return ax
+
+    def describe(self) -> str:
+        """What a drawing of the mesh shows, in numbers: its size, extent and quality (the picture's alt text).
+
+        Examples
+        --------
+        >>> from labkit import quad_mesh
+        >>> import numpy as np
+        >>> x, y = np.meshgrid([0.0, 1.0, 2.0], [0.0, 1.0], indexing="ij")
+        >>> quad_mesh(x, y).describe()
+        'mesh of 2 quadrilaterals, 6 nodes, x from 0 to 2, y from 0 to 1: worst quality 1.00, none folded'
+        """
+        quality = self.quality()
+        count = len(self.quads)
+        text = f"mesh of {count} quadrilateral{'s' * (count != 1)}, {len(self.points)} nodes"
+        if len(self.quads) == 0:
+            return text
+        used = self.points[np.unique(self.quads)]
+        low, high = used.min(axis=0), used.max(axis=0)
+        folded = int(np.sum(quality <= 0))
+        return (
+            f"{text}, x from {num(low[0])} to {num(high[0])}, y from {num(low[1])} to {num(high[1])}: "
+            f"worst quality {quality.min():.2f}, " + (f"{folded} folded" if folded else "none folded")
+        )
 
 
 def quad_mesh(x: ArrayLike, y: ArrayLike, z: ArrayLike | None = None) -> QuadMesh:

@@ -176,9 +176,12 @@ def test_every_explorer_redraws_while_dragged_and_sends_a_new_picture(factory, c
     explorer.controls[control].value = value
     assert explorer.redraws == redraws + 1 and explorer.image.value != before
     assert _png_size(explorer.image.value) == tuple(int(v) for v in explorer.figure.canvas.get_width_height())
-    bundle = explorer._repr_mimebundle_()
+    bundle, metadata = explorer._repr_mimebundle_()
     assert "application/vnd.jupyter.widget-view+json" in bundle and "interactive" not in bundle["text/plain"]
-    assert _png_size(__import__("base64").b64decode(bundle["image/png"]))[0] > 100
+    width, height = _png_size(__import__("base64").b64decode(bundle["image/png"]))
+    # the static copy is the 2x picture, shown at its CSS size, with the figure's description as alt text
+    assert (metadata["image/png"]["width"], metadata["image/png"]["height"]) == (width // 2, height // 2)
+    assert width // 2 > 100 and metadata["image/png"]["alt"] == explorer.image.description != ""
 
 
 def test_the_explorer_figure_shows_what_the_controls_say():

@@ -11,17 +11,27 @@ picture, so a static copy of the notebook still shows the figure.
 
 One function per notebook builds its explorer, so a notebook's Explore cell
 is one line, e.g. ``plots.limacon_explorer()``.
+
+The pictures are rendered at ``PIXEL_RATIO`` (2) device pixels per CSS pixel
+and shown at their CSS size (``DPI`` CSS pixels per inch of figure), so their
+text stays sharp on HiDPI screens and at the width JupyterLab gives them. The
+picture's alternative text (and the image widget's ``description``) says what
+the figure shows, in numbers, and follows the controls.
 """
 
 import base64
+import functools
 import io
+import pathlib
 
 import numpy as np
 
+from .._alt import figure_alt
 from ..patches import Corner
 from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
 
-DPI = 80  # pixels per inch of the slider pictures: sharp enough, and quick to render and send
+DPI = 80  # CSS pixels per inch of the slider pictures (what they measure on the page)
+PIXEL_RATIO = 2  # device pixels rendered per CSS pixel: crisp on HiDPI screens and when zoomed
 
 
 def new_figure(size, dpi=DPI):
@@ -81,13 +91,36 @@ def freeze_layout(figure):
     figure.set_layout_engine("none")
 
 
+@functools.cache
+def _image_class():
+    import anywidget
+    import traitlets
+
+    class ExplorerImage(anywidget.AnyWidget):
+        """The explorer's picture (``image.js``): a PNG shown at its CSS size, with its description as alt text."""
+
+        _esm = pathlib.Path(__file__).with_name("image.js")
+        value = traitlets.Bytes(b"").tag(sync=True)
+        css_size = traitlets.List([0, 0]).tag(sync=True)  # [width, height] in CSS pixels
+        description = traitlets.Unicode("").tag(sync=True)
+
+    return ExplorerImage
+
+
+def explorer_image():
+    """A new image widget of the explorers: ``value`` (PNG bytes), ``css_size`` and ``description``."""
+    return _image_class()()
+
+
 class Explorer:
     """Controls and a figure that follows them.
 
     Parameters
     ----------
     figure : matplotlib.figure.Figure
-        Drawn into by `update`; rendered to PNG after every change.
+        Drawn into by `update`; rendered to PNG after every change, and
+        shown at ``DPI`` CSS pixels per inch: a figure of ``DPI * PIXEL_RATIO``
+        dots per inch (:func:`new_figure`'s ``ratio``) is sharp on HiDPI screens.
     update : callable
         ``update(**values)`` with the controls' current values by name; it
         changes the figure's artists in place.
@@ -100,13 +133,13 @@ class Explorer:
 
         self.figure, self._update, self.controls = figure, update, dict(controls)
         self.painter = Painter(figure, view)
-        self.image = widgets.Image(format="png")
-        self.image.add_class("labkit-explorer-image")
+        self.image = explorer_image()
         self.redraws = 0
         for control in self.controls.values():
             control.observe(self.refresh, names="value")
         self._update(**self.values())
         freeze_layout(figure)
+        self.image.css_size = list(self.css_size())
         self.refresh()
         self.widget = widgets.VBox([*self.controls.values(), self.image])
         self.widget.add_class("labkit-explorer")
@@ -115,28 +148,55 @@ class Explorer:
         return {name: control.value for name, control in self.controls.items()}
 
     def refresh(self, change=None):
-        """Update the figure from the controls and send its new picture."""
+        """Update the figure from the controls and send its new picture and description (one message)."""
         self._update(**self.values())
-        self.image.value = self.png()
+        picture = self.png()
+        with self.image.hold_sync():
+            self.image.description = self.description
+            self.image.value = picture
         self.redraws += 1
+
+    @property
+    def description(self):
+        """What the figure shows now, in numbers (the picture's alt text)."""
+        return figure_alt(self.figure)
+
+    def css_size(self):
+        """(width, height) of the picture on the page, in CSS pixels."""
+        width, height = self.figure.canvas.get_width_height()
+        ratio = self.figure.dpi / DPI
+        return round(width / ratio), round(height / ratio)
 
     def png(self):
         return png(self.figure, self.painter)
 
     def _repr_mimebundle_(self, **kwargs):
         return widget_with_picture(
-            self.widget, self.png(), f"<{type(self).__name__}: {', '.join(self.controls)}>", **kwargs
+            self.widget,
+            self.png(),
+            f"<{type(self).__name__}: {', '.join(self.controls)}>",
+            alt=self.description,
+            size=self.css_size(),
+            **kwargs,
         )
 
 
-def widget_with_picture(widget, picture, text, **kwargs):
+def widget_with_picture(widget, picture, text, alt=None, size=None, **kwargs):
     """A widget's output bundle that also carries a PNG: front ends with widgets show the widget,
-    static views (nbconvert, GitHub, nbviewer, nbval's saved outputs) the picture."""
+    static views (nbconvert, GitHub, nbviewer, nbval's saved outputs) the picture.
+
+    The picture's metadata carries `alt` (default: `text`) as its alternative text and, given `size`
+    (CSS pixels), its width and height, so a 2x picture shows at its CSS size there too.
+    Returns ``(data, metadata)``.
+    """
     bundle = widget._repr_mimebundle_(**kwargs)
-    data = bundle[0] if isinstance(bundle, tuple) else bundle
+    data, metadata = bundle if isinstance(bundle, tuple) else (bundle, {})
     data["image/png"] = base64.b64encode(picture).decode("ascii")
     data["text/plain"] = text
-    return bundle
+    picture_metadata = {"alt": text if alt is None else alt}
+    if size is not None:
+        picture_metadata.update(width=int(size[0]), height=int(size[1]))
+    return data, {**(metadata or {}), "image/png": picture_metadata}
 
 
 def _slider(kind, value, low, high, step=None, description=""):
@@ -152,7 +212,7 @@ def limacon_explorer():
     """01: the limaçon interpolated from n points, linear or Hermite, for a radius r0."""
     import ipywidgets as widgets
 
-    figure, ax = new_figure((5, 5))
+    figure, ax = new_figure((5, 5), dpi=DPI * PIXEL_RATIO)
     view = LimaconView(ax)
     return Explorer(
         figure,
@@ -174,7 +234,7 @@ def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notak
 
     from ..convergence import METHOD_TITLES
 
-    figure, ax = new_figure((6, 4))
+    figure, ax = new_figure((6, 4), dpi=DPI * PIXEL_RATIO)
     view = ErrorCurvesView(methods, ax)
     return Explorer(
         figure,
@@ -193,7 +253,7 @@ def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notak
 
 def mesh_explorer():
     """03: the graded unit-square patch: dx/ds at A, D and at B, C, the twist and the mesh size."""
-    figure, ax = new_figure((5.5, 5))
+    figure, ax = new_figure((5.5, 5), dpi=DPI * PIXEL_RATIO)
     view = PatchView(ax)
 
     def update(dxds_AD, dxds_BC, twist, elements):
@@ -222,7 +282,7 @@ def spline_explorer():
     """04: the error curves of the complete, natural and not-a-knot splines for ndata points."""
     import ipywidgets as widgets
 
-    figure, ax = new_figure((6, 4))
+    figure, ax = new_figure((6, 4), dpi=DPI * PIXEL_RATIO)
     methods = ("complete", "natural", "notaknot")
     view = ErrorCurvesView(methods, ax)
 
@@ -237,7 +297,7 @@ def spline_explorer():
 
 def pchip_explorer(xdata=(0.0, 1.0, 2.0, 3.0, 4.0)):
     """05: move two data values and watch the spline overshoot while pchip keeps the shape."""
-    figure, ax = new_figure((6, 4))
+    figure, ax = new_figure((6, 4), dpi=DPI * PIXEL_RATIO)
     view = SplinePchipView(np.asarray(xdata, dtype=float), ax)
     return Explorer(
         figure,
@@ -252,6 +312,6 @@ def pchip_explorer(xdata=(0.0, 1.0, 2.0, 3.0, 4.0)):
 
 def bilinear_explorer():
     """06: the bilinear interpolation error over the square for an ndata x ndata grid."""
-    figure, ax = new_figure((5.5, 4.5))
+    figure, ax = new_figure((5.5, 4.5), dpi=DPI * PIXEL_RATIO)
     view = BilinearErrorView(ax, ntest=161)
     return Explorer(figure, view.update, {"ndata": _slider(int, 11, 2, 41, description="ndata")}, view=view)

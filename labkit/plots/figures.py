@@ -5,11 +5,18 @@ when it is made, and ``update(...)`` puts new data into those same artists:
 ``set_data``, ``set_verts``, ``set_array`` and the title, never a new figure.
 The sliders of :mod:`labkit.plots.explorers` call ``update`` on every move;
 the ``plot_*`` functions are a view updated once, for a static figure.
-Every function labels its axes, sets a title and returns the axes.
+Every function labels its axes, sets a title and returns the axes, and describes
+what it drew in numbers (the picture's alternative text, see ``labkit/_alt.py``).
+
+Colours are safe for colour-blind readers: lines take the Okabe–Ito palette
+(``PALETTE``) and each method keeps its own colour, line style and marker
+(``METHOD_STYLES``) in every figure, so no two curves differ by colour alone;
+colour maps are cividis (mesh quality) and coolwarm (signed errors).
 """
 
 import numpy as np
 
+from .._alt import describe, num, sci
 from ..bilinear import eval_pbilin
 from ..convergence import METHOD_TITLES, _interpolate
 from ..functions import limacon, runge, runge2d
@@ -18,6 +25,34 @@ from ..monotone import pchip
 from ..patches import patch
 from ..piecewise import eval_pherm, eval_plin
 from ..splines import ccspline, nakspline, ncspline, spline
+
+# Okabe & Ito's palette (Color Universal Design, 2008): told apart with every common colour-vision deficiency
+PALETTE = {
+    "blue": "#0072B2",
+    "vermillion": "#D55E00",
+    "green": "#009E73",
+    "orange": "#E69F00",
+    "purple": "#CC79A7",
+    "sky": "#56B4E9",
+    "black": "#000000",
+}
+# one look per method in every figure: colour, line style and marker differ together
+METHOD_STYLES = {
+    "plin": {"color": PALETTE["blue"], "linestyle": "-", "marker": "o"},
+    "pherm": {"color": PALETTE["vermillion"], "linestyle": "--", "marker": "s"},
+    "complete": {"color": PALETTE["green"], "linestyle": "-.", "marker": "^"},
+    "natural": {"color": PALETTE["orange"], "linestyle": "-", "marker": "D"},
+    "notaknot": {"color": PALETTE["purple"], "linestyle": ":", "marker": "v"},
+    "pchip": {"color": PALETTE["sky"], "linestyle": (0, (5, 1, 1, 1, 1, 1)), "marker": "P"},
+}
+
+
+def method_style(method, markers=False):
+    """Colour and line style of `method` (and its marker if `markers`), as keyword arguments of ``plot``."""
+    style = dict(METHOD_STYLES[method])
+    if not markers:
+        style.pop("marker")
+    return style
 
 
 def new_axes(ax=None, size=(5, 5)):
@@ -80,8 +115,8 @@ class LimaconView(View):
     def __init__(self, ax=None):
         self.ax = new_axes(ax)
         (self.exact,) = self.ax.plot([], [], color="0.75", lw=3, label="exact")
-        (self.curve,) = self.ax.plot([], [], color="tab:blue", label="interpolant")
-        (self.data,) = self.ax.plot([], [], "o", color="tab:red", ms=4, label="data")
+        (self.curve,) = self.ax.plot([], [], color=PALETTE["blue"], label="interpolant")
+        (self.data,) = self.ax.plot([], [], "o", color=PALETTE["vermillion"], ms=4, label="data")
         self._r0 = None
         self.ax.set_aspect("equal")
         _label(self.ax, "x", "y", "")
@@ -108,6 +143,14 @@ class LimaconView(View):
             self.ax.legend(loc="upper right", fontsize="small")
         self.data.set_data(xdata, ydata)
         self.ax.set_title(f"limaçon r = {r0:g} + cos t, {nintervals} intervals")
+        xexact, yexact = limacon(tval, r0)[:2]
+        distance = np.hypot(xval - xexact, yval - yexact)
+        worst = int(np.argmax(distance))
+        describe(
+            self.ax,
+            f"limaçon r = {r0:g} + cos t and its {label} interpolant from {nintervals + 1} points "
+            f"({nintervals} intervals): largest error {sci(distance[worst])} at t = {num(tval[worst])}",
+        )
         return self.ax
 
     def dynamic(self):
@@ -127,7 +170,9 @@ class ErrorCurvesView(View):
         self.x = np.linspace(self.a, self.b, 1001)
         self.exact = f(self.x)[0]
         self._errors, self._shown = {}, None
-        self.lines = {m: self.ax.plot(self.x, 0 * self.x, label=METHOD_TITLES[m])[0] for m in methods}
+        self.lines = {
+            m: self.ax.plot(self.x, 0 * self.x, label=METHOD_TITLES[m], **method_style(m))[0] for m in methods
+        }
         (self.points,) = self.ax.plot([], [], "k.", ms=4, label="data points")
         self.ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
         _label(self.ax, "x", "p(x) - f(x)", "")
@@ -162,7 +207,16 @@ class ErrorCurvesView(View):
             self.ax.legend(handles=shown, fontsize="small")
             self._shown = shown
         self.ax.set_title(f"Interpolation error, {ndata} equally spaced points")
+        describe(self.ax, "; ".join(self._describe(method, ndata) for method in self.lines if method in methods))
         return self.ax
+
+    def _describe(self, method, ndata):
+        error = np.abs(self._error(method, ndata))
+        worst = int(np.argmax(error))
+        return (
+            f"error of the {METHOD_TITLES[method].lower()} with {ndata} points: "
+            f"largest {sci(error[worst])} at x = {num(self.x[worst])}"
+        )
 
     def dynamic(self):
         """The curves, the data points and the title: see PatchView.dynamic."""
@@ -179,8 +233,8 @@ class SplinePchipView(View):
         self.ax = new_axes(ax, size=(6, 4))
         self.xdata = np.asarray(xdata, dtype=float)
         self.xv = np.linspace(self.xdata[0], self.xdata[-1], 201)
-        (self.spline,) = self.ax.plot(self.xv, 0 * self.xv, label="not-a-knot spline")
-        (self.pchip,) = self.ax.plot(self.xv, 0 * self.xv, label="pchip")
+        (self.spline,) = self.ax.plot(self.xv, 0 * self.xv, label="not-a-knot spline", **method_style("notaknot"))
+        (self.pchip,) = self.ax.plot(self.xv, 0 * self.xv, label="pchip", **method_style("pchip"))
         (self.data,) = self.ax.plot(self.xdata, 0 * self.xdata, "o", mfc="none", color="k", label="data")
         self._fitted = False
         self.ax.legend(fontsize="small")
@@ -189,8 +243,9 @@ class SplinePchipView(View):
     def update(self, ydata):
         ydata = np.asarray(ydata, dtype=float)
         curve = spline(self.xdata, ydata, self.xv)
+        monotone = pchip(self.xdata, ydata, self.xv)
         self.spline.set_ydata(curve)
-        self.pchip.set_ydata(pchip(self.xdata, ydata, self.xv))
+        self.pchip.set_ydata(monotone)
         self.data.set_ydata(ydata)
         values = np.concatenate((curve, ydata))
         low, high = values.min(), values.max()
@@ -198,6 +253,13 @@ class SplinePchipView(View):
         if not self._fitted or low < bottom or high > top or top - bottom > 4 * (high - low):
             _fit(self.ax, self.xv, values)  # otherwise the axes stay still while the curves fit
             self._fitted = True
+        points = ", ".join(f"({num(x)}, {num(y)})" for x, y in zip(self.xdata, ydata))
+        describe(
+            self.ax,
+            f"data {points}: the not-a-knot spline goes from {num(curve.min())} to {num(curve.max())}, "
+            f"pchip from {num(monotone.min())} to {num(monotone.max())} (the data from {num(ydata.min())} "
+            f"to {num(ydata.max())})",
+        )
         return self.ax
 
     def dynamic(self):
@@ -229,10 +291,16 @@ class BilinearErrorView(View):
     def update(self, ndata):
         grid = np.linspace(self.a, self.b, ndata)
         error = eval_pbilin(self.f, grid, grid, self.test, self.test) - self.exact
-        largest = np.abs(error).max()
+        i, j = np.unravel_index(np.argmax(np.abs(error)), error.shape)
+        largest = np.abs(error[i, j])
         self.image.set_array(error.T)
         self.image.set_clim(-largest or -1e-16, largest or 1e-16)
         self.ax.set_title(f"Bilinear error, {ndata} x {ndata} data, max {largest:.1e}")
+        describe(
+            self.ax,
+            f"error I - f of bilinear interpolation from {ndata} x {ndata} data: largest |I - f| {sci(largest)} "
+            f"at (x, y) = ({num(self.test[i])}, {num(self.test[j])}), from {sci(error.min())} to {sci(error.max())}",
+        )
         return self.ax
 
     def dynamic(self):
@@ -244,34 +312,46 @@ class BilinearErrorView(View):
 
 
 class PatchView(View):
-    """A Coons patch's mesh, filled by element quality (folded elements red), with the worst in the title."""
+    """A Coons patch's mesh, filled by element quality (folded elements hatched), with the worst in the title."""
 
     def __init__(self, ax=None, color_by_quality=True, colorbar=True):
         self.ax = new_axes(ax)
         self.color_by_quality, self.colorbar = color_by_quality, colorbar
         self.cells = None
+        self.folded = None  # the hatched outlines of the folded elements, when coloured by quality
         self.mesh = None
 
     def update(self, corners, ns=11, nt=11, s=None, t=None, title=None):
         s = np.linspace(0, 1, ns) if s is None else s
         t = np.linspace(0, 1, nt) if t is None else t
         self.mesh = quad_mesh(*patch(*corners, s, t))
-        worst = self.mesh.quality().min()
+        quality = self.mesh.quality()
+        worst = quality.min()
         title = title or f"{len(s) - 1} x {len(t) - 1} elements, worst quality {worst:.2f}"
         if self.cells is None:
             self.mesh.plot(ax=self.ax, color_by_quality=self.color_by_quality, title=title, colorbar=self.colorbar)
-            self.cells = self.ax.collections[-1]
+            drawn = {c.get_gid(): c for c in self.ax.collections}
+            self.cells = drawn.get("quality", self.ax.collections[-1])
+            self.folded = drawn.get("folded")
         else:
-            self.cells.set_verts(self.mesh.points[self.mesh.quads][..., :2])
+            polygons = self.mesh.points[self.mesh.quads][..., :2]
+            self.cells.set_verts(polygons)
             if self.color_by_quality:
-                self.cells.set_array(self.mesh.quality())
+                self.cells.set_array(quality)
+                self.folded.set_verts(polygons[quality <= 0])
             self.ax.set_title(title)
         _fit(self.ax, self.mesh.points[:, 0], self.mesh.points[:, 1])
+        folded = int(np.sum(quality <= 0))
+        describe(
+            self.ax,
+            f"mesh of a Coons patch, {len(s) - 1} x {len(t) - 1} elements: worst quality {worst:.2f}, "
+            + (f"{folded} folded" + (" (hatched)" if self.color_by_quality else "") if folded else "none folded"),
+        )
         return self.ax
 
     def dynamic(self):
         """The artists a move changes (the rest is drawn once and copied: see Explorer)."""
-        return [self.cells, self.ax.title]
+        return [self.cells, self.ax.title] + ([self.folded] if self.folded is not None else [])
 
     def static_key(self):
         """What the copied background depends on: a new key means a full redraw."""
@@ -298,13 +378,26 @@ def plot_limacon(nintervals=20, r0=1.15, method="pherm", ax=None):
 def plot_convergence(tables, ax=None):
     """Log-log plot of error against number of data for ConvergenceTables, with slopes -2 and -4."""
     ax = new_axes(ax, size=(6, 4.5))
-    for table in tables:
-        ax.loglog(table.ndata, table.errors, "o-", ms=4, label=f"{table.title.split(', ')[-1]} (order {table.order})")
+    titles = {title.lower(): method for method, title in METHOD_TITLES.items()}
+    looks = list(METHOD_STYLES.values())
+    for k, table in enumerate(tables):
+        name = table.title.split(", ")[-1]
+        look = METHOD_STYLES.get(titles.get(name.lower()), looks[k % len(looks)])
+        ax.loglog(table.ndata, table.errors, ms=4, label=f"{name} (order {table.order})", **look)
     n = np.array([tables[0].ndata[2], tables[0].ndata[-1]], dtype=float)
     for order, style in ((2, "k--"), (4, "k:")):
         anchor = min(t.errors[2] for t in tables)
         ax.loglog(n, anchor * (n / n[0]) ** -order, style, lw=1, label=f"slope -{order}")
     ax.legend(fontsize="small")
+    describe(
+        ax,
+        "convergence on the Runge function, relative max error against the number of data points: "
+        + "; ".join(
+            f"{t.title.split(', ')[-1].lower()} from {sci(t.errors[0])} at {t.ndata[0]} points "
+            f"to {sci(t.errors[-1])} at {t.ndata[-1]} (order {t.order})"
+            for t in tables
+        ),
+    )
     return _label(ax, "number of data points", "relative max error", "Convergence on the Runge function")
 
 
@@ -337,12 +430,25 @@ def plot_second_derivatives(ndata=7, ax=None, f=runge, interval=(0.0, 5.0)):
             ]
         )
 
-    ax.plot(x, curve(yp), color="0.5", lw=2.5, label="Hermite (true slopes): s'' jumps")
-    ax.plot(x, curve(ccspline(xdata, y, yp[0], yp[-1])), label="complete spline")
-    ax.plot(x, curve(ncspline(xdata, y)), "--", label="natural spline (s'' = 0 at the ends)")
-    ax.plot(x, curve(nakspline(xdata, y)), ":", lw=2, label="not-a-knot spline")
+    hermite = curve(yp)
+    ax.plot(x, hermite, color="0.5", lw=2.5, label="Hermite (true slopes): s'' jumps")
+    ax.plot(x, curve(ccspline(xdata, y, yp[0], yp[-1])), label="complete spline", **method_style("complete"))
+    ax.plot(x, curve(ncspline(xdata, y)), label="natural spline (s'' = 0 at the ends)", **method_style("natural"))
+    ax.plot(x, curve(nakspline(xdata, y)), lw=2, label="not-a-knot spline", **method_style("notaknot"))
     ax.plot(xdata, np.zeros(ndata), "k|", ms=12, label="data points")
     ax.legend(fontsize="small")
+    pieces = hermite.reshape(ndata - 1, -1)  # each piece's 40 values and its NaN
+    jumps = np.abs(pieces[1:, 0] - pieces[:-1, -2])  # s'' just right and just left of each inner data point
+    jump = (
+        f"the Hermite cubics' s'' jumps by up to {num(jumps.max())} (at x = {num(xdata[1 + np.argmax(jumps)])})"
+        if jumps.size
+        else "one Hermite cubic"
+    )
+    describe(
+        ax,
+        f"second derivatives s'' from {ndata} equally spaced points: {jump}; the complete, natural and "
+        f"not-a-knot splines' s'' are continuous, the natural spline's 0 at x = {num(a)} and x = {num(b)}",
+    )
     return _label(ax, "x", "s''(x)", f"Second derivatives, {ndata} equally spaced points")
 
 

@@ -75,6 +75,17 @@ def _nudge_with_keys(page, panel, after_drag):
     assert keyed.splitlines()[2] != nudged.splitlines()[2]
 
 
+def _explorer_pictures(page, panel):
+    """Each explorer picture's natural width (device pixels), displayed CSS width and alt text, once loaded."""
+    images = panel.locator(".labkit-explorer img")
+    for k in range(images.count()):
+        images.nth(k).scroll_into_view_if_needed()
+        page.wait_for_function("img => img.complete && img.naturalWidth > 0", arg=images.nth(k).element_handle())
+    return images.evaluate_all(
+        "imgs => imgs.map(img => ({natural: img.naturalWidth, shown: img.getBoundingClientRect().width, alt: img.alt}))"
+    )
+
+
 @pytest.mark.parametrize("notebook", NOTEBOOKS, ids=lambda p: p.name)
 def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
     context = browser.new_context(viewport={"width": 1400, "height": 1000})
@@ -103,6 +114,11 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
 
     output = panel.locator(".labkit-explorer img, .labkit-patch-editor img").last
     output.wait_for(timeout=30_000)
+    pictures = _explorer_pictures(page, panel)
+    assert pictures, "no explorer picture"
+    for picture in pictures:  # crisp: at least two device pixels per CSS pixel shown, and described
+        assert picture["natural"] >= 2 * picture["shown"] > 0, picture
+        assert picture["alt"] and any(ch.isdigit() for ch in picture["alt"]), picture
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     stem = notebook.stem
     page.screenshot(path=str(SCREENSHOTS / f"{stem}-before.png"))
