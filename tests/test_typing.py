@@ -261,6 +261,7 @@ CALLS = [
     ("QuadMesh.__add__", lambda tmp: _mesh() + labkit.quad_mesh(*np.meshgrid([2.0, 3.0], [0.0, 1.0], indexing="ij"))),
     ("QuadMesh.write", lambda tmp: _mesh().write(str(tmp / "mesh.vtu"))),
     ("QuadMesh.plot", lambda tmp: _plot(_mesh())),
+    ("QuadMesh.describe", lambda tmp: _mesh().describe()),
     ("ConvergenceTable.__init__", lambda tmp: _init(labkit.ConvergenceTable, TABLE.title, TABLE.ndata, TABLE.errors)),
     ("ConvergenceTable.ratios", lambda tmp: TABLE.ratios),
     ("ConvergenceTable.rates", lambda tmp: TABLE.rates),

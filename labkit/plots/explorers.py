@@ -73,13 +73,14 @@ class Painter:
 
 
 def png(figure, painter=None):
-    """The figure as PNG bytes: one Agg draw (or a blit), fast compression."""
+    """The figure as PNG bytes (RGB): one Agg draw (or a blit), fast compression."""
     from PIL import Image
 
     canvas = figure.canvas
     (painter or Painter(figure)).draw()
     buffer = io.BytesIO()
-    Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).save(
+    # RGB: the figure is opaque, and three channels encode faster than four (the 2x pictures have 4x the pixels)
+    Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB").save(
         buffer, format="png", compress_level=1
     )
     return buffer.getvalue()
