@@ -3,10 +3,11 @@
 * :mod:`~labkit.plots.figures` - each figure as a view built once and updated in place,
   and the one-call ``plot_*`` functions;
 * :mod:`~labkit.plots.explorers` - the Explore sections' sliders (one function per notebook);
-* :mod:`~labkit.plots.editor` - the patch editor of exercises 5 to 9 (drag corners and derivatives).
+* :mod:`~labkit.plots.editor` - the patch editor of exercises 5 to 9 (drag corners and derivatives);
+* :mod:`~labkit.plots.labels` - accessible names for the widgets' sliders.
 """
 
-from .editor import corner_code, handle_positions, move_handle, nearest_handle, patch_editor
+from .editor import corner_code, handle_name, handle_positions, move_handle, nearest_handle, patch_editor, status_text
 from .explorers import (
     Explorer,
     bilinear_explorer,
@@ -43,6 +44,7 @@ __all__ = [
     "convergence_explorer",
     "corner_code",
     "draw_mesh",
+    "handle_name",
     "handle_positions",
     "limacon_explorer",
     "mesh_explorer",
@@ -58,4 +60,5 @@ __all__ = [
     "plot_second_derivatives",
     "plot_spline_vs_pchip",
     "spline_explorer",
+    "status_text",
 ]

@@ -2,9 +2,16 @@
 // The kernel sends the mesh picture, the handles in data coordinates and where the axes lie in
 // the picture; this module draws the handles over the picture, moves them under the mouse at once,
 // and sends the dragged handle's position to the kernel, one request at a time (the newest wins).
+// Keyboard: Tab enters and leaves the editor like any control (never trapped, WCAG 2.1.2); n / p select
+// the next / previous handle; the arrow keys move it (Shift: 5 times further). The picture and handles
+// form an ARIA "application" named by the model's label; a polite live region speaks the model's status
+// (the selected handle and the worst quality, both from the kernel) after every change.
 const SVG = "http://www.w3.org/2000/svg";
 const COLORS = ["#111", "#d62728", "#6a3d9a"]; // corner, d/ds tip, d/dt tip
 const NAMES = "ABCD";
+const CYCLE = { n: 1, p: 11 }; // next and previous handle, of 12
+const STYLE = `.labkit-editor:focus { outline: none; }
+.labkit-editor:focus-visible { outline: 3px solid #1a73e8; outline-offset: 2px; }`;
 
 function make(tag, attrs, parent) {
   const node = document.createElementNS(SVG, tag);
@@ -15,26 +22,45 @@ function make(tag, attrs, parent) {
 
 function render({ model, el }) {
   const root = document.createElement("div");
-  root.className = "labkit-editor";
-  root.tabIndex = 0;
-  root.dataset.lmSuppressShortcuts = "true"; // keys here are the editor's, not JupyterLab's commands
-  root.style.cssText = "display:flex; gap:12px; align-items:flex-start; outline:none";
+  root.className = "labkit-editor-box";
+  root.style.cssText = "display:flex; gap:12px; align-items:flex-start";
+  const style = document.createElement("style");
+  style.textContent = STYLE;
+  // the picture and its handles take the keyboard: an application, so a screen reader passes the keys on
   const stage = document.createElement("div");
+  stage.className = "labkit-editor";
+  stage.tabIndex = 0;
+  stage.setAttribute("role", "application");
+  stage.setAttribute("aria-label", model.get("label"));
+  stage.dataset.lmSuppressShortcuts = "true"; // keys here are the editor's, not JupyterLab's commands
   stage.style.cssText = "position:relative; line-height:0";
   const img = document.createElement("img");
   img.className = "labkit-editor-image";
   img.draggable = false;
-  const svg = make("svg", { class: "labkit-editor-handles" });
+  const svg = make("svg", { class: "labkit-editor-handles", "aria-hidden": "true", focusable: "false" });
   svg.style.cssText = "position:absolute; left:0; top:0; touch-action:none; cursor:default";
+  const side = document.createElement("div");
+  side.style.cssText = "display:flex; flex-direction:column; gap:6px; max-width:36em";
   const readout = document.createElement("pre");
   readout.className = "labkit-editor-readout";
-  readout.style.cssText = "font-size:12px; margin:0; padding:6px; border:1px solid #ccc; user-select:text";
+  readout.style.cssText = "font-size:12px; margin:0; padding:6px; border:1px solid #767676; user-select:text";
+  const live = document.createElement("div");
+  live.className = "labkit-editor-status";
+  live.setAttribute("role", "status");
+  live.setAttribute("aria-live", "polite");
+  live.setAttribute("aria-atomic", "true");
+  live.style.cssText = "font-size:12px";
+  const keys = document.createElement("div");
+  keys.className = "labkit-editor-keys";
+  keys.style.cssText = "font-size:12px";
+  keys.textContent = "Keys: " + model.get("key_help");
   stage.append(img, svg);
-  root.append(stage, readout);
+  side.append(readout, live, keys);
+  root.append(style, stage, side);
   el.appendChild(root);
 
   let positions = model.get("handles").map((p) => p.slice());
-  let dragging = null, selected = 0, waiting = false, queued = null, seq = 0, url = null, timer = null;
+  let dragging = null, selected = model.get("selected"), waiting = false, queued = null, seq = 0, url = null, timer = null;
 
   const frame = () => model.get("frame");
   function toPixels([x, y]) {
@@ -107,11 +133,11 @@ function render({ model, el }) {
   svg.addEventListener("pointerdown", (event) => {
     const index = event.target.getAttribute && event.target.getAttribute("data-handle");
     if (index === null || index === undefined) return;
-    dragging = selected = Number(index);
+    dragging = Number(index);
+    select(dragging);
     svg.setPointerCapture(event.pointerId);
-    root.focus();
+    stage.focus();
     event.preventDefault();
-    draw();
   });
   svg.addEventListener("pointermove", (event) => {
     if (dragging !== null) place(dragging, mouse(event));
@@ -120,19 +146,29 @@ function render({ model, el }) {
     if (dragging === null) return;
     place(dragging, mouse(event));
     dragging = null;
+    announce();
   };
   svg.addEventListener("pointerup", release);
-  // a click anywhere on the editor gives it the keyboard (after JupyterLab has focused the cell)
-  root.addEventListener("pointerup", () => setTimeout(() => root.focus(), 0));
+  // a click on the picture gives it the keyboard (after JupyterLab has focused the cell)
+  stage.addEventListener("pointerup", () => setTimeout(() => stage.focus(), 0));
   svg.addEventListener("pointercancel", release);
 
-  root.addEventListener("keydown", (event) => {
+  // the kernel answers a new selection with the status sentence the live region speaks
+  function select(index) {
+    selected = index;
+    draw();
+    model.set("selected", index);
+    model.save_changes();
+  }
+
+  stage.addEventListener("keydown", (event) => {
+    if (event.altKey || event.ctrlKey || event.metaKey) return; // Tab and the browser's keys are not ours
     const f = frame();
     const step = (event.shiftKey ? 0.05 : 0.01) * (f.x1 - f.x0);
     const moves = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, step], ArrowDown: [0, -step] };
-    if (event.key === "Tab" || event.key === "n") {
-      selected = (selected + (event.shiftKey ? 11 : 1)) % 12;
-      draw();
+    const key = event.key.length === 1 ? event.key.toLowerCase() : event.key;
+    if (CYCLE[key]) {
+      select((selected + CYCLE[key]) % 12);
     } else if (moves[event.key]) {
       const [dx, dy] = moves[event.key];
       place(selected, [positions[selected][0] + dx, positions[selected][1] + dy]);
@@ -151,18 +187,28 @@ function render({ model, el }) {
   }
   function showReadout() {
     readout.textContent = model.get("readout");
-    readout.style.borderColor = model.get("worst") <= 0 ? "#d62728" : "#ccc";
+    readout.style.borderColor = model.get("worst") <= 0 ? "#d62728" : "#767676";
+    img.alt = model.get("alt");
+  }
+  // the live region changes once a drag ends, not at every step of it (a screen reader would queue them all)
+  function announce() {
+    if (dragging === null) live.textContent = model.get("status");
   }
 
   model.on("change:image", showImage);
   model.on("change:ack", answered);
   model.on("change:readout", showReadout);
+  model.on("change:status", announce);
+  model.on("change:selected", () => { // set by the kernel (a drag's handle)
+    if (model.get("selected") !== selected) { selected = model.get("selected"); draw(); }
+  });
   model.on("change:handles", () => {
     if (dragging === null && !waiting) { positions = model.get("handles").map((p) => p.slice()); draw(); }
   });
   model.on("change:frame", draw);
   showImage();
   showReadout();
+  announce();
   draw();
   return () => { if (url) URL.revokeObjectURL(url); clearTimeout(timer); };
 }

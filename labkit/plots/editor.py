@@ -6,12 +6,20 @@ corners, and the tips of each corner's d/ds and d/dt arrows. Dragging a
 handle moves it at once in the browser and sends its position to the kernel,
 which rebuilds the mesh and sends the new picture, the worst quality and the
 corner data as ``Corner(...)`` lines to copy into an exercise cell. Sliders
-set the mesh size and the twist; the arrow keys nudge the selected handle.
+set the mesh size and the twist.
+
+Without a mouse (:data:`KEYS`): Tab reaches the editor and leaves it as it
+leaves any control; ``n`` and ``p`` select the next and the previous handle,
+the arrow keys move the selected handle (with Shift five times further). The
+editor is an ARIA ``application`` named by :data:`LABEL`, and a polite live
+region announces :func:`status_text`, the selected handle and the worst
+quality, after every change.
 
 The handles' logic is plain Python, tested without a browser
-(``tests/test_plots.py``): :func:`handle_positions`, :func:`nearest_handle`,
-:func:`move_handle`, :func:`corner_code`. The browser side is
-``editor.js`` beside this file, an anywidget module.
+(``tests/test_plots.py``, ``tests/test_editor_access.py``):
+:func:`handle_positions`, :func:`nearest_handle`, :func:`move_handle`,
+:func:`corner_code`, :func:`handle_name`, :func:`status_text`. The browser
+side is ``editor.js`` beside this file, an anywidget module.
 """
 
 import pathlib
@@ -21,9 +29,12 @@ import numpy as np
 from ..patches import Corner
 from .explorers import Painter, freeze_layout, new_figure, png, widget_with_picture
 from .figures import PatchView
+from .labels import label_sliders
 
 NAMES = "ABCD"
 ARROW = 0.25  # an arrow is this fraction of its derivative, so the handles stay near the patch
+KEYS = "n or p: next or previous handle. Arrow keys: move it, with Shift 5 times further. Tab: leave the editor."
+LABEL = "Patch editor, 12 handles: the corners A to D and the tips of their d/ds and d/dt arrows. " + KEYS
 
 
 def handle_positions(corners, scale=ARROW):
@@ -56,6 +67,43 @@ def move_handle(corners, index, point, scale=ARROW):
     else:
         raise ValueError(f"handle index must be 0 to 11; got {index}.")
     return corners
+
+
+def handle_name(index):
+    """What handle `index` is, as the editor announces it: "corner B", "B's d/ds arrow tip", ...
+
+    Examples
+    --------
+    >>> handle_name(1), handle_name(4), handle_name(11)
+    ('corner B', "A's d/ds arrow tip", "D's d/dt arrow tip")
+    """
+    if not isinstance(index, (int, np.integer)) or not 0 <= index < 12:
+        raise ValueError(f"handle index must be 0 to 11; got {index!r}.")
+    which, kind = NAMES[index % 4], index // 4
+    return f"corner {which}" if kind == 0 else f"{which}'s {('d/ds', 'd/dt')[kind - 1]} arrow tip"
+
+
+def status_text(corners, index, quality):
+    """The editor's live-region sentence: the selected handle, where it is, the worst quality and the folds.
+
+    `quality` holds the mesh's element qualities (``Mesh.quality()``); the
+    worst is their minimum, as in the readout.
+
+    Examples
+    --------
+    >>> from labkit import Corner
+    >>> square = [Corner(p, [1, 0], [0, 1]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+    >>> status_text(square, 5, [1.0, 0.5, -0.25])
+    "B's d/ds arrow tip at (1.25, 0). Worst quality -0.25, 1 folded."
+    """
+    x, y = handle_positions(corners)[index]
+    quality = np.asarray(quality, dtype=float)
+    folded = int(np.sum(quality <= 0))
+    return (
+        f"{handle_name(index)} at ({_number(x)}, {_number(y)}). Worst quality {quality.min():.2f}"
+        + (f", {folded} folded" if folded else "")
+        + "."
+    )
 
 
 def with_twist(corners, twist):
@@ -95,6 +143,11 @@ def _editor_class():
         readout = traitlets.Unicode("").tag(sync=True)
         worst = traitlets.Float(1.0).tag(sync=True)
         ack = traitlets.Int(0).tag(sync=True)  # the seq of the last drag drawn
+        selected = traitlets.Int(0).tag(sync=True)  # the handle the keys move, chosen in the browser
+        status = traitlets.Unicode("").tag(sync=True)  # the live region's sentence (status_text)
+        label = traitlets.Unicode(LABEL).tag(sync=True)  # the editor's aria-label, naming the keys
+        key_help = traitlets.Unicode(KEYS).tag(sync=True)  # the keys, shown under the readout
+        alt = traitlets.Unicode("").tag(sync=True)  # the picture's alt text
 
     return PatchEditor
 
@@ -124,10 +177,11 @@ class Editor:
         freeze_layout(self.figure)
         self.painter = Painter(self.figure, self.view)
         self.widget_.observe(self._dragged, names="drag")
+        self.widget_.observe(self._selected, names="selected")
         self.elements.observe(lambda change: self.refresh(), names="value")
         self.twist.observe(self._twisted, names="value")
         self.refresh()
-        self.widget = widgets.VBox([self.widget_, widgets.HBox([self.elements, self.twist])])
+        self.widget = label_sliders(widgets.VBox([self.widget_, widgets.HBox([self.elements, self.twist])]))
         self.widget.add_class("labkit-patch-editor")
 
     def _fit_limits(self):
@@ -144,9 +198,14 @@ class Editor:
             return
         if 0 <= index < 12 and all(np.isfinite(point)):
             self.corners = move_handle(self.corners, index, point)
+            self.widget_.selected = index  # the browser selects a handle before it drags it: usually no change
             self.refresh()
         if isinstance(drag.get("seq"), int):
             self.widget_.ack = drag["seq"]
+
+    def _selected(self, change):
+        if 0 <= change["new"] < 12:
+            self.widget_.status = status_text(self.corners, change["new"], self.quality)
 
     def _twisted(self, change):
         self.corners = with_twist(self.corners, change["new"])
@@ -160,17 +219,24 @@ class Editor:
         self.ax.set_aspect("equal")
 
     def refresh(self):
-        """Rebuild the mesh from the corners; send the picture, handles, readout and worst quality."""
+        """Rebuild the mesh from the corners; send the picture, handles, readout, worst quality, alt and status."""
         self._draw_mesh()
-        worst = float(self.view.mesh.quality().min())
+        self.quality = self.view.mesh.quality()
+        worst = float(self.quality.min())
         picture = png(self.figure, self.painter)
         self.widget_.frame = self._frame()
         self.widget_.handles = handle_positions(self.corners).round(6).tolist()
-        folded = int(np.sum(self.view.mesh.quality() <= 0))
+        folded = int(np.sum(self.quality <= 0))
         self.widget_.readout = (
             f"worst quality {worst:.2f}" + (f", {folded} folded" if folded else "") + "\n" + corner_code(self.corners)
         )
         self.widget_.worst = worst
+        n = self.elements.value
+        self.widget_.alt = (
+            f"Mesh of the patch, {n} by {n} elements coloured by quality, with its 12 handles; worst quality "
+            f"{worst:.2f}" + (f", {folded} folded" if folded else "") + "."
+        )
+        self.widget_.status = status_text(self.corners, self.widget_.selected, self.quality)
         self.widget_.image = picture
         self.redraws += 1
 

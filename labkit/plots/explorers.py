@@ -144,6 +144,9 @@ class Explorer:
         self.refresh()
         self.widget = widgets.VBox([*self.controls.values(), self.image])
         self.widget.add_class("labkit-explorer")
+        from .labels import label_sliders  # the sliders' handles get their descriptions as names (axe-core)
+
+        label_sliders(self.widget)
 
     def values(self):
         return {name: control.value for name, control in self.controls.items()}

@@ -57,7 +57,7 @@ SLIDERS = {"01_limacon": 2, "02_convergence": 1, "03_meshes": 6, "04_splines": 1
 
 
 def _nudge_with_keys(page, panel, after_drag):
-    """Check the keyboard fallback after a drag: the dragged handle stays selected, Tab moves on, arrows nudge."""
+    """Check the keyboard fallback after a drag: the dragged handle stays selected, n moves on, arrows nudge."""
     readout = panel.locator(".labkit-patch-editor").first.locator(".labkit-editor-readout")
     changed = "([node, old]) => node.innerText !== old"
     page.wait_for_function(
@@ -67,7 +67,7 @@ def _nudge_with_keys(page, panel, after_drag):
     page.wait_for_function(changed, arg=[readout.element_handle(), after_drag], timeout=10_000)
     nudged = readout.inner_text()
     for _ in range(4):  # handles: corners A-D (0-3), then the d/ds tips (4-7), then the d/dt tips
-        page.keyboard.press("Tab")
+        page.keyboard.press("n")
     page.keyboard.press("ArrowRight")  # now B's d/ds tip: B's ds changes, its point does not
     page.wait_for_function(changed, arg=[readout.element_handle(), nudged], timeout=10_000)
     keyed = readout.inner_text()
