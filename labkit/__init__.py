@@ -5,7 +5,8 @@ Everything a notebook needs is importable from here, e.g.
 
 ``import labkit`` loads the interpolation library only. The students'
 self-checks (:mod:`labkit.check`) and the figures (:mod:`labkit.plots`)
-load when first used, as ``labkit.check`` and ``labkit.plots``.
+load when first used, as ``labkit.check`` and ``labkit.plots``; so does
+``labkit.ready_to_hand_in`` (:mod:`labkit.handin`), every notebook's last cell.
 """
 
 import importlib
@@ -41,19 +42,22 @@ __all__ = [
     "pchip_slopes",
     "ratio_table",
     "ready",
+    "ready_to_hand_in",
     "runge",
     "runge2d",
     "spline",
 ]
 
-_LAZY = ("check", "plots", "exercises", "grading")
+_LAZY = ("check", "plots", "exercises", "grading", "handin")
 
 
 def __getattr__(name):
     if name in _LAZY:
         return importlib.import_module(f".{name}", __name__)
+    if name == "ready_to_hand_in":  # the notebooks' last cell: loads the self-checks, so only when called
+        return importlib.import_module(".handin", __name__).ready_to_hand_in
     raise AttributeError(f"module 'labkit' has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(list(globals()) + list(_LAZY))
+    return sorted(list(globals()) + list(_LAZY) + ["ready_to_hand_in"])

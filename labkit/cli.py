@@ -1,6 +1,7 @@
 """The ``labkit`` command: execute, release and grade the lab's notebooks.
 
 ``labkit notebooks DIR``                   write the student notebooks shipped with labkit into DIR
+``labkit handin DIR``                      ready to hand in? run DIR's notebooks and list what is left to do
 ``labkit execute DIR``                     re-run the instructor notebooks of DIR and save them clean
 ``labkit release DIR --out DIR``           write the student version of the instructor notebooks
 ``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
@@ -34,6 +35,51 @@ def _notebooks(args):
         (out / source.name).write_bytes(source.read_bytes())
         print(f"wrote {out / source.name}")
     return 0
+
+
+def _handin(args):
+    from .handin import lab_notebook_of
+
+    folder = args.folder
+    if not folder.exists():
+        raise ValueError(f"there is no {folder}; give the folder that holds your notebooks (or one notebook).")
+    if folder.is_file():
+        files = [folder] if folder.suffix == ".ipynb" else []
+    else:
+        files = sorted(p for p in folder.glob("*.ipynb") if not p.name.startswith("."))
+    if not files:
+        raise ValueError(f"{folder} holds no notebooks (*.ipynb); give the folder you work in.")
+    if args.timeout < 1:
+        raise ValueError(f"--timeout must be at least 1 second; got {args.timeout}.")
+    lab = [(path, lab_notebook_of(path)) for path in files]
+    skipped = [path.name for path, name in lab if name is None]
+    lab = [(path, name) for path, name in lab if name is not None]
+    if not lab:
+        raise ValueError(
+            f"none of the notebooks in {folder} is one of the lab's ({', '.join(skipped)}); give the folder "
+            "that holds 01_limacon.ipynb ... 06_bilinear.ipynb."
+        )
+    try:
+        import nbclient  # noqa: F401 - the student's install may lack it: say so before running anything
+
+        from .handin import run_notebook
+    except ModuleNotFoundError as exc:
+        raise ValueError(
+            f"labkit handin runs the notebooks with {exc.name}, which is not installed: pip install nbclient"
+        ) from None
+    results = []
+    for path, _ in lab:
+        print(f"running {path.name} ...", file=sys.stderr, flush=True)
+        result = run_notebook(path, timeout=args.timeout)
+        if path.name != result.notebook:
+            result.notebook = f"{path.name} ({result.notebook})"
+        results.append(result)
+        print(result.text() + "\n", flush=True)
+    ready = sum(result.ready for result in results)
+    if skipped:
+        print(f"Not lab notebooks, not run: {', '.join(skipped)}.")
+    print(f"Ready to hand in: {ready} of {len(results)} notebook(s), as far as the self-checks can tell.")
+    return 0 if ready == len(results) else 1
 
 
 def _execute(args):
@@ -283,6 +329,19 @@ def build_parser():
     nbs.add_argument("out", type=Path, metavar="DIR", help="folder for the notebooks (created if needed)")
     nbs.add_argument("--force", action="store_true", help="overwrite notebooks of the same name in DIR")
     nbs.set_defaults(handler=_notebooks)
+
+    hand = commands.add_parser(
+        "handin",
+        help="ready to hand in? run your notebooks and list what is left to do",
+        description="Run each lab notebook in DIR in a fresh kernel (every cell, even after one raised) and "
+        "print, per notebook, the table its last cell shows: each graded part done and passing its "
+        "self-check, failing (with the hint) or not started; the cells that raised; the answers in words "
+        "left empty. Only the self-checks run, never the grader. Exit status: 0 when every notebook is ready, "
+        "1 when something is left to do, 2 for bad input.",
+    )
+    hand.add_argument("folder", type=Path, metavar="DIR", help="the folder with your notebooks (or one notebook)")
+    hand.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell (default %(default)s)")
+    hand.set_defaults(handler=_handin)
 
     run = commands.add_parser(
         "execute",

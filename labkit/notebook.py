@@ -3,13 +3,17 @@
 If labkit is not installed, that line itself fails, and Jupyter shows it with
 its comment, which holds the install command. When labkit is there,
 :func:`ready` checks what the notebook needs from the kernel and says how to
-fix it when something is missing.
+fix it when something is missing. In an IPython kernel it also starts noting
+the cells that raise (:data:`CELLS`), which the notebook's last cell,
+``labkit.ready_to_hand_in(...)``, lists (:mod:`labkit.handin`).
 """
 
 from __future__ import annotations
 
 import importlib.util
+import sys
 import warnings
+from dataclasses import dataclass
 
 
 class VersionWarning(UserWarning):
@@ -61,9 +65,98 @@ def ready(written_for: str) -> None:
             VersionWarning,
             stacklevel=2,
         )
+    track_cells()
     missing = [name for name in NEEDED if importlib.util.find_spec(name) is None]
     if missing:
         raise ValueError(
             f"the kernel lacks {', '.join(missing)}, which the notebooks use: install labkit with "
             f"its dependencies in a cell,\n    {INSTALL}\nthen restart the kernel."
         )
+
+
+@dataclass(frozen=True)
+class RaisedCell:
+    """A cell whose last run raised: its number as Jupyter shows it (``[n]``), its source and the error."""
+
+    number: int | None
+    source: str
+    error: str  # the exception's type
+    message: str  # the first line of its message
+    line: int | None  # the line of the cell where it was raised, when known
+
+
+class CellErrors:
+    """IPython's ``post_run_cell`` hook: the cells whose last run raised, since the kernel started.
+
+    A cell is known by the id the front end sends with it (JupyterLab, Notebook 7 and VS Code send
+    one), so a cell that raised and then ran cleanly is dropped; without an id, by its source.
+    Only text is kept, never the exception (whose traceback holds the cell's variables).
+    """
+
+    def __init__(self):
+        self.raised = {}
+
+    def __call__(self, result=None) -> None:
+        try:  # a hook that raises would print its traceback under every cell
+            self._note(result)
+        except Exception:  # noqa: BLE001, S110 - the notebook goes on without this cell noted
+            pass
+
+    def _note(self, result) -> None:
+        info = getattr(result, "info", None)
+        source = str(getattr(info, "raw_cell", "") or "")
+        key = getattr(info, "cell_id", None) or ("source", source)
+        error = getattr(result, "error_before_exec", None) or getattr(result, "error_in_exec", None)
+        if error is None:
+            self.raised.pop(key, None)
+            return
+        self.raised.pop(key, None)  # re-inserted last: the order is the order of the runs
+        self.raised[key] = RaisedCell(
+            getattr(result, "execution_count", None),
+            source,
+            type(error).__name__,
+            _first_line(error),
+            _line_in_cell(error),
+        )
+
+    def cells(self) -> list:
+        """The cells that raised, in the order of their numbers (then of their runs)."""
+        found = list(self.raised.values())
+        return sorted(found, key=lambda cell: (cell.number is None, cell.number or 0))
+
+
+CELLS: CellErrors | None = None  # set by track_cells() in an IPython kernel
+
+
+def track_cells() -> bool:
+    """Start noting the cells that raise (once per kernel); False when not in IPython."""
+    global CELLS
+    ipython = sys.modules.get("IPython")  # never imported here: a notebook's kernel has it already
+    shell = ipython.get_ipython() if ipython is not None else None
+    if shell is None:
+        return False
+    if CELLS is None or CELLS not in shell.events.callbacks.get("post_run_cell", []):
+        CELLS = CELLS or CellErrors()
+        shell.events.register("post_run_cell", CELLS)
+    return True
+
+
+def _first_line(error) -> str:
+    try:
+        text = str(error)
+    except Exception:  # noqa: BLE001 - a student's exception class may break str()
+        return ""
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    return lines[0][:200] if lines else ""
+
+
+def _line_in_cell(error) -> int | None:
+    """The line of the cell itself (its module level) where `error` was raised."""
+    if isinstance(error, SyntaxError):
+        return error.lineno
+    tb = getattr(error, "__traceback__", None)
+    while tb is not None:  # the cell's own frame is the first module-level one (an import's come later)
+        if tb.tb_frame.f_code.co_name == "<module>":
+            return tb.tb_lineno
+        tb = tb.tb_next
+    return None

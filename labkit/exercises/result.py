@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 TOLERANCE = 1e-9
+NOT_IMPLEMENTED = "not implemented yet"  # the failed step of a function that still raises NotImplementedError
 
 
 @dataclass
@@ -92,7 +93,7 @@ def call(result, description, fn, *args):
     try:
         return True, fn(*args)
     except NotImplementedError:
-        result.fail(description, "not implemented yet", "replace the `raise NotImplementedError()` with your code.")
+        result.fail(description, NOT_IMPLEMENTED, "replace the `raise NotImplementedError()` with your code.")
     except Exception as exc:  # noqa: BLE001 - any student error is reported, not raised
         kind = getattr(exc, "kind", type(exc).__name__)
         refused = getattr(exc, "refused", None)
