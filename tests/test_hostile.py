@@ -669,7 +669,8 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
         ("background_process", "subprocess.Popen"),
         ("fork_loop", "os.fork"),
         ("memory_grab", "MemoryError"),
-        ("connects_out", "ConnectionRefusedError"),
+        # a forked worker's network namespace has no loopback up (the plain way's bwrap sandbox has one)
+        ("connects_out", ("ConnectionRefusedError", "Network is unreachable")),
         ("reads_solutions", "No such file or directory"),
         ("infinite_loop", "Timeout: interrupted"),
         ("sys_exit", "SystemExit"),
@@ -712,7 +713,8 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
     ],
 )
 def test_feedback_names_what_happened(attacked, name, named):
-    assert named in _feedback(attacked, name), _feedback(attacked, name)
+    feedback = _feedback(attacked, name)
+    assert any(words in feedback for words in ((named,) if isinstance(named, str) else named)), feedback
 
 
 def test_a_link_inside_a_submission_is_not_graded_as_its_work(attacked):
