@@ -195,6 +195,7 @@ def grade_options(args):
         rubric=args.rubric,
         grader_memory=args.grader_memory * MIB,
         limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE),
+        fork_server=not args.no_fork_server,
     )
 
 
@@ -454,6 +455,12 @@ def build_parser():
         action="store_true",
         help="a submission with no other time gets its notebooks' newest modification time (never without "
         "this option: copying or unpacking a file changes it)",
+    )
+    grd.add_argument(
+        "--no-fork-server",
+        action="store_true",
+        help="start every notebook's sandbox with a fresh Python that imports everything again (slower; the way "
+        "before the fork server, which forks each notebook's isolated worker from one warm process per run)",
     )
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)

@@ -188,7 +188,7 @@ def test_the_bwrap_backend_gives_the_worker_its_uid_and_hands_over_the_seccomp_d
     box = backends.get_backend("bwrap").box(worker, Limits())
     try:
         assert box.argv[-len(worker) - 2 :] == ["--", *worker, str(bwrap.sandbox_uid())]
-        assert list(inspect.signature(bwrap.command).parameters) == ["argv", "limits", "seccomp_fd"]  # no uid
+        assert list(inspect.signature(bwrap.command).parameters) == ["argv", "limits", "seccomp_fd", "zygote"]  # no uid
         for fd in box.pass_fds:
             assert f"--seccomp {fd}" in " ".join(box.argv)
             os.fstat(fd)  # open until the worker has it

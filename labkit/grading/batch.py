@@ -24,10 +24,12 @@ its result, so that ``--merge`` can apply a late rule later. A progress bar
 with an ETA is drawn on a terminal (:mod:`labkit.grading.progress`).
 """
 
+import contextlib
 import json
 import os
 import resource
 import secrets
+import select
 import shutil
 import signal
 import subprocess
@@ -36,7 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from . import backends, cgroup, refusals
+from . import backends, cgroup, forkserver, refusals
 from .backends.base import SandboxUnavailable
 from .late import submission_time
 from .options import GradeOptions
@@ -50,6 +52,8 @@ from .scoring import submission_name, submission_notebooks
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
 MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file
+LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
+LAUNCHER_READY = 120  # seconds for the launcher to import the grader
 
 
 def _low_space(out):
@@ -70,9 +74,11 @@ def _low_space(out):
 class _Job:
     """One submission's grading process."""
 
-    def __init__(self, path, name, work, options, profiles_file):
+    def __init__(self, path, name, work, options, profiles_file, server=None, launcher=None):
         self.path, self.name, self.attempt = Path(path), name, 0
         self.work, self.options, self.profiles_file = work, options, profiles_file
+        self.server = server  # the run's fork server (labkit.grading.forkserver), or None
+        self.launcher = launcher  # the run's Launcher of grading processes, or None (each one a new Python)
         self.process, self.cgroup, self.started = None, None, None
 
     def start(self):
@@ -105,7 +111,26 @@ class _Job:
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
             environment.update(group.sibling_environment())
+        environment.pop(forkserver.ENV, None)
+        if self.server is not None:
+            environment.update(self.server.environment())
         self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
+        if self.launcher is not None:
+            folders = [group.path, group.cpu_path] if group is not None else []
+            try:
+                self.process = self.launcher.launch(
+                    {
+                        "spec": str(spec),
+                        "log": str(self.log),
+                        "memory": memory,
+                        "cgroups": [str(folder / "cgroup.procs") for folder in folders if folder is not None],
+                        "environment": environment,
+                    }
+                )
+                self.started = time.monotonic()
+                return
+            except OSError:  # the launcher is gone: this submission and the next start the plain way
+                self.launcher = None
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "labkit.grading.scoring", str(spec)],
@@ -115,6 +140,7 @@ class _Job:
                 start_new_session=True,
                 preexec_fn=prepare,
                 env=environment,
+                pass_fds=(self.server.fd,) if self.server is not None else (),
             )
         self.started = time.monotonic()
 
@@ -262,9 +288,25 @@ def grade(
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
-        with Progress(len(submissions), "grading", enabled=progress) as bar:
+        with (
+            _fork_server(backend, options) as server,
+            _launcher(options, server) as launcher,
+            Progress(len(submissions), "grading", enabled=progress) as bar,
+        ):
+            forked = {"fork server": server is not None, "forked grading processes": launcher is not None}
             grades = _schedule(
-                submissions, names, work, options, profiles_file, rubric, max(1, int(jobs)), out, bar, peaks
+                submissions,
+                names,
+                work,
+                options,
+                profiles_file,
+                rubric,
+                max(1, int(jobs)),
+                out,
+                bar,
+                peaks,
+                server,
+                launcher,
             )
     finally:
         shutil.rmtree(work, ignore_errors=True)
@@ -280,6 +322,7 @@ def grade(
                 "not graded": sum(not g.graded for g in ordered),
                 "seconds": round(time.monotonic() - start, 1),
                 "jobs": int(jobs),
+                **forked,
                 "grader peak bytes": max((p for p in peaks if p), default=None),
             },
             indent=1,
@@ -297,9 +340,139 @@ def _notebooks(path):
         return []
 
 
-def _schedule(submissions, names, work, options, profiles_file, rubric, jobs, out, bar, peaks):
+@contextlib.contextmanager
+def _fork_server(backend, options):
+    """The run's fork server, or None: switched off, not offered by the backend, or it could not start (then
+    every notebook gets a sandbox of its own the plain way, and grading only takes longer)."""
+    server = None
+    if options.fork_server:
+        try:
+            server = forkserver.ForkServer(backend, options.limits).start()
+        except forkserver.ForkServerError:
+            server = None
+    try:
+        yield server
+    finally:
+        if server is not None:
+            server.stop()
+
+
+class _Launched:
+    """The part of a Popen that :class:`_Job` uses, for a grading process the :class:`Launcher` forked."""
+
+    def __init__(self, launcher, pid):
+        self.launcher, self.pid = launcher, pid
+
+    @property
+    def returncode(self):
+        return self.launcher.ended.get(self.pid)
+
+    def poll(self):
+        self.launcher.pump(0)
+        return self.returncode
+
+    def wait(self, timeout=None):
+        until = None if timeout is None else time.monotonic() + timeout
+        while self.returncode is None:
+            if until is not None and time.monotonic() > until:
+                raise subprocess.TimeoutExpired("grading process", timeout)
+            if not self.launcher.pump(0.05) and self.launcher.process.poll() is not None:
+                self.launcher.ended.setdefault(self.pid, -signal.SIGKILL)  # the launcher is gone, and its children
+        return self.returncode
+
+
+class Launcher:
+    """One warm process that forks each submission's grading process (:mod:`labkit.grading.launcher`)."""
+
+    def __init__(self, options, server=None):
+        self.ended, self._buffer = {}, b""
+        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "labkit.grading.launcher", options.exercises or ""],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+            env=environment,
+            pass_fds=(server.fd,) if server is not None else (),
+        )
+        if self._next(time.monotonic() + LAUNCHER_READY) != {"ready": True}:
+            self.stop()
+            raise OSError("the launcher of grading processes did not start")
+
+    def _next(self, until):
+        """The launcher's next message, or None when `until` passes or it is gone."""
+        fd = self.process.stdout.fileno()
+        while b"\n" not in self._buffer:
+            remaining = until - time.monotonic()
+            if not select.select([fd], [], [], max(0.0, remaining))[0]:
+                return None
+            chunk = os.read(fd, 1 << 16)
+            if not chunk:
+                return None
+            self._buffer += chunk
+        line, _, self._buffer = self._buffer.partition(b"\n")
+        return json.loads(line)
+
+    def pump(self, wait):
+        """File every ended process the launcher reported (waiting up to `wait` s for one); whether any."""
+        message = self._next(time.monotonic() + wait)
+        found = False
+        while message is not None:
+            if "ended" in message:
+                self.ended[int(message["ended"])] = int(message["code"])
+                found = True
+            message = self._next(time.monotonic())
+        return found
+
+    def launch(self, request):
+        """Fork a grading process for `request`; a :class:`_Launched` (OSError when the launcher is gone)."""
+        self.process.stdin.write((json.dumps(request) + "\n").encode())
+        self.process.stdin.flush()
+        while True:
+            message = self._next(time.monotonic() + LAUNCH_TIMEOUT)
+            if message is None:
+                raise OSError("the launcher of grading processes stopped answering")
+            if "ended" in message:
+                self.ended[int(message["ended"])] = int(message["code"])
+            elif "started" in message:
+                self.ended.pop(int(message["started"]), None)  # a pid used again
+                return _Launched(self, int(message["started"]))
+
+    def stop(self):
+        try:
+            self.process.stdin.close()  # it stops every grading process still running, then ends
+        except OSError:
+            pass
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        self.process.stdout.close()
+
+
+@contextlib.contextmanager
+def _launcher(options, server):
+    """The run's :class:`Launcher`, or None where it cannot start (each grading process is then a new Python)."""
+    try:
+        launcher = Launcher(options, server) if options.fork_server else None
+    except (OSError, ValueError):
+        launcher = None
+    try:
+        yield launcher
+    finally:
+        if launcher is not None:
+            launcher.stop()
+
+
+def _schedule(
+    submissions, names, work, options, profiles_file, rubric, jobs, out, bar, peaks, server=None, launcher=None
+):
     """Run the grading processes, `jobs` at a time; {path: SubmissionGrade} for every submission."""
-    pending = [_Job(path, name, work, options, profiles_file) for path, name in zip(submissions, names)]
+    pending = [
+        _Job(path, name, work, options, profiles_file, server, launcher) for path, name in zip(submissions, names)
+    ]
     pending.reverse()
     running, grades, stopped = [], {}, None
     while pending or running:

@@ -30,6 +30,7 @@ class GradeOptions:
     grader_memory: int = 3 * 1024**3  # bytes of address space for the grader's own work on one submission
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
     exercises: str = None  # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
+    fork_server: bool = True  # notebooks' workers forked from one warm server per run (labkit.grading.forkserver)
 
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):

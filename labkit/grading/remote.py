@@ -26,7 +26,7 @@ import subprocess
 import sys
 import time
 
-from . import backends, protocol, refusals
+from . import backends, forkserver, protocol, refusals
 from .backends.base import remove_tree  # noqa: F401 - where callers have found it
 from .options import GradeOptions
 
@@ -78,16 +78,18 @@ class Notebook:
         self.tampered = None  # what the notebook did that voids its answers
         self._buffer = b""
         self.backend = backends.get_backend(self.options.backend)
-        self.box = self.backend.box(list(WORKER), self.options.limits)
-        try:
-            self.process = self.box.start()
-        except OSError as exc:
-            self.box.close()
-            raise WorkerError(f"the {self.backend.name} sandbox could not start the worker ({exc})") from None
-        except BaseException:
-            self.box.stop()
-            self.box.close()
-            raise
+        self.box = self._forked() if self.options.fork_server else None
+        if self.box is None:
+            self.box = self.backend.box(list(WORKER), self.options.limits)
+            try:
+                self.process = self.box.start()
+            except OSError as exc:
+                self.box.close()
+                raise WorkerError(f"the {self.backend.name} sandbox could not start the worker ({exc})") from None
+            except BaseException:
+                self.box.stop()
+                self.box.close()
+                raise
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.process.stdout, selectors.EVENT_READ)
         self.request(
@@ -98,6 +100,19 @@ class Notebook:
             },
             SETUP_TIMEOUT,
         )
+
+    def _forked(self):
+        """A worker from this process's fork server (:mod:`labkit.grading.forkserver`), or None: there is no
+        server for this backend, or it could not give one (the notebook then gets a sandbox the plain way)."""
+        box = forkserver.box(self.backend, self.options.limits)
+        if box is None:
+            return None
+        try:
+            self.process = box.start()
+        except (forkserver.ForkServerError, OSError):
+            box.close()
+            return None
+        return box
 
     def __enter__(self):
         return self

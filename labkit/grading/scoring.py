@@ -276,6 +276,8 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
     problems, results = [], {}
     try:
         notebook = remote.Notebook(options, deadline, _for_sandbox(profiles), registry.passable)
+    except remote.NotebookTimeout:  # its sandbox was still starting when the submission's time ran out
+        return {}, [f"{name}: stopped after the submission's time limit of {options.total_timeout} s."]
     except remote.WorkerError as exc:
         return {}, [f"{name}: the sandbox could not start ({exc})."]
     with notebook:

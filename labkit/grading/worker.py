@@ -35,6 +35,7 @@ still only evidence: the grader checks it and computes every score itself.
 
 import hashlib
 import hmac
+import importlib
 import io
 import os
 import select
@@ -44,6 +45,7 @@ import time
 
 from . import guard, protocol, seccomp
 
+NOTEBOOK_IMPORTS = ("scipy.interpolate", "ipywidgets", "labkit.check", "labkit.plots", "labkit.plots.explorers")
 RESTARTS = 3  # new notebook processes after one died, per notebook
 _GUARD_FILE = guard.__file__
 
@@ -496,7 +498,7 @@ def _ended(status):
     return f"the notebook's process exited with status {os.WEXITSTATUS(status)} (os._exit or a crash)"
 
 
-def _drop_privileges(uid):
+def drop_privileges(uid):
     """As root inside the sandbox: become `uid`, so the process-count limit applies."""
     if os.getuid() == 0 and uid:
         os.setgroups([])
@@ -504,7 +506,7 @@ def _drop_privileges(uid):
         os.setuid(uid)
 
 
-def _not_dumpable():
+def not_dumpable():
     """No other process of the sandbox's user may read or write this one's memory (PR_SET_DUMPABLE 0)."""
     try:
         import ctypes
@@ -514,8 +516,9 @@ def _not_dumpable():
         pass
 
 
-def _warm():
-    """What every notebook imports, once, in the supervisor: each notebook's process starts with it."""
+def warm(everything=False):
+    """What every notebook imports, once, in the supervisor: each notebook's process starts with it; with
+    `everything`, what the lab's notebooks import as well."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -532,6 +535,14 @@ def _warm():
     import labkit  # noqa: F401
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
 
+    # what the lab's notebooks import too: paid once per fork server (labkit.grading.zygote); a worker of its
+    # own would pay for them in the notebook's own time, whether its notebook imports them or not
+    for name in NOTEBOOK_IMPORTS if everything else ():
+        try:
+            importlib.import_module(name)
+        except ImportError:  # a course without the lab's extras still grades
+            pass
+
     config = Config()
     config.HistoryManager.enabled = False
     shell = InteractiveShell.instance(config=config)
@@ -540,18 +551,28 @@ def _warm():
     return shell
 
 
-def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    _drop_privileges(int(argv[0]) if argv else 0)
-    _not_dumpable()
-    # the protocol gets private descriptors; 0, 1 and 2 become /dev/null for the student
-    requests = os.dup(0)
-    answers = os.dup(1)
+def serve(requests, answers, shell):
+    """Answer the grader on the descriptors `requests` and `answers` until it says bye; the student's code
+    gets /dev/null for 0, 1 and 2 and the working folder on its path, as in a kernel."""
+    given = (requests, answers)
+    requests, answers = os.dup(requests), os.dup(answers)
+    for fd in given:  # the student's code must not find a second copy of the grader's pipes
+        if fd > 2:
+            os.close(fd)
     null = os.open(os.devnull, os.O_RDWR)
     for fd in (0, 1, 2):
         os.dup2(null, fd)
-    sys.path.insert(0, os.getcwd())  # as in a kernel, the notebook's folder is importable
-    Supervisor(requests, answers, _warm()).serve()
+    if null > 2:
+        os.close(null)
+    sys.path.insert(0, os.getcwd())
+    Supervisor(requests, answers, shell).serve()
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    drop_privileges(int(argv[0]) if argv else 0)
+    not_dumpable()
+    serve(0, 1, warm())
 
 
 if __name__ == "__main__":

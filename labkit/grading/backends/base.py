@@ -187,5 +187,18 @@ class Backend(abc.ABC):
     def box(self, argv, limits):
         """The :class:`Box` that runs the worker's command `argv` in a new sandbox bounded by `limits`."""
 
+    def zygote_box(self, argv, limits, pass_fds):
+        """The :class:`Box` of a fork server (:mod:`labkit.grading.forkserver`), or None: this backend
+        offers none, and every notebook gets a sandbox of its own from :meth:`box`.
+
+        The server runs `argv` with the descriptors `pass_fds`, and must be
+        able to make namespaces, mount and change uid for the workers it
+        forks (:mod:`labkit.grading.zygote`)."""
+        return None
+
+    def notebook_uid(self):
+        """The uid a forked worker becomes (0: the server's own); unique among notebooks graded at once."""
+        return 0
+
     def __repr__(self):
         return f"<sandbox backend {self.name}>"

@@ -28,6 +28,7 @@ and sets the rlimits in the child before ``bwrap`` starts
 (:func:`~.base.apply_limits`); they are inherited by everything inside.
 """
 
+import itertools
 import os
 import shutil
 import subprocess
@@ -59,6 +60,10 @@ def _namespaces():
         "--die-with-parent",
         "--new-session",
     ]
+
+
+FORKED_UIDS = 1_000_000_000  # forked workers' uids start here (far above sandbox_uid's; pids are below 2**22)
+_FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def sandbox_uid():
@@ -94,13 +99,16 @@ def _parents(path, made):
     return args
 
 
-def command(argv, limits=None, seccomp_fd=None):
+def command(argv, limits=None, seccomp_fd=None, zygote=False):
     """The bwrap command that runs `argv` in a new sandbox bounded by `limits` (the defaults when None); pass
-    `seccomp_fd` to the process with pass_fds."""
+    `seccomp_fd` to the process with pass_fds. A `zygote` (a fork server, as root only) keeps the
+    capability to make namespaces and mount for the workers it forks."""
     limits = limits if limits is not None else Limits()
     args = [shutil.which("bwrap") or "bwrap", *_namespaces(), "--clearenv", "--cap-drop", "ALL"]
     if os.geteuid() == 0:
         args += ["--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID"]
+        if zygote:
+            args += ["--cap-add", "CAP_SYS_ADMIN"]
     if seccomp_fd is not None:
         args += ["--seccomp", str(seccomp_fd)]
     # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
@@ -198,3 +206,22 @@ class Bubblewrap(Backend):
                 os.close(seccomp_fd)
             raise
         return Box(args, limits, pass_fds=(seccomp_fd,), processes_base=base)
+
+    def zygote_box(self, argv, limits, pass_fds):
+        """As root: a fork server in a sandbox like every notebook's (see :mod:`labkit.grading.zygote`).
+
+        Not as another user: its workers could not each get a uid of their own."""
+        if os.geteuid() != 0:
+            return None
+        seccomp_fd = seccomp.pipe_with_program()
+        try:
+            args = command(list(argv), limits, seccomp_fd, zygote=True)
+        except BaseException:
+            if seccomp_fd is not None:
+                os.close(seccomp_fd)
+            raise
+        return Box(args, limits, pass_fds=(seccomp_fd, *pass_fds))
+
+    def notebook_uid(self):
+        """As :func:`sandbox_uid`, in a range of their own, and different for each notebook of one process."""
+        return FORKED_UIDS + 16 * os.getpid() + next(_FORKED) % 16

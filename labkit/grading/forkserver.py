@@ -1,0 +1,265 @@
+"""The grader's side of the fork server: imports paid once per run, not once per notebook.
+
+Starting a worker the plain way (:meth:`labkit.grading.backends.base.Backend.box`)
+costs a new sandbox and a new Python that imports numpy, scipy, matplotlib,
+IPython and labkit, for every notebook of every submission: most of a
+submission's grading time. A :class:`ForkServer` starts one process in a
+sandbox of the backend (:mod:`labkit.grading.zygote`) that imports all of
+that once; each notebook then gets a worker forked from it and isolated
+from every other notebook before any student code runs (namespaces of its
+own, empty private folders, its own uid, cgroup and rlimits; the zygote's
+description says how).
+
+A grading run (:func:`labkit.grading.batch.grade`) starts one server and
+hands its socket to every submission's grading process: the descriptor's
+number is in the environment variable :data:`ENV`. In that process
+:func:`box` makes a :class:`ForkedBox`, a :class:`~.backends.base.Box`
+whose worker comes from the server; where there is no server, or it cannot
+give a worker, the notebook gets a sandbox of its own the plain way, so a
+broken server costs time, never a grade.
+
+A backend offers a server through :meth:`~.backends.base.Backend.zygote_box`;
+the default backend does when the grader runs as root (the zygote needs the
+capabilities to make namespaces and change uid). ``--no-fork-server``
+(``GradeOptions.fork_server``) keeps the plain way.
+"""
+
+import array
+import json
+import os
+import select
+import socket
+import subprocess
+import sys
+import time
+
+from . import cgroup
+from .backends.base import WORKER_IMPORTS, Box
+
+ENV = "LABKIT_FORK_SERVER"  # the descriptor of a fork server's socket, in a grading process
+ZYGOTE = (sys.executable, "-I", "-m", "labkit.grading.zygote")
+READY_TIMEOUT = 180  # seconds for a new server to import what notebooks need
+START_TIMEOUT = 30  # seconds for one forked worker to be isolated and running
+
+
+class ForkServerError(RuntimeError):
+    """The fork server could not start, or could not give a worker."""
+
+
+def _wait_readable(fd, until):
+    remaining = until - time.monotonic()
+    return remaining > 0 and bool(select.select([fd], [], [], remaining)[0])
+
+
+class ForkServer:
+    """One zygote in a sandbox of `backend`, bounded by `limits`; use it as a context manager.
+
+    While it runs, :func:`box` in this process (and in every process started
+    with :meth:`environment` and :attr:`fd` passed on) forks workers from it.
+    """
+
+    def __init__(self, backend, limits):
+        self.backend, self.limits = backend, limits
+        self.box, self.socket = None, None
+
+    @property
+    def fd(self):
+        """The descriptor a grading process asks the server through (pass it with ``pass_fds``)."""
+        return self.socket.fileno()
+
+    def environment(self):
+        """What to add to a grading process's environment so that it uses this server."""
+        return {ENV: f"{self.fd}:{self.backend.name}"}
+
+    def start(self):
+        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        zygote_fd = theirs.detach()
+        try:
+            self.box = self.backend.zygote_box([*ZYGOTE, str(zygote_fd)], self.limits, (zygote_fd,))
+        except BaseException:
+            os.close(zygote_fd)
+            ours.close()
+            raise
+        if self.box is None:
+            os.close(zygote_fd)
+            ours.close()
+            raise ForkServerError(f"the {self.backend.name} sandbox offers no fork server")
+        self.socket = ours
+        try:
+            process = self.box.start()
+        except OSError as exc:
+            self.stop()
+            raise ForkServerError(f"the fork server could not start ({exc})") from None
+        line = b""
+        until = time.monotonic() + READY_TIMEOUT
+        while not line.endswith(b"\n") and _wait_readable(process.stdout.fileno(), until):
+            chunk = os.read(process.stdout.fileno(), 64)
+            if not chunk:
+                break
+            line += chunk
+        if line != b"ready\n":
+            self.stop()
+            raise ForkServerError("the fork server did not get ready (it could not import what notebooks need)")
+        global _client
+        _client = (self.socket, self.backend.name)
+        return self
+
+    def stop(self):
+        global _client
+        if _client is not None and _client[0] is self.socket:
+            _client = None
+        if self.socket is not None:
+            self.socket.close()  # the server ends when its socket's other end closes
+        if self.box is not None:
+            self.box.stop()
+            self.box.close()
+            for pipe in (self.box.process.stdin, self.box.process.stdout) if self.box.process else ():
+                try:
+                    pipe.close()
+                except OSError:
+                    pass
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()
+
+
+_client = None  # (socket, backend name) of the server this process asks
+
+
+def client():
+    """(socket, backend name) of the fork server this process may ask, or None."""
+    global _client
+    fd, _, name = os.environ.get(ENV, "").partition(":")
+    if _client is None and fd.isdigit() and name:
+        try:
+            server = socket.socket(fileno=int(fd))
+            if server.family != socket.AF_UNIX or server.type != socket.SOCK_SEQPACKET:
+                server.detach()
+                raise OSError("not a fork server's socket")
+            _client = (server, name)
+        except OSError:
+            os.environ.pop(ENV, None)
+    return _client
+
+
+def box(backend, limits):
+    """A :class:`ForkedBox` for one notebook when a fork server runs for `backend`, else None."""
+    found = client()
+    if found is None or found[1] != backend.name:
+        return None
+    return ForkedBox(found[0], limits, backend.notebook_uid())
+
+
+class ForkedProcess:
+    """The part of a Popen that :class:`labkit.grading.remote.Notebook` uses, for a forked worker."""
+
+    pid = None
+
+    def __init__(self, requests, answers, control, status):
+        self.stdin = os.fdopen(requests, "wb")
+        self.stdout = os.fdopen(answers, "rb", buffering=0)
+        self.control, self.status = control, status
+        self.returncode = None
+        self._said = b""
+
+    def _read_status(self, until):
+        while self.returncode is None:
+            if until is not None and not _wait_readable(self.status, until):
+                return
+            chunk = os.read(self.status, 64)
+            if not chunk:  # the keeper is gone without saying how the worker ended
+                self.returncode = -9
+                return
+            self._said += chunk
+            if self._said.startswith(b"W") and self._said[1:].lstrip(b"-").isdigit():
+                self.returncode = os.waitstatus_to_exitcode(int(self._said[1:]))
+
+    def poll(self):
+        self._read_status(time.monotonic())
+        return self.returncode
+
+    def wait(self, timeout=None):
+        self._read_status(None if timeout is None else time.monotonic() + timeout)
+        if self.returncode is None:
+            raise subprocess.TimeoutExpired("forked worker", timeout)
+        return self.returncode
+
+    def kill(self):
+        """Tell the keeper to stop the worker and every process of its namespace."""
+        if self.control is not None:
+            os.close(self.control)
+            self.control = None
+
+    def close(self):
+        self.kill()
+        if self.status is not None:
+            os.close(self.status)
+            self.status = None
+
+
+class ForkedBox(Box):
+    """One notebook's worker, forked by the server on `server` and isolated by it (see the module)."""
+
+    def __init__(self, server, limits, uid):
+        super().__init__([], limits)
+        self.server, self.uid = server, uid
+
+    def start(self):
+        self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
+        joins = []
+        try:
+            if self.cgroup is not None:
+                for folder in (self.cgroup.path, self.cgroup.cpu_path):
+                    if folder is not None:
+                        joins.append(os.open(folder / "cgroup.procs", os.O_WRONLY))
+            pipes = [os.pipe() for _ in range(4)]  # requests, answers, control, status
+            (requests_r, requests_w), (answers_r, answers_w), (control_r, control_w), (status_r, status_w) = pipes
+            theirs = [requests_r, answers_w, control_r, status_w, *joins]
+            text = json.dumps({"uid": self.uid, "limits": vars(self.limits), "cgroup": len(joins)}).encode()
+            try:
+                self.server.sendmsg([text], [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", theirs))])
+            except OSError as exc:
+                for fd in (requests_w, answers_r, control_w, status_r):
+                    os.close(fd)
+                raise ForkServerError(f"the fork server is gone ({exc})") from None
+            finally:
+                for fd in theirs:
+                    os.close(fd)
+                joins = []
+        finally:
+            for fd in joins:
+                os.close(fd)
+        process = ForkedProcess(requests_w, answers_r, control_w, status_r)
+        said = b""
+        until = time.monotonic() + START_TIMEOUT
+        while not said and _wait_readable(status_r, until):
+            said = os.read(status_r, 1)
+            if said == b"E":
+                said += os.read(status_r, 500)
+        if said != b"S":
+            process.close()
+            process.stdin.close()
+            process.stdout.close()
+            why = said[1:].decode("utf-8", "replace") if said.startswith(b"E") else "no answer"
+            raise ForkServerError(f"the fork server could not isolate a worker ({why})")
+        self.process = process
+        return process
+
+    def stop(self):
+        if self.process is None:
+            return
+        self.process.kill()
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            pass
+
+    def close(self):
+        if self.closed:
+            return
+        if self.process is not None:
+            self.process.close()
+        super().close()

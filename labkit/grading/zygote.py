@@ -1,0 +1,228 @@
+"""The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
+
+Started by the grader (:mod:`labkit.grading.forkserver`) as
+``python -I -m labkit.grading.zygote FD`` inside a sandbox its backend made
+(:meth:`labkit.grading.backends.base.Backend.zygote_box`), with the
+capabilities to make namespaces and to change uid. It imports what notebooks
+need (:func:`labkit.grading.worker.warm`), says ``ready`` on stdout and then
+waits on the socket `FD` for requests, one datagram each: a small JSON text
+(the notebook's uid and limits) and, passed along with it, the descriptors
+of the new worker (its requests and answers pipes, a control pipe, a status
+pipe and, where the grader made one, the files that put a process in the
+notebook's cgroup). It never reads a line of a notebook, and no student code
+ever runs in it.
+
+For each request it forks; the child (the notebook's **keeper**) makes what
+separates this notebook from every other one graded through the same
+server, before any student code exists:
+
+* new mount, network, IPC, UTS and PID namespaces;
+* fresh, empty tmpfs on ``/tmp``, the home folder and ``/dev/shm``, so no
+  file written by one notebook is ever seen by another;
+* a new ``/proc`` (read-only) that shows only this notebook's processes.
+
+The keeper then forks the **worker**, the first process of the new PID
+namespace: it joins the notebook's cgroup, takes the notebook's rlimits,
+closes every descriptor but its own pipes (the server's socket among them),
+becomes the notebook's own uid (which drops every capability), sets
+no-new-privileges and runs the worker's supervisor
+(:class:`labkit.grading.worker.Supervisor`) with the imports it inherited.
+When the worker ends, the kernel ends every process of its namespace.
+
+The keeper stays outside, as root, running only this module's code: it
+writes ``S`` on the status pipe once the worker runs (or ``E`` and why it
+could not), waits for the worker to end or for the control pipe to close
+(the grader stopped the notebook, or died), kills the worker if it still
+runs, and writes its wait status.
+"""
+
+import ctypes
+import json
+import os
+import select
+import signal
+import socket
+import struct
+import sys
+
+from . import worker
+from .backends.base import Limits, apply_limits
+
+CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC, CLONE_NEWPID, CLONE_NEWNET = (
+    0x00020000,
+    0x04000000,
+    0x08000000,
+    0x20000000,
+    0x40000000,
+)
+MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REC, MS_PRIVATE = 1, 2, 4, 8, 0x4000, 0x40000
+PR_SET_NO_NEW_PRIVS = 38
+MAX_REQUEST = 4 * 1024  # bytes of one request's text
+MAX_FDS = 8  # descriptors passed with one request
+FIRST_FD = 3  # where the worker's own descriptors are put before every other one is closed
+
+_libc = ctypes.CDLL(None, use_errno=True)
+_libc.mount.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_ulong, ctypes.c_char_p]
+_libc.unshare.argtypes = [ctypes.c_int]
+
+
+def _checked(result, what):
+    if result != 0:
+        number = ctypes.get_errno()
+        raise OSError(number, f"{what}: {os.strerror(number)}")
+
+
+def _mount(source, target, kind, flags, data=None):
+    _checked(
+        _libc.mount(
+            source.encode(), target.encode(), kind.encode() if kind else None, flags, data.encode() if data else None
+        ),
+        f"mount {target}",
+    )
+
+
+def isolate(limits, home):
+    """In the keeper: new namespaces and empty private folders (see the module's description)."""
+    _checked(_libc.unshare(CLONE_NEWNS | CLONE_NEWNET | CLONE_NEWIPC | CLONE_NEWUTS | CLONE_NEWPID), "unshare")
+    _mount("none", "/", None, MS_REC | MS_PRIVATE)  # nothing mounted here reaches the server's view
+    folders = [("/tmp", limits.tmp_size), (home, limits.home_size)]
+    if os.path.isdir("/dev/shm"):
+        folders.append(("/dev/shm", limits.tmp_size))
+    for path, size in folders:
+        _mount("tmpfs", path, "tmpfs", MS_NOSUID | MS_NODEV, f"size={int(size)},mode=1777")
+    os.chdir(home)
+
+
+def _become_worker(fds, uid, limits):
+    """In the worker, as the first process of the new PID namespace: everything up to the student's uid."""
+    _mount("proc", "/proc", "proc", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC)
+    for fd in fds["cgroup"]:
+        os.write(fd, b"0")  # 0: the writing process
+    apply_limits(limits)
+    # the worker's pipes at 3 and 4, then nothing else: the server's socket and any other descriptor close
+    wanted = [fds["requests"], fds["answers"]]
+    moved = [os.dup(fd) for fd in wanted]
+    for index, fd in enumerate(moved):
+        os.dup2(fd, FIRST_FD + index)
+    os.closerange(FIRST_FD + len(moved), os.sysconf("SC_OPEN_MAX"))
+    worker.drop_privileges(uid)
+    if os.getuid() == 0 and uid:
+        raise OSError("the worker is still root")
+    _checked(_libc.prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0), "no new privileges")
+    return FIRST_FD, FIRST_FD + 1
+
+
+def _keeper(fds, uid, limits, home, shell):
+    """The child of the server for one notebook; never returns."""
+    status = fds["status"]
+    signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+    try:
+        isolate(limits, home)
+        pid = os.fork()
+    except OSError as exc:
+        os.write(status, f"E{exc}"[:500].encode("utf-8", "replace"))
+        os._exit(1)
+    if pid == 0:
+        code = 0
+        try:
+            requests, answers = _become_worker(fds, uid, limits)
+            worker.serve(requests, answers, shell)
+        except BaseException:  # noqa: BLE001 - the worker's end, whatever it is, is its status
+            code = 1
+        os._exit(code)
+    for name in ("requests", "answers"):
+        os.close(fds[name])
+    for fd in fds["cgroup"]:
+        os.close(fd)
+    os.write(status, b"S")
+    watch = os.pidfd_open(pid)
+    control = fds["control"]
+    while True:
+        ready = select.select([watch, control], [], [])[0]
+        if watch in ready:
+            break
+        if control in ready:  # closed (or written to): the grader is done with this notebook
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            break
+    _, wait_status = os.waitpid(pid, 0)
+    os.write(status, f"W{wait_status}".encode())
+    os._exit(0)
+
+
+def _receive(server):
+    """(request dict, [descriptors]) of the next request, or None when the grader closed its end."""
+    space = socket.CMSG_SPACE(MAX_FDS * struct.calcsize("i"))
+    data, ancillary, flags, _ = server.recvmsg(MAX_REQUEST, space)
+    fds = []
+    for level, kind, payload in ancillary:
+        if level == socket.SOL_SOCKET and kind == socket.SCM_RIGHTS:
+            usable = len(payload) - len(payload) % struct.calcsize("i")
+            fds += list(struct.unpack(f"{usable // struct.calcsize('i')}i", payload[:usable]))
+    if not data and not fds:
+        return None
+    return data, fds, flags
+
+
+def _parse(data, fds):
+    """The request's fields, its descriptors named; ValueError when it is not a request of the grader's."""
+    request = json.loads(data.decode("utf-8"))
+    count = int(request.get("cgroup", 0))
+    if len(fds) != 4 + count or not 0 <= count <= MAX_FDS - 4:
+        raise ValueError("a request with the wrong descriptors")
+    named = dict(zip(("requests", "answers", "control", "status"), fds[:4]))
+    named["cgroup"] = fds[4:]
+    uid = int(request["uid"])
+    limits = Limits(**{key: int(value) for key, value in request["limits"].items()})
+    return named, uid, limits
+
+
+def serve(server, shell, home):
+    """Fork an isolated worker for each request until the grader closes its end of the socket."""
+    signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # keepers are reaped by the kernel
+    while True:
+        received = _receive(server)
+        if received is None:
+            return
+        data, fds, flags = received
+        try:
+            if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
+                raise ValueError("a request larger than the server takes")
+            named, uid, limits = _parse(data, fds)
+        except (ValueError, KeyError, TypeError):
+            for fd in fds:
+                os.close(fd)
+            continue
+        try:
+            pid = os.fork()
+        except OSError as exc:
+            os.write(named["status"], f"E{exc}"[:500].encode("utf-8", "replace"))
+            pid = None
+        if pid == 0:
+            try:
+                server.close()
+                _keeper(named, uid, limits, home, shell)
+            finally:
+                os._exit(1)
+        for fd in fds:
+            os.close(fd)
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    server = socket.socket(fileno=int(argv[0]))
+    worker.not_dumpable()
+    null = os.open(os.devnull, os.O_RDWR)
+    ready = os.dup(1)
+    for fd in (0, 1, 2):
+        os.dup2(null, fd)
+    shell = worker.warm(everything=True)
+    os.write(ready, b"ready\n")
+    os.close(ready)
+    serve(server, shell, os.getcwd())
+
+
+if __name__ == "__main__":
+    main()
