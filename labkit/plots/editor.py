@@ -1,7 +1,7 @@
 """The patch editor of exercises 5 to 9: shape a Coons patch by dragging its corners and derivatives.
 
-:func:`patch_editor` shows a patch's mesh, filled by element quality (folded
-elements red), with twelve handles drawn over it in the browser: the four
+:func:`patch_editor` shows a patch's mesh, filled by element quality on a
+colour-safe map (folded elements hatched and outlined), with twelve handles drawn over it in the browser: the four
 corners, and the tips of each corner's d/ds and d/dt arrows. Dragging a
 handle moves it at once in the browser and sends its position to the kernel,
 which rebuilds the mesh and sends the new picture, the worst quality and the
@@ -259,7 +259,7 @@ class Editor:
         }
 
     def _repr_mimebundle_(self, **kwargs):
-        return widget_with_picture(self.widget, self.widget_.image, self.widget_.readout, **kwargs)
+        return widget_with_picture(self.widget, self.widget_.image, self.widget_.readout, alt=self.widget_.alt, **kwargs)
 
 
 def _size_slider(elements):

@@ -8,8 +8,8 @@ driven by Playwright, one JupyterLab server for the whole file.
   the page, no network) finds no serious or critical violation in the notebook's outputs (labkit's widgets
   and figures). What it finds in JupyterLab itself is printed (``-s``, and the run's summary) and listed in
   docs/students.md, never asserted. Static pictures without alt count as JupyterLab's: its image renderer
-  never sets one, not even from the output's `alt` metadata. A violation listed in PENDING (another part of
-  issue 23 removes it) makes the test xfail instead of fail.
+  never sets one, not even from the output's `alt` metadata. A violation listed in PENDING (a known one of
+  labkit's, waiting for its fix; none today) makes the test xfail instead of fail.
 
 One page serves the whole file: 03_meshes first (the editor, then its axe check), then each other notebook
 in turn, the one before closed and its kernel shut down.
@@ -45,7 +45,7 @@ IMPACTS = ("critical", "serious", "moderate", "minor")
 AXE = {}  # notebook -> {"outputs": [...], "jupyterlab": [...]}, printed by tests/browser/conftest.py's summary
 # Violations in the outputs that another part of issue 23 removes (the explorers' pictures get alt text with
 # item 2): they make the test xfail, not pass; remove an entry once nothing matches it any more.
-PENDING = {("image-alt", "labkit-explorer-image"): "item 2: the explorers' pictures carry their description as alt"}
+PENDING = {}  # (rule, marker in the node) -> why: a known violation of labkit's own, waiting for its fix
 # 03_meshes first: it stays open from the editor's test to its axe check
 MESHES = next(p for p in NOTEBOOKS if p.stem == "03_meshes")
 ORDERED = sorted(NOTEBOOKS, key=lambda p: p != MESHES)
