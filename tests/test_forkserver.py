@@ -170,3 +170,26 @@ def test_the_plain_way_and_the_fork_server_give_the_same_grades(tmp_path):
     assert _rows(tmp_path / "forked" / "grades.csv") == _rows(tmp_path / "plain" / "grades.csv")
     totals = {row[0]: row for row in _rows(tmp_path / "plain" / "grades.csv")[1:]}
     assert totals["solved"] != totals["slip"]
+
+
+DESCRIPTORS = """
+import os
+held = []
+for fd in os.listdir("/proc/self/fd"):
+    try:
+        held.append(os.readlink(f"/proc/self/fd/{fd}").split(":")[0])
+    except OSError:  # the listing's own descriptor, closed by now
+        pass
+held.sort()
+"""
+
+
+def test_a_forked_notebook_holds_no_descriptor_a_sandbox_of_its_own_would_not(server):
+    """Only the notebook's own pipes cross the fork: not the keeper's control or status pipes, nor the files
+    that put it in its cgroup, nor the server's socket."""
+    held = {}
+    for label, fork in (("forked", True), ("plain", False)):
+        with remote.Notebook(GradeOptions(fork_server=fork)) as notebook:
+            assert isinstance(notebook.box, forkserver.ForkedBox) == fork
+            held[label] = _run(notebook, [DESCRIPTORS])["held"]
+    assert held["forked"] == held["plain"]
