@@ -376,7 +376,7 @@ def build_parser():
         metavar="ADDRESS",
         help="grade on a Dask cluster, one task per submission: the scheduler's address (tcp://host:8786), or "
         "'local' for a LocalCluster here; workers need the submissions at the same path (a shared file system), "
-        "labkit of this version and bwrap (pip install 'labkit[dask]')",
+        "labkit of this version and the sandbox (pip install 'labkit[dask]')",
     )
     grd.add_argument(
         "--dask-workers",

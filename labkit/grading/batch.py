@@ -332,8 +332,9 @@ def grade(
     (:func:`shard`). `dask`, a scheduler's address or ``"local"`` (a
     LocalCluster of `dask_workers` workers), sends the submissions to a Dask
     cluster (:mod:`labkit.grading.distributed`) in place of `jobs` grading
-    processes here. Returns the grades in the order given; those with
-    ``graded`` False could not be graded (their ``failure`` says why).
+    processes here. Returns the grades in the order given (a shard's in name
+    order), those of an earlier run included; those with ``graded`` False
+    could not be graded (their ``failure`` says why).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:

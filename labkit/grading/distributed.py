@@ -14,7 +14,7 @@ running it again.
 
 What the workers need: the same labkit version (a result written by another
 one is refused, and its submission reported as not graded), the course's
-exercises module when the rubric names one, the sandbox (``bwrap``), and the
+exercises module when the rubric names one, the sandbox backend's tool, and the
 submissions at the path the client gives: a file system shared with the
 client (NFS, a cluster's home or scratch). The notebooks are not sent with
 the tasks; the rubric is, and each worker computes the refusals once.
