@@ -12,6 +12,7 @@
 """
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -179,6 +180,21 @@ def _times_notes(grades, rubric, times):
     return sum(error for *_, error in unknown)
 
 
+def _resumed(out):
+    """Say how many submissions an earlier run into the same folder had graded, and which part of a shard this is."""
+    try:
+        record = json.loads((out / "run.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return
+    if record.get("already graded"):
+        print(
+            f"resumed {out}: {record['already graded']} submission(s) were graded there already and kept, "
+            f"{record.get('graded now', 0)} graded now (--fresh grades all again)"
+        )
+    if record.get("shard"):
+        print(f"shard {record['shard']}: {record.get('submissions')} submission(s); combine the shards with --merge")
+
+
 def grade_options(args):
     """The :class:`~labkit.grading.options.GradeOptions` of `labkit grade`'s arguments; ValueError for a bad one."""
     from .grading.backends.base import Limits
@@ -211,6 +227,11 @@ def _grade(args):
     if args.merge:
         if args.submissions:
             raise ValueError("--merge takes output folders of earlier runs, not submissions; give one or the other.")
+        given = [
+            flag for flag, value in (("--shard", args.shard), ("--dask", args.dask), ("--fresh", args.fresh)) if value
+        ]
+        if given:
+            raise ValueError(f"{', '.join(given)} grade(s) submissions, which --merge does not; merge without them.")
         if args.times_from_mtime:
             raise ValueError(
                 "--times-from-mtime reads the submissions' files, which --merge does not have: give the times in "
@@ -223,6 +244,8 @@ def _grade(args):
         return 1 if report_failures(grades) or unreadable else 0
     if not args.submissions:
         raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
+    if args.dask_workers is not None and args.dask != "local":
+        raise ValueError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
     options = grade_options(args)
     grades = grade(
         args.submissions,
@@ -233,8 +256,13 @@ def _grade(args):
         options=options,
         times=times,
         times_from_mtime=args.times_from_mtime,
+        shard=args.shard,
+        fresh=args.fresh,
+        dask=args.dask,
+        dask_workers=2 if args.dask_workers is None else args.dask_workers,
     )
     _summary(grades, args.out, start, "graded")
+    _resumed(args.out)
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} (repeat the run with --seed)")
     unreadable = _times_notes(grades, rubric, times)
     failed = report_failures(grades)
@@ -373,6 +401,10 @@ def build_parser():
         description="Run each submission (a notebook, or a folder with a student's notebooks) in a sandbox, "
         "check every exercise from outside it, and write grades.csv, feedback/<submission>.txt, "
         "results/<submission>.json and seed.txt. With --merge, combine earlier runs' results instead.",
+        epilog="Each submission's result is written as soon as it is graded. Resuming is automatic: when --out "
+        "already holds results of an earlier run (same rubric and labkit version), only the submissions without "
+        "one are graded, with that run's seed from seed.txt (a different --seed is refused), and a submission that "
+        "could not be graded is graded again; grades.csv then covers them all. --fresh starts over instead.",
     )
     grd.add_argument("submissions", nargs="*", type=Path, help="notebooks or folders of notebooks, one per student")
     grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv, feedback/ and results/")
@@ -384,7 +416,34 @@ def build_parser():
         help="combine the results/ of these earlier --out folders into one grades.csv; a later folder's result "
         "replaces an earlier one's for the same submission (a regrade goes last)",
     )
-    grd.add_argument("--jobs", type=int, default=2, help="submissions graded at once (default 2)")
+    grd.add_argument(
+        "--jobs", type=int, default=2, help="submissions graded at once on this machine (default 2; not with --dask)"
+    )
+    grd.add_argument(
+        "--shard",
+        metavar="I/N",
+        help="grade only the I-th of N equal parts of the submissions (in name order, I from 1): one task of a "
+        "batch array each (give every part the same --seed), then --merge the parts",
+    )
+    grd.add_argument(
+        "--fresh",
+        action="store_true",
+        help="delete the results and feedback already in --out and grade every submission (by default a run "
+        "into a folder with results resumes it)",
+    )
+    grd.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        help="grade on a Dask cluster, one task per submission: the scheduler's address (tcp://host:8786), or "
+        "'local' for a LocalCluster here; workers need the submissions at the same path (a shared file system), "
+        "labkit of this version and the sandbox (pip install 'labkit[dask]')",
+    )
+    grd.add_argument(
+        "--dask-workers",
+        type=int,
+        metavar="N",
+        help="worker processes of --dask local, one submission each at a time (default 2)",
+    )
     grd.add_argument(
         "--cell-timeout",
         type=int,

@@ -44,3 +44,17 @@ def pytest_terminal_summary(terminalreporter):
             terminalreporter.write_line(
                 f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)"
             )
+
+
+@pytest.fixture(scope="session")
+def small_class(tmp_path_factory):
+    """The small class of tests/small_class.py, graded once with ``--jobs 2`` and its seed: (its submissions in
+    name order, the output folder), the reference the other ways of grading it are compared with."""
+    from small_class import SEED, cli, plant_small_class
+
+    sandbox_or_skip()
+    tmp = tmp_path_factory.mktemp("small-class")
+    submissions = plant_small_class(tmp / "submissions")
+    run = cli("grade", *submissions, "--out", tmp / "reference", "--seed", SEED, "--jobs", "2", "--quiet")
+    assert run.returncode == 0, run.stderr
+    return submissions, tmp / "reference"

@@ -17,7 +17,8 @@ One module per concern:
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
 * :mod:`~labkit.grading.late` - the rubric's deadline, submission times, the late penalty;
 * :mod:`~labkit.grading.progress` - a progress bar with an ETA, on a terminal only;
-* :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own;
+* :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own; resuming, shards;
+* :mod:`~labkit.grading.distributed` - the same on a Dask cluster (``--dask``; the ``labkit[dask]`` extra);
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
 * :mod:`~labkit.grading.class_report` - ``report.html``: the class at a glance (``labkit report OUT``);
 * :mod:`~labkit.grading.lms` - the grades into a Canvas gradebook or a Moodle grade import file.
@@ -49,6 +50,7 @@ _MODULES = {
     "batch",
     "cgroup",
     "class_report",
+    "distributed",
     "guard",
     "late",
     "lms",

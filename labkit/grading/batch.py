@@ -22,9 +22,20 @@ Each submission's time (for a rubric's ``[late]`` table) is read here, on the
 grader's side (:func:`labkit.grading.late.submission_time`), and saved with
 its result, so that ``--merge`` can apply a late rule later. A progress bar
 with an ETA is drawn on a terminal (:mod:`labkit.grading.progress`).
+
+Each submission's ``results/<name>.json`` and feedback are written as soon as
+it is graded, so a run that stops can be resumed: grading into an output
+folder that already holds results of the same rubric, labkit version and seed
+grades only the submissions it lacks (:func:`resumed`; a submission that could
+not be graded is graded again). :func:`shard` picks the I-th of N parts of a
+class, for batch systems; :mod:`labkit.grading.distributed` sends the
+submissions to a Dask cluster instead of grading them here. Both engines grade
+a submission through :func:`grade_one`.
 """
 
+import atexit
 import contextlib
+import ctypes
 import json
 import os
 import resource
@@ -35,6 +46,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -43,7 +55,7 @@ from .backends.base import SandboxUnavailable
 from .late import submission_time
 from .options import GradeOptions
 from .progress import Progress
-from .report import SubmissionGrade, one_line, safe_name, write_report
+from .report import FORMAT, SubmissionGrade, one_line, safe_name, write_report, write_result
 from .rubric import Rubric
 from .rubric import default as default_rubric
 from .rubric import load as load_rubric
@@ -103,12 +115,16 @@ class _Job:
         self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
         group = self.cgroup
 
+        parent = os.getpid()
+
         def prepare():
             if group is not None:
                 group.join()
             resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            _die_with(parent)
 
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        environment.update(_process_environment())
         if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
             environment.update(group.sibling_environment())
         environment.pop(forkserver.ENV, None)
@@ -177,8 +193,49 @@ class _Job:
             self.peak = self.cgroup.peak()
             self.cgroup.remove()
 
-    def outcome(self, rubric, timed_out):
-        """(SubmissionGrade, None) from the result file, or (None, why the grading process failed)."""
+    def poll(self):
+        """Whether this attempt is over (its process ended, or it overran its limit and was stopped)."""
+        if self.process.poll() is None:
+            if not self.overdue():
+                return False
+            self.stop()
+            self.timed_out = True
+        else:
+            self.finish()
+            self.timed_out = False
+        return True
+
+    def wait(self):
+        """Wait until this attempt is over (its process ends, or it overruns its limit and is stopped)."""
+        try:
+            self.process.wait(timeout=max(0.0, self.limit - (time.monotonic() - self.started)))
+        except subprocess.TimeoutExpired:
+            self.stop()
+            self.timed_out = True
+        else:
+            self.finish()
+            self.timed_out = False
+
+    def conclude(self):
+        """After an attempt: True when the submission is done (:meth:`message`), False when its grading
+        process is to be started once more."""
+        self.peaks = [*getattr(self, "peaks", []), self.peak]
+        self.data, self.why = self.read(self.timed_out)
+        return self.data is not None or self.attempt >= ATTEMPTS
+
+    def message(self):
+        """The submission's outcome as plain data (what a Dask task sends back): its result file's data, or
+        why it could not be graded."""
+        return {
+            "name": self.name,
+            "result": self.data,
+            "failure": None if self.data is not None else f"{self.why} (tried {self.attempt} times)",
+            "attempts": self.attempt,
+            "peak": max((p for p in self.peaks if p), default=None),
+        }
+
+    def read(self, timed_out):
+        """(the result file's data, None), or (None, why the grading process failed)."""
         code = self.process.returncode
         if timed_out:
             return None, (
@@ -201,11 +258,102 @@ class _Job:
             if self.result.stat().st_size > MAX_RESULT:
                 return None, "its result was larger than the grader accepts"
             data = json.loads(self.result.read_text(encoding="utf-8"))
-            grade = SubmissionGrade.from_dict(data, self.name, rubric)
+            if not isinstance(data, dict) or data.get("format") != FORMAT:
+                raise ValueError(f"format {data.get('format') if isinstance(data, dict) else data!r:.60}")
         except (OSError, ValueError) as exc:
             return None, f"its result could not be read ({str(exc)[:200]})"
-        grade.name = self.name
-        return grade, None
+        return data, None
+
+
+def _process_environment():
+    """What each grading process gets in its environment beyond the grader's own (nothing yet).
+
+    Called in the process that starts the grading process: the grader with ``--jobs``, a Dask worker
+    with ``--dask``; the place for whatever a grading process must be handed (the fork server's address)."""
+    return {}
+
+
+_LIBC = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None
+
+
+def _die_with(parent):
+    """In a grading process before it runs: be killed when the thread that started it dies (the grader, or
+    a Dask worker killed mid-task), so no grading outlives its grader; Linux only."""
+    if _LIBC is not None:
+        _LIBC.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # the grader died before the line above
+            os._exit(1)
+
+
+def grade_one(path, name, options, profiles_file, work):
+    """Grade one submission in a grading process of its own (started once more if it breaks); blocks.
+
+    The seam both engines share: :func:`_schedule` runs the same steps (:class:`_Job`) a few at a time,
+    and a Dask task (:mod:`labkit.grading.distributed`) calls this. `options` is the run's
+    :class:`GradeOptions` (its seed drawn), `profiles_file` the refusals as JSON
+    (:func:`labkit.grading.refusals.wire`), `work` a folder for the process's files. Returns plain data:
+    ``{"name", "result": the result file's data or None, "failure": why it could not be graded or None,
+    "attempts", "peak": the grading process's peak memory in bytes or None}``; :func:`settled` makes a
+    :class:`SubmissionGrade` of it under a rubric."""
+    server, launcher = _kept(options)
+    job = _Job(path, name, Path(work), options, profiles_file, server, launcher)
+    while True:
+        job.start()
+        job.wait()
+        if job.conclude():
+            return job.message()
+
+
+_KEPT = {}  # (backend, limits, exercises) -> (fork server, launcher) this process keeps (a Dask worker's)
+_KEPT_LOCK = threading.Lock()
+
+
+def _kept(options):
+    """The fork server and launcher this process keeps for :func:`grade_one` (a Dask worker grades one
+    submission per task): started on first use, started again if they died, stopped when the process
+    ends; (None, None) with ``fork_server`` off or where they cannot start."""
+    if not options.fork_server:
+        return None, None
+    key = (options.backend, options.limits, options.exercises)
+    with _KEPT_LOCK:
+        server, launcher = _KEPT.get(key, (None, None))
+        alive = server is not None and server.box.process.poll() is None
+        if not alive or launcher is None or launcher.process.poll() is not None:
+            for thing in (launcher, server):
+                if thing is not None:
+                    thing.stop()
+            try:
+                server = forkserver.ForkServer(backends.get_backend(options.backend), options.limits).start()
+            except forkserver.ForkServerError:
+                server = None
+            try:
+                launcher = Launcher(options, server)
+            except (OSError, ValueError):
+                launcher = None
+            if key not in _KEPT:
+                atexit.register(_stop_kept, key)
+            _KEPT[key] = (server, launcher)
+        return server, launcher
+
+
+def _stop_kept(key):
+    for thing in reversed(_KEPT.pop(key, ())):
+        if thing is not None:
+            thing.stop()
+
+
+def settled(message, rubric, seed):
+    """The :class:`SubmissionGrade` of :func:`grade_one`'s outcome, scored with `rubric`; a result that cannot be
+    read (another labkit version's, say) makes a submission that could not be graded, saying why."""
+    name = message["name"]
+    if message.get("result") is not None:
+        try:
+            grade = SubmissionGrade.from_dict(message["result"], one_line(name, 80), rubric)
+        except ValueError as exc:
+            return SubmissionGrade(name, seed=seed, rubric=rubric, failure=f"its result could not be read ({exc})")
+        grade.name = name
+        return grade
+    return SubmissionGrade(name, seed=seed, rubric=rubric, failure=str(message.get("failure")))
 
 
 def grade(
@@ -222,6 +370,10 @@ def grade(
     options=None,
     times=None,
     times_from_mtime=False,
+    shard=None,
+    fresh=False,
+    dask=None,
+    dask_workers=2,
 ):
     """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
 
@@ -237,9 +389,19 @@ def grade(
     ``--times`` file), else from nbgrader's ``timestamp.txt`` in its folder,
     else, only with `times_from_mtime`, from its notebooks' modification
     time (:func:`labkit.grading.late.submission_time`). `progress` draws a
-    bar with an ETA on a terminal. Returns the grades in the order given;
-    those with ``graded`` False could not be graded (their ``failure`` says
-    why).
+    bar with an ETA on a terminal.
+
+    Each submission's result and feedback are written as soon as it is
+    graded. When `out_dir` already holds results of an earlier run, only the
+    submissions without one are graded, with that run's seed
+    (:func:`resumed`); `fresh` deletes those results first. `shard`, ``(I,
+    N)`` or ``"I/N"``, grades only the I-th of N parts of the class
+    (:func:`shard`). `dask`, a scheduler's address or ``"local"`` (a
+    LocalCluster of `dask_workers` workers), sends the submissions to a Dask
+    cluster (:mod:`labkit.grading.distributed`) in place of `jobs` grading
+    processes here. Returns the grades in the order given (a shard's in name
+    order), those of an earlier run included; those with ``graded`` False
+    could not be graded (their ``failure`` says why).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:
@@ -250,6 +412,9 @@ def grade(
     names = [submission_name(p) for p in submissions]
     if len(set(names)) != len(names):
         raise ValueError("two submissions have the same name; their feedback files would collide.")
+    if shard is not None:
+        shard = parse_shard(shard)
+        submissions, names = shard_of(submissions, names, shard)
     options = GradeOptions.build(
         options, cell_timeout=cell_timeout, total_timeout=total_timeout, limits=limits, seed=seed, sandboxed=sandboxed
     )
@@ -267,7 +432,9 @@ def grade(
         sys.stderr.write(warning)
     from dataclasses import replace
 
-    seed = secrets.randbits(63) if options.seed is None else int(options.seed)
+    out = Path(out_dir)
+    done, seed = resumed(out, names, options.seed, rubric, fresh)
+    seed = secrets.randbits(63) if seed is None else int(seed)
     options = replace(options, seed=seed)
     if options.exercises not in (None, rubric.registry.source):
         raise ValueError(
@@ -280,50 +447,60 @@ def grade(
         submission_time(path, name, times, _notebooks(path) if times_from_mtime else None, times_from_mtime)
         for path, name in zip(submissions, names)
     ]
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    for folder in ("results", "feedback"):
+        (out / folder).mkdir(parents=True, exist_ok=True)  # an empty shard's folder is a run's too
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
+    when = dict(zip(names, handed_in))
+    todo = [(path, name) for path, name in zip(submissions, names) if name not in done]
+
+    def arrived(grade):
+        """Write a submission's result and feedback as soon as it is graded (a stopped run resumes from them)."""
+        grade.time = when[grade.name]
+        write_result(out, grade)
+
     work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
-    start, peaks = time.monotonic(), []
+    start, peaks, record = time.monotonic(), [], {"engine": "local", "jobs": int(jobs)}
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
-        with (
-            _fork_server(backend, options) as server,
-            _launcher(options, server) as launcher,
-            Progress(len(submissions), "grading", enabled=progress) as bar,
-        ):
-            forked = {"fork server": server is not None, "forked grading processes": launcher is not None}
-            grades = _schedule(
-                submissions,
-                names,
-                work,
-                options,
-                profiles_file,
-                rubric,
-                max(1, int(jobs)),
-                out,
-                bar,
-                peaks,
-                server,
-                launcher,
-            )
+        if dask is None:
+            with (
+                _fork_server(backend, options) as server,
+                _launcher(options, server) as launcher,
+                Progress(len(todo), "grading", enabled=progress) as bar,
+            ):
+                record.update({"fork server": server is not None, "forked grading processes": launcher is not None})
+                graded = _schedule(
+                    [p for p, _ in todo], [n for _, n in todo], work, options, profiles_file, rubric,
+                    max(1, int(jobs)), out, bar, peaks, arrived, server, launcher,
+                )  # fmt: skip
+                graded = {grade.name: grade for grade in graded.values()}
+        else:
+            from . import distributed
+
+            with Progress(len(todo), "grading", enabled=progress) as bar:
+                graded, record = distributed.schedule(
+                    dask, todo, options, profiles_file, rubric, out, bar, peaks, arrived, workers=dask_workers
+                )
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    ordered = [grades[p] for p in submissions]
-    for grade, time_handed_in in zip(ordered, handed_in):
-        grade.time = time_handed_in
+    ordered = [graded[name] if name in graded else done[name] for name in names]
+    for grade in ordered:
+        grade.time = when[grade.name]
     write_report(out, ordered)
     (out / "run.json").write_text(
         json.dumps(
             {
                 "seed": seed,
                 "submissions": len(ordered),
+                "graded now": len(graded),
+                "already graded": len(done),
+                "shard": None if shard is None else f"{shard[0]}/{shard[1]}",
                 "not graded": sum(not g.graded for g in ordered),
                 "seconds": round(time.monotonic() - start, 1),
-                "jobs": int(jobs),
-                **forked,
+                **record,
                 "grader peak bytes": max((p for p in peaks if p), default=None),
+                "grader process peak bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
             },
             indent=1,
         ),
@@ -385,8 +562,9 @@ class Launcher:
     """One warm process that forks each submission's grading process (:mod:`labkit.grading.launcher`)."""
 
     def __init__(self, options, server=None):
-        self.ended, self._buffer = {}, b""
+        self.ended, self._buffer, self._lock = {}, b"", threading.RLock()
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        parent = os.getpid()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "labkit.grading.launcher", options.exercises or ""],
             stdin=subprocess.PIPE,
@@ -395,6 +573,7 @@ class Launcher:
             start_new_session=True,
             env=environment,
             pass_fds=(server.fd,) if server is not None else (),
+            preexec_fn=lambda: _die_with(parent),
         )
         if self._next(time.monotonic() + LAUNCHER_READY) != {"ready": True}:
             self.stop()
@@ -416,28 +595,33 @@ class Launcher:
 
     def pump(self, wait):
         """File every ended process the launcher reported (waiting up to `wait` s for one); whether any."""
-        message = self._next(time.monotonic() + wait)
-        found = False
-        while message is not None:
-            if "ended" in message:
-                self.ended[int(message["ended"])] = int(message["code"])
-                found = True
-            message = self._next(time.monotonic())
-        return found
+        with self._lock:
+            message = self._next(time.monotonic() + wait)
+            found = False
+            while message is not None:
+                if "ended" in message:
+                    self.ended[int(message["ended"])] = int(message["code"])
+                    found = True
+                message = self._next(time.monotonic())
+            return found
 
     def launch(self, request):
         """Fork a grading process for `request`; a :class:`_Launched` (OSError when the launcher is gone)."""
-        self.process.stdin.write((json.dumps(request) + "\n").encode())
-        self.process.stdin.flush()
-        while True:
-            message = self._next(time.monotonic() + LAUNCH_TIMEOUT)
-            if message is None:
-                raise OSError("the launcher of grading processes stopped answering")
-            if "ended" in message:
-                self.ended[int(message["ended"])] = int(message["code"])
-            elif "started" in message:
-                self.ended.pop(int(message["started"]), None)  # a pid used again
-                return _Launched(self, int(message["started"]))
+        with self._lock:
+            try:
+                self.process.stdin.write((json.dumps(request) + "\n").encode())
+                self.process.stdin.flush()
+            except ValueError:  # closed: stopped
+                raise OSError("the launcher of grading processes was stopped") from None
+            while True:
+                message = self._next(time.monotonic() + LAUNCH_TIMEOUT)
+                if message is None:
+                    raise OSError("the launcher of grading processes stopped answering")
+                if "ended" in message:
+                    self.ended[int(message["ended"])] = int(message["code"])
+                elif "started" in message:
+                    self.ended.pop(int(message["started"]), None)  # a pid used again
+                    return _Launched(self, int(message["started"]))
 
     def stop(self):
         try:
@@ -467,9 +651,11 @@ def _launcher(options, server):
 
 
 def _schedule(
-    submissions, names, work, options, profiles_file, rubric, jobs, out, bar, peaks, server=None, launcher=None
-):
-    """Run the grading processes, `jobs` at a time; {path: SubmissionGrade} for every submission."""
+    submissions, names, work, options, profiles_file, rubric, jobs, out, bar, peaks, arrived=None, server=None,
+    launcher=None,
+):  # fmt: skip
+    """Run the grading processes, `jobs` at a time; {path: SubmissionGrade} for every submission, each handed
+    to `arrived` as soon as it is graded. `server` and `launcher` are the run's (None: the plain way)."""
     pending = [
         _Job(path, name, work, options, profiles_file, server, launcher) for path, name in zip(submissions, names)
     ]
@@ -485,28 +671,23 @@ def _schedule(
         if stopped is not None and not running:
             for job in pending:
                 grades[job.path] = SubmissionGrade(job.name, seed=options.seed, rubric=rubric, failure=stopped)
+                if arrived is not None:
+                    arrived(grades[job.path])
                 bar.advance()
             pending = []
             break
         time.sleep(0.05)
         for job in list(running):
-            timed_out = False
-            if job.process.poll() is None:
-                if not job.overdue():
-                    continue
-                job.stop()
-                timed_out = True
-            else:
-                job.finish()
+            if not job.poll():
+                continue
             running.remove(job)
             peaks.append(job.peak)
-            result, why = job.outcome(rubric, timed_out)
-            if result is None and job.attempt < ATTEMPTS:
+            if not job.conclude():
                 pending.append(job)  # once more, in a fresh process
                 continue
-            grades[job.path] = result or SubmissionGrade(
-                job.name, seed=options.seed, rubric=rubric, failure=f"{why} (tried {job.attempt} times)"
-            )
+            grades[job.path] = settled(job.message(), rubric, options.seed)
+            if arrived is not None:
+                arrived(grades[job.path])
             bar.advance()
     return grades
 
@@ -517,3 +698,103 @@ def report_failures(grades, stream=sys.stderr):
     for g in failed:
         stream.write(f"could not grade {one_line(g.name, 80)}: {one_line(g.failure, 300)}\n")
     return len(failed)
+
+
+def resumed(out, names, seed, rubric, fresh=False):
+    """The results an earlier run left in `out` that this run keeps, and the seed to grade with.
+
+    An output folder that holds results (``results/*.json``) is resumed: the submissions graded there
+    are kept ({name: SubmissionGrade}), and the run grades the others with the earlier run's seed
+    (``seed.txt``), which `seed` may repeat but not change. A result of a submission that could not be
+    graded is not kept (it is graded again: such failures are the grader's, a crash, a stopped run, a
+    lost worker). Results of another rubric or labkit version, of several seeds (a merged folder), or of a
+    submission not in `names` are refused with a ValueError saying what to do, as nothing of them would
+    fit this run's grades.csv. A result file that is not JSON (a run killed while writing it) is graded
+    again. `fresh` deletes the earlier results and feedback instead: every submission is graded, with
+    `seed` (a fresh one when None)."""
+    out = Path(out)
+    files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
+    if fresh:
+        for path in [*files, *sorted((out / "feedback").glob("*.txt"))]:
+            path.unlink()
+        return {}, seed
+    if not files:
+        return {}, seed
+    how = "leave --seed out to resume it, give --fresh to grade every submission again, or choose a new --out"
+    try:
+        saved = [int(line) for line in (out / "seed.txt").read_text(encoding="utf-8").split()]
+    except (OSError, ValueError):
+        saved = []
+    datas = {}
+    for path in files:
+        try:
+            datas[path] = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError):
+            continue  # written in part when a run was killed: graded again, and the file replaced
+    seeds = {data.get("seed") for data in datas.values() if isinstance(data, dict)}
+    if len(saved) != 1:
+        saved = sorted(seeds, key=str)
+    if len(saved) != 1 or seeds - set(saved):
+        raise ValueError(
+            f"{out} holds results graded with several seeds ({', '.join(map(str, sorted(seeds | set(saved), key=str)))}"
+            "), as a --merge folder does: grade into a new --out, or give --fresh to grade every submission again."
+        )
+    saved = saved[0]
+    if seed is not None and int(seed) != saved:
+        raise ValueError(f"{out} holds results of a run with seed {saved}, not --seed {seed}: {how}.")
+    wanted, done = set(names), {}
+    for path, data in datas.items():
+        grade = SubmissionGrade.from_dict(data, str(path), rubric)  # ValueError: another labkit version's
+        if data.get("rubric digest") != rubric.digest:
+            raise ValueError(
+                f"{path} was graded under another rubric ({one_line(data.get('rubric'), 80)!r}, "
+                f"{one_line(data.get('rubric digest'), 20)}, not {rubric.digest}): give the --rubric of the run that "
+                "wrote it to resume it, give --fresh to grade every submission again, or choose a new --out."
+            )
+        if grade.name not in wanted or path.name != f"{safe_name(grade.name)}.json":
+            raise ValueError(
+                f"{path} is the result of {one_line(grade.name, 80)!r}, which is not among the submissions of "
+                "this run: give the submissions (and --shard) of the run that wrote it to resume it, give "
+                "--fresh to grade only these, or choose a new --out."
+            )
+        if grade.graded:
+            done[grade.name] = grade
+    return done, saved
+
+
+def parse_shard(spec):
+    """``(I, N)`` from ``"I/N"`` (or a pair): the I-th of N parts, counted from 1; ValueError says how to write it.
+
+    >>> parse_shard("3/50")
+    (3, 50)
+    """
+    how = "give --shard I/N with 1 <= I <= N, e.g. 3/50 for the third of 50 parts (a Slurm array: --array=1-50)"
+    try:
+        index, count = spec.split("/") if isinstance(spec, str) else spec
+        index, count = int(index), int(count)
+    except (TypeError, ValueError):
+        raise ValueError(f"{how}; got {one_line(spec, 40)!r}.") from None
+    if not 1 <= index <= count:
+        raise ValueError(f"{how}; got {index}/{count}.")
+    return index, count
+
+
+def shard(names, index, count):
+    """The `index`-th (from 1) of `count` parts of `names`, in name order: every name is in exactly one part,
+    the parts' sizes differ by at most one, and with more parts than names some parts are empty.
+
+    >>> [shard(["d", "a", "c", "b", "e"], i, 2) for i in (1, 2)]
+    [['a', 'b'], ['c', 'd', 'e']]
+    >>> shard(["a"], 2, 3)
+    []
+    """
+    index, count = parse_shard((index, count))
+    ordered = sorted(names)
+    return ordered[(index - 1) * len(ordered) // count : index * len(ordered) // count]
+
+
+def shard_of(submissions, names, part):
+    """The submissions (and their names) of `part`, ``(I, N)``, in name order (:func:`shard`)."""
+    by_name = dict(zip(names, submissions))
+    chosen = shard(names, *part)
+    return [by_name[name] for name in chosen], chosen

@@ -44,6 +44,11 @@ def _child(request):
     code = 1
     try:
         os.setsid()
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: die with the launcher
+        if os.getppid() != request["launcher"]:  # it died before the line above
+            os._exit(1)
         for procs in request.get("cgroups", ()):
             with open(procs, "w") as handle:
                 handle.write(str(os.getpid()))
@@ -108,6 +113,7 @@ def main(argv=None):
             *lines, buffer = buffer.split(b"\n")
             for line in lines:
                 request = json.loads(line)
+                request["launcher"] = os.getpid()
                 pid = os.fork()
                 if pid == 0:
                     _child(request)

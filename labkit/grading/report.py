@@ -23,6 +23,7 @@ import csv
 import functools
 import hashlib
 import json
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -369,14 +370,19 @@ def write_csv(path, grades):
 
 
 def write_result(out_dir, grade):
-    """results/<name>.json and feedback/<name>.txt of one submission."""
+    """results/<name>.json and feedback/<name>.txt of one submission, each replaced whole (a run killed while
+    writing leaves the earlier file or none, never half of one)."""
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
-    (out / "results" / f"{safe_name(grade.name)}.json").write_text(
-        json.dumps(grade.as_dict(), indent=1), encoding="utf-8"
-    )
-    (out / "feedback" / f"{safe_name(grade.name)}.txt").write_text(grade.feedback(), encoding="utf-8")
+    _replace(out / "feedback" / f"{safe_name(grade.name)}.txt", grade.feedback())
+    _replace(out / "results" / f"{safe_name(grade.name)}.json", json.dumps(grade.as_dict(), indent=1))
+
+
+def _replace(path, text):
+    partial = path.with_name(f".{path.name}.partial")
+    partial.write_text(text, encoding="utf-8")
+    os.replace(partial, path)
 
 
 def write_report(out_dir, grades):
@@ -421,16 +427,18 @@ def read_results(folders, rubric=None, replaced=None):
 
     A submission with a result in several folders counts from the last of them, in the order given (a
     regrade replaces the class's result); a later result without a submission time keeps the earlier one's.
-    Each replacement is appended to `replaced` (a list) when it is given. ValueError when a folder has no
-    results, is given twice, holds one submission twice, or when the results come from another labkit version
-    or from different rubrics (exercises, groups or points: the ``[late]`` table may differ)."""
+    Each replacement is appended to `replaced` (a list) when it is given. A folder without results counts only
+    when its ``run.json`` says its run had no submission (an empty ``--shard``). ValueError when no folder has
+    results, a folder has none but is not an empty shard's, a folder is given twice or holds one submission
+    twice, or when the results come from another labkit version or from different rubrics (exercises, groups
+    or points: the ``[late]`` table may differ)."""
     grades, files, first, given = {}, {}, None, set()
     for folder in map(Path, folders):
         if folder.resolve() in given:
             raise ValueError(f"{folder} is given twice; give each folder once.")
         given.add(folder.resolve())
         files_here = sorted((folder / "results").glob("*.json"))
-        if not files_here:
+        if not files_here and not _empty_run(folder):
             raise ValueError(
                 f"{folder} holds no results/*.json: give the --out folders of earlier `labkit grade` runs."
             )
@@ -465,7 +473,21 @@ def read_results(folders, rubric=None, replaced=None):
                 if replaced is not None:
                     replaced.append(Replaced(grade.name, files[grade.name], path, kept))
             grades[grade.name], files[grade.name] = grade, path
+    if not grades:
+        raise ValueError(
+            f"{', '.join(map(str, folders))} hold no results/*.json (only empty shards): give the --out folders of "
+            "earlier `labkit grade` runs."
+        )
     return [grades[name] for name in sorted(grades)]
+
+
+def _empty_run(folder):
+    """Whether `folder` is the output of a `labkit grade` run that had nothing to grade (an empty shard)."""
+    try:
+        record = json.loads((Path(folder) / "run.json").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return False
+    return isinstance(record, dict) and record.get("submissions") == 0 and (Path(folder) / "results").is_dir()
 
 
 def merge(folders, out_dir, rubric=None, times=None, progress=False):

@@ -259,7 +259,9 @@ class Editor:
         }
 
     def _repr_mimebundle_(self, **kwargs):
-        return widget_with_picture(self.widget, self.widget_.image, self.widget_.readout, alt=self.widget_.alt, **kwargs)
+        return widget_with_picture(
+            self.widget, self.widget_.image, self.widget_.readout, alt=self.widget_.alt, **kwargs
+        )
 
 
 def _size_slider(elements):

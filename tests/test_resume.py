@@ -1,0 +1,126 @@
+"""Resuming: ``labkit grade`` into an --out that holds an earlier run's results grades only the submissions
+without one (and those that could not be graded), with that run's seed; grades.csv then covers the class."""
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from small_class import SEED, cli, files
+
+from labkit.grading import rubric as rubrics
+from labkit.grading.batch import resumed
+from labkit.grading.report import safe_name
+from labkit.grading.scoring import submission_name
+
+pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
+
+
+def _result(out, name):
+    return Path(out) / "results" / f"{safe_name(name)}.json"
+
+
+def _run(out):
+    return json.loads((Path(out) / "run.json").read_text())
+
+
+def _processes_with(marker):
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            except OSError:
+                continue
+            if marker in cmdline:
+                found.append(cmdline)
+    return found
+
+
+def test_a_resumed_run_grades_only_the_missing_the_unreadable_and_the_not_graded(small_class, tmp_path):
+    submissions, reference = small_class
+    out = tmp_path / "grades"
+    shutil.copytree(reference, out)
+    _result(out, "bob").unlink()  # missing
+    _result(out, "carol").write_text('{"format": "labkit-gr')  # half written when a run was killed
+    failed = json.loads(_result(out, "dave").read_text())
+    failed["failure"] = "its grading ran out of memory (the grader's limit of 3072 MiB) and was stopped"
+    _result(out, "dave").write_text(json.dumps(failed))  # could not be graded: tried again
+    kept = json.loads(_result(out, "alice").read_text())
+    kept["problems"] = ["kept from the earlier run"]  # a mark that only a result not graded again keeps
+    _result(out, "alice").write_text(json.dumps(kept))
+    run = cli("grade", *submissions, "--out", out, "--quiet")  # no --seed: the earlier run's
+    assert run.returncode == 0, run.stderr
+    assert "resumed" in run.stdout and "2 submission(s) were graded there already and kept, 3 graded now" in run.stdout
+    assert (_run(out)["graded now"], _run(out)["already graded"], _run(out)["seed"]) == (3, 2, int(SEED))
+    assert (out / "grades.csv").read_bytes() == (reference / "grades.csv").read_bytes()
+    assert "kept from the earlier run" in (out / "feedback" / f"{safe_name('alice')}.txt").read_text()
+    regraded = {f"{safe_name(name)}.txt" for name in ("bob", "carol", "dave", "=1+1 eve")}
+    assert {k: v for k, v in files(out, "feedback").items() if k in regraded} == {
+        k: v for k, v in files(reference, "feedback").items() if k in regraded
+    }
+    assert sorted(files(out, "results")) == sorted(files(reference, "results"))  # no partial file left
+
+
+def test_an_interrupted_run_resumes_where_it_stopped(small_class, tmp_path):
+    submissions, reference = small_class
+    out, temporary = tmp_path / "grades", tmp_path / "tmp"
+    temporary.mkdir()
+    env = {**os.environ, "TMPDIR": str(temporary)}  # the grading processes' files, named in their command lines
+    command = [sys.executable, "-m", "labkit.cli", "grade", *map(str, submissions), "--out", str(out), "--jobs", "1"]
+    grader = subprocess.Popen([*command, "--seed", SEED, "--quiet"], env=env, stdout=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 240
+        while not list((out / "results").glob("*.json")) and grader.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert grader.poll() is None, "the run ended before it could be interrupted"
+        grader.send_signal(signal.SIGKILL)  # as a batch system ends a job that ran out of time
+        grader.wait(timeout=60)
+    finally:
+        if grader.poll() is None:
+            grader.kill()
+    written = sorted(path.name for path in (out / "results").glob("*.json"))
+    assert 1 <= len(written) < len(submissions) and not (out / "grades.csv").exists()
+    deadline = time.monotonic() + 30  # the grading process of the killed run dies with it (bounded wait)
+    while _processes_with(str(temporary)) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert _processes_with(str(temporary)) == []
+    again = subprocess.run([*command[:-2], "--quiet"], env=env, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert (_run(out)["already graded"], _run(out)["graded now"]) == (len(written), len(submissions) - len(written))
+    assert (out / "grades.csv").read_bytes() == (reference / "grades.csv").read_bytes()
+    assert files(out, "feedback") == files(reference, "feedback")
+
+
+def test_resuming_refuses_another_seed_rubric_or_class_and_fresh_starts_over(small_class, tmp_path):
+    submissions, reference = small_class
+    out = tmp_path / "grades"
+    shutil.copytree(reference, out)
+    before = files(out, "results")
+    names = [submission_name(path) for path in submissions]
+    run = cli("grade", *submissions, "--out", out, "--seed", "1")
+    assert run.returncode == 2 and f"holds results of a run with seed {SEED}, not --seed 1" in run.stderr
+    assert "leave --seed out to resume it, give --fresh" in run.stderr
+    other = rubrics.from_dict({"title": "bilinear only", "required": [16]})
+    with pytest.raises(ValueError, match="was graded under another rubric .*give the --rubric of the run"):
+        resumed(out, names, None, other)
+    with pytest.raises(ValueError, match="which is not among the submissions of this run"):
+        resumed(out, ["alice"], None, rubrics.default())  # the others' results would stay out of grades.csv
+    assert files(out, "results") == before  # nothing refused was changed
+    bob = json.loads(_result(out, "bob").read_text())
+    _result(out, "bob").write_text(json.dumps({**bob, "seed": 1}))  # as in a --merge folder of two runs
+    with pytest.raises(ValueError, match=f"holds results graded with several seeds \\(1, {SEED}\\), as a --merge"):
+        resumed(out, names, None, rubrics.default())
+    assert resumed(out, names, None, rubrics.default(), fresh=True) == ({}, None)
+    assert list((out / "results").iterdir()) == [] and list((out / "feedback").iterdir()) == []
+
+
+def test_a_run_into_a_folder_without_results_draws_a_fresh_seed(tmp_path):
+    (tmp_path / "seed.txt").write_text("123\n")  # a run stopped before its first result: nothing to keep
+    assert resumed(tmp_path, ["alice"], None, rubrics.default()) == ({}, None)
+    assert resumed(tmp_path, ["alice"], 7, rubrics.default()) == ({}, 7)
