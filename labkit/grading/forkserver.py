@@ -101,13 +101,13 @@ class ForkServer:
             self.stop()
             raise ForkServerError("the fork server did not get ready (it could not import what notebooks need)")
         global _client
-        _client = (self.socket, self.backend.name)
+        self._previous, _client = _client, (self.socket, self.backend.name)
         return self
 
     def stop(self):
         global _client
         if _client is not None and _client[0] is self.socket:
-            _client = None
+            _client = getattr(self, "_previous", None)  # a server started before this one is asked again
         if self.socket is not None:
             self.socket.close()  # the server ends when its socket's other end closes
         if self.box is not None:
