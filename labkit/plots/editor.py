@@ -27,7 +27,7 @@ import pathlib
 import numpy as np
 
 from ..patches import Corner
-from .explorers import Painter, freeze_layout, new_figure, png, widget_with_picture
+from .explorers import Painter, freeze_layout, headless, new_figure, png, shown_only, widget_with_picture
 from .figures import PatchView
 from .labels import label_sliders
 
@@ -223,6 +223,8 @@ class Editor:
         self._draw_mesh()
         self.quality = self.view.mesh.quality()
         worst = float(self.quality.min())
+        if headless():  # nothing will show the picture, its readout or its handles
+            return
         picture = png(self.figure, self.painter)
         self.widget_.frame = self._frame()
         self.widget_.handles = handle_positions(self.corners).round(6).tolist()
@@ -270,6 +272,7 @@ def _size_slider(elements):
     return widgets.IntSlider(value=elements, min=2, max=40, description="elements", continuous_update=True)
 
 
+@shown_only
 def patch_editor(corners=None, elements=10):
     """An editor for a Coons patch; `corners` default to exercise 5's unit square.
 
