@@ -316,20 +316,14 @@ def _kept(options):
         return None, None
     key = (options.backend, options.limits, options.exercises)
     with _KEPT_LOCK:
-        server, launcher = _KEPT.get(key, (None, None))
-        alive = server is not None and server.box.process.poll() is None
-        if not alive or launcher is None or launcher.process.poll() is not None:
-            for thing in (launcher, server):
-                if thing is not None:
-                    thing.stop()
-            try:
-                server = forkserver.ForkServer(backends.get_backend(options.backend), options.limits).start()
-            except forkserver.ForkServerError:
-                server = None
-            try:
-                launcher = Launcher(options, server)
-            except (OSError, ValueError):
-                launcher = None
+        found = _KEPT.get(key)
+        server, launcher = found or (None, None)
+        died = (server is not None and server.box.process.poll() is not None) or (
+            launcher is not None and launcher.process.poll() is not None
+        )
+        if found is None or died:  # none started yet (or none could be: then none is tried again), or one died
+            _stop_warm(server, launcher)
+            server, launcher = _start_warm(backends.get_backend(options.backend), options)
             if key not in _KEPT:
                 atexit.register(_stop_kept, key)
             _KEPT[key] = (server, launcher)
@@ -337,9 +331,7 @@ def _kept(options):
 
 
 def _stop_kept(key):
-    for thing in reversed(_KEPT.pop(key, ())):
-        if thing is not None:
-            thing.stop()
+    _stop_warm(*_KEPT.pop(key, (None, None)))
 
 
 def settled(message, rubric, seed):
@@ -464,11 +456,7 @@ def grade(
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
         if dask is None:
-            with (
-                _fork_server(backend, options) as server,
-                _launcher(options, server) as launcher,
-                Progress(len(todo), "grading", enabled=progress) as bar,
-            ):
+            with _warm(backend, options) as (server, launcher), Progress(len(todo), "grading", enabled=progress) as bar:
                 record.update({"fork server": server is not None, "forked grading processes": launcher is not None})
                 graded = _schedule(
                     [p for p, _ in todo], [n for _, n in todo], work, options, profiles_file, rubric,
@@ -517,21 +505,47 @@ def _notebooks(path):
         return []
 
 
-@contextlib.contextmanager
-def _fork_server(backend, options):
-    """The run's fork server, or None: switched off, not offered by the backend, or it could not start (then
-    every notebook gets a sandbox of its own the plain way, and grading only takes longer)."""
-    server = None
-    if options.fork_server:
+def _start_warm(backend, options):
+    """(fork server, launcher) for grading with `options`, each None where it is switched off or cannot start (the
+    plain way then: a sandbox of its own for every notebook, a new Python for every grading process, slower
+    and as safe). The two import what they need at the same time."""
+    if not options.fork_server:
+        return None, None
+    try:
+        server = forkserver.ForkServer(backend, options.limits).start(wait=False)
+    except forkserver.ForkServerError:
+        server = None
+    try:
+        launcher = Launcher(options, server, wait=False)
+    except (OSError, ValueError):
+        launcher = None
+    if server is not None:
         try:
-            server = forkserver.ForkServer(backend, options.limits).start()
+            server.wait_ready()
         except forkserver.ForkServerError:
             server = None
+    if launcher is not None:
+        try:
+            launcher.wait_ready()
+        except OSError:
+            launcher = None
+    return server, launcher
+
+
+def _stop_warm(server, launcher):
+    for thing in (launcher, server):
+        if thing is not None:
+            thing.stop()
+
+
+@contextlib.contextmanager
+def _warm(backend, options):
+    """The run's fork server and launcher (:func:`_start_warm`), stopped at the end."""
+    server, launcher = _start_warm(backend, options)
     try:
-        yield server
+        yield server, launcher
     finally:
-        if server is not None:
-            server.stop()
+        _stop_warm(server, launcher)
 
 
 class _Launched:
@@ -561,7 +575,7 @@ class _Launched:
 class Launcher:
     """One warm process that forks each submission's grading process (:mod:`labkit.grading.launcher`)."""
 
-    def __init__(self, options, server=None):
+    def __init__(self, options, server=None, wait=True):
         self.ended, self._buffer, self._lock = {}, b"", threading.RLock()
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         parent = os.getpid()
@@ -575,6 +589,11 @@ class Launcher:
             pass_fds=(server.fd,) if server is not None else (),
             preexec_fn=lambda: _die_with(parent),
         )
+        if wait:
+            self.wait_ready()
+
+    def wait_ready(self):
+        """Wait until the launcher has imported the grader; OSError (and the launcher stopped) when it does not."""
         if self._next(time.monotonic() + LAUNCHER_READY) != {"ready": True}:
             self.stop()
             raise OSError("the launcher of grading processes did not start")
@@ -634,20 +653,6 @@ class Launcher:
             self.process.kill()
             self.process.wait()
         self.process.stdout.close()
-
-
-@contextlib.contextmanager
-def _launcher(options, server):
-    """The run's :class:`Launcher`, or None where it cannot start (each grading process is then a new Python)."""
-    try:
-        launcher = Launcher(options, server) if options.fork_server else None
-    except (OSError, ValueError):
-        launcher = None
-    try:
-        yield launcher
-    finally:
-        if launcher is not None:
-            launcher.stop()
 
 
 def _schedule(

@@ -71,7 +71,9 @@ class ForkServer:
         """What to add to a grading process's environment so that it uses this server."""
         return {ENV: f"{self.fd}:{self.backend.name}"}
 
-    def start(self):
+    def start(self, wait=True):
+        """Start the server; with `wait`, wait until it is ready (:meth:`wait_ready`), else call that later
+        (what else must start can start meanwhile)."""
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         zygote_fd = theirs.detach()
         try:
@@ -86,10 +88,16 @@ class ForkServer:
             raise ForkServerError(f"the {self.backend.name} sandbox offers no fork server")
         self.socket = ours
         try:
-            process = self.box.start()
+            self.box.start()
         except OSError as exc:
             self.stop()
             raise ForkServerError(f"the fork server could not start ({exc})") from None
+        return self.wait_ready() if wait else self
+
+    def wait_ready(self):
+        """Wait until the server has imported what notebooks need, then let this process ask it; ForkServerError
+        (and the server stopped) when it does not get ready."""
+        process = self.box.process
         line = b""
         until = time.monotonic() + READY_TIMEOUT
         while not line.endswith(b"\n") and _wait_readable(process.stdout.fileno(), until):
