@@ -192,6 +192,8 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
         raise ValueError(
             f"namespace must be a mapping of the notebook's names (globals()); got {type(namespace).__name__}."
         )
+    if _notebook.headless():  # the grader's sandbox: nobody reads the table there, and the grade is its own
+        return HandIn(name, [], problem="not checked here: nothing shown here is read (LABKIT_HEADLESS=1)")
     raised = _notebook.CELLS.cells() if _notebook.CELLS is not None else None
     _notebook.track_cells()  # from now on, if the first cell did not
     cells, answers_from = _read_notebook(name, namespace, path)

@@ -110,7 +110,7 @@ class MemoryCgroup:
 
     def remove(self):
         """Stop every process still in the cgroup and remove it."""
-        for _ in range(50):
+        for _ in range(200):
             pids = self.pids()
             if not pids:
                 break
@@ -119,7 +119,7 @@ class MemoryCgroup:
                     os.kill(pid, signal.SIGKILL)
                 except (ProcessLookupError, PermissionError):
                     pass
-            time.sleep(0.02)
+            time.sleep(0.005)  # a killed process leaves its cgroup within milliseconds
         for folder in (self.path, self.cpu_path):
             for _ in range(50):
                 if folder is None:

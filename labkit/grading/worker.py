@@ -565,7 +565,7 @@ def serve(requests, answers, shell):
     if null > 2:
         os.close(null)
     sys.path.insert(0, os.getcwd())
-    os.environ["LABKIT_HEADLESS"] = "1"  # nothing is shown here: the explorers draw no picture (labkit.plots)
+    os.environ["LABKIT_HEADLESS"] = "1"  # nothing shown here is seen (labkit.notebook.headless)
     Supervisor(requests, answers, shell).serve()
 
 

@@ -22,22 +22,14 @@ the figure shows, in numbers, and follows the controls.
 import base64
 import functools
 import io
-import os
 import pathlib
 
 import numpy as np
 
 from .._alt import figure_alt
+from ..notebook import HEADLESS, headless
 from ..patches import Corner
 from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
-
-HEADLESS = "LABKIT_HEADLESS"  # set to 1 where no picture is ever shown (the grader's sandbox, labkit.grading.worker)
-
-
-def headless():
-    """Whether no picture is ever shown here (``LABKIT_HEADLESS=1``): the explorers then follow their
-    controls, but draw and send no picture, as nothing would show it."""
-    return os.environ.get(HEADLESS) == "1"
 
 
 class NotShown:
