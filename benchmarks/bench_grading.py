@@ -1,6 +1,6 @@
 """Seconds per submission of `labkit grade`: the fork server, the unforked path, and a plain-python floor.
 
-Run: ``.venv/bin/python benchmarks/bench_grading.py [--count 6] [--jobs 1] [--limit 3]``.
+Run: ``.venv/bin/python benchmarks/bench_grading.py [--count 8] [--jobs 1] [--limit 3]``.
 
 One run measures, on the same class of `count` solved submissions (all six
 notebooks each, every part of the lab graded):
@@ -82,7 +82,7 @@ def _floor(submissions, tmp):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--count", type=int, default=6, help="solved submissions in the class (default 6)")
+    parser.add_argument("--count", type=int, default=8, help="solved submissions in the class (default 8)")
     parser.add_argument("--jobs", type=int, default=1, help="submissions graded at once (default 1)")
     parser.add_argument("--limit", type=float, default=3.0, help="least unforked / forked ratio (default 3)")
     args = parser.parse_args()
