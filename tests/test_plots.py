@@ -386,3 +386,20 @@ def test_where_nothing_is_shown_an_explorer_draws_no_picture(monkeypatch, factor
     shown = factory()
     picture = shown.widget_.image if hasattr(shown, "widget_") else shown.image.value
     assert shown.redraws == 1 and picture[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("channels", [3, 4])
+def test_the_explorers_png_decodes_to_the_very_pixels(channels):
+    from io import BytesIO
+
+    from PIL import Image
+
+    from labkit.plots.explorers import encode_png
+
+    pixels = np.random.default_rng(channels).integers(0, 256, size=(37, 53, channels), dtype=np.uint8)
+    decoded = Image.open(BytesIO(encode_png(pixels)))
+    assert decoded.mode == "RGB" and decoded.size == (53, 37)
+    np.testing.assert_array_equal(np.asarray(decoded), pixels[:, :, :3])
+    for bad in (pixels.astype(float), pixels[:, :, 0], np.zeros((0, 4, 3), dtype=np.uint8)):
+        with pytest.raises(ValueError, match="uint8"):
+            encode_png(bad)
