@@ -215,6 +215,15 @@ def grade_options(args):
     )
 
 
+def _dask_engine(args):
+    """The Dask engine of ``--dask`` (labkit.grading.distributed), or None: grade here."""
+    if args.dask is None:
+        return None
+    from .grading import distributed
+
+    return distributed.engine(args.dask, 2 if args.dask_workers is None else args.dask_workers)
+
+
 def _grade(args):
     from .grading import grade, merge
     from .grading.batch import report_failures
@@ -258,8 +267,7 @@ def _grade(args):
         times_from_mtime=args.times_from_mtime,
         shard=args.shard,
         fresh=args.fresh,
-        dask=args.dask,
-        dask_workers=2 if args.dask_workers is None else args.dask_workers,
+        engine=_dask_engine(args),
     )
     _summary(grades, args.out, start, "graded")
     _resumed(args.out)

@@ -17,6 +17,9 @@ One module per concern:
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
 * :mod:`~labkit.grading.late` - the rubric's deadline, submission times, the late penalty;
 * :mod:`~labkit.grading.progress` - a progress bar with an ETA, on a terminal only;
+* :mod:`~labkit.grading.forkserver` - the grader's side of the fork server: notebooks' workers forked warm;
+* :mod:`~labkit.grading.zygote` - the fork server inside its sandbox, isolating each worker it forks;
+* :mod:`~labkit.grading.launcher` - each submission's grading process forked from one warm Python;
 * :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own; resuming, shards;
 * :mod:`~labkit.grading.distributed` - the same on a Dask cluster (``--dask``; the ``labkit[dask]`` extra);
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
@@ -51,8 +54,10 @@ _MODULES = {
     "cgroup",
     "class_report",
     "distributed",
+    "forkserver",
     "guard",
     "late",
+    "launcher",
     "lms",
     "nbgrader",
     "options",
@@ -67,6 +72,7 @@ _MODULES = {
     "scoring",
     "seccomp",
     "worker",
+    "zygote",
 }
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]

@@ -364,8 +364,7 @@ def grade(
     times_from_mtime=False,
     shard=None,
     fresh=False,
-    dask=None,
-    dask_workers=2,
+    engine=None,
 ):
     """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
 
@@ -388,12 +387,14 @@ def grade(
     submissions without one are graded, with that run's seed
     (:func:`resumed`); `fresh` deletes those results first. `shard`, ``(I,
     N)`` or ``"I/N"``, grades only the I-th of N parts of the class
-    (:func:`shard`). `dask`, a scheduler's address or ``"local"`` (a
-    LocalCluster of `dask_workers` workers), sends the submissions to a Dask
-    cluster (:mod:`labkit.grading.distributed`) in place of `jobs` grading
-    processes here. Returns the grades in the order given (a shard's in name
-    order), those of an earlier run included; those with ``graded`` False
-    could not be graded (their ``failure`` says why).
+    (:func:`shard`). `engine` grades the submissions elsewhere, in place of
+    `jobs` grading processes here: a callable ``engine(todo, options,
+    profiles_file, rubric, out, bar, peaks, arrived)`` returning ({name:
+    SubmissionGrade}, what ``run.json`` records of it), such as
+    :func:`labkit.grading.distributed.engine`'s for a Dask cluster. Returns
+    the grades in the order given (a shard's in name order), those of an
+    earlier run included; those with ``graded`` False could not be graded
+    (their ``failure`` says why).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:
@@ -455,7 +456,7 @@ def grade(
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
-        if dask is None:
+        if engine is None:
             with _warm(backend, options) as (server, launcher), Progress(len(todo), "grading", enabled=progress) as bar:
                 record.update({"fork server": server is not None, "forked grading processes": launcher is not None})
                 graded = _schedule(
@@ -464,12 +465,8 @@ def grade(
                 )  # fmt: skip
                 graded = {grade.name: grade for grade in graded.values()}
         else:
-            from . import distributed
-
             with Progress(len(todo), "grading", enabled=progress) as bar:
-                graded, record = distributed.schedule(
-                    dask, todo, options, profiles_file, rubric, out, bar, peaks, arrived, workers=dask_workers
-                )
+                graded, record = engine(todo, options, profiles_file, rubric, out, bar, peaks, arrived)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     ordered = [graded[name] if name in graded else done[name] for name in names]

@@ -97,6 +97,12 @@ def connect(address, workers=2):
     return client, client.close
 
 
+def engine(address, workers=2):
+    """The engine :func:`labkit.grading.batch.grade` takes to grade on the Dask cluster at `address` ("local": a
+    LocalCluster of `workers` workers): :func:`schedule` with these two given."""
+    return functools.partial(schedule, address, workers=workers)
+
+
 def schedule(address, todo, options, profiles_file, rubric, out, bar, peaks, arrived, workers=2):
     """Grade the (path, name) pairs of `todo` on the Dask cluster at `address` ("local": a LocalCluster of
     `workers` workers), one task per submission; each grade goes to `arrived` as it comes back.
