@@ -49,6 +49,8 @@ for folder in writable_folders():
 listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
 listener.bind("\\0labkit-first")
 listener.listen(1)
+terminal, other_end = os.openpty()  # a terminal anyone may open, if anyone else could see it
+os.chmod(os.ttyname(other_end), 0o666)
 uid, pids = os.getuid(), sorted(int(p) for p in os.listdir("/proc") if p.isdigit())
 """
 )
@@ -70,6 +72,12 @@ try:
 except OSError:
     reached = 0
 uid, pids = os.getuid(), sorted(int(p) for p in os.listdir("/proc") if p.isdigit())
+terminals = [name for name in os.listdir("/dev/pts") if name != "ptmx"]
+try:
+    open("/proc/1/environ", "rb").read()  # the supervisor's: readable only if its memory were
+    peeked = 1
+except OSError:
+    peeked = 0
 status = dict(line.split(":", 1) for line in open("/proc/self/status").read().splitlines() if ":" in line)
 capabilities = int(status["CapEff"].strip(), 16)
 no_new_privileges = int(status["NoNewPrivs"].strip())
@@ -107,6 +115,8 @@ def test_two_notebooks_from_one_server_share_no_file_socket_process_or_descripto
         assert min(ours["pids"]) == 1 and min(theirs["pids"]) == 1 and len(theirs["pids"]) <= 3
         assert theirs["sockets"] == 0, "the student's process holds a socket: the fork server's was not closed"
         assert theirs["capabilities"] == 0 and theirs["no_new_privileges"] == 1
+        assert theirs["terminals"] == [], "the second notebook sees the first one's terminal"
+        assert theirs["peeked"] == 0, "the notebook could read its supervisor's memory"
 
 
 def test_a_notebook_after_another_finds_nothing_it_left(server):

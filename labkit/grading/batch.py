@@ -304,7 +304,7 @@ def grade_one(path, name, options, profiles_file, work):
             return job.message()
 
 
-_KEPT = {}  # (backend, limits, exercises) -> (fork server, launcher) this process keeps (a Dask worker's)
+_KEPT = {}  # (backend, limits, exercises, thread) -> (fork server, launcher) kept (a Dask worker's)
 _KEPT_LOCK = threading.Lock()
 
 
@@ -314,7 +314,9 @@ def _kept(options):
     ends; (None, None) with ``fork_server`` off or where they cannot start."""
     if not options.fork_server:
         return None, None
-    key = (options.backend, options.limits, options.exercises)
+    # one pair per thread: a worker's threads never stop each other's, and the pair dies with its thread
+    # (the sandbox's --die-with-parent and the launcher's death signal follow the thread that started them)
+    key = (options.backend, options.limits, options.exercises, threading.get_ident())
     with _KEPT_LOCK:
         found = _KEPT.get(key)
         server, launcher = found or (None, None)
@@ -548,12 +550,12 @@ def _warm(backend, options):
 class _Launched:
     """The part of a Popen that :class:`_Job` uses, for a grading process the :class:`Launcher` forked."""
 
-    def __init__(self, launcher, pid):
-        self.launcher, self.pid = launcher, pid
+    def __init__(self, launcher, pid, key):
+        self.launcher, self.pid, self.key = launcher, pid, key  # `key`: its request's id, never used twice
 
     @property
     def returncode(self):
-        return self.launcher.ended.get(self.pid)
+        return self.launcher.ended.get(self.key)
 
     def poll(self):
         self.launcher.pump(0)
@@ -565,7 +567,7 @@ class _Launched:
             if until is not None and time.monotonic() > until:
                 raise subprocess.TimeoutExpired("grading process", timeout)
             if not self.launcher.pump(0.05) and self.launcher.process.poll() is not None:
-                self.launcher.ended.setdefault(self.pid, -signal.SIGKILL)  # the launcher is gone, and its children
+                self.launcher.ended.setdefault(self.key, -signal.SIGKILL)  # the launcher is gone, and its children
         return self.returncode
 
 
@@ -597,7 +599,10 @@ class Launcher:
 
     def _next(self, until):
         """The launcher's next message, or None when `until` passes or it is gone."""
-        fd = self.process.stdout.fileno()
+        try:
+            fd = self.process.stdout.fileno()
+        except ValueError:  # stopped
+            return None
         while b"\n" not in self._buffer:
             remaining = until - time.monotonic()
             if not select.select([fd], [], [], max(0.0, remaining))[0]:
@@ -616,7 +621,7 @@ class Launcher:
             found = False
             while message is not None:
                 if "ended" in message:
-                    self.ended[int(message["ended"])] = int(message["code"])
+                    self.ended[message.get("id")] = int(message["code"])
                     found = True
                 message = self._next(time.monotonic())
             return found
@@ -624,6 +629,7 @@ class Launcher:
     def launch(self, request):
         """Fork a grading process for `request`; a :class:`_Launched` (OSError when the launcher is gone)."""
         with self._lock:
+            key = request["id"] = secrets.token_hex(8)
             try:
                 self.process.stdin.write((json.dumps(request) + "\n").encode())
                 self.process.stdin.flush()
@@ -634,10 +640,9 @@ class Launcher:
                 if message is None:
                     raise OSError("the launcher of grading processes stopped answering")
                 if "ended" in message:
-                    self.ended[int(message["ended"])] = int(message["code"])
-                elif "started" in message:
-                    self.ended.pop(int(message["started"]), None)  # a pid used again
-                    return _Launched(self, int(message["started"]))
+                    self.ended[message.get("id")] = int(message["code"])
+                elif "started" in message and message.get("id") == key:
+                    return _Launched(self, int(message["started"]), key)
 
     def stop(self):
         try:

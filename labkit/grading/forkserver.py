@@ -69,7 +69,13 @@ class ForkServer:
 
     def environment(self):
         """What to add to a grading process's environment so that it uses this server."""
-        return {ENV: f"{self.fd}:{self.backend.name}"}
+        return {ENV: f"{self.fd}:{self.backend.name}:{int(self.needs_cgroup)}"}
+
+    @property
+    def needs_cgroup(self):
+        """Whether each notebook needs a cgroup of its own: the server has one, which a notebook's memory
+        must never fill (a notebook that cannot get one gets a sandbox the plain way)."""
+        return self.box is not None and self.box.cgroup is not None
 
     def start(self, wait=True):
         """Start the server; with `wait`, wait until it is ready (:meth:`wait_ready`), else call that later
@@ -109,7 +115,7 @@ class ForkServer:
             self.stop()
             raise ForkServerError("the fork server did not get ready (it could not import what notebooks need)")
         global _client
-        self._previous, _client = _client, (self.socket, self.backend.name)
+        self._previous, _client = _client, (self.socket, self.backend.name, self.needs_cgroup)
         return self
 
     def stop(self):
@@ -140,17 +146,25 @@ _client = None  # (socket, backend name) of the server this process asks
 def client():
     """(socket, backend name) of the fork server this process may ask, or None."""
     global _client
-    fd, _, name = os.environ.get(ENV, "").partition(":")
+    fd, name, needs = (os.environ.get(ENV, "").split(":") + ["", "", ""])[:3]
     if _client is None and fd.isdigit() and name:
         try:
             server = socket.socket(fileno=int(fd))
             if server.family != socket.AF_UNIX or server.type != socket.SOCK_SEQPACKET:
                 server.detach()
                 raise OSError("not a fork server's socket")
-            _client = (server, name)
+            _client = (server, name, needs == "1")
         except OSError:
             os.environ.pop(ENV, None)
     return _client
+
+
+def _broken(server):
+    """Ask the server `server` no more in this process (it is gone or does not answer): the plain way from now."""
+    global _client
+    if _client is not None and _client[0] is server:
+        _client = None
+        os.environ.pop(ENV, None)
 
 
 def box(backend, limits):
@@ -158,7 +172,7 @@ def box(backend, limits):
     found = client()
     if found is None or found[1] != backend.name:
         return None
-    return ForkedBox(found[0], limits, backend.notebook_uid())
+    return ForkedBox(found[0], limits, backend.notebook_uid(), needs_cgroup=found[2])
 
 
 class ForkedProcess:
@@ -211,12 +225,14 @@ class ForkedProcess:
 class ForkedBox(Box):
     """One notebook's worker, forked by the server on `server` and isolated by it (see the module)."""
 
-    def __init__(self, server, limits, uid):
+    def __init__(self, server, limits, uid, needs_cgroup=False):
         super().__init__([], limits)
-        self.server, self.uid = server, uid
+        self.server, self.uid, self.needs_cgroup = server, uid, needs_cgroup
 
     def start(self):
         self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
+        if self.cgroup is None and self.needs_cgroup:  # it would share the server's, and could take it down
+            raise ForkServerError("no cgroup of its own could be made for the notebook")
         joins = []
         try:
             if self.cgroup is not None:
@@ -228,10 +244,16 @@ class ForkedBox(Box):
             theirs = [requests_r, answers_w, control_r, status_w, *joins]
             text = json.dumps({"uid": self.uid, "limits": vars(self.limits), "cgroup": len(joins)}).encode()
             try:
-                self.server.sendmsg([text], [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", theirs))])
+                # never blocks on a server that stopped reading: its socket is shared, so it cannot be made
+                # non-blocking for everyone; wait until it can take the request, then send without waiting
+                if not select.select([], [self.server], [], START_TIMEOUT)[1]:
+                    raise OSError("it takes no requests")
+                message = [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", theirs))]
+                self.server.sendmsg([text], message, socket.MSG_DONTWAIT)
             except OSError as exc:
                 for fd in (requests_w, answers_r, control_w, status_r):
                     os.close(fd)
+                _broken(self.server)
                 raise ForkServerError(f"the fork server is gone ({exc})") from None
             finally:
                 for fd in theirs:
@@ -243,14 +265,16 @@ class ForkedBox(Box):
         process = ForkedProcess(requests_w, answers_r, control_w, status_r)
         said = b""
         until = time.monotonic() + START_TIMEOUT
-        while not said and _wait_readable(status_r, until):
-            said = os.read(status_r, 1)
+        if _wait_readable(status_r, until):
+            said = os.read(status_r, 1)  # S: isolated and running; E: why not; W or nothing: it died
             if said == b"E":
                 said += os.read(status_r, 500)
         if said != b"S":
             process.close()
             process.stdin.close()
             process.stdout.close()
+            if not said:  # no answer at all: the server dropped the request, or is stuck
+                _broken(self.server)
             why = said[1:].decode("utf-8", "replace") if said.startswith(b"E") else "no answer"
             raise ForkServerError(f"the fork server could not isolate a worker ({why})")
         self.process = process

@@ -13,7 +13,8 @@ runs here: student code runs only in the sandboxes the child starts.
 
 The launcher reads one request per line on stdin
 (``{"spec", "log", "memory", "cgroups", "environment"}``) and writes one line
-per event on stdout: ``{"started": pid}`` and ``{"ended": pid, "code": c}``
+per event on stdout: ``{"started": pid, "id": i}`` and ``{"ended": pid, "id": i, "code": c}``, `i`
+the request's own ``id`` (a pid can be used again once its process has ended)
 (``c`` as Popen's returncode). When its stdin closes (the run is over, or
 the grader died) it stops every child still running and ends.
 """
@@ -90,7 +91,7 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     _warm(argv[0] if argv and argv[0] else None)
     _say({"ready": True})
-    children, buffer = set(), b""
+    children, buffer = {}, b""  # pid -> the request's id
     try:
         while True:
             readable = select.select([0], [], [], 0.05)[0]
@@ -99,9 +100,8 @@ def main(argv=None):
                     done, status = os.waitpid(pid, os.WNOHANG)
                 except ChildProcessError:
                     done, status = pid, 0
-                if done:
-                    children.discard(pid)
-                    _say({"ended": pid, "code": os.waitstatus_to_exitcode(status)})
+                if done and pid in children:
+                    _say({"ended": pid, "id": children.pop(pid), "code": os.waitstatus_to_exitcode(status)})
             if not readable:
                 continue
             chunk = os.read(0, 1 << 16)
@@ -117,7 +117,7 @@ def main(argv=None):
                 pid = os.fork()
                 if pid == 0:
                     _child(request)
-                children.add(pid)
+                children[pid] = request.get("id")
                 _say({"started": pid, "id": request.get("id")})
     finally:
         for pid in children:
@@ -130,9 +130,9 @@ def main(argv=None):
             for pid in list(children):
                 try:
                     if os.waitpid(pid, os.WNOHANG)[0]:
-                        children.discard(pid)
+                        children.pop(pid)
                 except ChildProcessError:
-                    children.discard(pid)
+                    children.pop(pid)
             time.sleep(0.02)
 
 

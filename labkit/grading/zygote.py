@@ -56,7 +56,7 @@ CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC, CLONE_NEWPID, CLONE_NEWNET = (
     0x40000000,
 )
 MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REC, MS_PRIVATE = 1, 2, 4, 8, 0x4000, 0x40000
-PR_SET_NO_NEW_PRIVS = 38
+PR_SET_NO_NEW_PRIVS, PR_GET_DUMPABLE = 38, 3
 MAX_REQUEST = 4 * 1024  # bytes of one request's text
 MAX_FDS = 8  # descriptors passed with one request
 FIRST_FD = 3  # where the worker's own descriptors are put before every other one is closed
@@ -90,26 +90,54 @@ def isolate(limits, home):
         folders.append(("/dev/shm", limits.tmp_size))
     for path, size in folders:
         _mount("tmpfs", path, "tmpfs", MS_NOSUID | MS_NODEV, f"size={int(size)},mode=1777")
+    if os.path.isdir("/dev/pts"):  # terminals of its own: the sandbox's one instance would be every notebook's
+        _mount("devpts", "/dev/pts", "devpts", MS_NOSUID | MS_NOEXEC, "newinstance,ptmxmode=0666,mode=620,max=16")
     os.chdir(home)
 
 
+def _capabilities():
+    """The worker's permitted, effective and ambient capability sets (from /proc/self/status), as numbers."""
+    with open("/proc/self/status") as status:
+        fields = dict(line.split(":", 1) for line in status if ":" in line)
+    return [int(fields[name].strip(), 16) for name in ("CapPrm", "CapEff", "CapAmb")]
+
+
 def _become_worker(fds, uid, limits):
-    """In the worker, as the first process of the new PID namespace: everything up to the student's uid."""
+    """In the worker, as the first process of the new PID namespace: everything up to the student's uid, then
+    ``S`` on the status pipe (only then does the grader count on this worker)."""
+    if uid <= 0:
+        raise OSError(f"refusing to run a notebook as uid {uid}: a forked worker needs a uid of its own")
     _mount("proc", "/proc", "proc", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC)
     for fd in fds["cgroup"]:
         os.write(fd, b"0")  # 0: the writing process
-    apply_limits(limits)
-    # the worker's pipes at 3 and 4, then nothing else: the server's socket and any other descriptor close
-    wanted = [fds["requests"], fds["answers"]]
+    # the worker's pipes at 3 and 4, its status pipe at 5, then nothing else: the server's socket, the
+    # keeper's control pipe, the cgroup files and any other descriptor close
+    wanted = [fds["requests"], fds["answers"], fds["status"]]
     moved = [os.dup(fd) for fd in wanted]
     for index, fd in enumerate(moved):
         os.dup2(fd, FIRST_FD + index)
-    os.closerange(FIRST_FD + len(moved), os.sysconf("SC_OPEN_MAX"))
+    os.closerange(FIRST_FD + len(moved), 2**31 - 1)
+    apply_limits(limits)
     worker.drop_privileges(uid)
-    if os.getuid() == 0 and uid:
-        raise OSError("the worker is still root")
+    worker.not_dumpable()  # the change of uid made the process dumpable again (fs.suid_dumpable)
     _checked(_libc.prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0), "no new privileges")
+    if os.getuid() != uid or os.geteuid() != uid or any(_capabilities()):
+        raise OSError("the worker kept root's uid or a capability")
+    if _libc.prctl(PR_GET_DUMPABLE, 0, 0, 0, 0) != 0:
+        raise OSError("the worker's memory would be readable by its notebook")
+    _reseed()
+    os.write(FIRST_FD + 2, b"S")
+    os.close(FIRST_FD + 2)
     return FIRST_FD, FIRST_FD + 1
+
+
+def _reseed():
+    """Fresh random states, as a new Python would have: every worker forked from the server starts alike."""
+    import random
+
+    random.seed()
+    if "numpy" in sys.modules:
+        sys.modules["numpy"].random.seed()
 
 
 def _keeper(fds, uid, limits, home, shell):
@@ -123,18 +151,24 @@ def _keeper(fds, uid, limits, home, shell):
         os.write(status, f"E{exc}"[:500].encode("utf-8", "replace"))
         os._exit(1)
     if pid == 0:
-        code = 0
+        code, running = 0, False
         try:
             requests, answers = _become_worker(fds, uid, limits)
+            running = True
             worker.serve(requests, answers, shell)
-        except BaseException:  # noqa: BLE001 - the worker's end, whatever it is, is its status
+        except BaseException as exc:  # noqa: BLE001 - the worker's end, whatever it is, is its status
             code = 1
+            for fd in () if running else (FIRST_FD + 2, status):  # why it could not start, if it can still say
+                try:
+                    os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+                    break
+                except OSError:
+                    continue
         os._exit(code)
     for name in ("requests", "answers"):
         os.close(fds[name])
     for fd in fds["cgroup"]:
         os.close(fd)
-    os.write(status, b"S")
     try:
         watch = [os.pidfd_open(pid)]
     except (AttributeError, OSError):  # a kernel before 5.3: look at the worker ten times a second instead
@@ -154,7 +188,10 @@ def _keeper(fds, uid, limits, home, shell):
             except ProcessLookupError:
                 pass
             _, wait_status = os.waitpid(pid, 0)
-    os.write(status, f"W{wait_status}".encode())
+    try:
+        os.write(status, f"W{wait_status}".encode())
+    except OSError:  # the grader is gone
+        pass
     os._exit(0)
 
 
@@ -197,14 +234,17 @@ def serve(server, shell, home):
             if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
                 raise ValueError("a request larger than the server takes")
             named, uid, limits = _parse(data, fds)
-        except (ValueError, KeyError, TypeError):
+        except Exception:  # noqa: BLE001 - not a request of the grader's: dropped (its sender sees the pipes close)
             for fd in fds:
                 os.close(fd)
             continue
         try:
             pid = os.fork()
         except OSError as exc:
-            os.write(named["status"], f"E{exc}"[:500].encode("utf-8", "replace"))
+            try:
+                os.write(named["status"], f"E{exc}"[:500].encode("utf-8", "replace"))
+            except OSError:
+                pass
             pid = None
         if pid == 0:
             try:
