@@ -120,7 +120,7 @@ class ForkServer:
 
     def stop(self):
         global _client
-        if _client is not None and _client[0] is self.socket:
+        if _client is None or _client[0] is self.socket:  # asked, or found broken while asked
             _client = getattr(self, "_previous", None)  # a server started before this one is asked again
         if self.socket is not None:
             self.socket.close()  # the server ends when its socket's other end closes
