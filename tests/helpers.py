@@ -1,7 +1,23 @@
 """Data generators shared by the tests (imported as ``from helpers import ...``)."""
 
+from pathlib import Path
+
 import numpy as np
 from hypothesis import strategies as st
+
+
+def processes_with(marker):
+    """(pid, command line) of every process whose command line holds `marker`."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            except OSError:
+                continue
+            if marker in cmdline:
+                found.append((entry.name, cmdline))
+    return found
 
 
 def unequal_knots(rng, n, start=-2.0):

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import processes_with
 from small_class import SEED, cli, files, rows
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
@@ -19,16 +20,7 @@ WAIT = 120  # seconds for a process to come up or a run to reach a point (bounde
 
 
 def _processes_with(marker):
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-            except OSError:
-                continue
-            if marker in cmdline:
-                found.append(cmdline)
-    return found
+    return [cmdline for _, cmdline in processes_with(marker)]
 
 
 @pytest.fixture(scope="module")

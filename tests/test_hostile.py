@@ -25,6 +25,7 @@ from pathlib import Path
 import nbformat
 import pytest
 from conftest import sandbox_or_skip
+from helpers import processes_with as _processes_with
 
 from labkit import grading
 from labkit.grading import remote
@@ -52,19 +53,6 @@ def _tree_hash(folders, leave_out=()):
             if path.is_file() and not path.is_symlink():
                 digest.update(path.read_bytes())
     return digest.hexdigest()
-
-
-def _processes_with(marker):
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-            except OSError:
-                continue
-            if marker in cmdline:
-                found.append((entry.name, cmdline))
-    return found
 
 
 def _grading_processes():

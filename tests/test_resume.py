@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import processes_with
 from small_class import SEED, cli, files
 
 from labkit.grading import rubric as rubrics
@@ -30,16 +31,7 @@ def _run(out):
 
 
 def _processes_with(marker):
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-            except OSError:
-                continue
-            if marker in cmdline:
-                found.append(cmdline)
-    return found
+    return [cmdline for _, cmdline in processes_with(marker)]
 
 
 def test_a_resumed_run_grades_only_the_missing_the_unreadable_and_the_not_graded(small_class, tmp_path):

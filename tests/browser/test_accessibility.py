@@ -22,14 +22,11 @@ import re
 import urllib.request
 
 import pytest
-from jupyterlab_session import (
+from jupyterlab_session import (  # the lab and browser fixtures are in conftest.py
     CELL_SUMMARY,
-    CHROMIUM,
-    CHROMIUM_FLAGS,
     NOTEBOOKS,
     TOKEN,
     api,
-    course_lab,
     open_and_run,
     run_all,
     show_explorers,
@@ -50,21 +47,6 @@ PENDING = {}  # (rule, marker in the node) -> why: a known violation of labkit's
 MESHES = next(p for p in NOTEBOOKS if p.stem == "03_meshes")
 ORDERED = sorted(NOTEBOOKS, key=lambda p: p != MESHES)
 CORNER = re.compile(r"^(?P<name>[ABCD]) = Corner\(\[(?P<x>[-\d.]+), (?P<y>[-\d.]+)\], ds=(?P<ds>\[[^\]]*\]), dt=")
-
-
-@pytest.fixture(scope="module")
-def lab(tmp_path_factory):
-    """A JupyterLab server on 127.0.0.1 serving a temporary copy of notebooks/."""
-    with course_lab(tmp_path_factory.mktemp("lab")) as base:
-        yield base
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright_api.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=CHROMIUM_FLAGS)
-        yield chromium
-        chromium.close()
 
 
 def _shut_down(base, notebook):

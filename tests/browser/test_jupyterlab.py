@@ -15,13 +15,10 @@ from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
-from jupyterlab_session import (
-    CHROMIUM,
-    CHROMIUM_FLAGS,
+from jupyterlab_session import (  # the lab and browser fixtures are in conftest.py
     COUNT_IMAGE_FRAMES,
     NOTEBOOKS,
     close_sessions,
-    course_lab,
     drag_a_corner,
     latencies,
     move_every_slider,
@@ -35,21 +32,6 @@ ROOT = Path(__file__).resolve().parents[2]
 SCREENSHOTS = ROOT / "build" / "screenshots"
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 skip_without_chromium()
-
-
-@pytest.fixture(scope="module")
-def lab(tmp_path_factory):
-    """A JupyterLab server on 127.0.0.1 serving a temporary copy of notebooks/."""
-    with course_lab(tmp_path_factory.mktemp("lab")) as base:
-        yield base
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright_api.sync_playwright() as p:
-        chromium = p.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=CHROMIUM_FLAGS)
-        yield chromium
-        chromium.close()
 
 
 # sliders each notebook's Explore section shows (labkit.plots.explorers; 03 adds the patch editor's two)
