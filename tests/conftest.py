@@ -44,6 +44,43 @@ def pytest_terminal_summary(terminalreporter):
             terminalreporter.write_line(
                 f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)"
             )
+    # the axe-core check's findings per notebook: what is in the notebooks' outputs (asserted to be nothing
+    # serious) and what JupyterLab itself causes (named only)
+    found = getattr(sys.modules.get("test_accessibility"), "AXE", {})
+    if found:
+        terminalreporter.section("axe-core in JupyterLab: serious and critical violations")
+        for notebook, result in found.items():
+            nodes = ", ".join(f"{impact} {n}" for impact, n in result["all"].items() if n) or "none"
+            terminalreporter.write_line(f"{notebook}: nodes by impact: {nodes}")
+            for where in ("outputs", "jupyterlab"):
+                rules = sorted({f"{rule} ({impact})" for rule, impact, *_ in result[where]})
+                label = "in labkit's outputs" if where == "outputs" else "JupyterLab's own"
+                terminalreporter.write_line(f"    {label:<20} {', '.join(rules) or 'none'}")
+
+
+# the browser tests' (tests/browser/): one JupyterLab server and one headless Chromium per test module. Kept
+# here, as a second conftest.py there would be a second module named conftest (tests import this one's helpers)
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    """A JupyterLab server on 127.0.0.1 serving a temporary copy of notebooks/."""
+    from jupyterlab_session import course_lab
+
+    with course_lab(tmp_path_factory.mktemp("lab")) as base:
+        yield base
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Headless Chromium (/usr/bin/chromium, never a Playwright download)."""
+    from jupyterlab_session import CHROMIUM, CHROMIUM_FLAGS
+    from playwright import sync_api
+
+    with sync_api.sync_playwright() as p:
+        chromium = p.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=CHROMIUM_FLAGS)
+        yield chromium
+        chromium.close()
 
 
 @pytest.fixture(scope="session")

@@ -22,7 +22,7 @@ import re
 import urllib.request
 
 import pytest
-from jupyterlab_session import (  # the lab and browser fixtures are in conftest.py
+from jupyterlab_session import (  # the lab and browser fixtures are in tests/conftest.py
     CELL_SUMMARY,
     NOTEBOOKS,
     TOKEN,
@@ -39,7 +39,7 @@ skip_without_chromium()
 
 SERIOUS = ("serious", "critical")
 IMPACTS = ("critical", "serious", "moderate", "minor")
-AXE = {}  # notebook -> {"outputs": [...], "jupyterlab": [...]}, printed by tests/browser/conftest.py's summary
+AXE = {}  # notebook -> {"outputs": [...], "jupyterlab": [...]}, printed by tests/conftest.py's summary
 # Violations in the outputs that another part of issue 23 removes (the explorers' pictures get alt text with
 # item 2): they make the test xfail, not pass; remove an entry once nothing matches it any more.
 PENDING = {}  # (rule, marker in the node) -> why: a known violation of labkit's own, waiting for its fix

@@ -15,7 +15,7 @@ from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
-from jupyterlab_session import (  # the lab and browser fixtures are in conftest.py
+from jupyterlab_session import (  # the lab and browser fixtures are in tests/conftest.py
     COUNT_IMAGE_FRAMES,
     NOTEBOOKS,
     close_sessions,
