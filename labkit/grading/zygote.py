@@ -47,6 +47,7 @@ import sys
 
 from . import worker
 from .backends.base import Limits, apply_limits
+from .backends.bwrap import read_only_paths
 
 CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC, CLONE_NEWPID, CLONE_NEWNET = (
     0x00020000,
@@ -55,7 +56,16 @@ CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC, CLONE_NEWPID, CLONE_NEWNET = (
     0x20000000,
     0x40000000,
 )
-MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REC, MS_PRIVATE = 1, 2, 4, 8, 0x4000, 0x40000
+MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REMOUNT, MS_BIND, MS_REC, MS_PRIVATE = (
+    1,
+    2,
+    4,
+    8,
+    32,
+    4096,
+    0x4000,
+    0x40000,
+)
 PR_SET_NO_NEW_PRIVS, PR_GET_DUMPABLE = 38, 3
 MAX_REQUEST = 4 * 1024  # bytes of one request's text
 MAX_FDS = 8  # descriptors passed with one request
@@ -81,15 +91,30 @@ def _mount(source, target, kind, flags, data=None):
     )
 
 
-def isolate(limits, home):
-    """In the keeper: new namespaces and empty private folders (see the module's description)."""
+def isolate(limits, home, keep=()):
+    """In the keeper: new namespaces and empty private folders (see the module's description); the folders of
+    `keep` (the Python environment and labkit, read-only) that lie inside one are mounted back into it."""
     _checked(_libc.unshare(CLONE_NEWNS | CLONE_NEWNET | CLONE_NEWIPC | CLONE_NEWUTS | CLONE_NEWPID), "unshare")
     _mount("none", "/", None, MS_REC | MS_PRIVATE)  # nothing mounted here reaches the server's view
     folders = [("/tmp", limits.tmp_size), (home, limits.home_size)]
     if os.path.isdir("/dev/shm"):
         folders.append(("/dev/shm", limits.tmp_size))
+    inside = []
+    for path in keep:
+        for folder, _ in folders:
+            if path.startswith(folder.rstrip("/") + "/"):
+                inside.append((path, folder, os.open(path, os.O_PATH | os.O_DIRECTORY)))
     for path, size in folders:
         _mount("tmpfs", path, "tmpfs", MS_NOSUID | MS_NODEV, f"size={int(size)},mode=1777")
+    for path, folder, held in inside:  # e.g. a clone under /tmp, whose .venv the sandbox had bound there
+        os.makedirs(path, exist_ok=True)
+        current = folder
+        for part in os.path.relpath(path, folder).split(os.sep):  # root's, world-readable, as bwrap makes them
+            current = os.path.join(current, part)
+            os.chmod(current, 0o755)
+        _mount(f"/proc/self/fd/{held}", path, None, MS_BIND | MS_REC)
+        _mount("none", path, None, MS_REMOUNT | MS_BIND | MS_RDONLY | MS_NOSUID | MS_NODEV)
+        os.close(held)
     if os.path.isdir("/dev/pts"):  # terminals of its own: the sandbox's one instance would be every notebook's
         _mount("devpts", "/dev/pts", "devpts", MS_NOSUID | MS_NOEXEC, "newinstance,ptmxmode=0666,mode=620,max=16")
     os.chdir(home)
@@ -145,7 +170,7 @@ def _keeper(fds, uid, limits, home, shell):
     status = fds["status"]
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     try:
-        isolate(limits, home)
+        isolate(limits, home, KEEP)
         pid = os.fork()
     except OSError as exc:
         os.write(status, f"E{exc}"[:500].encode("utf-8", "replace"))
@@ -256,8 +281,13 @@ def serve(server, shell, home):
             os.close(fd)
 
 
+KEEP = ()  # the sandbox's read-only folders (the Python environment, labkit): set by main
+
+
 def main(argv=None):
+    global KEEP
     argv = sys.argv[1:] if argv is None else argv
+    KEEP = tuple(str(path) for path in read_only_paths())
     server = socket.socket(fileno=int(argv[0]))
     worker.not_dumpable()
     null = os.open(os.devnull, os.O_RDWR)

@@ -76,7 +76,7 @@ def sandbox_uid():
     return 100_000 + os.getpid() if os.geteuid() == 0 else 0
 
 
-def _read_only_paths():
+def read_only_paths():
     """The Python environment the worker needs: its prefixes and labkit's package folder."""
     import labkit
 
@@ -135,7 +135,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
         elif top.is_dir():
             args += ["--ro-bind", str(top), str(top)]
     made = {Path("/tmp")}
-    for path in _read_only_paths():
+    for path in read_only_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
     args += [
         *_parents(HOME, made),
