@@ -315,7 +315,7 @@ def _kept(options):
     if not options.fork_server:
         return None, None
     # one pair per thread: a worker's threads never stop each other's, and the pair dies with its thread
-    # (the sandbox's --die-with-parent and the launcher's death signal follow the thread that started them)
+    # (the sandbox and the launcher are set to die with the thread that started them)
     key = (options.backend, options.limits, options.exercises, threading.get_ident())
     with _KEPT_LOCK:
         found = _KEPT.get(key)

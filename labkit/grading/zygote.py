@@ -46,8 +46,7 @@ import struct
 import sys
 
 from . import worker
-from .backends.base import Limits, apply_limits
-from .backends.bwrap import read_only_paths
+from .backends.base import Limits, apply_limits, environment_paths
 
 CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC, CLONE_NEWPID, CLONE_NEWNET = (
     0x00020000,
@@ -109,7 +108,7 @@ def isolate(limits, home, keep=()):
     for path, folder, held in inside:  # e.g. a clone under /tmp, whose .venv the sandbox had bound there
         os.makedirs(path, exist_ok=True)
         current = folder
-        for part in os.path.relpath(path, folder).split(os.sep):  # root's, world-readable, as bwrap makes them
+        for part in os.path.relpath(path, folder).split(os.sep):  # root's and world-readable, as the sandbox made them
             current = os.path.join(current, part)
             os.chmod(current, 0o755)
         _mount(f"/proc/self/fd/{held}", path, None, MS_BIND | MS_REC)
@@ -287,7 +286,7 @@ KEEP = ()  # the sandbox's read-only folders (the Python environment, labkit): s
 def main(argv=None):
     global KEEP
     argv = sys.argv[1:] if argv is None else argv
-    KEEP = tuple(str(path) for path in read_only_paths())
+    KEEP = tuple(str(path) for path in environment_paths())
     server = socket.socket(fileno=int(argv[0]))
     worker.not_dumpable()
     null = os.open(os.devnull, os.O_RDWR)

@@ -26,7 +26,9 @@ import os
 import resource
 import signal
 import subprocess
+import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 from .. import cgroup
 
@@ -63,6 +65,20 @@ def apply_limits(limits, processes_base=0):
     cap(resource.RLIMIT_NPROC, processes_base + limits.processes)
     cap(resource.RLIMIT_FSIZE, limits.file_size)
     cap(resource.RLIMIT_NOFILE, limits.open_files)
+
+
+def environment_paths():
+    """The folders of the Python environment a worker needs (its prefixes and labkit's package folder), outside
+    /usr and /etc, none inside another: what a sandbox shows it read-only."""
+    import labkit
+
+    paths = {Path(p).resolve() for p in (sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix)}
+    paths.add(Path(labkit.__file__).resolve().parent)
+    paths.add(Path(sys.executable).resolve().parent.parent)
+    system = (Path("/usr"), Path("/etc"))
+    paths = {p for p in paths if p.exists() and not any(p == s or s in p.parents for s in system)}
+    # a folder inside another one is mounted with it
+    return sorted(p for p in paths if not any(q != p and q in p.parents for q in paths))
 
 
 def processes_of_this_user():

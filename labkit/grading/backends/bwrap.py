@@ -37,7 +37,7 @@ from pathlib import Path
 
 from .. import seccomp
 from . import register
-from .base import Backend, Box, Limits, SandboxUnavailable, processes_of_this_user
+from .base import Backend, Box, Limits, SandboxUnavailable, environment_paths, processes_of_this_user
 
 HOME = "/home/student"
 INSTALL_HINT = (
@@ -74,19 +74,6 @@ def sandbox_uid():
     never count against another's limit.
     """
     return 100_000 + os.getpid() if os.geteuid() == 0 else 0
-
-
-def read_only_paths():
-    """The Python environment the worker needs: its prefixes and labkit's package folder."""
-    import labkit
-
-    paths = {Path(p).resolve() for p in (sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix)}
-    paths.add(Path(labkit.__file__).resolve().parent)
-    paths.add(Path(sys.executable).resolve().parent.parent)
-    system = (Path("/usr"), Path("/etc"))
-    paths = {p for p in paths if p.exists() and not any(p == s or s in p.parents for s in system)}
-    # a folder inside another one is mounted with it
-    return sorted(p for p in paths if not any(q != p and q in p.parents for q in paths))
 
 
 def _parents(path, made):
@@ -135,7 +122,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
         elif top.is_dir():
             args += ["--ro-bind", str(top), str(top)]
     made = {Path("/tmp")}
-    for path in read_only_paths():
+    for path in environment_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
     args += [
         *_parents(HOME, made),
