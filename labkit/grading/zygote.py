@@ -61,7 +61,7 @@ MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REMOUNT, MS_BIND, MS_REC, MS_PRIVA
     4,
     8,
     32,
-    4096,
+    1 << 12,
     0x4000,
     0x40000,
 )
