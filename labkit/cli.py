@@ -13,7 +13,9 @@
 
 import argparse
 import json
+import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -186,11 +188,15 @@ def _resumed(out):
         record = json.loads((out / "run.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return
-    if record.get("already graded"):
+    changed = record.get("graded again, changed")
+    again = f", {changed} of them graded again because their notebooks changed" if changed else ""
+    if record.get("already graded") or changed:
         print(
             f"resumed {out}: {record['already graded']} submission(s) were graded there already and kept, "
-            f"{record.get('graded now', 0)} graded now (--fresh grades all again)"
+            f"{record.get('graded now', 0)} graded now{again} (--fresh grades all again)"
         )
+    else:
+        print(f"graded {record.get('graded now', 0)} submission(s) now")
     if record.get("shard"):
         print(f"shard {record['shard']}: {record.get('submissions')} submission(s); combine the shards with --merge")
 
@@ -227,11 +233,9 @@ def _dask_engine(args):
 def _grade(args):
     from .grading import grade, merge
     from .grading.batch import report_failures
-    from .grading.late import read_times
-    from .grading.rubric import load
+    from .grading.late import read_exchange, read_times
 
     start = time.perf_counter()
-    rubric = load(args.rubric)
     times = read_times(args.times) if args.times else None
     if args.merge:
         if args.submissions:
@@ -241,37 +245,59 @@ def _grade(args):
         ]
         if given:
             raise ValueError(f"{', '.join(given)} grade(s) submissions, which --merge does not; merge without them.")
-        if args.times_from_mtime:
-            raise ValueError(
-                "--times-from-mtime reads the submissions' files, which --merge does not have: give the times in "
-                "--times TIMES.csv (the results keep the times they were graded with)."
-            )
-        grades = merge(args.merge, args.out, rubric, times=times, progress=not args.quiet)
+        for flag in ("times_from_mtime", "times_from_submission", "times_from_exchange"):
+            if getattr(args, flag):
+                raise ValueError(
+                    f"--{flag.replace('_', '-')} reads the submissions' files or the exchange, which --merge does not: "
+                    "give the times in --times TIMES.csv (the results keep the times they were graded with)."
+                )
+        grades = merge(args.merge, args.out, args.rubric, times=times, progress=not args.quiet)
         _summary(grades, args.out, start, "merged")
         _replaced(grades.replaced)
-        unreadable = _times_notes(grades, rubric, times)
-        return 1 if report_failures(grades) or unreadable else 0
+        _refused(grades, "--merge")
+        unreadable = _times_notes(grades, grades.rubric, times)
+        return 1 if report_failures(grades) or unreadable or grades.refused else 0
     if not args.submissions:
-        raise ValueError("give the submissions to grade (notebooks or folders), or --merge DIR... to combine runs.")
+        raise ValueError(
+            "give the class folder (or zip) the LMS gave you, or the submissions one by one (notebooks or folders), "
+            "or --merge DIR... to combine runs."
+        )
     if args.dask_workers is not None and args.dask != "local":
         raise ValueError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
     options = grade_options(args)
-    grades = grade(
-        args.submissions,
-        args.out,
-        jobs=args.jobs,
-        progress=not args.quiet,
-        rubric=rubric,
-        options=options,
-        times=times,
-        times_from_mtime=args.times_from_mtime,
-        shard=args.shard,
-        fresh=args.fresh,
-        engine=_dask_engine(args),
-    )
-    _summary(grades, args.out, start, "graded")
+    exchange = None
+    if args.times_from_exchange is not None:
+        if not args.assignment:
+            raise ValueError("--times-from-exchange needs --assignment NAME: the assignment's name in nbgrader.")
+        exchange = read_exchange(args.times_from_exchange, args.assignment)
+    args.out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=".labkit-unpacked-", dir=args.out) as workspace:
+        found = _class(args, Path(workspace))
+        grades = grade(
+            found.paths,
+            args.out,
+            jobs=args.jobs,
+            progress=not args.quiet,
+            rubric=args.rubric,
+            options=options,
+            times=times,
+            times_from_mtime=args.times_from_mtime,
+            shard=args.shard,
+            fresh=args.fresh,
+            engine=_dask_engine(args),
+            names=found.names,
+            ungradable=found.ungradable,
+            times_from_submission=args.times_from_submission,
+            exchange_times=exchange,
+        )
+    rubric = grades.earlier.rubric
+    _summary(grades, args.out, start, "listed")
     _resumed(args.out)
+    _refused(grades.earlier, "the resumed run")
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} (repeat the run with --seed)")
+    for line in found.notes:
+        print(f"labkit grade: {line}", file=sys.stderr)
+    _late_marks(grades, found.marked_late)
     unreadable = _times_notes(grades, rubric, times)
     failed = report_failures(grades)
     if unreadable and not failed:
@@ -286,14 +312,66 @@ def _grade(args):
     return 0
 
 
+class _Class:
+    """The submissions of `labkit grade`'s arguments: paths and names to grade, students with nothing to grade
+    ({name: why}), notes for the instructor, and the names the LMS marked late."""
+
+    def __init__(self, paths, names=None, ungradable=None, notes=(), marked_late=()):
+        self.paths, self.names, self.ungradable = paths, names, dict(ungradable or {})
+        self.notes, self.marked_late = list(notes), set(marked_late)
+
+
+def _class(args, workspace):
+    """One class folder or zip as the LMS gives it (labkit.grading.intake), or the submissions one by one."""
+    from .grading import intake
+
+    paths = args.submissions
+    if len(paths) != 1 or not intake.is_class(paths[0]):
+        if args.assignment:
+            raise ValueError("--assignment picks an assignment of an nbgrader class folder; give the class folder.")
+        return _Class(paths)
+    found = intake.find_class(paths[0], workspace, assignment=args.assignment)
+    gradable = [student for student in found.students if student.path is not None]
+    return _Class(
+        [student.path for student in gradable],
+        [student.name for student in gradable],
+        {student.name: student.failure for student in found.students if student.path is None},
+        [f"{found.layout} layout in {paths[0]}: {len(found.students)} student(s)", *found.notes],
+        {student.name for student in found.students if student.marked_late},
+    )
+
+
+def _refused(found, what):
+    """Name each result file that was not read (its run's record does not vouch for it)."""
+    from .grading.report import one_line
+
+    for path, why in found.refused:
+        print(f"labkit: {what}: not read: {one_line(path, 200)}: {one_line(why, 300)}", file=sys.stderr)
+
+
+def _late_marks(grades, marked):
+    """Name the submissions the LMS marked late whose time labkit does not know (so no penalty was applied)."""
+    from .grading.report import one_line
+
+    unknown = [g.name for g in grades if g.name in marked and g.graded and (g.time is None or g.time.when is None)]
+    for name in unknown:
+        print(
+            f"labkit grade: the LMS marked {one_line(name, 80)} late, but gave no time: give the LMS's submission "
+            "times in --times TIMES.csv for the late rule to apply.",
+            file=sys.stderr,
+        )
+
+
 def _export(args):
     from .grading import lms
+    from .grading.record import rubric_for
     from .grading.report import read_results
-    from .grading.rubric import load
 
     if args.canvas is not None and args.feedback:
         raise ValueError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
-    grades = read_results([args.results], load(args.rubric))
+    # the run's recorded rubric (late rule included): what is exported is grades.csv's total
+    grades = read_results([args.results], rubric_for([args.results], args.rubric, "labkit export"))
+    _refused(grades, "labkit export")
     if args.canvas is not None:
         export = lms.to_canvas(
             grades,
@@ -317,20 +395,19 @@ def _export(args):
     for line in export.problems():
         print(f"labkit export: {line}", file=sys.stderr)
     print(export.summary())
-    return 1 if export.listed else 0
+    return 1 if export.listed or grades.refused else 0
 
 
 def _report(args):
     from .grading import class_report, similarity
     from .grading.progress import Progress
-    from .grading.rubric import load
 
     start = time.perf_counter()
     threshold = args.similarity_threshold
     if not 0.0 < threshold <= 1.0:
         raise ValueError(f"--similarity-threshold is a similarity above 0 and at most 1; got {threshold}.")
-    rubric = load(args.rubric)
-    grades = class_report.read(args.out, rubric)
+    grades = class_report.read(args.out, args.rubric)  # the run's recorded rubric; a different one is refused
+    _refused(grades, "labkit report")
     functions = {function for grade in grades for function in grade.sources}
     with Progress(len(functions), "comparing code", enabled=not args.quiet) as bar:
         pairs, note = similarity.similar_pairs(grades, threshold, progress=bar), None
@@ -341,7 +418,7 @@ def _report(args):
             f"wrote {path}: {len(grades)} submission(s), {similar}, in {time.perf_counter() - start:.1f} s "
             "(open it in a browser; it needs no network)"
         )
-    return 0
+    return 1 if grades.refused else 0
 
 
 def build_parser():
@@ -414,7 +491,14 @@ def build_parser():
         "one are graded, with that run's seed from seed.txt (a different --seed is refused), and a submission that "
         "could not be graded is graded again; grades.csv then covers them all. --fresh starts over instead.",
     )
-    grd.add_argument("submissions", nargs="*", type=Path, help="notebooks or folders of notebooks, one per student")
+    grd.add_argument(
+        "submissions",
+        nargs="*",
+        type=Path,
+        help="the class as the LMS gives it (one folder or zip: a folder per student, nbgrader's submitted/, "
+        "Canvas's or Moodle's download), or the submissions one by one (notebooks or folders of notebooks); put "
+        "`--` before them when a name could start with '-'",
+    )
     grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv, feedback/ and results/")
     grd.add_argument(
         "--merge",
@@ -506,22 +590,40 @@ def build_parser():
     grd.add_argument(
         "--rubric",
         type=Path,
-        default=DEFAULTS.rubric,
         help="TOML rubric: points, required exercises, branches, extra credit, a deadline ([late]) "
-        "(default: the lab's; `labkit rubric` prints it)",
+        "(default: the one recorded in --out by an earlier run, else the lab's; `labkit rubric` prints it)",
+    )
+    grd.add_argument(
+        "--assignment",
+        metavar="NAME",
+        help="the assignment to grade in an nbgrader class folder (submitted/STUDENT/NAME/) holding several, and "
+        "in the exchange of --times-from-exchange",
     )
     grd.add_argument(
         "--times",
         type=Path,
         metavar="TIMES.csv",
-        help="submission times for the rubric's [late] table: a CSV with the columns submission and time "
-        "(ISO 8601 with a UTC offset); a time listed there comes before nbgrader's timestamp.txt",
+        help="submission times for the rubric's [late] table, as the LMS exports them: a CSV with the columns "
+        "submission and time (ISO 8601 with a UTC offset); trusted, and it comes before every other source",
+    )
+    grd.add_argument(
+        "--times-from-exchange",
+        type=Path,
+        metavar="COURSE",
+        help="read the submission times from nbgrader's exchange itself (COURSE: the course's folder there, which "
+        "holds inbound/; with --assignment): each student's newest submission",
+    )
+    grd.add_argument(
+        "--times-from-submission",
+        action="store_true",
+        help="a submission with no other time gets the time in the timestamp.txt inside it (never without this "
+        "option: the student's own process writes that file; marked student-supplied)",
     )
     grd.add_argument(
         "--times-from-mtime",
         action="store_true",
         help="a submission with no other time gets its notebooks' newest modification time (never without "
-        "this option: copying or unpacking a file changes it)",
+        "this option: copying or unpacking a file changes it, and the student sets it; marked student-supplied)",
     )
     grd.add_argument(
         "--no-fork-server",
@@ -584,7 +686,9 @@ def build_parser():
         "--force", action="store_true", help="replace FILE and its summary if they exist (never an input file)"
     )
     exp.add_argument(
-        "--rubric", type=Path, help="TOML rubric to score the results with (default: the lab's), as for --merge"
+        "--rubric",
+        type=Path,
+        help="leave it out: the rubric recorded by the run is used (one that grades otherwise is refused)",
     )
     exp.set_defaults(handler=_export)
 
@@ -601,8 +705,7 @@ def build_parser():
     rep.add_argument(
         "--rubric",
         type=Path,
-        default=DEFAULTS.rubric,
-        help="the TOML rubric the run was scored with (default: the lab's)",
+        help="leave it out: the rubric recorded by the run is used (one that grades otherwise is refused)",
     )
     rep.add_argument(
         "--similarity-threshold",
@@ -641,7 +744,33 @@ def _rubric(args):
     return 0
 
 
+def options_that_are_files(argv):
+    """The arguments before ``--`` that read as options but name a file or folder here: a submission folder
+    named ``--sandbox=none`` that a shell's ``*`` put among the options.
+
+    >>> options_that_are_files(["grade", "--out", "g", "--", "-odd"])
+    []
+    """
+    found = []
+    for argument in argv:
+        if argument == "--":
+            break
+        if argument.startswith("-") and len(argument) > 1 and os.path.lexists(argument):
+            found.append(argument)
+    return found
+
+
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(map(str, argv))
+    clash = options_that_are_files(argv)
+    if clash:
+        print(
+            f"labkit: {clash[0]!r} is an option, and also a file or folder here (a submission named so?); nothing "
+            "was run. A name that starts with '-' reads as an option: give the class folder instead (labkit grade "
+            "CLASS --out OUT), or put `--` before the submissions (labkit grade --out OUT -- *).",
+            file=sys.stderr,
+        )
+        return 2
     args = build_parser().parse_args(argv)
     try:
         return args.handler(args)

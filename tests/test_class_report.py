@@ -497,7 +497,7 @@ def test_the_cli_refuses_a_missing_or_empty_folder(tmp_path, capsys):
     assert main(["report", str(tmp_path / "nowhere")]) == 2
     assert "nowhere is not a folder: give the --out folder of a `labkit grade` run" in capsys.readouterr().err
     assert main(["report", str(tmp_path)]) == 2
-    assert "holds no results/*.json" in capsys.readouterr().err
+    assert "has no run record (record.json)" in capsys.readouterr().err
     assert not (tmp_path / "report.html").exists() and not (tmp_path / "nowhere").exists()
 
 
@@ -511,22 +511,26 @@ def _cli(*args):
     )
 
 
-def test_results_of_another_labkit_version_or_course_are_refused_without_a_traceback(grades, tmp_path):
+def test_results_of_another_labkit_version_are_refused_and_changed_results_never_read(grades, tmp_path):
     write_report(tmp_path, grades)
-    path = sorted((tmp_path / "results").glob("*.json"))[0]
-    original = path.read_bytes()
-    data = json.loads(original)
+    record = tmp_path / "record.json"
+    original = record.read_bytes()
     before = snapshot(tmp_path)
-    path.write_text(json.dumps({**data, "format": "labkit-grade/1"}))
+    record.write_text(json.dumps({**json.loads(original), "labkit": "0.0.1"}))
     run = _cli("report", str(tmp_path))
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
-    assert "is not a labkit grade result (format is 'labkit-grade/1'" in run.stderr
-    path.write_text(json.dumps({**data, "results": {**data["results"], "17": {"fraction": 1.0, "checks": []}}}))
-    run = _cli("report", str(tmp_path))
-    assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
-    assert "grades exercises [2, 3, 4, 17]" in run.stderr and "written by another version of labkit" in run.stderr
-    path.write_bytes(original)
+    assert "was graded by labkit 0.0.1" in run.stderr and "grade those submissions again" in run.stderr
+    record.write_bytes(original)
     assert snapshot(tmp_path) == before and not (tmp_path / "report.html").exists()
+    # a result edited after the run (another course's exercise added, say) is not what the run wrote: never read
+    path = sorted((tmp_path / "results").glob("*.json"))[0]
+    data = json.loads(path.read_bytes())
+    path.write_text(json.dumps({**data, "results": {**data["results"], "17": {"fraction": 1.0, "checks": []}}}))
+    run = _cli("report", str(tmp_path), "--quiet")
+    assert run.returncode == 1 and "Traceback" not in run.stderr, run.stderr
+    assert f"not read: {path}: changed since the run wrote it" in run.stderr
+    html = (tmp_path / "report.html").read_text()
+    assert f"{len(grades) - 1} submission" in html and data["name"] not in html
 
 
 def test_results_of_another_rubric_need_that_rubric(grades, tmp_path, capsys):
@@ -537,12 +541,15 @@ def test_results_of_another_rubric_need_that_rubric(grades, tmp_path, capsys):
     write_report(
         out, [grade(g.name, {**full(16), (16, "runge2d"): slip("runge2d", "h")}, rubric=rubric) for g in grades[:3]]
     )
-    assert main(["report", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert "was scored under the rubric 'bilinear only'" in err and "--rubric FILE" in err
-    assert main(["report", str(out), "--rubric", str(tmp_path / "bilinear.toml"), "--quiet"]) == 0
+    # the run's record names its rubric: the report needs no --rubric, and refuses one that grades otherwise
+    assert main(["report", str(out), "--quiet"]) == 0
     html = (out / "report.html").read_text()
     assert "Class report: bilinear only" in html and "Full credit is 20 points" in html
+    assert main(["report", str(out), "--rubric", str(tmp_path / "bilinear.toml"), "--quiet"]) == 0
+    (tmp_path / "other.toml").write_text(text.replace("16 = 20", "16 = 10"))
+    assert main(["report", str(out), "--rubric", str(tmp_path / "other.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "differs from it in its exercises, groups or points" in err and "leave --rubric out" in err
 
 
 def test_bad_input_to_the_module_says_what_to_fix(grades, tmp_path):
@@ -571,18 +578,27 @@ def test_bad_input_to_the_module_says_what_to_fix(grades, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report.html"]  # no temporary file left
 
 
-def test_result_files_that_are_not_plain_files_or_too_large_are_refused(grades, tmp_path, monkeypatch):
+def test_result_files_that_are_not_plain_files_or_too_large_are_never_read(grades, tmp_path, monkeypatch):
+    from labkit.grading import record
+
     write_report(tmp_path, grades)
     fifo = tmp_path / "results" / "zz.json"
     import os
 
     os.mkfifo(fifo)  # reading it would wait forever
-    with pytest.raises(ValueError, match="zz.json is not a regular file"):
-        class_report.read(tmp_path)
+    read = class_report.read(tmp_path)
+    assert len(read) == len(grades) and [path.name for path, _ in read.refused] == ["zz.json"]
     fifo.unlink()
-    monkeypatch.setattr(class_report, "MAX_RESULT_BYTES", 100)
-    with pytest.raises(ValueError, match="larger than the 100 bytes a result can have"):
-        class_report.read(tmp_path)
+    named = sorted((tmp_path / "results").glob("*.json"))[0]
+    os.unlink(named)
+    os.mkfifo(named)  # even a file the record names is opened without waiting, and refused as no plain file
+    read = class_report.read(tmp_path)
+    assert len(read) == len(grades) - 1 and "not a regular file" in read.refused[0][1]
+    os.unlink(named)
+    write_report(tmp_path, grades)
+    monkeypatch.setattr(record, "MAX_RESULT", 100)
+    with pytest.raises(ValueError, match="no result their records vouch for"):
+        class_report.read(tmp_path)  # every result is larger than the limit: none is read
 
 
 def test_the_cli_help_names_the_options_and_their_defaults(capsys):

@@ -215,10 +215,49 @@ def test_the_times_file_comes_first_and_modification_times_only_when_asked(tmp_p
     by_mtime = late.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True)
     assert by_mtime == late.SubmissionTime(datetime(2026, 12, 3, 12, tzinfo=UTC), late.FROM_MTIME)
     (folder / "timestamp.txt").write_text("2026-12-01 22:59:59.123456 UTC")
-    assert late.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True).when == MOMENT
+    # the student's own timestamp.txt is never read unless asked for, and then it is marked student-supplied
+    assert late.submission_time(folder, "alice") is None
+    assert late.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True).source == late.FROM_MTIME
+    inside = late.submission_time(folder, "alice", from_submission=True)
+    assert inside.when == MOMENT and inside.source in late.STUDENT_SUPPLIED and "student-supplied" in inside.source
     listed = {"alice": datetime(2026, 12, 2, tzinfo=UTC)}
-    assert late.submission_time(folder, "alice", listed) == late.SubmissionTime(listed["alice"], late.FROM_CSV)
-    assert late.submission_time(folder, "bob", listed).source == late.FROM_NBGRADER
+    assert late.submission_time(folder, "alice", listed, from_submission=True) == late.SubmissionTime(
+        listed["alice"], late.FROM_CSV
+    )
+    assert late.submission_time(folder, "bob", listed, from_submission=True).source == late.FROM_NBGRADER
+    # labkit's own reading of nbgrader's exchange comes after the LMS's times, before anything inside
+    exchange = {"alice": datetime(2026, 12, 2, 5, tzinfo=UTC)}
+    assert late.submission_time(folder, "alice", None, exchange=exchange, from_submission=True).source == (
+        late.FROM_EXCHANGE
+    )
+    assert late.submission_time(folder, "alice", listed, exchange=exchange).source == late.FROM_CSV
+
+
+def test_the_exchange_is_read_from_its_folder_names_newest_first(tmp_path):
+    inbound = tmp_path / "course101" / "inbound"
+    for name in (
+        "alice+lab8+2026-12-01 22:00:00.000000 UTC+abc123",
+        "alice+lab8+2026-12-02 08:30:00.000000 UTC+def456",  # a second submission: the newest counts
+        "bob+lab8+2026-12-01 20:00:00 UTC",  # nbgrader before the random part was added
+        "carol+lab7+2026-12-09 20:00:00 UTC+x",  # another assignment
+        "d+ave+lab8+2026-12-01 21:00:00.5 UTC+q",  # a student id with a plus
+    ):
+        folder = inbound / name
+        folder.mkdir(parents=True)
+        # what travels with the work is the student's: a forged timestamp.txt changes nothing
+        (folder / "timestamp.txt").write_text("2026-11-01 00:00:00 UTC")
+    found = late.read_exchange(tmp_path / "course101", "lab8")
+    assert found == {
+        "alice": datetime(2026, 12, 2, 8, 30, tzinfo=UTC),
+        "bob": datetime(2026, 12, 1, 20, tzinfo=UTC),
+        "d+ave": datetime(2026, 12, 1, 21, 0, 0, 500000, tzinfo=UTC),
+    }
+    assert late.read_exchange(inbound, "lab7") == {"carol": datetime(2026, 12, 9, 20, tzinfo=UTC)}
+    (inbound / "eve+lab8+yesterday+r").mkdir()
+    with pytest.raises(ValueError, match="no readable time"):
+        late.read_exchange(inbound, "lab8")
+    with pytest.raises(ValueError, match="no inbound"):
+        late.read_exchange(tmp_path, "lab8")
 
 
 def test_a_times_file_is_read_with_extra_columns_and_either_time_format(tmp_path):
@@ -367,7 +406,7 @@ def test_with_a_late_table_grades_csv_shows_raw_total_time_lateness_penalty_and_
     ]
     write_report(tmp_path, grades)
     header, *rows = _rows(tmp_path / "grades.csv")
-    assert header[:15] == [
+    assert header[:16] == [
         "submission",
         "exercise 16",
         "required",
@@ -376,6 +415,7 @@ def test_with_a_late_table_grades_csv_shows_raw_total_time_lateness_penalty_and_
         "extra credit",
         "raw total",
         "submitted",
+        "time source",
         "deadline",
         "hours late",
         "lateness",
@@ -388,6 +428,7 @@ def test_with_a_late_table_grades_csv_shows_raw_total_time_lateness_penalty_and_
     ada, evil, cy, dee = ({key: value for key, value in zip(header, row)} for row in rows)
     assert (ada["raw total"], ada["penalty"], ada["total"]) == ("10", "2", "8")
     assert ada["submitted"] == "2026-12-03T05:59:00+01:00" and ada["deadline"] == "2026-12-01T23:59:00+01:00"
+    assert ada["time source"] == late.FROM_CSV and cy["time source"] == ""
     assert ada["hours late"] == "30.00" and ada["lateness"].startswith("late by 1 day 6 h: 2 started days, 20% off")
     assert evil["submission"].startswith("'=HYPERLINK") and "\x1b" not in evil["submission"]
     assert (evil["lateness"], evil["total"]) == ("on time", "20")
@@ -474,10 +515,12 @@ def test_merge_refuses_mixed_rubrics_a_folder_twice_one_submission_twice_and_wri
         merge([first, tmp_path / "class"], tmp_path / "m3", rubric)
     with pytest.raises(ValueError, match="is one of the folders merged"):
         merge([first, relaxed], first, rubric)
+    # a result file the run's record does not name (a copy, or one a submission wrote) is never merged
     shutil.copy(_result(first, "alice"), first / "results" / "copy.json")
-    with pytest.raises(ValueError, match="'alice' is graded twice in"):
-        merge([first], tmp_path / "m4", rubric)
-    assert not (tmp_path / "m1").exists() and not (tmp_path / "m4").exists()  # nothing written on a refusal
+    merged = merge([first], tmp_path / "m4", rubric)
+    assert [g.name for g in merged] == ["alice", "bob"] and [p.name for p, _ in merged.refused] == ["copy.json"]
+    assert "copy.json" in (tmp_path / "m4" / "merge.json").read_text()
+    assert not (tmp_path / "m1").exists()  # nothing written on a refusal
 
 
 def test_times_given_to_a_merge_replace_the_stored_ones_for_the_submissions_they_list(tmp_path):

@@ -236,15 +236,19 @@ def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
     assert rows[2][2] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"
 
 
-def test_a_rubric_given_rescores_the_results(out, inputs, tmp_path):
+def test_another_rubric_than_the_runs_is_refused_and_none_needed(out, inputs, tmp_path):
     rubric = tmp_path / "rubric.toml"
     rubric.write_text("required = [2, 3]\n[points]\n2 = 50\n3 = 50\n")
-    from labkit.grading.rubric import load
-
     gradebook, roster = inputs
-    lms.to_canvas(read_results([out], load(rubric)), gradebook, roster, tmp_path / "import.csv")
-    rows = {row[1] or row[0].strip(): row[-1] for row in _rows(tmp_path / "import.csv")[1:]}
-    assert rows["Points Possible"] == "100" and rows["1001"] == "100" and rows["1002"] == "75"
+    run = _cli(out, "--canvas", gradebook, "--roster", roster, "--rubric", rubric, "--out", tmp_path / "x.csv")
+    assert run.returncode == 2 and "differs from it in its exercises, groups or points" in run.stderr, run.stderr
+    assert not (tmp_path / "x.csv").exists()
+    # without --rubric, the run's own: the column holds grades.csv's totals
+    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    with open(out / "grades.csv", newline="", encoding="utf-8") as handle:
+        totals = {row["submission"]: row["total"] for row in csv.DictReader(handle)}
+    exported = {row[1]: row[-1] for row in _rows(tmp_path / "import.csv")[1:]}
+    assert (exported["1001"], exported["1002"]) == (totals["ada"], totals["bob"]) == ("104", "17.5")
 
 
 # --- bad input: a clear error, and nothing written or changed ---------------------------------------------------
@@ -416,7 +420,7 @@ def test_labkit_export_refuses_bad_input_with_status_2(tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
     run = _cli(empty, "--moodle", "--roster", roster)
-    assert run.returncode == 2 and "holds no results/*.json" in run.stderr
+    assert run.returncode == 2 and "has no run record (record.json)" in run.stderr
     run = _cli(empty, "--canvas", tmp_path / "gradebook.csv", "--roster", roster, "--feedback")
     assert run.returncode == 2 and "--feedback is for --moodle" in run.stderr
     run = _cli(empty, "--roster", roster)

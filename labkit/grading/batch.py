@@ -48,14 +48,16 @@ import sys
 import tempfile
 import threading
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import backends, cgroup, forkserver, refusals
+from . import record as records
 from .backends.base import SandboxUnavailable
 from .late import submission_time
 from .options import GradeOptions
 from .progress import Progress
-from .report import FORMAT, SubmissionGrade, one_line, safe_name, write_report, write_result
+from .report import FORMAT, SubmissionGrade, labkit_version, one_line, safe_name, write_report, write_result
 from .rubric import Rubric
 from .rubric import default as default_rubric
 from .rubric import load as load_rubric
@@ -63,7 +65,6 @@ from .scoring import submission_name, submission_notebooks
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
-MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
 LAUNCHER_READY = 120  # seconds for the launcher to import the grader
 
@@ -255,7 +256,7 @@ class _Job:
                 return None, f"its grading process was killed by {name}"
             return None, f"its grading process ended with status {code} without a result{self.last_words()}"
         try:
-            if self.result.stat().st_size > MAX_RESULT:
+            if self.result.stat().st_size > records.MAX_RESULT:
                 return None, "its result was larger than the grader accepts"
             data = json.loads(self.result.read_text(encoding="utf-8"))
             if not isinstance(data, dict) or data.get("format") != FORMAT:
@@ -367,8 +368,13 @@ def grade(
     shard=None,
     fresh=False,
     engine=None,
+    *,
+    names=None,
+    ungradable=None,
+    times_from_submission=False,
+    exchange_times=None,
 ):
-    """Grade submissions; write grades.csv, feedback/, results/ and seed.txt into `out_dir`.
+    """Grade submissions; write grades.csv, feedback/, results/, seed.txt and the run's record into `out_dir`.
 
     `options` (a :class:`labkit.grading.options.GradeOptions`, the defaults
     when None) bound the run, with the single keywords that are given in
@@ -377,26 +383,35 @@ def grade(
     backend is the sandbox (``sandboxed=False``, the old switch, means
     ``backend="none"``: student code runs unconfined, after a warning on
     stderr). `rubric` (a :class:`Rubric`, or a TOML file; else the options'
-    rubric, else the lab's) turns the checks' results into grades. Each
-    submission's time comes from `times` ({name: datetime}, the instructor's
-    ``--times`` file), else from nbgrader's ``timestamp.txt`` in its folder,
-    else, only with `times_from_mtime`, from its notebooks' modification
-    time (:func:`labkit.grading.late.submission_time`). `progress` draws a
-    bar with an ETA on a terminal.
+    rubric; else the rubric recorded in `out_dir` by an earlier run, else the
+    lab's) turns the checks' results into grades. `names` gives each
+    submission its name (by default its folder's or notebook's), and
+    `ungradable` ({name: why}) adds students who handed in nothing to grade:
+    they are reported as "could not be graded", never given a zero.
+
+    Each submission's time comes from `times` ({name: datetime}, the LMS's
+    times in the instructor's ``--times`` file), else from `exchange_times`
+    (read by labkit from nbgrader's exchange), else, only with
+    `times_from_submission`, from the ``timestamp.txt`` in its folder, else,
+    only with `times_from_mtime`, from its notebooks' modification time
+    (:func:`labkit.grading.late.submission_time`); the last two are written
+    by the student and marked "student-supplied" wherever they are shown.
+    `progress` draws a bar with an ETA on a terminal.
 
     Each submission's result and feedback are written as soon as it is
-    graded. When `out_dir` already holds results of an earlier run, only the
-    submissions without one are graded, with that run's seed
-    (:func:`resumed`); `fresh` deletes those results first. `shard`, ``(I,
-    N)`` or ``"I/N"``, grades only the I-th of N parts of the class
-    (:func:`shard`). `engine` grades the submissions elsewhere, in place of
-    `jobs` grading processes here: a callable ``engine(todo, options,
-    profiles_file, rubric, out, bar, peaks, arrived)`` returning ({name:
-    SubmissionGrade}, what ``run.json`` records of it), such as
+    graded, and entered in ``record.json`` (:mod:`labkit.grading.record`).
+    When `out_dir` already holds a run's record, only the submissions without
+    a result there, or whose notebooks changed since, are graded, with that
+    run's seed and rubric (:func:`resumed`); `fresh` deletes those results
+    first. `shard`, ``(I, N)`` or ``"I/N"``, grades only the I-th of N parts
+    of the class (:func:`shard`). `engine` grades the submissions elsewhere,
+    in place of `jobs` grading processes here: a callable ``engine(todo,
+    options, profiles_file, rubric, out, bar, peaks, arrived)`` returning
+    ({name: SubmissionGrade}, what ``run.json`` records of it), such as
     :func:`labkit.grading.distributed.engine`'s for a Dask cluster. Returns
-    the grades in the order given (a shard's in name order), those of an
-    earlier run included; those with ``graded`` False could not be graded
-    (their ``failure`` says why).
+    the grades in the order given (a shard's in name order; the ungradable
+    last), those of an earlier run included; those with ``graded`` False
+    could not be graded (their ``failure`` says why).
     """
     submissions = [Path(s) for s in submissions]
     for path in submissions:
@@ -404,19 +419,27 @@ def grade(
             raise ValueError(f"{path} does not exist.")
         if not path.is_symlink() and path.is_file() and path.suffix != ".ipynb":
             raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
-    names = [submission_name(p) for p in submissions]
-    if len(set(names)) != len(names):
+    names = [submission_name(p) for p in submissions] if names is None else [str(n) for n in names]
+    if len(names) != len(submissions):
+        raise ValueError(f"{len(names)} names for {len(submissions)} submissions; give one name per submission.")
+    ungradable = dict(ungradable or {})
+    every = names + list(ungradable)
+    if len(set(every)) != len(every):
         raise ValueError("two submissions have the same name; their feedback files would collide.")
     if shard is not None:
         shard = parse_shard(shard)
-        submissions, names = shard_of(submissions, names, shard)
+        chosen = set(shard_of(every, every, shard)[1])
+        by_name = dict(zip(names, submissions))
+        names = sorted(name for name in names if name in chosen)
+        submissions = [by_name[name] for name in names]
+        ungradable = {name: why for name, why in sorted(ungradable.items()) if name in chosen}
     options = GradeOptions.build(
         options, cell_timeout=cell_timeout, total_timeout=total_timeout, limits=limits, seed=seed, sandboxed=sandboxed
     )
     if rubric is not None and not isinstance(rubric, Rubric):
         options = GradeOptions.build(options, rubric=rubric)
     if not isinstance(rubric, Rubric):
-        rubric = default_rubric() if options.rubric is None else load_rubric(options.rubric)
+        rubric = None if options.rubric is None else load_rubric(options.rubric)
     backend = backends.get_backend(options.backend)
     try:
         backend.available()
@@ -428,8 +451,11 @@ def grade(
     from dataclasses import replace
 
     out = Path(out_dir)
-    done, seed = resumed(out, names, options.seed, rubric, fresh)
-    seed = secrets.randbits(63) if seed is None else int(seed)
+    # read before any student code runs, as collected
+    contents = {name: _content(path) for path, name in zip(submissions, names)}
+    earlier = resumed(out, [*names, *ungradable], options.seed, rubric, fresh, contents)
+    done, rubric = earlier.done, earlier.rubric
+    seed = secrets.randbits(63) if earlier.seed is None else int(earlier.seed)
     options = replace(options, seed=seed)
     if options.exercises not in (None, rubric.registry.source):
         raise ValueError(
@@ -437,30 +463,42 @@ def grade(
             'name the course\'s exercises in its rubric (exercises = "module:attribute") and leave the option out.'
         )
     options = replace(options, exercises=rubric.registry.source)  # the workers load the rubric's exercises
-    # read before any student code runs, as collected
     handed_in = [
-        submission_time(path, name, times, _notebooks(path) if times_from_mtime else None, times_from_mtime)
+        submission_time(
+            path,
+            name,
+            times,
+            _notebooks(path) if times_from_mtime else None,
+            times_from_mtime,
+            from_submission=times_from_submission,
+            exchange=exchange_times,
+        )
         for path, name in zip(submissions, names)
     ]
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)  # an empty shard's folder is a run's too
+    record = earlier.record or records.new("grade", labkit_version(), seed, rubric)
+    records.write(out, record)
+    if rubric.text is not None:  # the grading processes read the run's rubric from its record's copy
+        options = replace(options, rubric=str((out / records.RUBRIC_COPY).resolve()))
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
     when = dict(zip(names, handed_in))
+    when.update({name: submission_time(None, name, times, exchange=exchange_times) for name in ungradable})
     todo = [(path, name) for path, name in zip(submissions, names) if name not in done]
 
     def arrived(grade):
         """Write a submission's result and feedback as soon as it is graded (a stopped run resumes from them)."""
         grade.time = when[grade.name]
-        write_result(out, grade)
+        records.note(out, record, grade.name, write_result(out, grade), contents.get(grade.name))
 
     work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
-    start, peaks, record = time.monotonic(), [], {"engine": "local", "jobs": int(jobs)}
+    start, peaks, run = time.monotonic(), [], {"engine": "local", "jobs": int(jobs)}
     try:
         profiles_file = work / "profiles.json"
         profiles_file.write_text(json.dumps(refusals.wire(rubric.registry.refusals)), encoding="utf-8")
         if engine is None:
             with _warm(backend, options) as (server, launcher), Progress(len(todo), "grading", enabled=progress) as bar:
-                record.update({"fork server": server is not None, "forked grading processes": launcher is not None})
+                run.update({"fork server": server is not None, "forked grading processes": launcher is not None})
                 graded = _schedule(
                     [p for p, _ in todo], [n for _, n in todo], work, options, profiles_file, rubric,
                     max(1, int(jobs)), out, bar, peaks, arrived, server, launcher,
@@ -468,24 +506,28 @@ def grade(
                 graded = {grade.name: grade for grade in graded.values()}
         else:
             with Progress(len(todo), "grading", enabled=progress) as bar:
-                graded, record = engine(todo, options, profiles_file, rubric, out, bar, peaks, arrived)
+                graded, run = engine(todo, options, profiles_file, rubric, out, bar, peaks, arrived)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    ordered = [graded[name] if name in graded else done[name] for name in names]
+    for name, why in ungradable.items():
+        graded[name] = SubmissionGrade(name, seed=seed, rubric=rubric, failure=why)
+    ordered = [graded[name] if name in graded else done[name] for name in [*names, *ungradable]]
     for grade in ordered:
         grade.time = when[grade.name]
-    write_report(out, ordered)
+    write_report(out, ordered, record)
     (out / "run.json").write_text(
         json.dumps(
             {
                 "seed": seed,
                 "submissions": len(ordered),
-                "graded now": len(graded),
+                "graded now": len(graded) - len(ungradable),
                 "already graded": len(done),
+                "graded again, changed": len(earlier.changed),
+                "handed in nothing to grade": len(ungradable),
                 "shard": None if shard is None else f"{shard[0]}/{shard[1]}",
                 "not graded": sum(not g.graded for g in ordered),
                 "seconds": round(time.monotonic() - start, 1),
-                **record,
+                **run,
                 "grader peak bytes": max((p for p in peaks if p), default=None),
                 "grader process peak bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
             },
@@ -493,7 +535,21 @@ def grade(
         ),
         encoding="utf-8",
     )
-    return ordered
+    return Graded(ordered, earlier)
+
+
+class Graded(list):
+    """The grades of a run (:func:`grade`), with what it resumed (:attr:`earlier`, a :class:`Resumed`)."""
+
+    def __init__(self, grades, earlier):
+        super().__init__(grades)
+        self.earlier = earlier
+
+
+def _content(path):
+    """The digest of a submission's notebooks (:func:`labkit.grading.record.content_digest`)."""
+    path = Path(path)
+    return records.content_digest(_notebooks(path), path if path.is_dir() else path.parent)
 
 
 def _notebooks(path):
@@ -707,66 +763,106 @@ def report_failures(grades, stream=sys.stderr):
     return len(failed)
 
 
-def resumed(out, names, seed, rubric, fresh=False):
-    """The results an earlier run left in `out` that this run keeps, and the seed to grade with.
+@dataclass
+class Resumed:
+    """What an earlier run into the same output folder leaves to this one (:func:`resumed`).
 
-    An output folder that holds results (``results/*.json``) is resumed: the submissions graded there
-    are kept ({name: SubmissionGrade}), and the run grades the others with the earlier run's seed
-    (``seed.txt``), which `seed` may repeat but not change. A result of a submission that could not be
-    graded is not kept (it is graded again: such failures are the grader's, a crash, a stopped run, a
-    lost worker). Results of another rubric or labkit version, of several seeds (a merged folder), or of a
-    submission not in `names` are refused with a ValueError saying what to do, as nothing of them would
-    fit this run's grades.csv. A result file that is not JSON (a run killed while writing it) is graded
-    again. `fresh` deletes the earlier results and feedback instead: every submission is graded, with
-    `seed` (a fresh one when None)."""
+    Attributes
+    ----------
+    done : dict
+        {name: SubmissionGrade} kept: graded there, and its notebooks unchanged since.
+    seed : int or None
+        The seed to grade with (the earlier run's).
+    rubric : Rubric
+        The rubric to grade with (the earlier run's, when none was given).
+    record : RunRecord or None
+        The earlier run's record, which this run goes on writing.
+    changed : list
+        The submissions graded there whose notebooks changed since: graded again.
+    refused : list
+        (path, why) of result files in the folder that its record does not vouch for: never read.
+    """
+
+    done: dict
+    seed: object
+    rubric: Rubric
+    record: object = None
+    changed: list = field(default_factory=list)
+    refused: list = field(default_factory=list)
+
+
+def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
+    """What the earlier run in `out` leaves to this one: a :class:`Resumed`.
+
+    An output folder with a run record (:mod:`labkit.grading.record`) is resumed: the submissions graded
+    there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
+    digest}: they changed since, and are graded again), and the run grades the others with the earlier
+    run's seed, which `seed` may repeat but not change, and under the earlier run's rubric, which `rubric`
+    (a Rubric, or None for the recorded one) may repeat but not change. A submission that could not be
+    graded is graded again (such failures are the grader's: a crash, a stopped run, a lost worker). A
+    folder of another labkit version, a merge's folder, results without a record, a different rubric or
+    seed, or a submission graded there that is not in `names` are refused with a ValueError saying what to
+    do, as nothing of them would fit this run's grades.csv. `fresh` deletes the earlier results, feedback
+    and record instead: every submission is graded, with `seed` (a fresh one when None)."""
     out = Path(out)
     files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
     if fresh:
         for path in [*files, *sorted((out / "feedback").glob("*.txt"))]:
             path.unlink()
-        return {}, seed
-    if not files:
-        return {}, seed
-    how = "leave --seed out to resume it, give --fresh to grade every submission again, or choose a new --out"
-    try:
-        saved = [int(line) for line in (out / "seed.txt").read_text(encoding="utf-8").split()]
-    except (OSError, ValueError):
-        saved = []
-    datas = {}
-    for path in files:
-        try:
-            datas[path] = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, ValueError):
-            continue  # written in part when a run was killed: graded again, and the file replaced
-    seeds = {data.get("seed") for data in datas.values() if isinstance(data, dict)}
-    if len(saved) != 1:
-        saved = sorted(seeds, key=str)
-    if len(saved) != 1 or seeds - set(saved):
+        for name in (records.RECORD, records.RUBRIC_COPY):
+            (out / name).unlink(missing_ok=True)
+        return Resumed({}, seed, rubric if rubric is not None else default_rubric())
+    if not (out / records.RECORD).exists():
+        if files:
+            raise ValueError(
+                f"{out} holds results but no run record ({records.RECORD}; an older labkit wrote none): give "
+                "--fresh to grade every submission again there, or choose a new --out."
+            )
+        return Resumed({}, seed, rubric if rubric is not None else default_rubric())
+    how = "give --fresh to grade every submission again, or choose a new --out"
+    record = records.read(out)
+    if record.kind != "grade":
         raise ValueError(
-            f"{out} holds results graded with several seeds ({', '.join(map(str, sorted(seeds | set(saved), key=str)))}"
-            "), as a --merge folder does: grade into a new --out, or give --fresh to grade every submission again."
+            f"{out} holds a merge ({records.RECORD} says so), which is not resumed: grade into a new --out, or {how}."
         )
-    saved = saved[0]
-    if seed is not None and int(seed) != saved:
-        raise ValueError(f"{out} holds results of a run with seed {saved}, not --seed {seed}: {how}.")
-    wanted, done = set(names), {}
-    for path, data in datas.items():
+    if record.labkit != labkit_version():
+        raise ValueError(
+            f"{out} was graded by labkit {one_line(record.labkit, 40)}, and this is labkit {labkit_version()}: "
+            f"{how} with this version."
+        )
+    recorded = record.rubric_object(out)
+    if rubric is None:
+        rubric = recorded
+    elif not recorded.same_as(rubric):
+        raise ValueError(
+            f"{out} was graded under the rubric recorded there ({recorded.title!r}), and {rubric.source} differs "
+            f"from it in {' and '.join(recorded.differences(rubric))}: leave --rubric out to resume that run. "
+            f"To grade under {rubric.source}, {how}; to apply only another [late] table to these results, "
+            f"`labkit grade --merge {out} --rubric {rubric.source} --out NEW`."
+        )
+    if seed is not None and record.seed is not None and int(seed) != int(record.seed):
+        raise ValueError(
+            f"{out} holds results of a run with seed {record.seed}, not --seed {seed}: leave --seed out to resume "
+            f"it, {how}."
+        )
+    stray = sorted(set(record.submissions) - set(names))
+    if stray:
+        raise ValueError(
+            f"{out} holds the result of {one_line(stray[0], 80)!r}, which is not among the submissions of this "
+            "run: give the submissions (and --shard) of the run that wrote it to resume it, give --fresh to grade "
+            "only these, or choose a new --out."
+        )
+    found, refused = records.results(out, record)
+    done, changed = {}, []
+    for name, (path, data) in found.items():
         grade = SubmissionGrade.from_dict(data, str(path), rubric)  # ValueError: another labkit version's
-        if data.get("rubric digest") != rubric.digest:
-            raise ValueError(
-                f"{path} was graded under another rubric ({one_line(data.get('rubric'), 80)!r}, "
-                f"{one_line(data.get('rubric digest'), 20)}, not {rubric.digest}): give the --rubric of the run that "
-                "wrote it to resume it, give --fresh to grade every submission again, or choose a new --out."
-            )
-        if grade.name not in wanted or path.name != f"{safe_name(grade.name)}.json":
-            raise ValueError(
-                f"{path} is the result of {one_line(grade.name, 80)!r}, which is not among the submissions of "
-                "this run: give the submissions (and --shard) of the run that wrote it to resume it, give "
-                "--fresh to grade only these, or choose a new --out."
-            )
-        if grade.graded:
-            done[grade.name] = grade
-    return done, saved
+        if not grade.graded:
+            continue
+        if contents is not None and record.submissions[name].get("content") != contents.get(name):
+            changed.append(name)
+            continue
+        done[name] = grade
+    return Resumed(done, record.seed if record.seed is not None else seed, rubric, record, sorted(changed), refused)
 
 
 def parse_shard(spec):

@@ -22,7 +22,6 @@ from __future__ import annotations
 import base64
 import html
 import io
-import json
 import os
 import re
 import statistics
@@ -32,13 +31,12 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .record import rubric_for
 from .report import SubmissionGrade, one_line, printable, read_results
 from .rubric import Rubric, points_text
-from .rubric import default as default_rubric
 from .similarity import DEFAULT_THRESHOLD, Pair
 
 REPORT = "report.html"
-MAX_RESULT_BYTES = 32 * 1024**2  # one result file, as the grader accepts it (labkit.grading.batch.MAX_RESULT)
 MAX_SUBMISSIONS = 20_000  # result files in one folder
 MAX_NAME = 80  # characters of a submission's name shown
 MAX_TEXT = 300  # characters of a hint, a problem or a failed step shown
@@ -228,32 +226,16 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
     ...
     ValueError: no/such/folder is not a folder: give the --out folder of a `labkit grade` run.
     """
-    rubric = rubric if rubric is not None else default_rubric()
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
-    files = sorted((folder / "results").glob("*.json"))
-    if len(files) > MAX_SUBMISSIONS:
+    if (folder / "results").is_dir() and len(os.listdir(folder / "results")) > MAX_SUBMISSIONS:
         raise ValueError(
-            f"{folder / 'results'} holds {len(files):,} result files, more than the {MAX_SUBMISSIONS:,} "
-            "a class report shows: split the class and report on each part."
+            f"{folder / 'results'} holds more than {MAX_SUBMISSIONS:,} result files, more than a class report "
+            "shows: split the class and report on each part."
         )
-    for path in files:
-        if not path.is_file() or path.is_symlink():
-            raise ValueError(f"{path} is not a regular file; a grading run writes its results as plain files.")
-        if path.stat().st_size > MAX_RESULT_BYTES:
-            raise ValueError(
-                f"{path} is larger than the {MAX_RESULT_BYTES:,} bytes a result can have: "
-                "it was not written by `labkit grade`; remove it."
-            )
-    grades = read_results([folder], rubric)  # ValueError for an empty folder, another format, a clash
-    for path in files:
-        title = json.loads(path.read_text(encoding="utf-8")).get("rubric")
-        if title is not None and title != rubric.title:
-            raise ValueError(
-                f"{path} was scored under the rubric {one_line(title, 100)!r}, not {rubric.title!r}: give "
-                "`labkit report --rubric FILE` the rubric of that run, so the report's totals are grades.csv's."
-            )
+    # the run's record gives the rubric (a different one is refused) and vouches for each result file
+    grades = read_results([folder], rubric_for([folder], rubric, "the class report"))
     return grades
 
 

@@ -45,7 +45,12 @@ TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
 MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
 MAX_TIMES = 10 * 1024**2  # bytes of a --times file
 FORMAT = "ISO 8601 with a UTC offset, e.g. 2026-12-01T23:59:00+01:00 (or ...T22:59:00Z)"
-FROM_CSV, FROM_NBGRADER, FROM_MTIME = "the --times file", "nbgrader's timestamp.txt", "file modification time"
+FROM_CSV = "the --times file"
+FROM_EXCHANGE = "nbgrader's exchange"
+# written by the student's own process or tools (nbgrader's submit step writes timestamp.txt as the student)
+FROM_NBGRADER = "timestamp.txt in the submission, student-supplied"
+FROM_MTIME = "the notebooks' file times, student-supplied"
+STUDENT_SUPPLIED = (FROM_NBGRADER, FROM_MTIME)
 KEYS = {"deadline", "per", "percent", "cap", "grace", "extensions"}
 SHOWN = 80  # characters of a name or a bad value quoted in a message
 MINUTE = timedelta(minutes=1)
@@ -602,26 +607,34 @@ def read_times(path: str | os.PathLike) -> dict[str, datetime]:
 
 
 def submission_time(
-    submission: str | os.PathLike,
+    submission: str | os.PathLike | None,
     name: str,
     times: dict | None = None,
     notebooks: list | None = None,
     from_mtime: bool = False,
+    *,
+    from_submission: bool = False,
+    exchange: dict | None = None,
 ) -> SubmissionTime | None:
     """The time of one submission, by the precedence the module's documentation gives.
 
     Parameters
     ----------
-    submission : path-like
-        The submission (a folder or a notebook).
+    submission : path-like or None
+        The submission (a folder or a notebook); None when it has nothing on disk.
     name : str
         Its name (what the ``--times`` file lists).
     times : dict, optional
-        {name: datetime} from :func:`read_times`.
+        {name: datetime} from :func:`read_times`: the LMS's times, which the student cannot write.
     notebooks : list of path-like, optional
         Its notebooks, for `from_mtime`.
     from_mtime : bool
-        Fall back on the notebooks' modification time (never unless the instructor asks).
+        Fall back on the notebooks' modification time (never unless the instructor asks; student-supplied).
+    from_submission : bool
+        Fall back on the ``timestamp.txt`` in the submission's folder (never unless the instructor asks: the
+        student's process writes it; student-supplied).
+    exchange : dict, optional
+        {name: datetime} that labkit read from nbgrader's exchange (:func:`read_exchange`).
 
     Returns
     -------
@@ -630,12 +643,85 @@ def submission_time(
     """
     if times and name in times:
         return SubmissionTime(times[name], FROM_CSV)
-    found = read_timestamp(submission)
-    if found is not None:
-        return found
+    if exchange and name in exchange:
+        return SubmissionTime(exchange[name], FROM_EXCHANGE)
+    if submission is None:
+        return None
+    if from_submission:
+        found = read_timestamp(submission)
+        if found is not None:
+            return found
     if from_mtime:
         return modification_time(notebooks if notebooks is not None else [submission])
     return None
+
+
+def _inbound_time(folder, assignment):
+    """The time in the name of an inbound folder of `assignment` (``student+assignment+time[+random]``), why it
+    cannot be read (text), or None for another assignment's folder."""
+    problem = "its name is not student+assignment+time"
+    for cut in (3, 2):
+        parts = folder.rsplit("+", cut)
+        if len(parts) == cut + 1 and parts[1] == assignment:
+            try:
+                return parse_timestamp(parts[2])
+            except ValueError as exc:
+                problem = str(exc)
+    return problem if f"+{assignment}+" in folder else None
+
+
+MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
+
+
+def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datetime]:
+    """The submission times of `assignment` in nbgrader's exchange, read there: {student: datetime}.
+
+    nbgrader's ``submit`` copies a student's work into the course's ``inbound/`` folder, in a folder named
+    ``student+assignment+timestamp`` (newer versions add ``+random``); its ``collect`` step takes each
+    student's newest. The time read here is that newest one, from the folder's name in the exchange itself
+    (never from a ``timestamp.txt`` that travelled with the work).
+
+    Parameters
+    ----------
+    course : path-like
+        The course's folder in the exchange (``<exchange root>/<course id>``, which holds ``inbound/``), or
+        its ``inbound/`` folder itself.
+    assignment : str
+        The assignment's name, as nbgrader knows it.
+
+    Returns
+    -------
+    dict
+        {student id: the newest submission's time}.
+
+    Raises
+    ------
+    ValueError
+        When the folder holds no ``inbound/`` or a folder of that assignment has a time that cannot be read.
+    """
+    course = Path(course)
+    inbound = course if course.name == "inbound" else course / "inbound"
+    if not inbound.is_dir():
+        raise ValueError(
+            f"{course} is not a course folder of nbgrader's exchange (it has no inbound/): give "
+            "--times-from-exchange EXCHANGE/COURSE_ID, e.g. /srv/nbgrader/exchange/course101."
+        )
+    found = {}
+    with os.scandir(inbound) as entries:
+        for count, entry in enumerate(entries):
+            if count >= MAX_INBOUND:
+                raise ValueError(f"{inbound} holds more than {MAX_INBOUND:,} entries; it is not an exchange folder.")
+            if not entry.is_dir(follow_symlinks=False):
+                continue
+            when = _inbound_time(entry.name, assignment)
+            if when is None:
+                continue
+            if isinstance(when, str):
+                raise ValueError(f"{inbound}: the folder {entry.name[:SHOWN]!r} has no readable time ({when}).")
+            student = entry.name.split(f"+{assignment}+")[0]
+            if student not in found or when > found[student]:
+                found[student] = when
+    return found
 
 
 def unknown_times(grades: list) -> list[tuple[str, str, bool]]:

@@ -8,6 +8,7 @@ Layout of an output folder::
     feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
     results/<name>.json      the same grade as data: merged by ``labkit grade --merge``
     seed.txt                 the seed of the run's random test data
+    record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.record)
     merge.json               (--merge only) the folders merged and the results a later one replaced
 
 Every file here is written by the grader from its own results; nothing in
@@ -28,6 +29,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import record as records
 from . import rubric as rubrics
 from .late import FROM_CSV, SubmissionTime, time_text
 from .rubric import points_text
@@ -303,7 +305,7 @@ def csv_cell(value):
 
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
 # with a [late] table, between "extra credit" and "total" (which is then the total after the penalty)
-CSV_LATE = ["raw total", "submitted", "deadline", "hours late", "lateness", "penalty"]
+CSV_LATE = ["raw total", "submitted", "time source", "deadline", "hours late", "lateness", "penalty"]
 
 
 @functools.cache
@@ -325,6 +327,7 @@ def _late_cells(grade, lateness):
     return [
         points_text(lateness.raw_total),
         "" if when is None else time_text(when, zone),
+        "" if when is None else csv_cell(lateness.time.source),
         time_text(lateness.deadline, zone),
         "" if hours is None else f"{hours:.2f}",
         csv_cell(lateness.note),
@@ -376,7 +379,9 @@ def write_result(out_dir, grade):
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
     _replace(out / "feedback" / f"{safe_name(grade.name)}.txt", grade.feedback())
-    _replace(out / "results" / f"{safe_name(grade.name)}.json", json.dumps(grade.as_dict(), indent=1))
+    path = out / "results" / f"{safe_name(grade.name)}.json"
+    _replace(path, json.dumps(grade.as_dict(), indent=1))
+    return path
 
 
 def _replace(path, text):
@@ -385,13 +390,27 @@ def _replace(path, text):
     os.replace(partial, path)
 
 
-def write_report(out_dir, grades):
-    """grades.csv plus each submission's result and feedback files."""
+def write_report(out_dir, grades, record=None):
+    """grades.csv plus each submission's result and feedback files, each entered in the run's `record`
+    (:mod:`labkit.grading.record`; a new one of the grades' rubric and seeds when None), which is written too."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if record is None:
+        rubric = grades[0].rubric if grades else rubrics.default()
+        record = records.new("grade", labkit_version(), _seed_of(grades), rubric)
     for grade in grades:
-        write_result(out, grade)
+        path = write_result(out, grade)
+        content = record.submissions.get(grade.name, {}).get("content")
+        records.note(out, record, grade.name, path, content, save=False)
+    records.write(out, record)
     write_csv(out / "grades.csv", grades)
+    return record
+
+
+def _seed_of(grades):
+    """The seed of a run's grades: one number, or the list of them (a merge's)."""
+    seeds = sorted({g.seed for g in grades if g.seed is not None})
+    return seeds[0] if len(seeds) == 1 else seeds
 
 
 @dataclass(frozen=True)
@@ -415,56 +434,67 @@ class Replaced:
 
 
 class Merged(list):
-    """The grades of a merge, in name order, with the results that were replaced (:attr:`replaced`)."""
+    """Grades read from output folders, in name order, with the results a later folder replaced
+    (:attr:`replaced`) and the result files that were not read (:attr:`refused`: (path, why) pairs)."""
 
-    def __init__(self, grades, replaced=()):
+    def __init__(self, grades, replaced=(), refused=(), rubric=None):
         super().__init__(grades)
         self.replaced = tuple(replaced)
+        self.refused = tuple(refused)
+        self.rubric = rubric
+
+    def refused_lines(self):
+        """One printable line per result file that was not read, and why."""
+        return [f"not read: {one_line(path, 200)}: {one_line(why, 300)}" for path, why in self.refused]
 
 
 def read_results(folders, rubric=None, replaced=None):
-    """Every results/*.json of the given output folders, in name order, scored with `rubric` (the lab's when None).
+    """Every result of the given output folders that their run records vouch for, in name order, scored with
+    `rubric` (their recorded rubric when None; :mod:`labkit.grading.record`).
 
     A submission with a result in several folders counts from the last of them, in the order given (a
     regrade replaces the class's result); a later result without a submission time keeps the earlier one's.
-    Each replacement is appended to `replaced` (a list) when it is given. A folder without results counts only
-    when its ``run.json`` says its run had no submission (an empty ``--shard``). ValueError when no folder has
-    results, a folder has none but is not an empty shard's, a folder is given twice or holds one submission
-    twice, or when the results come from another labkit version or from different rubrics (exercises, groups
-    or points: the ``[late]`` table may differ)."""
-    grades, files, first, given = {}, {}, None, set()
-    for folder in map(Path, folders):
+    Each replacement is appended to `replaced` (a list) when it is given. A result file that a folder's record
+    does not name with that hash (its run never graded that submission, or the file changed since) is never
+    read: it is listed in the returned :class:`Merged`'s ``refused``. ValueError when a folder has no record,
+    no folder has results, a folder is given twice, the results come from another labkit version, or the
+    folders' rubrics differ from each other or from `rubric` in their exercises, groups or points (the
+    ``[late]`` table may differ when `rubric` is given: it is the one applied)."""
+    folders = [Path(folder) for folder in folders]
+    given = set()
+    for folder in folders:
+        if not folder.is_dir():
+            raise ValueError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
         if folder.resolve() in given:
             raise ValueError(f"{folder} is given twice; give each folder once.")
         given.add(folder.resolve())
-        files_here = sorted((folder / "results").glob("*.json"))
-        if not files_here and not _empty_run(folder):
+    if rubric is None:
+        rubric = records.rubric_for(folders, None, "reading these folders")
+    grades, files, refused = {}, {}, []
+    for folder in folders:
+        record = records.read(folder)
+        if record.labkit != labkit_version():
             raise ValueError(
-                f"{folder} holds no results/*.json: give the --out folders of earlier `labkit grade` runs."
+                f"{folder} was graded by labkit {one_line(record.labkit, 40)}, and this is labkit "
+                f"{labkit_version()}: results of another version are not mixed in (its checks may grade "
+                "differently); grade those submissions again with this version."
             )
-        here = {}
-        for path in files_here:
-            try:
-                data = json.loads(path.read_text(encoding="utf-8"))
-            except (UnicodeDecodeError, ValueError) as exc:
-                raise ValueError(f"{path} is not JSON ({exc}).") from None
+        recorded = record.rubric_object(folder)
+        if recorded.digest != rubric.digest:
+            raise ValueError(
+                f"{folder} was graded under the rubric {recorded.title!r} ({recorded.digest}), not "
+                f"{rubric.title!r} ({rubric.digest}): results of different rubrics (their exercises, groups or "
+                "points) are not merged. Grade again with the --rubric of the class's run; the [late] table may "
+                "differ, as --merge applies the one it is given."
+            )
+        found, bad = records.results(folder, record)
+        refused += bad
+        for name in sorted(found):
+            path, data = found[name]
             grade = SubmissionGrade.from_dict(data, str(path), rubric)
-            digest, title = data.get("rubric digest"), one_line(data.get("rubric"), 80)
-            if first is None:
-                first = (digest, title, path)
-            elif digest != first[0]:
-                raise ValueError(
-                    f"{path} was graded under the rubric {title!r} ({digest}) and {first[2]} under {first[1]!r} "
-                    f"({first[0]}): results of different rubrics (their exercises, groups or points) are not "
-                    "merged. Grade again with the --rubric of the class's run; the [late] table may differ, as "
-                    "--merge applies the one it is given."
-                )
-            if grade.name in here:
-                raise ValueError(
-                    f"submission {one_line(grade.name, 80)!r} is graded twice in {folder} ({here[grade.name]} and "
-                    f"{path}); keep one of the two results."
-                )
-            here[grade.name] = path
+            if data.get("rubric digest") != rubric.digest:
+                refused.append((path, "it was scored under another rubric than its run's record"))
+                continue
             earlier = grades.get(grade.name)
             if earlier is not None:
                 kept = grade.time is None and earlier.time is not None
@@ -474,35 +504,27 @@ def read_results(folders, rubric=None, replaced=None):
                     replaced.append(Replaced(grade.name, files[grade.name], path, kept))
             grades[grade.name], files[grade.name] = grade, path
     if not grades:
+        what = "no result their records vouch for" if refused else "no results (only empty shards)"
         raise ValueError(
-            f"{', '.join(map(str, folders))} hold no results/*.json (only empty shards): give the --out folders of "
-            "earlier `labkit grade` runs."
+            f"{', '.join(map(str, folders))} hold {what}: give the --out folders of earlier `labkit grade` runs."
         )
-    return [grades[name] for name in sorted(grades)]
-
-
-def _empty_run(folder):
-    """Whether `folder` is the output of a `labkit grade` run that had nothing to grade (an empty shard)."""
-    try:
-        record = json.loads((Path(folder) / "run.json").read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError):
-        return False
-    return isinstance(record, dict) and record.get("submissions") == 0 and (Path(folder) / "results").is_dir()
+    return Merged([grades[name] for name in sorted(grades)], replaced or (), refused, rubric)
 
 
 def merge(folders, out_dir, rubric=None, times=None, progress=False):
     """Combine the results of several grading runs (e.g. one per batch job, or a class's run and a regrade)
-    into one output folder, scored with `rubric` (the lab's when None).
+    into one output folder, scored with `rubric` (the folders' recorded rubric when None).
 
     Parameters
     ----------
     folders : list of path-like
         The ``--out`` folders of earlier runs. A submission in several of them counts from the last one
-        (:func:`read_results`).
+        (:func:`read_results`); a result file a folder's record does not vouch for is never merged.
     out_dir : path-like
         The merged output folder (not one of `folders`).
-    rubric : Rubric, optional
-        Scores every result, and its ``[late]`` table applies to the submission times they carry.
+    rubric : Rubric or path-like, optional
+        Scores every result, and its ``[late]`` table applies to the submission times they carry; its
+        exercises, groups and points must be the folders' own.
     times : dict, optional
         {submission name: datetime} (:func:`labkit.grading.late.read_times`): these times replace the
         stored ones of the submissions they name.
@@ -513,32 +535,42 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
     -------
     Merged
         The grades in name order; its ``replaced`` lists the results a later folder replaced, which
-        ``merge.json`` in `out_dir` records as well.
+        ``merge.json`` in `out_dir` records as well, and its ``refused`` the result files not merged.
     """
     from .progress import Progress
 
     out = Path(out_dir)
     if out.resolve() in {Path(folder).resolve() for folder in folders}:
         raise ValueError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
+    if rubric is not None and not isinstance(rubric, rubrics.Rubric):
+        rubric = rubrics.load(rubric)
     replaced = []
     grades = read_results(folders, rubric, replaced)
+    rubric = grades.rubric
+    contents = {}
+    for folder in folders:
+        for name, entry in records.read(folder).submissions.items():
+            contents[name] = entry.get("content")
     for grade in grades:
         if times and grade.name in times:
             grade.time = SubmissionTime(times[grade.name], FROM_CSV)
     out.mkdir(parents=True, exist_ok=True)
+    record = records.new("merge", labkit_version(), sorted({g.seed for g in grades if g.seed is not None}), rubric)
     with Progress(len(grades), "merging", enabled=progress) as bar:
         for grade in grades:
-            write_result(out, grade)
+            grade.rubric = rubric
+            records.note(out, record, grade.name, write_result(out, grade), contents.get(grade.name), save=False)
             bar.advance()
+    records.write(out, record)
     write_csv(out / "grades.csv", grades)
-    seeds = sorted({g.seed for g in grades if g.seed is not None})
-    (out / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")
-    record = {
+    (out / "seed.txt").write_text("".join(f"{s}\n" for s in record.seed), encoding="utf-8")
+    merged = {
         "folders": [str(folder) for folder in folders],
         "replaced": [
             {"submission": r.name, "earlier": str(r.earlier), "later": str(r.later), "time kept": r.time_kept}
             for r in replaced
         ],
+        "not merged": [{"file": str(path), "why": why} for path, why in grades.refused],
     }
-    (out / "merge.json").write_text(json.dumps(record, indent=1), encoding="utf-8")
-    return Merged(grades, replaced)
+    (out / "merge.json").write_text(json.dumps(merged, indent=1), encoding="utf-8")
+    return Merged(list(grades), replaced, grades.refused, rubric)

@@ -18,7 +18,7 @@ import functools
 import hashlib
 import json
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..exercises.registry import LAB, Registry
@@ -65,6 +65,8 @@ class Rubric:
     source: str = field(default="the lab's rubric", compare=False)
     registry: Registry = field(default=LAB, compare=False, repr=False)  # the exercises it grades
     late: lateness.Late = None  # the deadline and what lateness costs, when the rubric has a [late] table
+    data: dict = field(default=None, compare=False, repr=False)  # the parsed TOML it was read from, as JSON data
+    text: str = field(default=None, compare=False, repr=False)  # the TOML text itself, when read from a file
 
     @property
     def graded(self):
@@ -103,6 +105,20 @@ class Rubric:
             "extra_credit": list(self.extra_credit),
         }
         return hashlib.sha256(json.dumps(described, sort_keys=True).encode("utf-8")).hexdigest()[:16]
+
+    def differences(self, other):
+        """What makes `other` grade differently from this rubric: a list of short phrases, empty when the two
+        grade alike (the same :attr:`digest` and the same ``[late]`` rule, extensions included)."""
+        found = []
+        if self.digest != other.digest:
+            found.append("its exercises, groups or points")
+        if self.late != other.late:
+            found.append("its [late] table" if self.late is not None and other.late is not None else "a [late] table")
+        return found
+
+    def same_as(self, other):
+        """Whether `other` grades exactly as this rubric does (:meth:`differences` finds nothing)."""
+        return not self.differences(other)
 
     def score(self, fractions):
         """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1)."""
@@ -237,7 +253,20 @@ def from_dict(data, source="the rubric"):
         raise ValueError(f"{source}: grades nothing: list exercises in required, extra_credit or branches.")
     points = {number: points[number] for number in sorted(points)}
     late = lateness.from_dict(data["late"], source) if "late" in data else None
-    return Rubric(title, points, required, branches, branch_extra, extra_credit, source, registry, late)
+    return Rubric(
+        title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain(data)
+    )
+
+
+def plain(value):
+    """Parsed TOML as JSON data: its date-times as ISO 8601 text (the [late] table reads both)."""
+    if isinstance(value, dict):
+        return {str(key): plain(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [plain(item) for item in value]
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
+    return value
 
 
 def _branches(table, source, registry):
@@ -286,4 +315,4 @@ def load(path=None):
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{source} is not valid TOML: {exc}") from None
-    return from_dict(data, source)
+    return replace(from_dict(data, source), text=text)

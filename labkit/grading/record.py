@@ -1,0 +1,300 @@
+"""A grading run's record: what was graded, under which rubric and seed, by which labkit, and each result's hash.
+
+Every output folder that labkit writes (``labkit grade --out OUT``, a merge,
+:func:`labkit.grading.report.write_report`) holds ``record.json``, written by
+the grader alone and replaced whole each time it changes:
+
+* ``labkit``: the version that graded;
+* ``kind``: ``"grade"`` (a grading run, resumable) or ``"merge"``;
+* ``seed``: the run's seed (a list of seeds for a merge);
+* ``rubric``: the rubric in force, in full (its TOML as JSON data, the
+  ``[late]`` table and its extensions included), also copied to
+  ``rubric.toml`` beside it for a person to read;
+* ``submissions``: for each submission graded, its result file's name and
+  SHA-256, and the digest of its notebooks' content (:func:`content_digest`).
+
+Every later command reads the folder through this record
+(:func:`read_results`): ``labkit report``, ``labkit export``, a resumed
+``labkit grade`` and ``--merge`` take the recorded rubric when none is given,
+refuse one that grades differently, and take a result file only when the
+record names it with that hash. So a result file that the run did not write
+(a submission's code writing into an output folder, where the sandbox is
+switched off) is never read as a grade, and nothing a submission can write
+(a name, a time, a file) changes what the run's record says it graded.
+"""
+
+import hashlib
+import json
+import os
+import stat
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import rubric as rubrics
+
+RECORD = "record.json"
+RUBRIC_COPY = "rubric.toml"
+FORMAT = "labkit-run/1"
+MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file, as the grader accepts it
+MAX_RECORD = 256 * 1024**2  # bytes of a record (a few hundred bytes per submission)
+MAX_HASHED = 1024**3  # bytes of a submission's notebooks hashed; beyond that only their sizes count
+KINDS = ("grade", "merge")
+
+
+@dataclass
+class RunRecord:
+    """The record of one output folder (see the module's description).
+
+    Attributes
+    ----------
+    kind : str
+        ``"grade"`` or ``"merge"``.
+    labkit : str
+        The labkit version that wrote it.
+    seed : int or list of int or None
+        The run's seed; a merge's seeds.
+    rubric : dict
+        The rubric's data (:attr:`labkit.grading.rubric.Rubric.data`).
+    rubric_text : str or None
+        The rubric's TOML text, when it was read from a file.
+    submissions : dict
+        Submission name -> ``{"result": file name, "sha256": the file's hash, "content": the notebooks'
+        digest or None}``.
+    """
+
+    kind: str
+    labkit: str
+    seed: object
+    rubric: dict
+    rubric_text: str = None
+    submissions: dict = field(default_factory=dict)
+
+    def as_dict(self):
+        return {
+            "format": FORMAT,
+            "kind": self.kind,
+            "labkit": self.labkit,
+            "seed": self.seed,
+            "rubric": self.rubric,
+            "rubric text": self.rubric_text,
+            "submissions": self.submissions,
+        }
+
+    def rubric_object(self, folder):
+        """The recorded rubric, read again (its source named after `folder`)."""
+        source = f"the rubric recorded in {Path(folder) / RECORD}"
+        found = rubrics.from_dict(self.rubric, source)
+        return found if self.rubric_text is None else rubrics.replace(found, text=self.rubric_text)
+
+
+def new(kind, labkit, seed, rubric):
+    """A record of `kind` for a run under `rubric` (a Rubric that knows its data), with no submission yet."""
+    if rubric.data is None:
+        raise ValueError(
+            "the rubric was made in code, not read from TOML, so a run cannot record it: read it with "
+            "labkit.grading.rubric.load (or from_dict)."
+        )
+    return RunRecord(kind, labkit, seed, rubric.data, rubric.text)
+
+
+def write(folder, record):
+    """Write `record` into `folder` (``record.json``, replaced whole; ``rubric.toml`` beside it)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    _replace(folder / RECORD, json.dumps(record.as_dict(), indent=1))
+    if record.rubric_text is not None:
+        _replace(folder / RUBRIC_COPY, record.rubric_text)
+
+
+def _replace(path, text):
+    partial = path.with_name(f".{path.name}.partial")
+    partial.write_text(text, encoding="utf-8")
+    os.replace(partial, path)
+
+
+def note(folder, record, name, result_path, content=None, save=True):
+    """Enter submission `name`'s result file (as written, hashed now) into `record`, and write the record
+    (unless `save` is False: the caller writes it when done)."""
+    path = Path(result_path)
+    record.submissions[name] = {
+        "result": path.name,
+        "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "content": content,
+    }
+    if save:
+        write(folder, record)
+
+
+def read_small(path, limit):
+    """The bytes of the regular file `path` (never a link, never more than `limit`); ValueError says why not."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
+    except FileNotFoundError:
+        raise
+    except OSError as exc:
+        raise ValueError(f"{path} cannot be read ({exc.strerror or exc}); a run writes plain files.") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise ValueError(f"{path} is not a regular file; a run writes plain files.")
+        if info.st_size > limit:
+            raise ValueError(f"{path} is larger than the {limit:,} bytes labkit accepts; it was not written by it.")
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > limit:
+            raise ValueError(f"{path} is larger than the {limit:,} bytes labkit accepts; it was not written by it.")
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+NO_RECORD = (
+    "{folder} has no run record ({record}): it was not written by `labkit grade` of this version (an older "
+    "labkit wrote none). Grade the class again into a new --out."
+)
+
+
+def read(folder):
+    """The record of output folder `folder`; ValueError when it has none or it is not one."""
+    folder = Path(folder)
+    path = folder / RECORD
+    try:
+        raw = read_small(path, MAX_RECORD)
+    except FileNotFoundError:
+        raise ValueError(NO_RECORD.format(folder=folder, record=RECORD)) from None
+    try:
+        data = json.loads(raw.decode("utf-8"))
+        if not isinstance(data, dict) or data.get("format") != FORMAT:
+            raise ValueError(f"its format is not {FORMAT}")
+        if data.get("kind") not in KINDS:
+            raise ValueError(f"its kind is not one of {', '.join(KINDS)}")
+        submissions = data.get("submissions")
+        if not isinstance(submissions, dict) or not isinstance(data.get("rubric"), dict):
+            raise ValueError("it has no submissions or no rubric")
+        for name, entry in submissions.items():
+            if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("result", "sha256")):
+                raise ValueError(f"its entry for {str(name)[:80]!r} has no result file and hash")
+            if Path(entry["result"]).name != entry["result"] or not entry["result"].endswith(".json"):
+                raise ValueError(f"its entry for {str(name)[:80]!r} names a result outside results/")
+        text = data.get("rubric text")
+        if text is not None and not isinstance(text, str):
+            raise ValueError("its rubric text is not text")
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(
+            f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
+        ) from None
+    return RunRecord(data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions)
+
+
+def results(folder, record):
+    """The result files of `folder` that its `record` vouches for, read: ({name: (path, data)}, refused).
+
+    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of
+    ``results/`` that is not read: one the record does not name (a run never graded that submission there),
+    one whose content is not what the run wrote (its hash differs), one that is not a plain file. A
+    submission the record names whose file is missing is refused too. ValueError when a vouched-for file is not JSON."""
+    folder = Path(folder)
+    by_file = {entry["result"]: name for name, entry in record.submissions.items()}
+    found, refused = {}, []
+    present = sorted(os.listdir(folder / "results")) if (folder / "results").is_dir() else []
+    for file_name in present:
+        if not file_name.endswith(".json") or file_name.startswith("."):
+            continue
+        path = folder / "results" / file_name
+        name = by_file.get(file_name)
+        if name is None:
+            refused.append((path, "the run's record names no such result (that run never graded it)"))
+            continue
+        try:
+            raw = read_small(path, MAX_RESULT)
+        except (OSError, ValueError) as exc:
+            refused.append((path, str(exc)))
+            continue
+        if hashlib.sha256(raw).hexdigest() != record.submissions[name]["sha256"]:
+            refused.append((path, "changed since the run wrote it (its hash is not the record's)"))
+            continue
+        try:
+            data = json.loads(raw.decode("utf-8"))
+        except (UnicodeDecodeError, ValueError) as exc:
+            raise ValueError(f"{path} is not JSON ({exc}).") from None
+        if not isinstance(data, dict) or data.get("name") != name:
+            refused.append((path, f"it is not the result of the submission the record names ({name[:80]!r})"))
+            continue
+        found[name] = (path, data)
+    for name, entry in record.submissions.items():
+        if name not in found and entry["result"] not in present:
+            refused.append((folder / "results" / entry["result"], f"missing (the result of {name[:80]!r})"))
+    return found, refused
+
+
+def content_digest(notebooks, base=None):
+    """A digest of a submission's notebooks: their paths (relative to `base`) and bytes, in path order.
+
+    The same notebooks give the same digest wherever they lie, so a resumed run knows which submissions
+    changed. At most :data:`MAX_HASHED` bytes are read; beyond that a notebook counts by its size.
+
+    >>> import pathlib, tempfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "a.ipynb").write_text("{}")
+    >>> first = content_digest([folder / "a.ipynb"], folder)
+    >>> _ = (folder / "a.ipynb").write_text("{ }")
+    >>> first == content_digest([folder / "a.ipynb"], folder)
+    False
+    """
+    digest, budget = hashlib.sha256(), MAX_HASHED
+    for path in sorted(Path(p) for p in notebooks):
+        relative = path.relative_to(base) if base is not None and path.is_relative_to(base) else Path(path.name)
+        digest.update(b"\0file\0" + relative.as_posix().encode("utf-8", "surrogateescape") + b"\0")
+        try:
+            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
+        except OSError as exc:
+            digest.update(f"unreadable {exc.errno}".encode())
+            continue
+        try:
+            digest.update(str(os.fstat(fd).st_size).encode() + b"\0")
+            while budget > 0:
+                chunk = os.read(fd, min(1 << 20, budget))
+                if not chunk:
+                    break
+                digest.update(chunk)
+                budget -= len(chunk)
+        finally:
+            os.close(fd)
+    return digest.hexdigest()
+
+
+def rubric_for(folders, given, command):
+    """The rubric `command` scores the output `folders` with: their recorded one, which all must share.
+
+    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded
+    one; one that grades otherwise (:meth:`~labkit.grading.rubric.Rubric.differences`) is refused with a
+    ValueError saying how to score under it, since `command` shows what the run graded."""
+    records = [(Path(folder), read(folder)) for folder in folders]
+    first_folder, first = records[0]
+    recorded = first.rubric_object(first_folder)
+    for folder, record in records[1:]:
+        other = record.rubric_object(folder)
+        if not recorded.same_as(other):
+            raise ValueError(
+                f"{folder} was graded under another rubric than {first_folder} "
+                f"({' and '.join(recorded.differences(other))} differ): {command} shows one run's grades; "
+                "merge them under one rubric first (labkit grade --merge ... --rubric FILE --out NEW)."
+            )
+    if given is None:
+        return recorded
+    chosen = given if isinstance(given, rubrics.Rubric) else rubrics.load(given)
+    differ = recorded.differences(chosen)
+    if differ:
+        raise ValueError(
+            f"{first_folder} was graded under the rubric recorded in {first_folder / RECORD} "
+            f"({recorded.title!r}), and {chosen.source} differs from it in {' and '.join(differ)}; {command} shows "
+            f"grades.csv as graded, so leave --rubric out. To score the class under {chosen.source}: "
+            f"`labkit grade --merge {first_folder} --rubric {chosen.source} --out NEW` when only the [late] table "
+            f"differs, else grade again with it into a new --out."
+        )
+    return recorded
