@@ -245,17 +245,19 @@ def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackL
 
 def _unpack_top(zip_path, into, limits, nested, depth=0):
     into = Path(into)
-    created_root = not os.path.lexists(into)
+    created_root = None if os.path.lexists(into) else into
+    while created_root is not None and not os.path.lexists(created_root.parent):
+        created_root = created_root.parent  # the first folder this call creates, removed again on failure
     written: list[Path] = []
     made: list[Path] = []
     try:
-        if created_root:
+        if created_root is not None:
             into.mkdir(parents=True)
         elif not stat.S_ISDIR(os.lstat(into).st_mode):
             raise ValueError(f"{into} is not a folder to unpack into.")
         _unpack(Path(zip_path), into, _Budget(limits), depth, written, made, _text(Path(zip_path).name), nested)
     except BaseException:
-        _undo(into if created_root else None, written, made)
+        _undo(created_root, written, made)
         raise
     return sorted(p for p in written if os.path.lexists(p))
 
@@ -723,7 +725,7 @@ def _detect(root):
     moodle_files = [e for e in files if MOODLE_FILE.match(_text(e.name))]
     canvas_files = [e for e in files if not MOODLE_FILE.match(_text(e.name)) and _canvas_match(_text(e.name))]
     other_dirs = [e for e in dirs if not MOODLE_FOLDER.match(_text(e.name))]
-    notebooks = [e for e in files if e.name.endswith(".ipynb") and not _canvas_match(_text(e.name))]
+    notebooks = [e for e in files if e.name.endswith(".ipynb") and e not in canvas_files and e not in moodle_files]
     kinds = {
         "moodle": bool(moodle_dirs or moodle_files),
         "canvas": bool(canvas_files),
