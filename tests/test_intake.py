@@ -549,7 +549,7 @@ def test_damaged_and_duplicate(tmp_path):
 NAME_PARTS = st.sampled_from(["a", "b.ipynb", "..", ".", "", "C:", "\\", "~", "__MACOSX", "é", "/"])
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(names=st.lists(st.lists(NAME_PARTS, min_size=1, max_size=5).map("/".join), min_size=1, max_size=4))
 def test_any_member_names_stay_inside(tmp_path, names):
     root = Path(tempfile.mkdtemp(dir=tmp_path))
