@@ -41,28 +41,32 @@ from that folder.
 What the LMSs write, as this module relies on it
 -------------------------------------------------
 
-Canvas. The names in its download zip are built by Canvas's submissions
-zipper (``ContentZipper`` in instructure/canvas-lms; its quiz counterpart,
-``lib/quiz_submission_zipper.rb``, builds them the same way): the student's
-sortable name ("Lovelace, Ada"), lower-cased with everything but letters,
-digits and ``_`` dropped (``lovelaceada``); ``LATE`` after it when Canvas
-counts the submission late; the Canvas user id; the id of the file (often
-called the submission id); and the file's display name. Examples of such
-names in the wild: the README of mikewesthad/canvas-unzipper
-(``smithbob_340934_208490284_BobsWork.zip``) and instructure/canvas-lms issue
+Canvas. The names in its download zip: the student's sortable name
+("Lovelace, Ada"), lower-cased with everything but letters, digits and ``_``
+dropped (``lovelaceada``); ``LATE`` after it when Canvas counts the
+submission late; the Canvas user id; the id of the file (often called the
+submission id); and the file's display name. Sources: the naming code of
+Canvas's quiz-submissions zipper in instructure/canvas-lms
+(``question_attachment_filename``: last name first, spaces to ``_``, other
+non-word characters dropped, lower case, then ids and the display name; the
+assignment zipper itself was not in the sources read), and names of real
+downloads quoted in the README of mikewesthad/canvas-unzipper
+(``smithbob_340934_208490284_BobsWork.zip``) and in instructure/canvas-lms issue
 #2406 (``studenttest_3143_207797_zipsubmission.zip``). When a student uploads
 a file whose name they already used in the assignment, Canvas renames the new
 file ``name-1.ext``, then ``name-2.ext`` (students' reports of it:
 nus-cs2103-AY2223S2/forum #361 and nus-cs2103-AY2324S1/forum #459, IIC1253
-issues #26 and #34), so a number before the extension marks a re-upload: of
-the files one student has under one original name, the highest number is the
-newest and the only one kept, under the original name (the notes say so).
-The download holds the latest submission's files only, so a lone
-``02_convergence-1.ipynb`` is restored as ``02_convergence.ipynb`` too. A
-group assignment names the files after the group in place of the student (read
-the same way: the group is the "student"); an anonymously graded one after
-``anon`` and an anonymous id that is not a number (``anon_Ab3dE_98765_…``): the
-student is then ``anon_Ab3dE`` and the LMS id ``Ab3dE``.
+issues #26 and #34), so a number of one or two digits before the extension
+marks a re-upload: of the files one student has under one original name, the
+highest number is the newest and the only one kept, under the original name
+(the notes say so). The download holds the latest submission's files, so a
+lone ``02_convergence-1.ipynb`` is named back ``02_convergence.ipynb`` too. A
+group assignment names the files after the group in place of the student,
+which reads the same way (the group is the "student"). For anonymous grading
+this module assumes, without a source that shows it, ``anon`` (or
+``anonymous``) and an anonymous id that need not be a number
+(``anon_Ab3dE_98765_…``): the student is then ``anon_Ab3dE`` and the LMS id
+``Ab3dE``; anything else not in the pattern is a note, never a student.
 
 Moodle. ``mod/assign``'s download (``locallib.php``, ``download_submissions``,
 and the ``downloader`` class of recent versions) prefixes each file with the
