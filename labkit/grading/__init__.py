@@ -13,6 +13,7 @@ One module per concern:
 * :mod:`~labkit.grading.remote` - the grader's handle on a sandbox and its proxies;
 * :mod:`~labkit.grading.refusals` - what a graded function may not reach, as the watch recognises it;
 * :mod:`~labkit.grading.scan` - reading a notebook's source for refused references;
+* :mod:`~labkit.grading.intake` - the class as the LMS gives it (folders, nbgrader, Canvas, Moodle, a zip) as students;
 * :mod:`~labkit.grading.scoring` - grading one notebook and one submission (one process per submission);
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
 * :mod:`~labkit.grading.late` - the rubric's deadline, submission times, the late penalty;
@@ -56,6 +57,7 @@ _MODULES = {
     "distributed",
     "forkserver",
     "guard",
+    "intake",
     "late",
     "launcher",
     "lms",

@@ -1,0 +1,882 @@
+"""The class as the LMS hands it over: one folder or one zip becomes a list of students.
+
+Nothing is graded here, and nothing is written anywhere but the grader's
+`workspace`: a zip (the class's, or a student's) is unpacked there by
+:func:`unpack`, which refuses what a hostile zip does (leaving the folder,
+links, devices, bombs); a Canvas or Moodle download's loose files are
+grouped into one folder per student there. The class folder is only read,
+and no link is ever followed while reading it.
+
+The layouts recognised (:func:`find_class` tells them apart by their names):
+
+``folders``
+    ``CLASS/<student>/…/*.ipynb``: a folder per student, its notebooks at any
+    depth (within :data:`MAX_DEPTH`); a notebook at the top of ``CLASS`` is a
+    student of its own, named after the file (``alice.ipynb`` is ``alice``),
+    as ``labkit grade`` names it. A zip in a student's folder is unpacked.
+``nbgrader``
+    ``COURSE/submitted/<student>/<assignment>/*.ipynb`` (or ``submitted/``
+    itself): the student's id is the name, and the path is the assignment's
+    folder, so nbgrader's ``timestamp.txt`` stays where :mod:`~labkit.grading.late`
+    looks for it. With several assignments, ``assignment=`` picks one.
+``canvas``
+    Canvas's "Download Submissions": a flat folder of files named
+    ``{name}_{userid}_{fileid}_{original name}``, late ones
+    ``{name}_LATE_{userid}_{fileid}_{original name}``. The files are grouped per
+    student (name and user id) into a folder each, under their original
+    names; the student's name is ``{name}``, the LMS id ``{userid}``.
+``moodle``
+    Moodle's "Download all submissions": folders
+    ``{Full Name}_{participant id}_assignsubmission_{plugin}_`` (``file``,
+    ``onlinetext``), or, with "Download submissions in folders" off, flat files
+    ``{Full Name}_{participant id}_assignsubmission_{plugin}_{original name}``.
+    The name is ``{Full Name}_{participant id}``, so two students of one name
+    stay apart; the LMS id is the participant id.
+
+A zip given as the class (as Canvas and Moodle hand out their downloads) is
+unpacked into the workspace and read as one of these; a zip whose top holds
+just one folder without notebooks of its own (a folder zipped whole) is read
+from that folder.
+
+What the LMSs write, as this module relies on it
+-------------------------------------------------
+
+Canvas. The names in its download zip: the student's sortable name
+("Lovelace, Ada"), lower-cased with everything but letters, digits and ``_``
+dropped (``lovelaceada``); ``LATE`` after it when Canvas counts the
+submission late; the Canvas user id; the id of the file (often called the
+submission id); and the file's display name. Sources: the naming code of
+Canvas's quiz-submissions zipper in instructure/canvas-lms
+(``question_attachment_filename``: last name first, spaces to ``_``, other
+non-word characters dropped, lower case, then ids and the display name; the
+assignment zipper itself was not in the sources read), and names of real
+downloads quoted in the README of mikewesthad/canvas-unzipper
+(``smithbob_340934_208490284_BobsWork.zip``) and in instructure/canvas-lms issue
+#2406 (``studenttest_3143_207797_zipsubmission.zip``). When a student uploads
+a file whose name they already used in the assignment, Canvas renames the new
+file ``name-1.ext``, then ``name-2.ext`` (students' reports of it:
+nus-cs2103-AY2223S2/forum #361 and nus-cs2103-AY2324S1/forum #459, IIC1253
+issues #26 and #34), so a number of one or two digits before the extension
+marks a re-upload: of the files one student has under one original name, the
+highest number is the newest and the only one kept, under the original name
+(the notes say so). The download holds the latest submission's files, so a
+lone ``02_convergence-1.ipynb`` is named back ``02_convergence.ipynb`` too. A
+group assignment names the files after the group in place of the student,
+which reads the same way (the group is the "student"). For anonymous grading
+this module assumes, without a source that shows it, ``anon`` (or
+``anonymous``) and an anonymous id that need not be a number
+(``anon_Ab3dE_98765_…``): the student is then ``anon_Ab3dE`` and the LMS id
+``Ab3dE``; anything else not in the pattern is a note, never a student.
+
+Moodle. ``mod/assign``'s download (``locallib.php``, ``download_submissions``,
+and the ``downloader`` class of recent versions) prefixes each file with the
+student's full name in which every ``_`` became a space, then ``_`` and the
+student's participant id (``get_uniqueid_for_user``: the id blind marking
+shows, not the user's id), passed through ``clean_filename``. With folders (the
+default since Moodle 3.1) each submission plugin of the student gets a folder
+``{prefix}_assignsubmission_{plugin}_``, holding the files as uploaded; without,
+each file is ``{prefix}_assignsubmission_{plugin}_{file name}``. Blind marking
+writes "Participant" for the name; team submissions the group's name. Because
+the full name holds no ``_``, the first ``_<digits>_assignsubmission_`` ends it.
+
+The student's name is data: it is never used as a path; what is created for a
+student on disk is named with :func:`~labkit.grading.report.safe_name`.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import re
+import shutil
+import stat
+import tempfile
+import zipfile
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .report import one_line, safe_name
+
+MAX_FILES = 5_000  # entries looked at in one folder walk (as scoring's walk of a submission)
+MAX_DEPTH = 8  # folder levels looked into
+RATIO_FLOOR = 1 << 20  # the compression ratio is checked for members that grow past this many bytes
+CHUNK = 1 << 16
+IGNORED = {"__MACOSX", ".ipynb_checkpoints", "__pycache__", "Thumbs.db", "desktop.ini"}
+SHOWN = 4  # file names listed in a "holds no notebook" failure
+
+CANVAS = re.compile(r"^(?P<login>.+?)(?P<late>_LATE)?_(?P<uid>\d+)_(?P<fid>\d+)_(?P<file>.+)$", re.DOTALL)
+CANVAS_ANON = re.compile(
+    r"^(?P<login>anon(?:ymous)?)(?P<late>_LATE)?_(?P<uid>[A-Za-z0-9]+)_(?P<fid>\d+)_(?P<file>.+)$", re.DOTALL
+)
+REUPLOAD = re.compile(r"^(?P<stem>.+)-(?P<number>[1-9][0-9]?)(?P<ext>\.[^.]+)?$", re.DOTALL)
+MOODLE_FOLDER = re.compile(r"^(?P<name>.+?)_(?P<pid>\d+)_assignsubmission_(?P<plugin>[a-z0-9]+)_$", re.DOTALL)
+MOODLE_FILE = re.compile(r"^(?P<name>.+?)_(?P<pid>\d+)_assignsubmission_(?P<plugin>[a-z0-9]+)_(?P<file>.+)$", re.DOTALL)
+LAYOUTS = "a folder per student, nbgrader's submitted/, Canvas's or Moodle's download (a folder or its zip)"
+
+
+@dataclass(frozen=True)
+class UnpackLimits:
+    """What :func:`unpack` extracts at most from one zip, the zips inside it included.
+
+    Attributes
+    ----------
+    max_total : int
+        Bytes written in all (512 MiB).
+    max_members : int
+        Members, directories included (2000).
+    max_ratio : float
+        Uncompressed over compressed size of one member, for members that grow past 1 MiB (100).
+    max_member : int
+        Bytes of one member (64 MiB).
+    max_depth : int
+        Levels of zips inside the zip unpacked (2: a zip in a zip in the zip).
+
+    Examples
+    --------
+    >>> UnpackLimits().max_members, UnpackLimits(max_depth=0).max_depth
+    (2000, 0)
+    """
+
+    max_total: int = 512 << 20
+    max_members: int = 2000
+    max_ratio: float = 100.0
+    max_member: int = 64 << 20
+    max_depth: int = 2
+
+    def __post_init__(self):
+        for name in ("max_total", "max_members", "max_member", "max_ratio"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"UnpackLimits.{name} must be positive, not {getattr(self, name)!r}.")
+        if self.max_depth < 0:
+            raise ValueError(f"UnpackLimits.max_depth must be 0 or more, not {self.max_depth!r}.")
+
+
+@dataclass(frozen=True)
+class Student:
+    """One student of the class, as the LMS's layout gives them.
+
+    Attributes
+    ----------
+    name : str
+        The submission's name (what grades.csv, the feedback files and the roster use).
+    path : Path or None
+        A folder or one .ipynb to grade (possibly in the workspace); None when nothing can be graded.
+    failure : str or None
+        Why it cannot be graded; None when it can.
+    layout : str
+        The layout it was found in: ``"folders"``, ``"nbgrader"``, ``"canvas"`` or ``"moodle"``.
+    lms_id : str or None
+        The LMS's own id when the layout carries one (Canvas's user id, Moodle's participant id).
+    marked_late : bool
+        The LMS marked it late in the download (Canvas's ``LATE``).
+    """
+
+    name: str
+    path: Path | None
+    failure: str | None
+    layout: str
+    lms_id: str | None = None
+    marked_late: bool = False
+
+
+@dataclass
+class Intake:
+    """The students found in what the LMS gave, in name order, and what to tell the instructor.
+
+    Attributes
+    ----------
+    students : list of Student
+    layout : str
+        The layout recognised (see the module's documentation).
+    notes : list of str
+        Printable lines: files ignored, re-uploads, zips unpacked.
+    """
+
+    students: list[Student]
+    layout: str
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def gradable(self) -> list[Student]:
+        """The students with something to grade."""
+        return [s for s in self.students if s.path is not None]
+
+
+# ---------------------------------------------------------------------------------------------- zips
+
+
+class _Budget:
+    """What one :func:`unpack` call has spent, its nested zips included."""
+
+    def __init__(self, limits):
+        self.limits = limits
+        self.members = 0
+        self.total = 0
+
+
+def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = UnpackLimits()) -> list[Path]:
+    """Extract `zip_path` into the folder `into`, refusing whatever could harm, and return the files written.
+
+    A member is never extracted when its name is absolute, has a drive letter
+    or a ``..``, or when it is a link or a device; the members, the bytes of
+    each and of all, and each member's compression ratio are bounded by
+    `limits`, counted on the bytes actually decompressed (the sizes a zip
+    declares are checked first, and never trusted). A zip inside is unpacked
+    in its place (``work.zip`` into a folder ``work``), to ``limits.max_depth``
+    levels, on the same budget. ``__MACOSX/`` is skipped. Any refusal raises
+    ``ValueError`` naming the zip and the rule, after removing what this call
+    wrote; nothing is ever written outside `into`, and no existing file is
+    overwritten.
+
+    Examples
+    --------
+    >>> import io, pathlib, tempfile, zipfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> with zipfile.ZipFile(folder / "work.zip", "w") as z:
+    ...     z.writestr("lab/02_convergence.ipynb", "{}")
+    >>> [p.relative_to(folder).as_posix() for p in unpack(folder / "work.zip", folder / "out")]
+    ['out/lab/02_convergence.ipynb']
+    >>> with zipfile.ZipFile(folder / "evil.zip", "w") as z:
+    ...     z.writestr("../evil.ipynb", "{}")
+    >>> unpack(folder / "evil.zip", folder / "out2")
+    Traceback (most recent call last):
+    ...
+    ValueError: evil.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
+    """
+    return _unpack_top(zip_path, into, limits, True)
+
+
+def _unpack_top(zip_path, into, limits, nested, depth=0):
+    into = Path(into)
+    created_root = None if os.path.lexists(into) else into
+    while created_root is not None and not os.path.lexists(created_root.parent):
+        created_root = created_root.parent  # the first folder this call creates, removed again on failure
+    written: list[Path] = []
+    made: list[Path] = []
+    try:
+        if created_root is not None:
+            into.mkdir(parents=True)
+        elif not stat.S_ISDIR(os.lstat(into).st_mode):
+            raise ValueError(f"{into} is not a folder to unpack into.")
+        _unpack(Path(zip_path), into, _Budget(limits), depth, written, made, _text(Path(zip_path).name), nested)
+    except BaseException:
+        _undo(created_root, written, made)
+        raise
+    return sorted(p for p in written if os.path.lexists(p))
+
+
+def _undo(root, written, made):
+    if root is not None:
+        shutil.rmtree(root, ignore_errors=True)
+        return
+    for path in reversed(written):
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    for path in reversed(made):
+        try:
+            os.rmdir(path)
+        except OSError:
+            pass
+
+
+def _member_parts(name, label):
+    """The parts of a member's name, or ValueError when it would leave the folder."""
+    shown = one_line(name, 120)
+    text = name.replace("\\", "/")
+    if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
+        raise ValueError(f"{label}: member {shown!r} has an absolute path; labkit never extracts it.")
+    parts = [p for p in text.split("/") if p not in ("", ".")]
+    if ".." in parts:
+        raise ValueError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
+    return parts
+
+
+def _unpack(zip_path, into, budget, depth, written, made, label, nested=True):
+    limits = budget.limits
+    if depth > limits.max_depth:
+        raise ValueError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
+    try:
+        archive = zipfile.ZipFile(zip_path)
+    except (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError) as exc:
+        raise ValueError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
+    with archive:
+        infos = archive.infolist()
+        budget.members += len(infos)
+        if budget.members > limits.max_members:
+            raise ValueError(
+                f"{label}: more than {limits.max_members} members; labkit extracts at most {limits.max_members}."
+            )
+        plan, seen, declared = [], set(), 0
+        for info in infos:
+            shown = one_line(info.filename, 120)
+            parts = _member_parts(info.filename, label)
+            mode = info.external_attr >> 16
+            kind = stat.S_IFMT(mode)
+            if stat.S_ISLNK(mode):
+                raise ValueError(f"{label}: member {shown!r} is a symbolic link; labkit never extracts links.")
+            if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
+                raise ValueError(f"{label}: member {shown!r} is a device or a pipe; labkit never extracts those.")
+            if info.flag_bits & 0x1:
+                raise ValueError(f"{label}: member {shown!r} is encrypted; labkit cannot read it.")
+            if not parts or parts[0] == "__MACOSX":
+                continue
+            key = "/".join(parts)
+            if key in seen:
+                raise ValueError(f"{label}: member {shown!r} appears twice; labkit extracts each name once.")
+            seen.add(key)
+            is_dir = info.is_dir() or kind == stat.S_IFDIR
+            if not is_dir:
+                if info.file_size > limits.max_member:
+                    raise ValueError(
+                        f"{label}: member {shown!r} is larger than {_size(limits.max_member)} "
+                        f"({_size(info.file_size)}); labkit extracts at most {_size(limits.max_member)} a file."
+                    )
+                _check_ratio(label, shown, info.file_size, info.compress_size, limits)
+                declared += info.file_size
+                if budget.total + declared > limits.max_total:
+                    raise ValueError(
+                        f"{label}: more than {_size(limits.max_total)} uncompressed; "
+                        f"labkit extracts at most {_size(limits.max_total)}."
+                    )
+            plan.append((info, parts, is_dir, shown))
+        inner = []
+        for info, parts, is_dir, shown in plan:
+            target = into.joinpath(*parts)
+            _make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
+            if is_dir:
+                continue
+            _extract(archive, info, target, budget, label, shown, written)
+            if nested and target.suffix.lower() == ".zip":
+                inner.append((target, shown))
+    for target, shown in inner:
+        if depth + 1 > limits.max_depth:
+            raise ValueError(
+                f"{label}: member {shown!r} is a zip nested more than {limits.max_depth} deep; "
+                "labkit never extracts deeper."
+            )
+        folder = _free(target.with_suffix(""))
+        folder.mkdir()
+        made.append(folder)
+        _unpack(target, folder, budget, depth + 1, written, made, f"{label}/{shown}")
+        os.unlink(target)
+        written.remove(target)
+
+
+def _check_ratio(label, shown, size, compressed, limits):
+    if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
+        raise ValueError(
+            f"{label}: member {shown!r} is compressed more than {limits.max_ratio:g} times (a zip bomb?); "
+            f"labkit never extracts it."
+        )
+
+
+def _make_dirs(into, parts, made, label, shown):
+    folder = into
+    for part in parts:
+        folder = folder / part
+        try:
+            os.mkdir(folder)
+            made.append(folder)
+        except FileExistsError:
+            if not stat.S_ISDIR(os.lstat(folder).st_mode):
+                raise ValueError(f"{label}: member {shown!r} is inside a file of the zip; labkit refuses it.") from None
+        except OSError as exc:
+            raise ValueError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+
+
+def _extract(archive, info, target, budget, label, shown, written):
+    limits = budget.limits
+    try:
+        descriptor = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o600)
+    except OSError as exc:
+        raise ValueError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+    written.append(target)
+    size = 0
+    # Read as if the member were larger than any limit, so that the bytes it really holds are counted
+    # (zipfile would stop at the size it declares); the declared size is then checked against them.
+    probe = copy.copy(info)
+    probe.file_size = max(info.file_size, limits.max_member, limits.max_total) + 1
+    try:
+        with os.fdopen(descriptor, "wb") as out, archive.open(probe) as source:
+            while chunk := source.read(CHUNK):
+                size += len(chunk)
+                if size > limits.max_member:
+                    raise ValueError(
+                        f"{label}: member {shown!r} grows past {_size(limits.max_member)} while extracting; "
+                        f"labkit extracts at most {_size(limits.max_member)} a file."
+                    )
+                if budget.total + size > limits.max_total:
+                    raise ValueError(
+                        f"{label}: more than {_size(limits.max_total)} uncompressed while extracting; "
+                        f"labkit extracts at most {_size(limits.max_total)}."
+                    )
+                _check_ratio(label, shown, size, info.compress_size, limits)
+                out.write(chunk)
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
+        raise ValueError(f"{label}: member {shown!r} cannot be read ({one_line(exc, 120)}).") from None
+    if size != info.file_size:
+        raise ValueError(
+            f"{label}: member {shown!r} declares {info.file_size} bytes but holds {size}; labkit refuses the zip."
+        )
+    budget.total += size
+
+
+def _free(path):
+    """`path`, or the first of ``path~1``, ``path~2``… that does not exist."""
+    candidate, number = path, 0
+    while os.path.lexists(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.name}~{number}")
+    return candidate
+
+
+def _size(n):
+    for unit in ("bytes", "KiB", "MiB", "GiB"):
+        if n < 1024 or unit == "GiB":
+            return f"{n:g} {unit}" if unit == "bytes" else f"{n:.4g} {unit}"
+        n /= 1024
+    return f"{n} GiB"  # pragma: no cover
+
+
+# ---------------------------------------------------------------------------------------------- folders
+
+
+def _text(name):
+    """A file name as text: bytes that are not UTF-8 spelled out as escapes (as scoring names submissions)."""
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
+def _skipped(name):
+    return name.startswith(".") or name in IGNORED
+
+
+def _entries(folder):
+    """The entries of `folder` worth looking at, in name order; links never followed."""
+    try:
+        with os.scandir(folder) as found:
+            entries = [e for e in found if not _skipped(e.name)]
+    except OSError:
+        return []
+    return sorted(entries, key=lambda e: e.name)
+
+
+def _walk(folder, notes=None):
+    """The regular files under `folder` (no links, no hidden files), bounded in files and depth."""
+    found, todo, seen = [], [(Path(folder), 0)], 0
+    while todo:
+        current, depth = todo.pop()
+        for entry in _entries(current):
+            seen += 1
+            if seen > MAX_FILES:
+                raise ValueError(f"{_text(str(folder))} holds more than {MAX_FILES} files; a submission is a few.")
+            if entry.is_symlink():
+                if notes is not None:
+                    notes.append(f"ignored {one_line(_text(entry.path))}: a link (links are never followed)")
+                continue
+            if entry.is_dir(follow_symlinks=False):
+                if depth < MAX_DEPTH:
+                    todo.append((Path(entry.path), depth + 1))
+            elif entry.is_file(follow_symlinks=False):
+                found.append(Path(entry.path))
+    return sorted(found)
+
+
+def _listing(names):
+    names = sorted({one_line(n, 80) for n in names})
+    if not names:
+        return "it is empty"
+    shown = ", ".join(names[:SHOWN])
+    return f"it holds {shown}" + (f" and {len(names) - SHOWN} more" if len(names) > SHOWN else "")
+
+
+def _no_notebook(names):
+    return f"holds no notebook ({_listing(names)})"
+
+
+class _Builder:
+    """Turns one student's files (a folder, loose files, zips) into a Student, writing only in the workspace."""
+
+    def __init__(self, workspace, limits, notes, zip_depth):
+        self.workspace = workspace
+        self.limits = limits
+        self.notes = notes
+        self.zip_depth = zip_depth  # 1 when the class came as a zip: a student's zip is one level in
+
+    def folder_for(self, name):
+        folder = _free(self.workspace / "students" / safe_name(name))
+        folder.mkdir(parents=True)
+        return folder
+
+    def from_folder(self, name, folder, layout, lms_id=None, late=False, keep=()):
+        """A student whose work is the folder `folder` (read only): graded in place unless it holds zips."""
+        try:
+            files = _walk(folder, self.notes)
+        except ValueError as exc:
+            return Student(name, None, str(exc), layout, lms_id, late)
+        relative = [f.relative_to(folder).as_posix() for f in files]
+        zips = [f for f in files if f.suffix.lower() == ".zip"]
+        if not zips:
+            if not any(f.suffix == ".ipynb" for f in files):
+                return Student(name, None, _no_notebook(_text(r) for r in relative), layout, lms_id, late)
+            return Student(name, Path(folder), None, layout, lms_id, late)
+        pieces = [(f.relative_to(folder), f) for f in files if f.suffix == ".ipynb" or f.name in keep]
+        zips = [(f.relative_to(folder), f) for f in zips]
+        return self._assemble(name, pieces, zips, relative, layout, lms_id, late)
+
+    def from_files(self, name, pieces, layout, lms_id=None, late=False):
+        """A student given as loose files: `pieces` pairs the name to give each with its path."""
+        zips = [(relative, path) for relative, path in pieces if path.suffix.lower() == ".zip"]
+        shown = [_text(relative.as_posix()) for relative, _ in pieces]
+        gradable = [(relative, path) for relative, path in pieces if path.suffix == ".ipynb"]
+        return self._assemble(name, gradable, zips, shown, layout, lms_id, late)
+
+    def _assemble(self, name, pieces, zips, shown, layout, lms_id, late):
+        if not pieces and not zips:
+            return Student(name, None, _no_notebook(shown), layout, lms_id, late)
+        target = self.folder_for(name)
+        try:
+            for relative, path in pieces:
+                destination = _free(target / relative)
+                destination.parent.mkdir(parents=True, exist_ok=True)
+                size = os.lstat(path).st_size
+                if size > self.limits.max_member:
+                    raise ValueError(
+                        f"{one_line(_text(str(relative)))} is larger than {_size(self.limits.max_member)}; "
+                        "labkit does not copy it."
+                    )
+                shutil.copyfile(path, destination, follow_symlinks=False)
+            for relative, archive in zips:
+                folder = _free(target / relative.parent / _safe_part(relative.stem))
+                folder.parent.mkdir(parents=True, exist_ok=True)
+                _unpack_top(archive, folder, self.limits, True, self.zip_depth)
+                self.notes.append(f"{one_line(name, 80)}: unpacked {one_line(_text(relative.as_posix()), 80)}")
+        except (ValueError, OSError) as exc:
+            shutil.rmtree(target, ignore_errors=True)
+            return Student(name, None, one_line(_text(str(exc)), 400), layout, lms_id, late)
+        if not any(f.suffix == ".ipynb" for f in _walk(target)):
+            shutil.rmtree(target, ignore_errors=True)
+            return Student(name, None, _no_notebook(shown), layout, lms_id, late)
+        return Student(name, target, None, layout, lms_id, late)
+
+
+# ---------------------------------------------------------------------------------------------- layouts
+
+
+def _folders(root, builder, notes):
+    students = []
+    for entry in _entries(root):
+        name = _text(entry.name)
+        if entry.is_symlink():
+            notes.append(f"ignored {one_line(name)}: a link (links are never followed)")
+        elif entry.is_dir(follow_symlinks=False):
+            students.append(builder.from_folder(name, Path(entry.path), "folders"))
+        elif entry.is_file(follow_symlinks=False) and entry.name.endswith(".ipynb"):
+            students.append(Student(_text(entry.name[: -len(".ipynb")]), Path(entry.path), None, "folders"))
+        else:
+            notes.append(f"ignored {one_line(name)}: not a student's folder or notebook")
+    return students
+
+
+def _nbgrader(submitted, assignment, builder, notes):
+    found = {}  # student -> {assignment: folder}
+    for entry in _entries(submitted):
+        name = _text(entry.name)
+        if entry.is_symlink() or not entry.is_dir(follow_symlinks=False):
+            notes.append(f"ignored {one_line(name)} in submitted/: not a student's folder")
+            continue
+        found[name] = {}
+        for inner in _entries(entry.path):
+            if inner.is_dir(follow_symlinks=False) and not inner.is_symlink():
+                found[name][_text(inner.name)] = Path(inner.path)
+            else:
+                notes.append(f"ignored {one_line(name)}/{one_line(_text(inner.name))}: not an assignment's folder")
+    assignments = sorted({a for per in found.values() for a in per})
+    if not assignments:
+        raise ValueError(
+            f"{_text(str(submitted))} holds no assignment folders: nbgrader's layout is "
+            "submitted/<student>/<assignment>/*.ipynb."
+        )
+    if assignment is None:
+        if len(assignments) > 1:
+            raise ValueError(
+                f"{_text(str(submitted))} holds several assignments ({_names(assignments)}); "
+                "pass --assignment NAME to grade one."
+            )
+        assignment = assignments[0]
+    elif assignment not in assignments:
+        raise ValueError(
+            f"no student of {_text(str(submitted))} submitted {one_line(assignment, 60)!r}; "
+            f"the assignments there are {', '.join(one_line(a, 60) for a in assignments)}."
+        )
+    students, missing = [], []
+    for name, per in found.items():
+        if assignment in per:
+            students.append(builder.from_folder(name, per[assignment], "nbgrader", keep=("timestamp.txt",)))
+        else:
+            missing.append(name)
+    if missing:
+        notes.append(
+            f"{len(missing)} student(s) in submitted/ without {one_line(assignment, 60)!r}: "
+            + ", ".join(one_line(m, 60) for m in sorted(missing)[:10])
+            + (" …" if len(missing) > 10 else "")
+        )
+    return students
+
+
+def _names(names):
+    return ", ".join(one_line(n, 60) for n in names)
+
+
+def _canvas_match(name):
+    return CANVAS_ANON.match(name) or CANVAS.match(name)
+
+
+def _canvas(root, builder, notes):
+    groups = {}  # (login, uid) -> {"late": bool, "files": {original: [(number, path, shown)]}}
+    for entry in _entries(root):
+        name = _text(entry.name)
+        match = _canvas_match(name) if entry.is_file(follow_symlinks=False) and not entry.is_symlink() else None
+        if match is None:
+            notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
+            continue
+        login = match["login"] if match.re is CANVAS else f"{match['login']}_{match['uid']}"
+        group = groups.setdefault((login, match["uid"]), {"late": False, "files": {}})
+        group["late"] |= bool(match["late"])
+        original, number = match["file"], 0
+        again = REUPLOAD.match(original)
+        if again:
+            original, number = again["stem"] + (again["ext"] or ""), int(again["number"])
+        group["files"].setdefault(original, []).append((number, Path(entry.path), match["file"]))
+    students = []
+    for (login, uid), group in groups.items():
+        pieces = []
+        for original, versions in sorted(group["files"].items()):
+            versions.sort(key=lambda v: v[0])
+            number, path, given = versions[-1]
+            if len(versions) > 1:
+                dropped = ", ".join(one_line(v[2], 80) for v in versions[:-1])
+                notes.append(
+                    f"{one_line(login, 80)}: kept {one_line(given, 80)} (the newest upload) as "
+                    f"{one_line(original, 80)}; older: {dropped}"
+                )
+            elif number:
+                notes.append(
+                    f"{one_line(login, 80)}: {one_line(given, 80)} (a re-upload) named back {one_line(original, 80)}"
+                )
+            pieces.append((Path(_safe_part(original)), path))
+        student = builder.from_files(login, pieces, "canvas", uid, group["late"])
+        students.append(student)
+    return students
+
+
+def _safe_part(original):
+    """An original file name from an LMS as one file name to create: its own, unless it could not be one."""
+    text = original.replace("/", "_").replace("\\", "_").replace("\x00", "_")
+    if text in ("", ".", "..") or text.startswith(".") or len(text.encode("utf-8", "surrogateescape")) > 200:
+        stem, dot, ext = text.rpartition(".")
+        return safe_name(text) + (f".{ext}" if dot and ext.isalnum() and len(ext) <= 10 else "")
+    return text
+
+
+def _moodle(root, builder, notes):
+    folders, loose = {}, {}  # (name, pid) -> [folders] / [(original, path)]
+    for entry in _entries(root):
+        name = _text(entry.name)
+        if entry.is_symlink():
+            notes.append(f"ignored {one_line(name)}: a link (links are never followed)")
+            continue
+        if entry.is_dir(follow_symlinks=False) and (match := MOODLE_FOLDER.match(name)):
+            folders.setdefault((match["name"], match["pid"]), []).append(Path(entry.path))
+        elif entry.is_file(follow_symlinks=False) and (match := MOODLE_FILE.match(name)):
+            loose.setdefault((match["name"], match["pid"]), []).append((match["file"], Path(entry.path)))
+        else:
+            notes.append(f"ignored {one_line(name)}: not named as Moodle names a submission")
+    students = []
+    for key in sorted(set(folders) | set(loose)):
+        name = f"{key[0]}_{key[1]}"
+        if key in folders and key not in loose and len(folders[key]) == 1:
+            students.append(builder.from_folder(name, folders[key][0], "moodle", key[1]))
+            continue
+        pieces = [(Path(_safe_part(original)), path) for original, path in loose.get(key, [])]
+        for folder in folders.get(key, []):
+            try:
+                files = _walk(folder, notes)
+            except ValueError as exc:
+                notes.append(one_line(exc, 300))
+                files = []
+            pieces += [(f.relative_to(folder), f) for f in files]
+        students.append(builder.from_files(name, pieces, "moodle", key[1]))
+    return students
+
+
+def _detect(root):
+    """The layout of the folder `root`, or ValueError saying what is there."""
+    entries = _entries(root)
+    if os.path.basename(os.path.normpath(root)) == "submitted" and entries:
+        if all(e.is_dir(follow_symlinks=False) for e in entries) and any(
+            any(i.is_dir(follow_symlinks=False) for i in _entries(e.path)) for e in entries
+        ):
+            return "nbgrader"
+    sub = [e for e in entries if e.name == "submitted" and e.is_dir(follow_symlinks=False) and not e.is_symlink()]
+    if sub:
+        return "nbgrader"
+    dirs = [e for e in entries if e.is_dir(follow_symlinks=False) and not e.is_symlink()]
+    files = [e for e in entries if e.is_file(follow_symlinks=False) and not e.is_symlink()]
+    moodle_dirs = [e for e in dirs if MOODLE_FOLDER.match(_text(e.name))]
+    moodle_files = [e for e in files if MOODLE_FILE.match(_text(e.name))]
+    canvas_files = [e for e in files if not MOODLE_FILE.match(_text(e.name)) and _canvas_match(_text(e.name))]
+    other_dirs = [e for e in dirs if not MOODLE_FOLDER.match(_text(e.name))]
+    notebooks = [e for e in files if e.name.endswith(".ipynb") and e not in canvas_files and e not in moodle_files]
+    kinds = {
+        "moodle": bool(moodle_dirs or moodle_files),
+        "canvas": bool(canvas_files),
+        "folders": bool(other_dirs or notebooks),
+    }
+    found = [k for k, v in kinds.items() if v]
+    if len(found) == 1:
+        return found[0]
+    what = (
+        f"{len(moodle_dirs) + len(moodle_files)} named as Moodle names submissions, "
+        f"{len(canvas_files)} file(s) named as Canvas names them, "
+        f"{len(other_dirs)} other folder(s) and {len(notebooks)} other notebook(s)"
+    )
+    if not found:
+        shown = ", ".join(one_line(_text(e.name), 60) for e in entries[:SHOWN]) or "nothing"
+        raise ValueError(
+            f"{one_line(_text(str(root)))} holds no students ({shown}); expected {LAYOUTS}: see docs/instructors.md."
+        )
+    raise ValueError(
+        f"{one_line(_text(str(root)))} mixes layouts ({what}); expected one of {LAYOUTS}. "
+        "Give a folder that holds one of them only."
+    )
+
+
+def _unwrapped(root):
+    """A zip's top: its one folder when that is all it holds and it holds no notebook itself (a folder zipped)."""
+    while True:
+        entries = _entries(root)
+        if len(entries) != 1 or not entries[0].is_dir(follow_symlinks=False) or entries[0].is_symlink():
+            return root
+        inner = entries[0]
+        if inner.name == "submitted" or MOODLE_FOLDER.match(_text(inner.name)):
+            return root
+        if any(e.name.endswith(".ipynb") for e in _entries(inner.path)):
+            return root
+        root = Path(inner.path)
+
+
+def _inside(path, folder):
+    try:
+        Path(path).resolve().relative_to(Path(folder).resolve())
+    except ValueError:
+        return False
+    return True
+
+
+def find_class(
+    path: str | os.PathLike,
+    workspace: str | os.PathLike,
+    *,
+    assignment: str | None = None,
+    limits: UnpackLimits = UnpackLimits(),
+) -> Intake:
+    """The students of the class in `path`, one folder or one zip as the LMS gave it.
+
+    Parameters
+    ----------
+    path : path-like
+        The class: a folder, or a zip, in one of the layouts of the module's documentation.
+    workspace : path-like
+        A folder the caller owns (and deletes): every zip is unpacked there and every folder made
+        there; nothing is written anywhere else. It must not be inside `path`.
+    assignment : str, optional
+        nbgrader's assignment to take when students have several.
+    limits : UnpackLimits
+        What each zip may hold (:func:`unpack`).
+
+    Returns
+    -------
+    Intake
+        The students in name order; one that cannot be graded has ``path=None`` and the reason in
+        ``failure``. One student's bad zip never stops the others.
+
+    Raises
+    ------
+    ValueError
+        When no layout fits, the layouts are mixed, two students would share a name, nbgrader's
+        students have several assignments and `assignment` is None, or the class's own zip is unsafe.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> top = pathlib.Path(tempfile.mkdtemp())
+    >>> for student in ("bob", "alice"):
+    ...     (top / "class" / student).mkdir(parents=True)
+    ...     _ = (top / "class" / student / "02_convergence.ipynb").write_text("{}")
+    >>> (top / "class" / "carol").mkdir()
+    >>> _ = (top / "class" / "carol" / "notes.pdf").write_bytes(b"%PDF")
+    >>> intake = find_class(top / "class", top / "work")
+    >>> intake.layout, [(s.name, s.failure) for s in intake.students]
+    ('folders', [('alice', None), ('bob', None), ('carol', 'holds no notebook (it holds notes.pdf)')])
+    """
+    path, workspace = Path(path), Path(workspace)
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        raise ValueError(f"{one_line(_text(str(path)))} does not exist.") from None
+    if stat.S_ISLNK(info.st_mode):
+        raise ValueError(f"{one_line(_text(str(path)))} is a symbolic link; give the folder or zip itself.")
+    if stat.S_ISDIR(info.st_mode) and _inside(workspace, path):
+        raise ValueError(
+            f"the workspace {one_line(_text(str(workspace)))} is inside the class folder; "
+            "labkit writes nothing there: give a workspace elsewhere."
+        )
+    workspace.mkdir(parents=True, exist_ok=True)
+    own = Path(tempfile.mkdtemp(prefix="intake-", dir=workspace))
+    notes: list[str] = []
+    zip_depth = 0
+    if stat.S_ISREG(info.st_mode):
+        if path.suffix.lower() != ".zip":
+            raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip; give the class as one.")
+        root = own / "class"
+        _unpack_top(path, root, limits, False)
+        notes.append(f"unpacked {one_line(_text(path.name))} into the workspace")
+        root = _unwrapped(root)
+        zip_depth = 1
+    elif stat.S_ISDIR(info.st_mode):
+        root = path
+    else:
+        raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip.")
+    layout = _detect(root)
+    builder = _Builder(own, limits, notes, zip_depth)
+    if layout == "nbgrader":
+        submitted = root if root.name == "submitted" and not (root / "submitted").is_dir() else root / "submitted"
+        students = _nbgrader(submitted, assignment, builder, notes)
+    elif layout == "canvas":
+        students = _canvas(root, builder, notes)
+    elif layout == "moodle":
+        students = _moodle(root, builder, notes)
+    else:
+        students = _folders(root, builder, notes)
+    if assignment is not None and layout != "nbgrader":
+        notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
+    by_name = {}
+    for student in students:
+        if student.name in by_name:
+            other = by_name[student.name]
+            raise ValueError(
+                f"two students are both named {one_line(student.name, 80)!r} "
+                f"({_origin(other)} and {_origin(student)}); rename one so that each name is one student."
+            )
+        by_name[student.name] = student
+    students.sort(key=lambda s: (s.name.casefold(), s.name))
+    return Intake(students, layout, notes)
+
+
+def _origin(student):
+    if student.lms_id is not None:
+        return f"{student.layout} id {one_line(student.lms_id, 40)}"
+    return one_line(_text(str(student.path)), 120) if student.path is not None else student.layout
