@@ -291,12 +291,28 @@ def test_canvas_as_one_zip(tmp_path, workspace):
     assert any("submissions.zip" in n and "unpacked" in n for n in intake.notes)
 
 
-def test_canvas_namesakes_are_refused(tmp_path, workspace):
+def test_canvas_namesakes_are_told_apart_by_their_user_id(tmp_path, workspace):
     folder = tmp_path / "class"
     write_notebook(folder / "smithjohn_101_1_a.ipynb")
     write_notebook(folder / "smithjohn_202_2_a.ipynb")
-    with pytest.raises(ValueError, match=r"both named 'smithjohn' \(canvas id 101 and canvas id 202\)"):
-        find_class(folder, workspace)
+    write_notebook(folder / "doejane_303_3_a.ipynb")
+    intake = find_class(folder, workspace)
+    assert [(s.name, s.lms_id) for s in intake.students] == [
+        ("doejane", "303"),
+        ("smithjohn_101", "101"),
+        ("smithjohn_202", "202"),
+    ]
+    assert any("names several Canvas students" in note for note in intake.notes)
+
+
+def test_a_class_is_told_from_one_students_folder(tmp_path):
+    from labkit.grading.intake import is_class
+
+    write_notebook(tmp_path / "class" / "alice" / "a.ipynb")
+    write_notebook(tmp_path / "canvas" / "smithjohn_101_1_a.ipynb")
+    (tmp_path / "class.zip").write_bytes(b"PK")
+    assert is_class(tmp_path / "class") and is_class(tmp_path / "canvas") and is_class(tmp_path / "class.zip")
+    assert not is_class(tmp_path / "class" / "alice") and not is_class(tmp_path / "class" / "alice" / "a.ipynb")
 
 
 def test_a_lone_reupload_gets_its_name_back(tmp_path, workspace):

@@ -43,16 +43,17 @@ def test_a_resumed_run_grades_only_the_missing_the_unreadable_and_the_not_graded
     failed = json.loads(_result(out, "dave").read_text())
     failed["failure"] = "its grading ran out of memory (the grader's limit of 3072 MiB) and was stopped"
     _result(out, "dave").write_text(json.dumps(failed))  # could not be graded: tried again
-    kept = json.loads(_result(out, "alice").read_text())
-    kept["problems"] = ["kept from the earlier run"]  # a mark that only a result not graded again keeps
-    _result(out, "alice").write_text(json.dumps(kept))
+    forged = json.loads(_result(out, "alice").read_text())
+    forged["problems"] = ["not what the run wrote"]  # a result changed after the run: never trusted, graded again
+    _result(out, "alice").write_text(json.dumps(forged))
     run = cli("grade", *submissions, "--out", out, "--quiet")  # no --seed: the earlier run's
     assert run.returncode == 0, run.stderr
-    assert "resumed" in run.stdout and "2 submission(s) were graded there already and kept, 3 graded now" in run.stdout
-    assert (_run(out)["graded now"], _run(out)["already graded"], _run(out)["seed"]) == (3, 2, int(SEED))
+    assert "resumed" in run.stdout and "1 submission(s) were graded there already and kept, 4 graded now" in run.stdout
+    assert (_run(out)["graded now"], _run(out)["already graded"], _run(out)["seed"]) == (4, 1, int(SEED))
+    assert "changed since the run wrote it" in run.stderr and "missing (the result of 'bob')" in run.stderr
     assert (out / "grades.csv").read_bytes() == (reference / "grades.csv").read_bytes()
-    assert "kept from the earlier run" in (out / "feedback" / f"{safe_name('alice')}.txt").read_text()
-    regraded = {f"{safe_name(name)}.txt" for name in ("bob", "carol", "dave", "=1+1 eve")}
+    assert "not what the run wrote" not in (out / "feedback" / f"{safe_name('alice')}.txt").read_text()
+    regraded = {f"{safe_name(name)}.txt" for name in ("alice", "bob", "carol", "dave")}
     assert {k: v for k, v in files(out, "feedback").items() if k in regraded} == {
         k: v for k, v in files(reference, "feedback").items() if k in regraded
     }
@@ -99,20 +100,28 @@ def test_resuming_refuses_another_seed_rubric_or_class_and_fresh_starts_over(sma
     assert run.returncode == 2 and f"holds results of a run with seed {SEED}, not --seed 1" in run.stderr
     assert "leave --seed out to resume it, give --fresh" in run.stderr
     other = rubrics.from_dict({"title": "bilinear only", "required": [16]})
-    with pytest.raises(ValueError, match="was graded under another rubric .*give the --rubric of the run"):
+    with pytest.raises(ValueError, match="differs from it in its exercises, groups or points: leave --rubric out"):
         resumed(out, names, None, other)
+    late = rubrics.from_dict(
+        {**rubrics.default().data, "late": {"deadline": "2026-12-01T23:59:00Z", "per": "day", "percent": 10, "cap": 50}}
+    )
+    with pytest.raises(ValueError, match="differs from it in a \\[late\\] table.*labkit grade --merge"):
+        resumed(out, names, None, late)  # a late rule added afterwards: the merge applies it, a resume never
     with pytest.raises(ValueError, match="which is not among the submissions of this run"):
         resumed(out, ["alice"], None, rubrics.default())  # the others' results would stay out of grades.csv
     assert files(out, "results") == before  # nothing refused was changed
-    bob = json.loads(_result(out, "bob").read_text())
-    _result(out, "bob").write_text(json.dumps({**bob, "seed": 1}))  # as in a --merge folder of two runs
-    with pytest.raises(ValueError, match=f"holds results graded with several seeds \\(1, {SEED}\\), as a --merge"):
-        resumed(out, names, None, rubrics.default())
-    assert resumed(out, names, None, rubrics.default(), fresh=True) == ({}, None)
+    assert resumed(out, names, None).rubric.same_as(rubrics.default())  # no rubric given: the recorded one
+    assert resumed(out, names, None, rubrics.default(), fresh=True).done == {}
     assert list((out / "results").iterdir()) == [] and list((out / "feedback").iterdir()) == []
+    assert not (out / "record.json").exists()
 
 
 def test_a_run_into_a_folder_without_results_draws_a_fresh_seed(tmp_path):
     (tmp_path / "seed.txt").write_text("123\n")  # a run stopped before its first result: nothing to keep
-    assert resumed(tmp_path, ["alice"], None, rubrics.default()) == ({}, None)
-    assert resumed(tmp_path, ["alice"], 7, rubrics.default()) == ({}, 7)
+    first = resumed(tmp_path, ["alice"], None, rubrics.default())
+    assert (first.done, first.seed, first.record) == ({}, None, None)
+    assert resumed(tmp_path, ["alice"], 7, rubrics.default()).seed == 7
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "alice-0.json").write_text("{}")  # results without a record: an older labkit's
+    with pytest.raises(ValueError, match="holds results but no run record"):
+        resumed(tmp_path, ["alice"], None, rubrics.default())

@@ -651,7 +651,13 @@ def _canvas(root, builder, notes):
             original, number = again["stem"] + (again["ext"] or ""), int(again["number"])
         group["files"].setdefault(original, []).append((number, Path(entry.path), match["file"]))
     students = []
+    logins = [login for login, _ in groups]
     for (login, uid), group in groups.items():
+        if (
+            logins.count(login) > 1
+        ):  # namesakes: Canvas builds the prefix from the name, so the user id tells them apart
+            notes.append(f"{one_line(login, 80)} names several Canvas students: each is named {one_line(login, 60)}_ID")
+            login = f"{login}_{uid}"
         pieces = []
         for original, versions in sorted(group["files"].items()):
             versions.sort(key=lambda v: v[0])
@@ -773,6 +779,36 @@ def _inside(path, folder):
         Path(path).resolve().relative_to(Path(folder).resolve())
     except ValueError:
         return False
+    return True
+
+
+def is_class(path: str | os.PathLike) -> bool:
+    """Whether `path` is a whole class (a zip, or a folder in one of the layouts) rather than one student's work.
+
+    A folder that holds notebooks itself, not named as Canvas or Moodle name a download's files, is one
+    student's submission (``labkit grade submitted/alice``); so is a notebook. Every other folder, and every
+    zip, is a class.
+
+    >>> import pathlib, tempfile
+    >>> root = pathlib.Path(tempfile.mkdtemp())
+    >>> (root / "alice").mkdir(); _ = (root / "alice" / "02_convergence.ipynb").write_text("{}")
+    >>> is_class(root), is_class(root / "alice"), is_class(root / "alice" / "02_convergence.ipynb")
+    (True, False, False)
+    """
+    path = Path(path)
+    try:
+        info = os.lstat(path)
+    except OSError:
+        return False
+    if stat.S_ISREG(info.st_mode):
+        return path.suffix.lower() == ".zip"
+    if not stat.S_ISDIR(info.st_mode):
+        return False
+    for entry in _entries(path):
+        name = _text(entry.name)
+        loose = entry.is_file(follow_symlinks=False) and name.endswith(".ipynb")
+        if loose and not MOODLE_FILE.match(name) and _canvas_match(name) is None:
+            return False
     return True
 
 
