@@ -327,10 +327,23 @@ def _class(args, workspace):
 
     paths = args.submissions
     if len(paths) != 1 or not intake.is_class(paths[0]):
-        if args.assignment:
-            raise ValueError("--assignment picks an assignment of an nbgrader class folder; give the class folder.")
+        for flag, value in (("--assignment", args.assignment), ("--student", args.student)):
+            if value:
+                raise ValueError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
         return _Class(paths)
     found = intake.find_class(paths[0], workspace, assignment=args.assignment)
+    if args.student:
+        names = {student.name for student in found.students}
+        unknown = [name for name in args.student if name not in names]
+        if unknown:
+            from .grading.report import one_line
+
+            shown = ", ".join(repr(one_line(name, 60)) for name in sorted(names)[:10])
+            raise ValueError(
+                f"--student {one_line(unknown[0], 60)!r} is not in {paths[0]}; its students are named {shown}"
+                f"{' ...' if len(names) > 10 else ''} (as in grades.csv)."
+            )
+        found.students = [student for student in found.students if student.name in args.student]
     gradable = [student for student in found.students if student.path is not None]
     return _Class(
         [student.path for student in gradable],
@@ -592,6 +605,13 @@ def build_parser():
         type=Path,
         help="TOML rubric: points, required exercises, branches, extra credit, a deadline ([late]) "
         "(default: the one recorded in --out by an earlier run, else the lab's; `labkit rubric` prints it)",
+    )
+    grd.add_argument(
+        "--student",
+        action="append",
+        metavar="NAME",
+        help="grade only this student of the class folder (its name in grades.csv; repeat for more): a regrade, "
+        "merged over the class's run with --merge",
     )
     grd.add_argument(
         "--assignment",
