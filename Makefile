@@ -8,7 +8,8 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 ROOT_FLAG := $(if $(filter 0,$(shell id -u)),--allow-root,)
 # The student's working folder: written once from the packaged release, then only ever the student's.
-WORK ?= work
+# Set on the command line (make lab WORK=DIR); a WORK in the environment (some clusters set one) is ignored.
+WORK := work
 # Jupyter config of the student session: nbgrader's lab extension and server extensions disabled.
 # JUPYTER_CONFIG_PATH outranks every other config folder; JUPYTER_CONFIG_DIR would not, because in a
 # venv jupyter prefers the venv's etc/jupyter, where nbgrader enables itself.

@@ -39,17 +39,25 @@ SECRETS = ("BEGIN SOLUTION", "END SOLUTION", "BEGIN HIDDEN TESTS")
 pytestmark = pytest.mark.skipif(shutil.which("make") is None, reason="make is not installed")
 
 
-def _make(*args, dry=False, **kwargs):
+def _make(*args, dry=False, **env):
     """Run the Makefile in the repository with this environment as its venv."""
     command = ["make", "--no-print-directory", "-C", ROOT, "-o", VENV / ".installed", f"VENV={VENV}", *args]
     if dry:
         command.insert(1, "-n")
-    return subprocess.run([str(a) for a in command], capture_output=True, text=True, timeout=120, **kwargs)
+    return subprocess.run([str(a) for a in command], capture_output=True, text=True, timeout=120, env=_env(**env))
 
 
-def _jupyter_lab_line(target, *args):
+def _env(**extra):
+    """This environment without Jupyter's folders or an outer make's flags and variables (make test runs this)."""
+    outer = ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "MAKEOVERRIDES", "WORK", "ARGS")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("JUPYTER") and k not in outer}
+    env.update(NO_COLOR="1", **extra)
+    return env
+
+
+def _jupyter_lab_line(target, *args, **env):
     """The (joined) `jupyter lab` command that `make -n target` prints."""
-    run = _make(target, *args, dry=True)
+    run = _make(target, *args, dry=True, **env)
     assert run.returncode == 0, run.stderr
     text = run.stdout.replace("\\\n", " ")
     lines = [line for line in text.splitlines() if f"{JUPYTER} lab" in line]
@@ -75,6 +83,8 @@ def test_make_lab_opens_the_working_folder_with_the_student_config():
 def test_make_lab_takes_another_working_folder(tmp_path):
     line = _jupyter_lab_line("lab", f"WORK={tmp_path / 'mine'}")
     assert _notebook_dir(line) == str(tmp_path / "mine")
+    # only from the command line: some clusters export a WORK of their own
+    assert _notebook_dir(_jupyter_lab_line("lab", WORK=str(tmp_path))) == "work"
 
 
 def test_make_lab_instructor_opens_notebooks_with_nbgrader():
@@ -120,12 +130,6 @@ def test_lab_prepare_writes_the_student_release_once_and_never_overwrites_it(tmp
 
 
 # nbgrader in the two sessions, asked of the real tools
-
-
-def _env(**extra):
-    env = {k: v for k, v in os.environ.items() if not k.startswith("JUPYTER")}
-    env.update(NO_COLOR="1", **extra)
-    return env
 
 
 def _free_port():
