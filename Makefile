@@ -1,12 +1,21 @@
 # Two entry points for a fresh clone (see README): `make lab` and `make test`.
 # Both create .venv with the package installed editable with every extra (lab, grade, test).
+# `make lab` is the students' JupyterLab: the student copies in $(WORK)/, nbgrader's panels off;
+# `make lab-instructor` opens notebooks/ (every solution and hidden test) with nbgrader's panels.
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 ROOT_FLAG := $(if $(filter 0,$(shell id -u)),--allow-root,)
+# The student's working folder: written once from the packaged release, then only ever the student's.
+# Set on the command line (make lab WORK=DIR); a WORK in the environment (some clusters set one) is ignored.
+WORK := work
+# Jupyter config of the student session: nbgrader's lab extension and server extensions disabled.
+# JUPYTER_CONFIG_PATH outranks every other config folder; JUPYTER_CONFIG_DIR would not, because in a
+# venv jupyter prefers the venv's etc/jupyter, where nbgrader enables itself.
+STUDENT_CONFIG := $(CURDIR)/jupyter/student
 
-.PHONY: lab test bench notebooks chromium bwrap clean
+.PHONY: lab lab-prepare lab-instructor test bench notebooks chromium bwrap clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -14,7 +23,17 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[lab,grade,test]'
 	touch $(STAMP)
 
-lab: $(STAMP)
+# The student copies (labkit notebooks) into $(WORK)/ on the first run only: an existing folder is never written to.
+lab-prepare: $(STAMP)
+	@if [ -e "$(WORK)" ]; then echo "$(WORK)/ exists: your work is left as it is"; \
+	else $(PY) -m labkit.cli notebooks "$(WORK)"; fi
+
+lab: lab-prepare
+	JUPYTER_CONFIG_PATH="$(STUDENT_CONFIG)$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
+	  $(VENV)/bin/jupyter lab --notebook-dir="$(WORK)" $(ROOT_FLAG) $(ARGS)
+
+# The instructor notebooks, solutions and hidden tests included, with nbgrader's panels.
+lab-instructor: $(STAMP)
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(ROOT_FLAG) $(ARGS)
 
 test: $(STAMP) chromium bwrap

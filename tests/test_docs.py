@@ -67,8 +67,9 @@ def test_the_readme_fits_in_a_screen_or_two():
 
 def test_the_readme_keeps_the_two_commands():
     readme = (ROOT / "README.md").read_text()
-    assert "make lab      # set up .venv and open JupyterLab on notebooks/" in readme
-    assert "make test     # set up .venv and run every test" in readme
+    assert "make lab             # set up .venv and open JupyterLab on your copies of the student notebooks" in readme
+    assert "make lab-instructor  # the same on notebooks/" in readme
+    assert "make test            # set up .venv and run every test" in readme
     assert "make test" in (ROOT / ".ci" / "run").read_text()
 
 
