@@ -463,6 +463,9 @@ def grade(
             'name the course\'s exercises in its rubric (exercises = "module:attribute") and leave the option out.'
         )
     options = replace(options, exercises=rubric.registry.source)  # the workers load the rubric's exercises
+    if earlier.record is not None:  # the times an earlier run was given count again, unless given anew
+        times = {**earlier.record.given_times("csv"), **(times or {})}
+        exchange_times = {**earlier.record.given_times("exchange"), **(exchange_times or {})}
     handed_in = [
         submission_time(
             path,
@@ -478,6 +481,11 @@ def grade(
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)  # an empty shard's folder is a run's too
     record = earlier.record or records.new("grade", labkit_version(), seed, rubric)
+    record.times = {
+        source: {name: when.isoformat() for name, when in sorted((given or {}).items())}
+        for source, given in (("csv", times), ("exchange", exchange_times))
+        if given
+    }
     records.write(out, record)
     if rubric.text is not None:  # the grading processes read the run's rubric from its record's copy
         options = replace(options, rubric=str((out / records.RUBRIC_COPY).resolve()))

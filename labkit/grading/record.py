@@ -68,6 +68,13 @@ class RunRecord:
     rubric: dict
     rubric_text: str = None
     submissions: dict = field(default_factory=dict)
+    times: dict = field(default_factory=dict)  # source ("csv", "exchange") -> {name: ISO time}: the times given
+
+    def given_times(self, source):
+        """{name: datetime} of the times the run was given from `source` (``"csv"``: ``--times``; ``"exchange"``)."""
+        from datetime import datetime
+
+        return {name: datetime.fromisoformat(when) for name, when in self.times.get(source, {}).items()}
 
     def as_dict(self):
         return {
@@ -78,6 +85,7 @@ class RunRecord:
             "rubric": self.rubric,
             "rubric text": self.rubric_text,
             "submissions": self.submissions,
+            "times": self.times,
         }
 
     def rubric_object(self, folder):
@@ -184,11 +192,18 @@ def read(folder):
         text = data.get("rubric text")
         if text is not None and not isinstance(text, str):
             raise ValueError("its rubric text is not text")
+        times = data.get("times") or {}
+        if not isinstance(times, dict) or not all(
+            isinstance(given, dict) and all(isinstance(v, str) for v in given.values()) for given in times.values()
+        ):
+            raise ValueError("its times are not times")
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
-    return RunRecord(data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions)
+    return RunRecord(
+        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times
+    )
 
 
 def results(folder, record):
