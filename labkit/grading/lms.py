@@ -60,9 +60,18 @@ for the exact strings and rules. In my words:
 
 So the file written here is the export itself, every row and column as it
 was, with one assignment column filled in: the column named ``--column``
-(its title with or without the ``(number)``), or, when there is none, a new
-column at the end whose ``Points Possible`` cell is the rubric's full credit.
-The separator, byte-order mark and line endings are the export's.
+(its title with or without the ``(number)``). Because Canvas makes a new
+assignment of any header it does not know, a ``--column`` that matches no
+assignment column is refused, and the message lists the gradebook's
+assignment columns (at most :data:`MAX_LISTED`, each shown on one printable
+line): a typo never creates an assignment. A new column is added only on
+purpose, with ``--new-column`` (``new_column=True``): at the end, its
+``Points Possible`` cell the rubric's full credit. ``--new-column`` with the
+title of a column the gradebook already has is refused too, rather than
+filling that column: Canvas would match the title to the existing
+assignment, so the file would not do what was asked; leave out
+``--new-column`` to fill it. The separator, byte-order mark and line endings
+are the export's.
 
 Moodle's grade import, as this module relies on it
 --------------------------------------------------
@@ -99,7 +108,8 @@ the LMS has them. Names from submissions reach the summary through
 
 Bad input (a roster without its columns or with a name or identifier twice,
 a gradebook that is not Canvas's CSV or not UTF-8, an assignment column that
-is read-only or ambiguous) raises a ``ValueError`` that says what to fix, and
+is read-only, ambiguous, missing without ``--new-column`` or present with it)
+raises a ``ValueError`` that says what to fix, and
 then nothing is written. The output never replaces an input file, nor an
 existing file unless ``force`` is given; it is written to a temporary file
 and renamed into place.
@@ -130,6 +140,7 @@ CANVAS_TOTALS = re.compile(
 )
 SUMMARY_HEADER = ["submission", "id", "points", "status"]
 XLSX_MAGIC = b"PK\x03\x04"
+MAX_LISTED = 20  # assignment columns named in a message
 
 
 @dataclass
@@ -495,6 +506,38 @@ def _assignment_column(book, column, path):
     return found[0] if found else None
 
 
+def assignment_columns(book: CanvasGradebook) -> list[str]:
+    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only.
+
+    Examples
+    --------
+    >>> book = CanvasGradebook(
+    ...     ["Student", "ID", "Section", "Quiz 1 (501)", "Current Score"],
+    ...     [["    Points Possible", "", "", "10", "(read only)"]], ",", "\\n", False, 2)
+    >>> assignment_columns(book)
+    ['Quiz 1 (501)']
+    """
+    points_row = next((row for row in book.rows if row and book.kind(row) == "points"), None)
+    return [
+        cell.strip()
+        for i, cell in enumerate(book.header)
+        if i > book.section
+        and cell.strip()
+        and CANVAS_TOTALS.search(cell) is None
+        and not (points_row and "read only" in points_row[i].lower())
+    ]
+
+
+def _assignments_text(book):
+    """The gradebook's assignment columns in words, for a message: bounded, each name on one printable line."""
+    names = assignment_columns(book)
+    if not names:
+        return "it has no assignment column yet"
+    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
+    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
+    return f"its assignment columns are {shown}{more}"
+
+
 def _write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
     """Write `rows` as CSV: to a temporary file beside `path`, renamed into place when complete (checked by
     :func:`_check_outputs` first)."""
@@ -576,6 +619,7 @@ def to_canvas(
     *,
     column: str = DEFAULT_COLUMN,
     key: str = "ID",
+    new_column: bool = False,
     force: bool = False,
 ) -> Export:
     """Fill one assignment column of a Canvas gradebook export with the grades' totals.
@@ -591,10 +635,15 @@ def to_canvas(
     out : path
         The file to write, for Canvas's Grades > Import; the summary CSV goes beside it (:func:`summary_file`).
     column : str
-        The assignment: an existing column of that title (with or without Canvas's ``(number)``) is
-        filled, else a new column of that name is added at the end, worth the rubric's full credit.
+        The assignment: the existing column of that title (with or without Canvas's ``(number)``) is
+        filled. When the gradebook has none, the export is refused (a mistyped name would otherwise
+        become a new assignment in Canvas), unless `new_column` is given.
     key : {"ID", "SIS User ID", "SIS Login ID"}
         The gradebook column whose values the roster's ids are.
+    new_column : bool
+        Add `column` as a new column at the end, worth the rubric's full credit, which Canvas makes a new
+        assignment on import. Refused when the gradebook already has a column of that title: Canvas would
+        match the title to that assignment anyway, so leave out `new_column` to fill it.
     force : bool
         Replace `out` and its summary if they exist (an input file is never replaced).
 
@@ -607,8 +656,9 @@ def to_canvas(
     ------
     ValueError
         Bad input (see :func:`read_roster` and :func:`read_canvas`), a `key` the export lacks, two gradebook
-        rows with one id, an ambiguous or read-only assignment column, no student matched at all, or an
-        output that exists or is an input. Nothing is written then.
+        rows with one id, an ambiguous or read-only assignment column, a `column` the gradebook lacks
+        without `new_column` (the message lists its assignment columns) or has with it, no student matched
+        at all, or an output that exists or is an input. Nothing is written then.
     """
     if key not in CANVAS_KEYS:
         raise ValueError(f"--key for Canvas is one of {', '.join(CANVAS_KEYS)} (a gradebook column); got {key!r}.")
@@ -635,6 +685,19 @@ def to_canvas(
     target = _assignment_column(book, column, gradebook)
     points_row = next((row for row in book.rows if row and book.kind(row) == "points"), None)
     full_credit = by_name[next(iter(by_name))].rubric.full_credit
+    if target is None and not new_column:
+        raise ValueError(
+            f"{gradebook} has no assignment column named {column!r}; "
+            f"{_assignments_text(book)}. Give one of them with --column (its title, with or "
+            "without the number), or pass --new-column to add a column of that name on purpose (Canvas then "
+            "creates a new assignment when the file is imported)."
+        )
+    if target is not None and new_column:
+        raise ValueError(
+            f"{gradebook} already has the assignment column {one_line(book.header[target], 80)!r}, which "
+            f"--column {column!r} names (Canvas would fill that assignment, not make a new one): leave out "
+            "--new-column to fill it, or give the new assignment another name with --column."
+        )
     if target is None:
         book.header.append(column)
         for row in book.rows:
