@@ -1,13 +1,14 @@
 """Grades into the LMS: a Canvas gradebook export filled in, a Moodle grade import file, and bad input refused."""
 
 import csv
+import dataclasses
 import io
 import subprocess
 import sys
 
 import pytest
 
-from labkit.grading import lms
+from labkit.grading import late, lms
 from labkit.grading.report import SubmissionGrade, read_results, write_report
 from labkit.grading.rubric import default
 
@@ -287,6 +288,47 @@ def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
     assert rows[0] == ["ID number", "labkit", "Feedback"]
     assert rows[1][2] == "104 points: 100 of 100 for full credit, and 4 of extra credit (labkit grade)"
     assert rows[2][2] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"
+
+
+def _late_grades():
+    """The lab's rubric with a [late] table (10% per started day, at most 50%), and four submissions."""
+    rubric = dataclasses.replace(
+        LAB, late=late.from_dict({"deadline": "2026-12-01T23:59:00+01:00", "per": "day", "percent": 10, "cap": 50})
+    )
+    full = {n: 1.0 for n in (2, 3, 4, *SPLINES)}
+
+    def handed_in(text):
+        return late.SubmissionTime(late.parse_deadline(text), late.FROM_CSV)
+
+    return [
+        # 104 points (100 + 4 extra credit), 1 day 8 h late: 2 started days, 20% off: 104 - 20.8 = 83.2
+        SubmissionGrade("ada", _results({**full, 16: 0.5}), rubric=rubric, time=handed_in("2026-12-03T08:00+01:00")),
+        # 17.5 points, on time
+        SubmissionGrade("bob", _results({2: 1.0, 3: 0.5}), rubric=rubric, time=handed_in("2026-12-01T20:00+01:00")),
+        # 100 points, 6 days 10 h late: 7 started days, 70% capped at 50%: 100 - 50 = 50
+        SubmissionGrade("cy", _results(full), rubric=rubric, time=handed_in("2026-12-08T10:00+01:00")),
+        # 10 points, no known time: not penalised
+        SubmissionGrade("dee", _results({2: 1.0}), rubric=rubric),
+    ]
+
+
+def test_moodle_feedback_begins_with_the_grade_after_the_late_penalty_and_states_the_penalty(tmp_path):
+    roster = _write(tmp_path / "roster.csv", "submission,id\nada,S1\nbob,S2\ncy,S3\ndee,S4\n")
+    lms.to_moodle(_late_grades(), roster, tmp_path / "moodle.csv", feedback=True)
+    rows = {row[0]: row[1:] for row in _rows(tmp_path / "moodle.csv")[1:]}
+    assert {key: grade for key, (grade, _) in rows.items()} == {"S1": "83.2", "S2": "17.5", "S3": "50", "S4": "10"}
+    for grade, feedback in rows.values():
+        assert feedback.split(" ")[0] == grade  # the first number is the grade beside it
+    assert rows["S1"][1] == (
+        "83.2 points: 104 (100 of 100 for full credit, and 4 of extra credit) less 20.8 for late work "
+        "(2 started days, 20% off) (labkit grade)"
+    )
+    assert rows["S3"][1] == (
+        "50 points: 100 (100 of 100 for full credit) less 50 for late work (7 started days, 50% off, the cap) "
+        "(labkit grade)"
+    )
+    assert rows["S2"][1] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"  # on time: nothing to say
+    assert "late" not in rows["S4"][1]
 
 
 def test_a_rubric_given_rescores_the_results(out, inputs, tmp_path):

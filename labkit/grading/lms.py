@@ -90,7 +90,12 @@ so feedback always comes with the grade.
 
 The file written here has the columns ``ID number`` (or ``Email address``),
 the grade item named ``--column``, and with ``--feedback`` a ``Feedback``
-column (the points in words). Only students with a grade are in it: the
+column (the points in words). The feedback begins with the grade written
+beside it, so that the two never disagree: with a rubric's ``[late]`` table
+that is the total after the late penalty, followed by the points before it
+and the penalty (points, started days or hours, percent), e.g. ``94.4
+points: 118 (100 of 100 for full credit, and 18 of extra credit) less 23.6
+for late work (2 started days, 20% off) (labkit grade)``. Only students with a grade are in it: the
 others keep what Moodle has.
 
 What is listed
@@ -777,11 +782,27 @@ def to_canvas(
 
 
 def _feedback(grade):
+    """The points in words, first the grade written beside them (after any late penalty), then how it was made.
+
+    Examples
+    --------
+    >>> from labkit.grading.report import SubmissionGrade
+    >>> _feedback(SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}}))
+    '10 points: 10 of 100 for full credit (labkit grade)'
+    """
     score = grade.score
     extra = f", and {points_text(score.extra_total)} of extra credit" if score.extra_total else ""
+    earned = f"{points_text(score.required + score.counted)} of {points_text(score.full_credit)} for full credit{extra}"
+    lateness = grade.lateness
+    if lateness is None or not lateness.penalty:
+        return f"{points_text(grade.total)} points: {earned} (labkit grade)"
+    rule = grade.rubric.late
+    units = f"{lateness.units} started {rule.per}{'' if lateness.units == 1 else 's'}"
+    capped = ", the cap" if lateness.units * rule.percent > rule.cap else ""
     return (
-        f"{points_text(score.total)} points: {points_text(score.required + score.counted)} of "
-        f"{points_text(score.full_credit)} for full credit{extra} (labkit grade)"
+        f"{points_text(grade.total)} points: {points_text(lateness.raw_total)} ({earned}) less "
+        f"{points_text(lateness.penalty)} for late work ({units}, {points_text(lateness.percent)}% off{capped}) "
+        "(labkit grade)"
     )
 
 
@@ -811,7 +832,8 @@ def to_moodle(
     column : str
         The header of the points column, to map on import to a grade item (or a new one).
     feedback : bool
-        Add a ``Feedback`` column: the points in words, to map to the item's feedback.
+        Add a ``Feedback`` column: the points in words (the grade first, then how it was made, a late
+        penalty included), to map to the item's feedback.
     force : bool
         Replace `out` and its summary if they exist (the roster is never replaced).
 
