@@ -465,6 +465,36 @@ def test_moodle_refuses_ids_that_are_not_what_the_key_says(out, tmp_path):
     _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv", key="ID"), "idnumber or email")
 
 
+def test_moodle_refuses_email_addresses_under_the_id_number_key(out, tmp_path):
+    grades = read_results([out])
+    emails = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
+    message = _refused(
+        tmp_path,
+        lambda: lms.to_moodle(grades, emails, tmp_path / "m.csv"),  # key="idnumber", the default
+        "holds email addresses (e.g. 'ada' ('ada@uni.example'), 'bob' ('bob@uni.example')), not ID numbers",
+        "give --key email",
+    )
+    assert "ID number column" in message
+    mixed = _write(
+        tmp_path / "roster.csv",
+        f"submission,id\nada,S1001\nbob,bob@uni.example\ncarl,S1003\n{ESCAPE},m\x1b[2J@uni.example\n",
+    )
+    message = _refused(
+        tmp_path,
+        lambda: lms.to_moodle(grades, mixed, tmp_path / "m.csv", key="idnumber"),
+        "mixes email addresses (2 of 4: 'bob' ('bob@uni.example'), 'mal\ufffd[2Jory' ('m\ufffd[2J@uni.example'))",
+        "with other ids (e.g. 'ada' ('S1001'), 'carl' ('S1003'))",
+        "correct those rows",
+    )
+    assert "\x1b" not in message
+    # and under --key email, the ID numbers among the addresses are refused as before
+    _refused(tmp_path, lambda: lms.to_moodle(grades, mixed, tmp_path / "m.csv", key="email"), "not an email address")
+    # the same roster of addresses, under the key that says so, is exported
+    emails = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
+    export = lms.to_moodle(grades, emails, tmp_path / "m.csv", key="email")
+    assert export.exported == {"ada": ("ada@uni.example", 104.0), "bob": ("bob@uni.example", 17.5)}
+
+
 # --- the command ------------------------------------------------------------------------------------------------
 
 

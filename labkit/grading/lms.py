@@ -19,6 +19,17 @@ Canvas's own user number, by default; or ``SIS User ID`` or ``SIS Login
 ID``), for Moodle the user field (``idnumber`` by default, or ``email``).
 A submission and an identifier may each appear once.
 
+For Moodle the ids are checked against the key, because Moodle matches them
+only against the field it is told and a wrong field stops the whole import:
+with ``--key email`` every id must look like an email address (something,
+``@``, a domain with a dot); with ``--key idnumber`` none may. A roster of
+email addresses under the default ``idnumber`` is refused with the advice to
+give ``--key email``; a roster that mixes email addresses with other ids is
+refused under either key (under ``idnumber`` the email rows would match no
+student, under ``email`` the others), naming a few rows of each kind to
+correct. (A site whose ID numbers are the users' email addresses exports
+with ``--key email``.)
+
 Canvas's gradebook CSV, as this module relies on it
 ---------------------------------------------------
 Sources: Instructure's Canvas Instructor Guide, "How do I import grades in the
@@ -144,6 +155,7 @@ CANVAS_TOTALS = re.compile(
     "Override Score|Override Grade|Override Status"
 )
 SUMMARY_HEADER = ["submission", "id", "points", "status"]
+EMAIL = re.compile(r"[^@\s]+@[^@\s]+\.[^@\s]+")  # what looks like an email address, for --key
 XLSX_MAGIC = b"PK\x03\x04"
 MAX_LISTED = 20  # assignment columns named in a message
 
@@ -806,6 +818,36 @@ def _feedback(grade):
     )
 
 
+def _is_email(value):
+    """Whether an identifier looks like an email address (something, an @, a domain with a dot)."""
+    return EMAIL.fullmatch(value) is not None
+
+
+def _examples(entries, names):
+    """A few roster entries, for a message: each name and id on one printable line."""
+    shown = ", ".join(f"{one_line(name, 40)!r} ({one_line(entries[name], 60)!r})" for name in names[:3])
+    return shown + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+
+
+def _check_id_numbers(entries, roster):
+    """Refuse a roster for ``--key idnumber`` that holds email addresses: all of them, or some among ID numbers."""
+    emails = [name for name, value in entries.items() if _is_email(value)]
+    if not emails:
+        return
+    if len(emails) == len(entries):
+        raise ValueError(
+            f"the roster {roster} holds email addresses (e.g. {_examples(entries, emails)}), not ID numbers, and "
+            "--key idnumber (the default) would write them into Moodle's ID number column: give --key email, "
+            "or give the students' ID numbers in the roster."
+        )
+    others = [name for name in entries if name not in emails]
+    raise ValueError(
+        f"the roster {roster} mixes email addresses ({len(emails)} of {len(entries)}: {_examples(entries, emails)}) "
+        f"with other ids (e.g. {_examples(entries, others)}); with --key idnumber (the default) every id is an ID "
+        "number: correct those rows, or give every student's email address with --key email."
+    )
+
+
 def to_moodle(
     grades: list[SubmissionGrade],
     roster: str | os.PathLike,
@@ -845,8 +887,9 @@ def to_moodle(
     Raises
     ------
     ValueError
-        Bad input (see :func:`read_roster`), an id that is not an email address with ``key="email"`` or that
-        starts like a formula, no student to write, or an output that exists or is an input.
+        Bad input (see :func:`read_roster`), an id that is not an email address with ``key="email"``, a roster
+        with any email address with ``key="idnumber"`` (see the module's description of the roster), an id
+        that starts like a formula, no student to write, or an output that exists or is an input.
     """
     if key not in MOODLE_KEYS:
         raise ValueError(f"--key for Moodle is idnumber or email (the user field of the roster's ids); got {key!r}.")
@@ -854,7 +897,7 @@ def to_moodle(
     by_name = _by_name(grades)
     entries = read_roster(roster)
     for name, value in entries.items():
-        if key == "email" and re.fullmatch(r"[^@\s]+@[^@\s]+\.[^@\s]+", value) is None:
+        if key == "email" and not _is_email(value):
             raise ValueError(
                 f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which is not an "
                 "email address: with --key email every id is one (or use --key idnumber)."
@@ -864,6 +907,8 @@ def to_moodle(
                 f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which starts like "
                 "a spreadsheet formula; correct the roster."
             )
+    if key == "idnumber":
+        _check_id_numbers(entries, roster)
     out = Path(out)
     export = Export(out, summary_file(out), "Moodle", column)
     _check_outputs([out, export.summary_path], [roster], force)
