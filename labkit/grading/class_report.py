@@ -7,7 +7,9 @@ pass rate, the slips the checks named (most frequent first, with who made
 them), the problems (time limits, crashes, cells that raised, refused
 references, ...), the students with the most failed parts, and pairs of
 similar code side by side (:mod:`labkit.grading.similarity`; similarity never
-changes a grade, it is for a person to judge).
+changes a grade, it is for a person to judge). Without copydetect, which the
+similarity search needs, the page is written all the same and its similar code
+section says "not computed", and why.
 
 The page needs nothing but itself: its figures are inline PNG images drawn
 with matplotlib's Agg canvas (no pyplot state), its style and its one small
@@ -35,7 +37,7 @@ from pathlib import Path
 from .report import SubmissionGrade, one_line, printable, read_results
 from .rubric import Rubric, points_text
 from .rubric import default as default_rubric
-from .similarity import DEFAULT_THRESHOLD, Pair
+from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
 
 REPORT = "report.html"
 MAX_RESULT_BYTES = 32 * 1024**2  # one result file, as the grader accepts it (labkit.grading.batch.MAX_RESULT)
@@ -998,7 +1000,8 @@ def render(
     threshold : float
         The similarity from which pairs were listed (said on the page).
     similarity_note : str, optional
-        Why the pairs were not computed, when `pairs` is None.
+        Why the pairs were not computed, when `pairs` is None; when not given, the reason the similarity
+        search cannot run here, if it cannot (:func:`labkit.grading.similarity.unavailable`).
 
     Returns
     -------
@@ -1007,6 +1010,8 @@ def render(
     if not isinstance(summary, ClassSummary):
         raise ValueError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
     pairs = _check_pairs(pairs)
+    if pairs is None and similarity_note is None:
+        similarity_note = unavailable()
     rubric = summary.rubric
     seeds = ", ".join(str(s) for s in summary.seeds[:20]) or "not recorded"
     sections = [
