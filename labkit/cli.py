@@ -382,6 +382,8 @@ def _export(args):
 
     if args.canvas is not None and args.feedback:
         raise ValueError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
+    if args.canvas is None and args.new_column:
+        raise ValueError("--new-column is for --canvas; Moodle's import maps a column to a new grade item itself.")
     # the run's recorded rubric (late rule included): what is exported is grades.csv's total
     grades = read_results([args.results], rubric_for([args.results], args.rubric, "labkit export"))
     _refused(grades, "labkit export")
@@ -393,6 +395,7 @@ def _export(args):
             args.out or lms.default_file(args.results, "canvas"),
             column=args.column,
             key=args.key or "ID",
+            new_column=args.new_column,
             force=args.force,
         )
     else:
@@ -691,8 +694,15 @@ def build_parser():
         "--column",
         default="labkit",
         metavar="NAME",
-        help="the assignment: Canvas's column of that title is filled, or added if there is none; Moodle's "
-        "grade item column (default %(default)s)",
+        help="the assignment: Canvas's column of that title is filled (one the gradebook lacks is refused, "
+        "unless --new-column); Moodle's grade item column (default %(default)s)",
+    )
+    exp.add_argument(
+        "--new-column",
+        action="store_true",
+        help="Canvas: add --column as a new assignment column, worth the rubric's full credit (refused if the "
+        "gradebook has that column already); without it a --column the gradebook lacks is refused, so a typo "
+        "never creates an assignment",
     )
     exp.add_argument("--feedback", action="store_true", help="Moodle: add a Feedback column (the points in words)")
     exp.add_argument(

@@ -7,6 +7,7 @@ The page in a real browser (no request leaves the machine, axe-core finds no ser
 tests/browser/test_class_report_browser.py.
 """
 
+import dataclasses
 import hashlib
 import json
 import statistics
@@ -21,7 +22,7 @@ import pytest
 from labkit.cli import main
 from labkit.exercises.registry import LAB, _missing
 from labkit.exercises.result import CheckResult, call
-from labkit.grading import class_report, remote, scoring, similarity
+from labkit.grading import class_report, late, remote, scoring, similarity
 from labkit.grading.report import SubmissionGrade, merge, write_report
 from labkit.grading.rubric import default, load
 from labkit.grading.similarity import Pair
@@ -429,6 +430,123 @@ def test_similar_code_is_bounded(grades):
     assert "1000 of 1000 lines of the first and 1 of 1000 of the second" in html
 
 
+# ------------------------------------------------------------------ late work
+
+
+def late_class():
+    """Six graded submissions and one not graded, under the lab's rubric with a late rule: 10% of the points per
+    started day, at most 50%, 15 minutes' grace, due 2026-12-01 23:59 (+01:00); cleo has 48 hours more."""
+    rule = late.from_dict(
+        {
+            "deadline": "2026-12-01T23:59:00+01:00",
+            "per": "day",
+            "percent": 10,
+            "cap": 50,
+            "grace": 15,
+            "extensions": {"cleo": 48, "zed": 24},
+        }
+    )
+    rubric = dataclasses.replace(default(), late=rule)
+    everything = {key: check for n in (2, 3, 4, *SPLINES) for key, check in full(n).items()}  # 100 points
+    required = {**full(2), **full(3), **full(4)}  # 40 points
+
+    def at(name, checks, when=None, source=late.FROM_CSV):
+        g = grade(name, checks, rubric=rubric)
+        g.time = None if when is None else late.SubmissionTime(late.parse_deadline(when), source)
+        return g
+
+    return [
+        at("ann", everything, "2026-12-01T22:00:00+01:00"),  # 100, on time
+        at("ben", everything, "2026-12-03T08:00:00+01:00"),  # 100, 1 day 8 h 1 min late: 2 started days, 20%: 80
+        at("cleo", required, "2026-12-02T23:00:00+01:00"),  # 40, a day after the deadline, within her extension
+        at("dev", required),  # 40, no time: not penalised
+        at(HOSTILE, full(2), "2026-12-02T03:00:00+01:00", late.FROM_NBGRADER),  # 10, 3 h 1 min late: 10%: 9
+        at("gus", required, "2026-12-02T00:09:00+01:00"),  # 40, 10 minutes late: within the grace
+        grade("finn", failure="its grading crashed twice", rubric=rubric),
+    ]
+
+
+SPLINES = (10, 11, 12, 13, 14, 15)
+
+
+def test_the_late_view_says_who_was_late_by_how_much_and_what_it_cost(tmp_path):
+    grades = late_class()
+    summary = class_report.summarise(grades)
+    view = summary.late
+    assert [e.student for e in view.late] == ["ben", HOSTILE]
+    assert [(e.units, e.percent, e.penalty, e.total) for e in view.late] == [(2, 20, 20, 80), (1, 10, 1, 9)]
+    assert [e.student for e in view.on_time] == ["ann", "cleo", "gus"] and [e.student for e in view.within_grace] == [
+        "gus"
+    ]
+    assert [e.student for e in view.extended] == ["cleo"] and [e.student for e in view.unknown] == ["dev"]
+    assert [e.student for e in view.student_supplied] == [HOSTILE] and view.penalty == 21
+    assert view.unused_extensions == ["zed"]
+
+    html = class_report.render(summary)
+    page = Page(html)
+    words = page.words("late")
+    assert words.startswith("Late work The rubric's rule: late work: due 2026-12-01T23:59:00+01:00, with 15 minutes")
+    for figure in (
+        "graded submissions 6",
+        "on time 3 (1 within the grace)",
+        "late 2",
+        "points taken off, in all 21",
+        "with an extension 1",
+        "no known time (not penalised) 1",
+        "a time the student supplied 1",
+    ):
+        assert figure in words, figure
+    assert (
+        "ben 2026-12-01T23:59:00+01:00 2026-12-03T08:00:00+01:00 the --times file 1 day 8 h 1 min "
+        "2 started days 20% 20 100 80" in words
+    )
+    assert f"{HOSTILE} 2026-12-01T23:59:00+01:00 2026-12-02T03:00:00+01:00 nbgrader's timestamp.txt 3 h 1 min" in words
+    assert "1 started day 10% 1 10 9" in words
+    assert "Extensions: 1 submission" in words
+    assert "cleo 2026-12-03T23:59:00+01:00 2026-12-02T23:00:00+01:00 on time" in words
+    assert "names 1 submission this run has no graded result for (a misspelt name?): zed" in words
+    assert "No known time: 1 submission" in words and "dev no submission time: not penalised" in words
+    assert "Times the student supplied: 1 submission" in words
+    assert f"{HOSTILE} nbgrader's timestamp.txt 2026-12-02T03:00:00+01:00 late by 3 h 1 min" in words
+    assert "finn" not in words  # not graded: no lateness
+    # escaped, like every name on the page; headed tables; listed in the navigation
+    assert HOSTILE not in html and [tag for tag, _ in page.tags].count("script") == 1
+    assert ("a", {"href": "#late"}) in page.tags and ("h2", {"id": "late"}) in page.tags
+    late_section = html[
+        html.index('<section aria-labelledby="late">') : html.index('<section aria-labelledby="pass-rates">')
+    ]
+    assert late_section.count("<table>") + late_section.count('<table class="narrow">') == late_section.count(
+        "<caption>"
+    )
+    assert late_section.count('<th scope="row">') >= 6 + 2 + 1 + 1 + 1
+
+    # the totals are grades.csv's: after the penalty
+    totals = [g.total for g in grades if g.graded]
+    assert totals == [100, 80, 40, 40, 9, 40] and summary.totals == {g.name: g.total for g in grades if g.graded}
+    figures = page.words("totals")
+    assert f"mean {statistics.fmean(totals):.1f}" in figures and "mean 51.5" in figures  # before the penalty: 55.0
+    assert "full credit (100) or more 1" in figures  # ben's 100 is 80 after it
+    assert "after the late penalty" in figures
+    # and the page written by `labkit report` from a results folder says the same
+    write_report(tmp_path, grades)
+    rubric = tmp_path / "rubric.toml"
+    rubric.write_text(
+        (Path(class_report.__file__).parent / "rubric.toml").read_text()
+        + '\n[late]\ndeadline = "2026-12-01T23:59:00+01:00"\nper = "day"\npercent = 10\ncap = 50\ngrace = 15\n'
+        + "[late.extensions]\ncleo = 48\nzed = 24\n"
+    )
+    assert load(rubric) == grades[0].rubric
+    assert main(["report", str(tmp_path), "--rubric", str(rubric), "--quiet"]) == 0
+    written = Page((tmp_path / "report.html").read_text())
+    assert "points taken off, in all 21" in written.words("late") and "mean 51.5" in written.words("totals")
+
+
+def test_without_a_late_table_the_report_has_no_late_section(grades):
+    page = Page(page_of(grades))
+    assert "late" not in page.text and ("a", {"href": "#late"}) not in page.tags
+    assert class_report.summarise(grades).late is None
+
+
 # ------------------------------------------------------------------ writing it, and bad input
 
 
@@ -483,6 +601,28 @@ def test_the_cli_uses_the_similarity_search_when_labkit_has_one(grades, tmp_path
     monkeypatch.undo()  # the real search: these grades kept no sources, so there is nothing to compare
     assert main(["report", str(tmp_path), "--quiet"]) == 0
     assert "Not computed" not in (tmp_path / "report.html").read_text()
+
+
+def test_the_report_is_written_without_copydetect_and_says_why_similar_code_was_not_computed(tmp_path, monkeypatch):
+    from class_results import synthetic_class, synthetic_sources
+
+    grades = synthetic_class(12, seed=3)
+    sources, _ = synthetic_sources([g.name for g in grades if g.graded], seed=3, copies=2)
+    for g in grades:
+        g.sources = {function: by_student[g.name] for function, by_student in sources.items() if g.name in by_student}
+    write_report(tmp_path, grades)
+    # copydetect not installed (labkit without its grade extra): every import of it fails
+    for name in [name for name in sys.modules if name == "copydetect" or name.startswith("copydetect.")]:
+        monkeypatch.setitem(sys.modules, name, None)
+    monkeypatch.setitem(sys.modules, "copydetect", None)
+    assert main(["report", str(tmp_path), "--quiet"]) == 0
+    assert similarity.similar_pairs(grades) is None and "copydetect" in similarity.unavailable()
+    page = Page((tmp_path / "report.html").read_text())
+    similar = page.words("similar")
+    assert "Not computed (the similarity search needs copydetect, which cannot be imported here" in similar
+    assert "pip install 'labkit[grade]'" in similar
+    assert "12 submissions" in page.words(None)  # the rest of the page is there
+    assert page.words("totals").startswith("Totals")
 
 
 @pytest.mark.parametrize("threshold", ["0", "-0.5", "1.5", "nan"])

@@ -1,13 +1,14 @@
 """Grades into the LMS: a Canvas gradebook export filled in, a Moodle grade import file, and bad input refused."""
 
 import csv
+import dataclasses
 import io
 import subprocess
 import sys
 
 import pytest
 
-from labkit.grading import lms
+from labkit.grading import late, lms
 from labkit.grading.report import SubmissionGrade, read_results, write_report
 from labkit.grading.rubric import default
 
@@ -91,7 +92,7 @@ def _snapshot(folder):
 def test_a_new_canvas_column_holds_the_totals_and_everything_else_is_kept(out, inputs, tmp_path):
     gradebook, roster = inputs
     target = tmp_path / "import.csv"
-    export = lms.to_canvas(read_results([out]), gradebook, roster, target, column="Interpolation lab")
+    export = lms.to_canvas(read_results([out]), gradebook, roster, target, column="Interpolation lab", new_column=True)
     before, after = _rows(gradebook), _rows(target)
     # every row and column as exported, one column added at the end
     assert [row[:-1] for row in after] == before
@@ -116,7 +117,7 @@ def test_a_new_canvas_column_holds_the_totals_and_everything_else_is_kept(out, i
 
 def test_canvas_lists_everyone_who_got_nothing(out, inputs, tmp_path):
     gradebook, roster = inputs
-    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", column="Lab 8")
     assert export.not_graded == {"carl": "its grading crashed twice"}
     assert sorted(export.not_in_roster) == sorted(["dora", ESCAPE])
     assert export.no_submission == [("eve", "1005"), ("gus", "1007")]
@@ -131,7 +132,7 @@ def test_canvas_lists_everyone_who_got_nothing(out, inputs, tmp_path):
 
 def test_the_summary_has_every_student_once_and_neutralises_formula_names(out, inputs, tmp_path):
     gradebook, roster = inputs
-    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", column="Lab 8")
     assert export.summary_path == tmp_path / "import-summary.csv"
     rows = _rows(export.summary_path)
     assert rows[0] == ["submission", "id", "points", "status"]
@@ -171,12 +172,65 @@ def test_an_existing_canvas_column_is_filled_and_a_cell_without_a_grade_is_left_
     assert _rows(tmp_path / "again.csv") == after and again.column == "Lab 8 (777)"
 
 
+def test_a_column_the_gradebook_lacks_is_refused_with_its_assignments_unless_new_column_is_given(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    grades = read_results([out])
+    message = _refused(
+        tmp_path,
+        lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column="Lab 9"),
+        "has no assignment column named 'Lab 9'",
+        "its assignment columns are 'Quiz 1 (501)', 'Lab 8 (777)'.",
+        "--new-column",
+    )
+    # the totals are not assignments, and the student columns are not listed
+    assert "Current Score" not in message and "Final Score" not in message and "Section" not in message
+    # the default column is no exception: a gradebook without a 'labkit' column is not given one silently
+    _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv"), "named 'labkit'")
+    # asked for on purpose, the column is added
+    export = lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column="Lab 9", new_column=True)
+    assert _rows(tmp_path / "x.csv")[0][-1] == "Lab 9" and export.column == "Lab 9"
+
+
+def test_new_column_refuses_a_column_the_gradebook_has(out, inputs, tmp_path):
+    gradebook, roster = inputs
+    grades = read_results([out])
+    for column in ("Lab 8", "Lab 8 (777)", " lab 8 ".upper().title()):
+        _refused(
+            tmp_path,
+            lambda c=column: lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column=c, new_column=True),
+            "already has the assignment column 'Lab 8 (777)'",
+            "leave out --new-column to fill it",
+        )
+
+
+def test_the_assignments_listed_in_the_refusal_are_bounded_and_printable(out, tmp_path):
+    names = [f"Quiz {i} \x1b[2J (50{i})" for i in range(lms.MAX_LISTED + 7)] + ["Current Score"]
+    header = "Student,ID,Section," + ",".join(names)
+    points = "    Points Possible,,," + ",".join(["5"] * (len(names) - 1)) + ",(read only)"
+    gradebook = _write(tmp_path / "gradebook.csv", f"{header}\n{points}\nAda,1001,A{',' * len(names)}\n")
+    roster = _write(tmp_path / "roster.csv", "submission,id\nada,1001\n")
+    message = _refused(
+        tmp_path,
+        lambda: lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "x.csv", column="Exam"),
+        "and 7 more",
+    )
+    assert "\x1b" not in message and message.count("'Quiz") == lms.MAX_LISTED
+    empty = _write(tmp_path / "empty.csv", "Student,ID,Section,Current Score\nAda,1001,A,\n")
+    _refused(
+        tmp_path,
+        lambda: lms.to_canvas(read_results([out]), empty, roster, tmp_path / "x.csv", column="Quiz"),
+        "it has no assignment column yet",
+    )
+
+
 def test_the_roster_can_match_canvas_on_sis_ids(out, tmp_path):
     gradebook = _write(tmp_path / "gradebook.csv", CANVAS)
     roster = _write(
         tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\ndora,dora@uni.example\n"
     )
-    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", key="SIS Login ID")
+    export = lms.to_canvas(
+        read_results([out]), gradebook, roster, tmp_path / "import.csv", key="SIS Login ID", new_column=True
+    )
     rows = {row[1]: row[-1] for row in _rows(tmp_path / "import.csv")[3:]}
     assert rows["1001"] == "104" and rows["1002"] == "17.5" and rows["1003"] == ""
     # dora was graded, but no row of the gradebook has her login: listed, and her total is in the summary
@@ -197,7 +251,7 @@ def test_a_semicolon_export_keeps_its_separator_and_decimal_commas(out, tmp_path
     )
     gradebook = _write(tmp_path / "gradebook.csv", text)
     roster = _write(tmp_path / "roster.csv", "submission;id\nada;1001\nbob;1002\n")
-    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", new_column=True)
     written = (tmp_path / "import.csv").read_bytes().decode("utf-8")
     assert not written.startswith("\ufeff")  # no byte-order mark where the export had none
     assert written == (
@@ -236,6 +290,47 @@ def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
     assert rows[2][2] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"
 
 
+def _late_grades():
+    """The lab's rubric with a [late] table (10% per started day, at most 50%), and four submissions."""
+    rubric = dataclasses.replace(
+        LAB, late=late.from_dict({"deadline": "2026-12-01T23:59:00+01:00", "per": "day", "percent": 10, "cap": 50})
+    )
+    full = {n: 1.0 for n in (2, 3, 4, *SPLINES)}
+
+    def handed_in(text):
+        return late.SubmissionTime(late.parse_deadline(text), late.FROM_CSV)
+
+    return [
+        # 104 points (100 + 4 extra credit), 1 day 8 h late: 2 started days, 20% off: 104 - 20.8 = 83.2
+        SubmissionGrade("ada", _results({**full, 16: 0.5}), rubric=rubric, time=handed_in("2026-12-03T08:00+01:00")),
+        # 17.5 points, on time
+        SubmissionGrade("bob", _results({2: 1.0, 3: 0.5}), rubric=rubric, time=handed_in("2026-12-01T20:00+01:00")),
+        # 100 points, 6 days 10 h late: 7 started days, 70% capped at 50%: 100 - 50 = 50
+        SubmissionGrade("cy", _results(full), rubric=rubric, time=handed_in("2026-12-08T10:00+01:00")),
+        # 10 points, no known time: not penalised
+        SubmissionGrade("dee", _results({2: 1.0}), rubric=rubric),
+    ]
+
+
+def test_moodle_feedback_begins_with_the_grade_after_the_late_penalty_and_states_the_penalty(tmp_path):
+    roster = _write(tmp_path / "roster.csv", "submission,id\nada,S1\nbob,S2\ncy,S3\ndee,S4\n")
+    lms.to_moodle(_late_grades(), roster, tmp_path / "moodle.csv", feedback=True)
+    rows = {row[0]: row[1:] for row in _rows(tmp_path / "moodle.csv")[1:]}
+    assert {key: grade for key, (grade, _) in rows.items()} == {"S1": "83.2", "S2": "17.5", "S3": "50", "S4": "10"}
+    for grade, feedback in rows.values():
+        assert feedback.split(" ")[0] == grade  # the first number is the grade beside it
+    assert rows["S1"][1] == (
+        "83.2 points: 104 (100 of 100 for full credit, and 4 of extra credit) less 20.8 for late work "
+        "(2 started days, 20% off) (labkit grade)"
+    )
+    assert rows["S3"][1] == (
+        "50 points: 100 (100 of 100 for full credit) less 50 for late work (7 started days, 50% off, the cap) "
+        "(labkit grade)"
+    )
+    assert rows["S2"][1] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"  # on time: nothing to say
+    assert "late" not in rows["S4"][1]
+
+
 def test_another_rubric_than_the_runs_is_refused_and_none_needed(out, inputs, tmp_path):
     rubric = tmp_path / "rubric.toml"
     rubric.write_text("required = [2, 3]\n[points]\n2 = 50\n3 = 50\n")
@@ -244,7 +339,7 @@ def test_another_rubric_than_the_runs_is_refused_and_none_needed(out, inputs, tm
     assert run.returncode == 2 and "differs from it in its exercises, groups or points" in run.stderr, run.stderr
     assert not (tmp_path / "x.csv").exists()
     # without --rubric, the run's own: the column holds grades.csv's totals
-    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv")
+    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", new_column=True)
     with open(out / "grades.csv", newline="", encoding="utf-8") as handle:
         totals = {row["submission"]: row["total"] for row in csv.DictReader(handle)}
     exported = {row[1]: row[-1] for row in _rows(tmp_path / "import.csv")[1:]}
@@ -336,8 +431,10 @@ def test_canvas_columns_and_ids_that_cannot_be_filled_are_refused(out, inputs, t
     )
     refused("has no 'SIS User ID' column", book=no_sis, key="SIS User ID")
     twice = _write(tmp_path / "twice.csv", CANVAS.replace('"Fourier, Frank",1004', '"Fourier, Frank",1001'))
-    refused("has two rows with ID '1001' (rows 4 and 9)", book=twice)
-    refused("no submission of the results matched a row", key="SIS User ID")  # the roster holds Canvas IDs
+    refused("has two rows with ID '1001' (rows 4 and 9)", book=twice, column="Lab 8")
+    refused(
+        "no submission of the results matched a row", key="SIS User ID", column="Lab 8"
+    )  # the roster holds Canvas IDs
 
 
 def test_an_output_is_never_an_input_nor_an_existing_file_unless_forced(out, inputs, tmp_path):
@@ -349,7 +446,7 @@ def test_an_output_is_never_an_input_nor_an_existing_file_unless_forced(out, inp
     target = _write(tmp_path / "import.csv", "my earlier export")
     _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, target), "already exists", "--force")
     _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "no" / "x.csv"), "does not exist")
-    lms.to_canvas(grades, gradebook, roster, target, force=True)
+    lms.to_canvas(grades, gradebook, roster, target, force=True, new_column=True)
     assert _rows(target)[0][-1] == "labkit" and gradebook.read_text(encoding="utf-8") == CANVAS
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "gradebook.csv",
@@ -370,6 +467,36 @@ def test_moodle_refuses_ids_that_are_not_what_the_key_says(out, tmp_path):
     nobody = _write(tmp_path / "roster.csv", "submission,id\ncarl,S1003\n")  # only a student who was not graded
     _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv"), "no graded submission")
     _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv", key="ID"), "idnumber or email")
+
+
+def test_moodle_refuses_email_addresses_under_the_id_number_key(out, tmp_path):
+    grades = read_results([out])
+    emails = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
+    message = _refused(
+        tmp_path,
+        lambda: lms.to_moodle(grades, emails, tmp_path / "m.csv"),  # key="idnumber", the default
+        "holds email addresses (e.g. 'ada' ('ada@uni.example'), 'bob' ('bob@uni.example')), not ID numbers",
+        "give --key email",
+    )
+    assert "ID number column" in message
+    mixed = _write(
+        tmp_path / "roster.csv",
+        f"submission,id\nada,S1001\nbob,bob@uni.example\ncarl,S1003\n{ESCAPE},m\x1b[2J@uni.example\n",
+    )
+    message = _refused(
+        tmp_path,
+        lambda: lms.to_moodle(grades, mixed, tmp_path / "m.csv", key="idnumber"),
+        "mixes email addresses (2 of 4: 'bob' ('bob@uni.example'), 'mal\ufffd[2Jory' ('m\ufffd[2J@uni.example'))",
+        "with other ids (e.g. 'ada' ('S1001'), 'carl' ('S1003'))",
+        "correct those rows",
+    )
+    assert "\x1b" not in message
+    # and under --key email, the ID numbers among the addresses are refused as before
+    _refused(tmp_path, lambda: lms.to_moodle(grades, mixed, tmp_path / "m.csv", key="email"), "not an email address")
+    # the same roster of addresses, under the key that says so, is exported
+    emails = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
+    export = lms.to_moodle(grades, emails, tmp_path / "m.csv", key="email")
+    assert export.exported == {"ada": ("ada@uni.example", 104.0), "bob": ("bob@uni.example", 17.5)}
 
 
 # --- the command ------------------------------------------------------------------------------------------------
@@ -402,6 +529,23 @@ def test_labkit_export_canvas_writes_next_to_out_and_lists_on_stderr(out, tmp_pa
     # a second run refuses to replace the file
     again = _cli(run_dir, "--canvas", gradebook, "--roster", roster)
     assert again.returncode == 2 and "already exists" in again.stderr and again.stdout == ""
+
+
+def test_labkit_export_adds_a_canvas_column_only_with_new_column(tmp_path):
+    run_dir = tmp_path / "grades"
+    write_report(run_dir, _grades())
+    gradebook = _write(tmp_path / "gradebook.csv", CANVAS)
+    roster = _write(tmp_path / "roster.csv", ROSTER)
+    typo = _cli(run_dir, "--canvas", gradebook, "--roster", roster, "--column", "Lab 88")
+    assert typo.returncode == 2 and "has no assignment column named 'Lab 88'" in typo.stderr
+    assert "'Lab 8 (777)'" in typo.stderr and "--new-column" in typo.stderr
+    assert not (tmp_path / "grades-canvas.csv").exists()
+    run = _cli(run_dir, "--canvas", gradebook, "--roster", roster, "--column", "Lab 88", "--new-column")
+    assert run.returncode == 1, run.stderr
+    rows = _rows(tmp_path / "grades-canvas.csv")
+    assert rows[0][-1] == "Lab 88" and rows[2][-1] == "100" and rows[3][-1] == "104"
+    moodle = _cli(run_dir, "--moodle", "--roster", roster, "--new-column", "--out", tmp_path / "m.csv")
+    assert moodle.returncode == 2 and "--new-column is for --canvas" in moodle.stderr
 
 
 def test_labkit_export_moodle_exits_0_when_everyone_matched(tmp_path):

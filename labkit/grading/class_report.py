@@ -2,12 +2,17 @@
 
 :func:`read` reads a grading run's ``results/`` back (a merged run's too),
 :func:`summarise` counts what the class did, and :func:`write` writes
-``OUT/report.html``: the distribution of totals, each exercise's and part's
+``OUT/report.html``: the distribution of totals (after any late penalty:
+``grades.csv``'s ``total``), with a rubric's ``[late]`` table a late view
+(who was late, by how much and what it cost, extensions, unknown times and
+times the student supplied, :class:`LateSummary`), each exercise's and part's
 pass rate, the slips the checks named (most frequent first, with who made
 them), the problems (time limits, crashes, cells that raised, refused
 references, ...), the students with the most failed parts, and pairs of
 similar code side by side (:mod:`labkit.grading.similarity`; similarity never
-changes a grade, it is for a person to judge).
+changes a grade, it is for a person to judge). Without copydetect, which the
+similarity search needs, the page is written all the same and its similar code
+section says "not computed", and why.
 
 The page needs nothing but itself: its figures are inline PNG images drawn
 with matplotlib's Agg canvas (no pyplot state), its style and its one small
@@ -29,12 +34,14 @@ import tempfile
 from collections import defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from datetime import datetime, timedelta
 from pathlib import Path
 
+from . import late as lateness
 from .record import rubric_for
 from .report import SubmissionGrade, one_line, printable, read_results
 from .rubric import Rubric, points_text
-from .similarity import DEFAULT_THRESHOLD, Pair
+from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
 
 REPORT = "report.html"
 MAX_SUBMISSIONS = 20_000  # result files in one folder
@@ -178,6 +185,123 @@ class Struggle:
     not_done: int  # parts left as released or not defined, counted apart
 
 
+def _student_supplied(time: lateness.SubmissionTime | None) -> bool:
+    """Whether a submission's time is the student's own word rather than the instructor's or the LMS's.
+
+    The ``timestamp.txt`` in a submission is written by the student's own process (nbgrader's submit step
+    runs as the student), and a notebook's modification time is whatever the student's files say
+    (:data:`labkit.grading.late.STUDENT_SUPPLIED`); the LMS's ``--times`` and nbgrader's exchange, read by
+    labkit itself, are not. The one place that decides it, for the report's late view.
+
+    Examples
+    --------
+    >>> from labkit.grading.late import FROM_CSV, FROM_MTIME, SubmissionTime
+    >>> _student_supplied(SubmissionTime(None, FROM_MTIME)), _student_supplied(SubmissionTime(None, FROM_CSV))
+    (True, False)
+    """
+    return time is not None and time.source in lateness.STUDENT_SUPPLIED
+
+
+@dataclass(frozen=True)
+class LateEntry:
+    """One graded submission under the rubric's late rule, as the instructor sees it (extensions named)."""
+
+    student: str
+    deadline: datetime  # the student's deadline: the rubric's, or their extension
+    extended: bool
+    submitted: datetime | None  # None when the time is unknown
+    source: str | None  # where the time came from (labkit.grading.late's FROM_...)
+    late_by: timedelta | None  # None when the time is unknown; zero or less when on time
+    units: int  # started days or hours counted (0: on time, within the grace, or unknown)
+    percent: float  # the penalty in percent of raw_total
+    penalty: float  # points off
+    raw_total: float  # the points before the penalty
+    total: float  # after it: grades.csv's total
+    note: str  # what the late rule made of it, as grades.csv says
+    student_supplied: bool  # the time is the student's own word (:func:`_student_supplied`)
+
+    @property
+    def known(self):
+        return self.late_by is not None
+
+    @property
+    def late(self):
+        """Late past the deadline and its grace (so penalised, unless it had no points)."""
+        return self.units > 0
+
+
+@dataclass(frozen=True)
+class LateSummary:
+    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission."""
+
+    rule: lateness.Late
+    entries: tuple  # LateEntry, by name
+
+    @property
+    def late(self):
+        """The late submissions, latest first."""
+        return sorted((e for e in self.entries if e.late), key=lambda e: (-e.late_by, e.student))
+
+    @property
+    def on_time(self):
+        return [e for e in self.entries if e.known and not e.late]
+
+    @property
+    def within_grace(self):
+        return [e for e in self.on_time if e.late_by > timedelta(0)]
+
+    @property
+    def unknown(self):
+        return [e for e in self.entries if not e.known]
+
+    @property
+    def extended(self):
+        return [e for e in self.entries if e.extended]
+
+    @property
+    def student_supplied(self):
+        """Submissions whose known time the student supplied (an unknown time is listed as unknown)."""
+        return [e for e in self.entries if e.known and e.student_supplied]
+
+    @property
+    def penalty(self):
+        """Points taken off the class in all."""
+        return round(sum(e.penalty for e in self.entries), 2)
+
+    @property
+    def unused_extensions(self):
+        """Names in ``[late.extensions]`` that no graded submission has (a typo in the rubric?)."""
+        names = {e.student for e in self.entries}
+        return [name for name, _ in self.rule.extensions if name not in names]
+
+
+def _late_summary(rubric, graded):
+    if rubric.late is None:
+        return None
+    entries = []
+    for grade in sorted(graded, key=lambda g: g.name):
+        late = grade.lateness
+        time = late.time
+        entries.append(
+            LateEntry(
+                student=grade.name,
+                deadline=late.deadline,
+                extended=late.extended,
+                submitted=time.when if time is not None else None,
+                source=time.source if time is not None else None,
+                late_by=late.late_by,
+                units=late.units,
+                percent=late.percent,
+                penalty=late.penalty,
+                raw_total=late.raw_total,
+                total=late.total,
+                note=late.note,
+                student_supplied=_student_supplied(time),
+            )
+        )
+    return LateSummary(rubric.late, tuple(entries))
+
+
 @dataclass
 class ClassSummary:
     """Everything the page shows, counted from the grades (see :func:`summarise`)."""
@@ -191,6 +315,7 @@ class ClassSummary:
     problems: dict  # kind -> [Problem], by student
     most_failed: list  # Struggle, most failed parts first
     seeds: list = field(default_factory=list)
+    late: LateSummary | None = None  # the late view, when the rubric has a [late] table
 
     @property
     def submissions(self):
@@ -498,6 +623,7 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
         problems={kind: rows for kind, rows in by_kind.items() if rows},
         most_failed=struggles[:MOST_FAILED],
         seeds=sorted({g.seed for g in grades if isinstance(g.seed, int)}),
+        late=_late_summary(rubric, graded),
     )
 
 
@@ -704,6 +830,11 @@ def _totals_section(summary):
     parts.append('<table class="narrow"><caption>The totals in figures</caption><tbody>')
     parts += [f'<tr><th scope="row">{html.escape(k)}</th><td class="num">{v}</td></tr>' for k, v in rows]
     parts.append("</tbody></table></div>")
+    if summary.late is not None:
+        parts.append(
+            "<p>The totals are after the late penalty, as in grades.csv's <code>total</code> column; "
+            '<a href="#late">Late work</a> gives the points before it.</p>'
+        )
     parts.append(
         '<details><summary>The histogram as a table</summary><table class="narrow"><caption>Submissions per '
         'range of totals</caption><thead><tr><th scope="col">total points</th><th scope="col">submissions</th>'
@@ -716,6 +847,168 @@ def _totals_section(summary):
     ]
     parts.append("</tbody></table></details></section>")
     return "".join(parts)
+
+
+def _when(moment, rule):
+    """A moment in the deadline's offset, as grades.csv writes it (or a dash when unknown)."""
+    return "&ndash;" if moment is None else _e(lateness.time_text(moment, rule.deadline.tzinfo), 60)
+
+
+def _units(entry, rule):
+    return f"{entry.units} started {rule.per}{'' if entry.units == 1 else 's'}"
+
+
+def _table(caption, columns, rows):
+    """A table with a caption and column headers; each row's first cell is its header. Bounded."""
+    head = "".join(f'<th scope="col">{html.escape(c)}</th>' for c in columns)
+    body = "".join(
+        f'<tr><th scope="row">{row[0]}</th>' + "".join(f"<td{cls}>{cell}</td>" for cls, cell in row[1:]) + "</tr>"
+        for row in rows[:MAX_NAMES]
+    )
+    more = len(rows) - MAX_NAMES
+    tail = f"<p>and {more} more.</p>" if more > 0 else ""
+    return (
+        f"<table><caption>{html.escape(caption)}</caption><thead><tr>{head}</tr></thead>"
+        f"<tbody>{body}</tbody></table>{tail}"
+    )
+
+
+NUM, TEXT = ' class="num"', ""
+
+
+def _late_section(summary):
+    view = summary.late
+    rule = view.rule
+    count = len(view.entries)
+    out = ['<section aria-labelledby="late"><h2 id="late">Late work</h2>']
+    out.append(
+        f"<p>The rubric's rule: {_e(rule.describe())}. The penalty is a share of the submission's own points "
+        "(extra credit included), taken off its total; every total on this page and in grades.csv is after it. "
+        "Extensions are named here, for you; no student's feedback names another's.</p>"
+    )
+    if not count:
+        out.append("<p>No submission could be graded, so there is nothing to say about lateness.</p></section>")
+        return "".join(out)
+    late = view.late
+    figures = [
+        ("graded submissions", str(count)),
+        ("on time", f"{len(view.on_time)}" + (f" ({len(view.within_grace)} within the grace)" if rule.grace else "")),
+        ("late", str(len(late))),
+        ("points taken off, in all", points_text(view.penalty)),
+        ("with an extension", str(len(view.extended))),
+        ("no known time (not penalised)", str(len(view.unknown))),
+        ("a time the student supplied", str(len(view.student_supplied))),
+    ]
+    out.append('<table class="narrow"><caption>Late work in figures</caption><tbody>')
+    out += [f'<tr><th scope="row">{html.escape(k)}</th><td class="num">{v}</td></tr>' for k, v in figures]
+    out.append("</tbody></table>")
+
+    out.append(f'<h3 id="late-late">Late: {len(late)} submission{"" if len(late) == 1 else "s"}</h3>')
+    if late:
+        rows = [
+            (
+                _e(e.student, MAX_NAME),
+                (TEXT, _when(e.deadline, rule) + (" (extension)" if e.extended else "")),
+                (TEXT, _when(e.submitted, rule)),
+                (TEXT, _e(e.source or "", 60)),
+                (TEXT, _e(lateness.duration_text(e.late_by), 60)),
+                (NUM, _units(e, rule)),
+                (NUM, f"{points_text(e.percent)}%"),
+                (NUM, points_text(e.penalty)),
+                (NUM, points_text(e.raw_total)),
+                (NUM, points_text(e.total)),
+            )
+            for e in late
+        ]
+        out.append(
+            _table(
+                "Late submissions, latest first",
+                [
+                    "student",
+                    "deadline",
+                    "handed in",
+                    "time from",
+                    "late by",
+                    "counted",
+                    "penalty (percent)",
+                    "penalty (points)",
+                    "points before",
+                    "total",
+                ],
+                rows,
+            )
+        )
+    else:
+        out.append("<p>No submission was late.</p>")
+
+    extended = view.extended
+    out.append(
+        f'<h3 id="late-extensions">Extensions: {len(extended)} submission{"" if len(extended) == 1 else "s"}</h3>'
+    )
+    if extended:
+        rows = [
+            (
+                _e(e.student, MAX_NAME),
+                (TEXT, _when(e.deadline, rule)),
+                (TEXT, _when(e.submitted, rule)),
+                (TEXT, _e(e.note)),
+            )
+            for e in extended
+        ]
+        out.append(
+            _table("Submissions with an extension", ["student", "their deadline", "handed in", "lateness"], rows)
+        )
+    else:
+        out.append("<p>No graded submission has an extension.</p>")
+    unused = view.unused_extensions
+    if unused:
+        out.append(
+            f"<p>The rubric's <code>[late.extensions]</code> names {len(unused)} submission"
+            f"{'' if len(unused) == 1 else 's'} this run has no graded result for (a misspelt name?): "
+            f"{_names(unused, 'names')}.</p>"
+        )
+
+    unknown = view.unknown
+    out.append(f'<h3 id="late-unknown">No known time: {len(unknown)} submission{"" if len(unknown) == 1 else "s"}</h3>')
+    if unknown:
+        out.append(
+            "<p>Graded and not penalised. Give their times in <code>--times TIMES.csv</code> and merge again "
+            "(<code>labkit grade --merge</code>) to apply the rule.</p>"
+        )
+        rows = [(_e(e.student, MAX_NAME), (TEXT, _e(e.note))) for e in unknown]
+        out.append(_table("Submissions with no known time", ["student", "why"], rows))
+    else:
+        out.append("<p>Every graded submission has a time.</p>")
+
+    supplied = view.student_supplied
+    out.append(
+        f'<h3 id="late-supplied">Times the student supplied: {len(supplied)} submission'
+        f"{'' if len(supplied) == 1 else 's'}</h3>"
+    )
+    if supplied:
+        out.append(
+            "<p>These times come from the submission itself (nbgrader's <code>timestamp.txt</code> in the folder, "
+            "or the notebooks' modification time), so a student could have set them. Check them against the "
+            "LMS, and give the right ones in <code>--times</code> where they differ.</p>"
+        )
+        rows = [
+            (
+                _e(e.student, MAX_NAME),
+                (TEXT, _e(e.source or "", 60)),
+                (TEXT, _when(e.submitted, rule)),
+                (TEXT, _e(e.note)),
+            )
+            for e in supplied
+        ]
+        out.append(
+            _table(
+                "Submissions whose time the student supplied", ["student", "time from", "handed in", "lateness"], rows
+            )
+        )
+    else:
+        out.append("<p>No time came from the submission itself.</p>")
+    out.append("</section>")
+    return "".join(out)
 
 
 def _rates_section(summary):
@@ -980,7 +1273,8 @@ def render(
     threshold : float
         The similarity from which pairs were listed (said on the page).
     similarity_note : str, optional
-        Why the pairs were not computed, when `pairs` is None.
+        Why the pairs were not computed, when `pairs` is None; when not given, the reason the similarity
+        search cannot run here, if it cannot (:func:`labkit.grading.similarity.unavailable`).
 
     Returns
     -------
@@ -989,10 +1283,13 @@ def render(
     if not isinstance(summary, ClassSummary):
         raise ValueError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
     pairs = _check_pairs(pairs)
+    if pairs is None and similarity_note is None:
+        similarity_note = unavailable()
     rubric = summary.rubric
     seeds = ", ".join(str(s) for s in summary.seeds[:20]) or "not recorded"
     sections = [
         ("totals", "Totals"),
+        *([("late", "Late work")] if summary.late is not None else []),
         ("pass-rates", "Pass rates"),
         ("slips", "Slips the checks named"),
         ("problems", "Problems"),
@@ -1015,6 +1312,7 @@ def render(
         + "\n".join(
             [
                 _totals_section(summary),
+                *([_late_section(summary)] if summary.late is not None else []),
                 _rates_section(summary),
                 _slips_section(summary),
                 _problems_section(summary),

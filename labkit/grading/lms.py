@@ -19,6 +19,17 @@ Canvas's own user number, by default; or ``SIS User ID`` or ``SIS Login
 ID``), for Moodle the user field (``idnumber`` by default, or ``email``).
 A submission and an identifier may each appear once.
 
+For Moodle the ids are checked against the key, because Moodle matches them
+only against the field it is told and a wrong field stops the whole import:
+with ``--key email`` every id must look like an email address (something,
+``@``, a domain with a dot); with ``--key idnumber`` none may. A roster of
+email addresses under the default ``idnumber`` is refused with the advice to
+give ``--key email``; a roster that mixes email addresses with other ids is
+refused under either key (under ``idnumber`` the email rows would match no
+student, under ``email`` the others), naming a few rows of each kind to
+correct. (A site whose ID numbers are the users' email addresses exports
+with ``--key email``.)
+
 Canvas's gradebook CSV, as this module relies on it
 ---------------------------------------------------
 Sources: Instructure's Canvas Instructor Guide, "How do I import grades in the
@@ -60,9 +71,18 @@ for the exact strings and rules. In my words:
 
 So the file written here is the export itself, every row and column as it
 was, with one assignment column filled in: the column named ``--column``
-(its title with or without the ``(number)``), or, when there is none, a new
-column at the end whose ``Points Possible`` cell is the rubric's full credit.
-The separator, byte-order mark and line endings are the export's.
+(its title with or without the ``(number)``). Because Canvas makes a new
+assignment of any header it does not know, a ``--column`` that matches no
+assignment column is refused, and the message lists the gradebook's
+assignment columns (at most :data:`MAX_LISTED`, each shown on one printable
+line): a typo never creates an assignment. A new column is added only on
+purpose, with ``--new-column`` (``new_column=True``): at the end, its
+``Points Possible`` cell the rubric's full credit. ``--new-column`` with the
+title of a column the gradebook already has is refused too, rather than
+filling that column: Canvas would match the title to the existing
+assignment, so the file would not do what was asked; leave out
+``--new-column`` to fill it. The separator, byte-order mark and line endings
+are the export's.
 
 Moodle's grade import, as this module relies on it
 --------------------------------------------------
@@ -81,7 +101,12 @@ so feedback always comes with the grade.
 
 The file written here has the columns ``ID number`` (or ``Email address``),
 the grade item named ``--column``, and with ``--feedback`` a ``Feedback``
-column (the points in words). Only students with a grade are in it: the
+column (the points in words). The feedback begins with the grade written
+beside it, so that the two never disagree: with a rubric's ``[late]`` table
+that is the total after the late penalty, followed by the points before it
+and the penalty (points, started days or hours, percent), e.g. ``94.4
+points: 118 (100 of 100 for full credit, and 18 of extra credit) less 23.6
+for late work (2 started days, 20% off) (labkit grade)``. Only students with a grade are in it: the
 others keep what Moodle has.
 
 What is listed
@@ -99,7 +124,8 @@ the LMS has them. Names from submissions reach the summary through
 
 Bad input (a roster without its columns or with a name or identifier twice,
 a gradebook that is not Canvas's CSV or not UTF-8, an assignment column that
-is read-only or ambiguous) raises a ``ValueError`` that says what to fix, and
+is read-only, ambiguous, missing without ``--new-column`` or present with it)
+raises a ``ValueError`` that says what to fix, and
 then nothing is written. The output never replaces an input file, nor an
 existing file unless ``force`` is given; it is written to a temporary file
 and renamed into place.
@@ -129,7 +155,9 @@ CANVAS_TOTALS = re.compile(
     "Override Score|Override Grade|Override Status"
 )
 SUMMARY_HEADER = ["submission", "id", "points", "status"]
+EMAIL = re.compile(r"[^@\s]+@[^@\s]+\.[^@\s]+")  # what looks like an email address, for --key
 XLSX_MAGIC = b"PK\x03\x04"
+MAX_LISTED = 20  # assignment columns named in a message
 
 
 @dataclass
@@ -495,6 +523,38 @@ def _assignment_column(book, column, path):
     return found[0] if found else None
 
 
+def assignment_columns(book: CanvasGradebook) -> list[str]:
+    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only.
+
+    Examples
+    --------
+    >>> book = CanvasGradebook(
+    ...     ["Student", "ID", "Section", "Quiz 1 (501)", "Current Score"],
+    ...     [["    Points Possible", "", "", "10", "(read only)"]], ",", "\\n", False, 2)
+    >>> assignment_columns(book)
+    ['Quiz 1 (501)']
+    """
+    points_row = next((row for row in book.rows if row and book.kind(row) == "points"), None)
+    return [
+        cell.strip()
+        for i, cell in enumerate(book.header)
+        if i > book.section
+        and cell.strip()
+        and CANVAS_TOTALS.search(cell) is None
+        and not (points_row and "read only" in points_row[i].lower())
+    ]
+
+
+def _assignments_text(book):
+    """The gradebook's assignment columns in words, for a message: bounded, each name on one printable line."""
+    names = assignment_columns(book)
+    if not names:
+        return "it has no assignment column yet"
+    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
+    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
+    return f"its assignment columns are {shown}{more}"
+
+
 def _write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
     """Write `rows` as CSV: to a temporary file beside `path`, renamed into place when complete (checked by
     :func:`_check_outputs` first)."""
@@ -576,6 +636,7 @@ def to_canvas(
     *,
     column: str = DEFAULT_COLUMN,
     key: str = "ID",
+    new_column: bool = False,
     force: bool = False,
 ) -> Export:
     """Fill one assignment column of a Canvas gradebook export with the grades' totals.
@@ -591,10 +652,15 @@ def to_canvas(
     out : path
         The file to write, for Canvas's Grades > Import; the summary CSV goes beside it (:func:`summary_file`).
     column : str
-        The assignment: an existing column of that title (with or without Canvas's ``(number)``) is
-        filled, else a new column of that name is added at the end, worth the rubric's full credit.
+        The assignment: the existing column of that title (with or without Canvas's ``(number)``) is
+        filled. When the gradebook has none, the export is refused (a mistyped name would otherwise
+        become a new assignment in Canvas), unless `new_column` is given.
     key : {"ID", "SIS User ID", "SIS Login ID"}
         The gradebook column whose values the roster's ids are.
+    new_column : bool
+        Add `column` as a new column at the end, worth the rubric's full credit, which Canvas makes a new
+        assignment on import. Refused when the gradebook already has a column of that title: Canvas would
+        match the title to that assignment anyway, so leave out `new_column` to fill it.
     force : bool
         Replace `out` and its summary if they exist (an input file is never replaced).
 
@@ -607,8 +673,9 @@ def to_canvas(
     ------
     ValueError
         Bad input (see :func:`read_roster` and :func:`read_canvas`), a `key` the export lacks, two gradebook
-        rows with one id, an ambiguous or read-only assignment column, no student matched at all, or an
-        output that exists or is an input. Nothing is written then.
+        rows with one id, an ambiguous or read-only assignment column, a `column` the gradebook lacks
+        without `new_column` (the message lists its assignment columns) or has with it, no student matched
+        at all, or an output that exists or is an input. Nothing is written then.
     """
     if key not in CANVAS_KEYS:
         raise ValueError(f"--key for Canvas is one of {', '.join(CANVAS_KEYS)} (a gradebook column); got {key!r}.")
@@ -635,6 +702,19 @@ def to_canvas(
     target = _assignment_column(book, column, gradebook)
     points_row = next((row for row in book.rows if row and book.kind(row) == "points"), None)
     full_credit = by_name[next(iter(by_name))].rubric.full_credit
+    if target is None and not new_column:
+        raise ValueError(
+            f"{gradebook} has no assignment column named {column!r}; "
+            f"{_assignments_text(book)}. Give one of them with --column (its title, with or "
+            "without the number), or pass --new-column to add a column of that name on purpose (Canvas then "
+            "creates a new assignment when the file is imported)."
+        )
+    if target is not None and new_column:
+        raise ValueError(
+            f"{gradebook} already has the assignment column {one_line(book.header[target], 80)!r}, which "
+            f"--column {column!r} names (Canvas would fill that assignment, not make a new one): leave out "
+            "--new-column to fill it, or give the new assignment another name with --column."
+        )
     if target is None:
         book.header.append(column)
         for row in book.rows:
@@ -714,11 +794,57 @@ def to_canvas(
 
 
 def _feedback(grade):
+    """The points in words, first the grade written beside them (after any late penalty), then how it was made.
+
+    Examples
+    --------
+    >>> from labkit.grading.report import SubmissionGrade
+    >>> _feedback(SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}}))
+    '10 points: 10 of 100 for full credit (labkit grade)'
+    """
     score = grade.score
     extra = f", and {points_text(score.extra_total)} of extra credit" if score.extra_total else ""
+    earned = f"{points_text(score.required + score.counted)} of {points_text(score.full_credit)} for full credit{extra}"
+    lateness = grade.lateness
+    if lateness is None or not lateness.penalty:
+        return f"{points_text(grade.total)} points: {earned} (labkit grade)"
+    rule = grade.rubric.late
+    units = f"{lateness.units} started {rule.per}{'' if lateness.units == 1 else 's'}"
+    capped = ", the cap" if lateness.units * rule.percent > rule.cap else ""
     return (
-        f"{points_text(score.total)} points: {points_text(score.required + score.counted)} of "
-        f"{points_text(score.full_credit)} for full credit{extra} (labkit grade)"
+        f"{points_text(grade.total)} points: {points_text(lateness.raw_total)} ({earned}) less "
+        f"{points_text(lateness.penalty)} for late work ({units}, {points_text(lateness.percent)}% off{capped}) "
+        "(labkit grade)"
+    )
+
+
+def _is_email(value):
+    """Whether an identifier looks like an email address (something, an @, a domain with a dot)."""
+    return EMAIL.fullmatch(value) is not None
+
+
+def _examples(entries, names):
+    """A few roster entries, for a message: each name and id on one printable line."""
+    shown = ", ".join(f"{one_line(name, 40)!r} ({one_line(entries[name], 60)!r})" for name in names[:3])
+    return shown + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+
+
+def _check_id_numbers(entries, roster):
+    """Refuse a roster for ``--key idnumber`` that holds email addresses: all of them, or some among ID numbers."""
+    emails = [name for name, value in entries.items() if _is_email(value)]
+    if not emails:
+        return
+    if len(emails) == len(entries):
+        raise ValueError(
+            f"the roster {roster} holds email addresses (e.g. {_examples(entries, emails)}), not ID numbers, and "
+            "--key idnumber (the default) would write them into Moodle's ID number column: give --key email, "
+            "or give the students' ID numbers in the roster."
+        )
+    others = [name for name in entries if name not in emails]
+    raise ValueError(
+        f"the roster {roster} mixes email addresses ({len(emails)} of {len(entries)}: {_examples(entries, emails)}) "
+        f"with other ids (e.g. {_examples(entries, others)}); with --key idnumber (the default) every id is an ID "
+        "number: correct those rows, or give every student's email address with --key email."
     )
 
 
@@ -748,7 +874,8 @@ def to_moodle(
     column : str
         The header of the points column, to map on import to a grade item (or a new one).
     feedback : bool
-        Add a ``Feedback`` column: the points in words, to map to the item's feedback.
+        Add a ``Feedback`` column: the points in words (the grade first, then how it was made, a late
+        penalty included), to map to the item's feedback.
     force : bool
         Replace `out` and its summary if they exist (the roster is never replaced).
 
@@ -760,8 +887,9 @@ def to_moodle(
     Raises
     ------
     ValueError
-        Bad input (see :func:`read_roster`), an id that is not an email address with ``key="email"`` or that
-        starts like a formula, no student to write, or an output that exists or is an input.
+        Bad input (see :func:`read_roster`), an id that is not an email address with ``key="email"``, a roster
+        with any email address with ``key="idnumber"`` (see the module's description of the roster), an id
+        that starts like a formula, no student to write, or an output that exists or is an input.
     """
     if key not in MOODLE_KEYS:
         raise ValueError(f"--key for Moodle is idnumber or email (the user field of the roster's ids); got {key!r}.")
@@ -769,7 +897,7 @@ def to_moodle(
     by_name = _by_name(grades)
     entries = read_roster(roster)
     for name, value in entries.items():
-        if key == "email" and re.fullmatch(r"[^@\s]+@[^@\s]+\.[^@\s]+", value) is None:
+        if key == "email" and not _is_email(value):
             raise ValueError(
                 f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which is not an "
                 "email address: with --key email every id is one (or use --key idnumber)."
@@ -779,6 +907,8 @@ def to_moodle(
                 f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which starts like "
                 "a spreadsheet formula; correct the roster."
             )
+    if key == "idnumber":
+        _check_id_numbers(entries, roster)
     out = Path(out)
     export = Export(out, summary_file(out), "Moodle", column)
     _check_outputs([out, export.summary_path], [roster], force)

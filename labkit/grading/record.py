@@ -201,9 +201,7 @@ def read(folder):
         raise ValueError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
-    return RunRecord(
-        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times
-    )
+    return RunRecord(data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times)
 
 
 def results(folder, record):

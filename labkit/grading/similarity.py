@@ -67,7 +67,34 @@ class Pair:
     shared_second: frozenset
 
 
-def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, progress=None) -> list[Pair]:
+def unavailable() -> str | None:
+    """Why the similarity search cannot run here, or None when it can.
+
+    The search is copydetect's (labkit's ``grade`` extra); without it,
+    :func:`similar_pairs` returns None and the class report says the
+    similar code was not computed, and why.
+
+    Returns
+    -------
+    str or None
+        One line for the report, or None when copydetect can be imported.
+
+    Examples
+    --------
+    >>> unavailable() is None  # labkit's tests install every extra
+    True
+    """
+    try:
+        import copydetect  # noqa: F401
+    except ImportError as exc:
+        return (
+            f"the similarity search needs copydetect, which cannot be imported here ({one_line(exc, 120)}): "
+            "install labkit's grade extra, pip install 'labkit[grade]'"
+        )
+    return None
+
+
+def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, progress=None) -> list[Pair] | None:
     """The pairs of submissions whose versions of a graded function look alike, most similar first.
 
     Each submission's ``sources`` (the graded functions' definitions, kept
@@ -95,9 +122,10 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
 
     Returns
     -------
-    list of Pair
+    list of Pair or None
         By score, highest first (then by function and names); in each pair,
-        ``first`` is the name that sorts first.
+        ``first`` is the name that sorts first. None when copydetect cannot
+        be imported (:func:`unavailable` says why): the search was not made.
 
     Raises
     ------
@@ -121,7 +149,6 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
         grades = list(grades)
     except TypeError:
         raise ValueError(f"grades must be a list of SubmissionGrade; got {type(grades).__name__}.") from None
-    given = boilerplate(release)
     by_function, seen = {}, set()
     for index, grade in enumerate(grades):
         name, sources = getattr(grade, "name", None), getattr(grade, "sources", None)
@@ -140,6 +167,9 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
                     f"({type(function).__name__}: {type(source).__name__})."
                 )
             by_function.setdefault(function, []).append((name, _clean(source)))
+    if unavailable() is not None:
+        return None
+    given = boilerplate(release)
     pairs = []
     for function, versions in by_function.items():
         pairs += _function_pairs(function, versions, given, threshold)
