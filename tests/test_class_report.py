@@ -500,14 +500,14 @@ def test_the_late_view_says_who_was_late_by_how_much_and_what_it_cost(tmp_path):
         "ben 2026-12-01T23:59:00+01:00 2026-12-03T08:00:00+01:00 the --times file 1 day 8 h 1 min "
         "2 started days 20% 20 100 80" in words
     )
-    assert f"{HOSTILE} 2026-12-01T23:59:00+01:00 2026-12-02T03:00:00+01:00 nbgrader's timestamp.txt 3 h 1 min" in words
+    assert f"{HOSTILE} 2026-12-01T23:59:00+01:00 2026-12-02T03:00:00+01:00 {late.FROM_NBGRADER} 3 h 1 min" in words
     assert "1 started day 10% 1 10 9" in words
     assert "Extensions: 1 submission" in words
     assert "cleo 2026-12-03T23:59:00+01:00 2026-12-02T23:00:00+01:00 on time" in words
     assert "names 1 submission this run has no graded result for (a misspelt name?): zed" in words
     assert "No known time: 1 submission" in words and "dev no submission time: not penalised" in words
     assert "Times the student supplied: 1 submission" in words
-    assert f"{HOSTILE} nbgrader's timestamp.txt 2026-12-02T03:00:00+01:00 late by 3 h 1 min" in words
+    assert f"{HOSTILE} {late.FROM_NBGRADER} 2026-12-02T03:00:00+01:00 late by 3 h 1 min" in words
     assert "finn" not in words  # not graded: no lateness
     # escaped, like every name on the page; headed tables; listed in the navigation
     assert HOSTILE not in html and [tag for tag, _ in page.tags].count("script") == 1

@@ -13,6 +13,7 @@ import pytest
 from catalog import MISTAKES, Planted, plant
 from conftest import sandbox_or_skip
 
+from labkit.grading import late
 from labkit.grading import rubric as rubrics
 from labkit.grading.report import SubmissionGrade, safe_name, write_report
 
@@ -61,7 +62,7 @@ def regraded(tmp_path_factory):
     # 1. the class, graded with the course's rubric (no --quiet: its output is not a terminal here)
     first = _cli(
         "grade", str(alice), str(bob), "--out", str(tmp / "class"), "--rubric", str(rubric), "--seed", SEED,
-        "--times", str(times),
+        "--times", str(times), "--times-from-submission",
     )  # fmt: skip
     assert first.returncode == 0, first.stderr
     # 2. alice's notebook fixed (say the collected copy was damaged), graded alone into a folder of its own
@@ -69,8 +70,9 @@ def regraded(tmp_path_factory):
     plant(correct, fixed)
     shutil.copy(alice / "timestamp.txt", fixed / "timestamp.txt")
     again = _cli(
-        "grade", str(fixed), "--out", str(tmp / "regrade-alice"), "--rubric", str(rubric), "--seed", SEED, "--quiet"
-    )
+        "grade", str(fixed), "--out", str(tmp / "regrade-alice"), "--rubric", str(rubric), "--seed", SEED, "--quiet",
+        "--times-from-submission",
+    )  # fmt: skip
     assert again.returncode == 0, again.stderr
     # 3. the two runs merged: the later folder's result for alice replaces the class's
     merged = _cli(
@@ -94,7 +96,8 @@ def test_the_class_run_charges_the_slip_and_the_late_day_from_the_times_file_bef
     assert rows["bob"]["raw total"] == "8" and rows["bob"]["penalty"] == "0.8" and rows["bob"]["total"] == "7.2"
     assert rows["bob"]["submitted"] == "2026-12-02T11:30:00+01:00" and rows["bob"]["hours late"] == "11.52"
     feedback = {name: (tmp / "class" / "feedback" / f"{safe_name(name)}.txt").read_text() for name in rows}
-    assert "handed in 2026-12-01T22:00:00+01:00 (nbgrader's timestamp.txt): on time." in feedback["alice"]
+    assert f"handed in 2026-12-01T22:00:00+01:00 ({late.FROM_NBGRADER}): on time." in feedback["alice"]
+    assert rows["alice"]["time source"] == late.FROM_NBGRADER and "student-supplied" in late.FROM_NBGRADER
     assert "handed in 2026-12-02T11:30:00+01:00 (the --times file): late by 11 h 31 min" in feedback["bob"]
     assert "Total: 7.2 (8 less 0.8 for late work; full credit is 8)" in feedback["bob"]
 
