@@ -270,6 +270,12 @@ def _grade(args):
         if not args.assignment:
             raise ValueError("--times-from-exchange needs --assignment NAME: the assignment's name in nbgrader.")
         exchange = read_exchange(args.times_from_exchange, args.assignment)
+    for given in args.submissions:
+        if given.is_dir() and args.out.resolve().is_relative_to(given.resolve()):
+            raise ValueError(
+                f"--out {args.out} is inside {given}, where it would read as part of a submission: give an --out "
+                "outside it."
+            )
     args.out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=".labkit-unpacked-", dir=args.out) as workspace:
         found = _class(args, Path(workspace))
@@ -330,8 +336,9 @@ def _class(args, workspace):
         for flag, value in (("--assignment", args.assignment), ("--student", args.student)):
             if value:
                 raise ValueError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
-        return _Class(paths)
-    found = intake.find_class(paths[0], workspace, assignment=args.assignment)
+        found = intake.find_students(paths, workspace)
+    else:
+        found = intake.find_class(paths[0], workspace, assignment=args.assignment)
     if args.student:
         names = {student.name for student in found.students}
         unknown = [name for name in args.student if name not in names]
@@ -349,9 +356,10 @@ def _class(args, workspace):
         [student.path for student in gradable],
         [student.name for student in gradable],
         {student.name: student.failure for student in found.students if student.path is None},
-        [f"{found.layout} layout in {paths[0]}: {len(found.students)} student(s)", *found.notes],
+        ([f"{found.layout} layout in {paths[0]}: {len(found.students)} student(s)"] if found.layout != "listed" else [])
+        + found.notes,
         {student.name for student in found.students if student.marked_late},
-    )
+    )  # (a listed submission's name is its folder's or notebook's, as before)
 
 
 def _refused(found, what):

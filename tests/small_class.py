@@ -30,10 +30,15 @@ def plant_small_class(folder):
     return sorted(folder.iterdir(), key=lambda path: grading.scoring.submission_name(path))
 
 
-def cli(*args, env=None, timeout=300):
+def cli(*args, env=None, timeout=300, cwd=None):
     """``labkit`` in a process of its own (as an instructor runs it)."""
     return subprocess.run(
-        [sys.executable, "-m", "labkit.cli", *map(str, args)], capture_output=True, text=True, timeout=timeout, env=env
+        [sys.executable, "-m", "labkit.cli", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+        cwd=cwd,
     )
 
 

@@ -912,6 +912,32 @@ def find_class(
     return Intake(students, layout, notes)
 
 
+def find_students(paths, workspace, *, limits: UnpackLimits = UnpackLimits()) -> Intake:
+    """The students of submissions listed one by one (``labkit grade alice/ bob/ carol.ipynb``).
+
+    Each folder is one student, named after it, whose zips are unpacked into `workspace` (as in
+    :func:`find_class`); a folder with no notebook, even in its zips, is a student with nothing to grade.
+    A notebook, a link or a path that is neither is passed on as it is, for the grader to take or refuse.
+    """
+    workspace = Path(workspace)
+    workspace.mkdir(parents=True, exist_ok=True)
+    notes: list[str] = []
+    builder = _Builder(Path(tempfile.mkdtemp(prefix="listed-", dir=workspace)), limits, notes, 0)
+    students = []
+    for path in map(Path, paths):
+        name = path.stem if path.suffix == ".ipynb" else path.name
+        name = name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+        try:
+            folder = stat.S_ISDIR(os.lstat(path).st_mode)
+        except OSError:
+            folder = False
+        if folder:
+            students.append(builder.from_folder(name, path, "listed"))
+        else:
+            students.append(Student(name, path, None, "listed"))
+    return Intake(students, "listed", notes)
+
+
 def _origin(student):
     if student.lms_id is not None:
         return f"{student.layout} id {one_line(student.lms_id, 40)}"
