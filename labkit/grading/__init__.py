@@ -24,6 +24,7 @@ One module per concern:
 * :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own; resuming, shards;
 * :mod:`~labkit.grading.distributed` - the same on a Dask cluster (``--dask``; the ``labkit[dask]`` extra);
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
+* :mod:`~labkit.grading.record` - a run's record: its rubric, seed, version, the hash of each result it wrote;
 * :mod:`~labkit.grading.class_report` - ``report.html``: the class at a glance (``labkit report OUT``);
 * :mod:`~labkit.grading.lms` - the grades into a Canvas gradebook or a Moodle grade import file.
 
@@ -65,6 +66,7 @@ _MODULES = {
     "options",
     "progress",
     "protocol",
+    "record",
     "refusals",
     "release",
     "remote",
