@@ -89,6 +89,9 @@ def test_times_inside_a_submission_count_only_when_asked_and_are_marked_student_
     assert row["time source"] == late.FROM_NBGRADER and "student-supplied" in row["time source"]
     feedback = (tmp_path / "g2" / "feedback" / f"{safe_name('bob')}.txt").read_text()
     assert "student-supplied" in feedback
+    again = cli("grade", late_one, "--out", tmp_path / "g2", "--quiet")  # resumed: the run's own choice holds
+    assert again.returncode == 0, again.stderr
+    assert rows(tmp_path / "g2")["bob"]["time source"] == late.FROM_NBGRADER
 
 
 def test_a_result_a_submission_writes_into_its_own_output_folder_is_never_merged(submissions, tmp_path):

@@ -136,8 +136,11 @@ def test_links_are_never_followed(tmp_path, workspace):
     os.symlink(outside / "secret.ipynb", cls / "alice" / "linked.ipynb")
     os.symlink(outside, cls / "alice" / "linked_folder")
     intake = find_untouched(tmp_path, cls, workspace)
-    assert [s.name for s in intake.students] == ["alice"]
-    assert any("mallory" in n and "link" in n for n in intake.notes)
+    # mallory, a link, is a student with nothing labkit will read: a "could not be graded" row, never a gap
+    assert [(s.name, s.failure) for s in intake.students] == [
+        ("alice", None),
+        ("mallory", "is a link, and links are never followed"),
+    ]
     with pytest.raises(ValueError, match="symbolic link"):
         os.symlink(cls, tmp_path / "class-link")
         find_class(tmp_path / "class-link", workspace)
@@ -315,12 +318,28 @@ def test_a_class_is_told_from_one_students_folder(tmp_path):
     assert not is_class(tmp_path / "class" / "alice") and not is_class(tmp_path / "class" / "alice" / "a.ipynb")
 
 
-def test_a_lone_reupload_gets_its_name_back(tmp_path, workspace):
+def test_numbered_files_without_their_plain_name_are_all_kept_as_named(tmp_path, workspace):
     folder = tmp_path / "class"
     write_notebook(folder / "lovelaceada_1815_98770_02_convergence-1.ipynb")
+    write_notebook(folder / "lovelaceada_1815_98771_part-1.ipynb")  # two notebooks, not two uploads of one
+    write_notebook(folder / "lovelaceada_1815_98772_part-2.ipynb")
     write_notebook(folder / "lovelaceada_1815_98770_lab-2024.ipynb")
     [ada] = find_untouched(tmp_path, folder, workspace).students
-    assert [p.name for p in notebooks_of(ada)] == ["02_convergence.ipynb", "lab-2024.ipynb"]
+    assert [p.name for p in notebooks_of(ada)] == [
+        "02_convergence-1.ipynb",
+        "lab-2024.ipynb",
+        "part-1.ipynb",
+        "part-2.ipynb",
+    ]
+
+
+def test_a_folder_with_notebooks_of_its_own_and_folders_of_notebooks_is_refused(tmp_path):
+    from labkit.grading.intake import is_class
+
+    write_notebook(tmp_path / "mixed" / "alice" / "a.ipynb")
+    write_notebook(tmp_path / "mixed" / "dave.ipynb")
+    with pytest.raises(ValueError, match="could be a class or one student's work"):
+        is_class(tmp_path / "mixed")
 
 
 # ------------------------------------------------------------------------------------------- Moodle

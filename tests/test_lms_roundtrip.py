@@ -131,7 +131,8 @@ def _lay_out(root):
                 stale_path = scratch / f"{login}-stale.ipynb"
                 nbformat.write(stale, stale_path)
                 archive.write(stale_path, f"{prefix}_06_bilinear.ipynb")  # the first upload
-                archive.write(made, f"{prefix}_06_bilinear-1.ipynb")  # the re-upload: the one that counts
+                newer = f"{login}{'_LATE' if marked else ''}_{uid}_{int(uid) * 7 + 1}"  # Canvas's file ids grow
+                archive.write(made, f"{newer}_06_bilinear-1.ipynb")  # the re-upload: the one that counts
     (root / "canvas-times.csv").write_text(
         "submission,time\n" + "".join(f"{login},{_time(c[2])}\n" for login, c in CANVAS.items())
     )

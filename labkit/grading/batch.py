@@ -58,6 +58,7 @@ from .late import submission_time
 from .options import GradeOptions
 from .progress import Progress
 from .report import FORMAT, SubmissionGrade, labkit_version, one_line, safe_name, write_report, write_result
+from .rubric import DEFAULT as DEFAULT_RUBRIC
 from .rubric import Rubric
 from .rubric import default as default_rubric
 from .rubric import load as load_rubric
@@ -466,6 +467,8 @@ def grade(
     if earlier.record is not None:  # the times an earlier run was given count again, unless given anew
         times = {**earlier.record.given_times("csv"), **(times or {})}
         exchange_times = {**earlier.record.given_times("exchange"), **(exchange_times or {})}
+        times_from_submission = times_from_submission or earlier.record.flags.get("times from submission", False)
+        times_from_mtime = times_from_mtime or earlier.record.flags.get("times from mtime", False)
     handed_in = [
         submission_time(
             path,
@@ -486,6 +489,7 @@ def grade(
         for source, given in (("csv", times), ("exchange", exchange_times))
         if given
     }
+    record.flags = {"times from submission": bool(times_from_submission), "times from mtime": bool(times_from_mtime)}
     records.write(out, record)
     if rubric.text is not None:  # the grading processes read the run's rubric from its record's copy
         options = replace(options, rubric=str((out / records.RUBRIC_COPY).resolve()))
@@ -846,7 +850,7 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
             f"{out} was graded under the rubric recorded there ({recorded.title!r}), and {rubric.source} differs "
             f"from it in {' and '.join(recorded.differences(rubric))}: leave --rubric out to resume that run. "
             f"To grade under {rubric.source}, {how}; to apply only another [late] table to these results, "
-            f"`labkit grade --merge {out} --rubric {rubric.source} --out NEW`."
+            f"`labkit grade --merge {out} --rubric {_file_of(rubric)} --out NEW`."
         )
     if seed is not None and record.seed is not None and int(seed) != int(record.seed):
         raise ValueError(
@@ -871,6 +875,12 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
             continue
         done[name] = grade
     return Resumed(done, record.seed if record.seed is not None else seed, rubric, record, sorted(changed), refused)
+
+
+def _file_of(rubric):
+    """The TOML file a rubric was read from, for a command to show (the lab's own when it names none)."""
+    source = Path(str(rubric.source))
+    return source if source.suffix == ".toml" else DEFAULT_RUBRIC
 
 
 def parse_shard(spec):

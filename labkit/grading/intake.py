@@ -569,8 +569,8 @@ def _folders(root, builder, notes):
     students = []
     for entry in _entries(root):
         name = _text(entry.name)
-        if entry.is_symlink():
-            notes.append(f"ignored {one_line(name)}: a link (links are never followed)")
+        if entry.is_symlink():  # a student all the same, with nothing labkit will read: never a silent gap
+            students.append(Student(name, None, "is a link, and links are never followed", "folders"))
         elif entry.is_dir(follow_symlinks=False):
             students.append(builder.from_folder(name, Path(entry.path), "folders"))
         elif entry.is_file(follow_symlinks=False) and entry.name.endswith(".ipynb"):
@@ -649,28 +649,26 @@ def _canvas(root, builder, notes):
         again = REUPLOAD.match(original)
         if again:
             original, number = again["stem"] + (again["ext"] or ""), int(again["number"])
-        group["files"].setdefault(original, []).append((number, Path(entry.path), match["file"]))
+        group["files"].setdefault(original, []).append((number, Path(entry.path), match["file"], match["fid"]))
     students = []
     logins = [login for login, _ in groups]
     for (login, uid), group in groups.items():
-        if (
-            logins.count(login) > 1
-        ):  # namesakes: Canvas builds the prefix from the name, so the user id tells them apart
+        if logins.count(login) > 1:  # namesakes: Canvas makes the prefix from the name, the user id parts them
             notes.append(f"{one_line(login, 80)} names several Canvas students: each is named {one_line(login, 60)}_ID")
             login = f"{login}_{uid}"
         pieces = []
         for original, versions in sorted(group["files"].items()):
-            versions.sort(key=lambda v: v[0])
-            number, path, given = versions[-1]
+            if not any(number == 0 for number, *_ in versions):
+                # no file of that very name: `part-1` and `part-2` may be two notebooks, not two uploads of one
+                pieces += [(Path(_safe_part(given)), path) for _, path, given, _ in versions]
+                continue
+            versions.sort(key=lambda v: (int(v[3]), v[0]))  # file ids grow with each upload: the last is newest
+            number, path, given, _ = versions[-1]
             if len(versions) > 1:
                 dropped = ", ".join(one_line(v[2], 80) for v in versions[:-1])
                 notes.append(
                     f"{one_line(login, 80)}: kept {one_line(given, 80)} (the newest upload) as "
                     f"{one_line(original, 80)}; older: {dropped}"
-                )
-            elif number:
-                notes.append(
-                    f"{one_line(login, 80)}: {one_line(given, 80)} (a re-upload) named back {one_line(original, 80)}"
                 )
             pieces.append((Path(_safe_part(original)), path))
         student = builder.from_files(login, pieces, "canvas", uid, group["late"])
@@ -787,7 +785,8 @@ def is_class(path: str | os.PathLike) -> bool:
 
     A folder that holds notebooks itself, not named as Canvas or Moodle name a download's files, is one
     student's submission (``labkit grade submitted/alice``); so is a notebook. Every other folder, and every
-    zip, is a class.
+    zip, is a class. A folder that holds both notebooks of its own and folders of notebooks is refused
+    with a ValueError: which of the two it is cannot be told.
 
     >>> import pathlib, tempfile
     >>> root = pathlib.Path(tempfile.mkdtemp())
@@ -804,12 +803,23 @@ def is_class(path: str | os.PathLike) -> bool:
         return path.suffix.lower() == ".zip"
     if not stat.S_ISDIR(info.st_mode):
         return False
+    loose, folders = False, False
     for entry in _entries(path):
         name = _text(entry.name)
-        loose = entry.is_file(follow_symlinks=False) and name.endswith(".ipynb")
-        if loose and not MOODLE_FILE.match(name) and _canvas_match(name) is None:
-            return False
-    return True
+        if entry.is_file(follow_symlinks=False) and name.endswith(".ipynb"):
+            loose = loose or (not MOODLE_FILE.match(name) and _canvas_match(name) is None)
+        elif entry.is_dir(follow_symlinks=False) and not _skipped(entry.name):
+            try:
+                folders = folders or any(f.suffix == ".ipynb" for f in _walk(Path(entry.path)))
+            except ValueError:
+                folders = True
+    if loose and folders:
+        raise ValueError(
+            f"{one_line(_text(str(path)))} holds notebooks of its own and folders of notebooks, so it could be a "
+            "class or one student's work: for a class, list its students (labkit grade --out OUT -- "
+            f"{one_line(_text(str(path)), 60)}/*); for one student, give the notebooks one by one."
+        )
+    return not loose
 
 
 def find_class(

@@ -69,6 +69,7 @@ class RunRecord:
     rubric_text: str = None
     submissions: dict = field(default_factory=dict)
     times: dict = field(default_factory=dict)  # source ("csv", "exchange") -> {name: ISO time}: the times given
+    flags: dict = field(default_factory=dict)  # the run's switches that change grades ("times from submission", ...)
 
     def given_times(self, source):
         """{name: datetime} of the times the run was given from `source` (``"csv"``: ``--times``; ``"exchange"``)."""
@@ -86,6 +87,7 @@ class RunRecord:
             "rubric text": self.rubric_text,
             "submissions": self.submissions,
             "times": self.times,
+            "flags": self.flags,
         }
 
     def rubric_object(self, folder):
@@ -120,15 +122,18 @@ def _replace(path, text):
     os.replace(partial, path)
 
 
-def note(folder, record, name, result_path, content=None, save=True):
-    """Enter submission `name`'s result file (as written, hashed now) into `record`, and write the record
-    (unless `save` is False: the caller writes it when done)."""
-    path = Path(result_path)
-    record.submissions[name] = {
-        "result": path.name,
-        "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
-        "content": content,
-    }
+@dataclass(frozen=True)
+class Written:
+    """A result file as the grader wrote it: its path and the SHA-256 of the bytes it wrote."""
+
+    path: Path
+    sha256: str
+
+
+def note(folder, record, name, written, content=None, save=True):
+    """Enter submission `name`'s result file into `record`, with the hash of what the grader wrote (never
+    read back from the folder), and write the record (unless `save` is False: the caller writes it)."""
+    record.submissions[name] = {"result": written.path.name, "sha256": written.sha256, "content": content}
     if save:
         write(folder, record)
 
@@ -194,14 +199,35 @@ def read(folder):
             raise ValueError("its rubric text is not text")
         times = data.get("times") or {}
         if not isinstance(times, dict) or not all(
-            isinstance(given, dict) and all(isinstance(v, str) for v in given.values()) for given in times.values()
+            isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
+            for given in times.values()
         ):
-            raise ValueError("its times are not times")
+            raise ValueError("its times are not times with a UTC offset")
+        seed = data.get("seed")
+        whole = isinstance(seed, int) and not isinstance(seed, bool)
+        listed = isinstance(seed, list) and all(isinstance(s, int) and not isinstance(s, bool) for s in seed)
+        if not (seed is None or (whole if data["kind"] == "grade" else listed)):
+            raise ValueError(f"its seed is not {'a number' if data['kind'] == 'grade' else 'a list of numbers'}")
+        flags = data.get("flags") or {}
+        if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
+            raise ValueError("its flags are not true or false")
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
-    return RunRecord(data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times)
+    return RunRecord(
+        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags
+    )
+
+
+def _aware(text):
+    """Whether `text` is an ISO 8601 time with a UTC offset."""
+    from datetime import datetime
+
+    try:
+        return datetime.fromisoformat(text).utcoffset() is not None
+    except ValueError:
+        return False
 
 
 def results(folder, record):
@@ -303,11 +329,12 @@ def rubric_for(folders, given, command):
     chosen = given if isinstance(given, rubrics.Rubric) else rubrics.load(given)
     differ = recorded.differences(chosen)
     if differ:
+        file = given if not isinstance(given, rubrics.Rubric) else "FILE"
         raise ValueError(
             f"{first_folder} was graded under the rubric recorded in {first_folder / RECORD} "
             f"({recorded.title!r}), and {chosen.source} differs from it in {' and '.join(differ)}; {command} shows "
             f"grades.csv as graded, so leave --rubric out. To score the class under {chosen.source}: "
-            f"`labkit grade --merge {first_folder} --rubric {chosen.source} --out NEW` when only the [late] table "
+            f"`labkit grade --merge {first_folder} --rubric {file} --out NEW` when only the [late] table "
             f"differs, else grade again with it into a new --out."
         )
     return recorded

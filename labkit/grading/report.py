@@ -374,14 +374,16 @@ def write_csv(path, grades):
 
 def write_result(out_dir, grade):
     """results/<name>.json and feedback/<name>.txt of one submission, each replaced whole (a run killed while
-    writing leaves the earlier file or none, never half of one)."""
+    writing leaves the earlier file or none, never half of one); the result file and the SHA-256 of what was
+    written (:class:`labkit.grading.record.Written`), for the run's record."""
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
     _replace(out / "feedback" / f"{safe_name(grade.name)}.txt", grade.feedback())
     path = out / "results" / f"{safe_name(grade.name)}.json"
-    _replace(path, json.dumps(grade.as_dict(), indent=1))
-    return path
+    text = json.dumps(grade.as_dict(), indent=1)
+    _replace(path, text)
+    return records.Written(path, hashlib.sha256(text.encode("utf-8")).hexdigest())
 
 
 def _replace(path, text):
@@ -399,9 +401,9 @@ def write_report(out_dir, grades, record=None):
         rubric = grades[0].rubric if grades else rubrics.default()
         record = records.new("grade", labkit_version(), _seed_of(grades), rubric)
     for grade in grades:
-        path = write_result(out, grade)
+        written = write_result(out, grade)
         content = record.submissions.get(grade.name, {}).get("content")
-        records.note(out, record, grade.name, path, content, save=False)
+        records.note(out, record, grade.name, written, content, save=False)
     records.write(out, record)
     write_csv(out / "grades.csv", grades)
     return record
