@@ -259,12 +259,16 @@ def _grade(args):
         return 1 if report_failures(grades) or unreadable or grades.refused else 0
     if not args.submissions:
         raise ValueError(
-            "give the class folder (or zip) the LMS gave you, or the submissions one by one (notebooks or folders), "
-            "or --merge DIR... to combine runs."
+            "give the submissions: the class folder (or zip) the LMS gave you, or each submission (notebooks or "
+            "folders), or --merge DIR... to combine runs."
         )
     if args.dask_workers is not None and args.dask != "local":
         raise ValueError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
     options = grade_options(args)
+    if args.shard is not None:
+        from .grading.batch import parse_shard
+
+        parse_shard(args.shard)  # a bad one is refused before anything is read
     exchange = None
     if args.times_from_exchange is not None:
         if not args.assignment:
@@ -345,7 +349,7 @@ def _class(args, workspace):
         if unknown:
             from .grading.report import one_line
 
-            shown = ", ".join(repr(one_line(name, 60)) for name in sorted(names)[:10])
+            shown = ", ".join(repr(one_line(name, 64)) for name in sorted(names)[:10])
             raise ValueError(
                 f"--student {one_line(unknown[0], 60)!r} is not in {paths[0]}; its students are named {shown}"
                 f"{' ...' if len(names) > 10 else ''} (as in grades.csv)."

@@ -528,14 +528,17 @@ def test_the_late_view_says_who_was_late_by_how_much_and_what_it_cost(tmp_path):
     assert "full credit (100) or more 1" in figures  # ben's 100 is 80 after it
     assert "after the late penalty" in figures
     # and the page written by `labkit report` from a results folder says the same
-    write_report(tmp_path, grades)
-    rubric = tmp_path / "rubric.toml"
+    rubric = tmp_path / "course.toml"
     rubric.write_text(
         (Path(class_report.__file__).parent / "rubric.toml").read_text()
         + '\n[late]\ndeadline = "2026-12-01T23:59:00+01:00"\nper = "day"\npercent = 10\ncap = 50\ngrace = 15\n'
         + "[late.extensions]\ncleo = 48\nzed = 24\n"
     )
     assert load(rubric) == grades[0].rubric
+    for grade in grades:
+        grade.rubric = load(rubric)  # as the run read it: its record keeps the rubric's own text
+    write_report(tmp_path, grades)
+    assert main(["report", str(tmp_path), "--quiet"]) == 0  # the recorded rubric: no --rubric needed
     assert main(["report", str(tmp_path), "--rubric", str(rubric), "--quiet"]) == 0
     written = Page((tmp_path / "report.html").read_text())
     assert "points taken off, in all 21" in written.words("late") and "mean 51.5" in written.words("totals")

@@ -481,21 +481,31 @@ def test_merge_keeps_a_later_folders_result_and_refuses_folders_without_results(
     assert [(r.name, r.earlier, r.later) for r in merged.replaced] == [
         ("alice", tmp / "job1" / "results" / result, tmp / "job3" / "results" / result)
     ]
-    with pytest.raises(ValueError, match="holds no results"):
+    with pytest.raises(ValueError, match="has no run record"):
         grading.merge([tmp_path], tmp_path / "m")
     (tmp_path / "results").mkdir()
     (tmp_path / "results" / "x.json").write_text('{"format": "something else"}')
-    with pytest.raises(ValueError, match="is not a labkit grade result"):
+    with pytest.raises(ValueError, match="has no run record"):  # results no run vouches for are never read
         grading.merge([tmp_path], tmp_path / "m")
 
 
-def test_merge_scores_with_the_rubric_it_is_given(two_runs, tmp_path):
-    tmp, *_ = two_runs
+def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp_path, released):
+    solved, bare = tmp_path / "alice.ipynb", tmp_path / "bob.ipynb"
+    shutil.copy(NOTEBOOKS / "06_bilinear.ipynb", solved)
+    shutil.copy(released / "06_bilinear.ipynb", bare)
     rubric = tmp_path / "rubric.toml"
     rubric.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n')
-    run = _cli(
-        "grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"), "--rubric", str(rubric)
+    for path, job in ((solved, "job1"), (bare, "job2")):
+        grading.grade([path], tmp_path / job, jobs=1, seed=4242, progress=False, rubric=rubric)
+    tmp = tmp_path
+    other = tmp_path / "other.toml"
+    other.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 10\n')
+    refused = _cli(
+        "grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"), "--rubric", str(other)
     )
+    assert refused.returncode == 2 and "results of different rubrics" in refused.stderr
+    assert not (tmp_path / "m").exists()
+    run = _cli("grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"))
     assert run.returncode == 0, run.stderr
     with open(tmp_path / "m" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}

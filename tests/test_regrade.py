@@ -136,5 +136,10 @@ def test_results_of_another_rubric_or_another_labkit_version_are_refused(regrade
     data["labkit"] = "0.0.9"
     (tmp / "old-labkit" / "results" / later.name).write_text(json.dumps(data))
     run = _cli("grade", "--merge", str(tmp / "class"), str(tmp / "old-labkit"), "--out", str(tmp / "m2"))
-    assert run.returncode == 2 and "was written by labkit 0.0.9, and this is labkit" in run.stderr
+    assert run.returncode == 1 and "not read" in run.stderr and "changed since the run wrote it" in run.stderr
+    (tmp / "m2").rename(tmp / "m2-refused")
+    record_file = tmp / "old-labkit" / "record.json"
+    record_file.write_text(json.dumps({**json.loads(record_file.read_text()), "labkit": "0.0.9"}))
+    run = _cli("grade", "--merge", str(tmp / "class"), str(tmp / "old-labkit"), "--out", str(tmp / "m2"))
+    assert run.returncode == 2 and "was graded by labkit 0.0.9, and this is labkit" in run.stderr
     assert not (tmp / "m1").exists() and not (tmp / "m2").exists()

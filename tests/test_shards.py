@@ -36,7 +36,8 @@ def test_a_bad_shard_is_refused_saying_how_to_write_one(spec):
 
 
 def test_the_cli_refuses_a_bad_shard_before_grading(tmp_path):
-    run = cli("grade", tmp_path, "--out", tmp_path / "out", "--shard", "0/50")
+    (tmp_path / "class").mkdir()
+    run = cli("grade", tmp_path / "class", "--out", tmp_path / "out", "--shard", "0/50")
     assert run.returncode == 2 and "give --shard I/N with 1 <= I <= N" in run.stderr and "got 0/50" in run.stderr
     assert not (tmp_path / "out").exists()
     run = cli("grade", "--merge", tmp_path, "--out", tmp_path / "out", "--shard", "1/2")
@@ -71,7 +72,15 @@ def test_four_shards_merged_are_the_class_graded_in_one_run(small_class, shards)
 
 def test_an_empty_shard_writes_a_folder_that_merges_but_is_never_the_whole_merge(shards, tmp_path):
     empty = shards / "empty"
-    assert sorted(p.name for p in empty.iterdir()) == ["feedback", "grades.csv", "results", "run.json", "seed.txt"]
+    assert sorted(p.name for p in empty.iterdir()) == [
+        "feedback",
+        "grades.csv",
+        "record.json",
+        "results",
+        "rubric.toml",
+        "run.json",
+        "seed.txt",
+    ]
     assert list((empty / "results").iterdir()) == [] and (empty / "seed.txt").read_text() == f"{SEED}\n"
     record = json.loads((empty / "run.json").read_text())
     assert (record["submissions"], record["shard"]) == (0, "1/7")
@@ -79,5 +88,5 @@ def test_an_empty_shard_writes_a_folder_that_merges_but_is_never_the_whole_merge
     with pytest.raises(ValueError, match="hold no results"):
         merge([empty], tmp_path / "m")
     (tmp_path / "results").mkdir()  # an empty results/ without a run that says it had nothing to grade
-    with pytest.raises(ValueError, match="holds no results"):
+    with pytest.raises(ValueError, match="has no run record"):
         merge([shards / "part1", tmp_path], tmp_path / "m")

@@ -851,7 +851,7 @@ def _totals_section(summary):
 
 def _when(moment, rule):
     """A moment in the deadline's offset, as grades.csv writes it (or a dash when unknown)."""
-    return "&ndash;" if moment is None else _e(lateness.time_text(moment, rule.deadline.tzinfo), 60)
+    return "&ndash;" if moment is None else _e(lateness.time_text(moment, rule.deadline.tzinfo), 64)
 
 
 def _units(entry, rule):
@@ -910,8 +910,8 @@ def _late_section(summary):
                 _e(e.student, MAX_NAME),
                 (TEXT, _when(e.deadline, rule) + (" (extension)" if e.extended else "")),
                 (TEXT, _when(e.submitted, rule)),
-                (TEXT, _e(e.source or "", 60)),
-                (TEXT, _e(lateness.duration_text(e.late_by), 60)),
+                (TEXT, _e(e.source or "", 64)),
+                (TEXT, _e(lateness.duration_text(e.late_by), 64)),
                 (NUM, _units(e, rule)),
                 (NUM, f"{points_text(e.percent)}%"),
                 (NUM, points_text(e.penalty)),
@@ -994,7 +994,7 @@ def _late_section(summary):
         rows = [
             (
                 _e(e.student, MAX_NAME),
-                (TEXT, _e(e.source or "", 60)),
+                (TEXT, _e(e.source or "", 64)),
                 (TEXT, _when(e.submitted, rule)),
                 (TEXT, _e(e.note)),
             )

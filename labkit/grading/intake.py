@@ -620,14 +620,14 @@ def _nbgrader(submitted, assignment, builder, notes):
     if missing:
         notes.append(
             f"{len(missing)} student(s) in submitted/ without {one_line(assignment, 60)!r}: "
-            + ", ".join(one_line(m, 60) for m in sorted(missing)[:10])
+            + ", ".join(one_line(m, 64) for m in sorted(missing)[:10])
             + (" …" if len(missing) > 10 else "")
         )
     return students
 
 
 def _names(names):
-    return ", ".join(one_line(n, 60) for n in names)
+    return ", ".join(one_line(n, 64) for n in names)
 
 
 def _canvas_match(name):
@@ -748,7 +748,7 @@ def _detect(root):
         f"{len(other_dirs)} other folder(s) and {len(notebooks)} other notebook(s)"
     )
     if not found:
-        shown = ", ".join(one_line(_text(e.name), 60) for e in entries[:SHOWN]) or "nothing"
+        shown = ", ".join(one_line(_text(e.name), 64) for e in entries[:SHOWN]) or "nothing"
         raise ValueError(
             f"{one_line(_text(str(root)))} holds no students ({shown}); expected {LAYOUTS}: see docs/instructors.md."
         )

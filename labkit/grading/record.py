@@ -99,10 +99,10 @@ class RunRecord:
 
 def new(kind, labkit, seed, rubric):
     """A record of `kind` for a run under `rubric` (a Rubric that knows its data), with no submission yet."""
-    if rubric.data is None:
+    if rubric.data is None or not rubrics.from_dict(rubric.data, rubric.source).same_as(rubric):
         raise ValueError(
-            "the rubric was made in code, not read from TOML, so a run cannot record it: read it with "
-            "labkit.grading.rubric.load (or from_dict)."
+            "the rubric was made or changed in code, not read from TOML, so a run cannot record it as it grades: "
+            "read it with labkit.grading.rubric.load (or from_dict)."
         )
     return RunRecord(kind, labkit, seed, rubric.data, rubric.text)
 
@@ -320,9 +320,10 @@ def rubric_for(folders, given, command):
         other = record.rubric_object(folder)
         if not recorded.same_as(other):
             raise ValueError(
-                f"{folder} was graded under another rubric than {first_folder} "
-                f"({' and '.join(recorded.differences(other))} differ): {command} shows one run's grades; "
-                "merge them under one rubric first (labkit grade --merge ... --rubric FILE --out NEW)."
+                f"{folder} was graded under the rubric {other.title!r} and {first_folder} under {recorded.title!r} "
+                f"({' and '.join(recorded.differences(other))} differ): results of different rubrics are not read "
+                "together. Grade again under one rubric; when only the [late] tables differ, merge them under one "
+                "(labkit grade --merge ... --rubric FILE --out NEW)."
             )
     if given is None:
         return recorded
