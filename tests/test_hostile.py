@@ -542,7 +542,9 @@ def test_nothing_outside_the_sandbox_changed_and_nothing_is_left_behind(attacked
     assert sorted(p.name for p in attacked["out"].iterdir()) == [
         "feedback",
         "grades.csv",
+        "record.json",
         "results",
+        "rubric.toml",
         "run.json",
         "seed.txt",
     ]
