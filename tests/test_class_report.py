@@ -736,7 +736,7 @@ def test_result_files_that_are_not_plain_files_or_too_large_are_never_read(grade
     os.unlink(named)
     os.mkfifo(named)  # even a file the record names is opened without waiting, and refused as no plain file
     read = class_report.read(tmp_path)
-    assert len(read) == len(grades) - 1 and "not a regular file" in read.refused[0][1]
+    assert len(read) == len(grades) - 1 and "is not a file" in read.refused[0][1]
     os.unlink(named)
     write_report(tmp_path, grades)
     monkeypatch.setattr(record, "MAX_RESULT", 100)

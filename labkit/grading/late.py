@@ -477,8 +477,10 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
     return Late(deadline, per, percent, cap, grace, tuple(granted))
 
 
-def _read_small(path, limit):
-    """The bytes of regular file `path`, never following a link nor waiting on a pipe; ValueError says why not."""
+def read_small(path, limit):
+    """The bytes of regular file `path`, never following a link nor waiting on a pipe; ValueError says why not
+    (FileNotFoundError when there is none)."""
+    path = Path(path)
     if stat.S_ISLNK(os.lstat(path).st_mode):
         raise ValueError(f"{path.name} is a symbolic link; links are never followed")
     fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
@@ -521,7 +523,7 @@ def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
     except OSError:
         return None
     try:
-        raw = _read_small(path, MAX_TIMESTAMP)
+        raw = read_small(path, MAX_TIMESTAMP)
         return SubmissionTime(parse_timestamp(raw.decode("utf-8")), FROM_NBGRADER)
     except UnicodeDecodeError:
         return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP} is not text")
@@ -574,7 +576,7 @@ def read_times(path: str | os.PathLike) -> dict[str, datetime]:
     """
     path = Path(path)
     try:
-        raw = _read_small(path, MAX_TIMES)
+        raw = read_small(path, MAX_TIMES)
         text = raw.decode("utf-8-sig")
     except FileNotFoundError:
         raise ValueError(f"the times file {path} does not exist.") from None

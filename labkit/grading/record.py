@@ -26,11 +26,11 @@ switched off) is never read as a grade, and nothing a submission can write
 import hashlib
 import json
 import os
-import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import rubric as rubrics
+from .late import read_small
 
 RECORD = "record.json"
 RUBRIC_COPY = "rubric.toml"
@@ -136,34 +136,6 @@ def note(folder, record, name, written, content=None, save=True):
     record.submissions[name] = {"result": written.path.name, "sha256": written.sha256, "content": content}
     if save:
         write(folder, record)
-
-
-def read_small(path, limit):
-    """The bytes of the regular file `path` (never a link, never more than `limit`); ValueError says why not."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
-    except FileNotFoundError:
-        raise
-    except OSError as exc:
-        raise ValueError(f"{path} cannot be read ({exc.strerror or exc}); a run writes plain files.") from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise ValueError(f"{path} is not a regular file; a run writes plain files.")
-        if info.st_size > limit:
-            raise ValueError(f"{path} is larger than the {limit:,} bytes labkit accepts; it was not written by it.")
-        chunks, size = [], 0
-        while size <= limit:
-            chunk = os.read(fd, 1 << 20)
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-        if size > limit:
-            raise ValueError(f"{path} is larger than the {limit:,} bytes labkit accepts; it was not written by it.")
-        return b"".join(chunks)
-    finally:
-        os.close(fd)
 
 
 NO_RECORD = (
