@@ -37,7 +37,7 @@ import numpy as np
 
 from .. import convergence, functions, piecewise, splines
 from .model import EXPERIMENTS, Part
-from .result import CheckResult, call, case_rng, floats, shown
+from .result import CheckResult, call, case_rng, floats, judged_by_the_lab, shown
 
 DRIVER_TOLERANCE = 1e-6  # relative: the driver's error against the reference error
 PRINTED = 6e-4  # relative: a table copied from ratio_table's four significant digits (half a unit is 5e-4)
@@ -64,6 +64,26 @@ def scaled_runge2d(x, y):
     """3 / (1 + (x+y-1)^2): the two-dimensional Runge function moved and scaled (see :func:`scaled_runge`)."""
     s = np.asarray(x, dtype=float) + np.asarray(y, dtype=float) - 1.0
     return 3.0 / (1.0 + s * s)
+
+
+def runge_sign_slip(x):
+    """The Runge function with the sign slip in its derivative (+2x/(1+x^2)^2), as Exercise 3's check names it:
+    what a driver's own `f` may be and still count as an attempt at the experiment. Written out (see
+    :func:`scaled_runge`)."""
+    x = np.asarray(x, dtype=float)
+    return 1.0 / (1.0 + x * x), 2.0 * x / (1.0 + x * x) ** 2
+
+
+def runge_unsquared(x):
+    """The Runge function with -2x/(1+x^2) as its derivative: the chain-rule slip Exercise 3's check names."""
+    x = np.asarray(x, dtype=float)
+    return 1.0 / (1.0 + x * x), -2.0 * x / (1.0 + x * x)
+
+
+def runge2d_product(x, y):
+    """1 / (1 + (x y)^2): the slip in ``runge2d`` the catalog of typical mistakes plants (a product for the sum)."""
+    p = np.asarray(x, dtype=float) * np.asarray(y, dtype=float)
+    return 1.0 / (1.0 + p * p)
 
 
 @dataclass(frozen=True)
@@ -103,6 +123,11 @@ class Experiment:
     def passes(self):
         """Every function the checks hand the driver: the pieces and both test functions."""
         return tuple(self.pieces) + (self.f(), self.f(scaled=True))
+
+    @property
+    def f_slips(self):
+        """The test function with each slip its own check names: a driver's own `f` may be one of them."""
+        return (runge2d_product,) if self.key == "bilinear" else (runge_sign_slip, runge_unsquared)
 
     def reference(self, ndata, scaled=False, interval=(0.0, 5.0), ntest=None):
         """The relative errors labkit's experiment gives for `ndata` (a sequence of sizes)."""
@@ -146,6 +171,7 @@ class Experiment:
                 reads=both,
                 index=0,
                 refused=EXPERIMENTS,
+                passes=self.passes + self.f_slips,
                 functions=(self.table, self.driver),
                 experiment=self,
             ),
@@ -156,6 +182,7 @@ class Experiment:
                 reads=both,
                 index=1,
                 refused=EXPERIMENTS,
+                passes=self.passes + self.f_slips,
                 functions=(self.rate, self.driver),
                 experiment=self,
             ),
@@ -430,6 +457,47 @@ def _own_errors(method, fn, result):
 
 
 MISSING = type("Missing", (), {"__repr__": lambda self: "not defined"})()  # a name the notebook does not define
+LAB_EXPERIMENT = "the lab's experiment (labkit's table of it)"
+
+
+def _same(value, other):
+    number = _number(other)
+    return number is not None and _agrees(value, number)
+
+
+def attempted_driver(method, fn, own):
+    """Why the student's driver `fn` is no attempt at the lab's experiment ('' when it is one).
+
+    `own` is what it returned, with its own defaults, for the lab's sizes. It is an attempt when, given
+    labkit's test function and pieces as the driver check gives them, its first two errors are labkit's or
+    those of a slip the driver check names (another interval, other test points, another method, ...), and
+    when the `f` it uses by default is the test function or one with a slip its own check names (the
+    derivative's sign, a missing square; a product in ``runge2d``): so a driver, or a Runge function,
+    that measures something else is no reference for the table and the rate read from it.
+    """
+    scratch = CheckResult(method.driver)
+    for index, ndata in enumerate(method.ndata[:2]):
+        ok, err = call(scratch, "the driver with the lab's f", fn, ndata, method.f(), *method.pieces)
+        if not ok:  # a driver that takes no f or pieces: its own run is all there is to judge
+            err = own[index]
+        if not (_agrees(err, method.reference([ndata])[0]) or _diagnosis(method, err, ndata)):
+            return (
+                f"what your {method.driver} returns for ndata = {ndata} is neither the lab's experiment "
+                "nor the lab's experiment with one of the usual slips"
+            )
+    ndata = method.ndata[1]
+    ok, given = call(scratch, "the driver with the lab's f", fn, ndata, method.f())
+    if not ok or _same(own[1], given):
+        return ""
+    for slip in method.f_slips:
+        ok, given = call(scratch, "the driver with a slip in f", fn, ndata, slip)
+        if ok and _same(own[1], given):
+            return ""
+    name = "runge2d" if method.key == "bilinear" else "Runge"
+    return (
+        f"the f your {method.driver} uses when it is given none is not the {name} function, not even with one "
+        "of the slips its own check names"
+    )
 
 
 def check_experiment(method, errors, answer, fn):
@@ -446,12 +514,24 @@ def check_experiment(method, errors, answer, fn):
     """
     table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
     own = _own_errors(method, fn, table_result)
+    lab = None
     if own is None:
         rate_result.steps, rate_result.hint = list(table_result.steps), table_result.hint
-    return [_table(method, errors, own, table_result), _rate(method, answer, errors, own, rate_result)]
+    else:
+        why = attempted_driver(method, fn, own)
+        if why:  # the driver measures something else: the lab's experiment is the reference
+            lab = method.reference(method.ndata)
+            for result in (table_result, rate_result):
+                judged_by_the_lab(result, why, LAB_EXPERIMENT)
+    return [_table(method, errors, own, table_result, lab), _rate(method, answer, errors, own, rate_result, lab)]
 
 
-def _table(method, errors, own, result):
+def _printed(values, reference):
+    """True if `values` are `reference` to the four significant digits ratio_table prints."""
+    return bool(np.allclose(values, reference, rtol=PRINTED, atol=0))
+
+
+def _table(method, errors, own, result, lab=None):
     if own is None:
         return result
     sizes = ", ".join(map(str, method.ndata))
@@ -471,7 +551,7 @@ def _table(method, errors, own, result):
             f"[{method.driver}(n) for n in {list(method.ndata)}].",
         )
     result.step(description, True)
-    agree = bool(np.allclose(values, own, rtol=PRINTED, atol=0))
+    agree = _printed(values, own)
     if not result.step(
         f"the errors are what {method.driver} returns for each ndata (to 4 significant digits)",
         agree,
@@ -497,6 +577,16 @@ def _table(method, errors, own, result):
         result.hint = (
             f"{method.driver} must interpolate f from ndata points and measure the error at the test "
             "points; with more points the error gets smaller."
+        )
+        return result
+    if lab is not None and not result.step(
+        "the errors are those of the lab's experiment (to 4 significant digits)",
+        _printed(values, lab),
+        "they are not",
+    ):
+        result.hint = (
+            f"make {method.driver} measure the lab's experiment (f from ndata equally spaced points on [0, 5], the "
+            "error at the test points relative to max|f|), then refill the table."
         )
     return result
 
@@ -545,7 +635,7 @@ def supported_order(method, errors):
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
 
 
-def _rate(method, answer, errors, own, result):
+def _rate(method, answer, errors, own, result, lab=None):
     """The rate answer: the exponent p with Err(n)/Err(2n-1) close to 2**p, read from the student's table.
 
     The table must be read from an experiment: the driver ran (`own` is what it
@@ -575,6 +665,13 @@ def _rate(method, answer, errors, own, result):
             f"{method.table} is not a table of {len(method.ndata)} positive errors, "
             "so there is nothing to read the rate from",
             f"fill {method.table} from your driver first, then read the rate off its ratios.",
+        )
+    if lab is not None and not _printed(values, lab):
+        return result.fail(
+            description,
+            f"{method.table} is not the lab's experiment, so there is no rate of it to read",
+            f"make {method.driver} measure the lab's experiment, refill {method.table}, then read the rate "
+            "off the ratios.",
         )
     supported = supported_order(method, values)
     if supported is None:

@@ -10,10 +10,12 @@ import numpy as np
 from .. import patches
 from ..mesh import QuadMesh, quad_mesh
 from .model import OWN_PATCH, Exercise, Optional, Part, Together
-from .result import CheckResult, call, case_rng, close, worst
+from .result import CheckResult, call, case_rng, close, judged_by_the_lab, worst
 
 # the grader's work on a student's meshes is bounded by the lab's sizes (600 and 1170 nodes): far larger is refused
 MAX_NODES = 20_000
+SIZES9 = (20, 30)  # each patch of Exercise 9 is meshed with 20 x 30 points
+ON_CORNER = 1e-6  # a mesh node this close to a corner point is on it
 
 
 def _identity_corners():
@@ -196,6 +198,17 @@ def check_two_patches(fn, corners):
                 f"meshes of {sizes[0]:,} and {sizes[1]:,} nodes",
                 "each patch is meshed with 20 x 30 points (600 nodes); keep to the lab's sizes.",
             )
+        missed = _corners_missed((first, second), ABCD)
+        if not result.step(
+            f"{label}: the meshes pass through the corners two_patches is given",
+            not missed,
+            f"no node at {', '.join(missed)}",
+        ):
+            result.hint = (
+                "mesh the patches of the corners two_patches is given: the first mesh has A, B, C, D at its "
+                "corners, the second (abcd, the mirror image of ABCD in y = x) their mirror images."
+            )
+            return result
         try:
             merged = first + second
         except Exception as exc:  # noqa: BLE001
@@ -244,6 +257,47 @@ def _own_meshes(two_patches, corners):
     return first, second
 
 
+def _corner_points(corners):
+    """{label: point} of the corners of patch ABCD and of its mirror image abcd in y = x (a = A mirrored,
+    b = D, c = C, d = B: the points only, which the mirror rule for the derivatives does not change)."""
+    A, B, C, D = (np.asarray(c.point, dtype=float)[:2] for c in corners)
+    first = {"A": A, "B": B, "C": C, "D": D}
+    second = {"a": A[::-1], "b": D[::-1], "c": C[::-1], "d": B[::-1]}
+    return first, second
+
+
+def _corners_missed(meshes, corners):
+    """The corner points (as 'B = (0.707, 0.707)') that no node of their mesh is on: ABCD's for the first
+    mesh, abcd's for the second."""
+    missed = []
+    for mesh, points in zip(meshes, _corner_points(corners)):
+        nodes = np.asarray(mesh.points, dtype=float)[:, :2]
+        for label, point in points.items():
+            if not nodes.size or np.min(np.hypot(*(nodes - point).T)) > ON_CORNER:
+                missed.append(f"{label} = ({point[0]:.3g}, {point[1]:.3g})")
+    return missed
+
+
+def attempted_meshes(own, corners):
+    """Why the student's own two meshes are no attempt at the lab's two patches ('' when they are one).
+
+    They are one when each has the lab's size (20 x 30 points) and passes through its patch's corners (ABCD's
+    for the first mesh, the mirror image's for the second): a slip in ``coons`` or in the mirror rule changes
+    the inside and the edges of a patch, not its corner points, and is charged in its own part; two unit
+    squares, or meshes of other corners, are not the lab's region.
+    """
+    nodes, elements = SIZES9[0] * SIZES9[1], (SIZES9[0] - 1) * (SIZES9[1] - 1)
+    if any(len(mesh.points) != nodes or len(mesh.quads) != elements for mesh in own):
+        return (
+            f"your two_patches meshes have {len(own[0].points)} and {len(own[1].points)} nodes, not the lab's "
+            f"{SIZES9[0]} x {SIZES9[1]} points each"
+        )
+    missed = _corners_missed(own, corners)
+    if missed:
+        return f"your two_patches meshes do not pass through the lab's corners (no node at {', '.join(missed[:3])})"
+    return ""
+
+
 def _folded(mesh):
     return int(np.sum(mesh.quality() <= 0))
 
@@ -256,8 +310,10 @@ def check_combined_mesh(region, corners, two_patches=None):
     number of elements, no crack along the shared edge (no more boundary
     edges than the join) and no element folded that is not folded in the
     student's own meshes already. So a mistake in ``coons`` or the mirror is
-    marked there, once. When ``two_patches`` gives no meshes, the reference is
-    labkit's patch of the lab's corners.
+    marked there, once. When ``two_patches`` gives no meshes, or meshes that
+    are no attempt at the lab's two patches (:func:`attempted_meshes`: not the
+    lab's size, or not through the lab's corners), the reference is labkit's
+    patch of the lab's corners, and the feedback says why.
     """
     result = CheckResult("region")
     if not isinstance(region, QuadMesh):
@@ -273,6 +329,10 @@ def check_combined_mesh(region, corners, two_patches=None):
             "mesh the two patches with 20 x 30 points each and join them with +.",
         )
     own = _own_meshes(two_patches, corners)
+    why = attempted_meshes(own, corners) if own is not None else ""
+    if why:  # trivial meshes (two unit squares, other corners) are no reference: the lab's patches are
+        judged_by_the_lab(result, why, "the lab's two patches")
+        own = None
     if own is not None:
         whose = "your two_patches meshes"
         try:

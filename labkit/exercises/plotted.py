@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import functions, monotone, piecewise, splines
 from ..plotdata import NO_LINE, Line, line_of, lines_of  # noqa: F401 - Line and line_of for the checks' users
-from .result import CheckResult, Results, floats
+from .result import CheckResult, Results, close, floats, judged_by_the_lab
 
 MIN_POINTS = 100
 # bounds on the grader's work for one plot, whatever the notebook drew: the long lines examined,
@@ -77,11 +77,59 @@ def _hermite_curve(tdata, xdata, ydata, xpdata, ypdata, count=20001):
     return np.stack((piecewise.eval_pherm(tdata, xdata, xpdata, t), piecewise.eval_pherm(tdata, ydata, ypdata, t)))
 
 
-def _lab_hermite(r0=1.15, nintervals=20):
+NINTERVALS = 20  # the lab's: 21 points of the limaçon
+
+
+def _lab_hermite(r0=1.15, nintervals=NINTERVALS):
     """The lab's Hermite limaçon: 21 points of the curve with its exact derivatives."""
     tdata = np.linspace(0, 2 * np.pi, nintervals + 1)
     x, y, dx, dy = functions.limacon(tdata, r0=r0)
     return _hermite_curve(tdata, x, y, dx, dy)
+
+
+def derivative_slips(t, r0=1.15):
+    """dx/dt and dy/dt of the limaçon at `t`, each with the slips Exercise 4's derivative check names:
+    ``{"dx/dt": ((slip, values), ...), "dy/dt": ...}``, the right values first (slip ``""``)."""
+    t = np.asarray(t, dtype=float)
+    r = r0 + np.cos(t)
+    _, _, dxdt, dydt = functions.limacon(t, r0=r0)
+    return {
+        "dx/dt": (("", dxdt), ("has the wrong sign", -dxdt), ("leaves out the product rule", -r * np.sin(t))),
+        "dy/dt": (("", dydt), ("has the wrong sign", -dydt), ("leaves out the product rule", r * np.cos(t))),
+    }
+
+
+def attempted_data(own, r0=1.15):
+    """Is the notebook's ``(tdata, xdata, ydata, xpdata, ypdata)`` an attempt at the lab's data?
+
+    ``(data as floats, "")`` when it is: ``tdata``, ``xdata``, ``ydata`` are the lab's 21 points of the
+    limaçon, and ``xpdata``, ``ypdata`` its derivatives there, each right or wrong by a slip the derivative
+    check names (so a wrong derivative is charged there, once). ``(None, why)`` when it is not, `why` in the
+    student's words; ``(None, "")`` when the notebook lacks them.
+    """
+    if own is None:
+        return None, ""
+    try:
+        data = [floats(v) for v in own]
+    except (TypeError, ValueError):
+        return None, "your tdata, xdata, ydata, xpdata, ypdata are not arrays of numbers"
+    if len(data) != 5:
+        return None, "your tdata, xdata, ydata, xpdata, ypdata are not five arrays"
+    tdata = np.linspace(0, 2 * np.pi, NINTERVALS + 1)
+    x, y, _, _ = functions.limacon(tdata, r0=r0)
+    if not (close(data[0], tdata) and close(data[1], x) and close(data[2], y)):
+        return None, (
+            f"your tdata, xdata, ydata are not the lab's {NINTERVALS + 1} points of the limaçon "
+            f"(t from 0 to 2*pi, r0 = {r0:g})"
+        )
+    slips = derivative_slips(tdata, r0)
+    for name, got in (("dx/dt", data[3]), ("dy/dt", data[4])):
+        if not any(close(got, values) for _, values in slips[name]):
+            return None, (
+                f"your {'xpdata' if name == 'dx/dt' else 'ypdata'} are not {name} at tdata, not even with one "
+                "of the slips the derivative check names"
+            )
+    return data, ""
 
 
 def check_limacon_plot(plot, own=None, r0=1.15):
@@ -90,9 +138,11 @@ def check_limacon_plot(plot, own=None, r0=1.15):
     The curve must be the piecewise cubic Hermite interpolant itself (to
     1e-5), not the exact limaçon (which differs from it by up to 2.3e-4) and
     not straight segments: the interpolant of the notebook's own data `own`
-    (``tdata, xdata, ydata, xpdata, ypdata``) when it has them, so a wrong
-    slope is marked where the slopes are checked and not again here, or the
-    lab's (21 points, exact derivatives).
+    (``tdata, xdata, ydata, xpdata, ypdata``) when they are an attempt at the
+    lab's (:func:`attempted_data`: the lab's 21 points, slopes right or wrong by
+    a named slip), so a wrong slope is marked where the slopes are checked and
+    not again here; otherwise the lab's (21 points, exact derivatives), and the
+    feedback says why.
     """
     result = CheckResult("ax4")
     lines = lines_of(plot)
@@ -108,7 +158,10 @@ def check_limacon_plot(plot, own=None, r0=1.15):
         return result
     long = long[:MAX_CURVES]
     curves = [("the Hermite interpolant of the lab's data", _lab_hermite(r0))]
-    own_curve = _own_hermite(own)
+    data, why = attempted_data(own, r0)
+    if why:
+        judged_by_the_lab(result, why, "the lab's Hermite limaçon (its 21 points with the exact slopes)")
+    own_curve = _own_hermite(data)
     if own_curve is not None:
         curves.insert(0, ("the Hermite interpolant of your tdata, xdata, ydata, xpdata, ypdata", own_curve))
     best = None
@@ -151,8 +204,8 @@ def check_limacon_plot(plot, own=None, r0=1.15):
             )
         elif far <= HERMITE_LIMACON:
             result.hint = (
-                "close to the curve but not the interpolant of your data: plot eval_pherm of tdata, "
-                "xdata, xpdata and of tdata, ydata, ypdata at tval."
+                f"close to the curve but not the interpolant of {'the lab' if why else 'your'} data: plot "
+                "eval_pherm of tdata, xdata, xpdata and of tdata, ydata, ypdata at tval."
             )
         else:
             result.hint = (

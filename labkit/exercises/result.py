@@ -25,6 +25,9 @@ class CheckResult:
     name: str
     steps: list = field(default_factory=list)  # (description, passed, detail)
     hint: str = ""
+    # why the part was judged against labkit's reference rather than the student's earlier work: said with the
+    # hint when the part fails (see :func:`judged_by_the_lab`)
+    note: str = ""
 
     @property
     def passed(self):
@@ -40,22 +43,44 @@ class CheckResult:
         self.hint = hint
         return self
 
+    @property
+    def advice(self):
+        """The hint as the student reads it: after the note, when the part failed and has one."""
+        if self.note and not self.passed:
+            return f"{self.note} {self.hint[:1].upper()}{self.hint[1:]}".strip()
+        return self.hint
+
     def __repr__(self):
         verdict = "all checks passed" if self.passed else "FAILED"
         lines = [f"{self.name}: {verdict}"]
         for description, ok, detail in self.steps:
             lines.append(f"  [{'ok' if ok else 'FAIL'}] {description}" + (f": {detail}" if detail else ""))
-        if self.hint:
-            lines.append(f"  hint: {self.hint}")
+        if self.advice:
+            lines.append(f"  hint: {self.advice}")
         return "\n".join(lines)
 
     def as_dict(self):
         return {
             "name": self.name,
             "passed": self.passed,
-            "hint": self.hint,
+            "hint": self.advice,
             "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps],
         }
+
+
+def judged_by_the_lab(result, why, lab):
+    """Note in `result` that the part was judged against `lab` (labkit's reference) instead of the student's
+    earlier work, because that work is no attempt at its task: `why` says what it is, in the student's words
+    ("your tdata, ... are not the lab's 21 points"). The feedback gives the note with the hint when the part fails.
+
+    "One mistake, one part" lets a part follow the student's earlier work only when that work is an attempt at
+    the same task (the lab's, or within a slip the checks name): trivial earlier work is never a reference.
+    """
+    result.note = (
+        f"{why[:1].upper()}{why[1:]}: that is not an attempt at the lab's task, so this part was judged "
+        f"against {lab} instead of your own earlier work."
+    )
+    return result
 
 
 class Results(list):

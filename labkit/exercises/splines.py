@@ -11,7 +11,7 @@ import numpy as np
 from .. import piecewise, splines
 from .experiments import Experiment
 from .model import INTERPOLANTS, Exercise, Optional, Part
-from .result import CheckResult, call, case_rng, close, floats, shown, worst
+from .result import CheckResult, call, case_rng, close, floats, judged_by_the_lab, shown, worst
 
 SPLINE_CASES = [
     ("x^3 on [0 1 2 4] (exercise 10g)", [0.0, 1.0, 2.0, 4.0], [0.0, 1.0, 8.0, 64.0], 0.0, 48.0),
@@ -148,11 +148,16 @@ def check_ncspline(fn, seed=None, system=None):
     """Check ``ncspline(xdata, ydata)``: the lab's linear case, zero end curvature, labkit's reference.
 
     `system` is the student's ``complete_system``, which the lab's ncspline
-    builds on: when it is wrong (Exercise 10 marks that) and ncspline gives
-    exactly the natural spline of the student's own system, ncspline is right.
+    builds on: when it is wrong (Exercise 10 marks that) but still a spline
+    system (:func:`spline_system`) and ncspline gives exactly the natural
+    spline of it, ncspline is right. A system that is no spline system is no
+    reference: ncspline is judged against the lab's, and the feedback says why.
     """
     result = CheckResult("ncspline")
     own = _own_natural(fn, system, seed)
+    if isinstance(own, str):  # ncspline follows a complete_system that is no spline system: not forgiven
+        judged_by_the_lab(result, own, "the lab's natural spline")
+        own = None
     if own is not None:
         result.step(
             "slopes are the natural spline of your own complete_system (its mistake is marked in "
@@ -226,16 +231,51 @@ def _ncspline_data(seed):
     return x, np.exp(x / 2)
 
 
+def spline_system(given, xdata, ydata):
+    """Why `given`, a student's ``complete_system(xdata, ydata, ...)``, is no spline system ('' when it is one).
+
+    A spline system is an n x n tridiagonal matrix A and n entries D, whose inside rows are equations
+    (11)-(12): (h(k-1) + h(k))/3 on the diagonal, D(k) = the difference of the two secants, and h/6 beside the
+    diagonal, where the h of either neighbouring interval counts (the subscript slip Exercise 10 names). The
+    first and last rows are free: the natural spline replaces them, and Exercise 10 judges them.
+    """
+    n, h = len(xdata), np.diff(xdata)
+    try:
+        A, D = floats(_part(given, 0)), floats(_part(given, 1))
+    except (TypeError, ValueError):
+        return "your complete_system does not return a matrix A and a right side D of numbers"
+    if A.shape != (n, n) or D.shape != (n,) or not (np.all(np.isfinite(A)) and np.all(np.isfinite(D))):
+        return f"your complete_system does not return an {n} x {n} matrix A and {n} entries D for {n} knots"
+    rows, cols = np.indices(A.shape)
+    if not np.allclose(A[np.abs(rows - cols) > 1], 0.0):
+        return "your complete_system's A is not tridiagonal"
+    secant = np.diff(ydata) / h
+    beside = lambda got, k: np.isclose(got, h[k - 1] / 6) or np.isclose(got, h[k] / 6)  # noqa: E731
+    for k in range(1, n - 1):
+        if not (
+            np.isclose(A[k, k], (h[k - 1] + h[k]) / 3)
+            and beside(A[k, k - 1], k)
+            and beside(A[k, k + 1], k)
+            and np.isclose(D[k], secant[k] - secant[k - 1])
+        ):
+            return f"row {k + 1} of your complete_system's A and D is not the spline's equation at an inside knot"
+    return ""
+
+
 def _own_natural(fn, system, seed):
     """True when the student's complete_system is wrong and `fn` gives exactly the natural spline of it
-    (the lab's cases: linear data and a nonlinear function); None otherwise (the usual check decides)."""
+    (the lab's cases: linear data and a nonlinear function); None otherwise (the usual check decides).
+
+    A system that is no spline system (:func:`spline_system`) is no reference: when `fn` follows it, the
+    reason (in the student's words), so the usual check decides and the feedback says why."""
     if system is None:
         return None
-    scratch, differs = CheckResult("ncspline"), False
+    scratch, differs, why = CheckResult("ncspline"), False, ""
     for x, y in ((np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 2.0, 4.0, 6.0])), _ncspline_data(seed)):
         ok, given = call(scratch, "complete_system", system, x, y, 0.0, 0.0)
         if not ok:
             return None
+        why = why or spline_system(given, x, y)
         try:
             with np.errstate(all="ignore"):
                 own = _natural_slopes(x, y, system=given)
@@ -247,6 +287,8 @@ def _own_natural(fn, system, seed):
         ok, slopes = call(scratch, "ncspline", fn, x, y)
         if not ok or not close(slopes, own):
             return None
+    if why and differs:
+        return why
     return True if differs else None  # with a right system, the usual check decides
 
 
