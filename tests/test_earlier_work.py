@@ -289,6 +289,18 @@ def test_a_table_that_follows_a_named_slip_in_the_driver_still_costs_only_the_dr
     assert table.passed and rate.passed, (table, rate)
 
 
+@pytest.mark.parametrize(
+    "key, kwargs",
+    [("pherm", {"interval": (0.0, 3.0)}), ("natural", {"ntest": 333}), ("pchip", {"interval": (-1.0, 4.0)})],
+)
+def test_a_slip_no_check_names_in_a_real_driver_still_costs_only_the_driver(key, kwargs):
+    """A driver that measures an experiment, with a slip the catalog does not know: charged once, where it is."""
+    driver = _driver_1d(key, **kwargs)
+    assert not check.driver(key, driver).passed
+    table, rate = _graded(key, driver)
+    assert table.passed and rate.passed and not table.note, (table, rate)
+
+
 @pytest.mark.parametrize("key", ALL)
 def test_correct_work_says_nothing_of_the_lab_reference(key):
     driver = _driver_2d if key == "bilinear" else _driver_1d(key)

@@ -465,12 +465,32 @@ def _same(value, other):
     return number is not None and _agrees(value, number)
 
 
+def _measures(method, fn, scratch):
+    """Whether the driver `fn` measures an experiment, right or not: given labkit's pieces, its errors at the
+    lab's first three sizes are positive and shrink, and the moved, scaled test function changes them (a
+    driver that ignores what it is given, or returns errors made up, does neither)."""
+    values = []
+    for ndata in method.ndata[:3]:
+        ok, err = call(scratch, "the driver with the lab's f", fn, ndata, method.f(), *method.pieces)
+        number = _number(err) if ok else None
+        if number is None or not np.isfinite(number) or number <= 0:
+            return False
+        values.append(number)
+    if not all(later < earlier for earlier, later in zip(values, values[1:])):
+        return False
+    ok, plain = call(scratch, "the driver with the lab's f", fn, SHIFTED_PROBE, method.f(), *method.pieces)
+    ok_other, moved = call(scratch, "the driver with another f", fn, SHIFTED_PROBE, method.f(True), *method.pieces)
+    first, second = _number(plain) if ok else None, _number(moved) if ok_other else None
+    return first is not None and second is not None and not _agrees(first, second)
+
+
 def attempted_driver(method, fn, own):
     """Why the student's driver `fn` is no attempt at the lab's experiment ('' when it is one).
 
     `own` is what it returned, with its own defaults, for the lab's sizes. It is an attempt when, given
     labkit's test function and pieces as the driver check gives them, its first two errors are labkit's or
-    those of a slip the driver check names (another interval, other test points, another method, ...), and
+    those of a slip the driver check names (another interval, other test points, another method, ...) or,
+    for a slip no check names, it still measures an experiment (:func:`_measures`), and
     when the `f` it uses by default is the test function or one with a slip its own check names (the
     derivative's sign, a missing square; a product in ``runge2d``): so a driver, or a Runge function,
     that measures something else is no reference for the table and the rate read from it.
@@ -481,6 +501,8 @@ def attempted_driver(method, fn, own):
         if not ok:  # a driver that takes no f or pieces: its own run is all there is to judge
             err = own[index]
         if not (_agrees(err, method.reference([ndata])[0]) or _diagnosis(method, err, ndata)):
+            if _measures(method, fn, scratch):  # a slip no check names, in a driver that does measure
+                break
             return (
                 f"what your {method.driver} returns for ndata = {ndata} is neither the lab's experiment "
                 "nor the lab's experiment with one of the usual slips"
