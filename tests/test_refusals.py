@@ -8,6 +8,7 @@ calls the student's function with a part's refusal, as grading does.
 
 import subprocess
 import sys
+import types
 
 import numpy as np
 import pytest
@@ -480,3 +481,109 @@ def test_the_scan_names_the_self_checks_in_a_grading_process_that_never_imported
     first, second = run.stdout.splitlines()
     assert "labkit.check.driver" in first and "labkit.check.runge" in first, first
     assert "labkit.exercises.hermite.check_runge" in second, second
+
+
+# -- the allowed helpers, however they are spelled --------------------------
+
+# how a graded function calls each helper a refusal allows (a new allowed helper fails the tests below until it
+# has one here); the helpers themselves come from the registry
+EXAMPLE_CALLS = {
+    "labkit.piecewise.bracket": "({}([0.0, 1.0, 3.0], [0.5, 2.0]), 1.0)[1]",
+    "labkit.patches.Corner": "({}([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]), 1.0)[1]",
+    "labkit.patches._vector": "({}([1.0, 2.0], 'point'), 1.0)[1]",
+}
+
+
+def _spellings_of(spelling, tag=""):
+    """(import cell, expression of the object) for every way a notebook may name the object at `spelling`."""
+    module, _, name = spelling.rpartition(".")
+    parent, _, last = module.rpartition(".")
+    forms = [
+        (f"import {module}", spelling),
+        (f"from {module} import {name}", name),
+        (f"from {module} import {name} as helper_alias{tag}", f"helper_alias{tag}"),
+        (f"import {module} as mod_alias{tag}", f"mod_alias{tag}.{name}"),
+        (f"import {module} as mod_alias{tag}", f"getattr(mod_alias{tag}, {name!r})"),
+    ]
+    if parent:
+        forms.append((f"from {parent} import {last} as sub_alias{tag}", f"sub_alias{tag}.{name}"))
+    return forms
+
+
+def _allowed_helpers():
+    """(refusal, helper's own dotted name, a spelling of it) of every helper every refusal of the lab allows."""
+    found = []
+    for refusal in REFUSALS:
+        for helper in refusal.allowed:
+            spelled = [s for s in WIRED[refusal.name]["allowed"] if refusals._resolve(s) is refusals._resolve(helper)]
+            assert helper in spelled, (helper, spelled)
+            found += [(refusal, helper, spelling) for spelling in spelled]
+    return found
+
+
+def _refused_neighbour(refusal, spelling):
+    """A refused function exported by the same module as the allowed `spelling` (the same spellings must fail)."""
+    module = spelling.rpartition(".")[0]
+    own = {refusals._resolve(s) for s in WIRED[refusal.name]["allowed"]}
+    return next(
+        s
+        for s in sorted(WIRED[refusal.name]["spellings"])
+        if s.rpartition(".")[0] == module
+        and isinstance(refusals._resolve(s), types.FunctionType)
+        and refusals._resolve(s) not in own
+        and not s.rpartition(".")[2].startswith("__")
+    )
+
+
+def _graded_cells(spelling, call, inside, tag=""):
+    """The cells of a notebook whose `graded` uses the object at `spelling`, imported at the top or inside."""
+    cells = []
+    for i, (imports, expression) in enumerate(_spellings_of(spelling, tag)):
+        body = f"    return {call.format(expression)}"
+        if inside:
+            cells.append(f"def graded_{i}(*a):\n    {imports}\n{body}")
+        else:
+            cells.append(f"{imports}\ndef graded_{i}(*a):\n{body}")
+    return cells
+
+
+def test_every_allowed_helper_passes_the_scan_however_it_is_spelled_and_its_neighbours_do_not():
+    helpers = _allowed_helpers()
+    assert {helper for _, helper, _ in helpers} == {h for r in REFUSALS for h in r.allowed} == set(EXAMPLE_CALLS)
+    wrongly_refused, missed = [], []
+    for refusal, helper, spelling in helpers:
+        neighbour = _refused_neighbour(refusal, spelling)
+        for inside in (False, True):
+            cells = _graded_cells(spelling, EXAMPLE_CALLS[helper], inside)
+            refused_cells = _graded_cells(neighbour, "{}()", inside)
+            for i in range(len(cells)):
+                if _scan(cells, [f"graded_{i}"], refusal):
+                    wrongly_refused.append(cells[i])
+                if not _scan(refused_cells, [f"graded_{i}"], refusal):
+                    missed.append(refused_cells[i])
+    assert wrongly_refused == [] and missed == [], (wrongly_refused, missed)
+    # a refused module handed on whole is still refused: what it is used for is out of the scan's sight
+    assert _scan(["import labkit.piecewise as pw\ndef graded(*a):\n    return vars(pw)"], ["graded"], INTERPOLANTS)
+    assert _scan(["from labkit import piecewise\ndef graded(f):\n    return f(piecewise)"], ["graded"], INTERPOLANTS)
+
+
+def test_every_allowed_helper_passes_the_watch_however_it_is_spelled(open_notebooks):
+    allowed, refused = [], []  # (refusal, function name, cell): one notebook for each kind
+    for n, (refusal, helper, spelling) in enumerate(_allowed_helpers()):
+        for inside in (False, True):
+            for i, cell in enumerate(_graded_cells(spelling, EXAMPLE_CALLS[helper], inside, n)):
+                allowed.append(
+                    (refusal, f"allowed_{n}_{inside:d}_{i}", cell.replace(f"graded_{i}", f"allowed_{n}_{inside:d}_{i}"))
+                )
+        # called with as many numbers as it takes positional arguments: the call starts, whatever it then raises
+        neighbour = _refused_neighbour(refusal, spelling)
+        for i, cell in enumerate(_graded_cells(neighbour, "{0}(*[0.5] * {0}.__code__.co_argcount)", False, n)):
+            refused.append((refusal, f"refused_{n}_{i}", cell.replace(f"graded_{i}", f"refused_{n}_{i}")))
+    notebook = _notebook(open_notebooks, *[cell for *_, cell in allowed])
+    for refusal, name, cell in allowed:
+        assert _call(notebook, name, refusal) == 1.0, cell
+    notebook = _notebook(open_notebooks, *[cell for *_, cell in refused])
+    for refusal, name, cell in refused:
+        with pytest.raises(remote.StudentError, match="switched off"):
+            _call(notebook, name, refusal)
+            pytest.fail(cell)

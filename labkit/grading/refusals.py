@@ -158,6 +158,13 @@ def spellings(refusal):
     return spelled, sorted(allowed_spellings)
 
 
+def submodules(refusal):
+    """The loaded modules inside the refusal's module prefixes (the scan judges their uses, not their import)."""
+    spellings(refusal)  # imports the refused modules
+    loaded = list(sys.modules.items())
+    return sorted(name for name, module in loaded if module is not None and _within(name, refusal.modules))
+
+
 def wire(refusals):
     """The profiles of these refusals as JSON-ready data for the sandbox and the scan: {name: {...}}."""
     profiles = {}
@@ -170,5 +177,6 @@ def wire(refusals):
             "c_names": sorted(map(list, c_names)),
             "spellings": spelled,
             "allowed": allowed,
+            "submodules": submodules(refusal),
         }
     return profiles
