@@ -92,6 +92,16 @@ ATTACKS = {
     "labkit's code pasted into the notebook": (
         "import inspect\nexec(inspect.getsource(labkit.piecewise).replace('from ._', 'from labkit._'), globals())"
     ),
+    "labkit's file run statement by statement at the top level": (
+        "import ast\nsource = open(labkit.piecewise.__file__).read().replace('from ._', 'from labkit._')\n"
+        "for node in ast.parse(source).body:\n"
+        "    exec(compile(ast.Module([node], []), 'mine.py', 'exec'), globals())"
+    ),
+    "labkit's file run statement by statement, docstrings stripped": (
+        "import ast\nsource = open(labkit.piecewise.__file__).read().replace('from ._', 'from labkit._')\n"
+        "for node in ast.parse(source).body:\n"
+        "    exec(compile(ast.Module([node], []), 'mine.py', 'exec', optimize=2), globals())"
+    ),
     "scipy's CubicHermiteSpline": "import scipy.interpolate as si\n"
     "def eval_pherm(x, y, yp, xv):\n    return si.CubicHermiteSpline(x, y, yp)(xv)",
     "a compiled routine of scipy.interpolate": (
@@ -587,3 +597,60 @@ def test_every_allowed_helper_passes_the_watch_however_it_is_spelled(open_notebo
         with pytest.raises(remote.StudentError, match="switched off"):
             _call(notebook, name, refusal)
             pytest.fail(cell)
+
+
+# -- labkit's code pasted into a notebook ------------------------------------
+
+PASTED = (  # library functions a student might paste, private helpers among them
+    labkit.piecewise._hermite_eval,
+    labkit.piecewise.eval_pherm,
+    labkit.splines._slopes_from_curvatures,
+    labkit.splines.natural_curvatures,
+    labkit.monotone._interior_slopes,
+    labkit.bilinear._cell_and_weight,
+)
+PASTE_IMPORTS = (
+    "import numpy as np\nfrom numpy.typing import ArrayLike, NDArray\n"
+    "from labkit._validate import *\nfrom labkit._locate import *\nfrom labkit._frame import Frame"
+)
+
+
+def pasted(function, docstring=True):
+    """`function`'s source as a student pastes it into a cell: verbatim, or with its docstring's lines deleted."""
+    import ast
+    import inspect
+    import textwrap
+
+    lines = textwrap.dedent(inspect.getsource(function)).splitlines()
+    node = ast.parse("\n".join(lines)).body[0]
+    if not docstring and ast.get_docstring(node) is not None:
+        doc = node.body[0]
+        del lines[doc.lineno - 1 : doc.end_lineno]
+    return "\n".join(lines)
+
+
+def test_the_digest_is_the_same_with_or_without_the_docstring():
+    def key(source, name):
+        namespace = {}
+        exec(compile(PASTE_IMPORTS + "\n" + source, "<cell>", "exec"), namespace)
+        return guard.code_key(namespace[name].__code__)
+
+    for function in PASTED:
+        assert key(pasted(function), function.__name__) == key(pasted(function, False), function.__name__)
+    names = refusals.recognised(INTERPOLANTS)[0]
+    assert names[guard.code_key(labkit.piecewise._hermite_eval.__code__)] == "labkit.piecewise._hermite_eval"
+
+
+@pytest.mark.parametrize("docstring", [True, False], ids=["docstrings kept", "docstrings deleted"])
+def test_labkit_functions_pasted_into_cells_are_recognised(open_notebooks, docstring):
+    """Each copy is pasted in a cell of its own (IPython compiles it apart from the imports), with a function of
+    the student's own that calls it."""
+    cells = [PASTE_IMPORTS] + [pasted(function, docstring) for function in PASTED]
+    for i, function in enumerate(PASTED):
+        arguments = function.__code__.co_argcount - len(function.__defaults__ or ())
+        cells.append(f"def uses_{i}(*a):\n    return {function.__name__}(*[np.linspace(1.0, 2.0, 5)] * {arguments})")
+    notebook = _notebook(open_notebooks, *cells)
+    for i, function in enumerate(PASTED):
+        with pytest.raises(remote.StudentError, match="switched off") as refused:
+            _call(notebook, f"uses_{i}", INTERPOLANTS)
+        assert f"{function.__module__}.{function.__qualname__}" in str(refused.value)

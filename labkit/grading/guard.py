@@ -43,6 +43,7 @@ answer is voided afterwards: neither hook raises.
 import _hashlib
 import builtins
 import gc
+import opcode
 import os
 import sys
 import types
@@ -53,6 +54,7 @@ import types
 _sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
 _write, _getframe, _modules = os.write, sys._getframe, sys.modules
 _gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
+_HASCONST, _EXTENDED_ARG, _NoneType = frozenset(opcode.hasconst), opcode.EXTENDED_ARG, type(None)
 _ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
     types.ModuleType,
     types.CodeType,
@@ -96,17 +98,47 @@ GUARDED_ATTRIBUTES = frozenset({"__code__"})  # libraries set __defaults__ and t
 EXPOSED = frozenset({"_stand_in", "_plain", "_handed_over", "_barrier"})
 
 
+def _constant(value):
+    """What a constant the bytecode loads contributes to :func:`code_key`: numbers and None by value, any other
+    constant by its kind only (exact built-in types only; nothing of the student's is touched)."""
+    kind = type(value)
+    if kind is _NoneType or kind is bool:
+        return repr(value)
+    if kind is int:
+        return f"i{value}" if -(1 << 64) < value < 1 << 64 else f"I{value.bit_length()}"
+    if kind is float or kind is complex:
+        return f"{kind.__name__[0]}{value!r}"
+    if kind is tuple:
+        return "(" + ",".join([_constant(item) for item in value]) + ")"
+    if kind is str:
+        return "s"
+    if kind is _CodeType:
+        return "c"
+    return "o"
+
+
 def code_key(code):
     """A digest of a function's code that survives renaming the function but not rewriting it.
 
-    Bytecode, the names and local names it uses and its numeric constants;
-    short functions (which an honest student might write identically) are
-    also keyed by their name, file and line.
+    The bytecode with each constant it loads replaced by that constant's value
+    (numbers and None; strings by their kind only), the names and local names
+    it uses and its number of arguments. So where a constant sits in
+    ``co_consts`` does not count: a function whose docstring was deleted (None
+    in its place, and the constants after it one place earlier) has the same
+    key. Short functions (which an honest student might write identically)
+    are also keyed by their name, file and line.
     """
-    consts = tuple(c for c in code.co_consts if type(c) in (int, float, complex, type(None)))
-    digest = _sha1(code.co_code)
-    digest.update(repr((code.co_names, code.co_varnames, code.co_argcount, consts)).encode())
-    if len(code.co_code) < SMALL_CODE:
+    raw, consts = code.co_code, code.co_consts
+    structure, loaded, count, extended = bytearray(raw), [], len(consts), 0
+    for i in range(0, len(raw) - 1, 2):
+        op, arg = raw[i], raw[i + 1] | extended
+        extended = (arg << 8) if op == _EXTENDED_ARG else 0
+        if op in _HASCONST:
+            structure[i + 1] = 0
+            loaded.append(_constant(consts[arg]) if arg < count else "?")
+    digest = _sha1(bytes(structure))
+    digest.update(repr((code.co_names, code.co_varnames, code.co_argcount, loaded)).encode())
+    if len(raw) < SMALL_CODE:
         digest.update(repr((code.co_qualname, code.co_filename, code.co_firstlineno)).encode())
     return digest.digest()[:12]
 
