@@ -654,3 +654,36 @@ def test_labkit_functions_pasted_into_cells_are_recognised(open_notebooks, docst
         with pytest.raises(remote.StudentError, match="switched off") as refused:
             _call(notebook, f"uses_{i}", INTERPOLANTS)
         assert f"{function.__module__}.{function.__qualname__}" in str(refused.value)
+
+
+def test_every_alias_of_numpys_compiled_interp_is_switched_off(open_notebooks):
+    import importlib
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        importlib.import_module("numpy.core.multiarray")  # numpy 2's shim of the old names, which the notebook loads
+    compiled = {
+        id(importlib.import_module(module).__dict__[name]): name
+        for module, name in (f.rsplit(".", 1) for f in INTERPOLANTS.functions)
+        if not hasattr(importlib.import_module(module).__dict__[name], "__code__")
+    }
+    aliases = sorted(
+        (module, attribute)
+        for module, value in list(sys.modules.items())
+        if module.split(".")[0] == "numpy" and value is not None
+        for attribute, held in list(vars(value).items())
+        if id(held) in compiled
+    )
+    assert len({module for module, _ in aliases}) >= 4, aliases
+    cells = [
+        "import sys, warnings, numpy as np\nwith warnings.catch_warnings():\n    warnings.simplefilter('ignore')\n"
+        "    import numpy.core.multiarray"
+    ]
+    for i, (module, attribute) in enumerate(aliases):
+        cells.append(f"def via_{i}(x, xp, fp):\n    return getattr(sys.modules[{module!r}], {attribute!r})(x, xp, fp)")
+    notebook = _notebook(open_notebooks, *cells)
+    for i, alias in enumerate(aliases):
+        with pytest.raises(remote.StudentError, match="switched off"):
+            _call(notebook, f"via_{i}", INTERPOLANTS, XV, X, Y)
+            pytest.fail(str(alias))

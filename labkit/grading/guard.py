@@ -274,6 +274,24 @@ def _install(secret, verdict_fd, profiles, passables, chain):
         union[1].update(mods)
         union[2].update(c_names)
     strictest = (union[0], tuple(union[1]), frozenset(union[2]))
+    identity = id
+    # the refused compiled functions themselves, taken while the process is pristine: {c_names: {id: (it, name)}}
+    c_objects = {}
+    for _names, _mods, c_names in [*profiles.values(), strictest]:
+        found = {}
+        for module_name, attribute in c_names:
+            module = modules.get(module_name)
+            namespace = module.__dict__ if type(module) is module_type else {}
+            if attribute in namespace:
+                found[identity(namespace[attribute])] = (namespace[attribute], f"{module_name}.{attribute}")
+        c_objects[c_names] = found
+    # the modules as the watch found them: how many names each held, and which held a refused compiled function
+    sizes, holders, every_target = {}, set(), frozenset(i for found in c_objects.values() for i in found)
+    for module_name, module in list(modules.items()):
+        if type(module_name) is str_type and type(module) is module_type and type(module.__dict__) is dict_type:
+            sizes[module_name] = len(module.__dict__)
+            if not every_target.isdisjoint(map(identity, module.__dict__.values())):
+                holders.add(module_name)
     copies = {}
     for name, function in passables.items():
         code = function.__code__.replace()  # equal, but another object: trusted by identity
@@ -316,21 +334,38 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     def stub(profile):
         """Replace the compiled functions and classes of the refused modules (exact types only)."""
         mods, c_names = profile[1], profile[2]
+        # a refused compiled function is switched off under every name a module holds it by (numpy's interp is
+        # numpy._core._multiarray_umath.interp, numpy._core.multiarray.interp, ...): found by identity only
+        targets = c_objects.get(c_names, {})
+        target_ids = frozenset(targets)
         for module_name, module in list(modules.items()):
             if type(module_name) is not str_type or type(module) is not module_type:
                 continue
             namespace = module.__dict__
+            if type(namespace) is not dict_type:
+                continue
             whole = within(module_name, mods)
-            if not whole and not any(m == module_name for m, _ in c_names):
+            # where the process held a target when the watch was installed, and any module loaded or grown since
+            # (ids compared in C: no object of the notebook's is asked anything; a live target's id is its own)
+            held = module_name in holders
+            if target_ids and not held and sizes.get(module_name) != len(namespace):
+                held = not target_ids.isdisjoint(map(identity, namespace.values()))
+                if not held:
+                    sizes[module_name] = len(namespace)  # looked at with this many names: again once it changes
+            if not whole and not held and not any(m == module_name for m, _ in c_names):
                 continue
             entries = list(namespace.items())
             if any(type(attribute) is not str_type for attribute, _ in entries):
-                continue  # a key of the notebook's making could run code when the dictionary compares it
+                # a key of the notebook's making could run code when the dictionary compares it
+                note_tampering(f"a name that is not a string put in {module_name}")
+                continue
             for attribute, value in entries:
                 kind = type(value)
                 compiled = kind in compiled_types or (kind is type and not value.__flags__ & heap_type)
-                if ((module_name, attribute) in c_names) or (whole and compiled):
-                    namespace[attribute] = make_stand_in(f"{module_name}.{attribute}")
+                alias = identity(value) in targets and targets[identity(value)][0] is value
+                if ((module_name, attribute) in c_names) or (whole and compiled) or alias:
+                    name = targets[identity(value)][1] if alias else f"{module_name}.{attribute}"
+                    namespace[attribute] = make_stand_in(name)
                     state["stubbed"].append((namespace, attribute, value))
 
     def unstub():
@@ -417,7 +452,9 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             if state["gc"]:
                 gc_enable()
         elif profile is not None:
+            set_profile(None, None)  # the watch's own walk over the modules runs unprofiled (no student code runs)
             stub(profile)
+            set_profile(hook_address, None)
 
     def end(args):
         if state["mode"] not in ("graded", RUN) or len(args) != 1 or type(args[0]) is not bytes_type:
