@@ -54,7 +54,8 @@ import types
 _sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
 _write, _getframe, _modules = os.write, sys._getframe, sys.modules
 _gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
-_HASCONST, _EXTENDED_ARG, _NoneType = frozenset(opcode.hasconst), opcode.EXTENDED_ARG, type(None)
+_HASCONST, _EXTENDED_ARG, _NOP = frozenset(opcode.hasconst), opcode.EXTENDED_ARG, opcode.opmap["NOP"]
+_NoneType = type(None)
 _ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
     types.ModuleType,
     types.CodeType,
@@ -125,17 +126,23 @@ def code_key(code):
     it uses and its number of arguments. So where a constant sits in
     ``co_consts`` does not count: a function whose docstring was deleted (None
     in its place, and the constants after it one place earlier) has the same
-    key. Short functions (which an honest student might write identically)
+    key, and so has one compiled with its docstring stripped (``optimize=2``,
+    which leaves a NOP: NOPs are left out). Short functions (which an honest student might write identically)
     are also keyed by their name, file and line.
     """
     raw, consts = code.co_code, code.co_consts
-    structure, loaded, count, extended = bytearray(raw), [], len(consts), 0
+    structure, loaded, count, extended = bytearray(), [], len(consts), 0
     for i in range(0, len(raw) - 1, 2):
         op, arg = raw[i], raw[i + 1] | extended
         extended = (arg << 8) if op == _EXTENDED_ARG else 0
+        if op == _NOP:
+            continue  # where a statement compiled to nothing stood (a docstring stripped by optimize=2)
+        structure.append(op)
         if op in _HASCONST:
-            structure[i + 1] = 0
+            structure.append(0)
             loaded.append(_constant(consts[arg]) if arg < count else "?")
+        else:
+            structure.append(raw[i + 1])
     digest = _sha1(bytes(structure))
     digest.update(repr((code.co_names, code.co_varnames, code.co_argcount, loaded)).encode())
     if len(raw) < SMALL_CODE:
