@@ -27,6 +27,7 @@ import pytest
 from conftest import sandbox_or_skip
 from helpers import processes_with as _processes_with
 
+import labkit.piecewise
 from labkit import grading
 from labkit.grading import remote
 from labkit.grading.report import safe_name
@@ -40,6 +41,16 @@ GRADER_MEMORY_BOUND = 1536 * 1024**2  # the grader's own work on one submission,
 TOTAL_TIMEOUT, CELL_TIMEOUT = 60, 5
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
+
+
+def _pasted(function):
+    """A library function's source as a student pastes it into a cell, its docstring's lines deleted."""
+    import ast
+    import inspect
+
+    lines = inspect.getsource(function).splitlines()
+    doc = ast.parse("\n".join(lines)).body[0].body[0]
+    return "\n".join(lines[: doc.lineno - 1] + lines[doc.end_lineno :])
 
 
 def _tree_hash(folders, leave_out=()):
@@ -235,6 +246,12 @@ ATTACKS = {
         "                cell.cell_contents['profile'] = None\n"
         "    return np.ref(xdata, ydata, ypdata, xval)"
     ],
+    # labkit's own file run statement by statement, its docstrings stripped: no copy in the notebook
+    "exec_statement_by_statement": [
+        "import ast, labkit\nsource = open(labkit.piecewise.__file__).read().replace('from ._', 'from labkit._')\n"
+        "for node in ast.parse(source).body:\n"
+        "    exec(compile(ast.Module([node], []), 'mine.py', 'exec', optimize=2), globals())"
+    ],
     "spins_sixty_processes": [
         "import os\nfor _ in range(60):\n    if os.fork() == 0:\n        os.setsid()\n"
         "        while True:\n            pass",
@@ -327,6 +344,31 @@ REPLACED = {  # cells of the release replaced by an attack: {name: (base noteboo
             "    return nd.map_coordinates(z, np.meshgrid(i, j, indexing='ij'), order=1)"
         },
     ),
+    # a private helper of labkit's pasted into the notebook, its docstring deleted, under a function of one's own
+    "pasted_private_helper": (
+        "02_convergence.ipynb",
+        {
+            "def eval_pherm(": "import numpy as np\nfrom labkit._validate import *\n\n"
+            + _pasted(labkit.piecewise._hermite_eval)
+            + "\n\ndef eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "    x, y, yp, xv = (np.asarray(v, dtype=float) for v in (xdata, ydata, ypdata, xval))\n"
+            "    return _hermite_eval(x, y, yp, xv)"
+        },
+    ),
+    # numpy's compiled interp under another of the names numpy holds it by
+    "interp_alias": (
+        "06_bilinear.ipynb",
+        {
+            "def runge2d(": "import numpy as np\nimport numpy._core.multiarray\n"
+            "def runge2d(x, y):\n    raise NotImplementedError\n"
+            "def eval_pbilin(f, xdata, ydata, xval, yval):\n"
+            "    xdata, ydata = np.asarray(xdata, float), np.asarray(ydata, float)\n"
+            "    line = getattr(numpy._core.multiarray, 'interp')\n"
+            "    X, Y = np.meshgrid(xdata, ydata, indexing='ij')\n    z = f(X, Y)\n"
+            "    rows = np.array([line(yval, ydata, row) for row in z])\n"
+            "    return np.array([line(xval, xdata, column) for column in rows.T]).T"
+        },
+    ),
 }
 EXTRA = {  # attacks added after a release notebook's last cell: {name: (base notebook, cells)}
     "mesh_bomb": (
@@ -358,6 +400,26 @@ EXTRA = {  # attacks added after a release notebook's last cell: {name: (base no
         ],
     ),
 }
+
+
+def _auto_import_copy(folder):
+    """The instructor notebooks with bracket imported as an editor's auto-import writes it, or through a module
+    alias: honest work, every point earned."""
+    target = folder / "honest_auto_import"
+    target.mkdir()
+    for base, old, new in (
+        ("02_convergence.ipynb", "labkit.bracket(xdata, xval)", "bracket(xdata, xval)"),
+        ("06_bilinear.ipynb", "labkit.bracket(xdata, xval), labkit.bracket(", "pw.bracket(xdata, xval), pw.bracket("),
+    ):
+        nb = nbformat.read(NOTEBOOKS / base, as_version=4)
+        hits = [c for c in nb.cells if c.cell_type == "code" and old in c.source]
+        assert len(hits) == 1, (base, old)
+        imports = (
+            "from labkit.piecewise import bracket\n" if base.startswith("02") else "import labkit.piecewise as pw\n"
+        )
+        hits[0].source = imports + hits[0].source.replace(old, new)
+        nbformat.write(nb, target / base)
+    return target
 
 
 def _fill(source, values):
@@ -463,6 +525,7 @@ def attacked(tmp_path_factory):
     # the honest classmates, in the same run
     subs["honest_alice"] = _honest_copy(subs_dir, "honest_alice")
     subs["honest_bob"] = _honest_copy(subs_dir, "honest_bob", {"02_convergence.ipynb", "06_bilinear.ipynb"})
+    subs["honest_auto_import"] = _auto_import_copy(subs_dir)
 
     outside = [LABKIT, NOTEBOOKS, tmp]
     before = _tree_hash(outside, leave_out=[out])
@@ -492,6 +555,12 @@ def attacked(tmp_path_factory):
 
 def _feedback(attacked, name):
     return attacked["results"][name].feedback()
+
+
+def test_an_allowed_helper_imported_from_its_module_costs_nothing(attacked):
+    grade = attacked["results"]["honest_auto_import"]
+    assert grade.total == 25 + 8 and grade.points[2] == 10 and grade.points[16] == 8, grade.feedback()
+    assert "reaches for" not in grade.feedback()
 
 
 def test_the_honest_classmates_get_their_usual_scores(attacked):
@@ -698,6 +767,9 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
         ("fake_compiled_object", "which is switched off"),
         ("profile_hook_fetched_from_c", "which is switched off"),
         ("spins_sixty_processes", "os.fork"),
+        ("exec_statement_by_statement", "labkit.piecewise.eval_pherm, which is switched off"),
+        ("pasted_private_helper", "labkit.piecewise._hermite_eval, which is switched off"),
+        ("interp_alias", "interp, which is switched off"),
         ("bad\\xff\\xfename", "not implemented yet"),
         ("linked_inside", "not implemented yet"),
     ],

@@ -8,6 +8,7 @@ calls the student's function with a part's refusal, as grading does.
 
 import subprocess
 import sys
+import types
 
 import numpy as np
 import pytest
@@ -90,6 +91,16 @@ ATTACKS = {
     ),
     "labkit's code pasted into the notebook": (
         "import inspect\nexec(inspect.getsource(labkit.piecewise).replace('from ._', 'from labkit._'), globals())"
+    ),
+    "labkit's file run statement by statement at the top level": (
+        "import ast\nsource = open(labkit.piecewise.__file__).read().replace('from ._', 'from labkit._')\n"
+        "for node in ast.parse(source).body:\n"
+        "    exec(compile(ast.Module([node], []), 'mine.py', 'exec'), globals())"
+    ),
+    "labkit's file run statement by statement, docstrings stripped": (
+        "import ast\nsource = open(labkit.piecewise.__file__).read().replace('from ._', 'from labkit._')\n"
+        "for node in ast.parse(source).body:\n"
+        "    exec(compile(ast.Module([node], []), 'mine.py', 'exec', optimize=2), globals())"
     ),
     "scipy's CubicHermiteSpline": "import scipy.interpolate as si\n"
     "def eval_pherm(x, y, yp, xv):\n    return si.CubicHermiteSpline(x, y, yp)(xv)",
@@ -480,3 +491,201 @@ def test_the_scan_names_the_self_checks_in_a_grading_process_that_never_imported
     first, second = run.stdout.splitlines()
     assert "labkit.check.driver" in first and "labkit.check.runge" in first, first
     assert "labkit.exercises.hermite.check_runge" in second, second
+
+
+# -- the allowed helpers, however they are spelled --------------------------
+
+# how a graded function calls each helper a refusal allows (a new allowed helper fails the tests below until it
+# has one here); the helpers themselves come from the registry
+EXAMPLE_CALLS = {
+    "labkit.piecewise.bracket": "({}([0.0, 1.0, 3.0], [0.5, 2.0]), 1.0)[1]",
+    "labkit.patches.Corner": "({}([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]), 1.0)[1]",
+    "labkit.patches._vector": "({}([1.0, 2.0], 'point'), 1.0)[1]",
+}
+
+
+def _spellings_of(spelling, tag=""):
+    """(import cell, expression of the object) for every way a notebook may name the object at `spelling`."""
+    module, _, name = spelling.rpartition(".")
+    parent, _, last = module.rpartition(".")
+    forms = [
+        (f"import {module}", spelling),
+        (f"from {module} import {name}", name),
+        (f"from {module} import {name} as helper_alias{tag}", f"helper_alias{tag}"),
+        (f"import {module} as mod_alias{tag}", f"mod_alias{tag}.{name}"),
+        (f"import {module} as mod_alias{tag}", f"getattr(mod_alias{tag}, {name!r})"),
+    ]
+    if parent:
+        forms.append((f"from {parent} import {last} as sub_alias{tag}", f"sub_alias{tag}.{name}"))
+    return forms
+
+
+def _allowed_helpers():
+    """(refusal, helper's own dotted name, a spelling of it) of every helper every refusal of the lab allows."""
+    found = []
+    for refusal in REFUSALS:
+        for helper in refusal.allowed:
+            spelled = [s for s in WIRED[refusal.name]["allowed"] if refusals._resolve(s) is refusals._resolve(helper)]
+            assert helper in spelled, (helper, spelled)
+            found += [(refusal, helper, spelling) for spelling in spelled]
+    return found
+
+
+def _refused_neighbour(refusal, spelling):
+    """A refused function exported by the same module as the allowed `spelling` (the same spellings must fail)."""
+    module = spelling.rpartition(".")[0]
+    own = {refusals._resolve(s) for s in WIRED[refusal.name]["allowed"]}
+    return next(
+        s
+        for s in sorted(WIRED[refusal.name]["spellings"])
+        if s.rpartition(".")[0] == module
+        and isinstance(refusals._resolve(s), types.FunctionType)
+        and refusals._resolve(s) not in own
+        and not s.rpartition(".")[2].startswith("__")
+    )
+
+
+def _graded_cells(spelling, call, inside, tag=""):
+    """The cells of a notebook whose `graded` uses the object at `spelling`, imported at the top or inside."""
+    cells = []
+    for i, (imports, expression) in enumerate(_spellings_of(spelling, tag)):
+        body = f"    return {call.format(expression)}"
+        if inside:
+            cells.append(f"def graded_{i}(*a):\n    {imports}\n{body}")
+        else:
+            cells.append(f"{imports}\ndef graded_{i}(*a):\n{body}")
+    return cells
+
+
+def test_every_allowed_helper_passes_the_scan_however_it_is_spelled_and_its_neighbours_do_not():
+    helpers = _allowed_helpers()
+    assert {helper for _, helper, _ in helpers} == {h for r in REFUSALS for h in r.allowed} == set(EXAMPLE_CALLS)
+    wrongly_refused, missed = [], []
+    for refusal, helper, spelling in helpers:
+        neighbour = _refused_neighbour(refusal, spelling)
+        for inside in (False, True):
+            cells = _graded_cells(spelling, EXAMPLE_CALLS[helper], inside)
+            refused_cells = _graded_cells(neighbour, "{}()", inside)
+            for i in range(len(cells)):
+                if _scan(cells, [f"graded_{i}"], refusal):
+                    wrongly_refused.append(cells[i])
+                if not _scan(refused_cells, [f"graded_{i}"], refusal):
+                    missed.append(refused_cells[i])
+    assert wrongly_refused == [] and missed == [], (wrongly_refused, missed)
+    # a refused module handed on whole is still refused: what it is used for is out of the scan's sight
+    assert _scan(["import labkit.piecewise as pw\ndef graded(*a):\n    return vars(pw)"], ["graded"], INTERPOLANTS)
+    assert _scan(["from labkit import piecewise\ndef graded(f):\n    return f(piecewise)"], ["graded"], INTERPOLANTS)
+
+
+def test_every_allowed_helper_passes_the_watch_however_it_is_spelled(open_notebooks):
+    allowed, refused = [], []  # (refusal, function name, cell): one notebook for each kind
+    for n, (refusal, helper, spelling) in enumerate(_allowed_helpers()):
+        for inside in (False, True):
+            for i, cell in enumerate(_graded_cells(spelling, EXAMPLE_CALLS[helper], inside, n)):
+                allowed.append(
+                    (refusal, f"allowed_{n}_{inside:d}_{i}", cell.replace(f"graded_{i}", f"allowed_{n}_{inside:d}_{i}"))
+                )
+        # called with as many numbers as it takes positional arguments: the call starts, whatever it then raises
+        neighbour = _refused_neighbour(refusal, spelling)
+        for i, cell in enumerate(_graded_cells(neighbour, "{0}(*[0.5] * {0}.__code__.co_argcount)", False, n)):
+            refused.append((refusal, f"refused_{n}_{i}", cell.replace(f"graded_{i}", f"refused_{n}_{i}")))
+    notebook = _notebook(open_notebooks, *[cell for *_, cell in allowed])
+    for refusal, name, cell in allowed:
+        assert _call(notebook, name, refusal) == 1.0, cell
+    notebook = _notebook(open_notebooks, *[cell for *_, cell in refused])
+    for refusal, name, cell in refused:
+        with pytest.raises(remote.StudentError, match="switched off"):
+            _call(notebook, name, refusal)
+            pytest.fail(cell)
+
+
+# -- labkit's code pasted into a notebook ------------------------------------
+
+PASTED = (  # library functions a student might paste, private helpers among them
+    labkit.piecewise._hermite_eval,
+    labkit.piecewise.eval_pherm,
+    labkit.splines._slopes_from_curvatures,
+    labkit.splines.natural_curvatures,
+    labkit.monotone._interior_slopes,
+    labkit.bilinear._cell_and_weight,
+)
+PASTE_IMPORTS = (
+    "import numpy as np\nfrom numpy.typing import ArrayLike, NDArray\n"
+    "from labkit._validate import *\nfrom labkit._locate import *\nfrom labkit._frame import Frame"
+)
+
+
+def pasted(function, docstring=True):
+    """`function`'s source as a student pastes it into a cell: verbatim, or with its docstring's lines deleted."""
+    import ast
+    import inspect
+    import textwrap
+
+    lines = textwrap.dedent(inspect.getsource(function)).splitlines()
+    node = ast.parse("\n".join(lines)).body[0]
+    if not docstring and ast.get_docstring(node) is not None:
+        doc = node.body[0]
+        del lines[doc.lineno - 1 : doc.end_lineno]
+    return "\n".join(lines)
+
+
+def test_the_digest_is_the_same_with_or_without_the_docstring():
+    def key(source, name, optimize=-1):
+        namespace = {}
+        exec(compile(PASTE_IMPORTS + "\n" + source, "<cell>", "exec", optimize=optimize), namespace)
+        return guard.code_key(namespace[name].__code__)
+
+    for function in PASTED:
+        kept = key(pasted(function), function.__name__)
+        assert kept == key(pasted(function, False), function.__name__)  # the docstring's lines deleted
+        assert kept == key(pasted(function), function.__name__, optimize=2)  # stripped by the compiler
+    names = refusals.recognised(INTERPOLANTS)[0]
+    assert names[guard.code_key(labkit.piecewise._hermite_eval.__code__)] == "labkit.piecewise._hermite_eval"
+
+
+@pytest.mark.parametrize("docstring", [True, False], ids=["docstrings kept", "docstrings deleted"])
+def test_labkit_functions_pasted_into_cells_are_recognised(open_notebooks, docstring):
+    """Each copy is pasted in a cell of its own (IPython compiles it apart from the imports), with a function of
+    the student's own that calls it."""
+    cells = [PASTE_IMPORTS] + [pasted(function, docstring) for function in PASTED]
+    for i, function in enumerate(PASTED):
+        arguments = function.__code__.co_argcount - len(function.__defaults__ or ())
+        cells.append(f"def uses_{i}(*a):\n    return {function.__name__}(*[np.linspace(1.0, 2.0, 5)] * {arguments})")
+    notebook = _notebook(open_notebooks, *cells)
+    for i, function in enumerate(PASTED):
+        with pytest.raises(remote.StudentError, match="switched off") as refused:
+            _call(notebook, f"uses_{i}", INTERPOLANTS)
+        assert f"{function.__module__}.{function.__qualname__}" in str(refused.value)
+
+
+def test_every_alias_of_numpys_compiled_interp_is_switched_off(open_notebooks):
+    import importlib
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        importlib.import_module("numpy.core.multiarray")  # numpy 2's shim of the old names, which the notebook loads
+    compiled = {
+        id(importlib.import_module(module).__dict__[name]): name
+        for module, name in (f.rsplit(".", 1) for f in INTERPOLANTS.functions)
+        if not hasattr(importlib.import_module(module).__dict__[name], "__code__")
+    }
+    aliases = sorted(
+        (module, attribute)
+        for module, value in list(sys.modules.items())
+        if module.split(".")[0] == "numpy" and value is not None
+        for attribute, held in list(vars(value).items())
+        if id(held) in compiled
+    )
+    assert len({module for module, _ in aliases}) >= 4, aliases
+    cells = [
+        "import sys, warnings, numpy as np\nwith warnings.catch_warnings():\n    warnings.simplefilter('ignore')\n"
+        "    import numpy.core.multiarray"
+    ]
+    for i, (module, attribute) in enumerate(aliases):
+        cells.append(f"def via_{i}(x, xp, fp):\n    return getattr(sys.modules[{module!r}], {attribute!r})(x, xp, fp)")
+    notebook = _notebook(open_notebooks, *cells)
+    for i, alias in enumerate(aliases):
+        with pytest.raises(remote.StudentError, match="switched off"):
+            _call(notebook, f"via_{i}", INTERPOLANTS, XV, X, Y)
+            pytest.fail(str(alias))

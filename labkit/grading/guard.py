@@ -43,6 +43,7 @@ answer is voided afterwards: neither hook raises.
 import _hashlib
 import builtins
 import gc
+import opcode
 import os
 import sys
 import types
@@ -53,6 +54,8 @@ import types
 _sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
 _write, _getframe, _modules = os.write, sys._getframe, sys.modules
 _gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
+_HASCONST, _EXTENDED_ARG, _NOP = frozenset(opcode.hasconst), opcode.EXTENDED_ARG, opcode.opmap["NOP"]
+_NoneType = type(None)
 _ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
     types.ModuleType,
     types.CodeType,
@@ -96,17 +99,53 @@ GUARDED_ATTRIBUTES = frozenset({"__code__"})  # libraries set __defaults__ and t
 EXPOSED = frozenset({"_stand_in", "_plain", "_handed_over", "_barrier"})
 
 
+def _constant(value):
+    """What a constant the bytecode loads contributes to :func:`code_key`: numbers and None by value, any other
+    constant by its kind only (exact built-in types only; nothing of the student's is touched)."""
+    kind = type(value)
+    if kind is _NoneType or kind is bool:
+        return repr(value)
+    if kind is int:
+        return f"i{value}" if -(1 << 64) < value < 1 << 64 else f"I{value.bit_length()}"
+    if kind is float or kind is complex:
+        return f"{kind.__name__[0]}{value!r}"
+    if kind is tuple:
+        return "(" + ",".join([_constant(item) for item in value]) + ")"
+    if kind is str:
+        return "s"
+    if kind is _CodeType:
+        return "c"
+    return "o"
+
+
 def code_key(code):
     """A digest of a function's code that survives renaming the function but not rewriting it.
 
-    Bytecode, the names and local names it uses and its numeric constants;
-    short functions (which an honest student might write identically) are
-    also keyed by their name, file and line.
+    The bytecode with each constant it loads replaced by that constant's value
+    (numbers and None; strings by their kind only), the names and local names
+    it uses and its number of arguments. So where a constant sits in
+    ``co_consts`` does not count: a function whose docstring was deleted (None
+    in its place, and the constants after it one place earlier) has the same
+    key, and so has one compiled with its docstring stripped (``optimize=2``,
+    which leaves a NOP: NOPs are left out). Short functions (which an honest student might write identically)
+    are also keyed by their name, file and line.
     """
-    consts = tuple(c for c in code.co_consts if type(c) in (int, float, complex, type(None)))
-    digest = _sha1(code.co_code)
-    digest.update(repr((code.co_names, code.co_varnames, code.co_argcount, consts)).encode())
-    if len(code.co_code) < SMALL_CODE:
+    raw, consts = code.co_code, code.co_consts
+    structure, loaded, count, extended = bytearray(), [], len(consts), 0
+    for i in range(0, len(raw) - 1, 2):
+        op, arg = raw[i], raw[i + 1] | extended
+        extended = (arg << 8) if op == _EXTENDED_ARG else 0
+        if op == _NOP:
+            continue  # where a statement compiled to nothing stood (a docstring stripped by optimize=2)
+        structure.append(op)
+        if op in _HASCONST:
+            structure.append(0)
+            loaded.append(_constant(consts[arg]) if arg < count else "?")
+        else:
+            structure.append(raw[i + 1])
+    digest = _sha1(bytes(structure))
+    digest.update(repr((code.co_names, code.co_varnames, code.co_argcount, loaded)).encode())
+    if len(raw) < SMALL_CODE:
         digest.update(repr((code.co_qualname, code.co_filename, code.co_firstlineno)).encode())
     return digest.digest()[:12]
 
@@ -242,6 +281,24 @@ def _install(secret, verdict_fd, profiles, passables, chain):
         union[1].update(mods)
         union[2].update(c_names)
     strictest = (union[0], tuple(union[1]), frozenset(union[2]))
+    identity = id
+    # the refused compiled functions themselves, taken while the process is pristine: {c_names: {id: (it, name)}}
+    c_objects = {}
+    for _names, _mods, c_names in [*profiles.values(), strictest]:
+        found = {}
+        for module_name, attribute in c_names:
+            module = modules.get(module_name)
+            namespace = module.__dict__ if type(module) is module_type else {}
+            if attribute in namespace:
+                found[identity(namespace[attribute])] = (namespace[attribute], f"{module_name}.{attribute}")
+        c_objects[c_names] = found
+    # the modules as the watch found them: how many names each held, and which held a refused compiled function
+    sizes, holders, every_target = {}, set(), frozenset(i for found in c_objects.values() for i in found)
+    for module_name, module in list(modules.items()):
+        if type(module_name) is str_type and type(module) is module_type and type(module.__dict__) is dict_type:
+            sizes[module_name] = len(module.__dict__)
+            if not every_target.isdisjoint(map(identity, module.__dict__.values())):
+                holders.add(module_name)
     copies = {}
     for name, function in passables.items():
         code = function.__code__.replace()  # equal, but another object: trusted by identity
@@ -284,21 +341,38 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     def stub(profile):
         """Replace the compiled functions and classes of the refused modules (exact types only)."""
         mods, c_names = profile[1], profile[2]
+        # a refused compiled function is switched off under every name a module holds it by (numpy's interp is
+        # numpy._core._multiarray_umath.interp, numpy._core.multiarray.interp, ...): found by identity only
+        targets = c_objects.get(c_names, {})
+        target_ids = frozenset(targets)
         for module_name, module in list(modules.items()):
             if type(module_name) is not str_type or type(module) is not module_type:
                 continue
             namespace = module.__dict__
+            if type(namespace) is not dict_type:
+                continue
             whole = within(module_name, mods)
-            if not whole and not any(m == module_name for m, _ in c_names):
+            # where the process held a target when the watch was installed, and any module loaded or grown since
+            # (ids compared in C: no object of the notebook's is asked anything; a live target's id is its own)
+            held = module_name in holders
+            if target_ids and not held and sizes.get(module_name) != len(namespace):
+                held = not target_ids.isdisjoint(map(identity, namespace.values()))
+                if not held:
+                    sizes[module_name] = len(namespace)  # looked at with this many names: again once it changes
+            if not whole and not held and not any(m == module_name for m, _ in c_names):
                 continue
             entries = list(namespace.items())
             if any(type(attribute) is not str_type for attribute, _ in entries):
-                continue  # a key of the notebook's making could run code when the dictionary compares it
+                # a key of the notebook's making could run code when the dictionary compares it
+                note_tampering(f"a name that is not a string put in {module_name}")
+                continue
             for attribute, value in entries:
                 kind = type(value)
                 compiled = kind in compiled_types or (kind is type and not value.__flags__ & heap_type)
-                if ((module_name, attribute) in c_names) or (whole and compiled):
-                    namespace[attribute] = make_stand_in(f"{module_name}.{attribute}")
+                alias = identity(value) in targets and targets[identity(value)][0] is value
+                if ((module_name, attribute) in c_names) or (whole and compiled) or alias:
+                    name = targets[identity(value)][1] if alias else f"{module_name}.{attribute}"
+                    namespace[attribute] = make_stand_in(name)
                     state["stubbed"].append((namespace, attribute, value))
 
     def unstub():
@@ -385,7 +459,9 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             if state["gc"]:
                 gc_enable()
         elif profile is not None:
+            set_profile(None, None)  # the watch's own walk over the modules runs unprofiled (no student code runs)
             stub(profile)
+            set_profile(hook_address, None)
 
     def end(args):
         if state["mode"] not in ("graded", RUN) or len(args) != 1 or type(args[0]) is not bytes_type:

@@ -21,6 +21,10 @@ spelling of the allowed ones. Everything is computed once per grading run
 runs.
 """
 
+import __future__
+
+import ast
+import codeop
 import functools
 import importlib
 import importlib.util
@@ -55,11 +59,40 @@ def _module_files(prefix):
     return []  # a compiled module: its routines are refused by the module's name
 
 
+# the flags IPython compiles a cell's statements with (codeop's, which its CachingCompiler keeps), and the
+# __future__ features a notebook's earlier cells may have added to them
+CELL_FLAGS = codeop.PyCF_DONT_IMPLY_DEDENT | getattr(codeop, "PyCF_ALLOW_INCOMPLETE_INPUT", 0)
+
+
 @functools.cache
 def _compiled_codes(path):
-    """Every code object of one source file, compiled as the import system does."""
+    """Every code object of one source file, compiled as the import system does and as a notebook does.
+
+    The import system compiles the whole file; IPython compiles each top-level
+    statement of a cell on its own. The bytecode differs: a call through a
+    module the same compilation imports (``np.diff(x)`` under ``import numpy as
+    np``) is a global load and an attribute load in the file, a method load in a
+    cell. So each top-level statement is also compiled on its own, with the
+    flags of a cell, with and without the file's ``__future__`` features."""
     source = Path(path).read_bytes()
-    return tuple(codes_in(compile(source, str(path), "exec", dont_inherit=True)))
+    whole = compile(source, str(path), "exec", dont_inherit=True)
+    found = list(codes_in(whole))
+    try:
+        tree = ast.parse(source, str(path))
+    except (SyntaxError, ValueError):
+        return tuple(found)
+    futures = 0
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and node.module == "__future__":
+            for alias in node.names:
+                feature = getattr(__future__, alias.name, None)
+                futures |= feature.compiler_flag if feature is not None else 0
+    for flags in sorted({CELL_FLAGS, CELL_FLAGS | futures}):
+        for node in tree.body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.If, ast.Try, ast.With)):
+                module = ast.Module([node], type_ignores=[])
+                found += codes_in(compile(module, str(path), "exec", flags=flags, dont_inherit=True))
+    return tuple(found)
 
 
 def _inside(qualname, names):
@@ -158,6 +191,13 @@ def spellings(refusal):
     return spelled, sorted(allowed_spellings)
 
 
+def submodules(refusal):
+    """The loaded modules inside the refusal's module prefixes (the scan judges their uses, not their import)."""
+    spellings(refusal)  # imports the refused modules
+    loaded = list(sys.modules.items())
+    return sorted(name for name, module in loaded if module is not None and _within(name, refusal.modules))
+
+
 def wire(refusals):
     """The profiles of these refusals as JSON-ready data for the sandbox and the scan: {name: {...}}."""
     profiles = {}
@@ -170,5 +210,6 @@ def wire(refusals):
             "c_names": sorted(map(list, c_names)),
             "spellings": spelled,
             "allowed": allowed,
+            "submodules": submodules(refusal),
         }
     return profiles

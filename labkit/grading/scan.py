@@ -255,13 +255,32 @@ def _imported(node):
 
 
 def _dotted(node, aliases):
+    """The dotted name an attribute chain spells, aliases resolved (``getattr(m, "name")`` is ``m.name``)."""
     parts = []
-    while isinstance(node, ast.Attribute):
-        parts.append(node.attr)
-        node = node.value
+    while isinstance(node, ast.Attribute) or _constant_getattr(node):
+        if isinstance(node, ast.Attribute):
+            parts.append(node.attr)
+            node = node.value
+        else:
+            parts.append(node.args[1].value)
+            node = node.args[0]
     if not isinstance(node, ast.Name) or node.id not in aliases:
         return None
     return ".".join([aliases[node.id]] + parts[::-1])
+
+
+def _constant_getattr(node):
+    """Whether `node` is ``getattr(value, "name")`` (or with a default): an attribute written as a string."""
+    return (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id == "getattr"
+        and len(node.args) in (2, 3)
+        and not node.keywords
+        and isinstance(node.args[1], ast.Constant)
+        and isinstance(node.args[1].value, str)
+        and node.args[1].value.isidentifier()
+    )
 
 
 def _within(dotted, prefixes):
@@ -275,6 +294,7 @@ class _Refused:
         self.modules = tuple(profile["modules"])
         self.spellings = dict(profile["spellings"])  # dotted spelling -> the refused object's own name
         self.allowed = set(profile["allowed"])
+        self.submodules = set(profile.get("submodules", ()))  # the refused modules themselves, as loaded
 
     def reason(self, dotted):
         """Why `dotted` (a name as the notebook writes it, aliases resolved) is refused, or None."""
@@ -286,6 +306,23 @@ class _Refused:
         if _within(dotted, self.modules):
             return dotted
         return None
+
+    def chain(self, dotted):
+        """Why a whole attribute chain is refused, or None: its longest refused prefix, unless a longer
+        prefix is an allowed helper (``labkit.piecewise.bracket`` is allowed however ``labkit.piecewise`` is
+        reached)."""
+        while dotted:
+            if dotted in self.allowed:
+                return None
+            what = self.reason(dotted)
+            if what:
+                return what
+            dotted = dotted.rpartition(".")[0]
+        return None
+
+    def is_module(self, dotted):
+        """Whether `dotted` names a refused module itself (its uses are judged, not its import)."""
+        return dotted in self.submodules
 
 
 def _dynamic(node, aliases):
@@ -355,20 +392,27 @@ def scan(sources, names, profile, deadline=None):
                 if isinstance(node, (ast.Import, ast.ImportFrom)):
                     for alias_name, dotted in _imported(node):
                         local[alias_name] = dotted
-                        why = refused.reason(dotted) or (
+                        # a refused module imported is judged by its uses (``pw.bracket`` is allowed)
+                        why = (None if refused.is_module(dotted) else refused.chain(dotted)) or (
                             dotted.split(".")[0] if dotted.split(".")[0] in DYNAMIC_MODULES else None
                         )
                         if why:
                             findings.add((owner, node.lineno - start + 1, why))
+            outside = {k: v for k, v in local.items() if k not in reader.definitions}
+            # the inner links of an attribute chain are judged with the whole chain (``pw`` in ``pw.bracket``)
+            inner = set()
+            for node in ast.walk(definition):
+                if isinstance(node, ast.Attribute):
+                    inner.add(id(node.value))
+                elif _constant_getattr(node):
+                    inner.add(id(node.args[0]))
             for node in ast.walk(definition):
                 reader._tick()
                 what = None
-                if isinstance(node, (ast.Name, ast.Attribute)):
-                    dotted = _dotted(node, {k: v for k, v in local.items() if k not in reader.definitions})
-                    while dotted and what is None:
-                        what = refused.reason(dotted)
-                        dotted = dotted.rpartition(".")[0]
-                what = what or _dynamic(node, {k: v for k, v in local.items() if k not in reader.definitions})
+                if isinstance(node, (ast.Name, ast.Attribute, ast.Call)) and id(node) not in inner:
+                    dotted = _dotted(node, outside)
+                    what = refused.chain(dotted) if dotted else None
+                what = what or _dynamic(node, outside)
                 if what:
                     findings.add((owner, getattr(node, "lineno", start) - start + 1, what))
     # an attribute chain reports itself and its prefixes: keep the longest on each line
