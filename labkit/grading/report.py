@@ -399,7 +399,8 @@ def write_report(out_dir, grades, record=None):
     out.mkdir(parents=True, exist_ok=True)
     if record is None:
         rubric = grades[0].rubric if grades else rubrics.default()
-        record = records.new("grade", labkit_version(), _seed_of(grades), rubric)
+        seed = _seed_of(grades)  # grades of several seeds are a merge's
+        record = records.new("merge" if isinstance(seed, list) else "grade", labkit_version(), seed, rubric)
     for grade in grades:
         written = write_result(out, grade)
         content = record.submissions.get(grade.name, {}).get("content")
@@ -410,9 +411,9 @@ def write_report(out_dir, grades, record=None):
 
 
 def _seed_of(grades):
-    """The seed of a run's grades: one number, or the list of them (a merge's)."""
+    """The seed of a run's grades: one number, the list of them (a merge's), or None when none has one."""
     seeds = sorted({g.seed for g in grades if g.seed is not None})
-    return seeds[0] if len(seeds) == 1 else seeds
+    return None if not seeds else seeds[0] if len(seeds) == 1 else seeds
 
 
 @dataclass(frozen=True)
