@@ -532,16 +532,20 @@ def _allowed_helpers():
 
 
 def _refused_neighbour(refusal, spelling):
-    """A refused function exported by the same module as the allowed `spelling` (the same spellings must fail)."""
+    """A refused function exported by the same module as the allowed `spelling` (the same spellings must fail),
+    or None when that module holds none (``labkit.plots.editor.Corner``: a module that only uses the helper)."""
     module = spelling.rpartition(".")[0]
     own = {refusals._resolve(s) for s in WIRED[refusal.name]["allowed"]}
     return next(
-        s
-        for s in sorted(WIRED[refusal.name]["spellings"])
-        if s.rpartition(".")[0] == module
-        and isinstance(refusals._resolve(s), types.FunctionType)
-        and refusals._resolve(s) not in own
-        and not s.rpartition(".")[2].startswith("__")
+        (
+            s
+            for s in sorted(WIRED[refusal.name]["spellings"])
+            if s.rpartition(".")[0] == module
+            and isinstance(refusals._resolve(s), types.FunctionType)
+            and refusals._resolve(s) not in own
+            and not s.rpartition(".")[2].startswith("__")
+        ),
+        None,
     )
 
 
@@ -565,10 +569,13 @@ def test_every_allowed_helper_passes_the_scan_however_it_is_spelled_and_its_neig
         neighbour = _refused_neighbour(refusal, spelling)
         for inside in (False, True):
             cells = _graded_cells(spelling, EXAMPLE_CALLS[helper], inside)
-            refused_cells = _graded_cells(neighbour, "{}()", inside)
             for i in range(len(cells)):
                 if _scan(cells, [f"graded_{i}"], refusal):
                     wrongly_refused.append(cells[i])
+            if neighbour is None:
+                continue
+            refused_cells = _graded_cells(neighbour, "{}()", inside)
+            for i in range(len(refused_cells)):
                 if not _scan(refused_cells, [f"graded_{i}"], refusal):
                     missed.append(refused_cells[i])
     assert wrongly_refused == [] and missed == [], (wrongly_refused, missed)
@@ -587,6 +594,8 @@ def test_every_allowed_helper_passes_the_watch_however_it_is_spelled(open_notebo
                 )
         # called with as many numbers as it takes positional arguments: the call starts, whatever it then raises
         neighbour = _refused_neighbour(refusal, spelling)
+        if neighbour is None:
+            continue
         for i, cell in enumerate(_graded_cells(neighbour, "{0}(*[0.5] * {0}.__code__.co_argcount)", False, n)):
             refused.append((refusal, f"refused_{n}_{i}", cell.replace(f"graded_{i}", f"refused_{n}_{i}")))
     notebook = _notebook(open_notebooks, *[cell for *_, cell in allowed])
