@@ -218,6 +218,7 @@ def grade_options(args):
         grader_memory=args.grader_memory * MIB,
         limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE),
         fork_server=not args.no_fork_server,
+        solutions=args.solutions,
     )
 
 
@@ -659,6 +660,14 @@ def build_parser():
         action="store_true",
         help="a submission with no other time gets its notebooks' newest modification time (never without "
         "this option: copying or unpacking a file changes it, and the student sets it; marked student-supplied)",
+    )
+    grd.add_argument(
+        "--solutions",
+        type=Path,
+        metavar="DIR",
+        help="the instructor notebooks (the course repository's notebooks/): a graded part whose code is mostly "
+        "theirs, names aside, is held for you like one that is labkit's or scipy's own (see "
+        "docs/grading-security.md); recorded, and used again when the run resumes",
     )
     grd.add_argument(
         "--no-fork-server",

@@ -25,6 +25,7 @@ from pathlib import Path
 import nbformat
 import pytest
 from conftest import sandbox_or_skip
+from copies import module_source
 from helpers import processes_with as _processes_with
 
 import labkit.piecewise
@@ -355,6 +356,31 @@ REPLACED = {  # cells of the release replaced by an attack: {name: (base noteboo
             "    return _hermite_eval(x, y, yp, xv)"
         },
     ),
+    # labkit's own modules pasted in, every local renamed and a dummy first statement in each function (the
+    # recognition digest never matches, and the scan sees only the notebook's own names)
+    "renamed_piecewise": ("02_convergence.ipynb", {"def eval_pherm(": module_source("labkit.piecewise")}),
+    "renamed_splines": (
+        "04_splines.ipynb",
+        {
+            "def complete_system(": module_source("labkit.piecewise")
+            + "\n\n"
+            + module_source("labkit.splines", drop=("labkit.piecewise",)),
+            "def ncspline(": "pass",
+        },
+    ),
+    # labkit's module byte for byte but for its docstrings (reformatted): the sandbox's watch knows its code
+    "nodoc_bilinear": ("06_bilinear.ipynb", {"def runge2d(": module_source("labkit.bilinear", rename=False)}),
+    "renamed_bilinear": ("06_bilinear.ipynb", {"def runge2d(": module_source("labkit.bilinear")}),
+    # the copy moved into helpers under a graded function of one's own
+    "renamed_helpers": (
+        "02_convergence.ipynb",
+        {
+            "def eval_pherm(": module_source("labkit.piecewise")
+            + "\n\ndef eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "    x, y, yp, xv = (np.asarray(v, dtype=float) for v in (xdata, ydata, ypdata, xval))\n"
+            "    return _hermite_eval(x, y, yp, xv)"
+        },
+    ),
     # numpy's compiled interp under another of the names numpy holds it by
     "interp_alias": (
         "06_bilinear.ipynb",
@@ -561,6 +587,35 @@ def test_an_allowed_helper_imported_from_its_module_costs_nothing(attacked):
     grade = attacked["results"]["honest_auto_import"]
     assert grade.total == 25 + 8 and grade.points[2] == 10 and grade.points[16] == 8, grade.feedback()
     assert "reaches for" not in grade.feedback()
+
+
+COPIES = {  # the copies of labkit's code: the part held, and the source its feedback names
+    "renamed_piecewise": (2, "eval_pherm", "labkit.piecewise."),
+    "renamed_splines": (10, "ccspline", "labkit.splines."),
+    "renamed_bilinear": (16, "eval_pbilin", "labkit.bilinear."),
+    "renamed_helpers": (2, "eval_pherm", "labkit.piecewise."),
+}
+
+
+@pytest.mark.parametrize("name", sorted(COPIES))
+def test_a_copy_of_labkits_code_is_held_for_a_person(attacked, name):
+    number, part, source = COPIES[name]
+    grade = attacked["results"][name]
+    held = {(n, p): what for n, p, what, released in grade.held() if not released}
+    assert (number, part) in held, grade.feedback()
+    assert held[(number, part)]["source"].startswith(source)
+    assert grade.points[number] == 0
+    feedback = grade.feedback()
+    assert "HELD" in feedback and source in feedback and " | " in feedback  # the shared lines side by side
+    with open(attacked["out"] / "grades.csv", newline="") as handle:
+        row = next(r for r in csv.DictReader(handle) if r["submission"] == name)
+    assert f"exercise {number} {part}" in row["held for a person"]
+
+
+def test_no_honest_classmate_is_held(attacked):
+    for name, grade in attacked["results"].items():
+        if name.startswith("honest_"):
+            assert grade.held() == [], grade.feedback()
 
 
 def test_the_honest_classmates_get_their_usual_scores(attacked):

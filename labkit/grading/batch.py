@@ -62,7 +62,7 @@ from .rubric import DEFAULT as DEFAULT_RUBRIC
 from .rubric import Rubric
 from .rubric import default as default_rubric
 from .rubric import load as load_rubric
-from .scoring import submission_name, submission_notebooks
+from .scoring import known_sources, submission_name, submission_notebooks
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
@@ -469,6 +469,9 @@ def grade(
         exchange_times = {**earlier.record.given_times("exchange"), **(exchange_times or {})}
         times_from_submission = times_from_submission or earlier.record.flags.get("times from submission", False)
         times_from_mtime = times_from_mtime or earlier.record.flags.get("times from mtime", False)
+        if options.solutions is None and earlier.record.known.get("solutions"):  # compared with them again
+            options = replace(options, solutions=earlier.record.known["solutions"])
+    known = known_sources(rubric.registry, options.solutions)  # computed (or read from its cache) once, here
     handed_in = [
         submission_time(
             path,
@@ -490,6 +493,7 @@ def grade(
         if given
     }
     record.flags = {"times from submission": bool(times_from_submission), "times from mtime": bool(times_from_mtime)}
+    record.known = {"digest": known.digest, "solutions": options.solutions}
     records.write(out, record)
     if rubric.text is not None:  # the grading processes read the run's rubric from its record's copy
         options = replace(options, rubric=str((out / records.RUBRIC_COPY).resolve()))
@@ -849,7 +853,7 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
         raise ValueError(
             f"{out} was graded under the rubric recorded there ({recorded.title!r}), and {rubric.source} differs "
             f"from it in {' and '.join(recorded.differences(rubric))}: leave --rubric out to resume that run. "
-            f"To grade under {rubric.source}, {how}; to apply only another [late] table to these results, "
+            f"To grade under {rubric.source}, {how}; to apply only another [late] or [held] table to these results, "
             f"`labkit grade --merge {out} --rubric {_file_of(rubric)} --out NEW`."
         )
     if seed is not None and record.seed is not None and int(seed) != int(record.seed):

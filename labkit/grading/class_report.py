@@ -41,6 +41,7 @@ from . import late as lateness
 from .record import rubric_for
 from .report import SubmissionGrade, one_line, printable, read_results
 from .rubric import Rubric, points_text
+from .known import THRESHOLD
 from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
 
 REPORT = "report.html"
@@ -302,6 +303,21 @@ def _late_summary(rubric, graded):
     return LateSummary(rubric.late, tuple(entries))
 
 
+@dataclass(frozen=True)
+class Held:
+    """A part held for a person: its check passed, but its code is mostly a known source's
+    (:mod:`labkit.grading.known`); its points count only once the rubric's ``[held]`` table releases them."""
+
+    student: str
+    exercise: int
+    part: str
+    definition: str  # the notebook's definition that matched
+    source: str  # what it matched
+    share: float
+    released: bool
+    lines: tuple  # (the student's line, the source's line) pairs
+
+
 @dataclass
 class ClassSummary:
     """Everything the page shows, counted from the grades (see :func:`summarise`)."""
@@ -316,6 +332,7 @@ class ClassSummary:
     most_failed: list  # Struggle, most failed parts first
     seeds: list = field(default_factory=list)
     late: LateSummary | None = None  # the late view, when the rubric has a [late] table
+    held: list = field(default_factory=list)  # Held: parts held for a person (their code matched a known source)
 
     @property
     def submissions(self):
@@ -624,7 +641,16 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
         most_failed=struggles[:MOST_FAILED],
         seeds=sorted({g.seed for g in grades if isinstance(g.seed, int)}),
         late=_late_summary(rubric, graded),
-    )
+        held=[
+            Held(
+                g.name, number, str(part), str(what.get("definition", "")), str(what.get("source", "")),
+                float(what.get("share", 0) or 0), released,
+                tuple(tuple(map(str, pair)) for pair in what.get("lines", ()) if len(pair) == 2),
+            )
+            for g in graded
+            for number, part, what, released in g.held()
+        ],
+    )  # fmt: skip
 
 
 # ---------------------------------------------------------------------------------------------- figures
@@ -1163,6 +1189,40 @@ def _code_side(name, lines, shared):
     return f"<figure><figcaption>{_e(name, MAX_NAME)}</figcaption><pre>" + "\n".join(rows) + "</pre></figure>"
 
 
+def _held_section(summary):
+    out = ['<section aria-labelledby="held"><h2 id="held">Held for a person</h2>']
+    out.append(
+        "<p>A part is held when its check passed but its code is, names aside, mostly code every student has "
+        f"on disk: labkit's, scipy's, or the solutions' given to <code>--solutions</code> (a share of "
+        f"{THRESHOLD:.2f} or more of the part's own code; see <code>docs/grading-security.md</code>). Its points "
+        "are not in the total until you release them: list the student and the exercise in the rubric's "
+        '<code>[held]</code> table (<code>release = {"ada" = [2]}</code>) and run '
+        "<code>labkit grade --merge OUT --rubric RUBRIC --out NEW</code>.</p>"
+    )
+    if not summary.held:
+        out.append("<p>No part of this class is held.</p></section>")
+        return "\n".join(out)
+    rows = [
+        [_e(s.student, MAX_NAME)]
+        + [(TEXT, _e(cell, MAX_NAME)) for cell in (f"{s.exercise} {s.part}", s.definition, s.source)]
+        + [(NUM, f"{s.share:.0%}"), (TEXT, "released" if s.released else "held")]
+        for s in summary.held
+    ]
+    out.append(_table("Parts held for a person", ["Student", "Part", "Definition", "Matched", "Share", "State"], rows))
+    for entry in summary.held[:MAX_PAIRS]:
+        mine = [pair[0] for pair in entry.lines]
+        theirs = [pair[1] for pair in entry.lines]
+        out.append(
+            f"<h3>{_e(entry.student, MAX_NAME)}: exercise {entry.exercise}, {_e(entry.part, MAX_NAME)}</h3>"
+            '<div class="pair">'
+            + _code_side(f"{entry.student}: {entry.definition}", mine, set(range(len(mine))))
+            + _code_side(entry.source, theirs, {i for i, line in enumerate(theirs) if line})
+            + "</div>"
+        )
+    out.append("</section>")
+    return "\n".join(out)
+
+
 def _similar_section(pairs, threshold, note):
     out = ['<section aria-labelledby="similar"><h2 id="similar">Similar code</h2>']
     out.append(
@@ -1294,6 +1354,7 @@ def render(
         ("slips", "Slips the checks named"),
         ("problems", "Problems"),
         ("most-failed", "The most failed parts"),
+        ("held", "Held for a person"),
         ("similar", "Similar code"),
     ]
     nav = "".join(f'<li><a href="#{anchor}">{title}</a></li>' for anchor, title in sections)
@@ -1317,6 +1378,7 @@ def render(
                 _slips_section(summary),
                 _problems_section(summary),
                 _most_failed_section(summary),
+                _held_section(summary),
                 _similar_section(pairs, threshold, similarity_note),
             ]
         )

@@ -31,6 +31,7 @@ class GradeOptions:
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
     exercises: str = None  # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
     fork_server: bool = True  # notebooks' workers forked from one warm server per run (labkit.grading.forkserver)
+    solutions: str = None  # the instructor notebooks' folder, a known source (labkit.grading.known); None: left out
 
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):
@@ -43,6 +44,12 @@ class GradeOptions:
                     f"rubric must be the path of a TOML rubric (or None for the lab's own); got {self.rubric!r}."
                 )
             object.__setattr__(self, "rubric", os.fspath(self.rubric))
+        if self.solutions is not None:
+            if not isinstance(self.solutions, (str, os.PathLike)):
+                raise ValueError(
+                    f"solutions must be the folder of the instructor notebooks (or None); got {self.solutions!r}."
+                )
+            object.__setattr__(self, "solutions", os.path.abspath(os.fspath(self.solutions)))
         if not isinstance(self.limits, Limits):
             raise ValueError(f"limits must be a labkit.grading.backends.base.Limits; got {self.limits!r}.")
 

@@ -70,6 +70,8 @@ class RunRecord:
     submissions: dict = field(default_factory=dict)
     times: dict = field(default_factory=dict)  # source ("csv", "exchange") -> {name: ISO time}: the times given
     flags: dict = field(default_factory=dict)  # the run's switches that change grades ("times from submission", ...)
+    # the known sources graded parts were compared with (labkit.grading.known): {"digest": ..., "solutions": path}
+    known: dict = field(default_factory=dict)
 
     def given_times(self, source):
         """{name: datetime} of the times the run was given from `source` (``"csv"``: ``--times``; ``"exchange"``)."""
@@ -88,6 +90,7 @@ class RunRecord:
             "submissions": self.submissions,
             "times": self.times,
             "flags": self.flags,
+            "known": self.known,
         }
 
     def rubric_object(self, folder):
@@ -183,13 +186,17 @@ def read(folder):
         flags = data.get("flags") or {}
         if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
             raise ValueError("its flags are not true or false")
+        known = data.get("known") or {}
+        if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
+            raise ValueError("its known sources are not named by text")
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
     return RunRecord(
-        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags
-    )
+        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags,
+        known,
+    )  # fmt: skip
 
 
 def _aware(text):
@@ -294,7 +301,7 @@ def rubric_for(folders, given, command):
             raise ValueError(
                 f"{folder} was graded under the rubric {other.title!r} and {first_folder} under {recorded.title!r} "
                 f"({' and '.join(recorded.differences(other))} differ): results of different rubrics are not read "
-                "together. Grade again under one rubric; when only the [late] tables differ, merge them under one "
+                "together. Grade again under one rubric; when only the [late] or [held] tables differ, merge them under one "
                 "(labkit grade --merge ... --rubric FILE --out NEW)."
             )
     if given is None:
@@ -307,7 +314,7 @@ def rubric_for(folders, given, command):
             f"{first_folder} was graded under the rubric recorded in {first_folder / RECORD} "
             f"({recorded.title!r}), and {chosen.source} differs from it in {' and '.join(differ)}; {command} shows "
             f"grades.csv as graded, so leave --rubric out. To score the class under {chosen.source}: "
-            f"`labkit grade --merge {first_folder} --rubric {file} --out NEW` when only the [late] table "
-            f"differs, else grade again with it into a new --out."
+            f"`labkit grade --merge {first_folder} --rubric {file} --out NEW` when only the [late] or [held] "
+            f"table differs, else grade again with it into a new --out."
         )
     return recorded

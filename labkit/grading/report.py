@@ -60,7 +60,26 @@ class SubmissionGrade:
 
     @property
     def fractions(self):
-        return {n: float(v.get("fraction", 0.0)) for n, v in self.results.items()}
+        """The share of each exercise's weight that its parts earned, with the held parts the rubric releases."""
+        found = {}
+        for number, verdict in self.results.items():
+            fraction = float(verdict.get("fraction", 0.0))
+            if self.rubric.releases(self.name, number):
+                checks = verdict.get("checks", [])
+                total = sum(check.get("weight", 0) for check in checks)
+                held = sum(check.get("weight", 0) for check in checks if check.get("held") and check.get("passed"))
+                fraction = min(1.0, fraction + held / total) if total else fraction
+            found[number] = fraction
+        return found
+
+    def held(self):
+        """(exercise, part, what it matched, whether the rubric released it) of each part held for a person."""
+        return [
+            (number, check["name"], check["held"], self.rubric.releases(self.name, number))
+            for number, verdict in sorted(self.results.items())
+            for check in verdict.get("checks", [])
+            if check.get("held") and check.get("passed")
+        ]
 
     @property
     def score(self):
@@ -128,7 +147,11 @@ class SubmissionGrade:
                 f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
                 f"('## Exercise {number}') or it never ran."
             ]
-        status = "passed" if verdict["passed"] else "FAILED"
+        held = [c for c in verdict["checks"] if c.get("held") and c["passed"]]
+        earned = self.fractions.get(number, 0.0) >= 1.0 - 1e-9
+        status = "passed" if verdict["passed"] or earned else "FAILED"
+        if held and not self.rubric.releases(self.name, number):
+            status = "held for your instructor" if all(c["passed"] for c in verdict["checks"]) else status + ", part held"
         lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(points)} - {status}"]
         total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
         for check in verdict["checks"]:
@@ -143,6 +166,8 @@ class SubmissionGrade:
                 )
             if check["hint"] and not check["passed"]:
                 lines.append(f"    hint: {one_line(check['hint'], 1000)}")
+            if check.get("held") and check["passed"]:
+                lines += _held_lines(check, self.rubric.releases(self.name, number))
         return lines
 
     def _answer_lines(self):
@@ -262,6 +287,29 @@ def _sources(value):
     return {printable(k)[:200]: printable(v)[:MAX_SOURCE_CHARS] for k, v in sources.items()}
 
 
+SIDE = 56  # characters of a line shown on each side of a held part's shared lines
+
+
+def _held_lines(check, released):
+    """A held part's lines in the feedback: what it matched, and the shared lines side by side."""
+    held = check["held"]
+    source = one_line(held.get("source", "?"), 120)
+    if released:
+        lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
+    else:
+        lines = [
+            f"    HELD: {one_line(held.get('definition', '?'), 80)} is, names aside, mostly the code of {source} "
+            f"({float(held.get('share', 0)):.0%} of it); its points wait for your instructor.",
+            f"    hint: {one_line(check['hint'], 1000)}",
+        ]
+    pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
+    if pairs:
+        width = min(SIDE, max(len(one_line(mine, SIDE)) for mine, _ in pairs))
+        lines.append(f"      {'yours':<{width}} | {source}")
+        lines += [f"      {one_line(mine, SIDE):<{width}} | {one_line(theirs, SIDE)}" for mine, theirs in pairs]
+    return lines
+
+
 def _problem_lines(problem):
     first, *rest = str(problem).split("\n") or [""]
     return [f"! {one_line(first, 1000)}"] + [
@@ -335,6 +383,18 @@ def _late_cells(grade, lateness):
     ]
 
 
+CSV_HELD = "held for a person"  # only when a submission of the run has a part held (labkit.grading.known)
+
+
+def held_text(grade):
+    """grades.csv's cell of held parts: "exercise 2 eval_pherm (labkit.piecewise.eval_pherm, 97%)"; ...."""
+    return "; ".join(
+        f"exercise {number} {one_line(part, 60)} ({one_line(held.get('source', '?'), 80)}, "
+        f"{float(held.get('share', 0)):.0%}{', released' if released else ''})"
+        for number, part, held, released in grade.held()
+    )
+
+
 def read_columns(graded, registry):
     """One empty column per answer in words of the graded exercises, for the instructor to fill in."""
     return [f"to read: exercise {number}, {what}" for number, what in registry.answers.values() if number in graded]
@@ -350,14 +410,15 @@ def write_csv(path, grades):
         to_read = read_columns(graded, grades[0].rubric.registry if grades else None) if grades else []
         late = bool(grades) and grades[0].rubric.late is not None
         tail = CSV_TAIL[:4] + CSV_LATE + CSV_TAIL[4:] if late else CSV_TAIL
-        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + tail + to_read)
+        held = [CSV_HELD] if any(g.graded and g.held() for g in grades) else []
+        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + tail + held + to_read)
         for g in grades:
             if not g.graded:
                 writer.writerow(
                     [csv_cell(g.name)]
                     + [""] * (len(graded) + len(tail) - 1)
                     + [csv_cell(f"not graded: {g.failure}")]
-                    + [""] * len(to_read)
+                    + [""] * (len(held) + len(to_read))
                 )
                 continue
             s = g.score
@@ -368,6 +429,7 @@ def write_csv(path, grades):
                 + [points_text(s.required), csv_cell(s.branch), points_text(s.counted), points_text(s.extra_total)]
                 + (_late_cells(g, lateness) if lateness is not None else [])
                 + [points_text(g.total), points_text(s.full_credit), "graded"]
+                + ([csv_cell(held_text(g))] if held else [])
                 + [""] * len(to_read)
             )
 

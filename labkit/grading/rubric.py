@@ -8,7 +8,9 @@ weights of its parts (:mod:`labkit.exercises`); a rubric may give an
 exercise other points in a ``[points]`` table, which scales its parts.
 ``exercises = "module:attribute"`` names another course's exercises (the
 lab's by default). An optional ``[late]`` table sets a deadline and what
-lateness costs (:mod:`labkit.grading.late`). :func:`load` reads and validates one; :meth:`Rubric.score`
+lateness costs (:mod:`labkit.grading.late`). An optional ``[held]`` table releases parts held for a person
+(their code matched a known source, :mod:`labkit.grading.known`): ``release = {"ada" = [2, 10]}`` pays
+ada's held parts of exercises 2 and 10. :func:`load` reads and validates one; :meth:`Rubric.score`
 turns the fractions an exercise's parts earned
 (:meth:`labkit.exercises.registry.Registry.check`) into points, the branch
 that counted, the extra credit and the total.
@@ -67,6 +69,8 @@ class Rubric:
     late: lateness.Late = None  # the deadline and what lateness costs, when the rubric has a [late] table
     data: dict = field(default=None, compare=False, repr=False)  # the parsed TOML it was read from, as JSON data
     text: str = field(default=None, compare=False, repr=False)  # the TOML text itself, when read from a file
+    # submission name -> the exercises whose held parts a person released ([held] release)
+    released: dict = field(default_factory=dict)
 
     @property
     def graded(self):
@@ -114,7 +118,13 @@ class Rubric:
             found.append("its exercises, groups or points")
         if self.late != other.late:
             found.append("its [late] table" if self.late is not None and other.late is not None else "a [late] table")
+        if self.released != other.released:
+            found.append("the held parts its [held] table releases")
         return found
+
+    def releases(self, submission, number):
+        """Whether a person released the held parts of exercise `number` of `submission` ([held] release)."""
+        return number in self.released.get(submission, ())
 
     def same_as(self, other):
         """Whether `other` grades exactly as this rubric does (:meth:`differences` finds nothing)."""
@@ -190,7 +200,7 @@ def _exercise_list(value, where, source, registry):
 
 def from_dict(data, source="the rubric"):
     """A validated :class:`Rubric` from parsed TOML; ValueError says what is wrong and where."""
-    known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late"}
+    known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late", "held"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
@@ -253,9 +263,35 @@ def from_dict(data, source="the rubric"):
         raise ValueError(f"{source}: grades nothing: list exercises in required, extra_credit or branches.")
     points = {number: points[number] for number in sorted(points)}
     late = lateness.from_dict(data["late"], source) if "late" in data else None
+    released = _released(data.get("held"), source, registry, points)
     return Rubric(
-        title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain(data)
-    )
+        title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain(data),
+        released=released,
+    )  # fmt: skip
+
+
+def _released(table, source, registry, points):
+    """The [held] table's releases: {submission name: frozenset of exercise numbers}."""
+    if table is None:
+        return {}
+    example = 'release = {"ada" = [2, 10]}'
+    if not isinstance(table, dict) or set(table) - {"release"}:
+        raise ValueError(
+            f"{source}: [held] has one key, release: a table of submission names and the exercises whose "
+            f"held parts a person looked at and released, e.g. {example}."
+        )
+    release = table.get("release", {})
+    if not isinstance(release, dict):
+        raise ValueError(f"{source}: [held] release must be a table of submission names, e.g. {example}.")
+    found = {}
+    for name, numbers in release.items():
+        where = f"[held] release for {name!r}"
+        numbers = _exercise_list(numbers, where, source, registry)
+        for number in numbers:
+            if number not in points:
+                raise ValueError(f"{source}: {where} names exercise {number}, which this rubric does not grade.")
+        found[str(name)] = frozenset(numbers)
+    return found
 
 
 def plain(value):

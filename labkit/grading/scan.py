@@ -154,7 +154,7 @@ class _Reader:
 
     def __init__(self, sources, deadline):
         self.deadline = deadline
-        self.trees = []
+        self.trees, self.texts = [], {}
         for source in sources:
             text = python_source(source)
             if text is None:
@@ -164,6 +164,8 @@ class _Reader:
                 self.trees.append(ast.parse(text))
             except (SyntaxError, ValueError, RecursionError, MemoryError):
                 continue  # IPython could not run it either: it defines nothing
+            for node in _top_level(self.trees[-1].body):
+                self.texts[id(node)] = text
         self.aliases, self.definitions = {}, {}
         for tree in self.trees:
             for node in tree.body:
@@ -216,6 +218,37 @@ class _Reader:
                 ):
                     todo.append(inner.id)
         return found
+
+
+def reached_sources(sources, names, deadline=None):
+    """``[(name, source text)]`` of every definition in a notebook's code cells that the graded `names` reach
+    (the names themselves first), as :func:`scan` follows them; nothing is run.
+
+    Raises :class:`Unreadable` as :func:`scan` does.
+
+    Examples
+    --------
+    >>> cells = ["def h(x):\\n    return x + 1", "def f(x):\\n    return h(x) * 2", "def g(x):\\n    return 0"]
+    >>> [name for name, _ in reached_sources(cells, ["f"])]
+    ['f', 'h']
+    """
+    size = sum(len(s.encode("utf-8", "surrogatepass")) for s in sources)
+    if size > MAX_CODE_BYTES:
+        raise Unreadable(
+            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
+        )
+    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    found, seen = [], set()
+    for name in names:
+        for owner, node, _ in reader.reached(name):
+            if id(node) in seen or id(node) not in reader.texts:
+                continue
+            seen.add(id(node))
+            text = reader.texts[id(node)]
+            first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
+            lines = text.split("\n")[first - 1 : node.end_lineno]
+            found.append((owner, _clip("\n".join(lines), MAX_SOURCE_CHARS)))
+    return found
 
 
 def _locals(node):

@@ -5,8 +5,11 @@ run), start the sandboxed worker, have it run the code cells, then run
 every exercise's checks here through proxies into the worker
 (:mod:`labkit.grading.remote`), each part with its references switched off
 in the sandbox (:mod:`labkit.grading.guard`) and named if the source
-reaches for them (:mod:`labkit.grading.scan`). Scores, hints and problems
-are all computed on this side.
+reaches for them (:mod:`labkit.grading.scan`). A part whose code is, for the
+most part, code the student has on disk (labkit's, scipy's, the solutions':
+:mod:`labkit.grading.known`) is held for a person: its points wait until the
+rubric's ``[held]`` table releases them. Scores, hints and problems are all
+computed on this side.
 
 A submission has one time limit for all its notebooks together. An
 exercise counts from the first notebook (in name order) that defines its
@@ -28,7 +31,7 @@ from pathlib import Path
 
 from ..exercises.registry import LAB
 from ..exercises.registry import load as load_registry
-from . import backends, refusals, remote, scan
+from . import backends, known, refusals, remote, scan
 from .options import GradeOptions
 from .report import SubmissionGrade, one_line, printable
 
@@ -167,9 +170,28 @@ def _own_code(check, findings):
     }
 
 
+def _held(check, found):
+    """The part's check, held for a person: it passed, but its code is mostly a known source's."""
+    return {
+        **check,
+        "held": found.as_dict(),
+        "steps": list(check.get("steps", []))
+        + [
+            {
+                "step": "is the student's own code",
+                "passed": False,
+                "detail": f"{found.definition} shares {found.share:.0%} of its code with {found.source}, "
+                "names aside; held for your instructor to look at",
+            }
+        ],
+        "hint": "this part's points wait until your instructor has compared your code with the one it "
+        "resembles (shown below); write the exercise in your own way to be paid without waiting.",
+    }
+
+
 def _rescore(verdict, registry):
     exercise = registry.exercises[verdict["exercise"]]
-    points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"])
+    points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"] and not check.get("held"))
     verdict.update(
         points=points, passed=points == exercise.points, fraction=points / exercise.points if exercise.points else 1.0
     )
@@ -223,6 +245,41 @@ def _profiles(registry):
     if getattr(_profiles, "source", None) != registry.source:
         _profiles.value, _profiles.source = refusals.wire(registry.refusals), registry.source
     return _profiles.value
+
+
+def solutions(folder):
+    """The instructor notebooks of `folder` as :func:`labkit.grading.known.corpus` takes them: a tuple of
+    (notebook name, tuple of its code cells); ValueError when the folder holds none."""
+    folder = Path(folder)
+    notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
+    if not notebooks:
+        raise ValueError(
+            f"{folder} holds no instructor notebooks (*.ipynb): give --solutions the folder of the course's "
+            "instructor notebooks (the course repository's notebooks/)."
+        )
+    return tuple((path.name, tuple(read_cells(path)[0])) for path in notebooks)
+
+
+def known_sources(registry, folder=None):
+    """The known sources a graded part's code is compared with (:func:`labkit.grading.known.corpus`):
+    labkit's, the refused modules' and, with `folder`, the instructor notebooks'."""
+    return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
+
+
+def registry_graded(registry):
+    """Every name a part of the registry scans: the functions judged for copied code each in their own part."""
+    if getattr(registry_graded, "source", None) != registry.source:
+        registry_graded.source = registry.source
+        registry_graded.value = {n for e in registry.exercises.values() for p in e.parts for n in p.scanned}
+    return registry_graded.value
+
+
+def _release_grams():
+    if not hasattr(_release_grams, "value"):
+        from ..student_notebooks import paths
+
+        _release_grams.value = known.release_grams([c for p in paths() for c in read_cells(Path(str(p)))[0]])
+    return _release_grams.value
 
 
 def _for_sandbox(profiles):
@@ -329,6 +386,16 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                     continue
                 if findings:
                     verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
+                elif verdict["checks"][index]["passed"]:
+                    try:
+                        reached = scan.reached_sources(code, part.scanned)
+                    except scan.Unreadable:
+                        reached = ()  # the scan above read the same cells in time: not reached here
+                    # a graded function another part judges (the driver's interpolant) is judged there, once
+                    reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
+                    found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
+                    if found is not None:
+                        verdict["checks"][index] = _held(verdict["checks"][index], found)
             results[number] = _rescore(verdict, registry)
         if notebook.stopped:
             problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")

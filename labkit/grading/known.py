@@ -1,0 +1,444 @@
+"""Code every student has on disk, recognised in a graded function however it is renamed or reordered.
+
+A student has labkit's own source (every helper of it, private ones
+included), scipy's, and, if they ever leak, the instructor notebooks'
+solutions. A graded function that is one of those with its names changed,
+its docstring gone, its statements moved about or split into helpers is not
+the student's work. The source scan (:mod:`labkit.grading.scan`) and the
+sandbox's watch (:mod:`labkit.grading.guard`) refuse *calls* of that code;
+this module recognises *copies* of it, so that a part built on one is held
+for a person (:func:`labkit.grading.scoring.grade_notebook`) instead of paid.
+
+How code is compared (winnowing, Schleimer, Wilkerson and Aiken 2003, as
+copydetect and MOSS do it, with hashes of labkit's own so that they are the
+same in every process):
+
+1. :func:`normalise` tokenises a source with pygments (never parses or
+   runs it) and writes every token as one or a few characters: a variable or
+   argument name is ``V``, a function's name ``F``, a class's ``O``, a string
+   ``S``; comments, docstrings and white space go. Keywords, operators,
+   numbers, builtins and the attribute after a dot (``np.searchsorted``'s
+   ``searchsorted``) stay as they are: they are what the code does.
+2. :func:`fingerprints` hashes every run of :data:`NOISE` normalised
+   characters and keeps the smallest hash of each :data:`WINDOW` consecutive
+   ones, so that any shared run of ``NOISE + WINDOW - 1`` characters shares a
+   fingerprint, wherever it sits in either source.
+3. A graded part's code is every definition its graded names reach in the
+   notebook (:meth:`labkit.grading.scan._Reader.reached`). For each of them
+   that has at least :data:`MIN_OWN` normalised characters of its own (what
+   the student release does not give everyone), its *share* is the part of
+   those characters that fingerprints of one known source (a module, or one
+   instructor notebook) cover. A share of :data:`THRESHOLD` or more is a
+   match (:class:`Match`).
+
+The known sources are fingerprinted once per source file and kept in a
+cache folder (:func:`cache_folder`) under the file's SHA-256, so a grading
+run pays only for what changed since the last one.
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+NOISE = 25  # normalised characters hashed together: a shorter shared run is never evidence
+WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characters always shares a fingerprint
+# the share of a definition's own code that one known source covers from which the definition is held for a
+# person: measured on the catalog's correct work and on independent solutions (docs/grading-security.md)
+THRESHOLD = 0.75
+MIN_OWN = 150  # normalised characters of its own a definition needs to be judged at all (about four lines)
+SHOWN = 12  # shared lines shown side by side
+VERSION = "labkit-known/1"  # the cache's format and normalisation: a change here recomputes every fingerprint
+
+BASE = np.uint64(1_000_003)
+POWERS = BASE ** np.arange(NOISE - 1, -1, -1, dtype=np.uint64)  # wraps modulo 2**64, as the hashes do
+
+
+def normalise(text):
+    """``(normalised, where)``: `text`'s tokens as :func:`fingerprints` reads them, and the index in `text`
+    of each normalised character.
+
+    Examples
+    --------
+    >>> normalise("def area(w, h):\\n    '''Doc.'''\\n    return w * h  # cm2")[0]
+    'defF(V,V):returnV*V'
+    >>> normalise("y = np.searchsorted(x, 'a')")[0]
+    'V=V.searchsorted(V,S)'
+    """
+    from pygments import lexers, token
+
+    lexer = lexers.get_lexer_by_name("python")
+    out, where, previous = [], [], None
+    for start, kind, value in lexer.get_tokens_unprocessed(str(text)):
+        if kind in token.Text or kind in token.Comment or kind in token.String.Doc:
+            continue
+        if kind in token.String:
+            if previous != "S":
+                out.append("S")
+                where.append(start)
+            previous = "S"
+            continue
+        if kind in token.Name.Function:
+            piece = "F"
+        elif kind in token.Name.Class:
+            piece = "O"
+        elif kind in token.Name and kind not in token.Name.Builtin and previous != ".":
+            piece = "V"
+        else:
+            piece = value
+        out.append(piece)
+        where.extend(range(start, start + len(piece)) if piece == value else [start])
+        previous = piece
+    return "".join(out), np.asarray(where, dtype=np.int64)
+
+
+def fingerprints(normalised):
+    """``(hashes, positions)``: the winnowed fingerprints of a normalised text, in order of position.
+
+    Examples
+    --------
+    >>> hashes, positions = fingerprints("V=V+1" * 20)
+    >>> bool(len(hashes)) and bool(np.all(np.diff(positions) > 0))
+    True
+    >>> fingerprints("V=1")[0].size  # shorter than NOISE: nothing to fingerprint
+    0
+    """
+    grams = kgrams(normalised)
+    if grams.size == 0:
+        return grams, np.zeros(0, dtype=np.int64)
+    width = min(WINDOW, grams.size)
+    windows = np.lib.stride_tricks.sliding_window_view(grams, width)
+    # robust winnowing: the rightmost smallest hash of each window
+    chosen = np.arange(windows.shape[0]) + (width - 1 - np.argmin(windows[:, ::-1], axis=1))
+    chosen = np.unique(chosen)
+    return grams[chosen], chosen
+
+
+def kgrams(normalised):
+    """The hash of every run of :data:`NOISE` characters of a normalised text (the same in every process)."""
+    codes = np.frombuffer(str(normalised).encode("utf-32-le"), dtype=np.uint32).astype(np.uint64)
+    if codes.size < NOISE:
+        return np.zeros(0, dtype=np.uint64)
+    windows = np.lib.stride_tricks.sliding_window_view(codes, NOISE)
+    return windows @ POWERS
+
+
+def _covered(positions, length):
+    """How many characters of a text of `length` the fingerprints at `positions` cover, and the mask."""
+    marks = np.zeros(length + NOISE + 1, dtype=np.int64)
+    np.add.at(marks, positions, 1)
+    np.add.at(marks, positions + NOISE, -1)
+    mask = np.cumsum(marks)[:length] > 0
+    return int(mask.sum()), mask
+
+
+# -- the known sources -------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One definition of a known source: a function, or a method of a class."""
+
+    name: str  # as the feedback names it: labkit.piecewise.eval_pherm, scipy.interpolate._cubic.pchip...
+    path: str  # its file
+    first: int  # its lines in the file (1-based, inclusive)
+    last: int
+    text: str = None  # a notebook's definition itself (a module's is read from its file when shown)
+
+
+@dataclass(frozen=True)
+class Corpus:
+    """The fingerprints of the known sources: which unit and which source (file) each one comes from."""
+
+    units: tuple  # Unit
+    sources: tuple  # the names of the known sources: a module or a notebook
+    hashes: np.ndarray  # sorted fingerprint hashes, one entry per (hash, unit)
+    unit_of: np.ndarray  # the unit of each entry
+    source_of: np.ndarray  # its source (an index into `sources`)
+    digest: str  # what the corpus was made of (its files' SHA-256), for the run's record
+
+    def holders(self, hashes):
+        """For each hash, the entries of the corpus that have it: (index of the hash, entry) pairs."""
+        left = np.searchsorted(self.hashes, hashes, side="left")
+        right = np.searchsorted(self.hashes, hashes, side="right")
+        counts = right - left
+        which = np.repeat(np.arange(len(hashes)), counts)
+        entries = np.repeat(left - np.cumsum(np.r_[0, counts[:-1]]), counts) + np.arange(counts.sum())
+        return which, entries
+
+
+def cache_folder():
+    """Where the known sources' fingerprints are kept between runs: ``$LABKIT_CACHE`` or the user's cache."""
+    base = os.environ.get("LABKIT_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "labkit"
+    )
+    return Path(base) / "known"
+
+
+def _definitions(tree, prefix):
+    """(name, first line, last line) of each top-level function and each method of a top-level class."""
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            first = min([node.lineno] + [d.lineno for d in node.decorator_list])
+            yield f"{prefix}{node.name}", first, node.end_lineno
+        elif isinstance(node, ast.ClassDef):
+            for inner in node.body:
+                if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    first = min([inner.lineno] + [d.lineno for d in inner.decorator_list])
+                    yield f"{prefix}{node.name}.{inner.name}", first, inner.end_lineno
+
+
+def _fingerprint_units(texts):
+    """[(unit text, hashes)] → the unit index and hash arrays of their fingerprints."""
+    hashes, units = [], []
+    for index, text in enumerate(texts):
+        found = np.unique(fingerprints(normalise(text)[0])[0])
+        hashes.append(found)
+        units.append(np.full(found.size, index, dtype=np.int32))
+    if not hashes:
+        return np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int32)
+    return np.concatenate(hashes), np.concatenate(units)
+
+
+def _cached(raw, compute):
+    """`compute()` (JSON data), kept in the cache folder under the SHA-256 of `raw` and :data:`VERSION`."""
+    key = hashlib.sha256(VERSION.encode() + b"\0" + raw).hexdigest()
+    folder = cache_folder()
+    path = folder / f"{key}.json"
+    try:
+        return json.loads(path.read_text(encoding="utf-8")), key
+    except (OSError, ValueError):
+        pass
+    data = compute()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        handle, partial = tempfile.mkstemp(dir=folder, suffix=".partial")
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            json.dump(data, stream)
+        os.replace(partial, path)
+    except OSError:
+        pass  # a cache that cannot be written only costs time
+    return data, key
+
+
+def _module_entry(module, path):
+    """The units and fingerprints of one Python source file, cached."""
+    raw = Path(path).read_bytes()
+
+    def compute():
+        try:
+            tree = ast.parse(raw)
+        except (SyntaxError, ValueError):
+            return {"units": [], "hashes": [], "unit_of": []}
+        lines = raw.decode("utf-8", "replace").split("\n")
+        found = list(_definitions(tree, f"{module}."))
+        hashes, unit_of = _fingerprint_units(["\n".join(lines[a - 1 : b]) for _, a, b in found])
+        return {"units": found, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
+
+    return _cached(raw, compute)
+
+
+def _notebook_entry(name, cells):
+    """The units and fingerprints of one instructor notebook's code cells, cached."""
+    raw = json.dumps([name, list(cells)]).encode("utf-8")
+
+    def compute():
+        units, texts = [], []
+        for cell in cells:
+            try:
+                tree = ast.parse(cell)
+            except (SyntaxError, ValueError):
+                continue  # a cell with IPython's syntax: its functions are in other cells in the lab's notebooks
+            lines = cell.split("\n")
+            for unit, first, last in _definitions(tree, f"{name}: "):
+                texts.append("\n".join(lines[first - 1 : last]))
+                units.append([unit, first, last, texts[-1]])
+        hashes, unit_of = _fingerprint_units(texts)
+        return {"units": units, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
+
+    return _cached(raw, compute)
+
+
+def known_modules(refusals):
+    """(module, file) of every Python source a student has that the lab's answers are in: labkit's library
+    (its grader left out: it holds no answer) and the Python modules the refusals switch off."""
+    from .refusals import _module_files
+
+    prefixes = ["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]
+    found = {}
+    for prefix in dict.fromkeys(prefixes):
+        for module, path in _module_files(prefix):
+            if not module.startswith("labkit.grading"):
+                found.setdefault(str(path), module)
+    return sorted((module, path) for path, module in found.items())
+
+
+@functools.lru_cache(maxsize=4)
+def corpus(refusals=(), solutions=()):
+    """The known sources' fingerprints: labkit's library and the refused modules' Python sources, and the
+    definitions of the instructor notebooks' code cells.
+
+    `refusals` are :class:`labkit.exercises.model.Refusal` objects; `solutions` is a tuple of (notebook
+    name, tuple of its code cells), the instructor notebooks as the grader reads them
+    (:func:`labkit.grading.scoring.solutions`)."""
+    entries = [(module, str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
+    entries += [(f"the solutions' {name}", name, _notebook_entry(name, cells)) for name, cells in solutions]
+    units, sources, hashes, unit_of, source_of, keys = [], [], [], [], [], []
+    for source, path, (data, key) in entries:
+        keys.append(key)
+        offset = len(units)
+        for unit in data["units"]:
+            name, first, last = unit[:3]
+            units.append(Unit(name, path, int(first), int(last), unit[3] if len(unit) > 3 else None))
+        hashes.append(np.asarray(data["hashes"], dtype=np.uint64))
+        unit_of.append(np.asarray(data["unit_of"], dtype=np.int64) + offset)
+        source_of.append(np.full(len(data["hashes"]), len(sources), dtype=np.int64))
+        sources.append(source)
+    hashes = np.concatenate(hashes) if hashes else np.zeros(0, dtype=np.uint64)
+    order = np.argsort(hashes, kind="stable")
+    cat = (lambda parts: np.concatenate(parts)[order]) if hashes.size else (lambda parts: np.zeros(0, np.int64))
+    digest = hashlib.sha256("\n".join(sorted(keys)).encode()).hexdigest()[:16]
+    return Corpus(tuple(units), tuple(sources), hashes[order], cat(unit_of), cat(source_of), digest)
+
+
+# -- a notebook's code against them ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Match:
+    """A definition of the notebook that is, for the most part, a known source's code."""
+
+    definition: str  # the notebook's name that holds it (the graded function or a helper it reaches)
+    source: str  # the known unit it shares most with, e.g. "labkit.piecewise.eval_pherm"
+    share: float  # 0..1: the part of the definition's own code that the known source covers
+    lines: tuple  # (the student's line, the known source's line) pairs of shared code, at most SHOWN
+
+    def as_dict(self):
+        return {"definition": self.definition, "source": self.source, "share": self.share, "lines": self.lines}
+
+
+class Given:
+    """Every :data:`NOISE`-character hash of the release's code cells: what every student was given."""
+
+    def __init__(self, cells):
+        found = [kgrams(normalise(cell)[0]) for cell in cells]
+        self.array = np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
+
+
+def release_grams(cells):
+    """:class:`Given` of a release's code cells (one per run: :func:`match` caches by it)."""
+    return Given(cells)
+
+
+def match(known, definitions, given, threshold=THRESHOLD):
+    """The :class:`Match` of a part's code, when one known source covers :data:`THRESHOLD` or more of it; else
+    None.
+
+    The part's code is `definitions`, the graded function and every definition it reaches. What counts is
+    each definition's own code (what the release does not give everyone): the part matches when one known
+    source covers THRESHOLD of all of it together, or of one definition that is big enough to stand alone
+    (:data:`MIN_OWN` normalised characters of its own or more).
+
+    Parameters
+    ----------
+    known : Corpus
+        The known sources (:func:`corpus`).
+    definitions : iterable of (str, str)
+        (name, source text) of the notebook's definitions to judge: a graded function and what it reaches.
+    given : Given
+        :func:`release_grams` of what every student was given: code that only repeats it is nobody's.
+    threshold : float, optional
+        The share from which the part matches (:data:`THRESHOLD`; 0 gives the best source whatever its share).
+    """
+    judged, total = [], 0
+    for name, text in definitions:
+        normalised, where, hashes, positions, own = _read(text, given)
+        if not own:
+            continue
+        which, entries = known.holders(hashes)
+        covered = {}
+        for source in np.unique(known.source_of[entries]) if entries.size else ():
+            chosen = known.source_of[entries] == source
+            count, mask = _covered(positions[np.unique(which[chosen])], len(normalised))
+            covered[int(source)] = (count, mask, known.unit_of[entries[chosen]])
+        judged.append((name, text, where, own, covered))
+        total += own
+    if total < MIN_OWN:
+        return None
+    candidates = []
+    for source in {s for *_, covered in judged for s in covered}:
+        whole = sum(covered[source][0] for *_, covered in judged if source in covered) / total
+        candidates.append((whole, source, None))
+        for index, (_, _, _, own, covered) in enumerate(judged):
+            if own >= MIN_OWN and source in covered:
+                candidates.append((covered[source][0] / own, source, index))
+    if not candidates:
+        return None
+    share, source, index = max(candidates, key=lambda c: (c[0], c[2] is None))
+    if share < threshold:
+        return None
+    if index is None:  # the whole part: shown through its definition that shares most with the source
+        index = max(range(len(judged)), key=lambda i: judged[i][4].get(source, (0,))[0])
+    name, text, where, _, covered = judged[index]
+    _, mask, units = covered[source]
+    unit = known.units[int(np.bincount(units).argmax())]
+    return Match(name, unit.name, round(float(share), 3), _side_by_side(text, where, mask, unit))
+
+
+@functools.lru_cache(maxsize=256)
+def _read(text, given):
+    """A definition's normalised text, its fingerprints that the release does not give, and how much of
+    the text they cover. (`given` is hashed by identity: one array per run.)"""
+    normalised, where = normalise(text)
+    hashes, positions = fingerprints(normalised)
+    mine = ~np.isin(hashes, given.array)
+    hashes, positions = hashes[mine], positions[mine]
+    own, _ = _covered(positions, len(normalised))
+    return normalised, where, hashes, positions, own
+
+
+def _unit_text(unit):
+    if unit.text is not None:
+        return unit.text
+    lines = Path(unit.path).read_text(encoding="utf-8", errors="replace").split("\n")
+    return "\n".join(lines[unit.first - 1 : unit.last])
+
+
+def _shared_lines(text, where, mask):
+    """The lines of `text` (0-based numbers) with a normalised character that `mask` marks."""
+    starts = np.cumsum([0] + [len(line) + 1 for line in text.split("\n")[:-1]])
+    return sorted(set((np.searchsorted(starts, where[mask], side="right") - 1).tolist()))
+
+
+def _side_by_side(text, where, mask, unit):
+    """Up to :data:`SHOWN` pairs of shared lines: the student's, and the known unit's line most like it."""
+    try:
+        theirs = _unit_text(unit)
+    except (OSError, IndexError, ValueError):
+        theirs = ""
+    mine_lines = text.split("\n")
+    their_lines = theirs.split("\n")
+    their_normal = [normalise(line)[0] for line in their_lines]
+    pairs, after = [], 0
+    for number in _shared_lines(text, where, mask):
+        line = mine_lines[number].strip()
+        normal = normalise(line)[0]
+        if not normal:
+            continue
+        # the known line of the same shape, the first after the last one paired (copies keep their order)
+        order = list(range(after, len(their_normal))) + list(range(after))
+        found = next((i for i in order if their_normal[i] == normal), None)
+        if found is not None:
+            after = found + 1
+        pairs.append((line[:120], "" if found is None else their_lines[found].strip()[:120]))
+        if len(pairs) == SHOWN:
+            break
+    return tuple(pairs)
