@@ -38,9 +38,13 @@ def pytest_terminal_summary(terminalreporter):
         )
     shares = getattr(sys.modules.get("test_known"), "SHARES", {})
     if shares:
-        terminalreporter.section("known code: the share of a part's code a known source covers (held from 0.75)")
-        for what, share in sorted(shares.items()):
-            terminalreporter.write_line(f"{what:<70} {share:.3f}")
+        from labkit.grading.known import MIN_SHARED, THRESHOLD
+
+        terminalreporter.section(
+            f"known code: a part is held from a share of {THRESHOLD} with {MIN_SHARED} fingerprints shared"
+        )
+        for what, value in sorted(shares.items()):
+            terminalreporter.write_line(f"{what:<72} {value:g}")
     module = sys.modules.get("test_jupyterlab")
     latencies = getattr(module, "LATENCIES", {})
     if latencies:

@@ -62,7 +62,9 @@ def module_source(name, rename=True, drop=()):
             node.body = node.body[1:] or [ast.Pass()]
     for node in tree.body:
         functions = [node] if isinstance(node, ast.FunctionDef) else []
-        functions += [n for n in getattr(node, "body", []) if isinstance(node, ast.ClassDef) and isinstance(n, ast.FunctionDef)]
+        functions += [
+            n for n in getattr(node, "body", []) if isinstance(node, ast.ClassDef) and isinstance(n, ast.FunctionDef)
+        ]
         for function in functions:
             if rename:
                 _Renamer(dummy=True).visit(function)

@@ -375,8 +375,7 @@ REPLACED = {  # cells of the release replaced by an attack: {name: (base noteboo
     "renamed_helpers": (
         "02_convergence.ipynb",
         {
-            "def eval_pherm(": module_source("labkit.piecewise")
-            + "\n\ndef eval_pherm(xdata, ydata, ypdata, xval):\n"
+            "def eval_pherm(": module_source("labkit.piecewise") + "\n\ndef eval_pherm(xdata, ydata, ypdata, xval):\n"
             "    x, y, yp, xv = (np.asarray(v, dtype=float) for v in (xdata, ydata, ypdata, xval))\n"
             "    return _hermite_eval(x, y, yp, xv)"
         },

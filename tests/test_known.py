@@ -8,22 +8,22 @@ the catalog's correct variations are planted into the instructor notebooks (test
 
 import csv
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
-import nbformat
 import numpy as np
 import pytest
 from catalog import CORRECT, plant
 from conftest import sandbox_or_skip
-from copies import module_source, renamed_cells
+from copies import module_source
 
 from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading import known, report, rubric, scan
 from labkit.grading.options import GradeOptions
-from labkit.grading.scoring import exercises_in, known_sources, read_cells, registry_graded
+from labkit.grading.scoring import _rescore, exercises_in, judge_known, known_sources, read_cells, registry_graded
 from labkit.student_notebooks import paths
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,10 +48,15 @@ def _parts(cells, markdown):
             yield number, part.name, [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(LAB)]
 
 
-def _best_share(corpus, definitions, given):
-    """The share the best known source has of these definitions, whatever the threshold (0 when none)."""
-    found = known.match(corpus, definitions, given, threshold=0.0)
-    return 0.0 if found is None else found.share
+def _best(corpus, definitions, given):
+    """(share, shared) of the best known units for these definitions, whatever the thresholds (None: nothing
+    of the part's own code is in any known source)."""
+    found = known.match(corpus, definitions, given, threshold=0.0, minimum=0)
+    return None if found is None else (found.share, found.shared)
+
+
+def _note(key, value, largest=True):
+    SHARES[key] = max(SHARES.get(key, value), value) if largest else min(SHARES.get(key, value), value)
 
 
 # -- the normalised text and its fingerprints -----------------------------------------------------------------
@@ -112,12 +117,13 @@ def test_a_copy_of_labkits_code_is_recognised_and_named(module, also, names, ren
     cells = [module_source(m, rename) for m in also] + [module_source(module, rename, drop=also)]
     for name in names:
         found = known.match(corpus, scan.reached_sources(cells, [name]), given)
-        assert found is not None and found.share >= known.THRESHOLD, (module, name)
+        assert found is not None, (module, name, _best(corpus, scan.reached_sources(cells, [name]), given))
+        assert found.share >= known.THRESHOLD and found.shared >= known.MIN_SHARED
         assert found.source.startswith(module + ".") or any(found.source.startswith(m + ".") for m in also)
-        assert found.lines and all(mine for mine, _ in found.lines)
-        SHARES[f"smallest share of a copy ({'renamed' if rename else 'docstrings deleted'})"] = min(
-            found.share, SHARES.get(f"smallest share of a copy ({'renamed' if rename else 'docstrings deleted'})", 1)
-        )
+        assert found.lines and all(mine for mine, _ in found.lines) and found.public
+        form = "renamed" if rename else "docstrings deleted"
+        _note(f"copies of labkit ({form}): smallest share", found.share, largest=False)
+        _note(f"copies of labkit ({form}): fewest fingerprints shared", found.shared, largest=False)
 
 
 def test_a_copy_moved_into_helpers_is_recognised_through_the_graded_function(given):
@@ -132,11 +138,11 @@ def test_a_copy_moved_into_helpers_is_recognised_through_the_graded_function(giv
 
 
 def test_a_copy_of_the_solutions_is_recognised_only_when_they_are_given(given):
-    cells = renamed_cells(read_cells(NOTEBOOKS / "04_splines.ipynb")[0])
-    with_them, without = known_sources(LAB, NOTEBOOKS), known_sources(LAB)
-    found = known.match(with_them, scan.reached_sources(cells, ["ccspline"]), given)
-    assert found is not None and found.source.startswith("04_splines.ipynb: ")
-    assert _best_share(without, scan.reached_sources(cells, ["ccspline"]), given) < known.THRESHOLD
+    cells = read_cells(NOTEBOOKS / "03_meshes.ipynb")[0]  # the solutions, leaked whole
+    reached = scan.reached_sources(cells, ["coons"])
+    found = known.match(known_sources(LAB, NOTEBOOKS), reached, given)
+    assert found is not None and found.source == "03_meshes.ipynb: coons" and not found.public
+    assert known.match(known_sources(LAB), reached, given) is None
 
 
 def test_the_solutions_folder_must_hold_notebooks(tmp_path):
@@ -150,45 +156,136 @@ def test_the_cache_is_used_and_a_broken_cache_entry_is_computed_again(tmp_path, 
     first, _ = known._module_entry("labkit.bilinear", path)
     files = list((tmp_path / "known").glob("*.json"))
     assert len(files) == 1 and first["hashes"]
+
+    def never(*args):
+        raise AssertionError("the cached fingerprints were computed again")
+
+    with monkeypatch.context() as patched:
+        patched.setattr(known, "_fingerprint_units", never)
+        assert known._module_entry("labkit.bilinear", path)[0] == first  # read from the cache
     files[0].write_text("{not json")
     again, _ = known._module_entry("labkit.bilinear", path)
     assert again == first
+    assert known._module_entry("labkit.splines", path)[1] != known._module_entry("labkit.bilinear", path)[1]
 
 
 # -- honest work is never held --------------------------------------------------------------------------------
 
 
-def _shares(corpus, cells, markdown, given):
-    return {(n, p): _best_share(corpus, d, given) for n, p, d in _parts(cells, markdown)}
+def _judged(corpus, cells, markdown, given):
+    """{(exercise, part): (share, shared)} of every part with a refusal whose code is in a known source."""
+    found = {(n, p): _best(corpus, d, given) for n, p, d in _parts(cells, markdown)}
+    return {key: value for key, value in found.items() if value is not None}
+
+
+def _never_held(judged):
+    held = {k: v for k, v in judged.items() if v[0] >= known.THRESHOLD and v[1] >= known.MIN_SHARED}
+    assert not held, held
 
 
 @pytest.mark.parametrize("style", STYLES)
 def test_an_independent_solution_is_never_held(style, given):
     corpus = known_sources(LAB, NOTEBOOKS)  # the solutions given too: the strictest comparison
-    shares = {}
+    judged, parts = {}, 0
     for path in sorted((INDEPENDENT / style).glob("*.ipynb")):
-        shares.update(_shares(corpus, *read_cells(path), given))
-    assert len(shares) >= 25  # every refused part of the lab was judged
-    assert max(shares.values()) < known.THRESHOLD, {k: v for k, v in shares.items() if v >= known.THRESHOLD}
-    SHARES[f"largest share, independent {style}"] = max(shares.values())
+        cells, markdown = read_cells(path)
+        parts += len(list(_parts(cells, markdown)))
+        judged.update(_judged(corpus, cells, markdown, given))
+    assert parts >= 25 and len(judged) >= 5  # every refused part of the lab judged; some share a little
+    _never_held(judged)
+    _note("independent solutions: largest share", max(v[0] for v in judged.values()))
+    _note("independent solutions: most fingerprints shared", max(v[1] for v in judged.values()))
 
 
 def test_the_instructor_solutions_are_not_held_against_labkit(given):
-    shares = {}
+    judged = {}
     for path in sorted(NOTEBOOKS.glob("*.ipynb")):
-        shares.update(_shares(known_sources(LAB), *read_cells(path), given))
-    assert max(shares.values()) < known.THRESHOLD
-    SHARES["largest share, instructor notebooks against labkit and scipy"] = max(shares.values())
+        judged.update(_judged(known_sources(LAB), *read_cells(path), given))
+    _never_held(judged)
+    _note("instructor notebooks against labkit and scipy: most fingerprints shared", max(v[1] for v in judged.values()))
 
 
 @pytest.mark.parametrize("entry", CORRECT, ids=lambda e: e.name)
 def test_a_correct_variation_of_the_catalog_is_not_held(entry, tmp_path, given):
-    cells, markdown = read_cells(plant(entry, tmp_path))
-    shares = _shares(known_sources(LAB), cells, markdown, given)
-    shares = {k: v for k, v in shares.items() if not entry.full or k[0] in entry.full}
-    assert all(v < known.THRESHOLD for v in shares.values()), shares
-    key = "largest share, catalog's correct variations"
-    SHARES[key] = max([SHARES.get(key, 0.0), *shares.values()])
+    judged = _judged(known_sources(LAB), *read_cells(plant(entry, tmp_path)), given)
+    judged = {k: v for k, v in judged.items() if not entry.full or k[0] in entry.full}
+    _never_held(judged)
+    if judged:
+        _note("catalog's correct variations: most fingerprints shared", max(v[1] for v in judged.values()))
+
+
+# short honest versions in the forms the lab's text suggests: what a formula dictates comes out alike from
+# everyone (each passes its own check, below)
+HONEST = """
+def complete_system(xdata, ydata, y1p, ynp):
+    h = np.diff(xdata)
+    secants = np.diff(ydata) / h
+    main = np.concatenate(([h[0] / 3], (h[:-1] + h[1:]) / 3, [h[-1] / 3]))
+    A = np.diag(main) + np.diag(h / 6, 1) + np.diag(h / 6, -1)
+    D = np.concatenate(([secants[0] - y1p], np.diff(secants), [ynp - secants[-1]]))
+    return A, D
+
+def ccspline(xdata, ydata, y1p, ynp):
+    A, D = complete_system(xdata, ydata, y1p, ynp)
+    M = np.linalg.solve(A, D)
+    h = np.diff(xdata)
+    sprime = -h / 3 * M[:-1] - h / 6 * M[1:] + np.diff(ydata) / h
+    return np.append(sprime, ynp)
+
+def coons(A, B, C, D, s, t):
+    out = []
+    for c in range(2):
+        bottom = labkit.eval_pherm([0, 1], [A.point[c], B.point[c]], [A.ds[c], B.ds[c]], s)
+        bottom_t = labkit.eval_pherm([0, 1], [A.dt[c], B.dt[c]], [A.dsdt[c], B.dsdt[c]], s)
+        top = labkit.eval_pherm([0, 1], [D.point[c], C.point[c]], [D.ds[c], C.ds[c]], s)
+        top_t = labkit.eval_pherm([0, 1], [D.dt[c], C.dt[c]], [D.dsdt[c], C.dsdt[c]], s)
+        grid = np.zeros((len(s), len(t)))
+        for i in range(len(s)):
+            grid[i, :] = labkit.eval_pherm([0, 1], [bottom[i], top[i]], [bottom_t[i], top_t[i]], t)
+        out.append(grid)
+    return out[0], out[1]
+
+def eval_pherm(xdata, ydata, ypdata, xval):
+    xdata = np.asarray(xdata, dtype=float)
+    ydata = np.asarray(ydata, dtype=float)
+    ypdata = np.asarray(ypdata, dtype=float)
+    xval = np.asarray(xval, dtype=float)
+    k = labkit.bracket(xdata, xval)
+    xk, xk1 = xdata[k], xdata[k + 1]
+    h1 = (xval - xk1) ** 2 * (3 * xk - xk1 - 2 * xval) / (xk - xk1) ** 3
+    h2 = (xval - xk) * (xval - xk1) ** 2 / (xk - xk1) ** 2
+    h3 = (xval - xk) ** 2 * (3 * xk1 - xk - 2 * xval) / (xk1 - xk) ** 3
+    h4 = (xval - xk1) * (xval - xk) ** 2 / (xk1 - xk) ** 2
+    return ydata[k] * h1 + ypdata[k] * h2 + ydata[k + 1] * h3 + ypdata[k + 1] * h4
+
+def test_pbilin_interpolate(ndata, f=labkit.runge2d, interpolate=labkit.eval_pbilin):
+    xdata = np.linspace(0, 5, ndata)
+    ydata = np.linspace(0, 5, ndata)
+    xtest = np.linspace(0, 5, 401)
+    ytest = np.linspace(0, 5, 401)
+    X, Y = np.meshgrid(xtest, ytest, indexing="ij")
+    exact = f(X, Y)
+    return np.max(np.abs(interpolate(f, xdata, ydata, xtest, ytest) - exact)) / np.max(np.abs(exact))
+"""
+
+
+def test_short_honest_code_in_the_forms_the_lab_suggests_is_never_held(given):
+    from labkit.exercises import bilinear, experiments, hermite, patches, splines
+
+    namespace = {"np": np, "labkit": __import__("labkit")}
+    exec(HONEST, namespace)
+    assert splines.check_ccspline(namespace["ccspline"], namespace["complete_system"]).passed
+    assert patches.check_coons(namespace["coons"]).passed
+    assert hermite.check_eval_pherm(namespace["eval_pherm"]).passed
+    assert experiments.check_driver(bilinear.BILINEAR, namespace["test_pbilin_interpolate"]).passed
+    cells = ["import numpy as np\nimport labkit", HONEST]
+    for corpus in (known_sources(LAB), known_sources(LAB, NOTEBOOKS)):
+        for name in ("complete_system", "ccspline", "coons", "eval_pherm", "test_pbilin_interpolate"):
+            reached = [(n, t) for n, t in scan.reached_sources(cells, [name]) if n == name]
+            assert known.match(corpus, reached, given) is None, (name, _best(corpus, reached, given))
+            best = _best(corpus, reached, given)
+            if best:
+                _note("short honest code: most fingerprints shared", best[1])
 
 
 # -- what a held part does to the grade -------------------------------------------------------------------------
@@ -253,31 +350,76 @@ def test_a_run_is_released_by_merging_it_under_a_rubric_that_releases(tmp_path):
 def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tmp_path):
     sandbox_or_skip()
     subs = [INDEPENDENT / style for style in STYLES]
-    copier = tmp_path / "copier"
+    copier = tmp_path / "copier"  # the solutions, leaked whole
     copier.mkdir()
-    nb = nbformat.read(NOTEBOOKS / "04_splines.ipynb", as_version=4)
-    code = [c for c in nb.cells if c.cell_type == "code"]
-    for cell, text in zip(code, renamed_cells([c.source for c in code])):
-        cell.source = text
-    nbformat.write(nb, copier / "04_splines.ipynb")
+    shutil.copy(NOTEBOOKS / "03_meshes.ipynb", copier / "03_meshes.ipynb")
     options = GradeOptions(solutions=str(NOTEBOOKS))
-    graded = grading.grade([*subs, copier], tmp_path / "out", jobs=2, progress=False, options=options)
+    out = tmp_path / "out"
+    graded = grading.grade([*subs, copier], out, jobs=2, progress=False, options=options)
     by_name = {g.name: g for g in graded}
     for style in STYLES:
         assert by_name[style].total == rubric.default().maximum, by_name[style].feedback()
         assert by_name[style].held() == []
     held = {(n, p) for n, p, _, _ in by_name["copier"].held()}
-    assert (10, "ccspline") in held and by_name["copier"].points[10] == 0, by_name["copier"].feedback()
-    record = json.loads((tmp_path / "out" / "record.json").read_text())
+    assert (5, "coons") in held and by_name["copier"].points[5] == 0, by_name["copier"].feedback()
+    feedback = by_name["copier"].feedback()
+    assert "HELD" in feedback and "03_meshes.ipynb: coons" in feedback
+    solution = read_cells(NOTEBOOKS / "03_meshes.ipynb")[0]
+    assert "| " not in feedback.split("HELD")[1].split("Exercise")[0]  # the solutions' lines are not shown
+    record = json.loads((out / "record.json").read_text())
     assert record["known"]["solutions"] == str(NOTEBOOKS) and record["known"]["digest"]
+    assert solution  # (read as the grader reads it)
+    # a resumed run compares with the same sources, recorded: without --solutions they are used again
+    again = grading.grade([*subs, copier], out, jobs=2, progress=False)
+    assert {(n, p) for n, p, _, _ in {g.name: g for g in again}["copier"].held()} == held
+    assert json.loads((out / "record.json").read_text())["known"] == record["known"]
+    # other solutions are other known sources: the run is not resumed under them
+    other = tmp_path / "other-solutions"
+    other.mkdir()
+    shutil.copy(NOTEBOOKS / "02_convergence.ipynb", other / "02_convergence.ipynb")
+    with pytest.raises(ValueError, match="other known sources"):
+        grading.grade([*subs, copier], out, jobs=2, progress=False, options=GradeOptions(solutions=str(other)))
+
+
+def _part(number, name):
+    return next(p for p in LAB.exercises[number].parts if p.name == name)
+
+
+def test_the_grader_holds_a_passed_part_whose_code_is_labkits_and_keeps_one_that_failed(given):
+    cells = [module_source("labkit.piecewise")]
+    part, options = _part(2, "eval_pherm"), GradeOptions()
+    passed = {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}
+    held = judge_known(passed, part, cells, LAB, options)
+    assert held["held"]["source"].startswith("labkit.piecewise.") and held["passed"]
+    assert [s["step"] for s in held["steps"]] == [report.HELD_STEP]
+    failed = {**passed, "passed": False}
+    assert judge_known(failed, part, cells, LAB, options) is failed  # no points to hold
+    honest = read_cells(INDEPENDENT / STYLES[0] / "02_convergence.ipynb")[0]
+    assert judge_known(passed, part, honest, LAB, options) is passed
+    verdict = _rescore({"exercise": 2, "checks": [held]}, LAB)
+    assert verdict["points"] == 0 and not verdict["passed"]
+
+
+def test_a_release_pays_only_the_held_part_of_a_partly_passed_exercise(tmp_path):
+    grade = _held_grade()
+    checks = grade.results[2]["checks"]
+    checks.append({"name": "other", "passed": False, "hint": "h", "weight": 10, "steps": []})  # worth as much
+    path = tmp_path / "rubric.toml"
+    path.write_text(rubric.DEFAULT.read_text() + '\n[held]\nrelease = {"ada" = [2]}\n')
+    grade.rubric = rubric.load(path)
+    assert grade.points[2] == 5  # half of exercise 2's 10 points: the released half
+    assert "released: your instructor looked at eval_pherm" in grade.feedback()
 
 
 def test_the_class_report_lists_a_held_part_side_by_side(tmp_path):
     from labkit.grading import class_report
 
     honest = report.SubmissionGrade("bartholomew", results={}, rubric=rubric.default())
-    page = class_report.render(class_report.summarise([_held_grade(), honest]), [])
+    copier = _held_grade()
+    copier.results[2]["checks"][0]["held"]["lines"].append(["x = a < b & c  # </pre><script>", "y"])
+    page = class_report.render(class_report.summarise([copier, honest]), [])
     section = page[page.index('<h2 id="held">') :]
     section = section[: section.index("</section>")]
     assert "ada" in section and "labkit.piecewise.eval_pherm" in section and "93%" in section
     assert "q1 = np.diff(q0)" in section and "h = np.diff(x)" in section and "bartholomew" not in section
+    assert "<script>" not in section and "a &lt; b &amp; c" in section

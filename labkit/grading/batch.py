@@ -472,6 +472,13 @@ def grade(
         if options.solutions is None and earlier.record.known.get("solutions"):  # compared with them again
             options = replace(options, solutions=earlier.record.known["solutions"])
     known = known_sources(rubric.registry, options.solutions)  # computed (or read from its cache) once, here
+    recorded = earlier.record.known.get("digest") if earlier.record is not None else None
+    if recorded and earlier.done and recorded != known.digest:
+        raise ValueError(
+            f"{out} was graded against other known sources ({recorded}; now {known.digest}): the solutions given "
+            "to --solutions, labkit or scipy changed since, so its held parts would be judged otherwise. Grade "
+            "into a new --out, or again with --fresh."
+        )
     handed_in = [
         submission_time(
             path,

@@ -38,10 +38,10 @@ from datetime import datetime, timedelta
 from pathlib import Path
 
 from . import late as lateness
+from .known import THRESHOLD
 from .record import rubric_for
 from .report import SubmissionGrade, one_line, printable, read_results
 from .rubric import Rubric, points_text
-from .known import THRESHOLD
 from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
 
 REPORT = "report.html"

@@ -24,12 +24,13 @@ same in every process):
    ones, so that any shared run of ``NOISE + WINDOW - 1`` characters shares a
    fingerprint, wherever it sits in either source.
 3. A graded part's code is every definition its graded names reach in the
-   notebook (:meth:`labkit.grading.scan._Reader.reached`). For each of them
-   that has at least :data:`MIN_OWN` normalised characters of its own (what
-   the student release does not give everyone), its *share* is the part of
-   those characters that fingerprints of one known source (a module, or one
-   instructor notebook) cover. A share of :data:`THRESHOLD` or more is a
-   match (:class:`Match`).
+   notebook (:func:`labkit.grading.scan.reached_sources`). Each definition's
+   own fingerprints (those the student release does not give everyone, each
+   counted once) are set against the one known unit (a function or method)
+   that has most of them. The part matches (:class:`Match`) when those units
+   have :data:`THRESHOLD` of all its own fingerprints and at least
+   :data:`MIN_SHARED` of them: the lab's formulas make short code come out
+   alike from everyone, so only a long shared stretch is evidence.
 
 The known sources are fingerprinted once per source file and kept in a
 cache folder (:func:`cache_folder`) under the file's SHA-256, so a grading
@@ -51,13 +52,15 @@ import numpy as np
 
 NOISE = 25  # normalised characters hashed together: a shorter shared run is never evidence
 WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characters always shares a fingerprint
-# the share of a definition's own code that one known source covers from which the definition is held for a
-# person: measured on the catalog's correct work and on independent solutions (docs/grading-security.md)
-THRESHOLD = 0.75
-MIN_OWN = 150  # normalised characters of its own a definition needs to be judged at all (about four lines)
+# a part is held for a person when known units have THRESHOLD or more of its own fingerprints and it shares
+# MIN_SHARED or more with them: measured on copies, on independent solutions and on honest variants written
+# for the purpose (docs/grading-security.md). Honest work shares at most 46; the copies tried, 98 or more.
+THRESHOLD = 0.5
+MIN_SHARED = 70
 SHOWN = 12  # shared lines shown side by side
-VERSION = "labkit-known/1"  # the cache's format and normalisation: a change here recomputes every fingerprint
+VERSION = "labkit-known/3"  # the cache's format and normalisation: a change here recomputes every fingerprint
 
+PARENTHESES = {"(", ")"}
 BASE = np.uint64(1_000_003)
 POWERS = BASE ** np.arange(NOISE - 1, -1, -1, dtype=np.uint64)  # wraps modulo 2**64, as the hashes do
 
@@ -69,17 +72,17 @@ def normalise(text):
     Examples
     --------
     >>> normalise("def area(w, h):\\n    '''Doc.'''\\n    return w * h  # cm2")[0]
-    'defF(V,V):returnV*V'
+    'defFV,V:returnV*V'
     >>> normalise("y = np.searchsorted(x, 'a')")[0]
-    'V=V.searchsorted(V,S)'
+    'V=V.searchsortedV,S'
     """
     from pygments import lexers, token
 
     lexer = lexers.get_lexer_by_name("python")
     out, where, previous = [], [], None
     for start, kind, value in lexer.get_tokens_unprocessed(str(text)):
-        if kind in token.Text or kind in token.Comment or kind in token.String.Doc:
-            continue
+        if kind in token.Text or kind in token.Comment or kind in token.String.Doc or value in PARENTHESES:
+            continue  # round brackets too: a formatter adds and drops them around tuples and long lines
         if kind in token.String:
             if previous != "S":
                 out.append("S")
@@ -208,9 +211,17 @@ def _fingerprint_units(texts):
     return np.concatenate(hashes), np.concatenate(units)
 
 
-def _cached(raw, compute):
-    """`compute()` (JSON data), kept in the cache folder under the SHA-256 of `raw` and :data:`VERSION`."""
-    key = hashlib.sha256(VERSION.encode() + b"\0" + raw).hexdigest()
+@functools.cache
+def _tokeniser():
+    from importlib.metadata import version
+
+    return f"{VERSION} pygments {version('pygments')}"
+
+
+def _cached(name, raw, compute):
+    """`compute()` (JSON data), kept in the cache folder under the SHA-256 of `raw`, its `name`,
+    :data:`VERSION` and the tokeniser's version (pygments')."""
+    key = hashlib.sha256(f"{_tokeniser()}\0{name}\0".encode() + raw).hexdigest()
     folder = cache_folder()
     path = folder / f"{key}.json"
     try:
@@ -239,11 +250,11 @@ def _module_entry(module, path):
         except (SyntaxError, ValueError):
             return {"units": [], "hashes": [], "unit_of": []}
         lines = raw.decode("utf-8", "replace").split("\n")
-        found = list(_definitions(tree, f"{module}."))
+        found = [list(unit) for unit in _definitions(tree, f"{module}.")]
         hashes, unit_of = _fingerprint_units(["\n".join(lines[a - 1 : b]) for _, a, b in found])
         return {"units": found, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
 
-    return _cached(raw, compute)
+    return _cached(module, raw, compute)
 
 
 def _notebook_entry(name, cells):
@@ -251,20 +262,23 @@ def _notebook_entry(name, cells):
     raw = json.dumps([name, list(cells)]).encode("utf-8")
 
     def compute():
+        from .scan import python_source
+
         units, texts = [], []
         for cell in cells:
+            text = python_source(cell)  # as the grader reads a notebook: magics and shell lines left out
             try:
-                tree = ast.parse(cell)
+                tree = ast.parse(text or "")
             except (SyntaxError, ValueError):
-                continue  # a cell with IPython's syntax: its functions are in other cells in the lab's notebooks
-            lines = cell.split("\n")
+                continue  # IPython could not run it either: it defines nothing
+            lines = text.split("\n")
             for unit, first, last in _definitions(tree, f"{name}: "):
                 texts.append("\n".join(lines[first - 1 : last]))
                 units.append([unit, first, last, texts[-1]])
         hashes, unit_of = _fingerprint_units(texts)
         return {"units": units, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
 
-    return _cached(raw, compute)
+    return _cached(name, raw, compute)
 
 
 def known_modules(refusals):
@@ -318,11 +332,20 @@ class Match:
 
     definition: str  # the notebook's name that holds it (the graded function or a helper it reaches)
     source: str  # the known unit it shares most with, e.g. "labkit.piecewise.eval_pherm"
-    share: float  # 0..1: the part of the definition's own code that the known source covers
+    share: float  # 0..1: the part of the part's own fingerprints that known units have
+    shared: int  # how many fingerprints they share
     lines: tuple  # (the student's line, the known source's line) pairs of shared code, at most SHOWN
+    public: bool = True  # whether the source is on every student's disk (labkit, scipy), not the solutions
 
     def as_dict(self):
-        return {"definition": self.definition, "source": self.source, "share": self.share, "lines": self.lines}
+        return {
+            "definition": self.definition,
+            "source": self.source,
+            "share": self.share,
+            "shared": self.shared,
+            "lines": self.lines,
+            "public": self.public,
+        }
 
 
 class Given:
@@ -338,14 +361,16 @@ def release_grams(cells):
     return Given(cells)
 
 
-def match(known, definitions, given, threshold=THRESHOLD):
-    """The :class:`Match` of a part's code, when one known source covers :data:`THRESHOLD` or more of it; else
-    None.
+def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
+    """The :class:`Match` of a part's code, when known sources have :data:`THRESHOLD` or more of it; else None.
 
     The part's code is `definitions`, the graded function and every definition it reaches. What counts is
-    each definition's own code (what the release does not give everyone): the part matches when one known
-    source covers THRESHOLD of all of it together, or of one definition that is big enough to stand alone
-    (:data:`MIN_OWN` normalised characters of its own or more).
+    each definition's own code: its distinct fingerprints that the release does not give everyone (a run
+    repeated in the student's code counts once). Each definition is set against the one known unit (a
+    function or method of labkit, scipy or the solutions) that has most of its fingerprints; the part's
+    share is the part of all its own fingerprints that those units have. It matches when that share is
+    `threshold` or more and at least `minimum` fingerprints are shared: short code that the lab's formulas
+    dictate is written alike by everyone, so it is never evidence.
 
     Parameters
     ----------
@@ -356,53 +381,44 @@ def match(known, definitions, given, threshold=THRESHOLD):
     given : Given
         :func:`release_grams` of what every student was given: code that only repeats it is nobody's.
     threshold : float, optional
-        The share from which the part matches (:data:`THRESHOLD`; 0 gives the best source whatever its share).
+        The share from which the part matches (:data:`THRESHOLD`; 0 gives the best sources whatever the share).
+    minimum : int, optional
+        The fingerprints the part must share at least (:data:`MIN_SHARED`).
     """
-    judged, total = [], 0
+    judged, total, shared = [], 0, 0
     for name, text in definitions:
-        normalised, where, hashes, positions, own = _read(text, given)
-        if not own:
+        normalised, where, hashes, positions = _read(text, given)
+        distinct = np.unique(hashes)
+        if not distinct.size:
             continue
-        which, entries = known.holders(hashes)
-        covered = {}
-        for source in np.unique(known.source_of[entries]) if entries.size else ():
-            chosen = known.source_of[entries] == source
-            count, mask = _covered(positions[np.unique(which[chosen])], len(normalised))
-            covered[int(source)] = (count, mask, known.unit_of[entries[chosen]])
-        judged.append((name, text, where, own, covered))
-        total += own
-    if total < MIN_OWN:
+        total += distinct.size
+        which, entries = known.holders(distinct)
+        if not entries.size:
+            continue
+        units, counts = np.unique(known.unit_of[entries], return_counts=True)
+        unit = int(units[np.argmax(counts)])
+        judged.append((int(counts.max()), name, text, where, hashes, positions, unit))
+        shared += int(counts.max())
+    if not judged or not total:
         return None
-    candidates = []
-    for source in {s for *_, covered in judged for s in covered}:
-        whole = sum(covered[source][0] for *_, covered in judged if source in covered) / total
-        candidates.append((whole, source, None))
-        for index, (_, _, _, own, covered) in enumerate(judged):
-            if own >= MIN_OWN and source in covered:
-                candidates.append((covered[source][0] / own, source, index))
-    if not candidates:
+    share = shared / total
+    if share < threshold or shared < minimum:
         return None
-    share, source, index = max(candidates, key=lambda c: (c[0], c[2] is None))
-    if share < threshold:
-        return None
-    if index is None:  # the whole part: shown through its definition that shares most with the source
-        index = max(range(len(judged)), key=lambda i: judged[i][4].get(source, (0,))[0])
-    name, text, where, _, covered = judged[index]
-    _, mask, units = covered[source]
-    unit = known.units[int(np.bincount(units).argmax())]
-    return Match(name, unit.name, round(float(share), 3), _side_by_side(text, where, mask, unit))
+    count, name, text, where, hashes, positions, unit = max(judged, key=lambda entry: entry[0])
+    theirs = known.hashes[known.unit_of == unit]
+    _, mask = _covered(positions[np.isin(hashes, theirs)], len(where))
+    unit = known.units[unit]
+    return Match(name, unit.name, round(share, 3), shared, _side_by_side(text, where, mask, unit), unit.text is None)
 
 
 @functools.lru_cache(maxsize=256)
 def _read(text, given):
-    """A definition's normalised text, its fingerprints that the release does not give, and how much of
-    the text they cover. (`given` is hashed by identity: one array per run.)"""
+    """A definition's normalised text, and its fingerprints that the release does not give. (`given` is
+    hashed by identity: one per run.)"""
     normalised, where = normalise(text)
     hashes, positions = fingerprints(normalised)
     mine = ~np.isin(hashes, given.array)
-    hashes, positions = hashes[mine], positions[mine]
-    own, _ = _covered(positions, len(normalised))
-    return normalised, where, hashes, positions, own
+    return normalised, where, hashes[mine], positions[mine]
 
 
 def _unit_text(unit):

@@ -301,8 +301,8 @@ def rubric_for(folders, given, command):
             raise ValueError(
                 f"{folder} was graded under the rubric {other.title!r} and {first_folder} under {recorded.title!r} "
                 f"({' and '.join(recorded.differences(other))} differ): results of different rubrics are not read "
-                "together. Grade again under one rubric; when only the [late] or [held] tables differ, merge them under one "
-                "(labkit grade --merge ... --rubric FILE --out NEW)."
+                "together. Grade again under one rubric; when only the [late] or [held] tables differ, merge them "
+                "under one (labkit grade --merge ... --rubric FILE --out NEW)."
             )
     if given is None:
         return recorded

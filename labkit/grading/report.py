@@ -151,16 +151,21 @@ class SubmissionGrade:
         earned = self.fractions.get(number, 0.0) >= 1.0 - 1e-9
         status = "passed" if verdict["passed"] or earned else "FAILED"
         if held and not self.rubric.releases(self.name, number):
-            status = "held for your instructor" if all(c["passed"] for c in verdict["checks"]) else status + ", part held"
+            status = (
+                "held for your instructor" if all(c["passed"] for c in verdict["checks"]) else status + ", part held"
+            )
         lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(points)} - {status}"]
         total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
         for check in verdict["checks"]:
             weight = check.get("weight") or 0
             share = points * weight / total_weight
             worth = f" ({points_text(share)} point{'' if share == 1 else 's'})" if weight else ""
+            released = bool(check.get("held")) and self.rubric.releases(self.name, number)
             for step in check["steps"]:
                 mark = "ok  " if step["passed"] else "FAIL"
                 detail = f": {one_line(step['detail'], 1000)}" if step["detail"] else ""
+                if released and step["step"] == HELD_STEP:
+                    mark, detail = "ok  ", ": released by your instructor, who compared it with the code it resembles"
                 lines.append(
                     f"    [{mark}] {one_line(check['name'], 100)}{worth}: {one_line(step['step'], 300)}{detail}"
                 )
@@ -288,6 +293,7 @@ def _sources(value):
 
 
 SIDE = 56  # characters of a line shown on each side of a held part's shared lines
+HELD_STEP = "is the student's own code"  # the step a held part fails until it is released (labkit.grading.known)
 
 
 def _held_lines(check, released):
@@ -298,15 +304,18 @@ def _held_lines(check, released):
         lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
     else:
         lines = [
-            f"    HELD: {one_line(held.get('definition', '?'), 80)} is, names aside, mostly the code of {source} "
-            f"({float(held.get('share', 0)):.0%} of it); its points wait for your instructor.",
+            f"    HELD: {float(held.get('share', 0)):.0%} of the code of {one_line(held.get('definition', '?'), 80)} "
+            f"and what it calls is, names aside, the same as {source}'s; its points wait for your instructor.",
             f"    hint: {one_line(check['hint'], 1000)}",
         ]
     pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
-    if pairs:
+    if pairs and held.get("public", True):
         width = min(SIDE, max(len(one_line(mine, SIDE)) for mine, _ in pairs))
         lines.append(f"      {'yours':<{width}} | {source}")
         lines += [f"      {one_line(mine, SIDE):<{width}} | {one_line(theirs, SIDE)}" for mine, theirs in pairs]
+    elif pairs:  # the solutions' lines are for the instructor's report only
+        lines.append("      your lines that are the same, names aside:")
+        lines += [f"      {one_line(mine, 2 * SIDE)}" for mine, _ in pairs]
     return lines
 
 
@@ -621,6 +630,11 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
             grade.time = SubmissionTime(times[grade.name], FROM_CSV)
     out.mkdir(parents=True, exist_ok=True)
     record = records.new("merge", labkit_version(), sorted({g.seed for g in grades if g.seed is not None}), rubric)
+    known = [records.read(folder).known for folder in folders]
+    record.known = {
+        "digest": " ".join(sorted({k.get("digest") or "" for k in known} - {""})) or None,
+        "solutions": " ".join(sorted({k.get("solutions") or "" for k in known} - {""})) or None,
+    }
     with Progress(len(grades), "merging", enabled=progress) as bar:
         for grade in grades:
             grade.rubric = rubric

@@ -70,6 +70,7 @@ DYNAMIC_NAMES = {
     "setattr": "setattr",
     "delattr": "delattr",
     "breakpoint": "breakpoint",
+    "get_ipython": "get_ipython() (the shell's own namespace)",
 }
 DYNAMIC_ATTRIBUTES = {
     "__code__",
@@ -247,7 +248,7 @@ def reached_sources(sources, names, deadline=None):
             text = reader.texts[id(node)]
             first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
             lines = text.split("\n")[first - 1 : node.end_lineno]
-            found.append((owner, _clip("\n".join(lines), MAX_SOURCE_CHARS)))
+            found.append((owner, "\n".join(lines)))  # whole: a long comment must not push the code out
     return found
 
 

@@ -21,6 +21,7 @@ starts one per submission, so whatever one submission does to the grader's
 memory or time costs only its own grade.
 """
 
+import functools
 import json
 import os
 import re
@@ -33,7 +34,7 @@ from ..exercises.registry import LAB
 from ..exercises.registry import load as load_registry
 from . import backends, known, refusals, remote, scan
 from .options import GradeOptions
-from .report import SubmissionGrade, one_line, printable
+from .report import HELD_STEP, SubmissionGrade, one_line, printable
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -178,10 +179,10 @@ def _held(check, found):
         "steps": list(check.get("steps", []))
         + [
             {
-                "step": "is the student's own code",
+                "step": HELD_STEP,
                 "passed": False,
-                "detail": f"{found.definition} shares {found.share:.0%} of its code with {found.source}, "
-                "names aside; held for your instructor to look at",
+                "detail": f"{found.share:.0%} of the code of {found.definition} (names aside) is the same as "
+                f"{found.source}'s; held for your instructor to look at",
             }
         ],
         "hint": "this part's points wait until your instructor has compared your code with the one it "
@@ -257,13 +258,35 @@ def solutions(folder):
             f"{folder} holds no instructor notebooks (*.ipynb): give --solutions the folder of the course's "
             "instructor notebooks (the course repository's notebooks/)."
         )
-    return tuple((path.name, tuple(read_cells(path)[0])) for path in notebooks)
+    stamps = tuple((str(p), p.stat().st_mtime_ns, p.stat().st_size) for p in notebooks)
+    return _solutions(stamps)
+
+
+@functools.lru_cache(maxsize=4)
+def _solutions(stamps):
+    """The notebooks named in `stamps` read once while none of them changes (their paths, times and sizes)."""
+    return tuple((Path(path).name, tuple(read_cells(Path(path))[0])) for path, _, _ in stamps)
 
 
 def known_sources(registry, folder=None):
     """The known sources a graded part's code is compared with (:func:`labkit.grading.known.corpus`):
     labkit's, the refused modules' and, with `folder`, the instructor notebooks'."""
     return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
+
+
+def judge_known(check, part, code, registry, options):
+    """A part's check, held for a person when it passed and its code is mostly known code
+    (:func:`labkit.grading.known.match`); else as it was. `code` is the notebook's code cells."""
+    if not check["passed"] or part.refused is None:
+        return check
+    try:
+        reached = scan.reached_sources(code, part.scanned)
+    except scan.Unreadable:
+        return check  # the refusal scan read the same cells in time: not reached here
+    # a graded function another part judges (the driver's interpolant) is judged there, once
+    reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
+    found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
+    return check if found is None else _held(check, found)
 
 
 def registry_graded(registry):
@@ -386,16 +409,8 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                     continue
                 if findings:
                     verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
-                elif verdict["checks"][index]["passed"]:
-                    try:
-                        reached = scan.reached_sources(code, part.scanned)
-                    except scan.Unreadable:
-                        reached = ()  # the scan above read the same cells in time: not reached here
-                    # a graded function another part judges (the driver's interpolant) is judged there, once
-                    reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
-                    found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
-                    if found is not None:
-                        verdict["checks"][index] = _held(verdict["checks"][index], found)
+                else:
+                    verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
             results[number] = _rescore(verdict, registry)
         if notebook.stopped:
             problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")
