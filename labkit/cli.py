@@ -450,6 +450,23 @@ def _report(args):
     return 1 if grades.refused else 0
 
 
+def _mark(args):
+    from .grading import marking
+    from .grading.rubric import load
+
+    rubric = None if args.rubric is None else load(args.rubric)
+    if args.import_ is None:
+        path = marking.write_page(args.out, args.marker, rubric)
+        if not args.quiet:
+            print(f"wrote {path} (open it in a browser; it needs no network; marks stay in that browser until "
+                  "you download marks.csv and import it with --import)")  # fmt: skip
+        return 0
+    changed = marking.import_marks(args.out, args.import_, rubric)
+    if not args.quiet:
+        print(f"{changed} mark(s) changed in {args.out} (grades.csv, feedback/, results/ and record.json)")
+    return 0
+
+
 def build_parser():
     from .grading import backends, similarity
     from .grading.options import DEFAULTS, MIB
@@ -768,6 +785,28 @@ def build_parser():
     )
     rep.add_argument("--quiet", action="store_true", help="print nothing when all goes well")
     rep.set_defaults(handler=_report)
+
+    mrk = commands.add_parser(
+        "mark",
+        help="write OUT/marking.html to mark answers in words and held parts by keyboard; --import its marks.csv",
+        description="--import marks.csv (submission,item,points,comment) puts the marks into the run in OUT: "
+        "grades.csv, the feedback, the results that `labkit report` and `labkit export` read. Every row is "
+        "checked first; one bad row and nothing changes. A later mark of an item replaces the earlier one.",
+    )
+    mrk.add_argument("out", type=Path, metavar="OUT", help="the --out folder of a `labkit grade` run")
+    mrk.add_argument("--import", dest="import_", type=Path, metavar="MARKS.csv", help="the marks to import")
+    mrk.add_argument(
+        "--rubric",
+        type=Path,
+        help="leave it out: the rubric recorded by the run is used (one that grades otherwise is refused)",
+    )
+    mrk.add_argument(
+        "--marker",
+        default="instructor",
+        help="whose marking order: each marker's page shuffles the students of each item in its own order",
+    )
+    mrk.add_argument("--quiet", action="store_true", help="print nothing when all goes well")
+    mrk.set_defaults(handler=_mark)
 
     rub = commands.add_parser(
         "rubric",

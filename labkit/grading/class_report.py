@@ -1057,7 +1057,7 @@ def _rates_section(summary):
         of_graded = e.passed / e.graded if e.graded else None
         out.append(
             f'<tr><th scope="row">{e.exercise}</th><td class="num">'
-            f"{points_text(summary.rubric.points.get(e.exercise, 0))}</td>"
+            f"{points_text(summary.rubric.worth(e.exercise) if e.exercise in summary.rubric.points else 0)}</td>"
             f'<td class="num">{e.found}</td><td class="num">{e.attempted}</td><td class="num">{e.passed}</td>'
             f'<td class="num">{_percent(e.rate)}</td><td class="num">{_percent(of_graded)}</td></tr>'
         )

@@ -53,29 +53,62 @@ class SubmissionGrade:
     # graded function -> the source of its definition (printable, at most MAX_SOURCE_CHARS), for the similarity
     # search (labkit.grading.similarity); never part of the grade
     sources: dict = field(default_factory=dict)
+    # item -> what a person marked (labkit.grading.marking): {"points": number or "excused"/"counted"/"release"/
+    # "keep", "comment": text, "time": ISO time}; items are answer grade ids, "exerciseN" and "exerciseN/part"
+    marks: dict = field(default_factory=dict)
 
     @property
     def graded(self):
         return self.failure is None
 
+    def released(self, number, part):
+        """Whether the held `part` of exercise `number` is paid: a person's mark (``exerciseN/part``, release or
+        keep) decides, else the rubric's ``[held] release`` table."""
+        mark = self.marks.get(f"exercise{number}/{part}")
+        if mark is not None:
+            return mark.get("points") == "release"
+        return self.rubric.releases(self.name, number)
+
+    @property
+    def excused(self):
+        """The exercises a person excused: out of this submission's total and full credit."""
+        return frozenset(
+            int(item[len("exercise") :])
+            for item, mark in self.marks.items()
+            if "/" not in item and "-" not in item and mark.get("points") == "excused"
+        )
+
+    @property
+    def marked(self):
+        """Exercise -> the points a person gave its answers in words."""
+        found = {}
+        for grade_id, (number, _) in self.rubric.registry.answers.items():
+            mark = self.marks.get(grade_id)
+            if mark is not None and isinstance(mark.get("points"), (int, float)):
+                found[number] = found.get(number, 0.0) + float(mark["points"])
+        return found
+
     @property
     def fractions(self):
-        """The share of each exercise's weight that its parts earned, with the held parts the rubric releases."""
+        """The share of each exercise's weight that its parts earned, with the held parts released."""
         found = {}
         for number, verdict in self.results.items():
             fraction = float(verdict.get("fraction", 0.0))
-            if self.rubric.releases(self.name, number):
-                checks = verdict.get("checks", [])
-                total = sum(check.get("weight", 0) for check in checks)
-                held = sum(check.get("weight", 0) for check in checks if check.get("held") and check.get("passed"))
-                fraction = min(1.0, fraction + held / total) if total else fraction
+            checks = verdict.get("checks", [])
+            total = sum(check.get("weight", 0) for check in checks)
+            held = sum(
+                check.get("weight", 0)
+                for check in checks
+                if check.get("held") and check.get("passed") and self.released(number, check.get("name"))
+            )
+            fraction = min(1.0, fraction + held / total) if total else fraction
             found[number] = fraction
         return found
 
     def held(self):
-        """(exercise, part, what it matched, whether the rubric released it) of each part held for a person."""
+        """(exercise, part, what it matched, whether it is released) of each part held for a person."""
         return [
-            (number, check["name"], check["held"], self.rubric.releases(self.name, number))
+            (number, check["name"], check["held"], self.released(number, check["name"]))
             for number, verdict in sorted(self.results.items())
             for check in verdict.get("checks", [])
             if check.get("held") and check.get("passed")
@@ -83,7 +116,7 @@ class SubmissionGrade:
 
     @property
     def score(self):
-        return self.rubric.score(self.fractions)
+        return self.rubric.score(self.fractions, self.marked, self.excused)
 
     @property
     def points(self):
@@ -142,6 +175,8 @@ class SubmissionGrade:
     def _exercise_lines(self, number):
         points = self.rubric.points[number]
         verdict = self.results.get(number)
+        if number in self.excused:
+            return [f"Exercise {number}: excused by your instructor (out of your total and full credit)"]
         if verdict is None:
             return [
                 f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
@@ -150,17 +185,18 @@ class SubmissionGrade:
         held = [c for c in verdict["checks"] if c.get("held") and c["passed"]]
         earned = self.fractions.get(number, 0.0) >= 1.0 - 1e-9
         status = "passed" if verdict["passed"] or earned else "FAILED"
-        if held and not self.rubric.releases(self.name, number):
+        if any(not self.released(number, c["name"]) for c in held):
             status = (
                 "held for your instructor" if all(c["passed"] for c in verdict["checks"]) else status + ", part held"
             )
-        lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(points)} - {status}"]
+        worth = self.rubric.worth(number)
+        lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(worth)} - {status}"]
         total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
         for check in verdict["checks"]:
             weight = check.get("weight") or 0
             share = points * weight / total_weight
             worth = f" ({points_text(share)} point{'' if share == 1 else 's'})" if weight else ""
-            released = bool(check.get("held")) and self.rubric.releases(self.name, number)
+            released = bool(check.get("held")) and self.released(number, check["name"])
             for step in check["steps"]:
                 mark = "ok  " if step["passed"] else "FAIL"
                 detail = f": {one_line(step['detail'], 1000)}" if step["detail"] else ""
@@ -172,7 +208,10 @@ class SubmissionGrade:
             if check["hint"] and not check["passed"]:
                 lines.append(f"    hint: {one_line(check['hint'], 1000)}")
             if check.get("held") and check["passed"]:
-                lines += _held_lines(check, self.rubric.releases(self.name, number))
+                lines += _held_lines(check, released)
+                mark = self.marks.get(f"exercise{number}/{check['name']}")
+                if mark and mark.get("comment"):
+                    lines.append(f"    your instructor: {one_line(mark['comment'], 1000)}")
         return lines
 
     def _answer_lines(self):
@@ -180,27 +219,35 @@ class SubmissionGrade:
         answers = self.rubric.registry.answers
         if not answers:
             return []
-        lines = ["", "For the instructor to read (answers in words, not scored by labkit):"]
+        lines = ["", "Answers in words (marked by your instructor, not by labkit):"]
         for grade_id, (number, what) in answers.items():
             if number not in self.rubric.points:
                 continue
             text = str(self.answers.get(grade_id, "")).strip()
             if not text or text == "YOUR ANSWER HERE":
                 text = "(no answer)"
-            lines.append(f"  Exercise {number}, {what}:")
+            mark = self.marks.get(grade_id)
+            worth = self.rubric.answers.get(grade_id, 0.0)
+            if mark is not None:
+                marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
+            else:
+                marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
+            lines.append(f"  Exercise {number}, {what}: {marked}")
             lines += [f"    | {one_line(line, 300)}" for line in text.splitlines()[:20]]
+            if mark is not None and mark.get("comment"):
+                lines.append(f"    your instructor: {one_line(mark['comment'], 1000)}")
         return lines
 
     def _summary(self):
         score, rubric = self.score, self.rubric
         lines = [
             f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
-            f"{points_text(sum(rubric.points[n] for n in rubric.required))}"
+            f"{points_text(sum(rubric.worth(n) for n in rubric.required if n not in self.excused))}"
         ]
         if score.branch == "none":
             lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
         elif score.branch:
-            full = sum(rubric.points[n] for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
+            full = sum(rubric.worth(n) for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
             lines.append(
                 f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
                 "(the better of the branches)"
@@ -235,6 +282,7 @@ class SubmissionGrade:
             "failure": self.failure,
             "answers": dict(self.answers),
             "sources": dict(self.sources),
+            "marks": dict(self.marks),
             "results": {str(n): v for n, v in self.results.items()},
             "rubric": self.rubric.title,
             "points": {str(n): v for n, v in score.points.items()},
@@ -266,6 +314,7 @@ class SubmissionGrade:
             if grade.failure is not None:
                 grade.failure = str(grade.failure)
             grade.time = SubmissionTime.from_dict(data.get("submitted"))
+            grade.marks = _marks(data.get("marks") or {})
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
         if data.get("labkit") != labkit_version():
@@ -282,6 +331,18 @@ class SubmissionGrade:
                 "it was written by another version of labkit."
             )
         return grade
+
+
+def _marks(value):
+    """A result file's marks: {item: {"points", "comment", "time"}}; TypeError when they are not."""
+    marks = {}
+    for item, mark in dict(value).items():
+        points = mark["points"]
+        if isinstance(points, bool) or not isinstance(points, (int, float, str)):
+            raise TypeError(f"the mark of {item!r} has points {points!r}")
+        marks[str(item)] = {"points": points, "comment": printable(mark.get("comment", ""))[:2000],
+                            "time": str(mark.get("time", ""))}  # fmt: skip
+    return marks
 
 
 def _sources(value):
@@ -409,6 +470,17 @@ def read_columns(graded, registry):
     return [f"to read: exercise {number}, {what}" for number, what in registry.answers.values() if number in graded]
 
 
+def _read_ids(graded, registry):
+    """The grade ids of :func:`read_columns`, in their order."""
+    return [grade_id for grade_id, (number, _) in registry.answers.items() if number in graded]
+
+
+def _mark_cell(grade, grade_id):
+    """An answer's cell in grades.csv: the points a person gave it, empty until then."""
+    mark = grade.marks.get(grade_id)
+    return "" if mark is None else points_text(mark["points"])
+
+
 def write_csv(path, grades):
     """One row per submission: points per exercise, the branch that counted, extra credit, total, status.
 
@@ -439,7 +511,7 @@ def write_csv(path, grades):
                 + (_late_cells(g, lateness) if lateness is not None else [])
                 + [points_text(g.total), points_text(s.full_credit), "graded"]
                 + ([csv_cell(held_text(g))] if held else [])
-                + [""] * len(to_read)
+                + [_mark_cell(g, grade_id) for grade_id in _read_ids(graded, g.rubric.registry)]
             )
 
 

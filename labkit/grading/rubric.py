@@ -10,8 +10,10 @@ exercise other points in a ``[points]`` table, which scales its parts.
 lab's by default). An optional ``[late]`` table sets a deadline and what
 lateness costs (:mod:`labkit.grading.late`). An optional ``[held]`` table releases parts held for a person
 (their code matched a known source, :mod:`labkit.grading.known`): ``release = {"ada" = [2, 10]}`` pays
-ada's held parts of exercises 2 and 10. :func:`load` reads and validates one; :meth:`Rubric.score`
-turns the fractions an exercise's parts earned
+ada's held parts of exercises 2 and 10. An optional ``[answers]`` table gives the answers in words points a
+person marks (``labkit mark``): ``exercise12-answer-1 = 2`` (the answer's nbgrader grade id, as in grades.csv);
+they add to their exercise's points, and the lab's rubric gives none. :func:`load` reads and validates one;
+:meth:`Rubric.score` turns the fractions an exercise's parts earned
 (:meth:`labkit.exercises.registry.Registry.check`) into points, the branch
 that counted, the extra credit and the total.
 """
@@ -71,6 +73,15 @@ class Rubric:
     text: str = field(default=None, compare=False, repr=False)  # the TOML text itself, when read from a file
     # submission name -> the exercises whose held parts a person released ([held] release)
     released: dict = field(default_factory=dict)
+    answers: dict = field(default_factory=dict)  # answer grade id -> the points a person gives it ([answers])
+
+    def answer_points(self, number):
+        """The points of exercise `number`'s answers in words ([answers]; 0 without them)."""
+        return sum(p for grade_id, p in self.answers.items() if self.registry.answers[grade_id][0] == number)
+
+    def worth(self, number):
+        """Exercise `number`'s points: its parts' and its answers' in words."""
+        return self.points[number] + self.answer_points(number)
 
     @property
     def graded(self):
@@ -79,8 +90,8 @@ class Rubric:
 
     @property
     def full_credit(self):
-        branch = sum(self.points[n] for n in self.branches[0].exercises) if self.branches else 0
-        return sum(self.points[n] for n in self.required) + branch
+        branch = sum(self.worth(n) for n in self.branches[0].exercises) if self.branches else 0
+        return sum(self.worth(n) for n in self.required) + branch
 
     @property
     def maximum(self):
@@ -88,7 +99,7 @@ class Rubric:
         return (
             self.full_credit
             + self.branch_extra * max(len(self.branches) - 1, 0)
-            + sum(self.points[n] for n in self.extra_credit)
+            + sum(self.worth(n) for n in self.extra_credit)
         )
 
     @property
@@ -108,6 +119,8 @@ class Rubric:
             "branch_extra": self.branch_extra,
             "extra_credit": list(self.extra_credit),
         }
+        if self.answers:  # left out without answer points, so earlier runs' digests stand
+            described["answers"] = dict(self.answers)
         return hashlib.sha256(json.dumps(described, sort_keys=True).encode("utf-8")).hexdigest()[:16]
 
     def differences(self, other):
@@ -130,9 +143,15 @@ class Rubric:
         """Whether `other` grades exactly as this rubric does (:meth:`differences` finds nothing)."""
         return not self.differences(other)
 
-    def score(self, fractions):
-        """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1)."""
-        points = {n: round(self.points[n] * float(fractions.get(n, 0.0)), 2) for n in self.graded}
+    def score(self, fractions, marked=None, excused=()):
+        """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1), with the points
+        a person `marked` (exercise -> points of its answers in words) and the exercises `excused` (out of the
+        total and of full credit)."""
+        marked = marked or {}
+        points = {
+            n: 0.0 if n in excused else round(self.points[n] * float(fractions.get(n, 0.0)) + marked.get(n, 0.0), 2)
+            for n in self.graded
+        }
         required = round(sum(points[n] for n in self.required), 2)
         extra = {f"exercise {n}": points[n] for n in self.extra_credit}
         branch, counted = "", 0.0
@@ -142,10 +161,14 @@ class Rubric:
             branch, counted = (self.branches[best].name if earned[best] else "none"), earned[best]
             for i, other in enumerate(self.branches):
                 if i != best:
-                    full = sum(self.points[n] for n in other.exercises)
+                    full = sum(self.worth(n) for n in other.exercises if n not in excused)
                     share = earned[i] / full if full else 0.0
                     extra[f"branch {other.name}"] = round(self.branch_extra * share, 2)
-        return Score(points, required, branch, counted, extra, self.full_credit)
+        counts = set(self.required) | set(next((b.exercises for b in self.branches if b.name == branch), ()))
+        if self.branches and branch in ("", "none"):
+            counts |= set(self.branches[0].exercises)
+        full_credit = self.full_credit - sum(self.worth(n) for n in excused if n in counts)
+        return Score(points, required, branch, counted, extra, round(full_credit, 2))
 
     def describe(self):
         """The rubric in a few lines, for the feedback."""
@@ -158,8 +181,13 @@ class Rubric:
             lines[-1] += f", plus one branch: {names}; the better branch counts"
             lines.append(f"  extra credit: the other branch, up to {points_text(self.branch_extra)}")
         if self.extra_credit:
-            extra = ", ".join(f"exercise {n} ({points_text(self.points[n])})" for n in self.extra_credit)
+            extra = ", ".join(f"exercise {n} ({points_text(self.worth(n))})" for n in self.extra_credit)
             lines.append(("  " if not self.branches else "  and ") + f"extra credit: {extra}")
+        if self.answers:
+            lines.append(
+                "  answers in words marked by a person: "
+                + ", ".join(f"{grade_id} ({points_text(p)})" for grade_id, p in self.answers.items())
+            )
         if self.late is not None:
             lines.append(f"  {self.late.describe()}")
         return "\n".join(lines)
@@ -200,7 +228,7 @@ def _exercise_list(value, where, source, registry):
 
 def from_dict(data, source="the rubric"):
     """A validated :class:`Rubric` from parsed TOML; ValueError says what is wrong and where."""
-    known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late", "held"}
+    known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late", "held", "answers"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
@@ -249,7 +277,9 @@ def from_dict(data, source="the rubric"):
                 f"{source}: exercise {number} has points but is in no group: add it to required, "
                 "extra_credit or a branch, or remove its points."
             )
-    totals = {b.name: sum(points[n] for n in b.exercises) for b in branches}
+    answers = _answers(data.get("answers"), source, registry, points)
+    worth = {n: p + sum(a for g, a in answers.items() if registry.answers[g][0] == n) for n, p in points.items()}
+    totals = {b.name: sum(worth[n] for n in b.exercises) for b in branches}
     if len(set(totals.values())) > 1:
         shown = ", ".join(f"{name} {points_text(total)}" for name, total in totals.items())
         raise ValueError(
@@ -266,8 +296,32 @@ def from_dict(data, source="the rubric"):
     released = _released(data.get("held"), source, registry, points)
     return Rubric(
         title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain(data),
-        released=released,
+        released=released, answers=answers,
     )  # fmt: skip
+
+
+def _answers(table, source, registry, points):
+    """The [answers] table: {answer grade id: points}, in the registry's order."""
+    if table is None:
+        return {}
+    example = "exercise12-answer-1 = 2"
+    if not isinstance(table, dict):
+        raise ValueError(f"{source}: [answers] must be a table of `grade-id = points` lines, e.g. {example}.")
+    found = {}
+    for grade_id, value in table.items():
+        if grade_id not in registry.answers:
+            known = ", ".join(registry.answers) or "none"
+            raise ValueError(
+                f"{source}: [answers] names {grade_id!r}, which is no answer in words of these exercises "
+                f"(their grade ids: {known})."
+            )
+        number = registry.answers[grade_id][0]
+        if number not in points:
+            raise ValueError(f"{source}: [answers] gives {grade_id} points, but exercise {number} is in no group.")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value < 0:
+            raise ValueError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a number, at least 0.")
+        found[grade_id] = float(value)
+    return {grade_id: found[grade_id] for grade_id in registry.answers if grade_id in found}
 
 
 def _released(table, source, registry, points):

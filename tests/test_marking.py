@@ -1,0 +1,264 @@
+"""What a person marks (issue 32): answer points in the rubric, and `labkit mark OUT --import marks.csv`."""
+
+import csv
+import json
+from datetime import UTC, datetime
+
+import pytest
+
+from labkit.cli import main
+from labkit.grading import marking, report, rubric
+from labkit.grading.class_report import read as read_class
+
+# the answers of both branches and of exercise 3 weighed: the branches stay worth the same (3 + 3)
+ANSWERS = """
+[answers]
+exercise3-answer-1 = 5
+exercise7-answer-1 = 3
+exercise11-answer-1 = 3
+"""
+
+
+def _rubric(tmp_path, extra=ANSWERS):
+    path = tmp_path / "marked.toml"
+    path.write_text(rubric.DEFAULT.read_text() + extra)
+    return rubric.load(path)
+
+
+def _passed(number, name="part", weight=10, held=None):
+    check = {"name": name, "passed": True, "hint": "", "weight": weight, "steps": []}
+    if held is not None:
+        check["held"] = held
+    return {"exercise": number, "defined": True, "checks": [check], "points": 0, "passed": held is None,
+            "fraction": 0.0 if held else 1.0}  # fmt: skip
+
+
+HELD = {"definition": "eval_pherm", "source": "labkit.piecewise.eval_pherm", "share": 0.93,
+        "lines": [["q1 = np.diff(q0)", "h = np.diff(x)"]]}  # fmt: skip
+
+
+def _run(tmp_path, rubric_object):
+    """A run of two submissions: ada passed 2, 3 and 4 (2 held); =bob passed 3 only, and wrote answers."""
+    ada = report.SubmissionGrade(
+        "ada",
+        {2: _passed(2, "eval_pherm", held=HELD), 3: _passed(3), 4: _passed(4)},
+        [],
+        7,
+        rubric_object,
+        answers={"exercise3-answer-1": "Order $h^4$ <script>alert(1)</script>"},
+    )
+    bob = report.SubmissionGrade("=bob", {3: _passed(3)}, [], 7, rubric_object)
+    out = tmp_path / "run"
+    report.write_report(out, [ada, bob])
+    return out
+
+
+def _marks(tmp_path, rows, name="marks.csv"):
+    path = tmp_path / name
+    with open(path, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(marking.HEADER)
+        writer.writerows(rows)
+    return path
+
+
+def _grades_csv(out):
+    with open(out / "grades.csv", newline="", encoding="utf-8") as handle:
+        return {row["submission"]: row for row in csv.DictReader(handle)}
+
+
+def _snapshot(out):
+    return {p.relative_to(out): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+
+
+# -- the rubric's [answers] table ----------------------------------------------------------------------------------
+
+
+def test_the_lab_rubric_gives_answers_no_points_and_keeps_its_totals():
+    lab = rubric.default()
+    assert lab.answers == {} and lab.full_credit == 100 and lab.maximum == 118
+    assert "answers" not in json.dumps(lab.data)  # nor in the digest: earlier runs' digests stand
+
+
+def test_answer_points_add_to_their_exercise_full_credit_and_maximum(tmp_path):
+    marked = _rubric(tmp_path)
+    assert marked.worth(3) == 15 + 5 and marked.worth(7) == 10 + 3 and marked.worth(2) == 10
+    assert marked.full_credit == 100 + 5 + 3 and marked.maximum == 118 + 5 + 3
+    assert marked.digest != rubric.default().digest
+    assert "exercise3-answer-1 (5)" in marked.describe()
+
+
+@pytest.mark.parametrize(
+    ("table", "message"),
+    [
+        ("[answers]\nexercise3-answer-9 = 2\n", "no answer in words"),
+        ("[answers]\nexercise3-answer-1 = -1\n", "at least 0"),
+        ('[answers]\nexercise3-answer-1 = "two"\n', "must be a number"),
+        ("[answers]\nexercise7-answer-1 = 3\n", "branches must be worth the same"),
+    ],
+)
+def test_a_bad_answers_table_is_refused_with_what_to_write(tmp_path, table, message):
+    with pytest.raises(ValueError, match=message):
+        _rubric(tmp_path, "\n" + table)
+
+
+def test_answers_that_are_no_table_are_refused(tmp_path):
+    path = tmp_path / "marked.toml"
+    path.write_text("answers = 3\n" + rubric.DEFAULT.read_text())
+    with pytest.raises(ValueError, match=r"\[answers\] must be a table"):
+        rubric.load(path)
+
+
+# -- importing marks -----------------------------------------------------------------------------------------------
+
+
+def test_marks_reach_grades_csv_the_feedback_the_report_and_the_export(tmp_path):
+    marked = _rubric(tmp_path)
+    out = _run(tmp_path, marked)
+    before = _grades_csv(out)
+    assert before["ada"]["total"] == "30" and before["ada"]["full credit"] == "108"  # 2 is held
+    path = _marks(
+        tmp_path,
+        [
+            ["ada", "exercise3-answer-1", "4.5", "Right order; say why."],
+            ["ada", "exercise2/eval_pherm", "release", "Compared: her own."],
+            ["'=bob", "exercise4", "excused", "ill"],
+        ],
+    )
+    assert main(["mark", str(out), "--import", str(path), "--quiet"]) == 0
+    rows = _grades_csv(out)
+    assert rows["ada"]["exercise 3"] == "19.5" and rows["ada"]["exercise 2"] == "10"
+    assert rows["ada"]["total"] == "44.5"  # 10 + 19.5 + 15
+    assert rows["ada"]["to read: exercise 3, the order the table shows, against piecewise linear"] == "4.5"
+    assert rows["'=bob"]["full credit"] == "93" and rows["'=bob"]["total"] == "15"  # 108 less exercise 4's 15
+    feedback = (out / "feedback" / f"{report.safe_name('ada')}.txt").read_text()
+    assert "4.5 / 5 points" in feedback and "Right order; say why." in feedback and "Compared: her own." in feedback
+    assert "excused" in (out / "feedback" / f"{report.safe_name('=bob')}.txt").read_text()
+    grades = read_class(out, None)  # what `labkit report` and `labkit export` read
+    assert {g.name: g.total for g in grades} == {"ada": 44.5, "=bob": 15}
+
+
+def test_importing_twice_changes_nothing_and_a_later_mark_replaces_the_earlier(tmp_path):
+    out = _run(tmp_path, _rubric(tmp_path))
+    first = _marks(tmp_path, [["ada", "exercise3-answer-1", "2", "thin"]])
+    assert marking.import_marks(out, first, now=datetime(2026, 12, 1, tzinfo=UTC)) == 1
+    snapshot = _snapshot(out)
+    assert marking.import_marks(out, first, now=datetime(2026, 12, 2, tzinfo=UTC)) == 0
+    assert _snapshot(out) == snapshot
+    later = _marks(tmp_path, [["ada", "exercise3-answer-1", "5", "better on a second read"]], "later.csv")
+    assert marking.import_marks(out, later, now=datetime(2026, 12, 3, tzinfo=UTC)) == 1
+    data = json.loads((out / "results" / f"{report.safe_name('ada')}.json").read_text())
+    assert data["marks"]["exercise3-answer-1"] == {
+        "points": 5.0,
+        "comment": "better on a second read",
+        "time": "2026-12-03T00:00:00+00:00",
+    }
+    assert _grades_csv(out)["ada"]["total"] == "35"  # 0 (2 held) + 15 + 5 + 15
+    assert main(["report", str(out), "--quiet"]) == 0  # the record vouches for the rewritten results
+
+
+@pytest.mark.parametrize(
+    ("row", "message"),
+    [
+        (["carol", "exercise3-answer-1", "1", ""], "no submission 'carol'"),
+        (["ada", "exercise99", "excused", ""], "nothing to mark"),
+        (["ada", "exercise3-answer-1", "6", ""], "outside 0 to 5"),
+        (["ada", "exercise3-answer-1", "-1", ""], "outside 0 to 5"),
+        (["ada", "exercise3-answer-1", "nan", ""], "outside 0 to 5"),
+        (["ada", "exercise3-answer-1", "lots", ""], "not a number"),
+        (["ada", "exercise12-answer-1", "1", ""], "gives this answer no points"),
+        (["ada", "exercise2/eval_pherm", "3", ""], "release or keep"),
+        (["ada", "exercise4", "0", ""], "excused or counted"),
+        (["=bob", "exercise2/eval_pherm", "release", ""], "nothing to mark"),  # bob has nothing held
+    ],
+)
+def test_a_bad_mark_is_refused_and_nothing_changes(tmp_path, row, message, capsys):
+    out = _run(tmp_path, _rubric(tmp_path))
+    snapshot = _snapshot(out)
+    good = ["ada", "exercise3-answer-1", "1", ""]
+    path = _marks(tmp_path, [good, row])
+    with pytest.raises(ValueError, match=message):
+        marking.import_marks(out, path)
+    assert _snapshot(out) == snapshot
+    assert main(["mark", str(out), "--import", str(path)]) == 2
+    assert "nothing changed" in capsys.readouterr().err
+    assert _snapshot(out) == snapshot
+
+
+def test_marks_under_another_rubric_are_refused(tmp_path):
+    out = _run(tmp_path, _rubric(tmp_path))
+    path = _marks(tmp_path, [["ada", "exercise3-answer-1", "1", ""]])
+    snapshot = _snapshot(out)
+    with pytest.raises(ValueError, match="graded under the rubric"):
+        marking.import_marks(out, path, rubric.default())
+    assert _snapshot(out) == snapshot
+
+
+def test_a_held_part_can_be_kept_against_the_rubric_release_and_released_again(tmp_path):
+    out = _run(tmp_path, _rubric(tmp_path, ANSWERS + '\n[held]\nrelease = {"ada" = [2]}\n'))
+    assert _grades_csv(out)["ada"]["exercise 2"] == "10"
+    marking.import_marks(out, _marks(tmp_path, [["ada", "exercise2/eval_pherm", "keep", ""]]))
+    assert _grades_csv(out)["ada"]["exercise 2"] == "0"
+    marking.import_marks(out, _marks(tmp_path, [["ada", "exercise2/eval_pherm", "release", ""]]))
+    assert _grades_csv(out)["ada"]["exercise 2"] == "10"
+
+
+def test_a_bad_header_or_a_missing_file_is_a_clear_error(tmp_path):
+    out = _run(tmp_path, _rubric(tmp_path))
+    bad = tmp_path / "bad.csv"
+    bad.write_text("name,score\nada,3\n")
+    with pytest.raises(ValueError, match="must start with the header submission,item,points,comment"):
+        marking.import_marks(out, bad)
+    with pytest.raises(ValueError, match="cannot read the marks"):
+        marking.import_marks(out, tmp_path / "missing.csv")
+
+
+def test_student_text_in_a_comment_is_data_in_grades_csv_and_the_feedback(tmp_path):
+    out = _run(tmp_path, _rubric(tmp_path))
+    path = _marks(tmp_path, [["ada", "exercise3-answer-1", "1", "=HYPERLINK(x)\x1b[31m red"]])
+    marking.import_marks(out, path)
+    feedback = (out / "feedback" / f"{report.safe_name('ada')}.txt").read_text()
+    assert "\x1b" not in feedback
+    text = marking.marks_csv(read_class(out, None))
+    assert "'=HYPERLINK" in text and "\x1b" not in text
+
+
+# -- the marking page ----------------------------------------------------------------------------------------------
+
+
+def test_a_student_answer_is_escaped_before_its_markdown_is_rendered():
+    rendered = marking.render_markdown("<script>alert(1)</script> **b** $h^4$ `x<y`\n\n- one\n- <img onerror=x>")
+    assert "<script" not in rendered and "<img" not in rendered and "&lt;script&gt;" in rendered
+    assert "<strong>b</strong>" in rendered and '<span class="math">h^4</span>' in rendered
+    assert "<code>x&lt;y</code>" in rendered and rendered.count("<li>") == 2
+    assert marking.render_markdown("") == "<p><em>(no answer)</em></p>"
+
+
+def test_the_model_answers_come_from_the_instructor_notebooks():
+    models = marking.model_answers()
+    assert set(models) == set(rubric.default().registry.answers)
+    question, model = models["exercise3-answer-1"]
+    assert "order" in question.lower() and model and "BEGIN SOLUTION" not in model
+
+
+def test_each_item_is_shuffled_per_marker_and_the_page_runs_only_its_own_script(tmp_path):
+    import base64
+    import hashlib
+    import re
+
+    grades = [
+        report.SubmissionGrade(f"s{k:02d}", {3: _passed(3)}, [], 7, _rubric(tmp_path), answers={}) for k in range(20)
+    ]
+    one, again, other = (marking.tasks(grades, m)[0] for m in ("ada", "ada", "bob"))
+    names = [a["submission"] for a in one["answers"]]
+    assert names == [a["submission"] for a in again["answers"]] != [a["submission"] for a in other["answers"]]
+    assert sorted(names) == [g.name for g in grades] and one["max"] == 5
+    out = _run(tmp_path, _rubric(tmp_path))
+    assert main(["mark", str(out), "--quiet"]) == 0
+    page = (out / marking.PAGE).read_text()
+    policy = re.search(r"script-src 'sha256-([^']+)'", page).group(1)
+    scripts = re.findall(r"<script>(.*?)</script>", page, re.S)
+    assert len(scripts) == 1 and base64.b64encode(hashlib.sha256(scripts[0].encode()).digest()).decode() == policy
+    assert "alert(1)" in scripts[0] and "<script>alert" not in scripts[0]  # the answer is data inside it
+    held = [t for t in marking.tasks(report.read_results([out]), "ada") if t["kind"] == "held"]
+    assert [t["item"] for t in held] == ["exercise2/eval_pherm"] and "h = np.diff(x)" in held[0]["answers"][0]["html"]
