@@ -229,9 +229,17 @@ def test_student_text_in_a_comment_is_data_in_grades_csv_and_the_feedback(tmp_pa
 def test_a_student_answer_is_escaped_before_its_markdown_is_rendered():
     rendered = marking.render_markdown("<script>alert(1)</script> **b** $h^4$ `x<y`\n\n- one\n- <img onerror=x>")
     assert "<script" not in rendered and "<img" not in rendered and "&lt;script&gt;" in rendered
-    assert "<strong>b</strong>" in rendered and '<span class="math">h^4</span>' in rendered
+    assert "<strong>b</strong>" in rendered and "<msup><mi>h</mi><mn>4</mn></msup>" in rendered  # typeset
     assert "<code>x&lt;y</code>" in rendered and rendered.count("<li>") == 2
     assert marking.render_markdown("") == "<p><em>(no answer)</em></p>"
+
+
+def test_an_answers_maths_is_typeset_and_can_carry_nothing_that_runs():
+    rendered = marking.render_markdown(r"$$\frac{a*b}{c*d}$$ is *small*, and $\text{<img src=x onerror=alert(1)>}$")
+    assert "<mfrac>" in rendered and 'display="block"' in rendered and "<em>small</em>" in rendered
+    assert "<img" not in rendered and "&lt;img" in rendered
+    assert "<em>" not in rendered.split("<mfrac>")[1].split("</math>")[0]  # no emphasis inside the maths
+    assert marking.math_html("\\frac{").startswith('<span class="math">')  # TeX it cannot read, as written
 
 
 def test_the_model_answers_come_from_the_instructor_notebooks():

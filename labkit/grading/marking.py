@@ -212,9 +212,51 @@ def model_answers(folder=SOLUTIONS):
     return found
 
 
+# the MathML a page may show: elements and attributes of presentation MathML, nothing that links or runs
+MATHML_TAGS = {
+    "math", "mrow", "mi", "mn", "mo", "ms", "mtext", "mspace", "msup", "msub", "msubsup", "mfrac", "msqrt",
+    "mroot", "mover", "munder", "munderover", "mtable", "mtr", "mtd", "mstyle", "mpadded", "mphantom",
+    "menclose", "semantics",
+}  # fmt: skip
+MATHML_ATTRIBUTES = {
+    "display", "stretchy", "mathvariant", "fence", "separator", "lspace", "rspace", "accent", "accentunder",
+    "columnalign", "rowspacing", "columnspacing", "displaystyle", "scriptlevel", "width", "height", "depth",
+    "linethickness", "notation", "minsize", "maxsize", "symmetric", "movablelimits", "largeop",
+}  # fmt: skip
+
+
+def math_html(tex, display=False):
+    """TeX a student wrote as MathML the browser typesets (offline, no script), every element and attribute
+    from a fixed list and every text escaped; the TeX itself, escaped, when it cannot be converted."""
+    import html
+    import xml.etree.ElementTree as ET
+
+    fallback = f'<span class="math{" display" if display else ""}">{html.escape(tex, quote=True)}</span>'
+    try:
+        from latex2mathml.converter import convert
+
+        tree = ET.fromstring(convert(tex, display="block" if display else "inline"))
+    except Exception:  # noqa: BLE001 - any TeX the converter cannot read is shown as it was written
+        return fallback
+
+    def build(node):
+        tag = node.tag.rpartition("}")[2]
+        if tag not in MATHML_TAGS:
+            return html.escape("".join(node.itertext()))
+        attributes = "".join(
+            f' {name}="{html.escape(value, quote=True)}"'
+            for name, value in node.attrib.items()
+            if name in MATHML_ATTRIBUTES
+        )
+        inner = html.escape(node.text or "") + "".join(build(child) + html.escape(child.tail or "") for child in node)
+        return f"<{tag}{attributes}>{inner}</{tag}>"
+
+    return build(tree)
+
+
 def render_markdown(text):
     """Markdown a student wrote as HTML that can run nothing: every character escaped first, then paragraphs,
-    lists, ``code``, **strong**, *emphasis*; maths ($...$, $$...$$) kept as its TeX in a ``math`` span."""
+    lists, ``code``, **strong**, *emphasis*; maths ($...$, $$...$$) as MathML (:func:`math_html`)."""
     import html
     import re
 
@@ -222,11 +264,18 @@ def render_markdown(text):
     out, items = [], []
 
     def inline(line):
+        maths = []  # typeset apart, so the emphasis rules below never reach into the MathML
+
+        def keep(rendered):
+            maths.append(rendered)
+            return f"\x00{len(maths) - 1}\x00"  # printable() took every control character out of the text
+
         line = re.sub(r"`([^`]+)`", r"<code>\1</code>", line)
-        line = re.sub(r"\$\$(.+?)\$\$", r'<span class="math display">\1</span>', line)
-        line = re.sub(r"\$([^$]+)\$", r'<span class="math">\1</span>', line)
+        line = re.sub(r"\$\$(.+?)\$\$", lambda m: keep(math_html(html.unescape(m.group(1)), display=True)), line)
+        line = re.sub(r"\$([^$]+)\$", lambda m: keep(math_html(html.unescape(m.group(1)))), line)
         line = re.sub(r"\*\*([^*]+)\*\*", r"<strong>\1</strong>", line)
-        return re.sub(r"(?<![*\w])\*([^*]+)\*(?!\w)", r"<em>\1</em>", line)
+        line = re.sub(r"(?<![*\w])\*([^*]+)\*(?!\w)", r"<em>\1</em>", line)
+        return re.sub(r"\x00(\d+)\x00", lambda m: maths[int(m.group(1))], line)
 
     def flush():
         if items:
