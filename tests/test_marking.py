@@ -7,8 +7,11 @@ from datetime import UTC, datetime
 import pytest
 
 from labkit.cli import main
+from labkit.exercises.registry import LAB
 from labkit.grading import marking, report, rubric
 from labkit.grading.class_report import read as read_class
+from labkit.grading.report import SubmissionGrade
+from labkit.grading.rubric import DEFAULT
 
 # the answers of both branches and of exercise 3 weighed: the branches stay worth the same (3 + 3)
 ANSWERS = """
@@ -270,3 +273,19 @@ def test_each_item_is_shuffled_per_marker_and_the_page_runs_only_its_own_script(
     assert "alert(1)" in scripts[0] and "<script>alert" not in scripts[0]  # the answer is data inside it
     held = [t for t in marking.tasks(report.read_results([out]), "ada") if t["kind"] == "held"]
     assert [t["item"] for t in held] == ["exercise2/eval_pherm"] and "h = np.diff(x)" in held[0]["answers"][0]["html"]
+
+
+def test_an_answer_can_carry_rubric_lines_that_the_page_shows_beside_the_model_answer(tmp_path):
+    path = tmp_path / "rubric.toml"
+    grade_id = next(iter(LAB.answers))
+    path.write_text(
+        DEFAULT.read_text() + f'\n[answers]\n{grade_id} = {{points = 2, rubric = ["names the order", "a < b"]}}\n'
+    )
+    loaded = rubric.load(path)
+    assert loaded.answers[grade_id] == 2 and loaded.answer_lines[grade_id] == ("names the order", "a < b")
+    grade = SubmissionGrade("ada", results={}, rubric=loaded)
+    task = next(t for t in marking.tasks([grade]) if t["item"] == grade_id)
+    assert "<li>names the order</li>" in task["model"] and "<li>a &lt; b</li>" in task["model"]
+    path.write_text(DEFAULT.read_text() + f'\n[answers]\n{grade_id} = {{points = 2, lines = "x"}}\n')
+    with pytest.raises(ValueError, match="a table of points and rubric lines"):
+        rubric.load(path)

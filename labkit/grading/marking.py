@@ -292,6 +292,15 @@ def render_markdown(text):
     return "".join(out) or "<p><em>(no answer)</em></p>"
 
 
+def _rubric_lines(lines):
+    """The rubric's lines for an answer ([answers] rubric), as a list under the model answer."""
+    import html
+
+    if not lines:
+        return ""
+    return '<p>Rubric:</p><ul class="rubric">' + "".join(f"<li>{html.escape(line)}</li>" for line in lines) + "</ul>"
+
+
 def tasks(grades, marker="instructor"):
     """What the page marks, by item: [{"item", "title", "max", "kind", "answers": [...]}], each item's
     submissions in an order shuffled for `marker` (the same marker, the same order)."""
@@ -316,7 +325,8 @@ def tasks(grades, marker="instructor"):
         found.append({
             "item": grade_id, "kind": "answer", "max": rubric.answers.get(grade_id, 0.0),
             "title": f"Exercise {number}: {what}", "question": render_markdown(question),
-            "model": render_markdown(model), "answers": entries,
+            "model": render_markdown(model) + _rubric_lines(rubric.answer_lines.get(grade_id, ())),
+            "answers": entries,
         })  # fmt: skip
     held = {}
     for g in grades:

@@ -74,6 +74,8 @@ class Rubric:
     # submission name -> the exercises whose held parts a person released ([held] release)
     released: dict = field(default_factory=dict)
     answers: dict = field(default_factory=dict)  # answer grade id -> the points a person gives it ([answers])
+    # answer grade id -> the rubric lines the marking page shows beside the model answer ([answers])
+    answer_lines: dict = field(default_factory=dict, compare=False)
 
     def answer_points(self, number):
         """The points of exercise `number`'s answers in words ([answers]; 0 without them)."""
@@ -277,7 +279,7 @@ def from_dict(data, source="the rubric"):
                 f"{source}: exercise {number} has points but is in no group: add it to required, "
                 "extra_credit or a branch, or remove its points."
             )
-    answers = _answers(data.get("answers"), source, registry, points)
+    answers, answer_lines = _answers(data.get("answers"), source, registry, points)
     worth = {n: p + sum(a for g, a in answers.items() if registry.answers[g][0] == n) for n, p in points.items()}
     totals = {b.name: sum(worth[n] for n in b.exercises) for b in branches}
     if len(set(totals.values())) > 1:
@@ -296,19 +298,34 @@ def from_dict(data, source="the rubric"):
     released = _released(data.get("held"), source, registry, points)
     return Rubric(
         title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain(data),
-        released=released, answers=answers,
+        released=released, answers=answers, answer_lines=answer_lines,
     )  # fmt: skip
 
 
 def _answers(table, source, registry, points):
-    """The [answers] table: {answer grade id: points}, in the registry's order."""
+    """The [answers] table: ({answer grade id: points}, in the registry's order; {grade id: rubric lines})."""
     if table is None:
-        return {}
+        return {}, {}
     example = "exercise12-answer-1 = 2"
     if not isinstance(table, dict):
         raise ValueError(f"{source}: [answers] must be a table of `grade-id = points` lines, e.g. {example}.")
-    found = {}
+    found, lines = {}, {}
     for grade_id, value in table.items():
+        if isinstance(value, dict):  # {points = 2, rubric = ["what earns a point", ...]}
+            unknown = sorted(set(value) - {"points", "rubric"})
+            given = value.get("rubric", [])
+            if (
+                unknown
+                or "points" not in value
+                or not isinstance(given, list)
+                or not all(isinstance(line, str) for line in given)
+            ):
+                raise ValueError(
+                    f"{source}: [answers] {grade_id} must be points, or a table of points and rubric lines: "
+                    f'{grade_id} = {{points = 2, rubric = ["names the order", "says why"]}}.'
+                )
+            lines[grade_id] = tuple(given)
+            value = value["points"]
         if grade_id not in registry.answers:
             known = ", ".join(registry.answers) or "none"
             raise ValueError(
@@ -321,7 +338,7 @@ def _answers(table, source, registry, points):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value < 0:
             raise ValueError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a number, at least 0.")
         found[grade_id] = float(value)
-    return {grade_id: found[grade_id] for grade_id in registry.answers if grade_id in found}
+    return {grade_id: found[grade_id] for grade_id in registry.answers if grade_id in found}, lines
 
 
 def _released(table, source, registry, points):
