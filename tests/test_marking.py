@@ -289,3 +289,22 @@ def test_an_answer_can_carry_rubric_lines_that_the_page_shows_beside_the_model_a
     path.write_text(DEFAULT.read_text() + f'\n[answers]\n{grade_id} = {{points = 2, lines = "x"}}\n')
     with pytest.raises(ValueError, match="a table of points and rubric lines"):
         rubric.load(path)
+
+
+def test_a_regraded_submission_keeps_the_marks_that_still_apply():
+    from labkit.grading.batch import carried_marks
+
+    answer, other = list(LAB.answers)[:2]
+    mark = {"points": 1.0, "comment": "", "time": "2026-12-01T10:00:00+00:00"}
+    held = {"definition": "eval_pherm", "source": "labkit.piecewise.eval_pherm", "share": 0.9, "lines": []}
+    checks = [{"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": [], "held": held}]
+    marks = {answer: mark, other: mark, "exercise2/eval_pherm": mark, "exercise5": mark}
+    earlier = SubmissionGrade("ada", answers={answer: "the same", other: "before"}, marks=marks)
+    again = SubmissionGrade(
+        "ada", results={2: {"exercise": 2, "checks": checks}}, answers={answer: "the same", other: "rewritten"}
+    )
+    kept, dropped = carried_marks(earlier, again)
+    assert set(kept) == {answer, "exercise2/eval_pherm", "exercise5"} and dropped == 1
+    checks[0].pop("held")  # rewritten: no longer held
+    kept, dropped = carried_marks(earlier, again)
+    assert set(kept) == {answer, "exercise5"} and dropped == 2

@@ -509,9 +509,15 @@ def grade(
     when.update({name: submission_time(None, name, times, exchange=exchange_times) for name in ungradable})
     todo = [(path, name) for path, name in zip(submissions, names) if name not in done]
 
+    dropped = []
+
     def arrived(grade):
         """Write a submission's result and feedback as soon as it is graded (a stopped run resumes from them)."""
         grade.time = when[grade.name]
+        if grade.name in earlier.earlier and grade.graded:
+            grade.marks, lost = carried_marks(earlier.earlier[grade.name], grade)
+            if lost:
+                dropped.append((grade.name, lost))
         records.note(out, record, grade.name, write_result(out, grade), contents.get(grade.name))
 
     work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
@@ -538,6 +544,11 @@ def grade(
     for grade in ordered:
         grade.time = when[grade.name]
     write_report(out, ordered, record)
+    for name, lost in dropped:
+        sys.stderr.write(
+            f"labkit grade: {one_line(name, 80)}'s notebooks changed; {lost} of the marks given to it no longer "
+            "apply (an answer rewritten, a part no longer held): mark them again (labkit mark OUT).\n"
+        )
     (out / "run.json").write_text(
         json.dumps(
             {
@@ -811,6 +822,8 @@ class Resumed:
     rubric: Rubric
     record: object = None
     changed: list = field(default_factory=list)
+    # {name: its earlier grade} of the changed submissions: the marks a person gave them carry over where they apply
+    earlier: dict = field(default_factory=dict)
     refused: list = field(default_factory=list)
 
 
@@ -876,16 +889,36 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
             "only these, or choose a new --out."
         )
     found, refused = records.results(out, record)
-    done, changed = {}, []
+    done, changed, before = {}, [], {}
     for name, (path, data) in found.items():
         grade = SubmissionGrade.from_dict(data, str(path), rubric)  # ValueError: another labkit version's
         if not grade.graded:
             continue
         if contents is not None and record.submissions[name].get("content") != contents.get(name):
             changed.append(name)
+            before[name] = grade
             continue
         done[name] = grade
-    return Resumed(done, record.seed if record.seed is not None else seed, rubric, record, sorted(changed), refused)
+    seed = record.seed if record.seed is not None else seed
+    return Resumed(done, seed, rubric, record, sorted(changed), refused, before)
+
+
+def carried_marks(earlier, grade):
+    """The marks of `earlier` (a submission's grade before its notebooks changed) that still apply to its new
+    `grade`: an answer's while its text is the same, a held part's while it is still held, an exercise's
+    excuse always; and how many no longer apply."""
+    kept, dropped = {}, 0
+    held = {f"exercise{number}/{part}" for number, part, _, _ in grade.held()}
+    for item, mark in earlier.marks.items():
+        if item in grade.rubric.registry.answers:
+            same = str(earlier.answers.get(item, "")) == str(grade.answers.get(item, ""))
+        else:
+            same = "/" not in item or item in held
+        if same:
+            kept[item] = mark
+        else:
+            dropped += 1
+    return kept, dropped
 
 
 def _file_of(rubric):
