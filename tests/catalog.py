@@ -41,6 +41,11 @@ class Planted:
     also: tuple = ()  # other (exercise, part) that the lab's rules make fail with it
     full: tuple = ()  # for correct work: the exercises that must earn full marks
     keep_rates: bool = False  # leave the rate answers as written (the slip is in a rate)
+    # a slip's feedback: does its hint name the slip (True), or say what is verified and what to look at (False)?
+    named: bool = True
+    # what its hint did before issue 30 ("named", "generic": it restated the task or pointed at the line that
+    # raised, "misleading": it named another cause; a slip of issue 30's block was graded by the checks of then)
+    was: str = "named"
 
 
 def plant(entry, folder):
@@ -395,6 +400,8 @@ MISTAKES = (
         "rate_pherm",
         "take the ratios",
         keep_rates=True,
+        named=False,
+        was="generic",
     ),
     # Exercise 4
     Planted(
@@ -425,6 +432,7 @@ MISTAKES = (
         4,
         "ax4",
         "straight segments",
+        was="generic",
     ),
     Planted(
         "limacon_drawn_exactly",
@@ -486,6 +494,7 @@ MISTAKES = (
         7,
         "straight",
         "d2xdsdt = -1",
+        was="generic",
     ),
     Planted(
         "straight_side_bent",
@@ -494,6 +503,7 @@ MISTAKES = (
         7,
         "straight",
         "vector along that side",
+        was="generic",
     ),
     Planted(
         "mirror_without_swapping",
@@ -506,7 +516,8 @@ MISTAKES = (
         ),
         9,
         "two_patches",
-        "mirrored dt as ds",
+        "ds is the mirror image of ABCD's ds",
+        was="generic",
     ),
     Planted(
         "region_not_merged",
@@ -529,6 +540,7 @@ MISTAKES = (
         8,
         "circle_sides",
         "both its direction and its length matter",
+        was="generic",
     ),
     Planted(
         "circle_sides_pointing_along_the_chord",
@@ -537,6 +549,7 @@ MISTAKES = (
         8,
         "circle_sides",
         "both its direction and its length matter",
+        was="generic",
     ),
     # Exercise 10: complete_system and ccspline
     Planted(
@@ -589,6 +602,7 @@ MISTAKES = (
         10,
         "ccspline",
         "A and D are right, so what ccspline does with them is wrong",
+        was="generic",
     ),
     # Exercise 12: ncspline
     Planted(
@@ -738,6 +752,7 @@ MISTAKES = (
         "test_pchip_interpolate",
         "xtest[4001]",
         also=((15, "errors_pchip"), (15, "rate_pchip")),
+        was="generic",
     ),
     # Exercise 16
     Planted(
@@ -760,6 +775,7 @@ MISTAKES = (
         16,
         "runge2d",
         "1 / (1 + (x + y)**2)",
+        was="misleading",
     ),
     Planted(
         "pbilin_transposed",
@@ -785,17 +801,509 @@ MISTAKES = (
 )
 
 
+# -- Issue 30: a hint for every slip -------------------------------------------------------------------------------
+# The slips a student makes at each step the lab describes, one each, that the block above did not have: the
+# interval search (past the last knot, the wrong side), the basis functions and the derivatives, the end
+# conditions, the rows of the matrix and the signs of the right side, the orientation of plots and grids
+# (swapped coordinates), and the interval, the point count and the row index of the drivers. `was` is what the
+# feedback said before issue 30 (graded by the checks of then); `hint` is what it says now. They are graded
+# several to a submission (see :func:`submissions`), one slip per notebook, so the grading test stays quick.
+BRACKET = "    k = labkit.bracket(xdata, xval)\n"
+PHERM_RETURN = "    return np.max(np.abs(exact - interpolate(xdata, ydata, ypdata, xtest))) / np.max(np.abs(exact))\n"
+PCHIP_RETURN = "    return np.max(np.abs(exact - labkit.pchip(xdata, f(xdata)[0], xtest))) / np.max(np.abs(exact))\n"
+PBILIN_SUM = (
+    "    return (f(x0, y0) * (x1 - X) * (y1 - Y) + f(x1, y0) * (X - x0) * (y1 - Y)\n"
+    "            + f(x1, y1) * (X - x0) * (Y - y0) + f(x0, y1) * (x1 - X) * (Y - y0)) / area\n"
+)
+GRADED = (
+    "graded = [Corner(A.point, [3.0, 0.0], A.dt), Corner(B.point, [0.1, 0.0], B.dt),\n"
+    "          Corner(C.point, [0.1, 0.0], C.dt), Corner(D.point, [3.0, 0.0], D.dt)]"
+)
+SLIPS = (
+    # Exercise 2: the interval search and the basis functions
+    Planted(
+        "search_fails_at_the_last_knot",
+        "02_convergence.ipynb",
+        ((BRACKET, "    k = np.searchsorted(xdata, xval, side='right') - 1\n"),),
+        2,
+        "eval_pherm",
+        "at or past the last knot",
+        also=((3, "errors_pherm"), (3, "rate_pherm")),  # the table's cell raises: no table, no rate
+        was="generic",
+    ),
+    Planted(
+        "search_on_the_wrong_side",
+        "02_convergence.ipynb",
+        ((BRACKET, "    k = np.clip(np.searchsorted(xdata, xval), 0, len(xdata) - 2)\n"),),
+        2,
+        "eval_pherm",
+        "the interval to its right",
+        was="generic",
+    ),  # a neighbouring cubic is still of the same order: the table keeps its points
+    Planted(
+        "h4_written_as_h2",
+        "02_convergence.ipynb",
+        (
+            (
+                "    h4 = (xval - xk1) * (xval - xk) ** 2 / (xk1 - xk) ** 2\n",
+                "    h4 = (xval - xk) * (xval - xk1) ** 2 / (xk1 - xk) ** 2\n",
+            ),
+        ),
+        2,
+        "eval_pherm",
+        "your h4 is h2",
+        was="misleading",
+    ),
+    # Exercise 3: runge and the driver
+    Planted(
+        "runge_derivative_not_squared",
+        "02_convergence.ipynb",
+        (("yprime = -2.0 * x / (1.0 + x**2) ** 2", "yprime = -2.0 * x / (1.0 + x**2)"),),
+        3,
+        "runge",
+        "yprime's denominator",
+        was="generic",
+    ),
+    Planted(
+        "driver_compares_with_the_derivative",
+        "02_convergence.ipynb",
+        (("    exact = f(xtest)[0]\n", "    exact = f(xtest)[1]\n"),),
+        3,
+        "test_pherm_interpolate",
+        "f's derivatives",
+        also=((3, "errors_pherm"), (3, "rate_pherm")),
+        was="generic",
+    ),
+    Planted(
+        "driver_with_ndata_plus_one_points",
+        "02_convergence.ipynb",
+        (("    xdata = np.linspace(0, 5, ndata)\n", "    xdata = np.linspace(0, 5, ndata + 1)\n"),),
+        3,
+        "test_pherm_interpolate",
+        "ndata + 1 data points",
+        was="generic",
+    ),
+    Planted(
+        "driver_with_the_2_norm",
+        "02_convergence.ipynb",
+        (
+            (
+                PHERM_RETURN,
+                "    return np.linalg.norm(exact - interpolate(xdata, ydata, ypdata, xtest)) / np.linalg.norm(exact)\n",
+            ),
+        ),
+        3,
+        "test_pherm_interpolate",
+        "square root of the sum of squares",
+        was="generic",
+    ),
+    Planted(
+        "table_one_row_short",
+        "02_convergence.ipynb",
+        (
+            (
+                "errors_pherm = [test_pherm_interpolate(n) for n in ndata]",
+                "errors_pherm = [test_pherm_interpolate(n) for n in ndata[1:]]",
+            ),
+        ),
+        3,
+        "errors_pherm",
+        "7 errors for the 8 sizes",
+        also=((3, "rate_pherm"),),  # the rate is read off the table
+        was="generic",
+    ),
+    # Exercise 4: the derivatives and the plot
+    Planted(
+        "limacon_derivatives_swapped",
+        "01_limacon.ipynb",
+        (("    return dxdt, dydt\n", "    return dydt, dxdt\n"),),
+        4,
+        "limacon_derivatives",
+        "the two are swapped",
+        was="generic",  # and it cost the plot too, which now follows the swapped slopes
+    ),
+    Planted(
+        "limacon_dr_dt_sign",
+        "01_limacon.ipynb",
+        (("dxdt = -np.sin(t) * np.cos(t) - r * np.sin(t)", "dxdt = np.sin(t) * np.cos(t) - r * np.sin(t)"),),
+        4,
+        "limacon_derivatives",
+        "dr/dt has the wrong sign",
+        was="generic",  # and it cost the plot too
+    ),
+    Planted(
+        "limacon_ignores_r0",
+        "01_limacon.ipynb",
+        (("    r = r0 + np.cos(t)\n", "    r = 1.15 + np.cos(t)\n"),),
+        4,
+        "limacon_derivatives",
+        "the r0 it is given",
+        was="generic",
+    ),
+    Planted(
+        "limacon_plot_x_and_y_swapped",
+        "01_limacon.ipynb",
+        (("ax4.plot(xherm, yherm)", "ax4.plot(yherm, xherm)"),),
+        4,
+        "ax4",
+        "x and y are swapped",
+        was="misleading",
+    ),
+    Planted(
+        "limacon_plotted_against_t",
+        "01_limacon.ipynb",
+        (("ax4.plot(xherm, yherm)", "ax4.plot(tval, yherm)"),),
+        4,
+        "ax4",
+        "against t",
+        was="misleading",
+    ),
+    Planted(
+        "limacon_plot_with_the_slopes_swapped",
+        "01_limacon.ipynb",
+        (
+            (
+                "xherm = labkit.eval_pherm(tdata, xdata, xpdata, tval)\nyherm = labkit.eval_pherm(tdata, ydata, ypdata, tval)",
+                "xherm = labkit.eval_pherm(tdata, xdata, ypdata, tval)\nyherm = labkit.eval_pherm(tdata, ydata, xpdata, tval)",
+            ),
+        ),
+        4,
+        "ax4",
+        "xpdata and ypdata are swapped",
+        was="generic",
+    ),
+    # Exercises 5 to 9
+    Planted(
+        "coons_dc_from_c_to_d",
+        "03_meshes.ipynb",
+        (
+            (
+                "along_DC = labkit.eval_pherm([0, 1], [D.point[c], C.point[c]], [D.ds[c], C.ds[c]], s)",
+                "along_DC = labkit.eval_pherm([0, 1], [C.point[c], D.point[c]], [C.ds[c], D.ds[c]], s)",
+            ),
+        ),
+        5,
+        "coons",
+        "runs from C to D",
+        was="generic",
+    ),
+    Planted(
+        "coons_join_without_the_t_derivatives",
+        "03_meshes.ipynb",
+        (("[dt_AB[k], dt_DC[k]]", "[0.0, 0.0]"),),
+        5,
+        "coons",
+        "ignores the t-derivatives along AB and DC",
+        was="generic",
+    ),
+    Planted(
+        "graded_changes_dt",
+        "03_meshes.ipynb",
+        (
+            (
+                GRADED,
+                GRADED.replace("[3.0, 0.0], A.dt", "A.ds, [3.0, 0.0]")
+                .replace("[0.1, 0.0], B.dt", "B.ds, [0.1, 0.0]")
+                .replace("[0.1, 0.0], C.dt", "C.ds, [0.1, 0.0]")
+                .replace("[3.0, 0.0], D.dt", "D.ds, [3.0, 0.0]"),
+            ),
+        ),
+        6,
+        "graded",
+        "you changed dt",
+        was="generic",
+    ),
+    Planted(
+        "straight_c_with_x_and_y_swapped",
+        "03_meshes.ipynb",
+        (("[1.0, 0.0], [1.0, 0.5], [0.0, 1.0]))", "[1.0, 0.0], [0.5, 1.0], [0.0, 1.0]))"),),
+        7,
+        "straight",
+        "C has its x and y swapped",
+        was="generic",
+    ),
+    Planted(
+        "mirror_keeps_the_derivative_vectors",
+        "03_meshes.ipynb",
+        (("corner.dt[::-1], corner.ds[::-1], corner.dsdt[::-1])", "corner.dt, corner.ds, corner.dsdt)"),),
+        9,
+        "two_patches",
+        "derivatives are not mirrored",
+        was="generic",
+    ),
+    Planted(
+        "abcd_in_the_wrong_order",
+        "03_meshes.ipynb",
+        (
+            (
+                "a, b, c, d = mirror(A), mirror(D), mirror(C), mirror(B)",
+                "a, b, c, d = mirror(A), mirror(B), mirror(C), mirror(D)",
+            ),
+        ),
+        9,
+        "two_patches",
+        "not in the order a, b, c, d",
+        was="misleading",
+    ),
+    # Exercises 10 to 13
+    Planted(
+        "complete_d_inside_sign",
+        "04_splines.ipynb",
+        (("        D[k] = secant[k] - secant[k - 1]\n", "        D[k] = secant[k - 1] - secant[k]\n"),),
+        10,
+        "ccspline",
+        "D's inside entries have the wrong sign",
+        also=((12, "ncspline"),),  # ncspline builds on it, and a system with that slip is no spline system
+        was="misleading",
+    ),
+    Planted(
+        "complete_first_row_swapped",
+        "04_splines.ipynb",
+        (
+            (
+                "    A[0, 0], A[0, 1], D[0] = h[0] / 3, h[0] / 6, secant[0] - y1p\n",
+                "    A[0, 0], A[0, 1], D[0] = h[0] / 6, h[0] / 3, secant[0] - y1p\n",
+            ),
+        ),
+        10,
+        "ccspline",
+        "A's first row",
+        was="misleading",
+    ),  # the natural spline replaces that row: ncspline is right
+    Planted(
+        "ccspline_end_slopes_swapped",
+        "04_splines.ipynb",
+        (("    sprime[0], sprime[-1] = y1p, ynp\n", "    sprime[0], sprime[-1] = ynp, y1p\n"),),
+        10,
+        "ccspline",
+        "the first and the last slope",
+        was="generic",
+    ),
+    Planted(
+        "natural_d_inside_sign",
+        "04_splines.ipynb",
+        (
+            (
+                "    A, D = complete_system(xdata, ydata, 0.0, 0.0)\n    A[0, :], A[-1, :] = 0.0, 0.0\n",
+                "    A, D = complete_system(xdata, ydata, 0.0, 0.0)\n    D[1:-1] = -D[1:-1]\n"
+                "    A[0, :], A[-1, :] = 0.0, 0.0\n",
+            ),
+        ),
+        12,
+        "ncspline",
+        "D's inside entries have the wrong sign",
+        was="misleading",
+    ),
+    Planted(
+        "natural_driver_interpolates_the_derivatives",
+        "04_splines.ipynb",
+        (("    ydata = f(xdata)[0]\n", "    ydata = f(xdata)[1]\n"),),
+        12,
+        "test_ncspline_interpolate",
+        "f's derivatives",
+        also=((12, "errors_natural"), (12, "rate_natural")),
+        was="generic",
+    ),
+    Planted(
+        "complete_driver_slope_at_the_second_point",
+        "04_splines.ipynb",
+        (
+            (
+                "sprime = slopes(xdata, ydata, ypdata[0], ypdata[-1])",
+                "sprime = slopes(xdata, ydata, ypdata[1], ypdata[-1])",
+            ),
+        ),
+        11,
+        "test_ccspline_interpolate",
+        "the second data point",
+        was="generic",  # and it cost the table and the rate too: the slip had no name, so no attempt
+    ),
+    Planted(
+        "complete_driver_index_past_the_end",
+        "04_splines.ipynb",
+        (
+            (
+                "sprime = slopes(xdata, ydata, ypdata[0], ypdata[-1])",
+                "sprime = slopes(xdata, ydata, ypdata[0], ypdata[ndata])",
+            ),
+        ),
+        11,
+        "test_ccspline_interpolate",
+        "one past the last",
+        also=((11, "errors_complete"), (11, "rate_complete")),  # the table's cell raises
+        was="generic",
+    ),
+    Planted(
+        "notaknot_driver_with_ndata_minus_one_points",
+        "04_splines.ipynb",
+        (
+            (
+                "    xdata = np.linspace(0, 5, ndata)\n    xtest = np.linspace(0, 5, 4001)\n",
+                "    xdata = np.linspace(0, 5, ndata - 1)\n    xtest = np.linspace(0, 5, 4001)\n",
+            ),
+        ),
+        13,
+        "test_spline_interpolate",
+        "ndata - 1 data points",
+        was="generic",
+    ),
+    # Exercises 14 and 15
+    Planted(
+        "boiling_data_x_and_y_swapped",
+        "05_monotone.ipynb",
+        (
+            (
+                'ax14.plot(xdata, ydata, "o", color="k", label="data")',
+                'ax14.plot(ydata, xdata, "o", color="k", label="data")',
+            ),
+        ),
+        14,
+        "ax14: the data",
+        "x and y are swapped",
+        was="generic",
+    ),
+    Planted(
+        "boiling_pchip_x_and_y_swapped",
+        "05_monotone.ipynb",
+        (
+            (
+                'ax14.plot(xval, labkit.pchip(xdata, ydata, xval), label="pchip")',
+                'ax14.plot(labkit.pchip(xdata, ydata, xval), xval, label="pchip")',
+            ),
+        ),
+        14,
+        "ax14: pchip",
+        "x and y are swapped",
+        was="generic",
+    ),
+    Planted(
+        "pchip_driver_with_the_mean_error",
+        "05_monotone.ipynb",
+        ((PCHIP_RETURN, PCHIP_RETURN.replace("np.max(np.abs(exact - ", "np.mean(np.abs(exact - ")),),
+        15,
+        "test_pchip_interpolate",
+        "the mean of |f - p|",
+        was="generic",
+    ),
+    Planted(
+        "pchip_driver_interpolates_the_derivatives",
+        "05_monotone.ipynb",
+        (("labkit.pchip(xdata, f(xdata)[0], xtest)", "labkit.pchip(xdata, f(xdata)[1], xtest)"),),
+        15,
+        "test_pchip_interpolate",
+        "f's derivatives",
+        also=((15, "errors_pchip"), (15, "rate_pchip")),
+        was="generic",
+    ),
+    # Exercise 16
+    Planted(
+        "pbilin_search_fails_at_the_last_knot",
+        "06_bilinear.ipynb",
+        (
+            (
+                "    i, j = labkit.bracket(xdata, xval), labkit.bracket(ydata, yval)\n",
+                "    i = np.searchsorted(xdata, xval, side='right') - 1\n"
+                "    j = np.searchsorted(ydata, yval, side='right') - 1\n",
+            ),
+        ),
+        16,
+        "eval_pbilin",
+        "at or past the last knot",
+        also=((16, "errors_bilinear"), (16, "rate_bilinear")),  # the table's cell raises
+        was="generic",
+    ),
+    Planted(
+        "pbilin_corner_values_swapped",
+        "06_bilinear.ipynb",
+        (
+            (
+                PBILIN_SUM,
+                PBILIN_SUM.replace("f(x1, y0) * (X - x0)", "f(x0, y1) * (X - x0)").replace(
+                    "f(x0, y1) * (x1 - X)", "f(x1, y0) * (x1 - X)"
+                ),
+            ),
+        ),
+        16,
+        "eval_pbilin",
+        "f(P_2) goes with phi_4",
+        was="misleading",
+    ),
+    Planted(
+        "bilinear_driver_with_ndata_plus_one_points",
+        "06_bilinear.ipynb",
+        (("    grid = np.linspace(0, 5, ndata)\n", "    grid = np.linspace(0, 5, ndata + 1)\n"),),
+        16,
+        "test_pbilin_interpolate",
+        "ndata + 1 data points",
+        was="generic",
+    ),
+)
+MISTAKES += SLIPS
+
+
+def submissions():
+    """{submission name: its entries}: one submission per entry of the catalogs, except issue 30's slips, which
+    go several to a submission (one per notebook, in the catalog's order), so each notebook of it has one slip."""
+    out = {entry.name: (entry,) for entry in CORRECT + MISTAKES if entry not in SLIPS}
+    rounds = {}
+    for entry in SLIPS:
+        rounds.setdefault(entry.notebook, []).append(entry)
+    for index in range(max(map(len, rounds.values()))):
+        out[f"slips_{index + 1}"] = tuple(entries[index] for entries in rounds.values() if index < len(entries))
+    return out
+
+
+def submission_of(entry):
+    """The name of the submission `entry` is graded in."""
+    return next(name for name, entries in submissions().items() if entry in entries)
+
+
+KINDS = ("named", "generic", "misleading")
+
+
+def summary():
+    """The catalog's slips and how their hints read: {"slips": n, "before": {kind: n}, "now": {kind: n}}.
+
+    "before" is what the feedback said before issue 30 (`was`; the slips of issue 30's block graded by the
+    checks of then), "now" what it says: "named" when the hint names the slip, "generic" when it says what
+    is verified and what to look at (tests/test_catalog.py checks both, and that none misleads)."""
+    count = lambda kinds: {kind: sum(k == kind for k in kinds) for kind in KINDS}  # noqa: E731
+    return {
+        "slips": len(MISTAKES),
+        "before": count([entry.was for entry in MISTAKES]),
+        "now": count(["named" if entry.named else "generic" for entry in MISTAKES]),
+        "new": len(SLIPS),
+        "new before": count([entry.was for entry in SLIPS]),
+    }
+
+
+def summary_text():
+    """The summary as the closing report gives it."""
+    counts = summary()
+    line = lambda c: ", ".join(f"{c[kind]} {kind}" for kind in KINDS)  # noqa: E731
+    earlier = counts["slips"] - counts["new"]
+    before = {kind: counts["before"][kind] - counts["new before"][kind] for kind in KINDS}
+    return (
+        f"catalog before issue 30: {earlier} slips: {line(before)}\n"
+        f"issue 30's {counts['new']} new slips, as the checks of then named them: {line(counts['new before'])}\n"
+        f"catalog now: {counts['slips']} slips: {line(counts['now'])}"
+    )
+
+
 def plant_class(folder):
-    """The catalog class in `folder`: one submission per entry, and one complete MATLAB-style solution set
-    (loops, lists, a dense solve, scatter plots, typed-in tables: every correct variation of a notebook
-    applied together). {submission name: its folder}, in a fixed order."""
+    """The catalog class in `folder`: one submission per entry (issue 30's slips several to a submission, see
+    :func:`submissions`), and one complete MATLAB-style solution set (loops, lists, a dense solve, scatter plots,
+    typed-in tables: every correct variation of a notebook applied together). {submission name: its folder}, in a
+    fixed order."""
     import json
 
     folder = Path(folder)
     folders = {}
+    grouped = {name: entries for name, entries in submissions().items() if name.startswith("slips_")}
     for entry in CORRECT + MISTAKES:
-        plant(entry, folder / entry.name)
-        folders[entry.name] = folder / entry.name
+        if entry not in SLIPS:
+            plant(entry, folder / entry.name)
+            folders[entry.name] = folder / entry.name
     matlab = folder / "matlab_style"
     for entry in CORRECT:
         if not (matlab / entry.notebook).exists():
@@ -814,4 +1322,12 @@ def plant_class(folder):
         path.write_text(text)
     plant(Planted("the meshes as they are", "03_meshes.ipynb", ()), matlab)
     folders["matlab_style"] = matlab
+    for name, entries in grouped.items():
+        for entry in entries:
+            plant(entry, folder / name)
+        folders[name] = folder / name
     return folders
+
+
+if __name__ == "__main__":
+    print(summary_text())

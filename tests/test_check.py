@@ -213,3 +213,162 @@ def test_ncspline_built_on_a_wrong_complete_system_is_not_charged_twice(seed):
     assert not slipped.passed
     # and the right natural spline next to the wrong system passes the usual way
     assert spline_checks.check_ncspline(labkit.ncspline, seed=seed, system=_system_with_h_subscript_slip).passed
+
+
+# -- issue 30: a hint for every slip (the catalog plants most of them; these are the ones it does not) ----------
+
+
+def test_an_index_one_past_the_end_and_a_caret_for_a_power_are_named_where_they_raise():
+    from labkit.exercises.result import CheckResult, call
+
+    past, caret = CheckResult("f"), CheckResult("f")
+    call(past, "runs", lambda n: np.linspace(0, 5, n)[n], 7)
+    call(caret, "runs", lambda x: 1 / (1 + x ^ 2), np.linspace(0, 1, 3))
+    assert "index 7 is one past the last entry of an array of 7 entries" in past.hint
+    assert "its last index is 6, or -1" in past.hint and "look at that line" not in past.hint
+    assert "`^` is bitwise xor in Python, not a power" in caret.hint
+    other = CheckResult("f")
+    call(other, "runs", lambda: np.zeros(3)[5])
+    assert "index 5 is outside an array of 3 entries" in other.hint
+
+
+def _pherm_with(search=labkit.bracket, h3=None):
+    def eval_pherm(xdata, ydata, ypdata, xval):
+        xdata, ydata, ypdata, xval = (np.asarray(a, dtype=float) for a in (xdata, ydata, ypdata, xval))
+        k = search(xdata, xval)
+        h = list(labkit.hermite_basis(xdata[k], xdata[k + 1], xval))
+        if h3 is not None:
+            h[2] = h3(xval, xdata[k], xdata[k + 1])
+        return ydata[k] * h[0] + ypdata[k] * h[1] + ydata[k + 1] * h[2] + ypdata[k + 1] * h[3]
+
+    return eval_pherm
+
+
+@pytest.mark.parametrize(
+    "search, said",
+    [
+        (lambda x, v: np.clip(np.searchsorted(x, v), 0, len(x) - 2), "the interval to its right"),
+        (lambda x, v: np.clip(np.searchsorted(x, v) - 2, 0, len(x) - 2), "the interval to its left"),
+        (lambda x, v: np.searchsorted(x, v, side="right") - 1, "points at or past the last knot raise an error"),
+        (lambda x, v: np.maximum(np.searchsorted(x, v) - 1, 0), "points past the last knot raise an error"),
+        (lambda x, v: np.minimum(np.searchsorted(x, v) - 1, len(x) - 2), "points before the first knot get the wrong"),
+    ],
+)
+def test_the_interval_search_is_named_on_either_side_and_at_either_end(search, said):
+    result = check.eval_pherm(_pherm_with(search))
+    assert not result.passed and said in result.hint and "look at that line" not in result.hint
+    assert check.eval_pherm(_pherm_with(lambda x, v: labkit.bracket(x, v))).passed
+
+
+def test_a_basis_function_is_named_by_the_entries_of_table_3_it_misses():
+    # h3 with h1's last factor: 3 x_k - x_{k+1} - 2x instead of 3 x_{k+1} - x_k - 2x
+    result = check.eval_pherm(_pherm_with(h3=lambda x, a, b: (x - a) ** 2 * (3 * a - b - 2 * x) / (b - a) ** 3))
+    assert "h3 is wrong: its value at x_{k+1} and its slope at x_{k+1} are not what the lab's table (3)" in result.hint
+
+
+def test_a_basis_function_written_as_another_is_not_blamed_on_the_combination():
+    result = check.eval_pherm(_pherm_with(h3=lambda x, a, b: labkit.hermite_basis(a, b, x)[0]))  # h3 is h1
+    assert "your h3 is h1's formula" in result.hint and "combination" not in result.hint
+
+
+def _natural_with(change_d):
+    def ncspline(x, y):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        A, D = labkit.exercises.splines._reference_complete_system(x, y, 0.0, 0.0)
+        change_d(D)
+        A[[0, -1], :], D[[0, -1]] = 0.0, 0.0
+        A[0, 0] = A[-1, -1] = 1.0
+        M = np.linalg.solve(A, D)
+        h, secant = np.diff(x), np.diff(y) / np.diff(x)
+        return np.append(-M[:-1] * h / 3 - M[1:] * h / 6 + secant, M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1])
+
+    return ncspline
+
+
+def test_a_natural_spline_with_a_wrong_inside_row_is_told_which_row_not_its_end_rows():
+    def third_row(D):
+        D[2] += 0.5
+
+    result = check.ncspline(_natural_with(third_row))
+    assert (
+        "row 3 of your system is not equations (11)-(12)" in result.hint
+        and "first and last rows are right" in result.hint
+    )
+
+    def negated(D):
+        D[1:-1] *= -1
+
+    assert "D's inside entries have the wrong sign" in check.ncspline(_natural_with(negated), seed=4).hint
+
+
+def test_a_complete_system_with_its_last_row_swapped_is_told_so():
+    def system(xdata, ydata, y1p, ynp):
+        A, D = labkit.exercises.splines._reference_complete_system(
+            np.asarray(xdata, float), np.asarray(ydata, float), y1p, ynp
+        )
+        A[-1, -2], A[-1, -1] = A[-1, -1], A[-1, -2]
+        return A, D
+
+    def ccspline(x, y, y1p, ynp):
+        A, D = system(x, y, y1p, ynp)
+        M, h = np.linalg.solve(A, D), np.diff(np.asarray(x, float))
+        return np.append(-M[:-1] * h / 3 - M[1:] * h / 6 + np.diff(np.asarray(y, float)) / h, ynp)
+
+    result = check.ccspline(ccspline, system)
+    assert "A's last row is not equation (11)'s: A(4, 3) and A(4, 4) differ from it" in result.hint
+
+
+def _pherm_driver(measure):
+    def test_pherm_interpolate(ndata, f=labkit.runge, interpolate=labkit.eval_pherm):
+        xdata, xtest = np.linspace(0, 5, ndata), np.linspace(0, 5, 4001)
+        return measure(f, xdata, xtest, interpolate)
+
+    return test_pherm_interpolate
+
+
+@pytest.mark.parametrize(
+    "measure, said",
+    [
+        (
+            lambda f, x, t, p: np.max(f(t)[0] - p(x, *f(x), t)) / np.max(np.abs(f(t)[0])),
+            "The error takes no absolute value",
+        ),
+        (
+            lambda f, x, t, p: np.max(np.abs(f(t)[0] - p(x, *f(x)[::-1], t))) / np.max(np.abs(f(t)[0])),
+            "The values and the slopes of the data look swapped",
+        ),
+        (
+            lambda f, x, t, p: np.mean(np.abs(f(t)[0] - p(x, *f(x), t))) / np.max(np.abs(f(t)[0])),
+            "the mean of |f - p|",
+        ),
+    ],
+)
+def test_a_driver_that_measures_another_way_is_told_how(measure, said):
+    result = check.driver("pherm", _pherm_driver(measure), seed=2)
+    assert not result.passed and said in result.hint
+
+
+def test_a_complete_driver_with_the_next_to_last_end_slope_is_told_so():
+    def test_ccspline_interpolate(ndata, f=labkit.runge, slopes=labkit.ccspline):
+        xdata, xtest = np.linspace(0, 5, ndata), np.linspace(0, 5, 4001)
+        ydata, ypdata = f(xdata)
+        values = labkit.eval_pherm(xdata, ydata, slopes(xdata, ydata, ypdata[0], ypdata[-2]), xtest)
+        return np.max(np.abs(f(xtest)[0] - values)) / np.max(np.abs(f(xtest)[0]))
+
+    result = check.driver("complete", test_ccspline_interpolate)
+    assert "The last end slope looks like f' at the next-to-last data point" in result.hint
+
+
+def test_a_quarter_circle_side_is_told_which_derivative_points_off_the_circle():
+    q = np.pi / 4
+    corners = [
+        labkit.Corner([0, 0], [q, -q], [q, q]),
+        labkit.Corner([1, 0], [q, q], [-q, q]),
+        labkit.Corner([1, 1], [q, -q], [q, q]),
+        labkit.Corner([0, 1], [q, q], [-q, q]),
+    ]
+    assert check.circle_corners(corners).passed
+    corners[1] = labkit.Corner([1, 0], [q, 0.5 * q], [-q, q])  # B's ds turned off the tangent
+    result = check.circle_corners(corners)
+    assert "at B, the derivative along AB (ds) does not point along the circle" in result.hint
+    assert "both its direction and its length matter" in result.hint

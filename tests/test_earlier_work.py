@@ -135,7 +135,7 @@ def test_region_built_on_a_slip_in_the_mirror_rule_still_costs_only_two_patches(
         return _patch_meshes([A, B, C, D], mirror_ds_dt=False)
 
     patches = check.two_patches(slipped, corners)
-    assert not patches.passed and "mirrored dt as ds" in patches.hint
+    assert not patches.passed and "ds is the mirror image of ABCD's ds" in patches.hint
     first, second = slipped(*corners)
     assert check.combined_mesh(first + second, corners, slipped).passed
     # and the right meshes with the right region

@@ -14,7 +14,7 @@ import numpy as np
 from .. import bilinear, functions
 from .experiments import Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part
-from .result import CheckResult, call, case_rng, close, floats, worst
+from .result import CheckResult, call, case_rng, close, floats, gave_up, worst
 
 
 def one(x, y):
@@ -40,6 +40,29 @@ def product(x, y):
 BILINEAR_FUNCTIONS = (("1", one), ("x", x_only), ("y", y_only), ("xy", product))
 
 
+def corner_1(x, y):
+    """phi_1 of the unit square: 1 at P_1 = (0, 0), 0 at the other corners."""
+    return (1 - np.asarray(x, dtype=float)) * (1 - np.asarray(y, dtype=float))
+
+
+def corner_2(x, y):
+    """phi_2 of the unit square: 1 at P_2 = (1, 0)."""
+    return np.asarray(x, dtype=float) * (1 - np.asarray(y, dtype=float))
+
+
+def corner_3(x, y):
+    """phi_3 of the unit square: 1 at P_3 = (1, 1)."""
+    return np.asarray(x, dtype=float) * np.asarray(y, dtype=float)
+
+
+def corner_4(x, y):
+    """phi_4 of the unit square: 1 at P_4 = (0, 1)."""
+    return (1 - np.asarray(x, dtype=float)) * np.asarray(y, dtype=float)
+
+
+CORNERS = (corner_1, corner_2, corner_3, corner_4)  # f(P_n) = 1 at one corner: which phi_m it is multiplied by
+
+
 def check_runge2d(fn, seed=None):
     """Check ``runge2d(x, y)`` = 1/(1+(x+y)^2), on arrays."""
     result = CheckResult("runge2d")
@@ -50,7 +73,11 @@ def check_runge2d(fn, seed=None):
     if ok and not result.step(
         "1/(1+(x+y)^2) on arrays", close(out, functions.runge2d(X, Y)), worst(out, functions.runge2d(X, Y))
     ):
-        result.hint = "use componentwise operations: 1 / (1 + (x + y)**2)."
+        result.hint = (
+            "your runge2d squares the product x*y, not the sum x + y: the lab's function is 1 / (1 + (x + y)**2)."
+            if close(out, 1 / (1 + (X * Y) ** 2))
+            else "compare it with the lab's function, 1 / (1 + (x + y)**2), written with componentwise operations."
+        )
     return result
 
 
@@ -60,6 +87,8 @@ def check_eval_pbilin(fn, seed=None):
     unit = np.array([0.0, 1.0])
     ok, z = call(result, "corners of [0, 1]^2", fn, functions.runge2d, unit, unit, unit, unit)
     if not ok:
+        if not gave_up(result):
+            result.hint = _pbilin_search_slip(fn) or result.hint
         return result
     X, Y = np.meshgrid(unit, unit, indexing="ij")
     if not result.step(
@@ -67,7 +96,9 @@ def check_eval_pbilin(fn, seed=None):
         close(z, functions.runge2d(X, Y)),
         worst(z, functions.runge2d(X, Y)),
     ):
-        result.hint = "zval(k, l) is I(xval(k), yval(l)): check the order of the indices and the four basis functions."
+        result.hint = _pbilin_corner_slip(fn) or (
+            "zval(k, l) is I(xval(k), yval(l)): check the order of the indices and the four basis functions."
+        )
         return result
     xdata, ydata = np.array([0.0, 0.5, 2.0, 3.0]), np.array([-1.0, 0.0, 2.5])
     if seed is not None:
@@ -78,6 +109,8 @@ def check_eval_pbilin(fn, seed=None):
     for name, f in BILINEAR_FUNCTIONS:
         ok, z = call(result, f"f = {name}", fn, f, xdata, ydata, xval, yval)
         if not ok:
+            if not gave_up(result):
+                result.hint = _pbilin_search_slip(fn) or result.hint
             return result
         if not result.step(f"reproduces f = {name} on an unequal grid", close(z, f(XV, YV)), worst(z, f(XV, YV))):
             if close(z, f(XV, YV).T):
@@ -87,11 +120,68 @@ def check_eval_pbilin(fn, seed=None):
                 )
             else:
                 result.hint = (
-                    "one cell works but a grid does not: use bracket on xval and on yval to find the cell "
-                    "and that cell's corners in the basis functions."
+                    _pbilin_corner_slip(fn)
+                    or _pbilin_search_slip(fn)
+                    or (
+                        "one cell works but a grid does not: use bracket on xval and on yval to find the cell "
+                        "and that cell's corners in the basis functions."
+                    )
                 )
             return result
     return result
+
+
+def _pbilin_corner_slip(fn):
+    """Which corner values a student's ``eval_pbilin`` pairs with another corner's basis function, in the
+    student's words ('' for none): on the unit square, f = phi_n (1 at P_n, 0 at the others) must come out
+    as phi_n itself."""
+    unit, points = np.array([0.0, 1.0]), np.array([0.0, 0.3, 0.8, 1.0])
+    X, Y = np.meshgrid(points, points, indexing="ij")
+    scratch, pairs = CheckResult("eval_pbilin"), []
+    for n, corner in enumerate(CORNERS, start=1):
+        ok, z = call(scratch, f"f = phi_{n}", fn, corner, unit, unit, points, points)
+        if not ok:
+            return ""
+        if not close(z, corner(X, Y)):
+            m = next((m for m, other in enumerate(CORNERS, start=1) if close(z, other(X, Y))), None)
+            if m is None:
+                return ""
+            pairs.append(f"f(P_{n}) goes with phi_{m}")
+    if not pairs:
+        return ""
+    return (
+        f"in your sum, {' and '.join(pairs)}: each corner's value f(P_n) goes with its own basis function phi_n, "
+        "I = f(P_1) phi_1 + f(P_2) phi_2 + f(P_3) phi_3 + f(P_4) phi_4 (equation 13)."
+    )
+
+
+def _pbilin_search_slip(fn):
+    """Where the cell search of a student's ``eval_pbilin`` fails, in the student's words ('' when it does
+    not): points inside the grid work, points at or past its last knot raise an error or come out wrong."""
+    xdata, ydata = np.array([0.0, 1.0, 2.5]), np.array([0.0, 1.5, 2.0])
+    scratch, inside = CheckResult("eval_pbilin"), (np.array([0.4, 1.7]), np.array([0.6, 1.8]))
+    ok, z = call(scratch, "inside the grid", fn, product, xdata, ydata, *inside)
+    if not ok or not close(z, np.outer(*inside)):
+        return ""
+    failed = []
+    for where, (xval, yval) in {
+        "at the last knot": (np.array([0.4, 2.5]), np.array([0.6, 2.0])),
+        "past the last knot": (np.array([0.4, 3.0]), np.array([0.6, 2.4])),
+    }.items():
+        ok, z = call(scratch, where, fn, product, xdata, ydata, xval, yval)
+        if not ok and gave_up(scratch):
+            return ""
+        if not ok or not close(z, np.outer(xval, yval)):
+            failed.append((where, ok))
+    if not failed:
+        return ""
+    where = "at or past the last knot" if len(failed) == 2 else failed[0][0]
+    what = "get the wrong value" if all(ok for _, ok in failed) else "raise an error"
+    return (
+        f"points {where} of xdata or ydata {what}: "
+        "there is no cell beyond the last knot, so they belong to the last cell, as labkit.bracket gives it "
+        "(use bracket twice, once for xval and once for yval)."
+    )
 
 
 def check_phi_table(table):
@@ -156,7 +246,7 @@ EXERCISES = (
                 ("eval_pbilin",),
                 seeded=True,
                 refused=INTERPOLANTS,
-                passes=(functions.runge2d,) + tuple(function for _, function in BILINEAR_FUNCTIONS),
+                passes=(functions.runge2d,) + tuple(function for _, function in BILINEAR_FUNCTIONS) + CORNERS,
             ),
         )
         + BILINEAR.parts(),

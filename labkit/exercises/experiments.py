@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import convergence, functions, piecewise, splines
+from .. import bilinear, convergence, functions, piecewise, splines
 from .model import EXPERIMENTS, Part
 from .result import CheckResult, call, case_rng, floats, judged_by_the_lab, shown
 
@@ -131,13 +131,9 @@ class Experiment:
 
     def reference(self, ndata, scaled=False, interval=(0.0, 5.0), ntest=None):
         """The relative errors labkit's experiment gives for `ndata` (a sequence of sizes)."""
-        ntest = ntest or self.ntest
-        sizes = list(ndata) * 2 if len(ndata) == 1 else list(ndata)  # the tables want two sizes
-        if self.key == "bilinear":
-            found = convergence.bilinear_convergence(sizes, self.f(scaled), interval, ntest)
-        else:
-            found = convergence.convergence_table(self.key, sizes, self.f(scaled), interval, ntest)
-        return found.errors[: len(ndata)]
+        # computed once per process: the driver's check and the table's ask for the same ones, and a driver's
+        # slips are looked for at each size (a bilinear one at 4001 x 4001 test points takes seconds)
+        return _reference(self, tuple(int(n) for n in ndata), scaled, tuple(interval), ntest or self.ntest).copy()
 
     @property
     def observed_order(self):
@@ -212,6 +208,17 @@ class ExperimentPart(Part):
         return check_experiment(self.experiment, *values)
 
 
+@functools.lru_cache(maxsize=256)
+def _reference(method, ndata, scaled, interval, ntest):
+    """:meth:`Experiment.reference`, computed."""
+    sizes = list(ndata) * 2 if len(ndata) == 1 else list(ndata)  # the tables want two sizes
+    if method.key == "bilinear":
+        found = convergence.bilinear_convergence(sizes, method.f(scaled), interval, ntest)
+    else:
+        found = convergence.convergence_table(method.key, sizes, method.f(scaled), interval, ntest)
+    return found.errors[: len(ndata)]
+
+
 @functools.cache
 def _reference_order(method):
     """Computed once per experiment: a grading run asks for it once per submission."""
@@ -267,7 +274,123 @@ def _diagnosis(method, got, ndata):
     for description, expected in _other_methods(method, ndata):
         if _agrees(got, expected):
             return description
+    for description, error in _measurement_slips(method, ndata):
+        try:
+            with np.errstate(all="ignore"):
+                expected = error()
+        except (ValueError, np.linalg.LinAlgError):  # too few points for the method
+            continue
+        if _agrees(got, expected):
+            return description
     return None
+
+
+@functools.lru_cache(maxsize=16)
+def _measured(method, ndata, data="values", against=0):
+    """The exact values at the test points and the error f - p of a driver of `method` at `ndata`, with the
+    interpolant built from the Runge function's `data` ("values": as f returns them, "swapped": values and
+    derivatives swapped, "derivatives": the derivatives as values) and compared with row `against` of what f
+    returns (0 the values, 1 the derivatives). Kept for the next slip: a driver's slips share them."""
+    if method.key == "bilinear":
+        grid, test = np.linspace(0.0, 5.0, ndata), np.linspace(0.0, 5.0, method.ntest)
+        exact = functions.runge2d(*np.meshgrid(test, test, indexing="ij"))
+        return exact, exact - bilinear.eval_pbilin(functions.runge2d, grid, grid, test, test)
+    rows = {"values": lambda y, yp: (y, yp), "swapped": lambda y, yp: (yp, y), "derivatives": lambda y, yp: (yp, yp)}
+    xtest = np.linspace(0.0, 5.0, method.ntest)
+    exact = functions.runge(xtest)[against]
+    f = lambda x: rows[data](*functions.runge(x))  # noqa: E731
+    return exact, exact - convergence._interpolate(method.key, f, 0.0, 5.0, ndata, xtest)
+
+
+def _slip_error(method, ndata, norm="max", **how):
+    """The error a driver of `method` returns at `ndata` when it measures as :func:`_measured` says, in the
+    `norm`: "max" (the lab's), "2", "mean", or "signed+" / "signed-" (the largest of f - p or p - f, with its
+    sign)."""
+    exact, error = _measured(method, ndata, **how)
+    scale = np.max(np.abs(exact))
+    return float(
+        {
+            "max": lambda: np.max(np.abs(error)) / scale,
+            "2": lambda: np.linalg.norm(error) / np.linalg.norm(exact),
+            "mean": lambda: np.mean(np.abs(error)) / scale,
+            "signed+": lambda: np.max(error) / scale,
+            "signed-": lambda: np.max(-error) / scale,
+        }[norm]()
+    )
+
+
+MEASURED = "the lab's error is the largest |f - p| over the test points (the infinity norm), relative to max|f|"
+
+
+def _measurement_slips(method, ndata):
+    """(hint, a function giving the error) of the usual slips in how a driver measures, besides the interval
+    and the test points: the number of data points, the norm of the error, the row of what f returns, an end
+    slope's index. The errors are computed as they are asked for."""
+    found = [
+        (
+            f"The data look like ndata {'+' if n > ndata else '-'} 1 data points ({n} for ndata = {ndata}): "
+            "the driver interpolates f from ndata equally spaced points on [0, 5].",
+            lambda n=n: _slip_error(method, n),
+        )
+        for n in (ndata + 1, ndata - 1)
+        if n >= (4 if method.key == "notaknot" else 2)
+    ]
+    found += [
+        (
+            "The error looks like the square root of the sum of squares of f - p (a 2-norm), not the largest "
+            f"difference: {MEASURED}.",
+            lambda: _slip_error(method, ndata, "2"),
+        ),
+        (
+            f"The error looks like the mean of |f - p| over the test points, not its largest value: {MEASURED}.",
+            lambda: _slip_error(method, ndata, "mean"),
+        ),
+    ]
+    found += [
+        (
+            "The error takes no absolute value: it is the largest difference with its sign, not the largest "
+            f"|f - p|; {MEASURED}.",
+            lambda norm=norm: _slip_error(method, ndata, norm),
+        )
+        for norm in ("signed+", "signed-")
+    ]
+    if method.key != "bilinear":
+        found.append(
+            (
+                "The error looks measured against f's derivatives, the second of the two things f returns, "
+                "instead of its values (the first).",
+                lambda: _slip_error(method, ndata, against=1),
+            )
+        )
+        if method.key == "pherm":
+            found.append(
+                (
+                    "The values and the slopes of the data look swapped: f returns the values first, then the "
+                    "derivatives.",
+                    lambda: _slip_error(method, ndata, data="swapped"),
+                )
+            )
+        elif method.key != "complete":
+            found.append(
+                (
+                    "The data look like f's derivatives, the second of the two things f returns, instead of its "
+                    "values (the first): interpolate the values.",
+                    lambda: _slip_error(method, ndata, data="derivatives"),
+                )
+            )
+    if method.key == "complete":
+        found += [
+            (
+                f"The {which} end slope looks like f' at the {where}: Python counts from 0, so the first data "
+                "point is index 0 and the last is index -1 (or ndata - 1).",
+                lambda ends=ends: _complete_error(ndata, ends),
+            )
+            for which, where, ends in (
+                ("first", "second data point (index 1), not the first", lambda yp: (yp[1], yp[-1])),
+                ("last", "next-to-last data point, not the last", lambda yp: (yp[0], yp[-2])),
+            )
+        ]
+    return found
 
 
 OTHER_METHOD_HINTS = {
@@ -566,10 +689,15 @@ def _table(method, errors, own, result, lab=None):
         )
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
+        count = (
+            f"your table has {values.size} errors for the {len(method.ndata)} sizes in ndata: "
+            if (values is not None and values.ndim == 1)
+            else ""
+        )
         return result.fail(
             description,
             f"got {_shown_errors(errors)}",
-            f"make {method.table} a list of {len(method.ndata)} positive errors: "
+            f"{count}make {method.table} a list of {len(method.ndata)} positive errors: "
             f"[{method.driver}(n) for n in {list(method.ndata)}].",
         )
     result.step(description, True)

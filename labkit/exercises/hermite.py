@@ -14,7 +14,7 @@ from .. import functions, piecewise
 from .experiments import Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part, Together
 from .plotted import check_limacon_plot, derivative_slips
-from .result import CheckResult, call, case_rng, close, floats, several, shown, worst
+from .result import CheckResult, call, case_rng, close, floats, gave_up, several, shown, worst
 
 MONOMIAL_POINTS = np.array([-1.0, 0.5, 1.5, 3.0])
 
@@ -39,11 +39,15 @@ def check_eval_pherm(fn, seed=None):
     Steps: the four monomials on [0, 2] at x = -1, 0.5, 1.5, 3; if that fails,
     the monomials on [0, 1] (interval length 1 hides wrong denominators),
     then each Hermite basis function alone on [0, 1] and on [0, 2]. Last,
-    several unequal intervals against labkit's reference.
+    several unequal intervals against labkit's reference. When a call raises,
+    or several intervals disagree, the interval search is probed point by
+    point (:func:`_search_slip`), so the hint can say which points it misses.
     """
     result = CheckResult("eval_pherm")
     wrong = _monomials(fn, [0.0, 2.0], result, "[0, 2]")
     if wrong is None:
+        if not gave_up(result):
+            result.hint = _search_slip(fn) or result.hint  # x = 3 is past the last knot
         return result
     if not result.step(
         "reproduces 1, x, x^2, x^3 on [0, 2] at x = -1, 0.5, 1.5, 3", not wrong, f"wrong for x^{wrong}" if wrong else ""
@@ -59,11 +63,96 @@ def check_eval_pherm(fn, seed=None):
         close(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval)),
         worst(yval, piecewise.eval_pherm(xdata, ydata, ypdata, xval)),
     ):
-        result.hint = (
+        result.hint = _search_slip(fn) or (
             "one interval works but several do not: use bracket(xdata, xval) to pick the "
             "interval k of each point, and x_k, x_{k+1} of that interval in h1..h4."
         )
     return result
+
+
+# knots, values and slopes of the interval search's probe: unequal intervals, no two pieces alike
+SEARCH_DATA = (
+    np.array([0.0, 1.0, 2.5, 3.0, 4.5]),
+    np.array([0.3, -1.2, 0.8, 2.0, -0.5]),
+    np.array([1.0, 0.4, -2.0, 0.7, 1.5]),
+)
+
+
+def _piece(xdata, ydata, ypdata, k, x):
+    """The cubic of interval k (0-based) at the points x, or None if there is no interval k."""
+    if not 0 <= k < len(xdata) - 1:
+        return None
+    h = piecewise.hermite_basis(xdata[k], xdata[k + 1], x)
+    return ydata[k] * h[0] + ypdata[k] * h[1] + ydata[k + 1] * h[2] + ypdata[k + 1] * h[3]
+
+
+def _search_slip(fn):
+    """What the interval search of a student's ``eval_pherm`` gets wrong, in the student's words ('' when
+    nothing, or when the interval search is not what is wrong).
+
+    Each probe point is evaluated alone, on several unequal intervals: points between two knots, at an
+    inside knot, at the first and the last knot, before the first and past the last. A point between two
+    knots that gets the cubic of the neighbouring interval is an index one off; a point at or past an end
+    that raises or gets another cubic has no interval of its own there.
+    """
+    xdata, ydata, ypdata = SEARCH_DATA
+    groups = {
+        "between": (xdata[:-1] + xdata[1:]) / 2,
+        "at an inside knot": xdata[1:-1],
+        "at the first knot": xdata[:1],
+        "before the first knot": xdata[:1] - 0.7,
+        "at the last knot": xdata[-1:],
+        "past the last knot": xdata[-1:] + 0.7,
+    }
+    scratch = CheckResult("eval_pherm")
+    found = {}
+    for group, points in groups.items():
+        outcomes = []
+        for x in points:
+            ok, got = call(scratch, "one point", fn, xdata, ydata, ypdata, np.array([x]))
+            k = int(piecewise.bracket(xdata, x))
+            if not ok and gave_up(scratch):
+                return ""
+            if not ok:
+                outcomes.append("raises")
+            elif close(got, _piece(xdata, ydata, ypdata, k, np.array([x]))):
+                outcomes.append("right")
+            else:
+                neighbours = {
+                    side: _piece(xdata, ydata, ypdata, k + step, np.array([x]))
+                    for side, step in (("its right", 1), ("its left", -1))
+                }
+                outcomes.append(next((side for side, value in neighbours.items() if close(got, value)), "wrong"))
+        found[group] = outcomes
+    between = set(found["between"])
+    for side in ("its right", "its left"):
+        if side in between and between <= {side, "right", "raises"}:
+            return (
+                f"each point between two knots is evaluated with the cubic of the interval to {side}: the "
+                "interval k of x is the one with x_k <= x < x_{k+1}, which labkit.bracket(xdata, xval) gives "
+                "(counting from 0, as Python does)"
+            )
+    if between != {"right"}:
+        return ""
+    hints = []
+    for at, beyond, interval in (
+        ("at the last knot", "past the last knot", "the last interval"),
+        ("at the first knot", "before the first knot", "the first interval"),
+    ):
+        failed = [where for where in (at, beyond) if found[where] != ["right"]]
+        if not failed:
+            continue
+        raised = any(found[where] == ["raises"] for where in failed)
+        where = f"at or {beyond}" if len(failed) == 2 else failed[0]
+        hints.append(
+            f"points {where} {'raise an error' if raised else 'get the wrong value'}: there is no interval "
+            f"{beyond}, so they belong to {interval}, as labkit.bracket gives them"
+        )
+    if found["at an inside knot"] != ["right"] * len(groups["at an inside knot"]):
+        hints.append(
+            "points exactly at an inside knot get the wrong value: such a point belongs to the interval it starts"
+        )
+    return "; ".join(hints)
 
 
 def _narrow_pherm(fn, result):
@@ -82,7 +171,7 @@ def _narrow_pherm(fn, result):
     label = f"each Hermite basis function alone on [{interval[0]:g}, {interval[1]:g}]"
     if not bad:
         result.step(label, True)
-        result.hint = (
+        result.hint = _search_slip(fn) or (  # the basis is checked inside [x_k, x_{k+1}], the monomials outside too
             "each basis function is right, so the combination is wrong: "
             "p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4)."
         )
@@ -97,7 +186,13 @@ def _narrow_pherm(fn, result):
         if factor2 is not None and not np.isclose(factor2, -1.0):
             factor, interval, unit_ok = factor2, [0.0, 2.0], True
             label = "each Hermite basis function alone on [0, 2]"
-    if other is not None and {name, other} in ({"h1", "h2"}, {"h3", "h4"}):
+    if other is not None and other not in {n for n, _, _ in bad}:
+        hint = (
+            f"with only the data of {name} set, your interpolant gives {other}, and {other}'s own data give "
+            f"{other}: your {name} is {other}'s formula. Compare {name} with the lab's definition, factor by "
+            "factor (which of x_k, x_{k+1} each factor has)."
+        )
+    elif other is not None and {name, other} in ({"h1", "h2"}, {"h3", "h4"}):
         hint = (
             f"with only the data of {name} set, your interpolant gives {other}: the values and the slopes are "
             "swapped in the combination. The value y_k goes with h1 and the slope y'_k with h2 "
@@ -129,12 +224,44 @@ def _narrow_pherm(fn, result):
         if factor is None:
             hint = hint.replace(" is the right polynomial on", " is right on [0, 1] but not on")
     else:
+        off = _table3_slips(fn, name)
         hint = (
-            f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
+            f"{name} is wrong: {off} {'is' if ' and ' not in off else 'are'} not what the lab's table (3) says. "
+            "Compare your formula with the lab's definition of the four Hermite polynomials, factor by factor."
+            if off
+            else f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
             "polynomials, factor by factor."
         )
     result.fail(label, f"wrong: {', '.join(n for n, _, _ in bad)}", hint)
     return result
+
+
+TABLE3 = {  # the lab's table (3): each basis function's value and slope at x_k and x_{k+1}
+    "h1": (1.0, 0.0, 0.0, 0.0),
+    "h2": (0.0, 1.0, 0.0, 0.0),
+    "h3": (0.0, 0.0, 1.0, 0.0),
+    "h4": (0.0, 0.0, 0.0, 1.0),
+}
+
+
+def _table3_slips(fn, name, eps=1e-5):
+    """Which entries of the lab's table (3) the student's basis function `name` misses on [0, 1] ('its value
+    at x_k and its slope at x_{k+1}'), '' for none; its slopes are centred differences of the interpolant."""
+    data = {"h1": ([1, 0], [0, 0]), "h2": ([0, 0], [1, 0]), "h3": ([0, 1], [0, 0]), "h4": ([0, 0], [0, 1])}[name]
+    points = np.array([0.0, -eps, eps, 1.0, 1.0 - eps, 1.0 + eps])
+    ok, got = call(
+        CheckResult("eval_pherm"), f"{name} near the ends", fn, np.array([0.0, 1.0]), *map(np.array, data), points
+    )
+    try:
+        values = floats(got) if ok else None
+    except (TypeError, ValueError):
+        values = None
+    if values is None or values.shape != points.shape or not np.all(np.isfinite(values)):
+        return ""
+    found = (values[0], (values[2] - values[1]) / (2 * eps), values[3], (values[5] - values[4]) / (2 * eps))
+    what = ("its value at x_k", "its slope at x_k", "its value at x_{k+1}", "its slope at x_{k+1}")
+    off = [w for w, got_, want in zip(what, found, TABLE3[name]) if abs(got_ - want) > 1e-4]
+    return ", ".join(off[:-1]) + (" and " if len(off) > 1 else "") + off[-1] if off else ""
 
 
 def _basis_failures(fn, interval, result):
@@ -198,7 +325,13 @@ def check_runge(fn, seed=None):
     if not result.step(
         "yprime = -2x/(1+x^2)^2", close(out[1], yprime), "" if close(out[1], yprime) else worst(out[1], yprime)
     ):
-        result.hint = "differentiate 1/(1+x^2) with the chain rule: -2x/(1+x^2)^2."
+        unsquared = close(out[1], yprime * (1 + x**2))  # -2x / (1 + x^2): the chain rule's square left out
+        result.hint = (
+            "yprime's denominator lacks a square: the chain rule, applied to 1/u with u = 1 + x**2, puts u "
+            "squared in the denominator."
+            if unsquared
+            else "differentiate 1/(1+x^2) with the chain rule, then compare yprime with a centred difference of y."
+        )
     return result
 
 
@@ -241,6 +374,25 @@ def check_limacon_derivatives(fn, seed=None):
                     result.hint = (
                         f"{name} leaves out the product rule: r = r0 + cos t depends on t too, so it "
                         "has a second term with dr/dt = -sin t."
+                    )
+                    return result
+                other = dict(slips[name])[f"is {'dy/dt' if name == 'dx/dt' else 'dx/dt'}: the two are swapped"]
+                if close(got, other):
+                    result.hint = (
+                        f"your {name} is {'dy/dt' if name == 'dx/dt' else 'dx/dt'}: the two are swapped. Return "
+                        "them in the order the function promises, dxdt first, then dydt."
+                    )
+                    return result
+                if close(got, dict(slips[name])["has dr/dt with the wrong sign"]):
+                    result.hint = (
+                        f"{name} has the product rule, but in it dr/dt has the wrong sign: r = r0 + cos t, so "
+                        "dr/dt is the derivative of cos t."
+                    )
+                    return result
+                if r0 != 1.15 and close(got, derivative_slips(t)[name][0][1]):
+                    result.hint = (
+                        f"{name} is right for r0 = 1.15 but not for r0 = {r0:g}: use the r0 it is given "
+                        "(r = r0 + cos t), not 1.15."
                     )
                     return result
                 slip = _sign_slip(got, want)

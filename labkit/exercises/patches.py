@@ -10,7 +10,7 @@ import numpy as np
 from .. import patches
 from ..mesh import QuadMesh, quad_mesh
 from .model import OWN_PATCH, Exercise, Optional, Part, Together
-from .result import CheckResult, call, case_rng, close, judged_by_the_lab, worst
+from .result import CheckResult, call, case_rng, close, floats, judged_by_the_lab, worst
 
 # the grader's work on a student's meshes is bounded by the lab's sizes (600 and 1170 nodes): far larger is refused
 MAX_NODES = 20_000
@@ -41,6 +41,8 @@ def check_coons(fn, seed=None):
                 "x and y are transposed: x[i, j] belongs to s[i] and t[j], so they have one row per "
                 "value of s (shape (len(s), len(t)))."
             )
+        elif _coons_slip(out, _identity_corners(), s, t):
+            result.hint = _coons_slip(out, _identity_corners(), s, t)
         else:
             result.hint = (
                 "start with the outline: x along AB is eval_pherm([0, 1], [xA, xB], [dxdsA, dxdsB], s); "
@@ -69,11 +71,46 @@ def check_coons(fn, seed=None):
             )
             break
     else:
-        result.hint = (
+        result.hint = _coons_slip(out, corners, s, t) or (
             "compare the four edge curves one at a time with labkit.patch: values along AB and DC, "
             "then the t-derivatives along them, then the join in t."
         )
     return result
+
+
+COONS_SLIPS = {
+    "dc_reversed": "your top edge DC runs from C to D: along DC, s = 0 is at D and s = 1 at C, as along AB s = 0 "
+    "is at A, so D's data come first when you interpolate along DC.",
+    "no_join_slopes": "your patch ignores the t-derivatives along AB and DC when it joins them: each line of "
+    "constant s is a Hermite cubic in t whose values are xAB(k), xDC(k) and whose slopes are dxdtAB(k), dxdtDC(k) "
+    "(likewise for y).",
+}
+
+
+def _coons_with(corners, s, t, dc_reversed=False, no_join_slopes=False):
+    """The lab's Coons patch with one of the slips of :data:`COONS_SLIPS`: x and y as one (2, len(s), len(t))."""
+    from ..piecewise import eval_pherm
+
+    A, B, C, D = corners
+    first, last = (C, D) if dc_reversed else (D, C)
+    out = np.empty((2, len(s), len(t)))
+    for c in range(2):
+        along_ab = eval_pherm([0, 1], [A.point[c], B.point[c]], [A.ds[c], B.ds[c]], s)
+        dt_ab = eval_pherm([0, 1], [A.dt[c], B.dt[c]], [A.dsdt[c], B.dsdt[c]], s)
+        along_dc = eval_pherm([0, 1], [first.point[c], last.point[c]], [first.ds[c], last.ds[c]], s)
+        dt_dc = eval_pherm([0, 1], [D.dt[c], C.dt[c]], [D.dsdt[c], C.dsdt[c]], s)
+        for k in range(len(s)):
+            slopes = [0.0, 0.0] if no_join_slopes else [dt_ab[k], dt_dc[k]]
+            out[c, k] = eval_pherm([0, 1], [along_ab[k], along_dc[k]], slopes, t)
+    return out
+
+
+def _coons_slip(out, corners, s, t):
+    """The hint of the slip of :data:`COONS_SLIPS` that gives the student's patch `out`, or ''."""
+    for slip, hint in COONS_SLIPS.items():
+        if close(out, _coons_with(corners, s, t, **{slip: True})):
+            return hint
+    return ""
 
 
 def _corner_list(corners, result, label):
@@ -99,7 +136,17 @@ def check_graded_corners(corners):
         [y[:, 0], y[:, -1]], [np.zeros(11), np.ones(11)]
     )
     if not result.step("outline is still the unit square", outline):
-        result.hint = "only dx/ds changes; every other value stays as in exercise 5."
+        moved_dt = [label for label, c in zip("ABCD", corners) if not close(c.dt, [0.0, 1.0])]
+        moved_dyds = [label for label, c in zip("ABCD", corners) if not close(c.ds[1], 0.0)]
+        result.hint = (
+            f"you changed dt at {_and(moved_dt)}: the exercise changes dx/ds, the first entry of ds, and every "
+            "other value stays as in exercise 5."
+            if moved_dt
+            else f"you changed dy/ds (the second entry of ds) at {_and(moved_dyds)}: only dx/ds, the first, "
+            "changes; every other value stays as in exercise 5."
+            if moved_dyds
+            else "only dx/ds changes; every other value stays as in exercise 5."
+        )
         return result
     dxds = [c.ds[0] for c in corners]
     if not result.step("dx/ds is 3 at A and D and 0.1 at B and C", close(dxds, [3.0, 0.1, 0.1, 3.0]), f"got {dxds}"):
@@ -117,21 +164,49 @@ def check_straight_corners(corners):
         return result
     A, B, C, D = (np.array(p) for p in ([-1.0, 0.0], [1.0, 0.0], [1.0, 0.5], [0.0, 1.0]))
     if not result.step("corner points A, B, C, D", close([c.point for c in corners], [A, B, C, D])):
-        result.hint = "A = (-1, 0), B = (1, 0), C = (1, 0.5), D = (0, 1)."
+        swapped = [label for label, c, P in zip("ABCD", corners, (A, B, C, D)) if close(c.point, P[::-1])]
+        result.hint = (
+            f"{_and(swapped)} {'has its' if len(swapped) == 1 else 'have their'} x and y swapped: a point is "
+            "(x, y). A = (-1, 0), B = (1, 0), C = (1, 0.5), D = (0, 1)."
+            if swapped
+            else "A = (-1, 0), B = (1, 0), C = (1, 0.5), D = (0, 1)."
+        )
         return result
     if not result.step("twists d2x/dsdt = -1, d2y/dsdt = -0.5", close([c.dsdt for c in corners], [A - B + C - D] * 4)):
-        result.hint = "set d2xdsdt = -1 and d2ydsdt = -0.5 at all four corners."
+        turned = close([c.dsdt for c in corners], [-(A - B + C - D)] * 4)
+        result.hint = (
+            "the twists have the wrong sign: set d2xdsdt = -1 and d2ydsdt = -0.5 at all four corners."
+            if turned
+            else "set d2xdsdt = -1 and d2ydsdt = -0.5 at all four corners."
+        )
         return result
     s, t = np.linspace(0, 1, 20), np.linspace(0, 1, 15)
     S, T = np.meshgrid(s, t, indexing="ij")
     bilinear_map = [(1 - S) * (1 - T) * A[i] + S * (1 - T) * B[i] + S * T * C[i] + (1 - S) * T * D[i] for i in (0, 1)]
     got = patches.patch(*corners, s, t)
     if not result.step("mesh lines straight and evenly spaced", close(got, bilinear_map), worst(got, bilinear_map)):
+        sides = {"ds": ("AB", "AB", "DC", "DC"), "dt": ("AD", "BC", "BC", "AD")}
+        along = {"AB": B - A, "DC": C - D, "AD": D - A, "BC": C - B}
+        off = [
+            f"{label}'s {d} (along {side})"
+            for d in ("ds", "dt")
+            for label, corner, side in zip("ABCD", corners, sides[d])
+            if not close(getattr(corner, d), along[side])
+        ]
         result.hint = (
-            "along a straight side with even spacing the derivative is the vector along that side: "
-            "d/ds = B - A on AB and C - D on DC, d/dt = D - A on AD and C - B on BC."
+            f"{_and(off)} {'bends its side or spaces' if len(off) == 1 else 'bend their sides or space'} the mesh "
+            "points unevenly: along a straight side with even spacing the derivative is the vector along that side, "
+            "from the corner where the side starts to the one where it ends."
+            if off
+            else "along a straight side with even spacing the derivative is the vector along that side."
         )
     return result
+
+
+def _and(labels):
+    """'A', 'A and D', 'A, B and D'."""
+    labels = list(labels)
+    return ", ".join(labels[:-1]) + (" and " if len(labels) > 1 else "") + (labels[-1] if labels else "")
 
 
 def check_circle_corners(corners):
@@ -159,16 +234,71 @@ def check_circle_corners(corners):
         if not result.step(
             f"side {name} close to a quarter circle of radius sqrt(2)/2", near < bound, f"off by {near:.3f}"
         ):
-            result.hint = (
+            found = _arc_slips(name, corners, centres, radius)
+            advice = (
                 "write the side as an arc with its angle growing by pi/2 as s goes from 0 to 1, "
                 "differentiate it, and give each corner that derivative at s = 0 or s = 1: both its "
                 "direction and its length matter."
             )
+            result.hint = f"{found}. {advice[:1].upper()}{advice[1:]}" if found else advice
             return result
     symmetric = close(x + x[::-1], np.ones_like(x)) and close(y + y[:, ::-1], np.ones_like(y))
     if not result.step("left-right and top-bottom symmetric", symmetric):
         result.hint = "mirror the bottom side's data to get the top, and the left side's to get the right."
     return result
+
+
+ARC_ENDS = {"AB": ("A", "B", "ds"), "DC": ("D", "C", "ds"), "AD": ("A", "D", "dt"), "BC": ("B", "C", "dt")}
+
+
+def _arc_slips(side, corners, centres, radius):
+    """What is wrong with the derivatives at the two ends of a side of Exercise 8 that is no quarter circle,
+    in the student's words ('at A and B, the derivative along AB points along the chord AB, not along the
+    circle'); '' if its end derivatives are those of a quarter circle through them (the slip is elsewhere).
+
+    The arc's derivative at an end is tangent to the circle (perpendicular to the radius there, heading round
+    the arc) and as long as the arc's speed, radius * pi/2; of the two circles the check allows (the side
+    bowing either way), the one whose tangents are nearer the student's counts.
+    """
+    first, last, which = ARC_ENDS[side]
+    by_label = dict(zip("ABCD", corners))
+    P, Q = (np.asarray(by_label[label].point, dtype=float)[:2] for label in (first, last))
+    chord = Q - P
+    found = {}
+    best = None
+    for centre in centres:
+        problems = {}
+        score = 0.0
+        for label, point in ((first, P), (last, Q)):
+            v = np.asarray(getattr(by_label[label], which), dtype=float)[:2]
+            radial = point - np.asarray(centre, dtype=float)
+            tangent = np.array([-radial[1], radial[0]])
+            tangent *= np.sign(tangent @ chord) * radius * np.pi / 2 / np.hypot(*tangent)
+            size = np.hypot(*v)
+            cosine = (v @ tangent) / (size * np.hypot(*tangent)) if size > 0 else -1.0
+            score += cosine
+            if (
+                size > 0
+                and abs(v @ np.array([-chord[1], chord[0]])) <= 1e-9 * size * np.hypot(*chord)
+                and v @ chord > 0
+            ):
+                problems[label] = f"points along the chord {side}, not along the circle"
+            elif cosine < 1 - 1e-9:
+                problems[label] = "does not point along the circle"
+            elif not np.isclose(size, np.hypot(*tangent), rtol=1e-6):
+                problems[label] = (
+                    f"points along the circle but is too {'long' if size > np.hypot(*tangent) else 'short'}"
+                )
+        if best is None or score > best:
+            best, found = score, problems
+    if not found:
+        return ""
+    said = {}
+    for label, problem in found.items():
+        said.setdefault(problem, []).append(label)
+    return "; ".join(
+        f"at {_and(labels)}, the derivative along {side} ({which}) {problem}" for problem, labels in said.items()
+    )
 
 
 def check_two_patches(fn, corners):
@@ -223,15 +353,61 @@ def check_two_patches(fn, corners):
             len(merged.points) == expected_nodes,
             f"{len(first.points)} + {len(second.points)} nodes gave {len(merged.points)}",
         ):
-            result.hint = (
-                "abcd is ABCD mirrored in y = x with s and t swapped: give each corner the mirrored "
-                "dt as ds and the mirrored ds as dt, and use 30 points along dc."
+            result.hint = _mirror_slip(second, ABCD) or (
+                "the two meshes do not share the 30 nodes of the edge BC (dc): compare the second patch's corners, "
+                "one at a time, with the mirror image of ABCD in y = x (points and derivatives), and use 30 points "
+                "along dc."
             )
             return result
         if not result.step(f"{label}: every element positively oriented", merged.quality().min() > 0):
-            result.hint = "a folded element means a corner derivative of abcd points the wrong way."
+            result.hint = (
+                _mirror_slip(second, ABCD) or "a folded element means a corner derivative of abcd points the wrong way."
+            )
             return result
     return result
+
+
+MIRROR_SLIPS = (
+    (
+        "the second patch's corners are not in the order a, b, c, d: a is A's mirror image, and b, c, d follow "
+        "round the patch abcd as the lab's table of its points lists them (d is B).",
+        lambda c: patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
+        "ABCD",
+    ),
+    (
+        "in your second patch each corner's ds is the mirror image of ABCD's ds (and dt of dt), so its mesh lines "
+        "do not meet the first patch's along dc: in the mirror image, which way does s run, and which way t?",
+        lambda c: patches.Corner(c.point[::-1], c.ds[::-1], c.dt[::-1], c.dsdt[::-1]),
+        "ADCB",
+    ),
+    (
+        "the second patch's derivatives are not mirrored: its corner points are the mirror images of ABCD's, but "
+        "their derivative vectors are ABCD's own; reflecting in y = x changes a vector as it changes a point.",
+        lambda c: patches.Corner(c.point[::-1], c.dt, c.ds, c.dsdt),
+        "ADCB",
+    ),
+)
+
+
+def _mirror_slip(second, corners):
+    """The hint of the slip of :data:`MIRROR_SLIPS` whose patch gives the student's second mesh (the same nodes,
+    in any order), or ''."""
+    try:
+        nodes = floats(getattr(second, "points", ()))
+    except (TypeError, ValueError):
+        return ""
+    if nodes.ndim != 2 or nodes.shape[1] < 2 or len(nodes) != SIZES9[0] * SIZES9[1] or not np.all(np.isfinite(nodes)):
+        return ""
+    by_label = dict(zip("ABCD", corners))
+    mine = nodes[np.lexsort(np.round(nodes[:, :2], 9).T[::-1])][:, :2]
+    for hint, mirrored, order in MIRROR_SLIPS:
+        x, y = patches.patch(
+            *(mirrored(by_label[label]) for label in order), np.linspace(0, 1, SIZES9[1]), np.linspace(0, 1, SIZES9[0])
+        )
+        theirs = np.stack((x.ravel(), y.ravel()), axis=1)
+        if close(mine, theirs[np.lexsort(np.round(theirs, 9).T[::-1])], 1e-7):
+            return hint
+    return ""
 
 
 def _boundary_edges(mesh):

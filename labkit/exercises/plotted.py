@@ -93,9 +93,22 @@ def derivative_slips(t, r0=1.15):
     t = np.asarray(t, dtype=float)
     r = r0 + np.cos(t)
     _, _, dxdt, dydt = functions.limacon(t, r0=r0)
+    sin, cos = np.sin(t), np.cos(t)
     return {
-        "dx/dt": (("", dxdt), ("has the wrong sign", -dxdt), ("leaves out the product rule", -r * np.sin(t))),
-        "dy/dt": (("", dydt), ("has the wrong sign", -dydt), ("leaves out the product rule", r * np.cos(t))),
+        "dx/dt": (
+            ("", dxdt),
+            ("has the wrong sign", -dxdt),
+            ("leaves out the product rule", -r * sin),
+            ("is dy/dt: the two are swapped", dydt),
+            ("has dr/dt with the wrong sign", sin * cos - r * sin),
+        ),
+        "dy/dt": (
+            ("", dydt),
+            ("has the wrong sign", -dydt),
+            ("leaves out the product rule", r * cos),
+            ("is dx/dt: the two are swapped", dxdt),
+            ("has dr/dt with the wrong sign", sin * sin + r * cos),
+        ),
     }
 
 
@@ -197,7 +210,10 @@ def check_limacon_plot(plot, own=None, r0=1.15):
         else f"points are more than {10 * HERMITE_LIMACON:g} away from it",
     )
     if not ok:
-        if on_exact:
+        slip = _plot_slip(long, data, r0)
+        if slip:
+            result.hint = slip
+        elif on_exact:
             result.hint = (
                 "that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
                 "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm."
@@ -220,6 +236,50 @@ def check_limacon_plot(plot, own=None, r0=1.15):
     ):
         result.hint = "interpolate over the whole turn: tval from 0 to 2*pi."
     return result
+
+
+def _plot_slip(long, data, r0=1.15):
+    """The slip that explains Exercise 4's curve, in the student's words ('' for none): x and y swapped, y
+    drawn against t, the slopes of x and y swapped, or straight segments; of the notebook's own data when they
+    are an attempt at the lab's (`data`), else of the lab's."""
+    if data is None:
+        tdata = np.linspace(0, 2 * np.pi, NINTERVALS + 1)
+        data = (tdata, *functions.limacon(tdata, r0=r0))
+    tdata, xdata, ydata, xpdata, ypdata = data
+    t = np.linspace(tdata[0], tdata[-1], 20001)
+    candidates = (
+        (
+            "x and y are swapped: the curve is drawn with y across and x up. The first argument of ax4.plot is "
+            "the horizontal coordinate: plot xherm, then yherm.",
+            _hermite_curve(tdata, ydata, xdata, ypdata, xpdata),
+        ),
+        (
+            "xpdata and ypdata are swapped in the eval_pherm calls: x is interpolated with the slopes of y and y "
+            "with those of x. Each coordinate takes its own derivative.",
+            _hermite_curve(tdata, xdata, ydata, ypdata, xpdata),
+        ),
+        (
+            "straight segments: that is eval_plin's curve (Exercise 1's), with corners at the data points, not "
+            "the Hermite interpolant; use eval_pherm with the derivatives of Exercise 4.",
+            np.stack((piecewise.eval_plin(tdata, xdata, t), piecewise.eval_plin(tdata, ydata, t))),
+        ),
+    )
+    for line in long:
+        points = np.stack((line.x, line.y))[:, :: -(-line.x.size // SAMPLE)]
+        if not np.all(np.isfinite(points)):
+            continue
+        for hint, curve in candidates:
+            if float(_distances(points, curve, 10 * HERMITE_LIMACON).max()) <= ON_CURVE:
+                return hint
+        inside = (points[0] >= tdata[0] - 1e-9) & (points[0] <= tdata[-1] + 1e-9)
+        if inside.all():
+            for name, values, slopes in (("x", xdata, xpdata), ("y", ydata, ypdata)):
+                if close(points[1], piecewise.eval_pherm(tdata, values, slopes, points[0]), 1e-6):
+                    return (
+                        f"the curve is {name} against t: the plot's horizontal axis is t. The limaçon is the "
+                        "curve of the points (x, y): plot xherm, then yherm, both from eval_pherm at tval."
+                    )
+    return ""
 
 
 def _limacon_curve(r0=1.15, count=20001):
@@ -269,7 +329,18 @@ def check_boiling_plot(plot):
         if ln.x.size == xdata.size and np.allclose(np.sort(ln.x), xdata) and _matches(ln, np.interp(ln.x, xdata, ydata))
     ]
     if not data.step("a line at the five data points", bool(at_data), "no line has exactly the data's points"):
-        data.hint = "plot xdata, ydata themselves: ax14.plot(xdata, ydata, 'o')."
+        swapped = any(
+            ln.y.size == xdata.size
+            and np.allclose(np.sort(ln.y), xdata)
+            and np.allclose(ln.x, np.interp(ln.y, xdata, ydata))
+            for ln in lines
+        )
+        data.hint = (
+            "x and y are swapped: the data are drawn with the temperatures across and the times up. The first "
+            "argument of ax14.plot is the horizontal coordinate: xdata, then ydata."
+            if swapped
+            else "plot xdata, ydata themselves: ax14.plot(xdata, ydata, 'o')."
+        )
     elif data.step(
         "drawn as circles",
         any(ln.marker == CIRCLE for ln in at_data),
@@ -297,8 +368,16 @@ def check_boiling_plot(plot):
         if not check.step(
             f"a curve that is {name}", bool(matching), f"none of the {len(curves)} other line(s) follows it"
         ):
+            swapped = any(  # a line whose x are the interpolant's values at its y
+                np.allclose(ln.x, interpolant(xdata, ydata, ln.y), rtol=0, atol=1e-6)
+                and not np.allclose(ln.x, _other(interpolant)(xdata, ydata, ln.y), rtol=0, atol=1e-6)
+                for ln in curves
+            )
             check.hint = (
-                f"evaluate {name} of the data at many points xval and plot them: "
+                f"x and y are swapped: {name} is drawn with its values across and xval up. The first argument "
+                "of ax14.plot is the horizontal coordinate: xval, then the values."
+                if swapped
+                else f"evaluate {name} of the data at many points xval and plot them: "
                 f"ax14.plot(xval, {'labkit.spline' if 'spline' in name else 'labkit.pchip'}(xdata, ydata, xval))."
             )
         else:

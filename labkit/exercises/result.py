@@ -16,6 +16,8 @@ import numpy as np
 
 TOLERANCE = 1e-9
 NOT_IMPLEMENTED = "not implemented yet"  # the failed step of a function that still raises NotImplementedError
+STUB = "replace the `raise NotImplementedError()` with your code."
+ABOUT_THE_NOTEBOOK = "see what the feedback says about the notebook above."  # timed out, tampered, worker failed
 
 
 @dataclass
@@ -118,7 +120,7 @@ def call(result, description, fn, *args):
     try:
         return True, fn(*args)
     except NotImplementedError:
-        result.fail(description, NOT_IMPLEMENTED, "replace the `raise NotImplementedError()` with your code.")
+        result.fail(description, NOT_IMPLEMENTED, STUB)
     except Exception as exc:  # noqa: BLE001 - any student error is reported, not raised
         kind = getattr(exc, "kind", type(exc).__name__)
         refused = getattr(exc, "refused", None)
@@ -129,17 +131,48 @@ def call(result, description, fn, *args):
                 f"the exercise asks you to write this yourself: do not call {refused}.",
             )
         elif kind in ("Tampered", "Timeout", "WorkerError"):
-            result.fail(description, _text(exc), "see what the feedback says about the notebook above.")
+            result.fail(description, _text(exc), ABOUT_THE_NOTEBOOK)
         else:
-            where = _where(exc)
+            where, slip = _where(exc), _raised_slip(kind, _text(exc))
             result.fail(
                 description,
                 f"raised {kind}: {_text(exc)}" + (f" ({where})" if where else ""),
-                f"the error happened {where}: look at that line."
-                if where
-                else "run the cell with the error on its own: the traceback shows where it happened.",
+                (f"the error happened {where}: " if where else "")
+                + (
+                    f"{slip}."
+                    if slip
+                    else "look at that line."
+                    if where
+                    else "run the cell with the error on its own: the traceback shows where it happened."
+                ),
             )
     return False, None
+
+
+def gave_up(result):
+    """True if the last call `result` recorded failed in a way no further call of the same code can explain: a
+    stub, or a notebook that ran out of time, failed or was tampered with. A check that probes further to name
+    a slip stops there (another call would only wait for the time limit again)."""
+    return result.hint in (STUB, ABOUT_THE_NOTEBOOK)
+
+
+def _raised_slip(kind, message):
+    """The slip an exception of student code names by itself, in the student's words ('' for none): an index
+    one past the end of an array (Python counts from 0), or ``^`` taken for a power (it is bitwise xor)."""
+    import re
+
+    found = re.search(r"index (-?\d+) is out of bounds for axis \d+ with size (\d+)", message or "")
+    if kind == "IndexError" and found:
+        index, size = int(found[1]), int(found[2])
+        if index == size:
+            return (
+                f"index {index} is one past the last entry of an array of {size} entries (Python counts from 0, so "
+                f"its last index is {size - 1}, or -1)"
+            )
+        return f"index {index} is outside an array of {size} entries (its indices are 0 to {size - 1})"
+    if kind == "TypeError" and "bitwise_xor" in (message or ""):
+        return "`^` is bitwise xor in Python, not a power: write a power with `**`"
+    return ""
 
 
 def _text(exc):

@@ -90,7 +90,7 @@ def check_ccspline(fn, system=None, seed=None):
                 "y1p and ynp in D.",
             )
         if not result.step("A is symmetric", A.shape == (4, 4) and np.allclose(A, A.T)):
-            result.hint = "A(k, k-1) and A(k-1, k) must both be h(k-1)/6."
+            result.hint = _matrix_slip(A, _reference_complete_system(np.array(x), np.array(y), y1p, ynp)[0])
             return result
         off = np.abs(A).sum(axis=1) - np.abs(np.diag(A))
         if not result.step("each diagonal entry exceeds the rest of its row (Gershgorin)", np.all(np.diag(A) > off)):
@@ -128,12 +128,18 @@ def check_ccspline(fn, system=None, seed=None):
                 which = flipped[0]
                 formula = "(y2 - y1)/h1 - y1p" if which == "first" else "ynp - (yn - y(n-1))/h(n-1)"
                 result.hint = f"D's {which} entry has the wrong sign: it is {formula} (equation 12)."
+            elif _flipped_inside(D, D_ref):
+                result.hint = (
+                    "D's inside entries have the wrong sign (its first and last are right): each is the difference "
+                    "of two neighbouring secants, taken in the order equation (12) takes them."
+                )
             else:
                 result.hint = "compute D by hand from (12): first and last entries use y1p and ynp."
             return result
         result.hint = (
-            "your complete_system's A and D are right, so what ccspline does with them is wrong: it must "
-            "solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
+            "your complete_system's A and D are right, so what ccspline does with them is wrong"
+            + _slopes_slip(sprime, expected, y1p, ynp)
+            + ": it must solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
             "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp."
         )
         return result
@@ -142,6 +148,62 @@ def check_ccspline(fn, system=None, seed=None):
         "(define complete_system so the grader can check them too), then the slopes against (8)."
     )
     return result
+
+
+def _matrix_slip(A, reference):
+    """Where a student's matrix A differs from equation (11) (the lab's case it was built for), in the
+    student's words, 1-based as the lab counts: the first or last row, or the inside rows' off-diagonals."""
+    with np.errstate(all="ignore"):  # a student's entries may be huge: no RuntimeWarning for them
+        rows, cols = np.nonzero(~np.isclose(A, reference))
+    named = [f"A({i + 1}, {j + 1})" for i, j in zip(rows, cols)]
+    entries = ", ".join(named[:-1]) + (" and " if len(named) > 1 else "") + (named[-1] if named else "")
+    ends = {0, len(A) - 1}
+    if rows.size and set(rows) <= ends:
+        which = " and ".join(name for row, name in ((0, "first"), (len(A) - 1, "last")) if row in set(rows))
+        return (
+            f"A's {which} row{'s are' if ' and ' in which else ' is'} not equation (11)'s: {entries} "
+            f"{'differs' if rows.size == 1 else 'differ'} from it. The inside rows are right; compare the end "
+            "rows entry by entry with (11)."
+        )
+    where = f"{entries} {'differs' if rows.size == 1 else 'differ'} from equation (11): " if rows.size else ""
+    return f"{where}A(k, k-1) and A(k-1, k) must both be h(k-1)/6."
+
+
+def _flipped_inside(D, D_ref):
+    """True if D's inside entries are the reference's with the sign turned, and its ends are the reference's."""
+    try:
+        values = floats(D)
+    except (TypeError, ValueError):
+        return False
+    inside = slice(1, -1)
+    with np.errstate(all="ignore"):
+        return bool(
+            values.shape == D_ref.shape
+            and np.any(np.abs(D_ref[inside]) > 1e-12)
+            and np.allclose(values[inside], -D_ref[inside])
+            and np.allclose(values[[0, -1]], D_ref[[0, -1]])
+        )
+
+
+def _slopes_slip(sprime, expected, y1p, ynp):
+    """Which of ccspline's slopes are wrong when its A and D are right, as a clause (', ...'), or ''."""
+    try:
+        got = floats(sprime)
+    except (TypeError, ValueError):
+        return ""
+    if got.shape != expected.shape:
+        return ""
+    with np.errstate(all="ignore"):
+        inside = np.allclose(got[1:-1], expected[1:-1])
+        ends_swapped = np.allclose(got[[0, -1]], [ynp, y1p])
+        ends = np.allclose(got[[0, -1]], expected[[0, -1]])
+    if inside and ends_swapped:
+        return ", as the first and the last slope are swapped (the first is y1p, the last ynp)"
+    if inside:
+        return ", as its inside slopes are right and an end slope is not"
+    if ends:
+        return ", as the end slopes are right and the inside slopes s'(x_2), ..., s'(x_{n-1}) are not"
+    return ""
 
 
 def check_ncspline(fn, seed=None, system=None):
@@ -210,16 +272,65 @@ def check_ncspline(fn, seed=None, system=None):
                 "0 in D): they are still the complete spline's rows."
             )
         else:
-            result.hint = (
+            result.hint = _natural_rows_slip(x, y, got) or (
                 "the second derivative is not 0 at the ends: the first and last equations of the system "
                 "must say M1 = 0 and Mn = 0."
             )
         return result
     if not result.step("slopes agree with labkit.ncspline", close(slopes, want), worst(slopes, want)) or not linear_ok:
-        result.hint = (
+        result.hint = _natural_rows_slip(x, y, got) or (
             "the ends are right, so check the interior rows and the slopes from (8) and, at the last knot, (9)."
         )
     return result
+
+
+def _curvatures(x, y, slopes, first_left=True):
+    """The M (second derivatives at the knots) a student's slopes were computed from, read back through the
+    lab's slope equations: (8) at every knot but the last and (9) there (`first_left`), or (8) at the first
+    and (9) at every other; None where they give none."""
+    n, h = len(x), np.diff(x)
+    secant = np.diff(y) / h
+    B, c = np.zeros((n, n)), np.zeros(n)
+    for k in range(n):
+        if k == 0 or (first_left and k < n - 1):  # (8): s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + secant_k
+            B[k, k], B[k, k + 1], c[k] = -h[k] / 3, -h[k] / 6, secant[k]
+        else:  # (9): s'(x_k) = M_k h_{k-1}/3 + M_{k-1} h_{k-1}/6 + secant_{k-1}
+            B[k, k], B[k, k - 1], c[k] = h[k - 1] / 3, h[k - 1] / 6, secant[k - 1]
+    try:
+        with np.errstate(all="ignore"):
+            M = np.linalg.solve(B, slopes - c)
+    except np.linalg.LinAlgError:
+        return None
+    return M if np.all(np.isfinite(M)) else None
+
+
+def _natural_rows_slip(x, y, slopes):
+    """What the system a student's natural-spline slopes come from gets wrong, in the student's words ('' when
+    nothing can be named): its M read back through the slope equations (:func:`_curvatures`), then the lab's
+    end equations M1 = Mn = 0 and the inside rows of equations (11)-(12) checked on it."""
+    A, D = _reference_complete_system(x, y, 0.0, 0.0)
+    for first_left in (True, False):
+        M = _curvatures(x, y, slopes, first_left)
+        if M is None or np.max(np.abs(M)) > 1e100:  # no spline's second derivatives
+            continue
+        if not np.allclose(M[[0, -1]], 0.0, atol=1e-9 * max(1.0, np.max(np.abs(M)))):
+            continue
+        inside = A[1:-1] @ M
+        if np.allclose(inside, D[1:-1]):
+            return ""
+        if np.allclose(inside, -D[1:-1]):
+            return (
+                "your first and last rows are right (M1 = Mn = 0 in what your slopes come from), but D's inside "
+                "entries have the wrong sign: each is the difference of two neighbouring secants, taken in the "
+                "order equation (12) takes them."
+            )
+        rows = [str(k + 2) for k in np.flatnonzero(~np.isclose(inside, D[1:-1]))]
+        return (
+            f"your first and last rows are right (M1 = Mn = 0 in what your slopes come from), but row"
+            f"{'s' if len(rows) > 1 else ''} {', '.join(rows)} of your system {'are' if len(rows) > 1 else 'is'} "
+            "not equations (11)-(12): compare them entry by entry, in A and in D."
+        )
+    return ""
 
 
 def _ncspline_data(seed):
