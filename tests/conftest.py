@@ -104,3 +104,8 @@ def small_class(tmp_path_factory):
     run = cli("grade", *submissions, "--out", tmp / "reference", "--seed", SEED, "--jobs", "2", "--quiet")
     assert run.returncode == 0, run.stderr
     return submissions, tmp / "reference"
+
+
+# the notebooks under tests/data are fixtures (students' submissions, graded by the tests), not notebooks of the
+# kit for nbval to run
+collect_ignore_glob = ["data/*"]
