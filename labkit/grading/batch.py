@@ -822,9 +822,9 @@ class Resumed:
     rubric: Rubric
     record: object = None
     changed: list = field(default_factory=list)
+    refused: list = field(default_factory=list)
     # {name: its earlier grade} of the changed submissions: the marks a person gave them carry over where they apply
     earlier: dict = field(default_factory=dict)
-    refused: list = field(default_factory=list)
 
 
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
@@ -900,7 +900,7 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
             continue
         done[name] = grade
     seed = record.seed if record.seed is not None else seed
-    return Resumed(done, seed, rubric, record, sorted(changed), refused, before)
+    return Resumed(done, seed, rubric, record, sorted(changed), refused, earlier=before)
 
 
 def carried_marks(earlier, grade):
