@@ -116,7 +116,7 @@ def _release(args):
 
 def _summary(grades, out, start, what):
     from .grading.report import one_line
-    from .grading.rubric import points_text
+    from .grading.text import points_text
 
     for g in grades:
         lateness = g.lateness
@@ -820,7 +820,8 @@ def build_parser():
 
 
 def _rubric(args):
-    from .grading.rubric import DEFAULT, load, points_text
+    from .grading.rubric import DEFAULT, load
+    from .grading.text import points_text
 
     if args.check:
         rubric = load(args.check)

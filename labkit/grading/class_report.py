@@ -41,8 +41,9 @@ from . import late as lateness
 from .known import THRESHOLD
 from .record import rubric_for
 from .report import SubmissionGrade, one_line, printable, read_results
-from .rubric import Rubric, points_text
+from .rubric import Rubric
 from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
+from .text import points_text
 
 REPORT = "report.html"
 MAX_SUBMISSIONS = 20_000  # result files in one folder

@@ -40,6 +40,8 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime, timedelta, timezone, tzinfo
 from pathlib import Path
 
+from .text import points_text
+
 UNITS = {"day": 86400, "hour": 3600}
 TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
 MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
@@ -381,8 +383,6 @@ class Late:
         handed_in = f"handed in {time_text(lateness.time.when, zone)} ({lateness.time.source})"
         if not lateness.units:
             return [f"Late work: due {due}; {handed_in}: {lateness.note}."]
-        from .rubric import points_text
-
         return [
             f"Late work: due {due}; {handed_in}: {lateness.note}: "
             f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points.",

@@ -142,7 +142,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .report import FORMULA_START, SubmissionGrade, csv_cell, one_line
-from .rubric import points_text
+from .text import points_text
 
 DEFAULT_COLUMN = "labkit"
 CANVAS_KEYS = ("ID", "SIS User ID", "SIS Login ID")

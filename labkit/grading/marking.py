@@ -24,7 +24,7 @@ from pathlib import Path
 
 from . import record as records
 from .report import csv_cell, one_line, printable, read_results, write_csv, write_result
-from .rubric import points_text
+from .text import points_text
 
 HEADER = ["submission", "item", "points", "comment"]
 MAX_MARKS_BYTES = 16 * 1024 * 1024  # a marks.csv larger than this is not read

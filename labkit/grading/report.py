@@ -32,8 +32,8 @@ from pathlib import Path
 from . import record as records
 from . import rubric as rubrics
 from .late import FROM_CSV, SubmissionTime, time_text
-from .rubric import points_text
 from .scan import MAX_SOURCE_CHARS
+from .text import points_text
 
 FORMAT = "labkit-grade/2"
 

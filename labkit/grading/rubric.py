@@ -28,6 +28,7 @@ from pathlib import Path
 from ..exercises.registry import LAB, Registry
 from ..exercises.registry import load as load_registry
 from . import late as lateness
+from .text import points_text
 
 DEFAULT = Path(__file__).with_name("rubric.toml")
 
@@ -193,12 +194,6 @@ class Rubric:
         if self.late is not None:
             lines.append(f"  {self.late.describe()}")
         return "\n".join(lines)
-
-
-def points_text(value):
-    """Points as text: whole numbers without a decimal point."""
-    value = round(float(value), 2)
-    return f"{int(value)}" if value == int(value) else f"{value:g}"
 
 
 def _list(numbers):

@@ -1,0 +1,64 @@
+"""labkit's layout as CONTRIBUTING states it: no two modules import each other, not even inside a function."""
+
+import ast
+from pathlib import Path
+
+import labkit
+
+ROOT = Path(labkit.__file__).parent
+
+
+def modules(root):
+    """{dotted module name: (path, whether it is a package's __init__)} of every .py file under `root`."""
+    found = {}
+    for path in root.rglob("*.py"):
+        parts = list(path.relative_to(root.parent).with_suffix("").parts)
+        package = parts[-1] == "__init__"
+        found[".".join(parts[:-1] if package else parts)] = (path, package)
+    return found
+
+
+def imports(root):
+    """{module: the modules it imports anywhere in its source}; `from package import name` counts as importing
+    the submodule when `name` is one, else the package."""
+    known = modules(root)
+    edges = {}
+    for name, (path, package) in known.items():
+        here = name.split(".") if package else name.split(".")[:-1]
+        targets = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                targets.update(alias.name for alias in node.names if alias.name in known)
+            elif isinstance(node, ast.ImportFrom):
+                base = here[: len(here) - node.level + 1] if node.level else []
+                target = ".".join(base + (node.module.split(".") if node.module else []))
+                if target in known:
+                    for alias in node.names:
+                        sub = f"{target}.{alias.name}"
+                        targets.add(sub if sub in known else target)
+        targets.discard(name)
+        edges[name] = targets
+    return edges
+
+
+def mutual(root):
+    edges = imports(root)
+    return sorted((a, b) for a, targets in edges.items() for b in targets if a < b and a in edges.get(b, ()))
+
+
+def test_no_two_modules_of_labkit_import_each_other():
+    assert mutual(ROOT) == []
+
+
+def test_the_search_finds_a_pair_that_imports_each_other_even_inside_a_function(tmp_path):
+    package = tmp_path / "pkg"
+    (package / "sub").mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "sub" / "__init__.py").write_text("")
+    (package / "sub" / "late.py").write_text("def f():\n    from .rubric import g\n    return g\n")
+    (package / "sub" / "rubric.py").write_text("from . import late\nfrom ..other import h\n")
+    (package / "other.py").write_text("import pkg.sub.late\n")
+    assert mutual(package) == [("pkg.sub.late", "pkg.sub.rubric")]
+    edges = imports(package)
+    assert edges["pkg.sub.rubric"] == {"pkg.sub.late", "pkg.other"}
+    assert edges["pkg.other"] == {"pkg.sub.late"}
