@@ -259,3 +259,27 @@ def test_a_new_backend_is_one_new_module_in_the_package(tmp_path):
     assert run.returncode == 0, run.stderr
     builtin, found, chosen = run.stdout.splitlines()
     assert builtin == "('bwrap', 'none', 'zzexample')" and found == "Example" and chosen == "zzexample"
+
+
+def test_a_course_module_is_shown_in_the_sandbox_alone_never_the_folder_around_it(tmp_path, monkeypatch):
+    from conftest import sandbox_or_skip  # here, not at the top: grading processes import this module
+
+    from labkit.exercises import registry
+    from labkit.grading.protocol import COURSE_FOLDER
+
+    sandbox_or_skip()
+    (tmp_path / "course_mod.py").write_text("ANSWER = 41 + 1\n")
+    (tmp_path / "submissions").mkdir()
+    (tmp_path / "submissions" / "ada.ipynb").write_text("{}")
+    monkeypatch.setitem(registry.COURSES, "course_mod", tmp_path / "course_mod.py")
+    probe = (
+        "import os, sys; sys.path.append(" + repr(COURSE_FOLDER) + "); import course_mod; "
+        f"print(course_mod.ANSWER, os.listdir({COURSE_FOLDER!r}), os.path.exists({str(tmp_path)!r}))"
+    )
+    args = bwrap.command([sys.executable, "-I", "-B", "-c", probe])
+    ran = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    assert ran.returncode == 0, ran.stderr
+    assert ran.stdout.split() == ["42", "['course_mod.py']", "False"]
+    # a course installed in the environment is there already: nothing more is shown
+    monkeypatch.setitem(registry.COURSES, "course_mod", Path(grading.__file__).resolve())
+    assert COURSE_FOLDER not in bwrap.command(["true"])

@@ -7,6 +7,7 @@ import nbformat
 import pytest
 from docs_markdown import exercise_table
 
+from labkit.exercises.model import sections
 from labkit.exercises.registry import LAB
 
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
@@ -55,10 +56,8 @@ def test_every_exercise_has_a_section_and_the_docs_map_it():
     for path in NOTEBOOKS:
         for cell in nbformat.read(path, as_version=4).cells:
             if cell.cell_type == "markdown":
-                for line in cell.source.splitlines():
-                    if line.startswith("## Exercise"):
-                        number = int(line.split()[2])
-                        headings.setdefault(number, path.name)
+                for number in sections(cell.source):
+                    headings.setdefault(number, path.name)
     assert set(headings) == set(EXERCISES)
     # docs/students.md's exercise table names, for each exercise, the notebook that holds its section
     documented = {int(row["exercise"]): row["notebook"] for row in exercise_table()}
@@ -66,11 +65,10 @@ def test_every_exercise_has_a_section_and_the_docs_map_it():
     # sections appear in order within each notebook
     for path in NOTEBOOKS:
         numbers = [
-            int(line.split()[2])
+            number
             for cell in nbformat.read(path, as_version=4).cells
             if cell.cell_type == "markdown"
-            for line in cell.source.splitlines()
-            if line.startswith("## Exercise")
+            for number in sections(cell.source)
         ]
         assert numbers == sorted(numbers), path.name
 

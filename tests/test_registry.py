@@ -26,7 +26,6 @@ from labkit.grading.rubric import default
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = {path.name: path for path in sorted((ROOT / "notebooks").glob("*.ipynb"))}
-HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
 
 
 def _cells(name, kind="code"):
@@ -75,7 +74,7 @@ def test_every_part_is_self_checked_by_its_declared_name(exercise):
 @pytest.mark.parametrize("exercise", list(LAB), ids=lambda e: f"exercise {e.number}")
 def test_each_notebook_holds_its_exercises_defines_their_names_and_self_checks_every_part(exercise):
     assert exercise.notebook in NOTEBOOKS
-    headings = {int(n) for text in _cells(exercise.notebook, "markdown") for n in HEADING.findall(text)}
+    headings = {n for text in _cells(exercise.notebook, "markdown") for n in model.sections(text)}
     assert exercise.number in headings
     code = _cells(exercise.notebook)
     missing = [

@@ -15,11 +15,30 @@ declarations by :class:`labkit.exercises.registry.Registry`.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 CHECK_PREFIX = "check_"
+# a notebook's section of exercise N: a markdown heading of any level, "## Exercise N", with or without a title
+SECTION = re.compile(r"^#+[ \t]*Exercise[ \t]+(\d{1,3})(?!\d)", re.MULTILINE)
+
+
+def sections(markdown: str) -> list[int]:
+    r"""The numbers of the exercise sections one markdown text opens, in order.
+
+    The grader, nbgrader's marking of the notebooks and the tests all read the sections with this one
+    function. A section is a heading line ``## Exercise N`` of any level, a title after the number or
+    not; numbers of more than three digits are no section (a submission's heading cannot make the
+    grader look for exercise 10**9).
+
+    >>> sections("# Notebook\n## Exercise 17: secants\ntext\n### Exercise 3\nExercise 4 in a sentence")
+    [17, 3]
+    >>> sections("## Exercise 12345")
+    []
+    """
+    return [int(number) for number in SECTION.findall(str(markdown))]
 
 
 @dataclass(frozen=True)

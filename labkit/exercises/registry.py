@@ -15,8 +15,10 @@ grader (:mod:`labkit.grading.remote`).
 from __future__ import annotations
 
 import importlib
+import sys
 import types
 from collections.abc import Iterable, Mapping
+from pathlib import Path
 from typing import Any
 
 from . import bilinear, hermite, monotone, patches, splines
@@ -239,4 +241,15 @@ def load(source: str | None = None) -> Registry:
         raise ValueError(f"{source!r} is a {type(found).__name__}, not a labkit Registry of exercises.")
     if found.source is None:
         found.source = source
+    top = module.split(".")[0]
+    origin = getattr(sys.modules.get(top), "__file__", None)
+    if origin:
+        origin = Path(origin).resolve()
+        COURSES[top] = origin.parent if origin.name == "__init__.py" else origin
     return found
+
+
+# course modules whose registries :func:`load` has loaded in this process: top-level name -> the package's
+# folder or the module's file; the grader's sandbox shows them to the student's notebook (which imports the
+# course module for its self-checks), read-only, and nothing else of the folder they are in
+COURSES: dict[str, Path] = {}

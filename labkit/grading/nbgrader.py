@@ -23,6 +23,7 @@ meaning follow nbgrader's ``nbgrader/nbgraderformat/v3.json``.
 
 import re
 
+from ..exercises.model import sections
 from . import rubric as rubrics
 from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
 
@@ -69,18 +70,15 @@ def test_points(source, where="a test cell", rubric=None):
     return number, int(points) if points == int(points) else round(points, 2)
 
 
-HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
-
-
 def answer_ids(nb):
     """The grade ids of a notebook's answers in words, in order: ``exerciseN-answer-K``."""
     ids, exercise, counters = [], None, {}
     for cell in nb.cells:
         if cell.cell_type != "markdown":
             continue
-        found = HEADING.findall(cell.source)
+        found = sections(cell.source)
         if found:
-            exercise = int(found[-1])
+            exercise = found[-1]
         if BEGIN_SOLUTION in cell.source:
             counters[exercise] = counters.get(exercise, 0) + 1
             ids.append(f"exercise{exercise}-answer-{counters[exercise]}")

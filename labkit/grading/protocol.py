@@ -33,6 +33,9 @@ import math
 import numpy as np
 
 MAX_DEPTH = 12
+# where a sandbox shows the course modules a rubric names (read-only); the worker puts it on the notebook's path
+COURSE_FOLDER = "/opt/labkit-course"
+COURSE_PATH = "LABKIT_COURSE_PATH"  # without a sandbox (the none backend): the folders of the course modules
 MAX_ELEMENTS = 4_000_000  # numbers in one message (the lab's largest answer has a few thousand)
 MAX_TEXT = 2_000
 MAX_LINE = 48 * 1024 * 1024  # bytes in one message: enforced while reading, before any parsing

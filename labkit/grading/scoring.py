@@ -24,12 +24,12 @@ memory or time costs only its own grade.
 import functools
 import json
 import os
-import re
 import stat
 import sys
 import time
 from pathlib import Path
 
+from ..exercises.model import sections
 from ..exercises.registry import LAB
 from ..exercises.registry import load as load_registry
 from . import backends, known, refusals, remote, scan
@@ -43,7 +43,6 @@ MAX_NOTEBOOKS = 20  # notebooks graded per submission
 MAX_FILES = 5_000  # entries looked at in one submission folder
 MAX_DEPTH = 8  # folder levels looked into
 MAX_ANSWER = 4_000  # characters of one answer in words kept for the instructor
-HEADING = re.compile(r"^#+\s*Exercise\s+(\d+)", re.MULTILINE)
 
 
 def read_cells(path, answers=None, registry=LAB):
@@ -98,7 +97,7 @@ def exercises_in(markdown, registry=LAB):
     """Graded exercises whose section heading ('## Exercise N') the markdown has."""
     if hasattr(markdown, "cells"):  # an nbformat notebook
         markdown = [cell.source for cell in markdown.cells if cell.cell_type == "markdown"]
-    found = {int(n) for text in markdown for n in HEADING.findall(text) if len(n) < 4}
+    found = {n for text in markdown for n in sections(text)}
     return sorted(found & set(registry.exercises))
 
 

@@ -565,6 +565,10 @@ def serve(requests, answers, shell):
     if null > 2:
         os.close(null)
     sys.path.insert(0, os.getcwd())
+    # the course module a rubric names, for the notebook's self-checks: shown by the sandbox, or without one where it is
+    for folder in [protocol.COURSE_FOLDER, *os.environ.pop(protocol.COURSE_PATH, "").split(os.pathsep)]:
+        if folder and os.path.isdir(folder):
+            sys.path.append(folder)
     os.environ["LABKIT_HEADLESS"] = "1"  # nothing shown here is seen (labkit.notebook.headless)
     Supervisor(requests, answers, shell).serve()
 

@@ -30,7 +30,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import cgroup
+from .. import cgroup, protocol
 
 WORKER_IMPORTS = 512 * 1024**2  # bytes of a notebook's cgroup on top of its limit: the worker's own imports
 
@@ -79,6 +79,24 @@ def environment_paths():
     paths = {p for p in paths if p.exists() and not any(p == s or s in p.parents for s in system)}
     # a folder inside another one is mounted with it
     return sorted(p for p in paths if not any(q != p and q in p.parents for q in paths))
+
+
+COURSE_FOLDER = protocol.COURSE_FOLDER
+
+
+def course_mounts():
+    """(the course module's file or package folder, where the sandbox shows it) for every course module whose
+    exercises this process grades (:data:`labkit.exercises.registry.COURSES`) and that the Python environment
+    does not hold already. Only the module itself is shown, never the folder around it (where the course
+    keeps its submissions and grades)."""
+    from ...exercises.registry import COURSES
+
+    environment = environment_paths()
+    mounts = []
+    for name, origin in sorted(COURSES.items()):
+        if origin.exists() and not any(origin == p or p in origin.parents for p in environment):
+            mounts.append((origin, Path(COURSE_FOLDER) / (name if origin.is_dir() else origin.name)))
+    return mounts
 
 
 def processes_of_this_user():

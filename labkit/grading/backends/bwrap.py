@@ -37,7 +37,15 @@ from pathlib import Path
 
 from .. import seccomp
 from . import register
-from .base import Backend, Box, Limits, SandboxUnavailable, environment_paths, processes_of_this_user
+from .base import (
+    Backend,
+    Box,
+    Limits,
+    SandboxUnavailable,
+    course_mounts,
+    environment_paths,
+    processes_of_this_user,
+)
 
 HOME = "/home/student"
 INSTALL_HINT = (
@@ -124,6 +132,9 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     made = {Path("/tmp")}
     for path in environment_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
+    courses = course_mounts()
+    for origin, shown in courses:
+        args += [*_parents(shown, made), "--ro-bind", str(origin), str(shown)]
     args += [
         *_parents(HOME, made),
         "--perms",

@@ -17,8 +17,9 @@ runs with the grader's permissions, so every run starts with
 import os
 import tempfile
 
+from ..protocol import COURSE_PATH
 from . import register
-from .base import Backend, Box, processes_of_this_user, remove_tree
+from .base import Backend, Box, course_mounts, processes_of_this_user, remove_tree
 
 WARNING = """\
 !!! labkit grade --sandbox none (--no-sandbox): student code runs UNCONFINED, with your permissions.
@@ -46,6 +47,9 @@ class Unconfined(Backend):
     def box(self, argv, limits):
         folder = tempfile.mkdtemp(prefix="labkit-grade-")
         env = {**os.environ, "HOME": folder, "MPLBACKEND": "Agg", "OPENBLAS_NUM_THREADS": "1"}
+        courses = [str(origin.parent) for origin, _ in course_mounts()]  # -I ignores PYTHONPATH: the worker adds them
+        if courses:
+            env[COURSE_PATH] = os.pathsep.join(courses)
         return Box(
             argv,
             limits,
