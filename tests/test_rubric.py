@@ -184,3 +184,20 @@ def test_cli_prints_the_lab_rubric_and_checks_an_edited_one(tmp_path):
         [sys.executable, "-m", "labkit.cli", "rubric", "--check", str(path)], capture_output=True, text=True, timeout=60
     )
     assert run.returncode == 2 and "negative points" in run.stderr
+
+
+def test_the_points_example_the_rubric_and_the_docs_give_is_one_a_rubric_accepts(tmp_path):
+    import re
+    from pathlib import Path
+
+    docs = (Path(__file__).resolve().parents[1] / "docs" / "instructors.md").read_text(encoding="utf-8")
+    comment = "\n".join(line.lstrip("# ") for line in rubrics.DEFAULT.read_text(encoding="utf-8").splitlines())
+    examples = re.findall(r"\[points\]\s*\n\s*(\d+ = \d+)", comment) + re.findall(
+        r"`\[points\]` table \(`(\d+ = \d+)`", docs
+    )
+    assert len(examples) == 2
+    for example in examples:
+        number, points = (int(v) for v in example.split(" = "))
+        path = tmp_path / "edited.toml"
+        path.write_text(rubrics.DEFAULT.read_text(encoding="utf-8") + f"\n[points]\n{example}\n", encoding="utf-8")
+        assert rubrics.load(path).points[number] == points
