@@ -15,7 +15,7 @@ WORK := work
 # venv jupyter prefers the venv's etc/jupyter, where nbgrader enables itself.
 STUDENT_CONFIG := $(CURDIR)/jupyter/student
 
-.PHONY: lab lab-prepare lab-instructor test bench notebooks chromium bwrap clean
+.PHONY: lab lab-prepare lab-instructor test test-fast bench notebooks chromium bwrap clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -39,7 +39,16 @@ lab-instructor: $(STAMP)
 test: $(STAMP) chromium bwrap
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
+	$(PY) -m mypy
 	$(PY) -m pytest tests labkit --nbval --nbval-current-env --nbval-sanitize-with tests/nbval_sanitize.cfg notebooks
+
+# The quick loop while changing code (under 3 minutes): lint, types, and every test that starts no sandbox, browser,
+# server or whole notebook (tests/conftest.py marks the others slow). `make test` runs everything before a commit.
+test-fast: $(STAMP)
+	$(PY) -m ruff check .
+	$(PY) -m ruff format --check .
+	$(PY) -m mypy
+	$(PY) -m pytest -q -m "not slow" tests labkit
 
 # The browser test drives Debian's Chromium (never a Playwright download).
 chromium:

@@ -28,7 +28,7 @@ import nbformat
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
-from jupyterlab_session import CHROMIUM_FLAGS, COUNT_IMAGE_FRAMES, TOKEN, frames, jupyterlab, run_all  # noqa: E402
+from jupyterlab_session import CHROMIUM_FLAGS, COUNT_IMAGE_FRAMES, TOKEN, frames, jupyterlab, run_all
 
 SETUP = """import io
 import ipywidgets as widgets

@@ -14,7 +14,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
-from jupyterlab_session import (  # noqa: E402
+from jupyterlab_session import (
     CHROMIUM,
     CHROMIUM_FLAGS,
     COUNT_IMAGE_FRAMES,

@@ -29,9 +29,9 @@ import nbformat
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 sys.path.insert(0, str(ROOT / "tests"))
-from test_hostile import ATTACKS  # noqa: E402  (the attacks' cells, as the hostile test plants them)
+from test_hostile import ATTACKS  # the attacks' cells, as the hostile test plants them
 
-from labkit import grading  # noqa: E402
+from labkit import grading
 
 SEED = "20261122"
 # attacks that end by themselves within the default limits (no placeholder to fill, no loop to wait out)

@@ -23,12 +23,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from bench_similarity import synthetic_class as similarity_class  # noqa: E402
-from class_results import pair_of, synthetic_class  # noqa: E402
+from bench_similarity import synthetic_class as similarity_class
+from class_results import pair_of, synthetic_class
 
-from labkit.cli import main as cli  # noqa: E402
-from labkit.grading import class_report, similarity  # noqa: E402
-from labkit.grading.report import write_report  # noqa: E402
+from labkit.cli import main as cli
+from labkit.grading import class_report, similarity
+from labkit.grading.report import write_report
 
 
 def timed(function, repeat):

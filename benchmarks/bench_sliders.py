@@ -14,11 +14,11 @@ import time
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-import labkit  # noqa: E402
-from labkit import plots  # noqa: E402
+import labkit
+from labkit import plots
 
 
 def _graded(elements, dxds_bc):

@@ -18,9 +18,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from catalog import plant_class  # noqa: E402
+from catalog import plant_class
 
-from labkit import grading  # noqa: E402
+from labkit import grading
 
 SEED = 20261201
 

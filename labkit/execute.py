@@ -30,7 +30,7 @@ def read_notebook(path):
         raise ValueError(f"{Path(path).name} is not a text file, so not a notebook.") from None
     try:
         return nbformat.reads(text, as_version=4)
-    except Exception as exc:  # nbformat raises several kinds for broken files
+    except Exception as exc:  # noqa: BLE001 - nbformat raises several kinds for broken files
         raise ValueError(
             f"{Path(path).name} is not a valid notebook ({type(exc).__name__}: {str(exc)[:200]})."
         ) from None

@@ -27,6 +27,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import notebook as _notebook
+from .exercises.model import sections
 from .exercises.result import NOT_IMPLEMENTED
 
 DONE, FAILING, NOT_STARTED = "done, passes its self-check", "done but failing", "not started"
@@ -204,7 +205,8 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
 def _parts(name: str, namespace: Mapping, raised: list) -> list:
     from .exercises.registry import LAB  # the exercises' declarations and their self-checks; never the grader
 
-    stubbed, failed = set(), {}  # names of cells still holding their stub; of the other cells that raised
+    stubbed: set = set()
+    failed: dict = {}  # names of cells still holding their stub; of the other cells that raised
     for cell in raised:
         names, stub = _assigned(cell.source)
         if stub and cell.error == "NotImplementedError":
@@ -233,10 +235,10 @@ def _status(number: int, part, check: Mapping, namespace: Mapping, stubbed: set,
         return PartStatus(number, part.name, NOT_STARTED, f"the cell of {left[0]} still raises NotImplementedError")
     if check["passed"]:
         return PartStatus(number, part.name, DONE)
-    failed = [s for s in check["steps"] if not s["passed"]]
-    if any(s["detail"] == NOT_IMPLEMENTED for s in failed):
+    steps = [s for s in check["steps"] if not s["passed"]]
+    if any(s["detail"] == NOT_IMPLEMENTED for s in steps):
         return PartStatus(number, part.name, NOT_STARTED, "it still raises NotImplementedError")
-    hint = check["hint"] or (f"{failed[0]['step']}: {failed[0]['detail']}" if failed else "")
+    hint = check["hint"] or (f"{steps[0]['step']}: {steps[0]['detail']}" if steps else "")
     return PartStatus(number, part.name, FAILING, " ".join(str(hint).split()))
 
 
@@ -332,7 +334,7 @@ def _colab_cells() -> list | None:
     if "google.colab" not in sys.modules:
         return None
     try:
-        from google.colab import _message  # type: ignore[import-not-found]
+        from google.colab import _message
 
         found = _message.blocking_request("get_ipynb", request="", timeout_sec=10)
         return found["ipynb"]["cells"]
@@ -355,11 +357,11 @@ def _empty_answers(name: str, cells: list) -> list:
         if cell.get("cell_type") != "markdown":
             continue
         text = _text(cell)
-        headings = re.findall(r"^#+\s*Exercise\s+(\d+)", text, re.MULTILINE)
+        headings = sections(text)
         if headings:
-            section = int(headings[-1])
+            section = headings[-1]
         meta = (cell.get("metadata") or {}).get("nbgrader") or {}
-        declared = LAB.answers.get(meta.get("grade_id"))
+        declared = LAB.answers.get(str(meta.get("grade_id")))
         is_answer = (meta.get("solution") and meta.get("grade")) or text.strip() == ANSWER_STUB
         if not is_answer or text.strip() not in ("", ANSWER_STUB):
             continue

@@ -170,17 +170,17 @@ class QuadMesh:
         quality = self.quality()
         if color_by_quality:
             cells = PolyCollection(
-                polygons,
+                polygons,  # type: ignore[arg-type]
                 array=quality,
                 cmap=QUALITY_CMAP,
-                clim=(-1, 1),  # type: ignore[arg-type]
+                clim=(-1, 1),
                 gid="quality",
                 **style,
             )
             ax.add_collection(cells)
             folded = PolyCollection(polygons[quality <= 0], gid="folded", **FOLDED_STYLE)  # type: ignore[arg-type]
             ax.add_collection(folded)
-            sample = Patch(label=FOLDED_LABEL, **{**FOLDED_STYLE, "facecolor": cells.cmap(0.25)})
+            sample = Patch(label=FOLDED_LABEL, **{**FOLDED_STYLE, "facecolor": cells.cmap(0.25)})  # type: ignore[arg-type]
             ax.legend(
                 handles=[sample],
                 loc="upper center",

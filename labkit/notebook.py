@@ -109,7 +109,7 @@ class CellErrors:
     def __call__(self, result=None) -> None:
         try:  # a hook that raises would print its traceback under every cell
             self._note(result)
-        except Exception:  # noqa: BLE001, S110 - the notebook goes on without this cell noted
+        except Exception:  # noqa: BLE001 - the notebook goes on without this cell noted
             pass
 
     def _note(self, result) -> None:

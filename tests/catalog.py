@@ -1267,7 +1267,7 @@ def summary():
     "before" is what the feedback said before issue 30 (`was`; the slips of issue 30's block graded by the
     checks of then), "now" what it says: "named" when the hint names the slip, "generic" when it says what
     is verified and what to look at (tests/test_catalog.py checks both, and that none misleads)."""
-    count = lambda kinds: {kind: sum(k == kind for k in kinds) for kind in KINDS}  # noqa: E731
+    count = lambda kinds: {kind: sum(k == kind for k in kinds) for kind in KINDS}
     return {
         "slips": len(MISTAKES),
         "before": count([entry.was for entry in MISTAKES]),
@@ -1280,7 +1280,7 @@ def summary():
 def summary_text():
     """The summary as the closing report gives it."""
     counts = summary()
-    line = lambda c: ", ".join(f"{c[kind]} {kind}" for kind in KINDS)  # noqa: E731
+    line = lambda c: ", ".join(f"{c[kind]} {kind}" for kind in KINDS)
     earlier = counts["slips"] - counts["new"]
     before = {kind: counts["before"][kind] - counts["new before"][kind] for kind in KINDS}
     return (

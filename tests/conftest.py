@@ -1,4 +1,5 @@
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +23,54 @@ def sandbox_or_skip():
         if os.environ.get("CI"):
             raise
         pytest.skip(f"no sandbox here: {exc}")
+
+
+# The fast tier (`make test-fast`, `pytest -m "not slow"`) leaves out what starts sandboxes, browsers, servers or
+# whole notebooks: the browser tests, these modules, and every test whose code or fixtures call sandbox_or_skip().
+SLOW_MODULES = {
+    "test_catalog",  # the catalog class, graded in one sandboxed run
+    "test_hostile",  # the hostile class
+    "test_make_lab",  # make lab in a fresh folder
+    "test_packaging",  # builds the package
+    "test_wheel",  # builds and installs a wheel
+    "test_dask",  # a Dask cluster
+    "test_nbgrader",  # nbgrader's own commands
+    "test_notebooks_clean",  # executes notebooks
+    "test_student_work",  # executes notebooks
+    "test_timeouts",  # waits for time limits
+    "test_grading",  # grades the instructor notebooks and small classes
+    "test_refusals",  # a worker process per case
+    "test_handin",  # executes notebooks
+}
+SLOW_CALLS = ("sandbox_or_skip(", "grading.grade(")  # a test or fixture calling one of these is slow
+
+
+def _calls_the_sandbox(item):
+    import inspect
+
+    functions = [getattr(item, "function", None)]
+    info = getattr(item, "_fixtureinfo", None)
+    for definitions in (info.name2fixturedefs.values() if info else ()):
+        functions += [definition.func for definition in definitions]
+    for function in functions:
+        try:
+            if function is not None and any(call in inspect.getsource(function) for call in SLOW_CALLS):
+                return True
+        except (OSError, TypeError):
+            continue
+    return False
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: left out of the fast tier (make test-fast); see tests/conftest.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        module = item.nodeid.split("::")[0]
+        name = Path(module).stem
+        if module.startswith("tests/browser/") or name in SLOW_MODULES or _calls_the_sandbox(item):
+            item.add_marker(pytest.mark.slow)
 
 
 def pytest_terminal_summary(terminalreporter):

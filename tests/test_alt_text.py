@@ -12,13 +12,13 @@ import re
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-from scipy.interpolate import CubicSpline, PchipInterpolator, RegularGridInterpolator  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from scipy.interpolate import CubicSpline, PchipInterpolator, RegularGridInterpolator
 
-import labkit  # noqa: E402
-from labkit import plots  # noqa: E402
+import labkit
+from labkit import plots
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")

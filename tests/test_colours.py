@@ -13,13 +13,13 @@ map at least half its range apart likewise.
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-from matplotlib import colors  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib import colors
 
-import labkit  # noqa: E402
-from labkit import plots  # noqa: E402
+import labkit
+from labkit import plots
 
 MACHADO = {
     "protan": np.array(

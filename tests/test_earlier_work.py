@@ -10,16 +10,16 @@ student's words. The named slips next to it still cost only their own part.
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-from test_check import _natural_from, _system_with_h_subscript_slip  # noqa: E402
-from test_student_work import _corners9, _driver_1d, _driver_2d, _patch_meshes  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from test_check import _natural_from, _system_with_h_subscript_slip
+from test_student_work import _corners9, _driver_1d, _driver_2d, _patch_meshes
 
-import labkit  # noqa: E402
-from labkit import check  # noqa: E402
-from labkit.exercises import experiments, splines  # noqa: E402
-from labkit.exercises.registry import LAB  # noqa: E402
+import labkit
+from labkit import check
+from labkit.exercises import experiments, splines
+from labkit.exercises.registry import LAB
 
 NOT_AN_ATTEMPT = "that is not an attempt at the lab's task, so this part was judged against"
 
@@ -139,7 +139,7 @@ def test_region_built_on_a_slip_in_the_mirror_rule_still_costs_only_two_patches(
     first, second = slipped(*corners)
     assert check.combined_mesh(first + second, corners, slipped).passed
     # and the right meshes with the right region
-    right = lambda *c: _patch_meshes(list(c))  # noqa: E731
+    right = lambda *c: _patch_meshes(list(c))
     assert check.two_patches(right, corners).passed
     assert check.combined_mesh(sum(right(*corners)[1:], right(*corners)[0]), corners, right).passed
 

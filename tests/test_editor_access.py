@@ -10,12 +10,12 @@ import re
 import matplotlib
 
 matplotlib.use("Agg")
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import numpy as np
+import pytest
 
-import labkit  # noqa: E402
-from labkit import plots  # noqa: E402
-from labkit.plots import editor as editor_module  # noqa: E402
+import labkit
+from labkit import plots
+from labkit.plots import editor as editor_module
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 SQUARE = [labkit.Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]

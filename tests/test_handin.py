@@ -122,7 +122,7 @@ def test_a_half_done_notebook_says_what_is_left(half):
     runge = next(p for p in half.parts if p.part == "runge")
     assert SLIP.hint in runge.detail  # the self-check's hint for this slip
     wrong = {"np": np, "eval_pherm": None}
-    exec(_instructor_cell("def runge(")[1].replace(*SLIP.replace[0]), wrong)  # noqa: S102 - the slip, run here
+    exec(_instructor_cell("def runge(")[1].replace(*SLIP.replace[0]), wrong)  # the slip, run here
     assert runge.detail == labkit.check.runge(wrong["runge"]).hint
     # the typo's cell and the untouched rate cell raised; nothing else did
     assert [(c.error, c.message) for c in half.raised] == [
@@ -220,7 +220,7 @@ def _namespace(name=NAME):
     namespace = {}
     for cell in nbformat.read(INSTRUCTOR / name, as_version=4).cells:
         if cell.cell_type == "code" and "explorer(" not in cell.source and "ready_to_hand_in" not in cell.source:
-            exec("\n".join(x for x in cell.source.splitlines() if not x.startswith("%")), namespace)  # noqa: S102
+            exec("\n".join(x for x in cell.source.splitlines() if not x.startswith("%")), namespace)
     return namespace
 
 
@@ -248,7 +248,7 @@ def test_import_labkit_stays_light():
 
 def test_the_notebooks_own_names_are_read_by_default():
     namespace = _namespace()
-    exec("import labkit\nresult = labkit.ready_to_hand_in('02_convergence.ipynb')", namespace)  # noqa: S102
+    exec("import labkit\nresult = labkit.ready_to_hand_in('02_convergence.ipynb')", namespace)
     assert set(_statuses(namespace["result"]).values()) == {DONE}
 
 

@@ -14,7 +14,7 @@ R2 = np.sqrt(2) / 2
 
 def mirror(corner):
     """Corner data of the mirror image in y = x with the roles of s and t swapped."""
-    flip = lambda v: v[::-1]  # noqa: E731
+    flip = lambda v: v[::-1]
     return Corner(flip(corner.point), flip(corner.dt), flip(corner.ds), flip(corner.dsdt))
 
 

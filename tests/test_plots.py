@@ -3,13 +3,13 @@
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
 
-import labkit  # noqa: E402
-from labkit import plots  # noqa: E402
-from labkit.plots.explorers import NotShown  # noqa: E402
+import labkit
+from labkit import plots
+from labkit.plots.explorers import NotShown
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 

@@ -9,15 +9,15 @@ its own hint while the right answer passes.
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
 
-import labkit  # noqa: E402
-from labkit import check  # noqa: E402
-from labkit.exercises import experiments, plotted  # noqa: E402
-from labkit.exercises.registry import LAB  # noqa: E402
-from labkit.grading import protocol  # noqa: E402
+import labkit
+from labkit import check
+from labkit.exercises import experiments, plotted
+from labkit.exercises.registry import LAB
+from labkit.grading import protocol
 
 # -- drivers ---------------------------------------------------------------------
 
@@ -208,8 +208,8 @@ def test_the_rate_is_read_from_the_students_own_table():
     # a right driver whose own slopes (its default, the student's ccspline) are the natural spline's: the driver
     # check gives it labkit's ccspline and it passes, Exercise 10 marks the slopes, and its table supports 2: the
     # answer 2 is right, the true 4 is not
-    natural_slopes = lambda x, y, y1p, ynp: labkit.ncspline(x, y)  # noqa: E731
-    driver = lambda n, f=labkit.runge, slopes=natural_slopes: _driver_1d("complete")(n, f, slopes)  # noqa: E731
+    natural_slopes = lambda x, y, y1p, ynp: labkit.ncspline(x, y)
+    driver = lambda n, f=labkit.runge, slopes=natural_slopes: _driver_1d("complete")(n, f, slopes)
     assert check.driver("complete", driver).passed
     errors = _table_of(driver, "complete")
     assert experiments.supported_order(LAB.experiment("complete"), errors) == 2
@@ -231,7 +231,7 @@ def test_a_table_and_rate_typed_in_without_a_driver_that_runs_earn_nothing():
     errors = list(1.0 / (np.array(labkit.convergence.DEFAULT_NDATA) - 1.0) ** 4)
     table, rate = experiments.check_experiment(LAB.experiment("pherm"), errors, 4, None)
     assert not table.passed and not rate.passed
-    broken = lambda n, *rest: 1 / 0  # noqa: E731 - a driver that does not run
+    broken = lambda n, *rest: 1 / 0  # a driver that does not run
     table, rate = experiments.check_experiment(LAB.experiment("pherm"), errors, 4, broken)
     assert not table.passed and not rate.passed and "must run" in rate.hint
     # ... nor next to a driver whose own errors do not shrink
@@ -285,7 +285,7 @@ def test_limacon_derivatives_match_centred_differences_and_a_sign_slip_is_named(
     assert check.limacon_derivatives(_derivatives(), seed=5).passed
     # the check's reference against a centred difference of the curve itself
     t, h = np.linspace(0, 2 * np.pi, 13), 1e-6
-    x = lambda t: (1.15 + np.cos(t)) * np.cos(t)  # noqa: E731
+    x = lambda t: (1.15 + np.cos(t)) * np.cos(t)
     np.testing.assert_allclose(labkit.limacon(t)[2], (x(t + h) - x(t - h)) / (2 * h), atol=1e-8)
     wrong = check.limacon_derivatives(_derivatives(-1.0))
     assert not wrong.passed and "dy/dt has the wrong sign" in wrong.hint

@@ -193,7 +193,7 @@ class ExperimentPart(Part):
     """A part of a convergence experiment: its check takes the experiment first, and reads what is missing as
     :data:`MISSING` (the table and the rate say which name is missing)."""
 
-    experiment: Experiment = None
+    experiment: Experiment | None = None
 
     @property
     def self_check(self):
@@ -298,7 +298,7 @@ def _measured(method, ndata, data="values", against=0):
     rows = {"values": lambda y, yp: (y, yp), "swapped": lambda y, yp: (yp, y), "derivatives": lambda y, yp: (yp, yp)}
     xtest = np.linspace(0.0, 5.0, method.ntest)
     exact = functions.runge(xtest)[against]
-    f = lambda x: rows[data](*functions.runge(x))  # noqa: E731
+    f = lambda x: rows[data](*functions.runge(x))
     return exact, exact - convergence._interpolate(method.key, f, 0.0, 5.0, ndata, xtest)
 
 

@@ -98,12 +98,12 @@ class Registry:
             for function in part.passes:
                 _check_passable(function, part.name)
         self.passable = frozenset(function_name(f) for p in parts for f in p.passes)
-        self.experiments = {}
+        self.experiments: dict = {}
         for part in parts:
             experiment = getattr(part, "experiment", None)
             if experiment is not None:
                 self.experiments.setdefault(experiment.key, experiment)
-        self.self_checks = {}
+        self.self_checks: dict = {}
         for part in parts:
             if getattr(part, "experiment", None) is not None:
                 continue
@@ -124,7 +124,7 @@ class Registry:
 
     def notebooks(self) -> dict:
         """Notebook file name -> the numbers of the exercises in it."""
-        found = {}
+        found: dict = {}
         for exercise in self:
             found.setdefault(exercise.notebook, []).append(exercise.number)
         return found
@@ -199,11 +199,11 @@ def _check_passable(function, part: str) -> None:
     """A function a check hands to student code must be one the sandbox can find by name: a module-level function
     of labkit's own (not of the grader), as its module has it."""
     module, qualname = getattr(function, "__module__", None), getattr(function, "__qualname__", None)
-    ok = isinstance(function, types.FunctionType) and isinstance(module, str) and isinstance(qualname, str)
-    ok = ok and module.startswith("labkit.") and not module.startswith("labkit.grading") and qualname.isidentifier()
-    if ok:
+    ok = False
+    if isinstance(function, types.FunctionType) and isinstance(module, str) and isinstance(qualname, str):
+        ok = module.startswith("labkit.") and not module.startswith("labkit.grading") and qualname.isidentifier()
         try:
-            ok = getattr(importlib.import_module(module), qualname, None) is function
+            ok = ok and getattr(importlib.import_module(module), qualname, None) is function
         except ImportError:
             ok = False
     if not ok:

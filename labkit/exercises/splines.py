@@ -361,7 +361,7 @@ def spline_system(given, xdata, ydata):
     if not np.allclose(A[np.abs(rows - cols) > 1], 0.0):
         return "your complete_system's A is not tridiagonal"
     secant = np.diff(ydata) / h
-    beside = lambda got, k: np.isclose(got, h[k - 1] / 6) or np.isclose(got, h[k] / 6)  # noqa: E731
+    beside = lambda got, k: np.isclose(got, h[k - 1] / 6) or np.isclose(got, h[k] / 6)
     for k in range(1, n - 1):
         if not (
             np.isclose(A[k, k], (h[k - 1] + h[k]) / 3)

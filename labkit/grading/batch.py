@@ -306,7 +306,7 @@ def grade_one(path, name, options, profiles_file, work):
             return job.message()
 
 
-_KEPT = {}  # (backend, limits, exercises, thread) -> (fork server, launcher) kept (a Dask worker's)
+_KEPT: dict = {}  # (backend, limits, exercises, thread) -> (fork server, launcher) kept (a Dask worker's)
 _KEPT_LOCK = threading.Lock()
 
 

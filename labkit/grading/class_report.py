@@ -571,12 +571,12 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     exercises, parts = [], []
     slips = defaultdict(list)
     problems = defaultdict(list)  # (kind, student) -> texts
-    failed = {g.name: [] for g in graded}
-    not_done = defaultdict(int)
+    failed: dict = {g.name: [] for g in graded}
+    not_done: defaultdict = defaultdict(int)
     for number in rubric.graded:
         names = _part_names(rubric, number, graded)
         weights = _weights(rubric, number)
-        counts = {name: defaultdict(int) for name in names}
+        counts: dict = {name: defaultdict(int) for name in names}
         found = attempted = passed = 0
         for grade in graded:
             checks = _checks(grade, number)
@@ -588,8 +588,8 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
             by_name = {one_line(c.get("name", "?"), MAX_TEXT): c for c in checks}
             outcomes = []
             for name in names:
-                check = by_name.get(name)
-                outcome = check_outcome(check) if check is not None else NOT_DONE
+                check = by_name.get(name) or {}
+                outcome = check_outcome(check) if check else NOT_DONE
                 outcomes.append(outcome)
                 counts[name][outcome] += 1
                 if outcome == PASSED:
@@ -619,7 +619,7 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
         for text in grade.problems:
             for kind, line in problem_kinds(text):
                 problems[(kind, grade.name)].append(line)
-    by_kind = {kind: [] for kind in KINDS}
+    by_kind: dict = {kind: [] for kind in KINDS}
     for (kind, student), texts in sorted(problems.items(), key=lambda item: (item[0][0], item[0][1])):
         by_kind[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))
     ordered = sorted(slips.items(), key=lambda item: (-len(set(item[1])), item[0][0], item[0][1], item[0][3]))
@@ -1453,7 +1453,7 @@ def write(
     if target.is_symlink() or (target.exists() and not target.is_file()):
         raise ValueError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
     page = render(summarise(grades), pairs, threshold=float(threshold), similarity_note=similarity_note)
-    handle = tempfile.NamedTemporaryFile(
+    handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
         "w", encoding="utf-8", dir=out, prefix=".report-", suffix=".html.tmp", delete=False
     )
     try:

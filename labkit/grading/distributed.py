@@ -131,7 +131,7 @@ def schedule(address, todo, options, profiles_file, rubric, out, bar, peaks, arr
             name = futures[future.key][1]
             try:
                 message = future.result()
-            except Exception as exc:  # KilledWorker, or what the task raised twice
+            except Exception as exc:  # noqa: BLE001 - KilledWorker, or what the task raised twice
                 why = (
                     "the Dask workers grading it died"
                     if isinstance(exc, distributed.KilledWorker)
@@ -162,7 +162,7 @@ def schedule(address, todo, options, profiles_file, rubric, out, bar, peaks, arr
                 bar.advance()
         try:
             worker_peaks = client.run(_peak_bytes)
-        except Exception:  # a worker that went away while asked
+        except Exception:  # noqa: BLE001 - a worker that went away while asked
             worker_peaks = {}
     finally:
         close()

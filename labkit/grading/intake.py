@@ -909,7 +909,7 @@ def find_class(
         students = _folders(root, builder, notes)
     if assignment is not None and layout != "nbgrader":
         notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
-    by_name = {}
+    by_name: dict = {}
     for student in students:
         if student.name in by_name:
             other = by_name[student.name]

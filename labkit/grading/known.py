@@ -154,7 +154,7 @@ class Unit:
     path: str  # its file
     first: int  # its lines in the file (1-based, inclusive)
     last: int
-    text: str = None  # a notebook's definition itself (a module's is read from its file when shown)
+    text: str | None = None  # a notebook's definition itself (a module's is read from its file when shown)
 
 
 @dataclass(frozen=True)

@@ -221,9 +221,9 @@ class SubmissionTime:
         Why the time could not be read (an unreadable ``timestamp.txt``), when it could not.
     """
 
-    when: datetime = None
-    source: str = None
-    problem: str = None
+    when: datetime | None = None
+    source: str | None = None
+    problem: str | None = None
 
     def as_dict(self) -> dict:
         """The time as JSON data (UTC, ISO 8601), for a result file."""
@@ -277,8 +277,8 @@ class Lateness:
 
     deadline: datetime
     extended: bool
-    time: SubmissionTime
-    late_by: timedelta
+    time: SubmissionTime | None
+    late_by: timedelta | None
     units: int
     percent: float
     raw_total: float
@@ -376,7 +376,7 @@ class Late:
         """The lines of one submission's feedback about its lateness."""
         zone = self.deadline.tzinfo
         due = f"{time_text(lateness.deadline, zone)}{' (your extension)' if lateness.extended else ''}"
-        if not lateness.known:
+        if not lateness.known or lateness.time is None or lateness.time.when is None:
             return [
                 f"Late work: due {due}; this submission's time is not known, so no late penalty was applied.",
             ]
@@ -708,7 +708,7 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
             f"{course} is not a course folder of nbgrader's exchange (it has no inbound/): give "
             "--times-from-exchange EXCHANGE/COURSE_ID, e.g. /srv/nbgrader/exchange/course101."
         )
-    found = {}
+    found: dict = {}
     with os.scandir(inbound) as entries:
         for count, entry in enumerate(entries):
             if count >= MAX_INBOUND:

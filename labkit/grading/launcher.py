@@ -36,7 +36,7 @@ def _warm(exercises):
     from .options import GradeOptions
 
     scoring.load_registry(GradeOptions(exercises=exercises).exercises)
-    import scipy.interpolate  # noqa: F401 - the checks compare with it
+    import scipy.interpolate  # the checks compare with it
     import scipy.linalg  # noqa: F401
 
 

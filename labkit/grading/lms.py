@@ -409,7 +409,9 @@ def read_roster(path: str | os.PathLike) -> dict[str, str]:
             raise ValueError(f"the roster {path} has two '{name}' columns; keep one.")
     rows = _rows(text, path, delimiter, ROSTER_FIX)
     at_name, at_id = header.index("submission"), header.index("id")
-    roster, lines_of, names_of = {}, {}, {}
+    roster: dict = {}
+    lines_of: dict = {}
+    names_of: dict = {}
     for number, row in enumerate(rows[1:], start=2):
         if not any(cell.strip() for cell in row):
             continue
@@ -559,7 +561,7 @@ def _write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
     """Write `rows` as CSV: to a temporary file beside `path`, renamed into place when complete (checked by
     :func:`_check_outputs` first)."""
     path = Path(path)
-    handle = tempfile.NamedTemporaryFile(
+    handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
         "w", encoding="utf-8", newline="", dir=path.parent, prefix=f".{path.name}.", suffix=".tmp", delete=False
     )
     try:
@@ -739,7 +741,8 @@ def to_canvas(
                 f"{points_text(full_credit)}: the totals are written as they are."
             )
 
-    students, rows_of = {}, {}  # the key's value -> its row; and its row number
+    students: dict = {}  # the key's value -> its row
+    rows_of: dict = {}  # and its row number
     for number, row in enumerate(book.rows, start=2):
         if not row or book.kind(row) != "student":
             continue

@@ -23,15 +23,17 @@ class GradeOptions:
 
     cell_timeout: int = 60  # seconds per cell, and per call of a student's function
     total_timeout: int = 600  # seconds for one submission in all, every notebook of it together
-    seed: int = None  # the random test data's seed (a fresh one per run when None)
+    seed: int | None = None  # the random test data's seed (a fresh one per run when None)
     backend: str = backends.DEFAULT  # the sandbox backend's name (labkit.grading.backends; `--sandbox NAME`)
-    rubric: str = None  # the rubric's TOML file (None: the lab's own, labkit/grading/rubric.toml)
+    rubric: str | None = None  # the rubric's TOML file (None: the lab's own, labkit/grading/rubric.toml)
     limits: Limits = field(default_factory=Limits)  # the sandbox's resource limits
     grader_memory: int = 3 * 1024**3  # bytes of address space for the grader's own work on one submission
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
-    exercises: str = None  # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
+    # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
+    exercises: str | None = None
     fork_server: bool = True  # notebooks' workers forked from one warm server per run (labkit.grading.forkserver)
-    solutions: str = None  # the instructor notebooks' folder, a known source (labkit.grading.known); None: left out
+    # the instructor notebooks' folder, a known source (labkit.grading.known); None: left out
+    solutions: str | None = None
 
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):

@@ -118,7 +118,6 @@ class Progress:
             self._bar.update(self._task, completed=self.done)
             self._bar.refresh()
 
-    def __exit__(self, *exc: object) -> bool:
+    def __exit__(self, *exc: object) -> None:
         if self._bar is not None:
             self._bar.stop()
-        return False

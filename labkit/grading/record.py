@@ -66,7 +66,7 @@ class RunRecord:
     labkit: str
     seed: object
     rubric: dict
-    rubric_text: str = None
+    rubric_text: str | None = None
     submissions: dict = field(default_factory=dict)
     times: dict = field(default_factory=dict)  # source ("csv", "exchange") -> {name: ISO time}: the times given
     flags: dict = field(default_factory=dict)  # the run's switches that change grades ("times from submission", ...)

@@ -61,7 +61,7 @@ def _module_files(prefix):
 
 # the flags IPython compiles a cell's statements with (codeop's, which its CachingCompiler keeps), and the
 # __future__ features a notebook's earlier cells may have added to them
-CELL_FLAGS = codeop.PyCF_DONT_IMPLY_DEDENT | getattr(codeop, "PyCF_ALLOW_INCOMPLETE_INPUT", 0)
+CELL_FLAGS = codeop.PyCF_DONT_IMPLY_DEDENT | getattr(codeop, "PyCF_ALLOW_INCOMPLETE_INPUT", 0)  # type: ignore[attr-defined]
 
 
 @functools.cache

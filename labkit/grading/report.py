@@ -45,11 +45,11 @@ class SubmissionGrade:
     name: str
     results: dict = field(default_factory=dict)  # exercise -> grade dict from Registry.check
     problems: list = field(default_factory=list)  # what went wrong while running, per notebook
-    seed: int = None
+    seed: int | None = None
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
-    failure: str = None  # why the submission could not be graded at all (then it has no points, not zero)
+    failure: str | None = None  # why the submission could not be graded at all (then it has no points, not zero)
     answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
-    time: SubmissionTime = None  # when it was handed in (labkit.grading.late), None when no source had a time
+    time: SubmissionTime | None = None  # when it was handed in (labkit.grading.late), None when no source had a time
     # graded function -> the source of its definition (printable, at most MAX_SOURCE_CHARS), for the similarity
     # search (labkit.grading.similarity); never part of the grade
     sources: dict = field(default_factory=dict)

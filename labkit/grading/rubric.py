@@ -69,9 +69,9 @@ class Rubric:
     extra_credit: tuple = ()
     source: str = field(default="the lab's rubric", compare=False)
     registry: Registry = field(default=LAB, compare=False, repr=False)  # the exercises it grades
-    late: lateness.Late = None  # the deadline and what lateness costs, when the rubric has a [late] table
-    data: dict = field(default=None, compare=False, repr=False)  # the parsed TOML it was read from, as JSON data
-    text: str = field(default=None, compare=False, repr=False)  # the TOML text itself, when read from a file
+    late: lateness.Late | None = None  # the deadline and what lateness costs, when the rubric has a [late] table
+    data: dict | None = field(default=None, compare=False, repr=False)  # the parsed TOML it was read from, as JSON data
+    text: str | None = field(default=None, compare=False, repr=False)  # the TOML text itself, when read from a file
     # submission name -> the exercises whose held parts a person released ([held] release)
     released: dict = field(default_factory=dict)
     answers: dict = field(default_factory=dict)  # answer grade id -> the points a person gives it ([answers])

@@ -455,7 +455,7 @@ def scan(sources, names, profile, deadline=None):
     )
 
 
-_READERS = {}
+_READERS: dict = {}
 
 
 def _reader(sources, deadline):

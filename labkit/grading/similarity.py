@@ -149,7 +149,8 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
         grades = list(grades)
     except TypeError:
         raise ValueError(f"grades must be a list of SubmissionGrade; got {type(grades).__name__}.") from None
-    by_function, seen = {}, set()
+    by_function: dict = {}
+    seen: set = set()
     for index, grade in enumerate(grades):
         name, sources = getattr(grade, "name", None), getattr(grade, "sources", None)
         if not isinstance(name, str) or not isinstance(sources, dict):
@@ -192,7 +193,7 @@ def _clean(text):
     return printable(text)[:MAX_SOURCE_CHARS]
 
 
-_PACKAGED = {}  # the packaged release's boilerplate, computed once per process (Python's hash() is per process)
+_PACKAGED: dict = {}  # the packaged release's boilerplate, computed once per process (Python's hash() is per process)
 
 
 @dataclass(frozen=True)
@@ -330,7 +331,10 @@ def shares(fingerprints) -> np.ndarray:
     from scipy import sparse
 
     n = len(fingerprints)
-    columns, rows, cols, layout = {}, [], [], []
+    columns: dict = {}
+    rows: list = []
+    cols: list = []
+    layout: list = []
     for i, fingerprint in enumerate(fingerprints):
         where, which = [], []
         for h, positions in fingerprint.hash_idx.items():
@@ -343,17 +347,17 @@ def shares(fingerprints) -> np.ndarray:
         layout.append((np.asarray(where, dtype=float)[order], np.asarray(which, dtype=np.int64)[order]))
     index = sparse.csc_matrix((np.ones(len(rows), dtype=bool), (rows, cols)), shape=(n, max(len(columns), 1)))
     result = np.zeros((n, n))
-    for i, (where, which) in enumerate(layout):
+    for i, (spots, which) in enumerate(layout):
         has = index[:, which].toarray()  # has[j, a]: source j has the fingerprint at position a of source i
         has[i] = False
         others = np.flatnonzero(has.any(axis=1))
         if not len(others):
             continue
         has = has[others]
-        at = np.where(has, where, np.inf)
+        at = np.where(has, spots, np.inf)
         after = np.minimum.accumulate(at[:, ::-1], axis=1)[:, ::-1]  # the first shared position from a on
         following = np.concatenate([after[:, 1:], np.full((len(others), 1), np.inf)], axis=1)
-        covered = np.where(has, np.minimum(NOISE, following - where), 0.0).sum(axis=1)
+        covered = np.where(has, np.minimum(NOISE, following - spots), 0.0).sum(axis=1)
         result[i, others] = covered / fingerprints[i].token_coverage
     return result
 

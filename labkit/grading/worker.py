@@ -522,17 +522,17 @@ def warm(everything=False):
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot  # noqa: F401
+    import matplotlib.pyplot
     import numpy  # noqa: F401
 
     # `import labkit` no longer loads scipy, but the watch learns the exact types of compiled routines
     # (Cython's, f2py's) from the modules loaded when it is installed: scipy's must be among them
-    import scipy.linalg  # noqa: F401
+    import scipy.linalg
     import scipy.spatial  # noqa: F401
     from IPython.core.interactiveshell import InteractiveShell
     from traitlets.config import Config
 
-    import labkit  # noqa: F401
+    import labkit
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
 
     # what the lab's notebooks import too: paid once per fork server (labkit.grading.zygote); a worker of its

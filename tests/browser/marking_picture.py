@@ -10,10 +10,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from jupyterlab_session import CHROMIUM_FLAGS  # noqa: E402
-from playwright.sync_api import sync_playwright  # noqa: E402
+from jupyterlab_session import CHROMIUM_FLAGS
+from playwright.sync_api import sync_playwright
 
-from labkit.grading import marking, report, rubric  # noqa: E402
+from labkit.grading import marking, report, rubric
 
 ROOT = Path(__file__).resolve().parents[2]
 PICTURE = ROOT / "docs" / "images" / "marking.png"

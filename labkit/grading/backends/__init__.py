@@ -37,7 +37,7 @@ BUILTIN = tuple(
 )
 UNCONFINED = "none"  # the backend the old switches (--no-sandbox, sandboxed=False, confined=False) stand for
 
-_registered = {}  # name -> Backend subclass
+_registered: dict = {}  # name -> Backend subclass
 
 
 def register(cls):

@@ -206,7 +206,7 @@ class Box:
 class Backend(abc.ABC):
     """A way of running the grading worker in a sandbox: subclass it in ``backends/<name>.py``."""
 
-    name = None  # what `labkit grade --sandbox` and GradeOptions.backend call it
+    name: str | None = None  # what `labkit grade --sandbox` and GradeOptions.backend call it
     summary = ""  # one line for `labkit grade --help`
 
     @abc.abstractmethod
