@@ -50,7 +50,7 @@ def _calls_the_sandbox(item):
 
     functions = [getattr(item, "function", None)]
     info = getattr(item, "_fixtureinfo", None)
-    for definitions in (info.name2fixturedefs.values() if info else ()):
+    for definitions in info.name2fixturedefs.values() if info else ():
         functions += [definition.func for definition in definitions]
     for function in functions:
         try:
