@@ -95,7 +95,10 @@ class Experiment:
     lab expects the table to show (tests check that labkit's own table shows
     it). ``driver``, ``table`` and ``rate`` are the student's names, and
     ``weights`` their parts' weights. ``pieces`` are what the check hands the
-    driver after ``ndata`` and ``f``.
+    driver after ``ndata`` and ``f``. ``uses`` are the student's earlier
+    functions the driver calls by default (its ``f`` and pieces, and what
+    they call): every part of the experiment relies on them
+    (:attr:`labkit.exercises.model.Part.uses`).
     """
 
     key: str
@@ -107,6 +110,7 @@ class Experiment:
     pieces: tuple = ()
     ndata: tuple = convergence.DEFAULT_NDATA
     ntest: int = 4001
+    uses: tuple = ()
 
     @property
     def title(self):
@@ -158,6 +162,7 @@ class Experiment:
                 seeded=True,
                 refused=EXPERIMENTS,
                 passes=self.passes,
+                uses=self.uses,
                 experiment=self,
             ),
             ExperimentPart(
@@ -169,6 +174,7 @@ class Experiment:
                 refused=EXPERIMENTS,
                 passes=self.passes + self.f_slips,
                 functions=(self.table, self.driver),
+                uses=self.uses,
                 experiment=self,
             ),
             ExperimentPart(
@@ -180,6 +186,7 @@ class Experiment:
                 refused=EXPERIMENTS,
                 passes=self.passes + self.f_slips,
                 functions=(self.rate, self.driver),
+                uses=self.uses,
                 experiment=self,
             ),
         )

@@ -585,8 +585,21 @@ EXERCISES = (
         9,
         ("two_patches", "mirror", "region"),
         (
-            Part("two_patches", 10, check_two_patches, ("two_patches", CORNERS9)),
-            Part("region", 6, check_combined_mesh, ("region", CORNERS9, Optional("two_patches"))),
+            Part(
+                "two_patches",
+                10,
+                check_two_patches,
+                ("two_patches", CORNERS9),
+                keywords=(("coons", Optional("coons")),),
+                uses=("coons",),
+            ),
+            Part(
+                "region",
+                6,
+                check_combined_mesh,
+                ("region", CORNERS9, Optional("two_patches")),
+                uses=("two_patches", "coons"),
+            ),
         ),
         notebook="03_meshes.ipynb",
         answers=("why the mirror image's corner data make the two patches match",),

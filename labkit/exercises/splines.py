@@ -443,6 +443,7 @@ COMPLETE = Experiment(
     "rate_complete",
     weights=(5, 2, 2),
     pieces=(splines.ccspline,),
+    uses=("ccspline", "complete_system"),
 )
 NATURAL = Experiment(
     "natural",
@@ -452,6 +453,7 @@ NATURAL = Experiment(
     "rate_natural",
     weights=(2, 2, 2),
     pieces=(splines.ncspline,),
+    uses=("ncspline", "complete_system"),
 )
 NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot", weights=(3, 2, 2))
 
@@ -491,6 +493,7 @@ EXERCISES = (
                 keywords=(("system", Optional("complete_system")),),
                 seeded=True,
                 refused=INTERPOLANTS,
+                uses=("complete_system",),
             ),
         )
         + NATURAL.parts(),
