@@ -663,10 +663,18 @@ def check_experiment(method, errors, answer, fn):
     shrink; the rate must be the order the driver's errors support. Neither
     earns anything without a driver that runs: a table typed in from
     elsewhere, or a rate read off it, is not the student's experiment.
+
+    A table that does not shrink earns nothing only when the driver itself is
+    not real: when, given labkit's test function and pieces, it measures no
+    experiment either (:func:`honest_driver`). When it does, the table is what
+    the driver honestly measured with the student's own pieces, whose mistake
+    is marked in their own part: the table keeps its points, and the rate is
+    right when it is the order read off that table's ratios (as the lab reads
+    them) or the order the lab's experiment shows.
     """
     table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
     own = _own_errors(method, fn, table_result)
-    lab = None
+    lab, honest = None, False
     if own is None:
         rate_result.steps, rate_result.hint = list(table_result.steps), table_result.hint
     else:
@@ -675,7 +683,27 @@ def check_experiment(method, errors, answer, fn):
             lab = method.reference(method.ndata)
             for result in (table_result, rate_result):
                 judged_by_the_lab(result, why, LAB_EXPERIMENT)
-    return [_table(method, errors, own, table_result, lab), _rate(method, answer, errors, own, rate_result, lab)]
+        else:
+            honest = honest_driver(method, fn, own)
+    return [
+        _table(method, errors, own, table_result, lab, honest),
+        _rate(method, answer, errors, own, rate_result, lab, honest),
+    ]
+
+
+def honest_driver(method, fn, own):
+    """True when the student's driver `fn` is real but its own run `own` (with its own defaults) shows no
+    experiment: given labkit's test function and pieces it measures one (:func:`_measures`), so what makes its
+    errors stand still is in the student's functions it uses by default, which are checked in their own parts."""
+    if supported_order(method, own) is not None or not method.pieces:
+        return False
+    return _measures(method, fn, CheckResult(method.driver))
+
+
+HONEST = (
+    "your errors do not shrink, but your driver, given labkit's {pieces}, measures the experiment: the table is "
+    "what it honestly measured with your own functions, whose mistake is marked where they are checked"
+)
 
 
 def _printed(values, reference):
@@ -683,7 +711,7 @@ def _printed(values, reference):
     return bool(np.allclose(values, reference, rtol=PRINTED, atol=0))
 
 
-def _table(method, errors, own, result, lab=None):
+def _table(method, errors, own, result, lab=None, honest=False):
     if own is None:
         return result
     sizes = ", ".join(map(str, method.ndata))
@@ -726,6 +754,9 @@ def _table(method, errors, own, result, lab=None):
         )
         return result
     order = table_order(method, values)
+    if honest and order < MIN_ORDER:
+        result.step(HONEST.format(pieces=_pieces(method)), True)
+        return result
     if not result.step(
         f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across the table)",
         order >= MIN_ORDER,
@@ -792,7 +823,17 @@ def supported_order(method, errors):
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
 
 
-def _rate(method, answer, errors, own, result, lab=None):
+def _pieces(method):
+    """The functions a driver is given from labkit when it is checked, in words ('runge and eval_pherm')."""
+    return " and ".join(function.__name__ for function in (method.f(), *method.pieces))
+
+
+def _read_off(method, values):
+    """The order a table's ratios settle near, read as the lab reads them, shrinking or not."""
+    return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
+
+
+def _rate(method, answer, errors, own, result, lab=None, honest=False):
     """The rate answer: the exponent p with Err(n)/Err(2n-1) close to 2**p, read from the student's table.
 
     The table must be read from an experiment: the driver ran (`own` is what it
@@ -803,7 +844,7 @@ def _rate(method, answer, errors, own, result, lab=None):
     if own is None:
         return result
     description = "the rate is the exponent p of the power of two 2**p that your table's ratios settle near"
-    if supported_order(method, own) is None:
+    if supported_order(method, own) is None and not honest:
         return result.fail(
             description,
             _no_experiment(method, own, f"{method.driver}'s", "they show no experiment, so there is no rate to read"),
@@ -831,6 +872,10 @@ def _rate(method, answer, errors, own, result, lab=None):
             "off the ratios.",
         )
     supported = supported_order(method, values)
+    readings = {supported}
+    if supported is None and honest and _printed(values, own):  # the honest table: read off it, or the lab's
+        supported = _read_off(method, values)
+        readings = {supported, method.observed_order}
     if supported is None:
         return result.fail(
             description,
@@ -845,7 +890,7 @@ def _rate(method, answer, errors, own, result, lab=None):
             f"set {method.rate} to a whole number p: the ratios Err(41)/Err(81), ... are close to 2**p.",
         )
     p = int(round(number))
-    if p == supported:
+    if p in readings:
         result.step(description, True)
         return result
     exponent = p.bit_length() - 1 if p > 1 else None
