@@ -152,3 +152,63 @@ def test_the_sandbox_charges_the_issues_three_slips_once(tmp_path):
         failed = {(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]}
         assert failed == {(number, part)}, (entry.name, grade.feedback())
         assert grade.points[downstream] == rubric.points[downstream], grade.feedback()
+
+
+def check_toy(fn):  # a toy part's check, for the registry's validation below
+    return fn
+
+
+def test_a_part_that_uses_a_function_no_part_grades_is_refused():
+    from labkit.exercises.model import Exercise, Part
+    from labkit.exercises.registry import Registry
+
+    first = Exercise(40, ("toy",), (Part("toy", 1, check_toy, ("toy",)),), notebook="toy.ipynb")
+    later = Exercise(41, ("later",), (Part("later", 1, check_toy, ("later",), uses=("toy",)),), notebook="toy.ipynb")
+    assert Registry([first, later]).dependencies == [("later", "toy")]
+    stray = Exercise(41, ("later",), (Part("later", 1, check_toy, ("later",), uses=("nobody",)),), notebook="t.ipynb")
+    with pytest.raises(ValueError, match="'nobody', which no part grades"):
+        Registry([first, stray])
+    with pytest.raises(ValueError, match="tuple of the student's function names"):
+        Part("later", 1, check_toy, ("later",), uses="toy")
+
+
+def _hermite_driver(interpolate):
+    """A real driver of Exercise 3 (the lab's experiment with the pieces it is given), `interpolate` by default."""
+    import numpy as np
+
+    import labkit
+
+    def test_pherm_interpolate(ndata, f=labkit.runge, interpolate=interpolate):
+        xdata, xtest = np.linspace(0, 5, ndata), np.linspace(0, 5, 4001)
+        ydata, ypdata = f(xdata)
+        exact = f(xtest)[0]
+        return np.max(np.abs(exact - interpolate(xdata, ydata, ypdata, xtest))) / np.max(np.abs(exact))
+
+    return test_pherm_interpolate
+
+
+def test_an_honest_table_keeps_its_points_and_its_rate_is_read_off_it_or_the_labs():
+    import numpy as np
+
+    import labkit
+    from labkit import convergence
+    from labkit.exercises import experiments
+
+    method = LAB.experiment("pherm")
+    # values and slopes swapped: the errors stand still, but the driver is real
+    driver = _hermite_driver(lambda x, y, yp, xv: labkit.eval_pherm(x, yp, y, xv))
+    errors = [driver(n) for n in method.ndata]
+    assert experiments.supported_order(method, errors) is None  # the table shows no experiment
+    read_off = int(np.rint(np.mean(np.log2(np.asarray(errors[-4:-1]) / np.asarray(errors[-3:])))))
+    lab = convergence.convergence_table("pherm", list(method.ndata), labkit.runge).order
+    for answer in {read_off, lab}:
+        table, rate = experiments.check_experiment(method, errors, answer, driver)
+        assert table.passed and rate.passed, (table, rate)
+        assert "measures the experiment" in repr(table)
+    wrong = next(p for p in range(-3, 9) if p not in {read_off, lab})
+    table, rate = experiments.check_experiment(method, errors, wrong, driver)
+    assert table.passed and not rate.passed
+    # the same table next to a driver that ignores the pieces it is given is no experiment: it earns nothing
+    fake = lambda n, *rest: driver(n)  # noqa: E731
+    table, rate = experiments.check_experiment(method, errors, read_off, fake)
+    assert not table.passed and not rate.passed and "shows no experiment" in repr(table)
