@@ -21,7 +21,9 @@ things, so one check of each kind serves every method:
 The table and the rate are checked together (:func:`experiment`), against
 one run of the student's driver: neither earns a point without a driver that
 runs and whose errors shrink, so a table typed in from elsewhere, and a rate
-read off it, earn nothing.
+read off it, earn nothing. The one exception is a real driver (given labkit's
+pieces, it measures the experiment: :func:`honest_driver`) whose errors stand
+still with the student's own pieces: its table is what it honestly measured.
 
 The pieces a driver builds on (the Runge function, the interpolant or the
 spline's slopes) are handed to it by the check, from labkit, so a mistake in
