@@ -133,7 +133,7 @@ def test_the_lab_still_charges_a_table_whose_driver_is_not_real(tmp_path_factory
 
 # the three double charges, graded in the sandbox: (the slip, the upstream part, the exercise it cost too)
 GRADED = (
-    (_also("coons_without_twists", *OWN_COONS), (5, "coons"), 9),
+    (_also("coons_dc_from_c_to_d", *OWN_COONS), (5, "coons"), 9),
     (_also("complete_h_subscript", *SLOPES_FROM_9), (10, "ccspline"), 12),
     (BY_NAME["wrong_denominator"], (2, "eval_pherm"), 3),
 )
