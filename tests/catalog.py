@@ -267,7 +267,6 @@ MISTAKES = (
         2,
         "eval_pherm",
         "denominator",
-        also=((3, "errors_pherm"), (3, "rate_pherm")),
     ),
     Planted(
         "basis_with_the_wrong_sign",
@@ -284,7 +283,6 @@ MISTAKES = (
         2,
         "eval_pherm",
         "values and the slopes are swapped",
-        also=((3, "errors_pherm"), (3, "rate_pherm")),
     ),
     Planted(
         "one_interval_for_every_point",
@@ -293,7 +291,6 @@ MISTAKES = (
         2,
         "eval_pherm",
         "one interval works but several do not",
-        also=((3, "errors_pherm"), (3, "rate_pherm")),
     ),
     # Exercise 3: runge, the driver, the table, the rate
     Planted(

@@ -17,7 +17,8 @@ RUBRIC = default()
 SEED = 20261201
 # grades.csv of this very class and seed, graded before the exercises were declared once (issue 20): the
 # refactoring changed where things are declared, not one grade; issue 30's slips added their rows at the end,
-# and every earlier row is as it was
+# and its "charged once" gave back Exercise 3's table and rate to the three wrong eval_pherm whose honest
+# driver's table stands still (wrong_denominator, values_and_slopes_swapped, one_interval_for_every_point)
 BEFORE = Path(__file__).with_name("data") / "catalog_grades_seed20261201.csv"
 RUN = {}
 

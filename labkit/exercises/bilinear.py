@@ -228,6 +228,7 @@ BILINEAR = Experiment(
     "errors_bilinear",
     "rate_bilinear",
     pieces=(bilinear.eval_pbilin,),
+    uses=("eval_pbilin", "runge2d"),
     ndata=(11, 21, 41, 81, 161),
     ntest=401,
 )

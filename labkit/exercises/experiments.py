@@ -21,7 +21,9 @@ things, so one check of each kind serves every method:
 The table and the rate are checked together (:func:`experiment`), against
 one run of the student's driver: neither earns a point without a driver that
 runs and whose errors shrink, so a table typed in from elsewhere, and a rate
-read off it, earn nothing.
+read off it, earn nothing. The one exception is a real driver (given labkit's
+pieces, it measures the experiment: :func:`honest_driver`) whose errors stand
+still with the student's own pieces: its table is what it honestly measured.
 
 The pieces a driver builds on (the Runge function, the interpolant or the
 spline's slopes) are handed to it by the check, from labkit, so a mistake in
@@ -95,7 +97,10 @@ class Experiment:
     lab expects the table to show (tests check that labkit's own table shows
     it). ``driver``, ``table`` and ``rate`` are the student's names, and
     ``weights`` their parts' weights. ``pieces`` are what the check hands the
-    driver after ``ndata`` and ``f``.
+    driver after ``ndata`` and ``f``. ``uses`` are the student's earlier
+    functions the driver calls by default (its ``f`` and pieces, and what
+    they call): every part of the experiment relies on them
+    (:attr:`labkit.exercises.model.Part.uses`).
     """
 
     key: str
@@ -107,6 +112,7 @@ class Experiment:
     pieces: tuple = ()
     ndata: tuple = convergence.DEFAULT_NDATA
     ntest: int = 4001
+    uses: tuple = ()
 
     @property
     def title(self):
@@ -158,6 +164,7 @@ class Experiment:
                 seeded=True,
                 refused=EXPERIMENTS,
                 passes=self.passes,
+                uses=self.uses,
                 experiment=self,
             ),
             ExperimentPart(
@@ -169,6 +176,7 @@ class Experiment:
                 refused=EXPERIMENTS,
                 passes=self.passes + self.f_slips,
                 functions=(self.table, self.driver),
+                uses=self.uses,
                 experiment=self,
             ),
             ExperimentPart(
@@ -180,6 +188,7 @@ class Experiment:
                 refused=EXPERIMENTS,
                 passes=self.passes + self.f_slips,
                 functions=(self.rate, self.driver),
+                uses=self.uses,
                 experiment=self,
             ),
         )
@@ -656,10 +665,18 @@ def check_experiment(method, errors, answer, fn):
     shrink; the rate must be the order the driver's errors support. Neither
     earns anything without a driver that runs: a table typed in from
     elsewhere, or a rate read off it, is not the student's experiment.
+
+    A table that does not shrink earns nothing only when the driver itself is
+    not real: when, given labkit's test function and pieces, it measures no
+    experiment either (:func:`honest_driver`). When it does, the table is what
+    the driver honestly measured with the student's own pieces, whose mistake
+    is marked in their own part: the table keeps its points, and the rate is
+    right when it is the order read off that table's ratios (as the lab reads
+    them) or the order the lab's experiment shows.
     """
     table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
     own = _own_errors(method, fn, table_result)
-    lab = None
+    lab, honest = None, False
     if own is None:
         rate_result.steps, rate_result.hint = list(table_result.steps), table_result.hint
     else:
@@ -668,7 +685,27 @@ def check_experiment(method, errors, answer, fn):
             lab = method.reference(method.ndata)
             for result in (table_result, rate_result):
                 judged_by_the_lab(result, why, LAB_EXPERIMENT)
-    return [_table(method, errors, own, table_result, lab), _rate(method, answer, errors, own, rate_result, lab)]
+        else:
+            honest = honest_driver(method, fn, own)
+    return [
+        _table(method, errors, own, table_result, lab, honest),
+        _rate(method, answer, errors, own, rate_result, lab, honest),
+    ]
+
+
+def honest_driver(method, fn, own):
+    """True when the student's driver `fn` is real but its own run `own` (with its own defaults) shows no
+    experiment: given labkit's test function and pieces it measures one (:func:`_measures`), so what makes its
+    errors stand still is in the student's functions it uses by default, which are checked in their own parts."""
+    if supported_order(method, own) is not None or not method.pieces:
+        return False
+    return _measures(method, fn, CheckResult(method.driver))
+
+
+HONEST = (
+    "your errors do not shrink, but your driver, given labkit's {pieces}, measures the experiment: the table is "
+    "what it honestly measured with your own functions, whose mistake is marked where they are checked"
+)
 
 
 def _printed(values, reference):
@@ -676,7 +713,7 @@ def _printed(values, reference):
     return bool(np.allclose(values, reference, rtol=PRINTED, atol=0))
 
 
-def _table(method, errors, own, result, lab=None):
+def _table(method, errors, own, result, lab=None, honest=False):
     if own is None:
         return result
     sizes = ", ".join(map(str, method.ndata))
@@ -719,6 +756,9 @@ def _table(method, errors, own, result, lab=None):
         )
         return result
     order = table_order(method, values)
+    if honest and order < MIN_ORDER:
+        result.step(HONEST.format(pieces=_pieces(method)), True)
+        return result
     if not result.step(
         f"the errors shrink as ndata grows (an observed order of at least {MIN_ORDER} across the table)",
         order >= MIN_ORDER,
@@ -785,7 +825,17 @@ def supported_order(method, errors):
     return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
 
 
-def _rate(method, answer, errors, own, result, lab=None):
+def _pieces(method):
+    """The functions a driver is given from labkit when it is checked, in words ('runge and eval_pherm')."""
+    return " and ".join(function.__name__ for function in (method.f(), *method.pieces))
+
+
+def _read_off(method, values):
+    """The order a table's ratios settle near, read as the lab reads them, shrinking or not."""
+    return convergence.ConvergenceTable(method.title, np.array(method.ndata), values).order
+
+
+def _rate(method, answer, errors, own, result, lab=None, honest=False):
     """The rate answer: the exponent p with Err(n)/Err(2n-1) close to 2**p, read from the student's table.
 
     The table must be read from an experiment: the driver ran (`own` is what it
@@ -796,7 +846,7 @@ def _rate(method, answer, errors, own, result, lab=None):
     if own is None:
         return result
     description = "the rate is the exponent p of the power of two 2**p that your table's ratios settle near"
-    if supported_order(method, own) is None:
+    if supported_order(method, own) is None and not honest:
         return result.fail(
             description,
             _no_experiment(method, own, f"{method.driver}'s", "they show no experiment, so there is no rate to read"),
@@ -824,6 +874,10 @@ def _rate(method, answer, errors, own, result, lab=None):
             "off the ratios.",
         )
     supported = supported_order(method, values)
+    readings = {supported}
+    if supported is None and honest and _printed(values, own):  # the honest table: read off it, or the lab's
+        supported = _read_off(method, values)
+        readings = {supported, method.observed_order}
     if supported is None:
         return result.fail(
             description,
@@ -838,7 +892,7 @@ def _rate(method, answer, errors, own, result, lab=None):
             f"set {method.rate} to a whole number p: the ratios Err(41)/Err(81), ... are close to 2**p.",
         )
     p = int(round(number))
-    if p == supported:
+    if p in readings:
         result.step(description, True)
         return result
     exponent = p.bit_length() - 1 if p > 1 else None

@@ -414,6 +414,7 @@ PHERM = Experiment(
     "rate_pherm",
     weights=(6, 3, 3),
     pieces=(piecewise.eval_pherm,),
+    uses=("eval_pherm", "runge"),
 )
 
 EXERCISES = (
@@ -447,6 +448,7 @@ EXERCISES = (
                 7,
                 check_limacon_plot,
                 ("ax4", Together(("tdata", "xdata", "ydata", "xpdata", "ypdata"), required=False)),
+                uses=("limacon_derivatives",),
             ),
         ),
         notebook="01_limacon.ipynb",

@@ -157,6 +157,12 @@ class Part:
     what is switched off while the grader calls the student's functions for
     this part; ``functions`` are the student's functions the part calls, when
     not just the one named like it (the grader scans their source).
+
+    ``uses`` are the student's earlier functions that the part's check, or the
+    student's code under it, relies on (``two_patches`` calls the student's
+    ``coons``): each is graded in a part of its own (some part's ``name`` or
+    ``functions``), and a slip in it is charged there only, so the check
+    protects itself from it (:attr:`labkit.exercises.registry.Registry.dependencies`).
     """
 
     name: str
@@ -169,11 +175,14 @@ class Part:
     functions: tuple = ()
     passes: tuple = ()
     keywords: tuple = ()  # (keyword, spec) pairs: notebook names handed to the check by keyword
+    uses: tuple = ()  # the student's earlier functions this part relies on, each graded in a part of its own
 
     def __post_init__(self):
         facade_name(self.check)
         if int(self.weight) < 0:
             raise ValueError(f"part {self.name!r} has a negative weight {self.weight}.")
+        if isinstance(self.uses, str) or not all(isinstance(name, str) for name in self.uses):
+            raise ValueError(f"part {self.name!r}: uses must be a tuple of the student's function names, as strings.")
 
     @property
     def scanned(self) -> tuple:

@@ -69,6 +69,9 @@ class Registry:
         ``labkit.check`` name -> the check function.
     experiments : dict
         The convergence experiments by key.
+    dependencies : list
+        ``(part, upstream)`` pairs of part names: `part` relies on the student's function graded in
+        `upstream` (:attr:`~labkit.exercises.model.Part.uses`), so a slip there is charged in `upstream` only.
     """
 
     def __init__(self, exercises: Iterable[Exercise], source: str | None = None):
@@ -98,6 +101,7 @@ class Registry:
             for function in part.passes:
                 _check_passable(function, part.name)
         self.passable = frozenset(function_name(f) for p in parts for f in p.passes)
+        self.dependencies = _dependencies(parts)
         self.experiments: dict = {}
         for part in parts:
             experiment = getattr(part, "experiment", None)
@@ -128,6 +132,13 @@ class Registry:
         for exercise in self:
             found.setdefault(exercise.notebook, []).append(exercise.number)
         return found
+
+    def upstream(self, part: str) -> list:
+        """The parts whose student's functions part `part` relies on (ValueError for an unknown part)."""
+        known = {p.name for e in self for p in e.parts}
+        if part not in known:
+            raise ValueError(f"no part is named {part!r}; choose one of {', '.join(map(repr, sorted(known)))}.")
+        return [upstream for dependent, upstream in self.dependencies if dependent == part]
 
     def experiment(self, key: str):
         """The convergence experiment `key`; ValueError naming the choices otherwise."""
@@ -193,6 +204,27 @@ class Registry:
             "defined": defined,
             "checks": checks,
         }
+
+
+def _dependencies(parts) -> list:
+    """(part, upstream part) name pairs from the parts' ``uses``, in the order they are declared; ValueError for
+    a name no part grades."""
+    graded: dict = {}
+    for part in parts:
+        for name in part.scanned:
+            graded.setdefault(name, part.name)
+    found = []
+    for part in parts:
+        for name in part.uses:
+            if name not in graded:
+                raise ValueError(
+                    f"part {part.name!r} uses {name!r}, which no part grades: name a function some part "
+                    "checks (its name or one of its functions), or declare the part that grades it."
+                )
+            pair = (part.name, graded[name])
+            if graded[name] != part.name and pair not in found:
+                found.append(pair)
+    return found
 
 
 def _check_passable(function, part: str) -> None:

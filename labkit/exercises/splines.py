@@ -382,21 +382,29 @@ def _own_natural(fn, system, seed):
     if system is None:
         return None
     scratch, differs, why = CheckResult("ncspline"), False, ""
+    sides = [True, False]  # the slopes from (8) at every knot but the last, or from (9) at every knot but the first
     for x, y in ((np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 2.0, 4.0, 6.0])), _ncspline_data(seed)):
         ok, given = call(scratch, "complete_system", system, x, y, 0.0, 0.0)
         if not ok:
             return None
         why = why or spline_system(given, x, y)
-        try:
-            with np.errstate(all="ignore"):
-                own = _natural_slopes(x, y, system=given)
-        except (TypeError, ValueError, IndexError, np.linalg.LinAlgError):
-            return None
-        if not np.all(np.isfinite(own)):
-            return None  # the student's system gives no spline: the usual check decides
-        differs = differs or not close(own, splines.ncspline(x, y))
         ok, slopes = call(scratch, "ncspline", fn, x, y)
-        if not ok or not close(slopes, own):
+        if not ok:
+            return None
+        followed = []
+        for first_left in sides:
+            try:
+                with np.errstate(all="ignore"):
+                    own = _natural_slopes(x, y, system=given, first_left=first_left)
+            except (TypeError, ValueError, IndexError, np.linalg.LinAlgError):
+                return None
+            if not np.all(np.isfinite(own)):
+                return None  # the student's system gives no spline: the usual check decides
+            if close(slopes, own):
+                followed.append(first_left)
+                differs = differs or not close(own, splines.ncspline(x, y))
+        sides = followed  # the same side in every case
+        if not sides:
             return None
     if why and differs:
         return why
@@ -418,9 +426,13 @@ def _flipped_ends(D, D_ref):
     ]
 
 
-def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None):
+def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None, first_left=True):
     """The slopes a natural spline comes out with when its end rows are set in A and/or in D (the usual slips),
-    from the complete spline's system: labkit's, or `system` (A, D) as the student's complete_system gave it."""
+    from the complete spline's system: labkit's, or `system` (A, D) as the student's complete_system gave it.
+
+    The slopes are read from the second derivatives M by equation (8) at every knot but the last and (9) there
+    (`first_left`), or by (8) at the first knot and (9) at every other: the lab allows both, and they agree
+    only when M is a spline's."""
     A, D = _reference_complete_system(x, y, 0.0, 0.0) if system is None else (floats(a).copy() for a in system)
     if rows_in_a:
         A[0, :], A[-1, :] = 0.0, 0.0
@@ -430,8 +442,12 @@ def _natural_slopes(x, y, rows_in_a=True, rows_in_d=True, system=None):
     M = np.linalg.solve(A, D)
     h, secant = np.diff(x), np.diff(y) / np.diff(x)
     slopes = np.empty_like(x)
-    slopes[:-1] = -M[:-1] * h / 3 - M[1:] * h / 6 + secant
-    slopes[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]
+    if first_left:
+        slopes[:-1] = -M[:-1] * h / 3 - M[1:] * h / 6 + secant
+        slopes[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]
+    else:
+        slopes[1:] = M[1:] * h / 3 + M[:-1] * h / 6 + secant
+        slopes[0] = -M[0] * h[0] / 3 - M[1] * h[0] / 6 + secant[0]
     return slopes
 
 
@@ -443,6 +459,7 @@ COMPLETE = Experiment(
     "rate_complete",
     weights=(5, 2, 2),
     pieces=(splines.ccspline,),
+    uses=("ccspline", "complete_system"),
 )
 NATURAL = Experiment(
     "natural",
@@ -452,6 +469,7 @@ NATURAL = Experiment(
     "rate_natural",
     weights=(2, 2, 2),
     pieces=(splines.ncspline,),
+    uses=("ncspline", "complete_system"),
 )
 NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot", weights=(3, 2, 2))
 
@@ -491,6 +509,7 @@ EXERCISES = (
                 keywords=(("system", Optional("complete_system")),),
                 seeded=True,
                 refused=INTERPOLANTS,
+                uses=("complete_system",),
             ),
         )
         + NATURAL.parts(),
