@@ -411,7 +411,7 @@ def test_the_phi_table_is_checked_against_the_definition():
     result = check.phi_table(shifted)
     assert not result.passed and "numbered in another order" in result.hint
     averaged = check.phi_table(np.full((4, 4), 0.25))
-    assert not averaged.passed and "vanishes at three corners" in averaged.hint
+    assert not averaged.passed and "put the corner's x and y into every factor" in averaged.hint
     assert not check.phi_table(np.eye(3)).passed
 
 
