@@ -286,7 +286,9 @@ def linked_docs():
 def test_the_answer_key_lists_each_asked_for_answer_computed_from_labkit():
     key = LAB.answer_key()
     for experiment in LAB.experiments.values():
-        number = next(n for n, e in LAB.exercises.items() if any(getattr(p, "experiment", None) is experiment for p in e.parts))
+        number = next(
+            n for n, e in LAB.exercises.items() if any(getattr(p, "experiment", None) is experiment for p in e.parts)
+        )
         assert f"order {experiment.order}" in key[number] and f"O(h^{experiment.order})" in key[number]
         assert experiment.order == experiment.observed_order  # the key's order is what labkit's table shows
         # each error of labkit's table, as labkit.ratio_table prints it, is in the key

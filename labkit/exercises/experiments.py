@@ -863,8 +863,7 @@ def _rate(method, answer, errors, own, result, lab=None):
         return result.fail(
             description,
             f"got {p}, a power of two: if you copied a ratio Err(n)/Err(2n-1), that is 2**p itself",
-            "the rate is not a ratio of your table but the exponent p of the power of two 2**p the ratios "
-            "settle near.",
+            "the rate is not a ratio of your table but the exponent p of the power of two 2**p the ratios settle near.",
         )
     return result.fail(
         description,

@@ -11,7 +11,6 @@ polynomials a cubic Hermite interpolant must reproduce exactly.
 import numpy as np
 
 from .. import functions, piecewise
-from .answer_key import values
 from .experiments import Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part, Together
 from .plotted import check_limacon_plot, derivative_slips
@@ -325,7 +324,9 @@ def check_runge(fn, seed=None):
             "check the sign the chain rule gives for the derivative of 1/u.",
         )
     if not result.step(
-        "yprime is the derivative of 1/(1+x^2)", close(out[1], yprime), "" if close(out[1], yprime) else worst(out[1], yprime)
+        "yprime is the derivative of 1/(1+x^2)",
+        close(out[1], yprime),
+        "" if close(out[1], yprime) else worst(out[1], yprime),
     ):
         unsquared = close(out[1], yprime * (1 + x**2))  # -2x / (1 + x^2): the chain rule's square left out
         result.hint = (

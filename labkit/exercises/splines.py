@@ -522,7 +522,9 @@ EXERCISES = (
         withheld=NATURAL_ROWS + NATURAL_WHY + NATURAL.withheld,
     ),
     Exercise(
-        13, NOTAKNOT.names(), NOTAKNOT.parts(),
+        13,
+        NOTAKNOT.names(),
+        NOTAKNOT.parts(),
         notebook="04_splines.ipynb",
         answers=("the three splines compared",),
         withheld=NOTAKNOT.withheld,
