@@ -267,9 +267,12 @@ def check_texts():
     return texts
 
 
+STUDENT_DOCS = ("docs/students.md", "docs/library.md")  # what the README points students to
+
+
 def linked_docs():
-    """The files of this repository the release's markdown links to (docs pages, README, ...)."""
-    found = []
+    """The students' docs, and the files of this repository the release's markdown links to."""
+    found = [(f"{name} (the students' docs)", (ROOT / name).read_text(encoding="utf-8")) for name in STUDENT_DOCS]
     for where, text in release_texts():
         for target in re.findall(r"\]\(([^)#\s]+)", text) + re.findall(r"\bdocs/[\w./-]+\.md\b", text):
             if target.startswith(("http:", "https:")):
