@@ -327,6 +327,21 @@ def test_the_scan_finds_a_planted_give_away():
     assert not giveaways([("hint", "the rate is the exponent p of the power of two 2**p the ratios settle near")])
 
 
+def test_the_scan_finds_the_answers_in_the_solutions_the_release_strips():
+    for path in sorted(INSTRUCTOR.glob("*.ipynb")):
+        cells = nbformat.read(path, as_version=4).cells
+        solutions = [
+            (f"{path.name} cell {i}", c.source) for i, c in enumerate(cells) if "### BEGIN SOLUTION" in c.source
+        ]
+        assert giveaways(solutions), f"{path.name}'s solutions state none of the answer key"
+    runge = next(
+        c.source
+        for c in nbformat.read(INSTRUCTOR / "02_convergence.ipynb", as_version=4).cells
+        if "def runge" in c.source
+    )
+    assert any("exercise 3's" in found for found in giveaways([("the solution of 3(a)", runge)]))
+
+
 def test_the_release_notebooks_give_nothing_away():
     assert_clean(release_texts())
 

@@ -9,7 +9,7 @@ notebook, a hint or a figure would ("order 4", "O(h^4)", "fourth-order",
 worked out from labkit's references when the key is asked for, never typed
 in. :func:`normal` is how both the key and the scanned texts are compared.
 
->>> "o(h^4)" in [normal(text) for text in orders(4)]
+>>> normal("O(h**4)") in [normal(text) for text in orders(4)]
 True
 >>> normal("-2*x / (1 + x**2)**2") == normal("−2x/(1+x^2)^2")
 True
@@ -22,14 +22,17 @@ from collections.abc import Callable, Iterable
 
 ORDINALS = {1: "first", 2: "second", 3: "third", 4: "fourth", 5: "fifth", 6: "sixth"}
 # dropped before comparing: spacing, multiplication signs, grouping, LaTeX's backslashes, numpy's prefixes
+_WHOLE = re.compile(r"(\d)\.0+(?![\d])")
 _DROPPED = re.compile(r"[\s*(){}\\$]|np\.|numpy\.|math\.")
 
 
 def normal(text: str) -> str:
     """`text` as the release scan compares it: lower case, one minus sign, ``^`` for powers, no spacing,
-    no multiplication signs or brackets (so ``-2*x/(1+x**2)**2`` and ``−2x/(1+x^2)^2`` read alike)."""
+    no multiplication signs or brackets, whole numbers without ``.0`` (so ``-2.0*x/(1+x**2)**2`` and
+    ``−2x/(1+x^2)^2`` read alike)."""
     text = str(text).lower().replace("\u2212", "-").replace("\u2013", "-").replace("**", "^")
     text = text.replace("\\left", "").replace("\\right", "").replace("\\cdot", "").replace("\\,", "")
+    text = _WHOLE.sub(r"\1", text)  # 2.0 * x reads as 2x
     return _DROPPED.sub("", text)
 
 
@@ -62,7 +65,7 @@ def orders(order: int, rate: str | None = None) -> tuple:
         word = ORDINALS[p]
         found += [f"{word} order", f"{word}-order"]
     if rate:
-        found += [f"{rate} = {p}", f"{rate}={p}"]
+        found += [f"{rate} = {p}", f"{rate} == {p}"]
     return tuple(found)
 
 
