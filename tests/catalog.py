@@ -386,7 +386,7 @@ MISTAKES = (
         (("rate_pherm = 4\n", "rate_pherm = 16\n"),),
         3,
         "rate_pherm",
-        "the ratio Err(n)/Err(2n-1) itself",
+        "if you copied a ratio Err(n)/Err(2n-1)",
         keep_rates=True,
     ),
     Planted(
@@ -499,7 +499,7 @@ MISTAKES = (
         (("Corner(PD, PC - PD, PD - PA, twist)", "Corner(PD, PC - PD, PC - PB, twist)"),),
         7,
         "straight",
-        "vector along that side",
+        "D's dt (along AD) bends its side",
         was="generic",
     ),
     Planted(

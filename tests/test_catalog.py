@@ -107,3 +107,19 @@ def test_every_slip_costs_exactly_its_part_and_is_named(graded, entry):
 def test_the_same_seed_gives_the_same_grades_csv_as_before_the_exercises_were_declared_once(graded):
     assert (RUN["out"] / "seed.txt").read_text().strip() == str(SEED)
     assert (RUN["out"] / "grades.csv").read_text(encoding="utf-8") == BEFORE.read_text(encoding="utf-8")
+
+
+def test_no_feedback_gives_an_answer_away(graded):
+    """The release scan (tests/test_giveaways.py) over the feedback of every graded slip and variation: step names,
+    details and hints, the student's own values ("got ...") left out; the answers in words are the student's."""
+    from test_giveaways import OWN, giveaways
+
+    texts = []
+    for name, grade in graded.items():
+        for number, verdict in grade.results.items():
+            for check in verdict["checks"]:
+                where = f"{name}: exercise {number}, {check['name']}"
+                texts.append((f"{where} (hint)", check["hint"]))
+                texts += [(where, OWN.sub("got (yours)", f"{s['step']}: {s['detail']}")) for s in check["steps"]]
+    found = sorted(set(giveaways(texts)))
+    assert not found, f"{len(found)} give-aways:\n" + "\n".join(found)

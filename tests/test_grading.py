@@ -184,7 +184,7 @@ PLANTED = [
         "rate_complete = 8",
         11,
         "rate_complete",
-        "take the ratios",
+        "the exponent p of the power of two",
     ),
     (
         "data_joined",

@@ -926,7 +926,7 @@ def test_the_notebooks_filter_refuses_memfd_keyrings_ptrace_threads_and_signal_h
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert run.returncode == 0, run.stderr
-    seen = eval(run.stdout)  # noqa: S307 - our own child's dict of numbers and words
+    seen = eval(run.stdout)
     assert all(seen[name] == (-1, 1) for name in ("add_key", "keyctl", "ptrace", "memfd_create")), seen
     assert seen["thread"] == "refused" and seen["sigaction"] == "refused"  # and fork still works (above)
     assert seccomp.program("sparc") is None

@@ -215,11 +215,25 @@ def check_phi_table(table):
             )
         else:
             result.hint = (
-                "evaluate each phi_m at each corner P_n from its formula: a factor such as (x1 - x) is 0 "
-                "on the side x = x1, so each phi_m vanishes at three corners."
+                "evaluate each phi_m at each corner P_n from its formula, one entry at a time: put the "
+                "corner's x and y into every factor, such as (x1 - x)."
             )
     return result
 
+
+# Exercise 16(a): what the table of phi_m(P_n) shows, in the words an explanation would use
+PHI_RULE = (
+    "identity matrix",
+    "np.eye(4)",
+    "kronecker",
+    "delta_mn",
+    "delta_{mn}",
+    "vanishes at three corners",
+    "vanishes at the other three",
+    "1 at its own corner",
+    "1 if m = n",
+    "1 when m = n",
+)
 
 BILINEAR = Experiment(
     "bilinear",
@@ -256,5 +270,6 @@ EXERCISES = (
             "16(a): why the phi table makes I the bilinear interpolant",
             "the order, against piecewise linear in one dimension",
         ),
+        withheld=PHI_RULE + BILINEAR.withheld,
     ),
 )

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import bilinear, convergence, functions, piecewise, splines
+from . import answer_key
 from .model import EXPERIMENTS, Part
 from .result import CheckResult, call, case_rng, floats, judged_by_the_lab, shown
 
@@ -145,6 +146,12 @@ class Experiment:
     def observed_order(self):
         """The order labkit's own table shows (the declared ``order`` must be it)."""
         return _reference_order(self)
+
+    @property
+    def withheld(self):
+        """What the experiment asks the student to find, for the exercise's ``withheld``: the order (as a text
+        would state it, and as the rate answer) and labkit's table (as it prints), computed when asked for."""
+        return answer_key.orders(self.order, self.rate) + (answer_key.values(lambda: self.reference(self.ndata)),)
 
     def parts(self):
         """The experiment's three parts: the driver, the table and the rate answer.
@@ -502,7 +509,7 @@ def check_driver(method, fn, seed=None):
         if not result.step(
             f"Err({ndata}) = max|f - p| / max|f| on {where}",
             _agrees(err, expected),
-            f"got {shown(err)}, expected {expected:.6e}",
+            f"got {shown(err)}, {_how_far(err, expected)}",
         ):
             slip = _diagnosis(method, err, ndata)
             result.hint = (
@@ -521,7 +528,7 @@ def check_driver(method, fn, seed=None):
     if not result.step(
         f"the error is relative to max|f|, for f = {other} too",
         _agrees(err, expected),
-        f"got {shown(err)}, expected {expected:.6e}",
+        f"got {shown(err)}, {_how_far(err, expected)}",
     ):
         number = _number(err)
         tripled = number is not None and abs(number - 3 * expected) <= DRIVER_TOLERANCE * 3 * expected
@@ -532,6 +539,16 @@ def check_driver(method, fn, seed=None):
             else "compute f from the function passed in as `f`, not from runge itself."
         )
     return result
+
+
+def _how_far(err, expected):
+    """How a driver's error misses the lab's, without saying the lab's (which is a row of the student's table)."""
+    number = _number(err)
+    if number is None or not np.isfinite(number) or expected <= 0:
+        return "which is not a relative error of the lab's experiment"
+    if number <= 0:
+        return "but an error of an interpolant that does not reproduce f exactly is positive"
+    return f"{'larger' if number > expected else 'smaller'} than the lab's experiment gives at this size"
 
 
 def table_order(method, errors):
@@ -896,11 +913,11 @@ def _rate(method, answer, errors, own, result, lab=None, honest=False):
         result.step(description, True)
         return result
     exponent = p.bit_length() - 1 if p > 1 else None
-    if exponent is not None and p == 2**exponent and exponent == supported:
+    if exponent is not None and p == 2**exponent and p > 2:  # any power of two: saying which would tell the rate
         return result.fail(
             description,
-            f"got {p}, which is the ratio Err(n)/Err(2n-1) itself",
-            f"the rate is the exponent p that gives {p} = 2**p.",
+            f"got {p}, a power of two: if you copied a ratio Err(n)/Err(2n-1), that is 2**p itself",
+            "the rate is not a ratio of your table but the exponent p of the power of two 2**p the ratios settle near.",
         )
     return result.fail(
         description,

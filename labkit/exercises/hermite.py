@@ -318,12 +318,15 @@ def check_runge(fn, seed=None):
         return result
     if _sign_slip(out[1], yprime):
         return result.fail(
-            "yprime = -2x/(1+x^2)^2",
+            "yprime is the derivative of 1/(1+x^2)",
             "yprime has the wrong sign",
-            "yprime has the wrong sign: the derivative of 1/(1+x^2) is -2x/(1+x^2)^2 (chain rule).",
+            "yprime has the wrong sign: 1/(1+x^2) falls for x > 0, so its derivative must be negative there; "
+            "check the sign the chain rule gives for the derivative of 1/u.",
         )
     if not result.step(
-        "yprime = -2x/(1+x^2)^2", close(out[1], yprime), "" if close(out[1], yprime) else worst(out[1], yprime)
+        "yprime is the derivative of 1/(1+x^2)",
+        close(out[1], yprime),
+        "" if close(out[1], yprime) else worst(out[1], yprime),
     ):
         unsquared = close(out[1], yprime * (1 + x**2))  # -2x / (1 + x^2): the chain rule's square left out
         result.hint = (
@@ -365,15 +368,15 @@ def check_limacon_derivatives(fn, seed=None):
             return result.fail(label, f"got {shown(got)}", "return both derivatives: `return dxdt, dydt`.")
         slips = derivative_slips(t, r0)  # the right values and the slips named here (the plot's check forgives them)
         for name, got, formula in (
-            ("dx/dt", out[0], "-sin t cos t - r sin t"),
-            ("dy/dt", out[1], "-sin^2 t + r cos t"),
+            ("dx/dt", out[0], "the derivative of x = r cos t"),
+            ("dy/dt", out[1], "the derivative of y = r sin t"),
         ):
             want, no_product_rule = dict(slips[name])[""], dict(slips[name])["leaves out the product rule"]
             if not result.step(f"{label}: {name} = {formula}", close(got, want), worst(got, want)):
                 if close(got, no_product_rule):
                     result.hint = (
                         f"{name} leaves out the product rule: r = r0 + cos t depends on t too, so it "
-                        "has a second term with dr/dt = -sin t."
+                        "has a second term, with dr/dt in it."
                     )
                     return result
                 other = dict(slips[name])[f"is {'dy/dt' if name == 'dx/dt' else 'dx/dt'}: the two are swapped"]
@@ -397,14 +400,42 @@ def check_limacon_derivatives(fn, seed=None):
                     return result
                 slip = _sign_slip(got, want)
                 result.hint = (
-                    f"{name} {slip}: differentiate with the product rule, r' = -sin t."
+                    f"{name} {slip}: differentiate with the product rule, and check the sign of each term."
                     if slip
                     else f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "
-                    "with the product rule, using dr/dt = -sin t; compare with a centred difference."
+                    "with the product rule (r = r0 + cos t depends on t too); compare with a centred difference."
                 )
                 return result
     return result
 
+
+# what Exercises 3(a) and 4(b) ask the student to derive, in the spellings a text or code would use
+RUNGE_DERIVATIVE = (
+    "-2x/(1+x^2)^2",
+    "-2*x/(1 + x**2)**2",
+    "-2x(1+x^2)^-2",
+    "-2x*(1+x^2)**(-2)",
+    "-\\frac{2x}{(1+x^2)^2}",
+    "-2x/(x^2+1)^2",
+    "2x/(1+x^2)^2",  # the sign alone would still give the rest away
+)
+LIMACON_DERIVATIVES = (
+    "-sin t cos t - r sin t",
+    "-r sin t - sin t cos t",
+    "-np.sin(t) * np.cos(t) - r * np.sin(t)",
+    "-sin t (r + cos t)",
+    "-sin t (r0 + 2 cos t)",
+    "-(r0 + 2 cos t) sin t",
+    "-sin 2t / 2 - r0 sin t",
+    "-sin^2 t + r cos t",
+    "r cos t - sin^2 t",
+    "-np.sin(t)**2 + r * np.cos(t)",
+    "cos 2t + r0 cos t",
+    "r0 cos t + cos 2t",
+    "cos^2 t - sin^2 t + r0 cos t",
+    "dr/dt = -sin t",
+    "r' = -sin t",
+)
 
 PHERM = Experiment(
     "pherm",
@@ -430,6 +461,7 @@ EXERCISES = (
         (Part("runge", 3, check_runge, ("runge",), seeded=True, refused=OWN_FUNCTIONS),) + PHERM.parts(),
         notebook="02_convergence.ipynb",
         answers=("the order the table shows, against piecewise linear",),
+        withheld=RUNGE_DERIVATIVE + PHERM.withheld,
     ),
     Exercise(
         4,
@@ -452,5 +484,6 @@ EXERCISES = (
             ),
         ),
         notebook="01_limacon.ipynb",
+        withheld=LIMACON_DERIVATIVES,
     ),
 )

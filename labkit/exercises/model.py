@@ -221,7 +221,12 @@ class Exercise:
     their weights. ``answers`` are the remarks and explanations the student
     writes in words: no check reads them, the feedback lists them for the
     instructor, and ``grades.csv`` has an empty column for each.
-    ``notebook`` is the notebook the exercise is in.
+    ``notebook`` is the notebook the exercise is in. ``withheld`` is what the
+    student is asked to find, written as it would appear in a text (an order,
+    a derived formula, a worked value): no string the student can see may
+    contain one (``tests/test_giveaways.py``). An entry is a string, or a
+    function of no arguments returning strings (values computed from labkit's
+    references only when the answer key is asked for).
     """
 
     number: int
@@ -230,6 +235,7 @@ class Exercise:
     notebook: str
     answers: tuple = ()
     topic: str = field(default="", compare=False)
+    withheld: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         seen = [part.name for part in self.parts]

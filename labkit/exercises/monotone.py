@@ -26,5 +26,6 @@ EXERCISES = (
         PCHIP.parts(),
         notebook="05_monotone.ipynb",
         answers=("pchip's order against the spline's, and when to choose pchip",),
+        withheld=PCHIP.withheld,
     ),
 )

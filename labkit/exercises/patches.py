@@ -195,10 +195,11 @@ def check_straight_corners(corners):
         ]
         result.hint = (
             f"{_and(off)} {'bends its side or spaces' if len(off) == 1 else 'bend their sides or space'} the mesh "
-            "points unevenly: along a straight side with even spacing the derivative is the vector along that side, "
-            "from the corner where the side starts to the one where it ends."
+            "points unevenly: each side is a Hermite cubic between its two corners, so ask which end derivatives "
+            "make that cubic a straight line traced at an even pace."
             if off
-            else "along a straight side with even spacing the derivative is the vector along that side."
+            else "each side is a Hermite cubic between its two corners: ask which end derivatives make it a straight "
+            "line traced at an even pace."
         )
     return result
 
@@ -391,7 +392,7 @@ def _two_patches_once(result, label, fn, ABCD):
     ):
         result.hint = (
             "mesh the patches of the corners two_patches is given: the first mesh has A, B, C, D at its "
-            "corners, the second (abcd, the mirror image of ABCD in y = x) their mirror images."
+            "corners, the second a, b, c, d at theirs."
         )
         return result
     try:
@@ -409,8 +410,8 @@ def _two_patches_once(result, label, fn, ABCD):
         f"{len(first.points)} + {len(second.points)} nodes gave {len(merged.points)}",
     ):
         result.hint = _mirror_slip(second, ABCD) or (
-            "the two meshes do not share the 30 nodes of the edge BC (dc): compare the second patch's corners, "
-            "one at a time, with the mirror image of ABCD in y = x (points and derivatives), and use 30 points "
+            "the two meshes do not share the 30 nodes of the edge BC (dc): compare the second patch's corners "
+            "(points and derivatives) one at a time with the patch abcd the lab describes, and use 30 points "
             "along dc."
         )
         return result
@@ -425,7 +426,7 @@ def _two_patches_once(result, label, fn, ABCD):
 MIRROR_SLIPS = (
     (
         "the second patch's corners are not in the order a, b, c, d: a is A's mirror image, and b, c, d follow "
-        "round the patch abcd as the lab's table of its points lists them (d is B).",
+        "round the patch abcd as the lab's table of its points lists them.",
         lambda c: patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
         "ABCD",
     ),
@@ -614,12 +615,60 @@ def check_combined_mesh(region, corners, two_patches=None):
 
 CORNERS9 = Together(("A9", "B9", "C9", "D9"))
 
+# what Exercises 5, 7, 8 and 9 ask the student to find, in the words and code a text would use
+IDENTITY_DATA = (  # 5: the identity map's corner derivatives
+    "dx/ds = 1, dy/ds = 0",
+    "\u2202x/\u2202s = 1, \u2202y/\u2202s = 0",
+    "dx/dt = 0, dy/dt = 1",
+    "\u2202x/\u2202t = 0, \u2202y/\u2202t = 1",
+    "[1, 0], [0, 1], [0, 0])",
+    "(1, 0), (0, 1), (0, 0)",
+)
+STRAIGHT_RULE = (  # 7: the derivatives of a straight, evenly divided side
+    "the derivative is the vector along that side",
+    "the vector along the side",
+    "the vector from the corner where the side starts",
+    "ds = B - A",
+    "dt = D - A",
+    "ds = C - D",
+    "dt = C - B",
+    "B - A, D - A",
+)
+ARC_ANSWERS = (  # 8: AB's parametrisation about G and its derivatives at A and B
+    "5 * np.pi / 4 + np.pi / 2 *",
+    "5pi/4 + pi/2",
+    "5\\pi/4 + \\pi s/2",
+    "(1 + s) * np.pi / 2 + np.pi / 4",
+    "0.5 + radius * np.cos(5 * np.pi / 4",
+    "dxds = [0.785",
+    "0.785398",
+    "0.7854",
+    "pi/4, -pi/4",
+    "pi / 4, pi / 4",
+)
+MIRROR_RULE = (  # 9: the mirror rule for abcd's corners
+    "d is B",
+    "b is D",
+    "d = B",
+    "b = D",
+    "a = A mirrored",
+    "swap ds and dt",
+    "ds and dt swap",
+    "ds and dt are swapped",
+    "ds is the mirror image of ABCD's dt",
+    "its ds is ABCD's dt",
+    "dt[::-1], c.ds[::-1]",
+    "dt[::-1], corner.ds[::-1]",
+    "point[::-1], dt[::-1], ds[::-1]",
+)
+
 EXERCISES = (
     Exercise(
         5,
         ("coons",),
         (Part("coons", 12, check_coons, ("coons",), seeded=True, refused=OWN_PATCH),),
         notebook="03_meshes.ipynb",
+        withheld=IDENTITY_DATA,
     ),
     Exercise(6, ("graded",), (Part("graded", 10, check_graded_corners, ("graded",)),), notebook="03_meshes.ipynb"),
     Exercise(
@@ -628,6 +677,7 @@ EXERCISES = (
         (Part("straight", 10, check_straight_corners, ("straight",)),),
         notebook="03_meshes.ipynb",
         answers=("why these corner data give straight, evenly divided sides",),
+        withheld=STRAIGHT_RULE,
     ),
     Exercise(
         8,
@@ -635,6 +685,7 @@ EXERCISES = (
         (Part("circle_sides", 12, check_circle_corners, ("circle_sides",)),),
         notebook="03_meshes.ipynb",
         answers=("AB as parametric equations, and dx/ds, dy/ds at A and B",),
+        withheld=ARC_ANSWERS,
     ),
     Exercise(
         9,
@@ -658,5 +709,6 @@ EXERCISES = (
         ),
         notebook="03_meshes.ipynb",
         answers=("why the mirror image's corner data make the two patches match",),
+        withheld=MIRROR_RULE,
     ),
 )

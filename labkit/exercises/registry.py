@@ -159,6 +159,21 @@ class Registry:
                 found.append(part)
         return found
 
+    def answer_key(self) -> dict:
+        """Exercise number -> the texts the student is asked to find (:attr:`Exercise.withheld`, expanded).
+
+        A computed entry (a function) is called here, so the reference values
+        are worked out only when the key is asked for (the release scan).
+        """
+        key = {}
+        for exercise in self:
+            texts: list = []
+            for entry in exercise.withheld:
+                found = entry() if callable(entry) else (entry,)
+                texts.extend(str(text) for text in found)
+            key[exercise.number] = tuple(dict.fromkeys(texts))
+        return key
+
     def check(self, number: int, namespace: Mapping, seed: int | None = None) -> dict:
         """Run the checks of exercise `number` on a notebook's variables; a dict for the grader.
 

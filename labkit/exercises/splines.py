@@ -268,8 +268,8 @@ def check_ncspline(fn, seed=None, system=None):
             )
         elif close(slopes, _natural_slopes(x, y, rows_in_a=False, rows_in_d=False)):
             result.hint = (
-                "the first and last rows of A must say M1 = 0 and Mn = 0 (1 on the diagonal, 0 elsewhere, "
-                "0 in D): they are still the complete spline's rows."
+                "the first and last rows of A, and the first and last entries of D, are still the complete "
+                "spline's rows: change them so that those two equations say M1 = 0 and Mn = 0."
             )
         else:
             result.hint = _natural_rows_slip(x, y, got) or (
@@ -471,6 +471,28 @@ NATURAL = Experiment(
     pieces=(splines.ncspline,),
     uses=("ncspline", "complete_system"),
 )
+# Exercise 12(b): the natural spline's end rows of A and D, as a text or code would write them
+NATURAL_ROWS = (
+    "1 on the diagonal, 0 elsewhere",
+    "A[0, 0] = 1",
+    "A[0] = [1, 0",
+    "A[-1, -1] = 1",
+    "D[0] = 0",
+    "D[-1] = 0",
+    "rows 1, 0, ..., 0",
+    "[1, 0, 0, 0]",
+    "[0, 0, 0, 1]",
+)
+# the remark after Exercise 12: why the natural spline converges more slowly
+NATURAL_WHY = (
+    "f''(0) = -2",
+    "f''(0) is not 0",
+    "f''(0) is not zero",
+    "f'' is not zero at",
+    "where the Runge function itself bends",
+    "errs at the left end",
+    "s'' = 0 at both ends, but",
+)
 NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot", weights=(3, 2, 2))
 
 EXERCISES = (
@@ -496,6 +518,7 @@ EXERCISES = (
         COMPLETE.parts(),
         notebook="04_splines.ipynb",
         answers=("the order, with f' used only at the ends",),
+        withheld=COMPLETE.withheld,
     ),
     Exercise(
         12,
@@ -515,8 +538,14 @@ EXERCISES = (
         + NATURAL.parts(),
         notebook="04_splines.ipynb",
         answers=("why the natural spline's order is lower",),
+        withheld=NATURAL_ROWS + NATURAL_WHY + NATURAL.withheld,
     ),
     Exercise(
-        13, NOTAKNOT.names(), NOTAKNOT.parts(), notebook="04_splines.ipynb", answers=("the three splines compared",)
+        13,
+        NOTAKNOT.names(),
+        NOTAKNOT.parts(),
+        notebook="04_splines.ipynb",
+        answers=("the three splines compared",),
+        withheld=NOTAKNOT.withheld,
     ),
 )
