@@ -90,14 +90,17 @@ def _execute(args):
 
     from .execute import execute, notebook_paths
     from .grading.nbgrader import mark
+    from .grading.release import tag_raising
     from .grading.rubric import load
 
     rubric = load(args.rubric)  # nbgrader's points are the rubric's in force
 
-    def marked(nb, name):
-        return mark(nb, name, rubric)
-
     for path in notebook_paths(args.notebooks):
+
+        def marked(nb, name, folder=path.parent):
+            tag_raising(nb, folder, name, args.timeout)  # Run All goes on past them in the student's copy
+            return mark(nb, name, rubric)
+
         print(f"executing {path.name} ...", flush=True)
         try:
             execute(path, timeout=args.timeout, before_save=marked)
