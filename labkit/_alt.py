@@ -10,10 +10,17 @@ templates read for the ``<img alt="...">`` of the exported page. A figure with
 several described axes joins their texts; a figure labkit did not describe
 keeps the inline backend's output unchanged.
 
+JupyterLab's image renderer ignores that metadata, so a described figure also gets
+a ``text/html`` output, :func:`img_tag`: the same PNG as an ``<img>`` with the text
+as its ``alt``. JupyterLab, nbconvert, GitHub and nbviewer show the richer ``text/html``;
+the ``image/png`` stays for the rest (and for the tests that read its metadata).
+
 Nothing here imports matplotlib or IPython unless they are loaded already, so
 ``import labkit`` stays light.
 """
 
+import base64
+import html
 import sys
 
 ATTRIBUTE = "_labkit_alt"
@@ -65,17 +72,64 @@ def install():
     from matplotlib.figure import Figure
 
     formatter = shell.display_formatter.formatters["image/png"]
+    html_formatter = shell.display_formatter.formatters["text/html"]
     try:
         printer = formatter.lookup_by_type(Figure)
+    except KeyError:  # no PNG of figures (SVG chosen, say): no <img> of one either
+        html_formatter.pop(Figure, None)
+        return
+    if not getattr(printer, "labkit_alt", False):
+        printer = _with_alt(printer)
+        formatter.for_type(Figure, printer)
+    try:
+        current = html_formatter.lookup_by_type(Figure)
     except KeyError:
-        return
-    if getattr(printer, "labkit_alt", False):
-        return
-    formatter.for_type(Figure, _with_alt(printer))
+        current = None
+    if getattr(current, "png_printer", None) is not printer:
+        html_formatter.for_type(Figure, _html_printer(printer))
+
+
+def img_tag(picture, alt, width=None, height=None):
+    """An HTML ``<img>`` of a PNG (bytes, or their base64 text) with `alt` as its alternative text, escaped.
+
+    >>> img_tag(b"PNG", 'a "quoted" <b>', width=10)
+    '<img src="data:image/png;base64,UE5H" alt="a &quot;quoted&quot; &lt;b&gt;" width="10">'
+    """
+    if isinstance(picture, bytes):
+        picture = base64.b64encode(picture).decode("ascii")
+    size = "".join(f' {name}="{int(value)}"' for name, value in (("width", width), ("height", height)) if value)
+    return f'<img src="data:image/png;base64,{picture}" alt="{html.escape(str(alt), quote=True)}"{size}>'
+
+
+def _html_printer(png_printer):
+    """The ``text/html`` printer of figures: the PNG printer's picture in an ``<img>`` with the alt text.
+
+    IPython asks for ``text/html`` before ``image/png``: the picture drawn here is kept on the figure for
+    the PNG printer (:func:`_with_alt`), so a figure is drawn once for both."""
+
+    def print_html(figure):
+        if not figure_alt(figure):
+            return None
+        output = png_printer(figure)
+        if output is None:
+            return None
+        setattr(figure, _DRAWN, output)
+        data, metadata = output if isinstance(output, tuple) else (output, {})
+        metadata = metadata or {}
+        return img_tag(data, metadata["alt"], metadata.get("width"), metadata.get("height"))
+
+    print_html.png_printer = png_printer
+    return print_html
+
+
+_DRAWN = "_labkit_drawn_png"
 
 
 def _with_alt(printer):
     def print_with_alt(figure):
+        drawn = figure.__dict__.pop(_DRAWN, None)  # what the text/html printer drew a moment ago
+        if drawn is not None:
+            return drawn
         output = printer(figure)
         alt = figure_alt(figure)
         if output is None or not alt:

@@ -90,14 +90,17 @@ def _execute(args):
 
     from .execute import execute, notebook_paths
     from .grading.nbgrader import mark
+    from .grading.release import tag_raising
     from .grading.rubric import load
 
     rubric = load(args.rubric)  # nbgrader's points are the rubric's in force
 
-    def marked(nb, name):
-        return mark(nb, name, rubric)
-
     for path in notebook_paths(args.notebooks):
+
+        def marked(nb, name, folder=path.parent):
+            tag_raising(nb, folder, name, args.timeout)  # Run All goes on past them in the student's copy
+            return mark(nb, name, rubric)
+
         print(f"executing {path.name} ...", flush=True)
         try:
             execute(path, timeout=args.timeout, before_save=marked)
@@ -507,7 +510,9 @@ def build_parser():
         "execute",
         help="re-execute every notebook in a fresh kernel and save it clean",
         description="Re-execute the notebooks top to bottom in a fresh python3 kernel and save "
-        "them without widget state: the reference outputs nbval compares against.",
+        "them without widget state: the reference outputs nbval compares against. Each notebook's "
+        "student release is run too, and the cells that raise there are tagged raises-exception, "
+        "so that Run All in a fresh copy goes on to the explorers.",
     )
     run.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     run.add_argument("--timeout", type=int, default=300, help="seconds allowed per cell (default 300)")

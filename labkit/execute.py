@@ -3,12 +3,18 @@
 Clean means: executed top to bottom in a fresh ``python3`` kernel, no widget
 state stored in the metadata (it churns on every run), no error outputs.
 Used by ``labkit execute`` and checked by tests/test_notebooks_clean.py.
+
+A cell tagged ``raises-exception`` (:data:`RAISES`) lets Run All go on past its error in JupyterLab,
+nbclient and nbval. ``labkit execute`` tags the cells that raise in the student's fresh copy (its
+stubs, and what uses their names), found with :func:`raising_cells`; the instructor's own run
+ignores the tag, so an error there still stops it.
 """
 
 import subprocess
 from pathlib import Path
 
 KERNEL = "python3"
+RAISES = "raises-exception"
 KERNELSPEC = {"display_name": "Python 3 (ipykernel)", "language": "python", "name": KERNEL}
 
 
@@ -46,6 +52,8 @@ def execute(path, timeout=300, before_save=None):
 
     path = Path(path)
     nb = nbformat.read(path, as_version=4)
+    for cell in nb.cells:
+        set_tag(cell, RAISES, False)  # the instructor's notebook runs without an error anywhere
     client = NotebookClient(nb, timeout=timeout, kernel_name=KERNEL, resources={"metadata": {"path": str(path.parent)}})
     client.execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # kernel log noise only
     clean(nb)
@@ -66,3 +74,32 @@ def clean(nb):
                 data = output.get("data", {})
                 data.pop("application/vnd.jupyter.widget-view+json", None)
     return nb
+
+
+def set_tag(cell, tag, on):
+    """Add (`on`) or remove the tag `tag` of a cell, in place; an emptied tag list is dropped."""
+    tags = [t for t in cell.metadata.get("tags", []) if t != tag] + ([tag] if on else [])
+    if tags:
+        cell.metadata["tags"] = tags
+    else:
+        cell.metadata.pop("tags", None)
+
+
+def raising_cells(nb, folder, timeout=300):
+    """The indices of the code cells of `nb` that end in an error when it runs top to bottom in `folder`.
+
+    Runs a copy in a fresh kernel, errors allowed; `nb` itself is left as it is."""
+    import copy
+
+    from nbclient import NotebookClient
+
+    run = copy.deepcopy(nb)
+    client = NotebookClient(
+        run, timeout=timeout, kernel_name=KERNEL, allow_errors=True, resources={"metadata": {"path": str(folder)}}
+    )
+    client.execute(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return [
+        index
+        for index, cell in enumerate(run.cells)
+        if cell.cell_type == "code" and any(output.output_type == "error" for output in cell.outputs)
+    ]

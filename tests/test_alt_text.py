@@ -156,6 +156,49 @@ def test_nbconvert_writes_the_alt_into_the_page(executed):
     assert 'alt="error of the natural cubic spline with 19 points: largest' in html
 
 
+def _img(output):
+    """The one <img> of an output's text/html, as its attributes (html.parser decodes the escapes)."""
+    from html.parser import HTMLParser
+
+    found = []
+
+    class Images(HTMLParser):
+        def handle_starttag(self, tag, attrs):
+            if tag == "img":
+                found.append(dict(attrs))
+
+    Images().feed(output["data"]["text/html"])
+    (img,) = found
+    return img
+
+
+@pytest.mark.parametrize("index", [1, 2, 3, 4, 6, 7])
+def test_jupyterlab_gets_the_alt_text_in_an_img_of_the_same_picture(executed, index):
+    """JupyterLab ignores metadata's alt: the text/html output (what it shows) is an <img> with that alt."""
+    import base64
+
+    (picture,) = _pictures(executed.cells[index])
+    img = _img(picture)
+    metadata = picture["metadata"]["image/png"]
+    assert img["alt"] == metadata["alt"] and any(ch.isdigit() for ch in img["alt"])
+    assert img["src"] == "data:image/png;base64," + picture["data"]["image/png"].replace("\n", "")
+    assert base64.b64decode(img["src"].split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
+    if "width" in metadata:  # a 2x picture shows at its CSS size in the <img> too
+        assert (int(img["width"]), int(img["height"])) == (metadata["width"], metadata["height"])
+
+
+def test_a_students_own_figure_gets_no_img_either(executed):
+    (picture,) = _pictures(executed.cells[5])
+    assert "text/html" not in picture["data"]
+
+
+def test_the_img_escapes_what_could_end_the_attribute():
+    from labkit._alt import img_tag
+
+    tag = img_tag(b"\x89PNG", 'error of "x" < 1 & more')
+    assert 'alt="error of &quot;x&quot; &lt; 1 &amp; more"' in tag and tag.count('"') == 4
+
+
 # -- the explorers: the image widget's description follows the sliders ---------------------------
 
 

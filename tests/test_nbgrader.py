@@ -4,7 +4,9 @@ A temporary course folder gets ``source/lab8/`` = ``notebooks/``; nbgrader's own
 ``generate_assignment`` must release all six notebooks with no solution and no
 hidden test, stripping exactly what ``labkit release`` strips; ``autograde``
 must give a submission made from the instructor notebooks full marks in
-nbgrader's own gradebook, and the untouched release zero.
+nbgrader's own gradebook, and the untouched release zero: nbgrader's, and labkit's
+packaged one, whose ``raises-exception`` tags (Run All goes on past the stubs) keep
+no point a stub's error loses.
 """
 
 import os
@@ -23,6 +25,8 @@ nbgrader_api = pytest.importorskip("nbgrader.api")
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+PACKAGED = ROOT / "labkit" / "student_notebooks"
+STUDENTS = ("instructor", "untouched", "untouched-labkit")
 
 
 def _nbgrader(course, *args):
@@ -49,7 +53,7 @@ def course(tmp_path_factory):
         shutil.copy(path, source / path.name)
     _nbgrader(root, "generate_assignment", "lab8", "--create")
     released = root / "release" / "lab8"
-    for student, folder in (("instructor", source), ("untouched", released)):
+    for student, folder in zip(STUDENTS, (source, released, PACKAGED)):
         submitted = root / "submitted" / student / "lab8"
         submitted.mkdir(parents=True)
         for path in NOTEBOOKS:
@@ -86,10 +90,29 @@ def test_nbgrader_and_labkit_release_strip_the_same_things(course):
             assert a.get("outputs", []) == b.get("outputs", []) == []
 
 
+def test_nbgraders_release_keeps_the_tags_that_let_run_all_go_on(course):
+    for path in NOTEBOOKS:
+        theirs = nbformat.read(course / "release" / "lab8" / path.name, as_version=4)
+        ours = nbformat.read(PACKAGED / path.name, as_version=4)
+        tagged = [
+            [c.source for c in nb.cells if "raises-exception" in c.metadata.get("tags", [])] for nb in (theirs, ours)
+        ]
+        assert tagged[0] == tagged[1] and tagged[0], path.name
+
+
+def test_every_graded_cell_of_the_untouched_releases_scores_zero(course):
+    with nbgrader_api.Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gradebook:
+        for student in STUDENTS[1:]:
+            for notebook in gradebook.find_submission("lab8", student).notebooks:
+                for grade in notebook.grades:
+                    if grade.max_score:
+                        assert grade.auto_score == 0, (student, notebook.name, grade.name)
+
+
 def _scores(course):
     with nbgrader_api.Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gradebook:
         scores = {}
-        for student in ("instructor", "untouched"):
+        for student in STUDENTS:
             submission = gradebook.find_submission("lab8", student)
             scores[student] = (submission.score, submission.max_score)
         cells = {
@@ -105,6 +128,7 @@ def test_autograde_gives_the_instructor_notebooks_full_marks_and_the_release_zer
     total = sum(e.points for e in EXERCISES.values())
     assert scores["instructor"] == (total, total)
     assert scores["untouched"] == (0, total)
+    assert scores["untouched-labkit"] == (0, total)  # its raises-exception tags cost no test cell its points
     # nbgrader's points per exercise are labkit's
     per_exercise = {}
     for (_, name), points in cells.items():

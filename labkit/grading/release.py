@@ -6,12 +6,18 @@ an answer in words (a remark, an explanation) and becomes ``YOUR ANSWER
 HERE``, for the student to write and the instructor to read. Hidden tests
 between ``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS`` disappear,
 outputs are cleared. The markers and the stubs are nbgrader's.
+
+The cells that raise in the release (the stubs, and the cells that use what the stubs
+leave undefined) carry the tag ``raises-exception``, which :func:`tag_raising`
+gives the instructor notebook (``labkit execute`` calls it): Run All then goes on to
+the Explore section of a notebook nobody has written in yet, the self-checks saying
+what fails on the way, and nbgrader's release (which keeps tags) does the same.
 """
 
 import json
 from pathlib import Path
 
-from ..execute import notebook_paths, read_notebook
+from ..execute import RAISES, notebook_paths, raising_cells, read_notebook, set_tag
 
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
 BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
@@ -57,6 +63,18 @@ def release_notebook(nb, name="notebook"):
         elif cell.cell_type == "markdown" and BEGIN_SOLUTION in cell.source:
             cell.source = strip_solutions(cell.source, f"{name}, cell {index}", TEXT_STUB)
     return student
+
+
+def tag_raising(nb, folder, name="notebook", timeout=300):
+    """Tag ``raises-exception`` the cells of instructor notebook `nb` that raise in its release, in place.
+
+    The release is run in `folder` (the notebook's own, for its data files); a cell that no longer
+    raises loses the tag. Returns the indices of the tagged cells."""
+    raising = set(raising_cells(release_notebook(nb, name), folder, timeout))
+    for index, cell in enumerate(nb.cells):
+        if cell.cell_type == "code":
+            set_tag(cell, RAISES, index in raising)
+    return sorted(raising)
 
 
 def release(notebook_dir, out_dir):

@@ -27,7 +27,7 @@ import zlib
 
 import numpy as np
 
-from .._alt import figure_alt
+from .._alt import figure_alt, img_tag
 from ..notebook import HEADLESS, headless
 from ..patches import Corner
 from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
@@ -247,8 +247,9 @@ def widget_with_picture(widget, picture, text, alt=None, size=None, **kwargs):
     static views (nbconvert, GitHub, nbviewer, nbval's saved outputs) the picture.
 
     The picture's metadata carries `alt` (default: `text`) as its alternative text and, given `size`
-    (CSS pixels), its width and height, so a 2x picture shows at its CSS size there too.
-    Returns ``(data, metadata)``.
+    (CSS pixels), its width and height, so a 2x picture shows at its CSS size there too. The same picture
+    is also an HTML ``<img>`` with that alt (``text/html``: what JupyterLab shows of a static copy, since
+    its image renderer ignores the metadata). Returns ``(data, metadata)``.
     """
     bundle = widget._repr_mimebundle_(**kwargs)
     data, metadata = bundle if isinstance(bundle, tuple) else (bundle, {})
@@ -257,6 +258,9 @@ def widget_with_picture(widget, picture, text, alt=None, size=None, **kwargs):
     picture_metadata = {"alt": text if alt is None else alt}
     if size is not None:
         picture_metadata.update(width=int(size[0]), height=int(size[1]))
+    data["text/html"] = img_tag(
+        data["image/png"], picture_metadata["alt"], picture_metadata.get("width"), picture_metadata.get("height")
+    )
     return data, {**(metadata or {}), "image/png": picture_metadata}
 
 
@@ -306,7 +310,7 @@ def convergence_explorer(methods=("plin", "pherm", "complete", "natural", "notak
         controls={
             "method": widgets.Dropdown(
                 options=[(METHOD_TITLES[m], m) for m in methods],
-                value="natural" if "natural" in methods else methods[0],
+                value="pherm" if "pherm" in methods else methods[0],  # the method 02 teaches
                 description="method",
             ),
             "ndata": _slider(int, 11, 3, 81, description="ndata"),

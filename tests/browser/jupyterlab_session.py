@@ -129,6 +129,16 @@ def course_lab(home):
         yield base
 
 
+@contextlib.contextmanager
+def release_lab(home):
+    """A JupyterLab server serving a copy of the packaged student release (labkit/student_notebooks/), as a
+    student gets it: nothing run, nothing written; yields its base URL."""
+    served = Path(home) / "release"
+    shutil.copytree(ROOT / "labkit" / "student_notebooks", served, ignore=shutil.ignore_patterns("*.py", "__pycache__"))
+    with jupyterlab(home, served) as base:
+        yield base
+
+
 def close_sessions(base):
     """Shut down every notebook's kernel, so the next notebook runs alone."""
     for session in api(base, "/api/sessions"):

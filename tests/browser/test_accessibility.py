@@ -8,7 +8,8 @@ driven by Playwright, one JupyterLab server for the whole file.
   the page, no network) finds no serious or critical violation in the notebook's outputs (labkit's widgets
   and figures). What it finds in JupyterLab itself is printed (``-s``, and the run's summary) and listed in
   docs/students.md, never asserted. Static pictures without alt count as JupyterLab's: its image renderer
-  never sets one, not even from the output's `alt` metadata. A violation listed in PENDING (a known one of
+  never sets one, not even from the output's `alt` metadata; labkit's own figures are an HTML <img> with
+  their alt (not JupyterLab's image renderer), so one of them without alt counts as labkit's. A violation listed in PENDING (a known one of
   labkit's, waiting for its fix; none today) makes the test xfail instead of fail.
 
 One page serves the whole file: 03_meshes first (the editor, then its axe check), then each other notebook
