@@ -51,6 +51,9 @@ def assert_clean(texts):
     assert not found, f"{len(found)} give-aways:\n" + "\n".join(found)
 
 
+PICTURE_DATA = re.compile(r"data:[\w/+.-]+;base64,[A-Za-z0-9+/=\s]*")
+
+
 def _joined(value):
     return "".join(value) if isinstance(value, list) else str(value)
 
@@ -61,8 +64,8 @@ def output_texts(where, outputs):
         if "text" in output:
             yield f"{where}, output {k}", _joined(output["text"])
         for kind, value in output.get("data", {}).items():
-            if kind.startswith("text/") or kind.endswith("json"):
-                yield f"{where}, output {k} ({kind})", _joined(value)
+            if kind.startswith("text/") or kind.endswith("json"):  # a picture inside (an <img>'s data) is no text
+                yield f"{where}, output {k} ({kind})", PICTURE_DATA.sub("data:", _joined(value))
         for kind, value in output.get("metadata", {}).items():
             yield f"{where}, output {k} metadata {kind}", str(value)
         if output.get("output_type") == "error":
@@ -150,6 +153,9 @@ def labkit_figures():
     for name in ("limacon_explorer", "convergence_explorer", "mesh_explorer", "spline_explorer", "pchip_explorer"):
         texts += explorer_texts(name, getattr(plots, name)())
     texts += explorer_texts("bilinear_explorer", plots.bilinear_explorer())
+    editor = plots.patch_editor()  # the corner data it opens on, as its readout shows them, and its figure
+    texts += [("plots.patch_editor() readout", editor.widget_.readout)]
+    texts += figure_texts(editor.figure, "plots.patch_editor()")
     plt.close("all")
     return texts
 

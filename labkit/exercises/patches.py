@@ -623,6 +623,7 @@ IDENTITY_DATA = (  # 5: the identity map's corner derivatives
     "\u2202x/\u2202t = 0, \u2202y/\u2202t = 1",
     "[1, 0], [0, 1], [0, 0])",
     "(1, 0), (0, 1), (0, 0)",
+    "ds=[1, 0], dt=[0, 1]",  # as labkit.Corner writes itself (the patch editor's readout)
 )
 STRAIGHT_RULE = (  # 7: the derivatives of a straight, evenly divided side
     "the derivative is the vector along that side",

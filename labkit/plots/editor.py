@@ -272,20 +272,30 @@ def _size_slider(elements):
     return widgets.IntSlider(value=elements, min=2, max=40, description="elements", continuous_update=True)
 
 
+# What the editor opens on: a gently curved patch near the unit square, none of whose data is an answer the lab
+# asks for (Exercise 5's identity data, a straight side's derivatives): the student shapes it from there.
+FIRST_PATCH = (
+    Corner([0.0, 0.0], [1.2, -0.3], [0.2, 1.0]),
+    Corner([1.2, 0.1], [1.0, 0.4], [-0.2, 1.1]),
+    Corner([1.1, 1.2], [0.9, -0.2], [-0.1, 0.9]),
+    Corner([-0.1, 1.0], [1.1, 0.3], [0.1, 0.8]),
+)
+
+
 @shown_only
 def patch_editor(corners=None, elements=10):
-    """An editor for a Coons patch; `corners` default to exercise 5's unit square.
+    """An editor for a Coons patch; `corners` default to :data:`FIRST_PATCH`.
 
     Examples
     --------
     >>> from labkit import Corner
     >>> from labkit.plots import patch_editor
-    >>> editor = patch_editor()
+    >>> editor = patch_editor([Corner(p, [2.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [2, 0], [2, 1], [0, 1])])
     >>> print(editor.widget_.readout.splitlines()[1])
-    A = Corner([0, 0], ds=[1, 0], dt=[0, 1], dsdt=[0, 0])
+    A = Corner([0, 0], ds=[2, 0], dt=[0, 1], dsdt=[0, 0])
     """
     if corners is None:
-        corners = [Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
+        corners = list(FIRST_PATCH)
     if len(corners) != 4 or not all(isinstance(c, Corner) for c in corners):
         raise ValueError("patch_editor needs a list of four labkit.Corner objects A, B, C, D.")
     if any(c.point.size != 2 for c in corners):
