@@ -395,9 +395,8 @@ MISTAKES = (
         (("rate_pherm = 4\n", "rate_pherm = 3\n"),),
         3,
         "rate_pherm",
-        "take the ratios",
+        "your rate does not fit your own table",
         keep_rates=True,
-        named=False,
         was="generic",
     ),
     # Exercise 4

@@ -922,6 +922,6 @@ def _rate(method, answer, errors, own, result, lab=None, honest=False):
     return result.fail(
         description,
         f"got {p}, which is not the exponent of the power of two your table's ratios settle near",
-        "take the ratios Err(41)/Err(81), Err(81)/Err(161), ... of your table; they settle near a "
-        "power of two 2**p, and p is the rate.",
+        "your rate does not fit your own table: take its ratios Err(41)/Err(81), Err(81)/Err(161), ...; they "
+        "settle near a power of two 2**p, and p is the rate.",
     )
