@@ -1325,5 +1325,37 @@ def plant_class(folder):
     return folders
 
 
+SEED = 20261201  # the golden grades' seed
+GOLDEN = Path(__file__).with_name("data") / f"catalog_grades_seed{SEED}.csv"
+
+
+def grade_class(folder):
+    """Plant the catalog class in `folder` and grade it in the sandbox with :data:`SEED`, as tests/test_catalog.py
+    does; ({submission name: its grade}, the run's output folder)."""
+    from labkit import grading
+
+    folders = plant_class(Path(folder))
+    out = Path(folder) / "out"
+    results = grading.grade(list(folders.values()), out, jobs=2, progress=False, seed=SEED)
+    return dict(zip(folders, results)), out
+
+
+def regenerate_golden():
+    """`make golden`: grade the catalog class afresh and write its grades.csv over :data:`GOLDEN`. Then
+    `git diff tests/data/` shows every row a change moved: keep it only when each moved row is one the change
+    meant to move."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="labkit-golden-") as folder:
+        _, out = grade_class(folder)
+        GOLDEN.write_bytes((out / "grades.csv").read_bytes())  # as written: its CSV line ends included
+    print(f"wrote {GOLDEN}; `git diff {GOLDEN.relative_to(Path(__file__).resolve().parents[1])}` shows what moved")
+
+
 if __name__ == "__main__":
-    print(summary_text())
+    import sys
+
+    if sys.argv[1:] == ["--golden"]:
+        regenerate_golden()
+    else:
+        print(summary_text())

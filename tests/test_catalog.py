@@ -2,35 +2,30 @@
 exactly its part and is named (the catalogs are in tests/catalog.py), all graded in one sandboxed run."""
 
 import os
-from pathlib import Path
 
 import pytest
-from catalog import CORRECT, MISTAKES, SLIPS, plant_class, submission_of, submissions, summary
+from catalog import CORRECT, GOLDEN, MISTAKES, SEED, SLIPS, grade_class, submission_of, submissions, summary
 from conftest import sandbox_or_skip
 
-from labkit import grading
 from labkit.check import EXERCISES
 from labkit.grading.rubric import default
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 RUBRIC = default()
-SEED = 20261201
-# grades.csv of this very class and seed, graded before the exercises were declared once (issue 20): the
-# refactoring changed where things are declared, not one grade; issue 30's slips added their rows at the end,
-# and its "charged once" gave back Exercise 3's table and rate to the three wrong eval_pherm whose honest
-# driver's table stands still (wrong_denominator, values_and_slopes_swapped, one_interval_for_every_point)
-BEFORE = Path(__file__).with_name("data") / "catalog_grades_seed20261201.csv"
+# grades.csv of this very class and seed (catalog.GOLDEN), first graded before the exercises were declared once
+# (issue 20: that refactoring changed where things are declared, not one grade); issue 30's slips added their rows
+# at the end, and its "charged once" gave back Exercise 3's table and rate to the three wrong eval_pherm whose
+# honest driver's table stands still. A change that moves grades on purpose regenerates it with `make golden`
+# (catalog.regenerate_golden), and its diff must show only the rows meant to move.
+BEFORE = GOLDEN
 RUN = {}
 
 
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
     sandbox_or_skip()
-    tmp = tmp_path_factory.mktemp("catalog")
-    folders = plant_class(tmp)
-    results = grading.grade(list(folders.values()), tmp / "out", jobs=2, progress=False, seed=SEED)
-    RUN["out"] = tmp / "out"
-    return dict(zip(folders, results))
+    grades, RUN["out"] = grade_class(tmp_path_factory.mktemp("catalog"))  # as `make golden` grades it
+    return grades
 
 
 def _failed(grade):
