@@ -203,3 +203,18 @@ def test_a_results_problems_keep_their_kinds_through_its_file_and_old_formats_ar
     for bad in ([[]], [[["crash"]], [["crash", "y"]]], [[["killed", "x"]], [["crash", "y"]]]):
         with pytest.raises(ValueError, match="ada.json is not a labkit grade result"):
             SubmissionGrade.from_dict({**data, "problem_kinds": bad}, "ada.json")
+
+
+def test_a_stubbed_driver_leaves_its_table_and_rate_not_done_not_slipped():
+    # the rate's check takes the table's failed steps: their kinds come along
+    from labkit.exercises.registry import LAB
+
+    def stub(*args):
+        raise NotImplementedError()
+
+    exercise = LAB.exercises[3]
+    namespace = {**dict.fromkeys(exercise.names, stub), "errors_pherm": [1.0] * 5, "rate_pherm": 4.0}
+    checks = LAB.check(3, namespace)["checks"]
+    assert {check["name"]: class_report.check_outcome(check) for check in checks} == dict.fromkeys(
+        exercise.names, "not done"
+    )

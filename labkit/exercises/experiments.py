@@ -696,7 +696,8 @@ def check_experiment(method, errors, answer, fn):
     own = _own_errors(method, fn, table_result)
     lab, honest = None, False
     if own is None:
-        rate_result.steps, rate_result.hint = list(table_result.steps), table_result.hint
+        rate_result.add_steps(table_result)
+        rate_result.hint = table_result.hint
     else:
         why = attempted_driver(method, fn, own)
         if why:  # the driver measures something else: the lab's experiment is the reference

@@ -65,6 +65,11 @@ class CheckResult:
         self.hint = hint
         return self
 
+    def add_steps(self, other):
+        """Record `other`'s steps after this result's own, each failed one with its kind."""
+        for index, (description, ok, detail) in enumerate(other.steps):
+            self.step(description, ok, detail, other.kinds.get(index))
+
     @property
     def advice(self):
         """The hint as the student reads it: after the note, when the part failed and has one."""
