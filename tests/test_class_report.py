@@ -2,7 +2,8 @@
 
 The class here is built from SubmissionGrade objects whose failed checks are made by the grader's own
 functions (labkit.exercises.result.call with the sandbox's exceptions, the registry's missing name, the
-scan's refusal, the run's problems), so the report's reading of them follows the grader's wording.
+scan's refusal, the run's problems), so the report reads the kind codes the grader sets where it makes them,
+never their wording (tests/test_kinds.py).
 The page in a real browser (no request leaves the machine, axe-core finds no serious violation) is
 tests/browser/test_class_report_browser.py.
 """
@@ -208,7 +209,7 @@ def page_of(grades, pairs=None, **options):
     return class_report.render(class_report.summarise(grades), pairs, **options)
 
 
-# ------------------------------------------------------------------ reading the grader's words
+# ------------------------------------------------------------------ reading the grader's codes
 
 
 @pytest.mark.parametrize(
