@@ -156,8 +156,9 @@ def test_the_patch_editor_lets_tab_leave_and_moves_handles_with_keys_it_announce
     assert live.get_attribute("aria-live") == "polite" and live.get_attribute("role") == "status"
     assert "Tab: leave" in editor.locator(".labkit-editor-keys").inner_text()  # the keys, shown as well
     assert (editor.locator(".labkit-editor-image").get_attribute("alt") or "").startswith("Mesh of the patch")
-    first = live.inner_text()
-    assert first.startswith("corner A at (0, 0). Worst quality 1.00"), first
+    first, shown = live.inner_text(), readout.inner_text()  # the editor opens on plots.editor.FIRST_PATCH
+    worst = re.search(r"^worst quality (-?[\d.]+)", shown)[1]
+    assert first.startswith(f"corner A at (0, 0). Worst quality {worst}"), (first, shown)
 
     stage.scroll_into_view_if_needed()
     stage.focus()
@@ -167,7 +168,8 @@ def test_the_patch_editor_lets_tab_leave_and_moves_handles_with_keys_it_announce
     page.keyboard.press("n")
     page.wait_for_function(changed, arg=[live.element_handle(), first], timeout=10_000)
     selected = live.inner_text()
-    assert selected.startswith("corner B at (1, 0). Worst quality "), selected
+    at_b = shown.splitlines()[2][len("B = Corner([") :].split("]")[0]
+    assert selected.startswith(f"corner B at ({at_b}). Worst quality "), (selected, shown)
     assert _focus_in_editor(page)[0], "n took the focus out of the editor"
 
     # an arrow moves B in the kernel's corner data (the readout is the model's), the live region follows
