@@ -326,10 +326,10 @@ def check_two_patches(fn, corners, coons=None):
                     True,
                 )
                 continue
-            result.add_steps(trial)
+            result.steps.extend(trial.steps)
             result.hint = trial.hint
             return result
-        result.add_steps(trial)
+        result.steps.extend(trial.steps)
     return result
 
 

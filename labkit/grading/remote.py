@@ -26,7 +26,6 @@ import subprocess
 import sys
 import time
 
-from ..exercises.result import CRASH, TAMPERED, TIMEOUT
 from . import backends, forkserver, protocol, refusals
 from .backends.base import remove_tree  # noqa: F401 - where callers have found it
 from .options import GradeOptions
@@ -39,21 +38,12 @@ class WorkerError(RuntimeError):
     """The sandboxed notebook stopped, hung or answered out of protocol: the grading error of one notebook."""
 
     kind = "WorkerError"
-    grader_kind = CRASH  # the kind of a failed step (labkit.exercises.result.grader_kind): no StudentError has one
-
-
-class Tampered(WorkerError):
-    """The notebook interfered with the grader's watch: none of its answers count."""
-
-    kind = "Tampered"
-    grader_kind = TAMPERED
 
 
 class WorkerTimeout(WorkerError):
     """The notebook did not answer in time (one of the two kinds below)."""
 
     kind = "Timeout"
-    grader_kind = TIMEOUT
     total = False  # whether the submission's whole time is used up
 
 
@@ -85,7 +75,6 @@ class Notebook:
         self.deadline = deadline if deadline is not None else time.monotonic() + self.options.total_timeout
         self.passables = frozenset(passables)  # functions the checks may hand to student code, by name
         self.stopped = None  # why the worker can no longer answer
-        self.stopped_kind = CRASH  # the kind of problem it is (labkit.exercises.result.KINDS), once stopped
         self.tampered = None  # what the notebook did that voids its answers
         self._buffer = b""
         self.backend = backends.get_backend(self.options.backend)
@@ -139,7 +128,6 @@ class Notebook:
         self.box.stop()
         if self.stopped is None and not self.box.closed and self.box.out_of_memory():
             self.stopped = "the notebook ran out of memory"
-            self.stopped_kind = CRASH
         self.box.close()
         self._selector.close()
         for pipe in (self.process.stdin, self.process.stdout):
@@ -149,7 +137,7 @@ class Notebook:
                 pass
 
     def _stop(self, why, error=WorkerError):
-        self.stopped, self.stopped_kind = why, error.grader_kind
+        self.stopped = why
         self.close()
         raise error(why)
 
@@ -172,7 +160,7 @@ class Notebook:
                 self._stop(f"the notebook's process answered out of protocol ({exc})")
             if answer.get("id") == rid:
                 error = answer.get("error") if isinstance(answer.get("error"), dict) else {}
-                if error.get("kind") == "Tampered" and error.get("grader"):  # the supervisor's word, not a name
+                if error.get("kind") == "Tampered":
                     self.tampered = str(error.get("message", "tampering"))[:500]
                 return answer
 
@@ -243,10 +231,6 @@ def _value(answer):
         refused = error.get("refused")
         if kind == WorkerTimeout.kind and error.get("timeout"):  # the worker stopped the call at its time limit
             raise CellTimeout(message)
-        if error.get("grader") and kind == Tampered.kind:  # the supervisor's own errors, marked as such
-            raise Tampered(message)
-        if error.get("grader") and kind == WorkerError.kind:
-            raise WorkerError(message)
         if kind == "NotImplementedError" and not refused:
             raise NotImplementedError(message)
         raise StudentError(
