@@ -75,7 +75,7 @@ def _class(tmp, count):
         nbformat.write(nb, target / "02_convergence.ipynb")
     if hostile:
         (folder / "hostile_not_json.ipynb").write_text('{"cells": [ this is not json')
-    return sorted(folder.iterdir(), key=grading.scoring.submission_name)
+    return sorted(folder.iterdir(), key=grading.submission.scoring.submission_name)
 
 
 def _grade(*args):

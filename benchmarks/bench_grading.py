@@ -7,7 +7,7 @@ notebooks each, every part of the lab graded):
 
 * **forked**: ``labkit grade`` as it runs by default, every notebook's worker
   forked from the run's fork server and every submission's grading process
-  from its launcher (:mod:`labkit.grading.forkserver`);
+  from its launcher (:mod:`labkit.grading.sandbox.forkserver`);
 * **unforked**: ``labkit grade --no-fork-server``, a new sandbox with a new
   Python for every notebook and a new Python for every submission;
 * **floor**: the notebooks' code cells run as six plain ``python`` processes

@@ -27,8 +27,8 @@ from bench_similarity import synthetic_class as similarity_class
 from class_results import pair_of, synthetic_class
 
 from labkit.cli import main as cli
-from labkit.grading import class_report, similarity
-from labkit.grading.report import write_report
+from labkit.grading.reports import class_report, similarity
+from labkit.grading.results.report import write_report
 
 
 def timed(function, repeat):
@@ -89,7 +89,7 @@ def main():
 
         search = getattr(similarity, "similar_pairs", None)
         if search is None:
-            print("similarity: not available (labkit.grading.similarity has no similar_pairs yet)")
+            print("similarity: not available (labkit.grading.reports.similarity has no similar_pairs yet)")
         else:
             search_s, found = timed(lambda: search(graded, similarity.DEFAULT_THRESHOLD), args.repeat)
             planted = {(f, *sorted((a, b))) for f, a, b in copied}

@@ -1,4 +1,6 @@
-"""Time the similarity search (labkit.grading.similarity) on a synthetic class: independent variants and a few copies.
+"""Time the similarity search (labkit.grading.reports.similarity) on a synthetic class.
+
+Independent variants and a few copies.
 
 Run: ``.venv/bin/python benchmarks/bench_similarity.py [--students 300] [--functions 15] [--copies 8]``.
 Each function has four approaches (programs of a dozen statements); each
@@ -18,8 +20,8 @@ import time
 import copydetect
 import numpy as np
 
-from labkit.grading import similarity
-from labkit.grading.report import SubmissionGrade
+from labkit.grading.reports import similarity
+from labkit.grading.results.report import SubmissionGrade
 
 OPERATORS = ["+", "-", "*", "/", "**"]
 CALLS = ["np.sqrt", "np.abs", "np.sum", "np.max", "len", "np.cos", "np.exp", "float", "np.asarray", "np.diff"]

@@ -89,9 +89,9 @@ def _execute(args):
     from nbclient.exceptions import CellExecutionError
 
     from .execute import execute, notebook_paths
-    from .grading.nbgrader import mark
-    from .grading.release import tag_raising
-    from .grading.rubric import load
+    from .grading.authoring.nbgrader import mark
+    from .grading.authoring.release import tag_raising
+    from .grading.results.rubric import load
 
     rubric = load(args.rubric)  # nbgrader's points are the rubric's in force
 
@@ -110,7 +110,7 @@ def _execute(args):
 
 
 def _release(args):
-    from .grading import release
+    from .grading.authoring import release
 
     for path in release(args.notebooks, args.out):
         print(f"wrote {path}")
@@ -118,8 +118,8 @@ def _release(args):
 
 
 def _summary(grades, out, start, what):
-    from .grading.report import one_line
-    from .grading.text import points_text
+    from .grading.results.report import one_line
+    from .grading.results.text import points_text
 
     for g in grades:
         lateness = g.lateness
@@ -133,7 +133,7 @@ def _summary(grades, out, start, what):
 
 def _replaced(replaced):
     """Say which results a later folder's replaced in a merge."""
-    from .grading.report import one_line
+    from .grading.results.report import one_line
 
     if not replaced:
         return
@@ -146,8 +146,8 @@ def _replaced(replaced):
 def _times_notes(grades, rubric, times):
     """Tell the instructor about the submission times: times that cost nothing or match no submission, and
     each submission a deadline applies to whose time is unknown. The number of times that could not be read."""
-    from .grading.late import unknown_times
-    from .grading.report import one_line
+    from .grading.results.late import unknown_times
+    from .grading.results.report import one_line
 
     def names(found):
         shown = ", ".join(repr(one_line(name, 40)) for name in sorted(found)[:5])
@@ -206,8 +206,8 @@ def _resumed(out):
 
 def grade_options(args):
     """The :class:`~labkit.grading.options.GradeOptions` of `labkit grade`'s arguments; ValueError for a bad one."""
-    from .grading.backends.base import Limits
     from .grading.options import CPU_GRACE, MIB, GradeOptions
+    from .grading.sandbox.backends.base import Limits
 
     for name in ("jobs", "cell_timeout", "total_timeout", "memory", "grader_memory"):
         if getattr(args, name) < 1:
@@ -237,7 +237,7 @@ def _dask_engine(args):
 def _grade(args):
     from .grading import grade, merge
     from .grading.batch import report_failures
-    from .grading.late import read_exchange, read_times
+    from .grading.results.late import read_exchange, read_times
 
     start = time.perf_counter()
     times = read_times(args.times) if args.times else None
@@ -351,7 +351,7 @@ def _class(args, workspace):
         names = {student.name for student in found.students}
         unknown = [name for name in args.student if name not in names]
         if unknown:
-            from .grading.report import one_line
+            from .grading.results.report import one_line
 
             shown = ", ".join(repr(one_line(name, 64)) for name in sorted(names)[:10])
             raise ValueError(
@@ -372,7 +372,7 @@ def _class(args, workspace):
 
 def _refused(found, what):
     """Name each result file that was not read (its run's record does not vouch for it)."""
-    from .grading.report import one_line
+    from .grading.results.report import one_line
 
     for path, why in found.refused:
         print(f"labkit: {what}: not read: {one_line(path, 200)}: {one_line(why, 300)}", file=sys.stderr)
@@ -380,7 +380,7 @@ def _refused(found, what):
 
 def _late_marks(grades, marked):
     """Name the submissions the LMS marked late whose time labkit does not know (so no penalty was applied)."""
-    from .grading.report import one_line
+    from .grading.results.report import one_line
 
     unknown = [g.name for g in grades if g.name in marked and g.graded and (g.time is None or g.time.when is None)]
     for name in unknown:
@@ -392,9 +392,9 @@ def _late_marks(grades, marked):
 
 
 def _export(args):
-    from .grading import lms
-    from .grading.record import rubric_for
-    from .grading.report import read_results
+    from .grading.reports import lms
+    from .grading.results.record import rubric_for
+    from .grading.results.report import read_results
 
     if args.canvas is not None and args.feedback:
         raise ValueError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
@@ -431,8 +431,8 @@ def _export(args):
 
 
 def _report(args):
-    from .grading import class_report, similarity
     from .grading.progress import Progress
+    from .grading.reports import class_report, similarity
 
     start = time.perf_counter()
     threshold = args.similarity_threshold
@@ -454,8 +454,8 @@ def _report(args):
 
 
 def _mark(args):
-    from .grading import marking
-    from .grading.rubric import load
+    from .grading.reports import marking
+    from .grading.results.rubric import load
 
     rubric = None if args.rubric is None else load(args.rubric)
     if args.import_ is None:
@@ -471,8 +471,9 @@ def _mark(args):
 
 
 def build_parser():
-    from .grading import backends, similarity
     from .grading.options import DEFAULTS, MIB
+    from .grading.reports import similarity
+    from .grading.sandbox import backends
 
     parser = argparse.ArgumentParser(
         prog="labkit",
@@ -825,8 +826,8 @@ def build_parser():
 
 
 def _rubric(args):
-    from .grading.rubric import DEFAULT, load
-    from .grading.text import points_text
+    from .grading.results.rubric import DEFAULT, load
+    from .grading.results.text import points_text
 
     if args.check:
         rubric = load(args.check)

@@ -6,7 +6,7 @@ the lines ``errorbar`` and ``stem`` draw) and a ``PathCollection``
 
 Used by the plot checks in a notebook (:mod:`labkit.exercises.plotted`) and by
 the sandboxed notebook when it sends a plot to the grader
-(:mod:`labkit.grading.protocol`), so a plot is judged from its data, never
+(:mod:`labkit.grading.sandbox.protocol`), so a plot is judged from its data, never
 from pixels. It holds no reference of the lab's: the grader's watch never
 refuses it.
 """

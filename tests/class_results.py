@@ -1,6 +1,6 @@
 """A made-up class's grading results, for the class report's browser test, its benchmark and the docs picture.
 
-:func:`synthetic_class` builds :class:`~labkit.grading.report.SubmissionGrade` objects for the lab's
+:func:`synthetic_class` builds :class:`~labkit.grading.results.report.SubmissionGrade` objects for the lab's
 exercises as `labkit grade` writes them: students of varying skill, a branch each, stubs left as
 released, slips named with the catalog's hints (``tests/catalog.py``), errors raised, time limits,
 refused references, cells that raised, a crash and a submission that could not be graded, all worded
@@ -12,8 +12,8 @@ tests/test_catalog.py's job); it is realistic input for the report, made in mill
 import numpy as np
 from catalog import MISTAKES
 
-from labkit.grading.report import SubmissionGrade
-from labkit.grading.rubric import default
+from labkit.grading.results.report import SubmissionGrade
+from labkit.grading.results.rubric import default
 
 FIRST = ("Ada", "Ben", "Chloé", "Dmitri", "Eun-ji", "Farah", "Goran", "Hana", "Iker", "Jun", "Kofi", "Lena")
 LAST = ("Abara", "Berg", "Costa", "Diaz", "Eriksen", "Fujita", "García", "Haddad", "Ivanova", "Jensen")
@@ -260,11 +260,11 @@ def synthetic_sources(students, seed=0, copies=4):
 
 
 def pair_of(function, first, second, first_source, second_source):
-    """A :class:`~labkit.grading.similarity.Pair` of two sources, the lines they share found with difflib
+    """A :class:`~labkit.grading.reports.similarity.Pair` of two sources, the lines they share found with difflib
     (a stand-in for the similarity search, to show pairs in the report without it)."""
     import difflib
 
-    from labkit.grading.similarity import Pair
+    from labkit.grading.reports.similarity import Pair
 
     a, b = first_source.splitlines(), second_source.splitlines()
     matcher = difflib.SequenceMatcher(None, [line.strip() for line in a], [line.strip() for line in b], autojunk=False)

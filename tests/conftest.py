@@ -14,8 +14,8 @@ def sandbox_or_skip():
     """Skip a test that needs bubblewrap where there is none, but fail in CI, which must have it."""
     import os
 
-    from labkit.grading.backends import get_backend
-    from labkit.grading.backends.base import SandboxUnavailable
+    from labkit.grading.sandbox.backends import get_backend
+    from labkit.grading.sandbox.backends.base import SandboxUnavailable
 
     try:
         get_backend("bwrap").available()
@@ -87,7 +87,7 @@ def pytest_terminal_summary(terminalreporter):
         )
     shares = getattr(sys.modules.get("test_known"), "SHARES", {})
     if shares:
-        from labkit.grading.known import MIN_SHARED, THRESHOLD
+        from labkit.grading.submission.known import MIN_SHARED, THRESHOLD
 
         terminalreporter.section(
             f"known code: a part is held from a share of {THRESHOLD} with {MIN_SHARED} fingerprints shared"

@@ -27,7 +27,7 @@ def plant_small_class(folder):
     nbformat.write(bare, folder / "carol" / "06_bilinear.ipynb")
     (folder / "dave.ipynb").write_text('{"cells": [ this is not json')
     plant(SLIP, folder / "=1+1 eve")
-    return sorted(folder.iterdir(), key=lambda path: grading.scoring.submission_name(path))
+    return sorted(folder.iterdir(), key=lambda path: grading.submission.scoring.submission_name(path))
 
 
 def cli(*args, env=None, timeout=300, cwd=None):

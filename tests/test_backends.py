@@ -15,14 +15,14 @@ import pytest
 
 from labkit import grading
 from labkit.cli import build_parser, grade_options
-from labkit.grading import backends
-from labkit.grading.backends import bwrap, none
-from labkit.grading.backends.base import Backend, Limits
 from labkit.grading.options import GradeOptions
+from labkit.grading.sandbox import backends
+from labkit.grading.sandbox.backends import bwrap, none
+from labkit.grading.sandbox.backends.base import Backend, Limits
 
 ROOT = Path(__file__).resolve().parents[1]
 LABKIT = ROOT / "labkit"
-BACKENDS = LABKIT / "grading" / "backends"
+BACKENDS = LABKIT / "grading" / "sandbox" / "backends"
 NOTEBOOKS = ROOT / "notebooks"
 RECORD = "LABKIT_TEST_BACKEND_RECORD"  # where the recording backend writes what it was asked, in any process
 
@@ -66,7 +66,7 @@ def test_a_built_in_backend_is_one_module_named_after_it_and_one_registry_entry(
     assert modules == sorted(backends.BUILTIN)
     for name in backends.BUILTIN:
         cls = backends.backend_class(name)
-        assert cls.__module__ == f"labkit.grading.backends.{name}" and cls.name == name
+        assert cls.__module__ == f"labkit.grading.sandbox.backends.{name}" and cls.name == name
         assert issubclass(cls, Backend) and cls.summary
 
 
@@ -163,7 +163,7 @@ def test_a_backend_defined_in_a_test_module_is_all_grading_needs(tmp_path, monke
     assert entries[0] == {"available": True}  # asked once, in this process, before anything was graded
     boxed = entries[1:]
     assert len(boxed) == 1 and boxed[0]["pid"] != os.getpid()  # in the submission's own grading process
-    assert boxed[0]["argv"][-3:] == ["-I", "-m", "labkit.grading.worker"] and boxed[0]["memory"] == 3 * 1024**3
+    assert boxed[0]["argv"][-3:] == ["-I", "-m", "labkit.grading.sandbox.worker"] and boxed[0]["memory"] == 3 * 1024**3
 
 
 def test_a_grading_process_cannot_use_a_backend_it_cannot_import(tmp_path):
@@ -184,7 +184,7 @@ def test_the_none_backend_gives_a_private_folder_and_removes_it():
 
 
 def test_the_bwrap_backend_gives_the_worker_its_uid_and_hands_over_the_seccomp_descriptor():
-    worker = [sys.executable, "-I", "-m", "labkit.grading.worker"]
+    worker = [sys.executable, "-I", "-m", "labkit.grading.sandbox.worker"]
     box = backends.get_backend("bwrap").box(worker, Limits())
     try:
         assert box.argv[-len(worker) - 2 :] == ["--", *worker, str(bwrap.sandbox_uid())]
@@ -234,7 +234,14 @@ def test_no_module_outside_the_backends_names_the_bwrap_tool():
 
 def test_the_grading_modules_reach_a_sandbox_only_through_the_interface():
     """remote.py and batch.py name no backend module, only the registry and the base interface."""
-    for name in ("remote.py", "batch.py", "scoring.py", "worker.py", "options.py", "../cli.py"):
+    for name in (
+        "sandbox/remote.py",
+        "batch.py",
+        "submission/scoring.py",
+        "sandbox/worker.py",
+        "options.py",
+        "../cli.py",
+    ):
         code, _ = _code_and_text(LABKIT / "grading" / name)
         assert not re.search(r"backends \. (bwrap|none)\b|backends import (bwrap|none)\b", code), name
 
@@ -249,7 +256,7 @@ def test_a_new_backend_is_one_new_module_in_the_package(tmp_path):
     )
     try:
         code = (
-            "from labkit.grading import backends\nfrom labkit.cli import build_parser\n"
+            "from labkit.grading.sandbox import backends\nfrom labkit.cli import build_parser\n"
             "print(backends.BUILTIN)\nprint(type(backends.get_backend('zzexample')).__name__)\n"
             "print(build_parser().parse_args(['grade', '--sandbox', 'zzexample', 'x', '--out', 'o']).sandbox)\n"
         )
@@ -265,7 +272,7 @@ def test_a_course_module_is_shown_in_the_sandbox_alone_never_the_folder_around_i
     from conftest import sandbox_or_skip  # here, not at the top: grading processes import this module
 
     from labkit.exercises import registry
-    from labkit.grading.protocol import COURSE_FOLDER
+    from labkit.grading.sandbox.protocol import COURSE_FOLDER
 
     sandbox_or_skip()
     (tmp_path / "course_mod.py").write_text("ANSWER = 41 + 1\n")

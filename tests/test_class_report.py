@@ -22,10 +22,13 @@ import pytest
 from labkit.cli import main
 from labkit.exercises.registry import LAB, _missing
 from labkit.exercises.result import CheckResult, call
-from labkit.grading import class_report, late, remote, scoring, similarity
-from labkit.grading.report import SubmissionGrade, merge, write_report
-from labkit.grading.rubric import default, load
-from labkit.grading.similarity import Pair
+from labkit.grading.reports import class_report, similarity
+from labkit.grading.reports.similarity import Pair
+from labkit.grading.results import late
+from labkit.grading.results.report import SubmissionGrade, merge, write_report
+from labkit.grading.results.rubric import default, load
+from labkit.grading.sandbox import remote
+from labkit.grading.submission import scoring
 
 HOSTILE = "<script>alert(1)</script>"
 HTML_HINT = 'divide by <b>h</b><img src=x onerror="alert(2)"> & not by 2'
@@ -79,7 +82,7 @@ def crashed(part, why):
 
 
 def ended(code, out_of_memory=False):
-    """The grader's words for a notebook process that ended (labkit.grading.remote.Notebook._ended)."""
+    """The grader's words for a notebook process that ended (labkit.grading.sandbox.remote.Notebook._ended)."""
     fake = types.SimpleNamespace(
         process=types.SimpleNamespace(poll=lambda: code), box=types.SimpleNamespace(out_of_memory=lambda: out_of_memory)
     )
@@ -87,7 +90,7 @@ def ended(code, out_of_memory=False):
 
 
 def cells_raised(name, *errors, output_chars=0):
-    """The problems of a notebook whose cells raised (labkit.grading.scoring's wording)."""
+    """The problems of a notebook whose cells raised (labkit.grading.submission.scoring's wording)."""
     ran = {
         "errors": [{"cell": cell, "kind": kind, "message": message, "traceback": ""} for cell, kind, message in errors],
         "output_chars": output_chars,
@@ -530,7 +533,7 @@ def test_the_late_view_says_who_was_late_by_how_much_and_what_it_cost(tmp_path):
     # and the page written by `labkit report` from a results folder says the same
     rubric = tmp_path / "course.toml"
     rubric.write_text(
-        (Path(class_report.__file__).parent / "rubric.toml").read_text()
+        (Path(class_report.__file__).parents[1] / "results" / "rubric.toml").read_text()
         + '\n[late]\ndeadline = "2026-12-01T23:59:00+01:00"\nper = "day"\npercent = 10\ncap = 50\ngrace = 15\n'
         + "[late.extensions]\ncleo = 48\nzed = 24\n"
     )
@@ -722,7 +725,7 @@ def test_bad_input_to_the_module_says_what_to_fix(grades, tmp_path):
 
 
 def test_result_files_that_are_not_plain_files_or_too_large_are_never_read(grades, tmp_path, monkeypatch):
-    from labkit.grading import record
+    from labkit.grading.results import record
 
     write_report(tmp_path, grades)
     fifo = tmp_path / "results" / "zz.json"

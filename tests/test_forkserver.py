@@ -16,9 +16,10 @@ import pytest
 from catalog import MISTAKES, plant
 from conftest import sandbox_or_skip
 
-from labkit.grading import backends, forkserver, grade, remote
-from labkit.grading.backends.base import Limits
+from labkit.grading import grade
 from labkit.grading.options import GradeOptions
+from labkit.grading.sandbox import backends, forkserver, remote
+from labkit.grading.sandbox.backends.base import Limits
 
 NOTEBOOKS = os.path.join(os.path.dirname(os.path.dirname(__file__)), "notebooks")
 

@@ -18,7 +18,7 @@ from labkit.check import EXERCISES
 from labkit.exercises.registry import LAB
 
 ANSWERS = LAB.answers
-from labkit.grading.rubric import default
+from labkit.grading.results.rubric import default
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -436,7 +436,7 @@ def test_every_submission_gets_a_result_file_and_the_seed_is_saved(graded):
     results, out, _, subs = graded
     seed = int((out / "seed.txt").read_text())
     for grade in results.values():
-        data = json.loads((out / "results" / f"{grading.report.safe_name(grade.name)}.json").read_text())
+        data = json.loads((out / "results" / f"{grading.results.report.safe_name(grade.name)}.json").read_text())
         assert data["total"] == grade.total and data["seed"] == seed
         assert {int(n): v for n, v in data["points"].items()} == grade.points
 
@@ -466,7 +466,7 @@ def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
     for grade in graded_apart:
         assert float(rows[grade.name][total]) == grade.total
         assert (
-            tmp / "merged" / "feedback" / f"{grading.report.safe_name(grade.name)}.txt"
+            tmp / "merged" / "feedback" / f"{grading.results.report.safe_name(grade.name)}.txt"
         ).read_text() == grade.feedback()
     assert (tmp / "merged" / "seed.txt").read_text() == "4242\n"
 
@@ -474,7 +474,7 @@ def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
 def test_merge_keeps_a_later_folders_result_and_refuses_folders_without_results(two_runs, tmp_path):
     tmp, *_ = two_runs
     merged = grading.merge([tmp / "job1", tmp / "job3"], tmp_path / "m0")
-    result = f"{grading.report.safe_name('alice')}.json"
+    result = f"{grading.results.report.safe_name('alice')}.json"
     assert [g.name for g in merged] == ["alice"]
     assert [(r.name, r.earlier, r.later) for r in merged.replaced] == [
         ("alice", tmp / "job1" / "results" / result, tmp / "job3" / "results" / result)
@@ -519,7 +519,7 @@ def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp
     ]
     assert [c.split(",")[0] for c in rows["submission"][9:]] == ["to read: exercise 16"] * 2
     assert rows["alice"][1:9] == ["20", "20", "", "0", "0", "20", "20", "graded"] and rows["bob"][6] == "0"
-    feedback = tmp_path / "m" / "feedback" / f"{grading.report.safe_name('alice')}.txt"
+    feedback = tmp_path / "m" / "feedback" / f"{grading.results.report.safe_name('alice')}.txt"
     assert "Rubric: bilinear only" in feedback.read_text()
     bad = tmp_path / "bad.toml"
     bad.write_text("[points]\n17 = 5\n")
@@ -529,7 +529,7 @@ def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp
 
 def test_the_same_seed_gives_the_same_feedback(two_runs):
     tmp, *_ = two_runs
-    name = f"{grading.report.safe_name('alice')}.txt"
+    name = f"{grading.results.report.safe_name('alice')}.txt"
     assert (tmp / "job1" / "feedback" / name).read_text() == (tmp / "job3" / "feedback" / name).read_text()
 
 

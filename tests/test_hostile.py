@@ -30,9 +30,9 @@ from helpers import processes_with as _processes_with
 
 import labkit.piecewise
 from labkit import grading
-from labkit.grading import remote
-from labkit.grading.report import safe_name
-from labkit.grading.rubric import default
+from labkit.grading.results.report import safe_name
+from labkit.grading.results.rubric import default
+from labkit.grading.sandbox import remote
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -71,7 +71,7 @@ def _grading_processes():
     """(pid, what it grades) of every submission's grading process: forked by the launcher, they all have its
     command line, so they are told apart by their log (stderr), which is named after the submission."""
     found = []
-    for pid, _ in _processes_with("labkit.grading.launcher") + _processes_with("labkit.grading.scoring"):
+    for pid, _ in _processes_with("labkit.grading.launcher") + _processes_with("labkit.grading.submission.scoring"):
         try:
             log = os.readlink(f"/proc/{pid}/fd/2")
         except OSError:
@@ -202,7 +202,7 @@ ATTACKS = {
     ],
     # the red team's ways into the watch's hooks, each with the reference kept where the scan does not look
     "object_run_inside_the_watch": [
-        "import numpy as np, labkit\nfrom labkit.grading import guard\n"
+        "import numpy as np, labkit\nfrom labkit.grading.sandbox import guard\n"
         "setattr(np, 'lab_ref', labkit.eval_pherm)\n"
         "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
         "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n"
@@ -215,7 +215,7 @@ ATTACKS = {
     # the second red team: the watch's module, hashlib and the builtins rebound, and the namespace of a
     # stand-in found in a refused module rewritten during the call
     "watch_names_rebound": [
-        "import sys, hashlib, numpy as np, labkit\nfrom labkit.grading import guard\n"
+        "import sys, hashlib, numpy as np, labkit\nfrom labkit.grading.sandbox import guard\n"
         "setattr(np, 'ref', labkit.eval_pherm)\nguard.any = guard._within = lambda *a: False\n"
         "guard.TAMPER_EVENTS = frozenset()\nguard.code_key = lambda code: bytes(12)\n"
         "hashlib.sha1 = hashlib.sha256 = lambda *a: hashlib.md5(b'same')\n"
@@ -680,8 +680,11 @@ def test_no_process_outlives_grading(attacked):
     while (_processes_with("sleep 7777") or _processes_with("labkit.grading")) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert _processes_with("sleep 7777") == []
-    assert _processes_with("labkit.grading.worker") == [] and _processes_with("labkit.grading.scoring") == []
-    assert _processes_with("labkit.grading.zygote") == [] and _processes_with("labkit.grading.launcher") == []
+    assert (
+        _processes_with("labkit.grading.sandbox.worker") == []
+        and _processes_with("labkit.grading.submission.scoring") == []
+    )
+    assert _processes_with("labkit.grading.sandbox.zygote") == [] and _processes_with("labkit.grading.launcher") == []
     assert _processes_with("bwrap") == []
 
 
@@ -701,7 +704,7 @@ def test_the_graders_own_memory_stays_under_its_bound(attacked):
 
 
 def test_the_class_was_graded_through_the_fork_server(attacked):
-    """Every attack here ran in workers forked from the run's fork server (labkit.grading.forkserver)."""
+    """Every attack here ran in workers forked from the run's fork server (labkit.grading.sandbox.forkserver)."""
     if os.geteuid() != 0:
         pytest.skip("the fork server is offered only to a grader running as root")
     run = json.loads((attacked["out"] / "run.json").read_text())
@@ -857,7 +860,7 @@ def test_an_uninterruptible_loop_is_stopped_by_the_total_limit(tmp_path):
     # the limit is 6 s; unstopped, only the grader's grace would end it (126 s): the rest is slack for a busy machine
     assert time.perf_counter() - start < 100
     assert results == {} and "the submission's time limit of 6 s" in problems[0]
-    assert _processes_with("labkit.grading.worker") == []
+    assert _processes_with("labkit.grading.sandbox.worker") == []
 
 
 def test_deep_folders_are_removed_without_recursion(tmp_path):
@@ -877,7 +880,7 @@ def test_deep_folders_are_removed_without_recursion(tmp_path):
 
 
 def test_a_memory_cgroup_counts_what_the_address_space_limit_does_not(tmp_path):
-    from labkit.grading import cgroup
+    from labkit.grading.sandbox import cgroup
 
     group = cgroup.create(96 * 1024**2, label="labkit-test")
     if group is None:
@@ -906,12 +909,12 @@ def test_a_memory_cgroup_counts_what_the_address_space_limit_does_not(tmp_path):
 
 
 def test_the_notebooks_filter_refuses_memfd_keyrings_ptrace_threads_and_signal_handlers():
-    from labkit.grading import seccomp
+    from labkit.grading.sandbox import seccomp
 
     if seccomp.program() is None:
         pytest.skip("no seccomp filter for this architecture")
     code = (
-        "import ctypes, os, signal, threading\nfrom labkit.grading import seccomp, guard\n"
+        "import ctypes, os, signal, threading\nfrom labkit.grading.sandbox import seccomp, guard\n"
         "numbers = seccomp.SYSCALLS[__import__('platform').machine()]\n"
         "assert seccomp.install_for_notebook()\nlibc = ctypes.CDLL(None, use_errno=True)\nseen = {}\n"
         "for name, args in (('add_key', (b'user', b'k', b'v', 1, -4)), ('keyctl', (0, -4)),\n"

@@ -1,5 +1,5 @@
 """Known code (labkit's, scipy's, the solutions') recognised in a graded part however it is renamed, and a
-part built on it held for a person: never an independent correct solution (labkit.grading.known).
+part built on it held for a person: never an independent correct solution (labkit.grading.submission.known).
 
 The copies are made from labkit's installed source (tests/copies.py), the independent solutions are two
 complete solutions written from the lab text and the student release alone (tests/data/independent), and
@@ -21,9 +21,17 @@ from copies import module_source
 
 from labkit import grading
 from labkit.exercises.registry import LAB
-from labkit.grading import known, report, rubric, scan
 from labkit.grading.options import GradeOptions
-from labkit.grading.scoring import _rescore, exercises_in, judge_known, known_sources, read_cells, registry_graded
+from labkit.grading.results import report, rubric
+from labkit.grading.submission import known, scan
+from labkit.grading.submission.scoring import (
+    _rescore,
+    exercises_in,
+    judge_known,
+    known_sources,
+    read_cells,
+    registry_graded,
+)
 from labkit.student_notebooks import paths
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,7 +90,7 @@ def test_fingerprints_are_the_same_in_every_process():
     here = known.fingerprints(known.normalise(text)[0])[0].tolist()
     code = (
         "import sys, json; sys.path.insert(0, 'tests'); from copies import module_source; "
-        "from labkit.grading import known; "
+        "from labkit.grading.submission import known; "
         "print(json.dumps(known.fingerprints(known.normalise(module_source('labkit.bilinear'))[0])[0].tolist()))"
     )
     there = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
@@ -412,7 +420,7 @@ def test_a_release_pays_only_the_held_part_of_a_partly_passed_exercise(tmp_path)
 
 
 def test_the_class_report_lists_a_held_part_side_by_side(tmp_path):
-    from labkit.grading import class_report
+    from labkit.grading.reports import class_report
 
     honest = report.SubmissionGrade("bartholomew", results={}, rubric=rubric.default())
     copier = _held_grade()

@@ -62,3 +62,47 @@ def test_the_search_finds_a_pair_that_imports_each_other_even_inside_a_function(
     edges = imports(package)
     assert edges["pkg.sub.rubric"] == {"pkg.sub.late", "pkg.other"}
     assert edges["pkg.other"] == {"pkg.sub.late"}
+
+
+SUBPACKAGES = ("authoring", "reports", "results", "sandbox", "submission")
+
+
+def reaching_out(edges, inside, allowed_prefix="labkit.grading."):
+    """{module under `inside`: the labkit.grading modules outside `inside` it imports}."""
+    found = {}
+    for name, targets in edges.items():
+        if name == inside or name.startswith(inside + "."):
+            out = {
+                t for t in targets if t.startswith(allowed_prefix) and not (t == inside or t.startswith(inside + "."))
+            }
+            if out:
+                found[name] = out
+    return found
+
+
+def test_the_sandbox_imports_nothing_else_of_the_grader():
+    assert reaching_out(imports(ROOT), "labkit.grading.sandbox") == {}
+
+
+def test_the_check_for_the_sandbox_finds_a_module_that_reaches_out(tmp_path):
+    package = tmp_path / "labkit"
+    (package / "grading" / "sandbox").mkdir(parents=True)
+    (package / "grading" / "results").mkdir()
+    for init in ("", "grading", "grading/sandbox", "grading/results"):
+        (package / init / "__init__.py").write_text("")
+    (package / "grading" / "results" / "rubric.py").write_text("")
+    (package / "grading" / "sandbox" / "remote.py").write_text("def f():\n    from ..results import rubric\n")
+    assert reaching_out(imports(package), "labkit.grading.sandbox") == {
+        "labkit.grading.sandbox.remote": {"labkit.grading.results.rubric"}
+    }
+
+
+def test_each_subpackage_of_grading_says_its_job_and_its_process():
+    for name in SUBPACKAGES:
+        init = ROOT / "grading" / name / "__init__.py"
+        tree = ast.parse(init.read_text(encoding="utf-8"))
+        doc = ast.get_docstring(tree)
+        assert doc, f"{init} has no docstring"
+        first = doc.splitlines()[0]
+        assert first.endswith(".") and len(first) <= 120, f"{init}: the first line is its job, in one line"
+        assert "process" in doc, f"{init} does not say which process its code runs in"

@@ -8,9 +8,10 @@ import sys
 
 import pytest
 
-from labkit.grading import late, lms
-from labkit.grading.report import SubmissionGrade, read_results, write_report
-from labkit.grading.rubric import default
+from labkit.grading.reports import lms
+from labkit.grading.results import late
+from labkit.grading.results.report import SubmissionGrade, read_results, write_report
+from labkit.grading.results.rubric import default
 
 LAB = default()
 SPLINES = (10, 11, 12, 13, 14, 15)
@@ -54,7 +55,7 @@ Eve Noether,eve,1005
 Gus Riemann,gus,1007
 '''
 
-# Canvas's layout (see labkit/grading/lms.py): the student columns, closed by Section; assignments titled
+# Canvas's layout (see labkit/grading/reports/lms.py): the student columns, closed by Section; assignments titled
 # "Title (number)"; read-only totals; a Muted row, the Points Possible row, then the students. Exported with a
 # byte-order mark. Frank has no roster entry; "Student, Test" is Canvas's test student.
 CANVAS = (

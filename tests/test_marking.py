@@ -8,10 +8,11 @@ import pytest
 
 from labkit.cli import main
 from labkit.exercises.registry import LAB
-from labkit.grading import marking, report, rubric
-from labkit.grading.class_report import read as read_class
-from labkit.grading.report import SubmissionGrade
-from labkit.grading.rubric import DEFAULT
+from labkit.grading.reports import marking
+from labkit.grading.reports.class_report import read as read_class
+from labkit.grading.results import report, rubric
+from labkit.grading.results.report import SubmissionGrade
+from labkit.grading.results.rubric import DEFAULT
 
 # the answers of both branches and of exercise 3 weighed: the branches stay worth the same (3 + 3)
 ANSWERS = """
@@ -141,8 +142,8 @@ def test_marks_reach_grades_csv_the_feedback_the_report_and_the_export(tmp_path)
     assert {g.name: g.total for g in grades} == {"ada": 44.5, "=bob": 15}
     assert main(["report", str(out), "--quiet"]) == 0
     assert "44.5" in (out / "report.html").read_text(encoding="utf-8")
-    from labkit.grading import lms
-    from labkit.grading.report import read_results
+    from labkit.grading.reports import lms
+    from labkit.grading.results.report import read_results
 
     roster = tmp_path / "roster.csv"
     roster.write_text("submission,id\nada,S1\n=bob,S2\n", encoding="utf-8")

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from labkit.cli import build_parser, grade_options
-from labkit.grading import remote
-from labkit.grading.backends.base import Limits
 from labkit.grading.options import CPU_GRACE, DEFAULTS, MIB, GradeOptions
+from labkit.grading.sandbox import remote
+from labkit.grading.sandbox.backends.base import Limits
 
 ROOT = Path(__file__).resolve().parents[1]
 LABKIT = ROOT / "labkit"
@@ -110,7 +110,7 @@ def _numbers(path):
 # numbers equal to a default that mean something else: each is looked at when it changes
 NOT_A_DEFAULT = {
     (
-        "grading/report.py",
+        "grading/results/report.py",
         'readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"',
     ): "characters of a file name",
     ("grading/batch.py", "log.seek(max(0, os.path.getsize(self.log) - 4096))"): "bytes of a log's tail",

@@ -135,19 +135,23 @@ def test_one_repository_url_for_the_badges_and_the_install_line():
 def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
     # every notebook starts a worker: what it imports is paid once per notebook graded
     code = (
-        "import sys, labkit.grading.worker\n"
+        "import sys, labkit.grading.sandbox.worker\n"
         "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.batch', "
-        "'labkit.grading.scoring', 'labkit.grading.report', 'concurrent.futures.process'}))"
+        "'labkit.grading.submission.scoring', 'labkit.grading.results.report', 'concurrent.futures.process'}))"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
     from labkit import grading
 
-    assert callable(grading.release) and callable(grading.grade) and grading.report.safe_name("a b").startswith("a_b-")
+    assert (
+        callable(grading.release)
+        and callable(grading.grade)
+        and grading.results.report.safe_name("a b").startswith("a_b-")
+    )
 
 
 def test_every_package_of_labkit_is_in_the_wheel():
     listed = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
     found = sorted(".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "labkit").rglob("__init__.py"))
-    assert "labkit.grading.backends" in found
+    assert "labkit.grading.sandbox.backends" in found
     assert sorted(listed) == found

@@ -7,7 +7,7 @@ import pytest
 
 import labkit
 from labkit.exercises.result import close, worst
-from labkit.grading import protocol
+from labkit.grading.sandbox import protocol
 
 
 def _roundtrip(value, functions=False):

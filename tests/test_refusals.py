@@ -19,9 +19,10 @@ from labkit.exercises.model import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN
 from labkit.exercises.registry import LAB
 
 REFUSALS = LAB.refusals
-from labkit.grading import guard, refusals, remote, scoring
 from labkit.grading.options import GradeOptions
-from labkit.grading.scan import Unreadable, python_source, scan
+from labkit.grading.sandbox import guard, remote
+from labkit.grading.submission import refusals, scoring
+from labkit.grading.submission.scan import Unreadable, python_source, scan
 
 X, Y, YP = np.array([0.0, 1.0, 3.0]), np.array([1.0, -1.0, 2.0]), np.array([0.0, 2.0, -1.0])
 XV = np.linspace(-0.5, 3.5, 9)
@@ -202,7 +203,7 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
         # a stand-in made with a name of the student's own, whose formatting calls the reference
         (
             [
-                "import numpy as np\nfrom labkit.grading import guard\nnp.lab_ref = labkit.eval_pherm\n"
+                "import numpy as np\nfrom labkit.grading.sandbox import guard\nnp.lab_ref = labkit.eval_pherm\n"
                 "class Name:\n    def __init__(self, args):\n        self.args, self.out = args, None\n"
                 "    def __format__(self, spec):\n        self.out = np.lab_ref(*self.args)\n        return 'x'\n"
                 "def eval_pherm(x, y, yp, xv):\n    name = Name((x, y, yp, xv))\n    try:\n        guard._stand_in(name)()\n"
@@ -213,7 +214,7 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
         # the second red team: every name the watch's module, hashlib and the builtins hold, rebound
         (
             [
-                "import builtins, hashlib, numpy as np\nfrom labkit.grading import guard\nnp.ref = labkit.eval_pherm\n"
+                "import builtins, hashlib, numpy as np\nfrom labkit.grading.sandbox import guard\nnp.ref = labkit.eval_pherm\n"
                 "guard.any = guard._within = lambda *a: False\nguard.TAMPER_EVENTS = frozenset()\n"
                 "guard.code_key = lambda code: bytes(12)\nguard._sha1 = guard._sha256 = lambda *a: hashlib.md5(b'same')\n"
                 "hashlib.sha1 = hashlib.sha256 = guard._sha1\nguard.sign = lambda *a: ''\n"
@@ -255,7 +256,7 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
         ),
         (
             [
-                "from labkit.grading import protocol\nseen, decode, encode = [], protocol.decode, protocol.encode\n"
+                "from labkit.grading.sandbox import protocol\nseen, decode, encode = [], protocol.decode, protocol.encode\n"
                 "def peek(tag, *a, **k):\n    value = decode(tag, *a, **k)\n    seen.append(value)\n    return value\n"
                 "def answer(value, *a):\n    return encode(labkit.eval_pherm(*seen[-4:]) if len(seen) >= 4 else value, *a)\n"
                 "protocol.decode, protocol.encode = peek, answer"
@@ -264,7 +265,7 @@ def test_coons_may_use_eval_pherm_and_the_corners_it_is_given(open_notebooks):
         ),
         (
             [
-                "import labkit.grading.protocol as p, json\nreal = p.loads\nstash = {}\n"
+                "import labkit.grading.sandbox.protocol as p, json\nreal = p.loads\nstash = {}\n"
                 "def peek(line):\n    request = real(line)\n    if request.get('op') == 'call':\n"
                 "        stash['answer'] = labkit.eval_pherm(X, Y, YP, XV)\n    return request\np.loads = peek"
             ],
@@ -477,7 +478,7 @@ def test_the_scan_names_the_self_checks_in_a_grading_process_that_never_imported
     """The grader's process loads labkit.check only because the refusals name it: the scan must not depend on
     what happened to be imported (``import labkit`` no longer loads the checks)."""
     code = (
-        "import sys\nfrom labkit.exercises.registry import LAB\nfrom labkit.grading import refusals, scan\n"
+        "import sys\nfrom labkit.exercises.registry import LAB\nfrom labkit.grading.submission import refusals, scan\n"
         "assert 'labkit.check' not in sys.modules\n"
         "wired = refusals.wire(LAB.refusals)\n"
         "sources = ['import labkit.check\\nfrom labkit.check import runge as r\\n"

@@ -20,9 +20,9 @@ import labkit.check
 from labkit import convergence
 from labkit.exercises import model
 from labkit.exercises.registry import LAB, Registry, function_name, load
-from labkit.grading import protocol
-from labkit.grading.nbgrader import CHECK_CALL
-from labkit.grading.rubric import default
+from labkit.grading.authoring.nbgrader import CHECK_CALL
+from labkit.grading.results.rubric import default
+from labkit.grading.sandbox import protocol
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = {path.name: path for path in sorted((ROOT / "notebooks").glob("*.ipynb"))}
@@ -135,7 +135,7 @@ def test_the_docs_exercise_table_is_the_declarations():
 
 
 def test_the_answers_in_words_are_the_notebooks_answer_cells():
-    from labkit.grading.nbgrader import answer_ids
+    from labkit.grading.authoring.nbgrader import answer_ids
 
     found = {grade_id for path in NOTEBOOKS.values() for grade_id in answer_ids(nbformat.read(path, as_version=4))}
     assert found == set(LAB.answers)

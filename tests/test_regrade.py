@@ -13,9 +13,9 @@ import pytest
 from catalog import MISTAKES, Planted, plant
 from conftest import sandbox_or_skip
 
-from labkit.grading import late
-from labkit.grading import rubric as rubrics
-from labkit.grading.report import SubmissionGrade, safe_name, write_report
+from labkit.grading.results import late
+from labkit.grading.results import rubric as rubrics
+from labkit.grading.results.report import SubmissionGrade, safe_name, write_report
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 SEED = "4242"

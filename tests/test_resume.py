@@ -14,10 +14,10 @@ import pytest
 from helpers import processes_with
 from small_class import SEED, cli, files
 
-from labkit.grading import rubric as rubrics
 from labkit.grading.batch import resumed
-from labkit.grading.report import safe_name
-from labkit.grading.scoring import submission_name
+from labkit.grading.results import rubric as rubrics
+from labkit.grading.results.report import safe_name
+from labkit.grading.submission.scoring import submission_name
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 

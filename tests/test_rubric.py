@@ -7,8 +7,8 @@ import tomllib
 import pytest
 
 from labkit.check import EXERCISES
-from labkit.grading import rubric as rubrics
-from labkit.grading.report import SubmissionGrade
+from labkit.grading.results import rubric as rubrics
+from labkit.grading.results.report import SubmissionGrade
 
 MESH, SPLINES = (5, 6, 7, 8, 9), (10, 11, 12, 13, 14, 15)
 

@@ -13,11 +13,11 @@ from copydetect import compare_files
 
 from labkit import grading
 from labkit.exercises.registry import LAB
-from labkit.grading import similarity
-from labkit.grading.report import SubmissionGrade, read_results, write_csv
-from labkit.grading.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources
-from labkit.grading.scoring import graded_functions, read_cells
-from labkit.grading.similarity import DEFAULT_THRESHOLD, Pair, similar_pairs
+from labkit.grading.reports import similarity
+from labkit.grading.reports.similarity import DEFAULT_THRESHOLD, Pair, similar_pairs
+from labkit.grading.results.report import SubmissionGrade, read_results, write_csv
+from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources
+from labkit.grading.submission.scoring import graded_functions, read_cells
 from labkit.student_notebooks import paths
 
 DOC = '''    """Piecewise cubic Hermite interpolant of (xdata, ydata) with slopes ypdata, at xval.

@@ -17,7 +17,7 @@ import labkit
 from labkit import check
 from labkit.exercises import experiments, plotted
 from labkit.exercises.registry import LAB
-from labkit.grading import protocol
+from labkit.grading.sandbox import protocol
 
 # -- drivers ---------------------------------------------------------------------
 

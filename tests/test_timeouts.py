@@ -10,8 +10,9 @@ import time
 import nbformat
 import pytest
 
-from labkit.grading import remote, scoring
 from labkit.grading.options import GradeOptions
+from labkit.grading.sandbox import remote
+from labkit.grading.submission import scoring
 
 UNCONFINED = GradeOptions(backend="none", cell_timeout=2)
 

@@ -49,7 +49,7 @@ class Refusal:
     compiled routine in them is switched off, private helpers included.
     ``functions`` are single functions of other modules (numpy's linear
     ``interp``). ``allowed`` are the few functions of those modules that the
-    lab lets students reuse. :mod:`labkit.grading.refusals` turns this into
+    lab lets students reuse. :mod:`labkit.grading.submission.refusals` turns this into
     what the sandbox recognises, and the source scan reads the same lists.
     """
 
@@ -150,7 +150,7 @@ class Part:
     for all. ``reads`` are the notebook's names passed to it, in order: a name,
     an :class:`Optional` name, or names :class:`Together`. The weights of an
     exercise's parts are its points; a rubric that gives the exercise other
-    points scales them (:mod:`labkit.grading.rubric`).
+    points scales them (:mod:`labkit.grading.results.rubric`).
 
     ``passes`` are labkit's functions the check hands to the student's code
     (the only functions that may cross into the sandbox); ``refused`` is

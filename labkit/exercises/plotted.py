@@ -4,7 +4,7 @@ A plot is read as its lines: for every ``Line2D`` of an Axes (or of every
 Axes of a Figure), its x and y data, its marker and whether a line is drawn
 between the points (:func:`lines_of`). In a notebook that is the real
 Axes; in ``labkit grade`` the sandboxed notebook sends the same lines as
-plain numbers (:mod:`labkit.grading.protocol`) and the decisions are made
+plain numbers (:mod:`labkit.grading.sandbox.protocol`) and the decisions are made
 here, on the grader's side.
 
 * Exercise 4 (:func:`limacon_plot`): a curve of at least 100 points that

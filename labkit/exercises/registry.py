@@ -9,7 +9,7 @@ module in :data:`TOPICS`; a toy course (the tests') builds its own
 The same registry serves a student's notebook and ``labkit grade``:
 :meth:`Registry.check` only reads names from a mapping, which is the notebook's
 own variables in the notebook and a proxy into the sandboxed notebook in the
-grader (:mod:`labkit.grading.remote`).
+grader (:mod:`labkit.grading.sandbox.remote`).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ that returns a :class:`CheckResult`. It calls the student's code only through
 reference implementation while being graded) becomes a failed step with a
 hint, never an exception. The same check runs in a student's notebook, on
 the real function, and in ``labkit grade``, on a proxy that forwards the call
-into the sandboxed notebook: see :mod:`labkit.grading.remote`.
+into the sandboxed notebook: see :mod:`labkit.grading.sandbox.remote`.
 """
 
 import hashlib

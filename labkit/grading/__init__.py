@@ -1,82 +1,52 @@
 """Releasing the lab to students and grading what comes back.
 
-One module per concern:
+One subpackage per process and job (CONTRIBUTING.md draws the process tree):
 
-* :mod:`~labkit.grading.release` - the student version of the instructor notebooks;
-* :mod:`~labkit.grading.options` - the limits of a grading run, defaults defined once;
-* :mod:`~labkit.grading.backends` - the sandbox a notebook runs in, one module per backend (``--sandbox NAME``);
-* :mod:`~labkit.grading.seccomp` - the system calls a sandboxed notebook may not make;
-* :mod:`~labkit.grading.cgroup` - a memory cgroup around each sandbox and grading process;
-* :mod:`~labkit.grading.protocol` - the plain-number messages between grader and sandbox;
-* :mod:`~labkit.grading.worker` - the sandboxed side: a pristine supervisor and the notebook's process;
-* :mod:`~labkit.grading.guard` - the watch in the notebook's process: refusals, tampering, attestations;
-* :mod:`~labkit.grading.remote` - the grader's handle on a sandbox and its proxies;
-* :mod:`~labkit.grading.refusals` - what a graded function may not reach, as the watch recognises it;
-* :mod:`~labkit.grading.scan` - reading a notebook's source for refused references;
-* :mod:`~labkit.grading.intake` - the class as the LMS gives it (folders, nbgrader, Canvas, Moodle, a zip) as students;
-* :mod:`~labkit.grading.scoring` - grading one notebook and one submission (one process per submission);
-* :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
-* :mod:`~labkit.grading.late` - the rubric's deadline, submission times, the late penalty;
-* :mod:`~labkit.grading.progress` - a progress bar with an ETA, on a terminal only;
-* :mod:`~labkit.grading.forkserver` - the grader's side of the fork server: notebooks' workers forked warm;
-* :mod:`~labkit.grading.zygote` - the fork server inside its sandbox, isolating each worker it forks;
-* :mod:`~labkit.grading.launcher` - each submission's grading process forked from one warm Python;
-* :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own; resuming, shards;
-* :mod:`~labkit.grading.distributed` - the same on a Dask cluster (``--dask``; the ``labkit[dask]`` extra);
-* :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
-* :mod:`~labkit.grading.record` - a run's record: its rubric, seed, version, the hash of each result it wrote;
-* :mod:`~labkit.grading.class_report` - ``report.html``: the class at a glance (``labkit report OUT``);
-* :mod:`~labkit.grading.lms` - the grades into a Canvas gradebook or a Moodle grade import file.
+* :mod:`~labkit.grading.authoring` - handing the lab out: the student release, nbgrader's markup;
+* :mod:`~labkit.grading.batch`, :mod:`~labkit.grading.launcher`, :mod:`~labkit.grading.distributed`,
+  :mod:`~labkit.grading.options`, :mod:`~labkit.grading.progress`, :mod:`~labkit.grading.intake` - the
+  grader's own process: the class as the LMS gives it, the run's limits, its jobs, resume, shards, Dask;
+* :mod:`~labkit.grading.submission` - one submission's grading process: its notebooks, the source scan,
+  the refusals, copied code, scoring;
+* :mod:`~labkit.grading.sandbox` - isolation: backends, cgroup, seccomp, the protocol, the grader's handle,
+  the fork server and, inside the sandbox, the zygote, the worker and its watch;
+* :mod:`~labkit.grading.results` - what a run writes and reads back: results, the record, the rubric, lateness;
+* :mod:`~labkit.grading.reports` - what a person reads afterwards: the class report, similarity, marking, LMS.
 
-Student code never runs in the grading process: see docs/instructors.md.
+Student code never runs in the grading process: see docs/grading-security.md.
 """
 
 import importlib
 
-from .release import release, release_notebook, strip_solutions  # light: nbformat is imported when used
+from .authoring.release import release, release_notebook, strip_solutions  # light: nbformat is imported when used
 
 # Names are imported on first use (PEP 562), so that the sandboxed worker, started as
-# ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
+# ``python -m labkit.grading.sandbox.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {
     "grade": "batch",
-    "SubmissionGrade": "report",
-    "merge": "report",
-    "Rubric": "rubric",
-    "load_rubric": "rubric",
-    "exercises_in": "scoring",
-    "grade_notebook": "scoring",
-    "grade_submission": "scoring",
-    "submission_notebooks": "scoring",
+    "SubmissionGrade": "results.report",
+    "merge": "results.report",
+    "Rubric": "results.rubric",
+    "load_rubric": "results.rubric",
+    "exercises_in": "submission.scoring",
+    "grade_notebook": "submission.scoring",
+    "grade_submission": "submission.scoring",
+    "submission_notebooks": "submission.scoring",
     "GradeOptions": "options",
-    "get_backend": "backends",
+    "get_backend": "sandbox.backends",
 }
 _MODULES = {
-    "backends",
+    "authoring",
     "batch",
-    "cgroup",
-    "class_report",
     "distributed",
-    "forkserver",
-    "guard",
     "intake",
-    "late",
     "launcher",
-    "lms",
-    "nbgrader",
     "options",
     "progress",
-    "protocol",
-    "record",
-    "refusals",
-    "release",
-    "remote",
-    "report",
-    "rubric",
-    "scan",
-    "scoring",
-    "seccomp",
-    "worker",
-    "zygote",
+    "reports",
+    "results",
+    "sandbox",
+    "submission",
 }
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]

@@ -1,9 +1,9 @@
 """Grading a class: every submission in a grading process of its own, a few at a time.
 
-:func:`grade` checks the sandbox backend once (:mod:`labkit.grading.backends`),
+:func:`grade` checks the sandbox backend once (:mod:`labkit.grading.sandbox.backends`),
 draws the run's seed (or takes the one given), computes what the sandbox
 refuses once, and then starts one process
-per submission (``python -m labkit.grading.scoring``), at most `jobs` at a
+per submission (``python -m labkit.grading.submission.scoring``), at most `jobs` at a
 time. Each has its own limits: address space and a memory cgroup for the
 grader's own work, and the submission's time limit plus a grace for the
 checks. So a submission that makes its grading crash, run out of memory or
@@ -14,12 +14,12 @@ the reason, while every other submission is graded as usual.
 Before each submission the free space of the temporary and output folders
 is checked; when it runs low the run stops starting new submissions and
 says so, rather than grading students into zeros. The output folder
-(:mod:`labkit.grading.report`) always gets a ``grades.csv`` with every
+(:mod:`labkit.grading.results.report`) always gets a ``grades.csv`` with every
 submission once, and ``run.json`` says how the run went (its seed, how many
 could not be graded, its time, the grader's peak memory for one submission).
 
 Each submission's time (for a rubric's ``[late]`` table) is read here, on the
-grader's side (:func:`labkit.grading.late.submission_time`), and saved with
+grader's side (:func:`labkit.grading.results.late.submission_time`), and saved with
 its result, so that ``--merge`` can apply a late rule later. A progress bar
 with an ETA is drawn on a terminal (:mod:`labkit.grading.progress`).
 
@@ -51,18 +51,19 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import backends, cgroup, forkserver, refusals
-from . import record as records
-from .backends.base import SandboxUnavailable
-from .late import submission_time
 from .options import GradeOptions
 from .progress import Progress
-from .report import FORMAT, SubmissionGrade, labkit_version, one_line, safe_name, write_report, write_result
-from .rubric import DEFAULT as DEFAULT_RUBRIC
-from .rubric import Rubric
-from .rubric import default as default_rubric
-from .rubric import load as load_rubric
-from .scoring import known_sources, submission_name, submission_notebooks
+from .results import record as records
+from .results.late import submission_time
+from .results.report import FORMAT, SubmissionGrade, labkit_version, one_line, safe_name, write_report, write_result
+from .results.rubric import DEFAULT as DEFAULT_RUBRIC
+from .results.rubric import Rubric
+from .results.rubric import default as default_rubric
+from .results.rubric import load as load_rubric
+from .sandbox import backends, cgroup, forkserver
+from .sandbox.backends.base import SandboxUnavailable
+from .submission import refusals
+from .submission.scoring import known_sources, submission_name, submission_notebooks
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
@@ -91,7 +92,7 @@ class _Job:
     def __init__(self, path, name, work, options, profiles_file, server=None, launcher=None):
         self.path, self.name, self.attempt = Path(path), name, 0
         self.work, self.options, self.profiles_file = work, options, profiles_file
-        self.server = server  # the run's fork server (labkit.grading.forkserver), or None
+        self.server = server  # the run's fork server (labkit.grading.sandbox.forkserver), or None
         self.launcher = launcher  # the run's Launcher of grading processes, or None (each one a new Python)
         self.process, self.cgroup, self.started = None, None, None
 
@@ -151,7 +152,7 @@ class _Job:
                 self.launcher = None
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen(
-                [sys.executable, "-m", "labkit.grading.scoring", str(spec)],
+                [sys.executable, "-m", "labkit.grading.submission.scoring", str(spec)],
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,
                 stderr=log,
@@ -293,7 +294,7 @@ def grade_one(path, name, options, profiles_file, work):
     The seam both engines share: :func:`_schedule` runs the same steps (:class:`_Job`) a few at a time,
     and a Dask task (:mod:`labkit.grading.distributed`) calls this. `options` is the run's
     :class:`GradeOptions` (its seed drawn), `profiles_file` the refusals as JSON
-    (:func:`labkit.grading.refusals.wire`), `work` a folder for the process's files. Returns plain data:
+    (:func:`labkit.grading.submission.refusals.wire`), `work` a folder for the process's files. Returns plain data:
     ``{"name", "result": the result file's data or None, "failure": why it could not be graded or None,
     "attempts", "peak": the grading process's peak memory in bytes or None}``; :func:`settled` makes a
     :class:`SubmissionGrade` of it under a rubric."""
@@ -395,12 +396,12 @@ def grade(
     (read by labkit from nbgrader's exchange), else, only with
     `times_from_submission`, from the ``timestamp.txt`` in its folder, else,
     only with `times_from_mtime`, from its notebooks' modification time
-    (:func:`labkit.grading.late.submission_time`); the last two are written
+    (:func:`labkit.grading.results.late.submission_time`); the last two are written
     by the student and marked "student-supplied" wherever they are shown.
     `progress` draws a bar with an ETA on a terminal.
 
     Each submission's result and feedback are written as soon as it is
-    graded, and entered in ``record.json`` (:mod:`labkit.grading.record`).
+    graded, and entered in ``record.json`` (:mod:`labkit.grading.results.record`).
     When `out_dir` already holds a run's record, only the submissions without
     a result there, or whose notebooks changed since, are graded, with that
     run's seed and rubric (:func:`resumed`); `fresh` deletes those results
@@ -581,7 +582,7 @@ class Graded(list):
 
 
 def _content(path):
-    """The digest of a submission's notebooks (:func:`labkit.grading.record.content_digest`)."""
+    """The digest of a submission's notebooks (:func:`labkit.grading.results.record.content_digest`)."""
     path = Path(path)
     return records.content_digest(_notebooks(path), path if path.is_dir() else path.parent)
 
@@ -830,7 +831,7 @@ class Resumed:
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     """What the earlier run in `out` leaves to this one: a :class:`Resumed`.
 
-    An output folder with a run record (:mod:`labkit.grading.record`) is resumed: the submissions graded
+    An output folder with a run record (:mod:`labkit.grading.results.record`) is resumed: the submissions graded
     there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
     digest}: they changed since, and are graded again), and the run grades the others with the earlier
     run's seed, which `seed` may repeat but not change, and under the earlier run's rubric, which `rubric`

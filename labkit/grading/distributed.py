@@ -41,10 +41,12 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from . import backends, batch, refusals
-from .backends.base import SandboxUnavailable
+from . import batch
 from .options import GradeOptions
-from .report import SubmissionGrade, one_line, safe_name
+from .results.report import SubmissionGrade, one_line, safe_name
+from .sandbox import backends
+from .sandbox.backends.base import SandboxUnavailable
+from .submission import refusals
 
 LOCAL = "local"  # --dask local: a LocalCluster on this machine
 CONNECT_TIMEOUT = "30s"  # to reach a scheduler

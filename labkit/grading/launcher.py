@@ -3,12 +3,12 @@
 A grading run (:mod:`labkit.grading.batch`) grades every submission in a
 process of its own, so that a submission that makes its grading crash, run
 out of memory or hang costs only its own grade. Started as
-``python -m labkit.grading.scoring SPEC``, each of those processes would
+``python -m labkit.grading.submission.scoring SPEC``, each of those processes would
 import labkit's checks, numpy and scipy again. :class:`Launcher` starts
 ``python -m labkit.grading.launcher`` once per run instead: it imports all
 that, then forks one child per submission, which puts itself in a session,
 cgroup and address-space limit of its own (what ``Popen``'s ``preexec_fn``
-did before) and runs :func:`labkit.grading.scoring.main`. No student code
+did before) and runs :func:`labkit.grading.submission.scoring.main`. No student code
 runs here: student code runs only in the sandboxes the child starts.
 
 The launcher reads one request per line on stdin
@@ -32,8 +32,8 @@ REQUEST_LIMIT = 1 << 16  # bytes of one request line
 
 def _warm(exercises):
     """Import what grading a submission needs, once."""
-    from . import scoring
     from .options import GradeOptions
+    from .submission import scoring
 
     scoring.load_registry(GradeOptions(exercises=exercises).exercises)
     import scipy.interpolate  # the checks compare with it
@@ -67,7 +67,7 @@ def _child(request):
         sys.stderr = os.fdopen(2, "w", buffering=1)
         os.environ.clear()
         os.environ.update(request["environment"])
-        from . import scoring
+        from .submission import scoring
 
         code = int(scoring.main([request["spec"]]) or 0)
     except SystemExit as exc:

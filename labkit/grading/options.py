@@ -2,16 +2,16 @@
 
 :class:`GradeOptions` travels from the command line (``labkit grade``, whose
 defaults are read from here) or :func:`labkit.grading.grade` to each
-submission's grading process (:mod:`labkit.grading.scoring`) and into the
-sandbox (:class:`labkit.grading.remote.Notebook`). No other module spells out
+submission's grading process (:mod:`labkit.grading.submission.scoring`) and into the
+sandbox (:class:`labkit.grading.sandbox.remote.Notebook`). No other module spells out
 a default of its own: they take the options object, or values from it.
 """
 
 import os
 from dataclasses import asdict, dataclass, field, fields, replace
 
-from . import backends
-from .backends.base import Limits
+from .sandbox import backends
+from .sandbox.backends.base import Limits
 
 MIB = 1024**2
 CPU_GRACE = 30  # CPU seconds a notebook's process gets beyond the total time limit (`labkit grade`)
@@ -24,15 +24,17 @@ class GradeOptions:
     cell_timeout: int = 60  # seconds per cell, and per call of a student's function
     total_timeout: int = 600  # seconds for one submission in all, every notebook of it together
     seed: int | None = None  # the random test data's seed (a fresh one per run when None)
-    backend: str = backends.DEFAULT  # the sandbox backend's name (labkit.grading.backends; `--sandbox NAME`)
-    rubric: str | None = None  # the rubric's TOML file (None: the lab's own, labkit/grading/rubric.toml)
+    backend: str = backends.DEFAULT  # the sandbox backend's name (labkit.grading.sandbox.backends; `--sandbox NAME`)
+    rubric: str | None = None  # the rubric's TOML file (None: the lab's own, labkit/grading/results/rubric.toml)
     limits: Limits = field(default_factory=Limits)  # the sandbox's resource limits
     grader_memory: int = 3 * 1024**3  # bytes of address space for the grader's own work on one submission
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
     # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
     exercises: str | None = None
-    fork_server: bool = True  # notebooks' workers forked from one warm server per run (labkit.grading.forkserver)
-    # the instructor notebooks' folder, a known source (labkit.grading.known); None: left out
+    fork_server: bool = (
+        True  # notebooks' workers forked from one warm server per run (labkit.grading.sandbox.forkserver)
+    )
+    # the instructor notebooks' folder, a known source (labkit.grading.submission.known); None: left out
     solutions: str | None = None
 
     def __post_init__(self):
@@ -53,7 +55,7 @@ class GradeOptions:
                 )
             object.__setattr__(self, "solutions", os.path.abspath(os.fspath(self.solutions)))
         if not isinstance(self.limits, Limits):
-            raise ValueError(f"limits must be a labkit.grading.backends.base.Limits; got {self.limits!r}.")
+            raise ValueError(f"limits must be a labkit.grading.sandbox.backends.base.Limits; got {self.limits!r}.")
 
     @classmethod
     def build(cls, options=None, *, sandboxed=None, confined=None, **given):

@@ -13,7 +13,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from jupyterlab_session import CHROMIUM_FLAGS
 from playwright.sync_api import sync_playwright
 
-from labkit.grading import marking, report, rubric
+from labkit.grading.reports import marking
+from labkit.grading.results import report, rubric
 
 ROOT = Path(__file__).resolve().parents[2]
 PICTURE = ROOT / "docs" / "images" / "marking.png"

@@ -15,7 +15,7 @@ from class_results import class_with_pairs
 from jupyterlab_session import CHROMIUM_FLAGS
 from playwright.sync_api import sync_playwright
 
-from labkit.grading import class_report
+from labkit.grading.reports import class_report
 
 ROOT = Path(__file__).resolve().parents[2]
 PICTURE = ROOT / "docs" / "images" / "class-report.png"

@@ -14,7 +14,7 @@ import pytest
 from class_results import class_with_pairs
 from jupyterlab_session import CHROMIUM, CHROMIUM_FLAGS, skip_without_chromium
 
-from labkit.grading import class_report
+from labkit.grading.reports import class_report
 
 HOSTILE = "<script>alert(1)</script>"
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")

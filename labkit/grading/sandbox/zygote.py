@@ -1,10 +1,10 @@
 """The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
 
-Started by the grader (:mod:`labkit.grading.forkserver`) as
-``python -I -m labkit.grading.zygote FD`` inside a sandbox its backend made
-(:meth:`labkit.grading.backends.base.Backend.zygote_box`), with the
+Started by the grader (:mod:`labkit.grading.sandbox.forkserver`) as
+``python -I -m labkit.grading.sandbox.zygote FD`` inside a sandbox its backend made
+(:meth:`labkit.grading.sandbox.backends.base.Backend.zygote_box`), with the
 capabilities to make namespaces and to change uid. It imports what notebooks
-need (:func:`labkit.grading.worker.warm`), says ``ready`` on stdout and then
+need (:func:`labkit.grading.sandbox.worker.warm`), says ``ready`` on stdout and then
 waits on the socket `FD` for requests, one datagram each: a small JSON text
 (the notebook's uid and limits) and, passed along with it, the descriptors
 of the new worker (its requests and answers pipes, a control pipe, a status
@@ -26,7 +26,7 @@ namespace: it joins the notebook's cgroup, takes the notebook's rlimits,
 closes every descriptor but its own pipes (the server's socket among them),
 becomes the notebook's own uid (which drops every capability), sets
 no-new-privileges and runs the worker's supervisor
-(:class:`labkit.grading.worker.Supervisor`) with the imports it inherited.
+(:class:`labkit.grading.sandbox.worker.Supervisor`) with the imports it inherited.
 When the worker ends, the kernel ends every process of its namespace.
 
 The keeper stays outside, as root, running only this module's code: it

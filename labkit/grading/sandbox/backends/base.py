@@ -1,6 +1,6 @@
 """What every sandbox backend provides, and what backends share.
 
-The grader's handle on a notebook (:class:`labkit.grading.remote.Notebook`)
+The grader's handle on a notebook (:class:`labkit.grading.sandbox.remote.Notebook`)
 and a grading run (:func:`labkit.grading.batch.grade`) use a backend only
 through :class:`Backend`:
 
@@ -10,13 +10,13 @@ through :class:`Backend`:
 * :meth:`Backend.warning` is printed on stderr once per run, when there is
   something the instructor must know (student code running unconfined);
 * :meth:`Backend.box` makes one notebook's :class:`Box` from the worker's
-  command (``python -I -m labkit.grading.worker``) and the notebook's
+  command (``python -I -m labkit.grading.sandbox.worker``) and the notebook's
   :class:`Limits`: the command that starts the worker inside the sandbox,
   and whatever has to be set up for it and undone after it.
 
 :class:`Box` runs the command as a local process in a session of its own,
 in a memory cgroup of its own where one can be made
-(:mod:`labkit.grading.cgroup`), under the rlimits of :class:`Limits`
+(:mod:`labkit.grading.sandbox.cgroup`), under the rlimits of :class:`Limits`
 (:func:`apply_limits`); a backend whose sandbox lives elsewhere (a
 container engine) overrides :meth:`Box.start` and :meth:`Box.stop`.
 """
@@ -89,7 +89,7 @@ def course_mounts():
     exercises this process grades (:data:`labkit.exercises.registry.COURSES`) and that the Python environment
     does not hold already. Only the module itself is shown, never the folder around it (where the course
     keeps its submissions and grades)."""
-    from ...exercises.registry import COURSES
+    from ....exercises.registry import COURSES
 
     environment = environment_paths()
     mounts = []
@@ -222,12 +222,12 @@ class Backend(abc.ABC):
         """The :class:`Box` that runs the worker's command `argv` in a new sandbox bounded by `limits`."""
 
     def zygote_box(self, argv, limits, pass_fds):
-        """The :class:`Box` of a fork server (:mod:`labkit.grading.forkserver`), or None: this backend
+        """The :class:`Box` of a fork server (:mod:`labkit.grading.sandbox.forkserver`), or None: this backend
         offers none, and every notebook gets a sandbox of its own from :meth:`box`.
 
         The server runs `argv` with the descriptors `pass_fds`, and must be
         able to make namespaces, mount and change uid for the workers it
-        forks (:mod:`labkit.grading.zygote`)."""
+        forks (:mod:`labkit.grading.sandbox.zygote`)."""
         return None
 
     def notebook_uid(self):

@@ -3,7 +3,7 @@
 The notebook's process is the student's: anything its cells leave behind (a
 patched module, a saved code object, code that rewrites labkit's own grading
 code) is in it. So the watch is installed before the first cell runs, by
-the pristine process that forks the notebook's (:mod:`labkit.grading.worker`),
+the pristine process that forks the notebook's (:mod:`labkit.grading.sandbox.worker`),
 and nothing of it is reachable from Python afterwards:
 
 * an **audit hook** (``sys.addaudithook``: it cannot be removed or listed)
@@ -35,7 +35,7 @@ Neither hook ever touches an object of the student's (no attribute, no
 comparison, no hash): they read code objects, frames and exact built-in
 types only, and the garbage collector is off while they work, so no student
 code ever runs while the watch's own frames are on the stack. The sandbox
-makes threads and new signal handlers impossible (:mod:`labkit.grading.seccomp`),
+makes threads and new signal handlers impossible (:mod:`labkit.grading.sandbox.seccomp`),
 so nothing interrupts them either. A refused call is allowed to run and its
 answer is voided afterwards: neither hook raises.
 """
@@ -525,7 +525,7 @@ def _install(secret, verdict_fd, profiles, passables, chain):
 
 
 def unwire(profiles):
-    """The profiles the grader sent (:func:`labkit.grading.refusals.wire`) as :func:`install` takes them."""
+    """The profiles the grader sent (:func:`labkit.grading.submission.refusals.wire`) as :func:`install` takes them."""
     return {
         name: (
             {bytes.fromhex(key): text for key, text in profile["names"].items()},

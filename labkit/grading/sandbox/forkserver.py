@@ -1,10 +1,10 @@
 """The grader's side of the fork server: imports paid once per run, not once per notebook.
 
-Starting a worker the plain way (:meth:`labkit.grading.backends.base.Backend.box`)
+Starting a worker the plain way (:meth:`labkit.grading.sandbox.backends.base.Backend.box`)
 costs a new sandbox and a new Python that imports numpy, scipy, matplotlib,
 IPython and labkit, for every notebook of every submission: most of a
 submission's grading time. A :class:`ForkServer` starts one process in a
-sandbox of the backend (:mod:`labkit.grading.zygote`) that imports all of
+sandbox of the backend (:mod:`labkit.grading.sandbox.zygote`) that imports all of
 that once; each notebook then gets a worker forked from it and isolated
 from every other notebook before any student code runs (namespaces of its
 own, empty private folders, its own uid, cgroup and rlimits; the zygote's
@@ -37,7 +37,7 @@ from . import cgroup
 from .backends.base import WORKER_IMPORTS, Box
 
 ENV = "LABKIT_FORK_SERVER"  # the descriptor of a fork server's socket, in a grading process
-ZYGOTE = (sys.executable, "-I", "-m", "labkit.grading.zygote")
+ZYGOTE = (sys.executable, "-I", "-m", "labkit.grading.sandbox.zygote")
 READY_TIMEOUT = 180  # seconds for a new server to import what notebooks need
 START_TIMEOUT = 30  # seconds for one forked worker to be isolated and running
 
@@ -176,7 +176,7 @@ def box(backend, limits):
 
 
 class ForkedProcess:
-    """The part of a Popen that :class:`labkit.grading.remote.Notebook` uses, for a forked worker."""
+    """The part of a Popen that :class:`labkit.grading.sandbox.remote.Notebook` uses, for a forked worker."""
 
     pid = None
 

@@ -9,7 +9,7 @@ times the student supplied, :class:`LateSummary`), each exercise's and part's
 pass rate, the slips the checks named (most frequent first, with who made
 them), the problems (time limits, crashes, cells that raised, refused
 references, ...), the students with the most failed parts, and pairs of
-similar code side by side (:mod:`labkit.grading.similarity`; similarity never
+similar code side by side (:mod:`labkit.grading.reports.similarity`; similarity never
 changes a grade, it is for a person to judge). Without copydetect, which the
 similarity search needs, the page is written all the same and its similar code
 section says "not computed", and why.
@@ -19,7 +19,7 @@ with matplotlib's Agg canvas (no pyplot state), its style and its one small
 script are inline, and it names no other resource. Everything a submission
 could have influenced (its name, a hint that quotes its values, a problem's
 text, its code) is data: made printable and bounded in length
-(:func:`labkit.grading.report.one_line`), then HTML-escaped.
+(:func:`labkit.grading.results.report.one_line`), then HTML-escaped.
 """
 
 from __future__ import annotations
@@ -37,13 +37,13 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
-from . import late as lateness
-from .known import THRESHOLD
-from .record import rubric_for
-from .report import SubmissionGrade, one_line, printable, read_results
-from .rubric import Rubric
+from ..results import late as lateness
+from ..results.record import rubric_for
+from ..results.report import SubmissionGrade, one_line, printable, read_results
+from ..results.rubric import Rubric
+from ..results.text import points_text
+from ..submission.known import THRESHOLD
 from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
-from .text import points_text
 
 REPORT = "report.html"
 MAX_SUBMISSIONS = 20_000  # result files in one folder
@@ -93,8 +93,8 @@ KINDS = {
 }
 
 # How the grader words what went wrong (labkit.exercises.result.call, labkit.exercises.registry,
-# labkit.grading.scoring, labkit.grading.remote, labkit.grading.worker); tests/test_class_report.py
-# produces each wording with the grader's own functions, so a change of words fails there.
+# labkit.grading.submission.scoring, labkit.grading.sandbox.remote, labkit.grading.sandbox.worker);
+# tests/test_class_report.py produces each wording with the grader's own functions, so a change of words fails there.
 NOT_DONE_DETAILS = ("not implemented yet", "not defined when the notebook finished")
 REFUSED_WORDS = ("switched off while this exercise is graded",)
 REFUSED_STEP = "calls no reference implementation"
@@ -192,12 +192,12 @@ def _student_supplied(time: lateness.SubmissionTime | None) -> bool:
 
     The ``timestamp.txt`` in a submission is written by the student's own process (nbgrader's submit step
     runs as the student), and a notebook's modification time is whatever the student's files say
-    (:data:`labkit.grading.late.STUDENT_SUPPLIED`); the LMS's ``--times`` and nbgrader's exchange, read by
+    (:data:`labkit.grading.results.late.STUDENT_SUPPLIED`); the LMS's ``--times`` and nbgrader's exchange, read by
     labkit itself, are not. The one place that decides it, for the report's late view.
 
     Examples
     --------
-    >>> from labkit.grading.late import FROM_CSV, FROM_MTIME, SubmissionTime
+    >>> from labkit.grading.results.late import FROM_CSV, FROM_MTIME, SubmissionTime
     >>> _student_supplied(SubmissionTime(None, FROM_MTIME)), _student_supplied(SubmissionTime(None, FROM_CSV))
     (True, False)
     """
@@ -212,7 +212,7 @@ class LateEntry:
     deadline: datetime  # the student's deadline: the rubric's, or their extension
     extended: bool
     submitted: datetime | None  # None when the time is unknown
-    source: str | None  # where the time came from (labkit.grading.late's FROM_...)
+    source: str | None  # where the time came from (labkit.grading.results.late's FROM_...)
     late_by: timedelta | None  # None when the time is unknown; zero or less when on time
     units: int  # started days or hours counted (0: on time, within the grace, or unknown)
     percent: float  # the penalty in percent of raw_total
@@ -307,7 +307,7 @@ def _late_summary(rubric, graded):
 @dataclass(frozen=True)
 class Held:
     """A part held for a person: its check passed, but its code is mostly a known source's
-    (:mod:`labkit.grading.known`); its points count only once the rubric's ``[held]`` table releases them."""
+    (:mod:`labkit.grading.submission.known`); its points count only once the rubric's ``[held]`` table releases them."""
 
     student: str
     exercise: int
@@ -550,7 +550,7 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
 
     Examples
     --------
-    >>> from labkit.grading.report import SubmissionGrade
+    >>> from labkit.grading.results.report import SubmissionGrade
     >>> summarise([SubmissionGrade("ann", {2: {"fraction": 1.0, "passed": True, "checks": [
     ...     {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}]}})]).totals
     {'ann': 10.0}
@@ -561,8 +561,8 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     for grade in grades:
         if not isinstance(grade, SubmissionGrade):
             raise ValueError(
-                f"a class report is made of SubmissionGrade objects (labkit.grading.report); got "
-                f"{type(grade).__name__}: read a run's results with labkit.grading.class_report.read."
+                f"a class report is made of SubmissionGrade objects (labkit.grading.results.report); got "
+                f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
             )
     rubric = grades[0].rubric
     if any(grade.rubric != rubric for grade in grades):
@@ -1335,7 +1335,7 @@ def render(
         The similarity from which pairs were listed (said on the page).
     similarity_note : str, optional
         Why the pairs were not computed, when `pairs` is None; when not given, the reason the similarity
-        search cannot run here, if it cannot (:func:`labkit.grading.similarity.unavailable`).
+        search cannot run here, if it cannot (:func:`labkit.grading.reports.similarity.unavailable`).
 
     Returns
     -------
@@ -1393,13 +1393,13 @@ def _check_pairs(pairs):
         return None
     if isinstance(pairs, (str, bytes, dict)):
         raise ValueError(
-            f"pairs must be a list of labkit.grading.similarity.Pair (or None); got {type(pairs).__name__}."
+            f"pairs must be a list of labkit.grading.reports.similarity.Pair (or None); got {type(pairs).__name__}."
         )
     pairs = list(pairs)
     for pair in pairs:
         if not isinstance(pair, Pair):
             raise ValueError(
-                f"pairs must be labkit.grading.similarity.Pair objects (similarity.similar_pairs gives them); "
+                f"pairs must be labkit.grading.reports.similarity.Pair objects (similarity.similar_pairs gives them); "
                 f"got {type(pair).__name__}."
             )
         if not isinstance(pair.score, (int, float)) or not 0.0 <= float(pair.score) <= 1.0:
@@ -1442,7 +1442,7 @@ def write(
     ------
     ValueError
         For a folder that does not exist, a ``report.html`` that is not a file, no grades, a threshold
-        outside (0, 1], or pairs that are not :class:`~labkit.grading.similarity.Pair` objects.
+        outside (0, 1], or pairs that are not :class:`~labkit.grading.reports.similarity.Pair` objects.
     """
     out = Path(out_dir)
     if not out.is_dir():

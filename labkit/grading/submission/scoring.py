@@ -3,11 +3,11 @@
 For each notebook: check its size and read it here (JSON only, nothing
 run), start the sandboxed worker, have it run the code cells, then run
 every exercise's checks here through proxies into the worker
-(:mod:`labkit.grading.remote`), each part with its references switched off
-in the sandbox (:mod:`labkit.grading.guard`) and named if the source
-reaches for them (:mod:`labkit.grading.scan`). A part whose code is, for the
+(:mod:`labkit.grading.sandbox.remote`), each part with its references switched off
+in the sandbox (:mod:`labkit.grading.sandbox.guard`) and named if the source
+reaches for them (:mod:`labkit.grading.submission.scan`). A part whose code is, for the
 most part, code the student has on disk (labkit's, scipy's, the solutions':
-:mod:`labkit.grading.known`) is held for a person: its points wait until the
+:mod:`labkit.grading.submission.known`) is held for a person: its points wait until the
 rubric's ``[held]`` table releases them. Scores, hints and problems are all
 computed on this side.
 
@@ -15,7 +15,7 @@ A submission has one time limit for all its notebooks together. An
 exercise counts from the first notebook (in name order) that defines its
 names; later notebooks are not checked for it.
 
-``python -m labkit.grading.scoring SPEC`` grades one submission in a
+``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a
 process of its own and writes its result file: :mod:`labkit.grading.batch`
 starts one per submission, so whatever one submission does to the grader's
 memory or time costs only its own grade.
@@ -29,12 +29,13 @@ import sys
 import time
 from pathlib import Path
 
-from ..exercises.model import sections
-from ..exercises.registry import LAB
-from ..exercises.registry import load as load_registry
-from . import backends, known, refusals, remote, scan
-from .options import GradeOptions
-from .report import HELD_STEP, SubmissionGrade, one_line, printable
+from ...exercises.model import sections
+from ...exercises.registry import LAB
+from ...exercises.registry import load as load_registry
+from ..options import GradeOptions
+from ..results.report import HELD_STEP, SubmissionGrade, one_line, printable
+from ..sandbox import backends, remote
+from . import known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -248,7 +249,7 @@ def _profiles(registry):
 
 
 def solutions(folder):
-    """The instructor notebooks of `folder` as :func:`labkit.grading.known.corpus` takes them: a tuple of
+    """The instructor notebooks of `folder` as :func:`labkit.grading.submission.known.corpus` takes them: a tuple of
     (notebook name, tuple of its code cells); ValueError when the folder holds none."""
     folder = Path(folder)
     notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
@@ -268,14 +269,14 @@ def _solutions(stamps):
 
 
 def known_sources(registry, folder=None):
-    """The known sources a graded part's code is compared with (:func:`labkit.grading.known.corpus`):
+    """The known sources a graded part's code is compared with (:func:`labkit.grading.submission.known.corpus`):
     labkit's, the refused modules' and, with `folder`, the instructor notebooks'."""
     return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
 
 
 def judge_known(check, part, code, registry, options):
     """A part's check, held for a person when it passed and its code is mostly known code
-    (:func:`labkit.grading.known.match`); else as it was. `code` is the notebook's code cells."""
+    (:func:`labkit.grading.submission.known.match`); else as it was. `code` is the notebook's code cells."""
     if not check["passed"] or part.refused is None:
         return check
     try:
@@ -298,7 +299,7 @@ def registry_graded(registry):
 
 def _release_grams():
     if not hasattr(_release_grams, "value"):
-        from ..student_notebooks import paths
+        from ...student_notebooks import paths
 
         _release_grams.value = known.release_grams([c for p in paths() for c in read_cells(Path(str(p)))[0]])
     return _release_grams.value
@@ -433,7 +434,7 @@ def grade_submission(path, options=None, *, rubric=None, profiles=None, **single
     notebook of the submission."""
     options = GradeOptions.build(options, **single)
     if rubric is None and options.rubric is not None:
-        from .rubric import load
+        from ..results.rubric import load
 
         rubric = load(options.rubric)
     deadline = time.monotonic() + options.total_timeout

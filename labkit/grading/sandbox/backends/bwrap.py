@@ -12,7 +12,7 @@
   the machine and there is nothing to clean up;
 * ``/proc`` of its own, read-only (no process writes its own memory
   through ``/proc/self/mem``); a minimal ``/dev``;
-* a seccomp filter (:mod:`labkit.grading.seccomp`, handed to ``bwrap
+* a seccomp filter (:mod:`labkit.grading.sandbox.seccomp`, handed to ``bwrap
   --seccomp`` through a pipe): no anonymous memory files, no kernel
   keyrings, no reading or writing another process's memory;
 * no network (``--unshare-net``: only a loopback of its own), its own PID,
@@ -23,7 +23,7 @@
   its command line, so the process limit holds).
 
 :class:`Bubblewrap` is the backend: its :class:`~.base.Box` adds a memory
-cgroup around the whole sandbox where it can (:mod:`labkit.grading.cgroup`)
+cgroup around the whole sandbox where it can (:mod:`labkit.grading.sandbox.cgroup`)
 and sets the rlimits in the child before ``bwrap`` starts
 (:func:`~.base.apply_limits`); they are inherited by everything inside.
 """
@@ -206,7 +206,7 @@ class Bubblewrap(Backend):
         return Box(args, limits, pass_fds=(seccomp_fd,), processes_base=base)
 
     def zygote_box(self, argv, limits, pass_fds):
-        """As root: a fork server in a sandbox like every notebook's (see :mod:`labkit.grading.zygote`).
+        """As root: a fork server in a sandbox like every notebook's (see :mod:`labkit.grading.sandbox.zygote`).
 
         Not as another user: its workers could not each get a uid of their own."""
         if os.geteuid() != 0:

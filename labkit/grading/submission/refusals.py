@@ -4,16 +4,16 @@ An exercise's part declares a :class:`labkit.exercises.model.Refusal`:
 whole modules (scipy's interpolation and spline modules, labkit's
 interpolation modules and the grader's own references), a few single
 functions, and the few functions the lab lets students reuse. This module
-turns one into what :mod:`labkit.grading.guard` needs inside the sandbox:
+turns one into what :mod:`labkit.grading.sandbox.guard` needs inside the sandbox:
 
-* a digest (:func:`labkit.grading.guard.code_key`) of every Python function,
+* a digest (:func:`labkit.grading.sandbox.guard.code_key`) of every Python function,
   method and nested function of those modules, computed here by compiling
   the library's own files, so nothing the notebook did to the live modules
   (a patched class, a saved code object) changes what is recognised;
 * the module prefixes, whose compiled routines are refused by name;
 * single compiled functions ``(module, name)``.
 
-For the source scan (:mod:`labkit.grading.scan`) it also lists every dotted
+For the source scan (:mod:`labkit.grading.submission.scan`) it also lists every dotted
 spelling under which labkit, scipy and numpy export a refused object
 (``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``) and every
 spelling of the allowed ones. Everything is computed once per grading run
@@ -32,7 +32,7 @@ import sys
 import types
 from pathlib import Path
 
-from .guard import code_key, codes_in
+from ..sandbox.guard import code_key, codes_in
 
 
 def _module_files(prefix):

@@ -1,7 +1,7 @@
 """Similar code between submissions, flagged for a person to judge (it never changes a grade).
 
 For each graded function, the students' sources are compared pairwise; pairs
-above a threshold are listed in the class report (:mod:`labkit.grading.class_report`)
+above a threshold are listed in the class report (:mod:`labkit.grading.reports.class_report`)
 side by side, with the lines they share marked.
 
 How two sources are compared is copydetect's (winnowing, Schleimer, Wilkerson
@@ -21,7 +21,7 @@ more than :data:`COMMON_SHARE` of a function's versions, and in more than
 would: the obvious way to write a short function is no evidence.
 
 The work is bounded: each source is at most
-:data:`~labkit.grading.scan.MAX_SOURCE_CHARS` characters, tokenised (never
+:data:`~labkit.grading.submission.scan.MAX_SOURCE_CHARS` characters, tokenised (never
 parsed, never run) and fingerprinted once; the scores of all pairs of one
 function are then computed together from an inverted index of the
 fingerprints (which submissions have each one), exactly as copydetect's
@@ -39,8 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .report import one_line, printable
-from .scan import MAX_SOURCE_CHARS
+from ..results.report import one_line, printable
+from ..submission.scan import MAX_SOURCE_CHARS
 
 DEFAULT_THRESHOLD = 0.8  # similarity (0..1) from which a pair is shown
 NOISE = 25  # normalised characters hashed into one fingerprint (copydetect's noise threshold): shorter runs never count
@@ -105,7 +105,7 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
     Parameters
     ----------
     grades : iterable of SubmissionGrade
-        The class's grades (:class:`labkit.grading.report.SubmissionGrade`,
+        The class's grades (:class:`labkit.grading.results.report.SubmissionGrade`,
         or any objects with a ``name`` and a ``sources`` dict of function
         name to source text); names must differ.
     threshold : float, optional
@@ -136,7 +136,7 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
 
     Examples
     --------
-    >>> from labkit.grading.report import SubmissionGrade
+    >>> from labkit.grading.results.report import SubmissionGrade
     >>> mine = "def area(width, height):\\n    return 0.5 * (width + height) * abs(width - height) ** 2 / 3"
     >>> theirs = "def area(w, h):\\n    # renamed\\n    return 0.5*(w+h)*abs(w-h)**2/3"
     >>> own = "def area(a, b):\\n    s = min(a, b)\\n    return s * s + max(a, b) - 7"
@@ -242,12 +242,12 @@ def boilerplate(release=None) -> Boilerplate:
     """
     if release is None:
         if None not in _PACKAGED:
-            from ..student_notebooks import paths
+            from ...student_notebooks import paths
 
             _PACKAGED[None] = _boilerplate_of(_notebook_code([Path(str(p)) for p in paths()]))
         return _PACKAGED[None]
     if isinstance(release, (str, os.PathLike)):
-        from .scoring import submission_notebooks
+        from ..submission.scoring import submission_notebooks
 
         return _boilerplate_of(_notebook_code(submission_notebooks(release)))
     try:
@@ -262,7 +262,7 @@ def boilerplate(release=None) -> Boilerplate:
 
 
 def _notebook_code(paths):
-    from .scoring import read_cells
+    from ..submission.scoring import read_cells
 
     code = []
     for path in paths:

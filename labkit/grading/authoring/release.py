@@ -17,7 +17,7 @@ what fails on the way, and nbgrader's release (which keeps tags) does the same.
 import json
 from pathlib import Path
 
-from ..execute import RAISES, notebook_paths, raising_cells, read_notebook, set_tag
+from ...execute import RAISES, notebook_paths, raising_cells, read_notebook, set_tag
 
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
 BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"

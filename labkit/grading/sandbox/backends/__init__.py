@@ -1,14 +1,14 @@
 """Sandbox backends: where a student's notebook runs while it is graded.
 
 The rest of grading knows a backend only through :class:`~.base.Backend`
-(:mod:`labkit.grading.backends.base`): whether it can run here, what to warn
+(:mod:`labkit.grading.sandbox.backends.base`): whether it can run here, what to warn
 about once per run, and a :class:`~.base.Box` per notebook, which starts the
 grading worker inside the sandbox and cleans up after it. Everything a
 backend knows about its own tool lives in its own module, named after it:
 
-* :mod:`~labkit.grading.backends.bwrap` - the default: bubblewrap namespaces,
+* :mod:`~labkit.grading.sandbox.backends.bwrap` - the default: bubblewrap namespaces,
   a seccomp filter, rlimits and a memory cgroup, on this machine;
-* :mod:`~labkit.grading.backends.none` - no sandbox of labkit's own, for
+* :mod:`~labkit.grading.sandbox.backends.none` - no sandbox of labkit's own, for
   when something outside already isolates each submission (a Kubernetes pod
   or a batch job's container of its own); it warns that student code runs
   unconfined.
@@ -46,7 +46,8 @@ def register(cls):
 
     if not (isinstance(cls, type) and issubclass(cls, Backend)):
         raise ValueError(
-            f"{cls!r} is not a subclass of labkit.grading.backends.base.Backend; only backends can be registered."
+            f"{cls!r} is not a subclass of labkit.grading.sandbox.backends.base.Backend; "
+            "only backends can be registered."
         )
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not name.isidentifier() or name != name.lower():

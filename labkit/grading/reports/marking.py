@@ -4,7 +4,7 @@ A mark is one row of ``marks.csv``, ``submission,item,points,comment``:
 
 * ``exercise12-answer-1`` (an answer's nbgrader grade id, as in grades.csv's "to read" columns) with
   points between 0 and what the rubric's ``[answers]`` table gives it;
-* ``exercise2/eval_pherm`` (a part held for a person, :mod:`labkit.grading.known`) with ``release``
+* ``exercise2/eval_pherm`` (a part held for a person, :mod:`labkit.grading.submission.known`) with ``release``
   (its points are paid) or ``keep`` (they are not);
 * ``exercise12`` with ``excused`` (out of the student's total and full credit) or ``counted`` (back in).
 
@@ -22,9 +22,9 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
-from . import record as records
-from .report import csv_cell, one_line, printable, read_results, write_csv, write_result
-from .text import points_text
+from ..results import record as records
+from ..results.report import csv_cell, one_line, printable, read_results, write_csv, write_result
+from ..results.text import points_text
 
 HEADER = ["submission", "item", "points", "comment"]
 MAX_MARKS_BYTES = 16 * 1024 * 1024  # a marks.csv larger than this is not read
@@ -185,7 +185,7 @@ def marks_csv(grades):
 # -- the marking page ---------------------------------------------------------------------------------------------
 
 PAGE = "marking.html"
-SOLUTIONS = Path(__file__).resolve().parents[2] / "notebooks"  # the instructor notebooks, in a source tree
+SOLUTIONS = Path(__file__).resolve().parents[3] / "notebooks"  # the instructor notebooks, in a source tree
 MAX_SHOWN = 20000  # characters of a student's answer shown
 
 
@@ -194,8 +194,8 @@ def model_answers(folder=SOLUTIONS):
     when there are none, as in an installed labkit without its source tree)."""
     import nbformat
 
-    from .nbgrader import answer_ids
-    from .release import BEGIN_SOLUTION, END_SOLUTION
+    from ..authoring.nbgrader import answer_ids
+    from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION
 
     found = {}
     for path in sorted(Path(folder).glob("*.ipynb")) if Path(folder).is_dir() else ():

@@ -4,10 +4,10 @@ A student has labkit's own source (every helper of it, private ones
 included), scipy's, and, if they ever leak, the instructor notebooks'
 solutions. A graded function that is one of those with its names changed,
 its docstring gone, its statements moved about or split into helpers is not
-the student's work. The source scan (:mod:`labkit.grading.scan`) and the
-sandbox's watch (:mod:`labkit.grading.guard`) refuse *calls* of that code;
+the student's work. The source scan (:mod:`labkit.grading.submission.scan`) and the
+sandbox's watch (:mod:`labkit.grading.sandbox.guard`) refuse *calls* of that code;
 this module recognises *copies* of it, so that a part built on one is held
-for a person (:func:`labkit.grading.scoring.grade_notebook`) instead of paid.
+for a person (:func:`labkit.grading.submission.scoring.grade_notebook`) instead of paid.
 
 How code is compared (winnowing, Schleimer, Wilkerson and Aiken 2003, as
 copydetect and MOSS do it, with hashes of labkit's own so that they are the
@@ -24,7 +24,7 @@ same in every process):
    ones, so that any shared run of ``NOISE + WINDOW - 1`` characters shares a
    fingerprint, wherever it sits in either source.
 3. A graded part's code is every definition its graded names reach in the
-   notebook (:func:`labkit.grading.scan.reached_sources`). Each definition's
+   notebook (:func:`labkit.grading.submission.scan.reached_sources`). Each definition's
    own fingerprints (those the student release does not give everyone, each
    counted once) are set against the one known unit (a function or method)
    that has most of them. The part matches (:class:`Match`) when those units
@@ -302,7 +302,7 @@ def corpus(refusals=(), solutions=()):
 
     `refusals` are :class:`labkit.exercises.model.Refusal` objects; `solutions` is a tuple of (notebook
     name, tuple of its code cells), the instructor notebooks as the grader reads them
-    (:func:`labkit.grading.scoring.solutions`)."""
+    (:func:`labkit.grading.submission.scoring.solutions`)."""
     entries = [(module, str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
     entries += [(f"the solutions' {name}", name, _notebook_entry(name, cells)) for name, cells in solutions]
     units, sources, hashes, unit_of, source_of, keys = [], [], [], [], [], []

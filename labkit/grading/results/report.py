@@ -8,7 +8,7 @@ Layout of an output folder::
     feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
     results/<name>.json      the same grade as data: merged by ``labkit grade --merge``
     seed.txt                 the seed of the run's random test data
-    record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.record)
+    record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.results.record)
     merge.json               (--merge only) the folders merged and the results a later one replaced
 
 Every file here is written by the grader from its own results; nothing in
@@ -29,10 +29,10 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..submission.scan import MAX_SOURCE_CHARS
 from . import record as records
 from . import rubric as rubrics
 from .late import FROM_CSV, SubmissionTime, time_text
-from .scan import MAX_SOURCE_CHARS
 from .text import points_text
 
 FORMAT = "labkit-grade/2"
@@ -49,11 +49,13 @@ class SubmissionGrade:
     rubric: rubrics.Rubric = field(default_factory=rubrics.default, repr=False, compare=False)
     failure: str | None = None  # why the submission could not be graded at all (then it has no points, not zero)
     answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
-    time: SubmissionTime | None = None  # when it was handed in (labkit.grading.late), None when no source had a time
+    time: SubmissionTime | None = (
+        None  # when it was handed in (labkit.grading.results.late), None when no source had a time
+    )
     # graded function -> the source of its definition (printable, at most MAX_SOURCE_CHARS), for the similarity
-    # search (labkit.grading.similarity); never part of the grade
+    # search (labkit.grading.reports.similarity); never part of the grade
     sources: dict = field(default_factory=dict)
-    # item -> what a person marked (labkit.grading.marking): {"points": number or "excused"/"counted"/"release"/
+    # item -> what a person marked (labkit.grading.reports.marking): {"points": number or "excused"/"counted"/"release"/
     # "keep", "comment": text, "time": ISO time}; items are answer grade ids, "exerciseN" and "exerciseN/part"
     marks: dict = field(default_factory=dict)
 
@@ -125,7 +127,7 @@ class SubmissionGrade:
 
     @property
     def lateness(self):
-        """What the rubric's late rule makes of this submission (:class:`labkit.grading.late.Lateness`), or None
+        """What the rubric's late rule makes of this submission (:class:`labkit.grading.results.late.Lateness`), or None
         when the rubric has no ``[late]`` table or the submission could not be graded."""
         if self.rubric.late is None or not self.graded:
             return None
@@ -354,7 +356,9 @@ def _sources(value):
 
 
 SIDE = 56  # characters of a line shown on each side of a held part's shared lines
-HELD_STEP = "is the student's own code"  # the step a held part fails until it is released (labkit.grading.known)
+HELD_STEP = (
+    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
+)
 
 
 def _held_lines(check, released):
@@ -453,7 +457,7 @@ def _late_cells(grade, lateness):
     ]
 
 
-CSV_HELD = "held for a person"  # only when a submission of the run has a part held (labkit.grading.known)
+CSV_HELD = "held for a person"  # only when a submission of the run has a part held (labkit.grading.submission.known)
 
 
 def held_text(grade):
@@ -518,7 +522,7 @@ def write_csv(path, grades):
 def write_result(out_dir, grade):
     """results/<name>.json and feedback/<name>.txt of one submission, each replaced whole (a run killed while
     writing leaves the earlier file or none, never half of one); the result file and the SHA-256 of what was
-    written (:class:`labkit.grading.record.Written`), for the run's record."""
+    written (:class:`labkit.grading.results.record.Written`), for the run's record."""
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
@@ -537,7 +541,8 @@ def _replace(path, text):
 
 def write_report(out_dir, grades, record=None):
     """grades.csv plus each submission's result and feedback files, each entered in the run's `record`
-    (:mod:`labkit.grading.record`; a new one of the grades' rubric and seeds when None), which is written too."""
+    (:mod:`labkit.grading.results.record`; a new one of the grades' rubric and seeds when None), which is
+    written too."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if record is None:
@@ -596,7 +601,7 @@ class Merged(list):
 
 def read_results(folders, rubric=None, replaced=None):
     """Every result of the given output folders that their run records vouch for, in name order, scored with
-    `rubric` (their recorded rubric when None; :mod:`labkit.grading.record`).
+    `rubric` (their recorded rubric when None; :mod:`labkit.grading.results.record`).
 
     A submission with a result in several folders counts from the last of them, in the order given (a
     regrade replaces the class's result); a later result without a submission time keeps the earlier one's.
@@ -672,7 +677,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         Scores every result, and its ``[late]`` table applies to the submission times they carry; its
         exercises, groups and points must be the folders' own.
     times : dict, optional
-        {submission name: datetime} (:func:`labkit.grading.late.read_times`): these times replace the
+        {submission name: datetime} (:func:`labkit.grading.results.late.read_times`): these times replace the
         stored ones of the submissions they name.
     progress : bool
         Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).
@@ -683,7 +688,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         The grades in name order; its ``replaced`` lists the results a later folder replaced, which
         ``merge.json`` in `out_dir` records as well, and its ``refused`` the result files not merged.
     """
-    from .progress import Progress
+    from ..progress import Progress
 
     out = Path(out_dir)
     if out.resolve() in {Path(folder).resolve() for folder in folders}:

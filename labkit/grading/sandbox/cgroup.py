@@ -10,7 +10,7 @@ slowing a classmate graded beside it (with ``--jobs`` no more than the cores).
 :class:`MemoryCgroup` makes one under the grading process's own cgroup
 (cgroup v2, or v1's memory hierarchy and, where there is one, its cpu
 hierarchy), moves the sandbox into it from inside the new process before it
-starts the sandbox (:class:`labkit.grading.backends.base.Box`), and removes
+starts the sandbox (:class:`labkit.grading.sandbox.backends.base.Box`), and removes
 it afterwards.
 Where no cgroup can be made (not root, no delegation, no cgroup file
 system) :func:`create` returns None and the sandbox relies on its other

@@ -22,7 +22,7 @@ that IPython would hand to another program are skipped.
 
 :func:`function_sources` reads the same cells for the text of the graded
 functions' definitions, which the grade keeps for the similarity search
-(:mod:`labkit.grading.similarity`).
+(:mod:`labkit.grading.reports.similarity`).
 """
 
 import ast
@@ -403,7 +403,7 @@ def scan(sources, names, profile, deadline=None):
     """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a
     reference that `profile` switches off, or reach for code in a way the scan cannot follow.
 
-    `profile` is one refusal as :func:`labkit.grading.refusals.wire` gives it (modules, spellings,
+    `profile` is one refusal as :func:`labkit.grading.submission.refusals.wire` gives it (modules, spellings,
     allowed). Raises :class:`Unreadable` when the code is over :data:`MAX_CODE_BYTES` or reading it
     takes longer than :data:`TIME_BUDGET` seconds."""
     if profile is None:

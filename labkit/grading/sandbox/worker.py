@@ -1,21 +1,21 @@
 """The sandboxed side of grading: a pristine supervisor and the notebook's process it watches.
 
-Started by the grader as ``python -I -m labkit.grading.worker [UID]`` inside the
-sandbox its backend made (:mod:`labkit.grading.backends`); a backend that
+Started by the grader as ``python -I -m labkit.grading.sandbox.worker [UID]`` inside the
+sandbox its backend made (:mod:`labkit.grading.sandbox.backends`); a backend that
 starts it as root gives the otherwise unused UID it is to become, so that
 the sandbox's process limit holds. Two processes:
 
 * the **supervisor** holds the grader's pipes and never runs a line of the
   student's code. It imports what notebooks need once, then forks
 * the **notebook's process**, which installs the watch
-  (:mod:`labkit.grading.guard`) before anything else, closes the grader's
+  (:mod:`labkit.grading.sandbox.guard`) before anything else, closes the grader's
   pipes, runs the cells and answers the grader's requests through the
   supervisor.
 
-Requests, one JSON line each (:mod:`labkit.grading.protocol`):
+Requests, one JSON line each (:mod:`labkit.grading.sandbox.protocol`):
 
 * ``{"op": "setup", "profiles": {...}, "passables": [...]}``: what the watch
-  refuses (:func:`labkit.grading.refusals.wire`) and the functions the
+  refuses (:func:`labkit.grading.submission.refusals.wire`) and the functions the
   checks may hand to student code; the first request;
 * ``{"op": "run", "cells": [...], "cell_timeout": s}``: run the code cells
   in an IPython shell, in order, each interrupted after ``s`` seconds;
@@ -93,7 +93,7 @@ def _describe(exc):
 
 def _tail(exc, lines=40):
     """The last lines of an exception's traceback, as the student's cell would show them (the grader picks
-    the student's own frames from them, :func:`labkit.grading.scoring._student_frames`)."""
+    the student's own frames from them, :func:`labkit.grading.submission.scoring._student_frames`)."""
     import traceback
 
     try:
@@ -216,7 +216,7 @@ class Notebook:
 
 
 def _serve_one(notebook, reader, answers):
-    """Answer one request, between the sentinels the watch recognises (see :mod:`labkit.grading.guard`).
+    """Answer one request, between the sentinels the watch recognises (see :mod:`labkit.grading.sandbox.guard`).
 
     The request is read only after the watch has started watching, so nothing
     the notebook left behind sees a request's data unwatched."""
@@ -535,7 +535,7 @@ def warm(everything=False):
     import labkit
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
 
-    # what the lab's notebooks import too: paid once per fork server (labkit.grading.zygote); a worker of its
+    # what the lab's notebooks import too: paid once per fork server (labkit.grading.sandbox.zygote); a worker of its
     # own would pay for them in the notebook's own time, whether its notebook imports them or not
     for name in NOTEBOOK_IMPORTS if everything else ():
         try:

@@ -1,14 +1,15 @@
 """The grader's handle on one sandboxed notebook: start it, run it, call into it, stop it.
 
-:class:`Notebook` starts the worker (:mod:`labkit.grading.worker`) inside the
-sandbox of the backend its :class:`~labkit.grading.options.GradeOptions` name
-(:mod:`labkit.grading.backends`), tells it what the watch refuses, sends it
+:class:`Notebook` starts the worker (:mod:`labkit.grading.sandbox.worker`) inside the
+sandbox of the backend its settings name (a :class:`~labkit.grading.options.GradeOptions`, or
+anything with the same fields: :class:`Settings`)
+(:mod:`labkit.grading.sandbox.backends`), tells it what the watch refuses, sends it
 requests and reads its answers with a deadline and a size limit, and stops
 every process of the sandbox when it is done, stuck or misbehaving.
 :class:`Namespace` is the mapping the checks read (``ns["eval_pherm"]``): a
 function comes back as a :class:`Function` proxy that forwards each call
 into the sandbox, and data come back decoded as plain numbers
-(:func:`labkit.grading.protocol.decode`). So the checks of
+(:func:`labkit.grading.sandbox.protocol.decode`). So the checks of
 :mod:`labkit.exercises` run unchanged on this side, never in the student's
 process.
 
@@ -25,12 +26,12 @@ import signal
 import subprocess
 import sys
 import time
+from typing import Protocol
 
-from . import backends, forkserver, protocol, refusals
-from .backends.base import remove_tree  # noqa: F401 - where callers have found it
-from .options import GradeOptions
+from . import backends, forkserver, protocol
+from .backends.base import Limits, remove_tree  # noqa: F401 - where callers have found it
 
-WORKER = (sys.executable, "-I", "-m", "labkit.grading.worker")  # the worker's command, run inside the sandbox
+WORKER = (sys.executable, "-I", "-m", "labkit.grading.sandbox.worker")  # the worker's command, run inside the sandbox
 SETUP_TIMEOUT = 120  # seconds for a new worker to import what notebooks need and answer its setup
 
 
@@ -67,11 +68,30 @@ class StudentError(Exception):
         self.traceback = traceback
 
 
-class Notebook:
-    """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest."""
+class Settings(Protocol):
+    """What a sandboxed notebook needs of the run's options (the fields of GradeOptions it reads)."""
 
-    def __init__(self, options=None, deadline=None, profiles=None, passables=()):
-        self.options = options if options is not None else GradeOptions()
+    @property
+    def backend(self) -> str: ...  # the sandbox backend's name
+    @property
+    def limits(self) -> Limits: ...
+    @property
+    def fork_server(self) -> bool: ...
+    @property
+    def cell_timeout(self) -> float: ...  # seconds
+    @property
+    def total_timeout(self) -> float: ...  # seconds
+
+
+class Notebook:
+    """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest.
+
+    `profiles` are what the watch refuses (:func:`labkit.grading.submission.refusals.wire`; none when
+    None), `passables` the functions the checks may hand to student code, by name.
+    """
+
+    def __init__(self, options: Settings, deadline=None, profiles=None, passables=()):
+        self.options = options
         self.deadline = deadline if deadline is not None else time.monotonic() + self.options.total_timeout
         self.passables = frozenset(passables)  # functions the checks may hand to student code, by name
         self.stopped = None  # why the worker can no longer answer
@@ -95,14 +115,14 @@ class Notebook:
         self.request(
             {
                 "op": "setup",
-                "profiles": profiles if profiles is not None else refusals.wire(()),
+                "profiles": profiles if profiles is not None else {},
                 "passables": sorted(self.passables),
             },
             SETUP_TIMEOUT,
         )
 
     def _forked(self):
-        """A worker from this process's fork server (:mod:`labkit.grading.forkserver`), or None: there is no
+        """A worker from this process's fork server (:mod:`labkit.grading.sandbox.forkserver`), or None: there is no
         server for this backend, or it could not give one (the notebook then gets a sandbox the plain way)."""
         box = forkserver.box(self.backend, self.options.limits)
         if box is None:

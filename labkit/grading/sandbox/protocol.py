@@ -16,7 +16,7 @@ Both directions use one format, one JSON object per line:
 * towards the notebook only, a function of labkit's that the checks hand to
   student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``. Only the
   functions the exercises declare (``Registry.passable``) are named; the
-  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.guard`);
+  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.sandbox.guard`);
 * from the notebook only, ``["obj", description]`` for anything else.
 
 The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
@@ -80,8 +80,8 @@ def encode(value, passable=frozenset(), depth=0):
 
     Used on both sides: the notebook's answers (which may be hostile, so they are re-checked) and the
     arguments the grader's checks pass."""
-    from ..mesh import QuadMesh
-    from ..patches import Corner
+    from ...mesh import QuadMesh
+    from ...patches import Corner
 
     if depth > MAX_DEPTH:
         return ["obj", "a value nested too deeply"]
@@ -125,7 +125,7 @@ def _is_plot(value):
 
 
 def _lines_tag(plot):
-    from ..plotdata import lines_of
+    from ...plotdata import lines_of
 
     try:
         lines = lines_of(plot)
@@ -212,7 +212,7 @@ def _array(tag):
 
 
 def _line(item):
-    from ..plotdata import Line
+    from ...plotdata import Line
 
     if not (
         isinstance(item, list)
@@ -228,7 +228,7 @@ def _line(item):
 def _corner(parts):
     """A Corner from four arrays, checked here and built without running labkit.patches' code (which
     the grader's watch may refuse while the student's function that receives it runs)."""
-    from ..patches import Corner
+    from ...patches import Corner
 
     fields = [_array(part).ravel() if isinstance(part, list) and part[:1] == ["a"] else None for part in parts]
     if any(f is None for f in fields):
@@ -247,7 +247,7 @@ def decode(tag, depth=0, functions=None):
     """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
     Corners, QuadMeshes, or a NotNumbers. On the notebook's side `functions` maps the
     names of ``["fn", name]`` to the functions handed over for this request."""
-    from ..mesh import QuadMesh
+    from ...mesh import QuadMesh
 
     if depth > MAX_DEPTH + 1:
         raise ProtocolError("nested too deeply")
