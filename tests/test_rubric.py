@@ -10,7 +10,17 @@ from labkit.check import EXERCISES
 from labkit.grading.results import rubric as rubrics
 from labkit.grading.results.report import SubmissionGrade
 
-MESH, SPLINES = (5, 6, 7, 8, 9), (10, 11, 12, 13, 14, 15)
+# The groups come from the lab's rubric file and the points from the exercises' declarations (the registry), so a
+# new exercise in a group changes the expectations below with it; only the first test states the lab's own rule.
+LAB_RUBRIC = rubrics.default()
+REQUIRED_GROUP = tuple(LAB_RUBRIC.required)
+FIRST, SECOND = (tuple(b.exercises) for b in LAB_RUBRIC.branches)
+FIRST_NAME, SECOND_NAME = (b.name for b in LAB_RUBRIC.branches)
+EXTRA_GROUP = tuple(LAB_RUBRIC.extra_credit)
+P = {n: float(e.points) for n, e in EXERCISES.items()}  # the declared points
+REQUIRED, BRANCH = sum(P[n] for n in REQUIRED_GROUP), sum(P[n] for n in FIRST)
+EXTRA = sum(P[n] for n in EXTRA_GROUP)
+BONUS = LAB_RUBRIC.branch_extra  # the rubric's extra credit for a complete second branch
 
 
 def _fractions(*groups, value=1.0):
@@ -18,81 +28,86 @@ def _fractions(*groups, value=1.0):
 
 
 def test_the_lab_rubric_is_its_branch_rule():
-    lab = rubrics.default()
-    assert lab.required == (2, 3, 4) and lab.extra_credit == (16,)
-    assert [b.exercises for b in lab.branches] == [MESH, SPLINES]
-    assert lab.branch_extra == 10
-    # the points are the declared parts' weights, kept nowhere else
-    assert lab.points == {n: exercise.points for n, exercise in EXERCISES.items()}
+    """The lab's rule: exercises 2-4 for everyone, then the mesh (5-9) or the spline branch (10-15), the
+    better counting and the other extra credit, and exercise 16 extra credit."""
+    assert {2, 3, 4} <= set(REQUIRED_GROUP) and 16 in EXTRA_GROUP
+    assert (FIRST_NAME, SECOND_NAME) == ("mesh generation", "splines")
+    assert {5, 6, 7, 8, 9} <= set(FIRST) and {10, 11, 12, 13, 14, 15} <= set(SECOND)
+    assert BONUS > 0
+    groups = [REQUIRED_GROUP, FIRST, SECOND, EXTRA_GROUP]
+    graded = [n for group in groups for n in group]
+    assert sorted(graded) == sorted(set(graded)), "an exercise is in two groups"
+    # every graded exercise of the registry is in a group, and the points are the declared parts' weights
+    assert set(graded) == {n for n in EXERCISES if n != 1} == set(LAB_RUBRIC.points)
+    assert LAB_RUBRIC.points == {n: exercise.points for n, exercise in EXERCISES.items() if n in LAB_RUBRIC.points}
     assert "[points]" not in "".join(
         line for line in rubrics.DEFAULT.read_text().splitlines() if not line.startswith("#")
     )
-    assert lab.full_credit == sum(lab.points[n] for n in (2, 3, 4) + MESH)
-    assert lab.maximum == lab.full_credit + 10 + lab.points[16]
-
-
-P = {n: float(e.points) for n, e in EXERCISES.items()}  # the declared points: the totals below follow them
-REQUIRED, BRANCH = sum(P[n] for n in (2, 3, 4)), sum(P[n] for n in MESH)
-BONUS = 10  # the rubric's extra credit for a complete second branch
+    assert LAB_RUBRIC.full_credit == REQUIRED + BRANCH
+    assert LAB_RUBRIC.maximum == REQUIRED + BRANCH + BONUS + EXTRA
 
 
 def test_the_lab_branches_are_worth_the_same():
-    assert BRANCH == sum(P[n] for n in SPLINES)
+    assert BRANCH == sum(P[n] for n in SECOND)
 
 
 @pytest.mark.parametrize(
-    "done, total, branch, extra",
+    "done, total, branch, other, bonus, extra",
     [
-        (((2, 3, 4), SPLINES), REQUIRED + BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
-        (((2, 3, 4), MESH), REQUIRED + BRANCH, "mesh generation", {"exercise 16": 0, "branch splines": 0}),
+        (("required", "second"), REQUIRED + BRANCH, SECOND_NAME, FIRST_NAME, 0, False),
+        (("required", "first"), REQUIRED + BRANCH, FIRST_NAME, SECOND_NAME, 0, False),
+        (("required", "first", "second"), REQUIRED + BRANCH + BONUS, FIRST_NAME, SECOND_NAME, BONUS, False),
+        (("required", "second", "extra"), REQUIRED + BRANCH + EXTRA, SECOND_NAME, FIRST_NAME, 0, True),
         (
-            ((2, 3, 4), MESH, SPLINES),
-            REQUIRED + BRANCH + BONUS,
-            "mesh generation",
-            {"exercise 16": 0, "branch splines": BONUS},
+            ("required", "first", "second", "extra"),
+            REQUIRED + BRANCH + BONUS + EXTRA,
+            FIRST_NAME,
+            SECOND_NAME,
+            BONUS,
+            True,
         ),
-        (
-            ((2, 3, 4), SPLINES, (16,)),
-            REQUIRED + BRANCH + P[16],
-            "splines",
-            {"exercise 16": P[16], "branch mesh generation": 0},
-        ),
-        (
-            ((2, 3, 4), MESH, SPLINES, (16,)),
-            REQUIRED + BRANCH + BONUS + P[16],
-            "mesh generation",
-            {"exercise 16": P[16], "branch splines": BONUS},
-        ),
-        ((SPLINES,), BRANCH, "splines", {"exercise 16": 0, "branch mesh generation": 0}),
-        ((), 0, "none", {"exercise 16": 0, "branch splines": 0}),
+        (("second",), BRANCH, SECOND_NAME, FIRST_NAME, 0, False),
+        ((), 0, "none", SECOND_NAME, 0, False),
     ],
 )
-def test_the_better_branch_counts_and_the_other_is_extra_credit(done, total, branch, extra):
-    score = rubrics.default().score(_fractions(*done))
-    assert (score.total, score.branch, score.extra) == (total, branch, extra)
+def test_the_better_branch_counts_and_the_other_is_extra_credit(done, total, branch, other, bonus, extra):
+    named = {"required": REQUIRED_GROUP, "first": FIRST, "second": SECOND, "extra": EXTRA_GROUP}
+    score = LAB_RUBRIC.score(_fractions(*(named[d] for d in done)))
+    expected_extra = {f"exercise {n}": (P[n] if extra else 0) for n in EXTRA_GROUP}
+    expected_extra[f"branch {other}"] = bonus
+    assert (score.total, score.branch, score.extra) == (total, branch, expected_extra)
 
 
 def test_a_partly_done_second_branch_earns_its_share_of_the_extra_credit():
-    lab = rubrics.default()
-    fractions = {**_fractions((2, 3, 4), SPLINES), 5: 1.0, 9: 0.5}  # 12 + 8 of the mesh branch's 60 points
-    score = lab.score(fractions)
-    assert score.branch == "splines" and score.counted == 60
-    assert score.extra["branch mesh generation"] == pytest.approx(10 * 20 / 60, abs=0.01)
-    assert score.total == pytest.approx(100 + 10 * 20 / 60, abs=0.01)
-    # the mesh branch ahead of the spline branch swaps the roles
-    swapped = lab.score({**_fractions((2, 3, 4), MESH), 10: 1.0})
-    assert swapped.branch == "mesh generation" and swapped.extra["branch splines"] == pytest.approx(2.5)
+    lab = LAB_RUBRIC
+    a, b = FIRST[0], FIRST[-1]  # one exercise of the first branch done, another half done
+    earned = P[a] + P[b] / 2
+    score = lab.score({**_fractions(REQUIRED_GROUP, SECOND), a: 1.0, b: 0.5})
+    assert score.branch == SECOND_NAME and score.counted == BRANCH
+    assert score.extra[f"branch {FIRST_NAME}"] == pytest.approx(BONUS * earned / BRANCH, abs=0.01)
+    assert score.total == pytest.approx(REQUIRED + BRANCH + BONUS * earned / BRANCH, abs=0.01)
+    # the first branch ahead of the second swaps the roles
+    c = SECOND[0]
+    swapped = lab.score({**_fractions(REQUIRED_GROUP, FIRST), c: 1.0})
+    assert swapped.branch == FIRST_NAME
+    assert swapped.extra[f"branch {SECOND_NAME}"] == pytest.approx(BONUS * P[c] / BRANCH, abs=0.01)
 
 
 def test_parts_scale_with_the_points_an_edited_rubric_gives():
     data = tomllib.loads(rubrics.DEFAULT.read_text())
-    data["points"] = {"11": 18, "5": 21}  # 11: twice the lab's 9
+    n, m = SECOND[1], FIRST[0]
+    data["points"] = {str(n): 2 * P[n], str(m): P[m] + (2 * P[n] - P[n])}  # n doubled; m keeps the branches level
     edited = rubrics.from_dict(data, "edited")
-    assert edited.score({11: 5 / 9}).points[11] == 10  # the driver part: 5 of 9, now of 18
+    part = EXERCISES[n].parts[0].weight
+    assert edited.score({n: part / P[n]}).points[n] == pytest.approx(2 * part)
+
+
+def _text(points):
+    return f"{points:g}"
 
 
 def test_the_feedback_explains_the_rubric_and_where_the_points_came_from():
-    lab = rubrics.default()
+    lab = LAB_RUBRIC
     results = {
         n: {
             "exercise": n,
@@ -102,13 +117,16 @@ def test_the_feedback_explains_the_rubric_and_where_the_points_came_from():
             "defined": True,
             "checks": [],
         }
-        for n in (2, 3, 4) + SPLINES
+        for n in REQUIRED_GROUP + SECOND
     }
     text = SubmissionGrade("ada", results, [], None, lab).feedback()
-    assert "Feedback for ada: 100 points (100 / 100)" in text
-    assert "plus one branch: mesh generation (5, 6, 7, 8, 9) or splines (10, 11, 12, 13, 14, 15)" in text
-    assert "Branch that counts: splines, 60 / 60" in text and "Extra credit, branch mesh generation: 0" in text
-    assert "Exercise 5: 0 / 12 - not found" in text
+    full = _text(REQUIRED + BRANCH)
+    assert f"Feedback for ada: {full} points ({full} / {full})" in text
+    listed = lambda group: ", ".join(map(str, group))
+    assert f"plus one branch: {FIRST_NAME} ({listed(FIRST)}) or {SECOND_NAME} ({listed(SECOND)})" in text
+    assert f"Branch that counts: {SECOND_NAME}, {_text(BRANCH)} / {_text(BRANCH)}" in text
+    assert f"Extra credit, branch {FIRST_NAME}: 0" in text
+    assert f"Exercise {FIRST[0]}: 0 / {_text(P[FIRST[0]])} - not found" in text
 
 
 def _write(tmp_path, text):
