@@ -17,12 +17,13 @@ One module per concern:
 * :mod:`~labkit.grading.scoring` - grading one notebook and one submission (one process per submission);
 * :mod:`~labkit.grading.rubric` - how exercise results become a grade (``rubric.toml``: the lab's);
 * :mod:`~labkit.grading.late` - the rubric's deadline, submission times, the late penalty;
-* :mod:`~labkit.grading.progress` - a progress bar with an ETA, on a terminal only;
 * :mod:`~labkit.grading.forkserver` - the grader's side of the fork server: notebooks' workers forked warm;
 * :mod:`~labkit.grading.zygote` - the fork server inside its sandbox, isolating each worker it forks;
-* :mod:`~labkit.grading.launcher` - each submission's grading process forked from one warm Python;
-* :mod:`~labkit.grading.batch` - grading a class, each submission in a process of its own; resuming, shards;
-* :mod:`~labkit.grading.distributed` - the same on a Dask cluster (``--dask``; the ``labkit[dask]`` extra);
+* :mod:`~labkit.grading.run` - the grader's own process: grading a class (:mod:`~labkit.grading.run.classrun`),
+  its engines here or on a Dask cluster (:mod:`~labkit.grading.run.engines`, :mod:`~labkit.grading.run.dask`),
+  each submission's grading process and the launcher that forks it (:mod:`~labkit.grading.run.processes`,
+  :mod:`~labkit.grading.run.launcher`, :mod:`~labkit.grading.run.warm`), resuming and shards
+  (:mod:`~labkit.grading.run.resume`), the progress bar (:mod:`~labkit.grading.run.progress`);
 * :mod:`~labkit.grading.report` - grades.csv, feedback, per-submission JSON, merging;
 * :mod:`~labkit.grading.record` - a run's record: its rubric, seed, version, the hash of each result it wrote;
 * :mod:`~labkit.grading.class_report` - ``report.html``: the class at a glance (``labkit report OUT``);
@@ -38,7 +39,7 @@ from .release import release, release_notebook, strip_solutions  # light: nbform
 # Names are imported on first use (PEP 562), so that the sandboxed worker, started as
 # ``python -m labkit.grading.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {
-    "grade": "batch",
+    "grade": "run.classrun",
     "SubmissionGrade": "report",
     "merge": "report",
     "Rubric": "rubric",
@@ -52,19 +53,15 @@ _EXPORTS = {
 }
 _MODULES = {
     "backends",
-    "batch",
     "cgroup",
     "class_report",
-    "distributed",
     "forkserver",
     "guard",
     "intake",
     "late",
-    "launcher",
     "lms",
     "nbgrader",
     "options",
-    "progress",
     "protocol",
     "record",
     "refusals",
@@ -72,6 +69,7 @@ _MODULES = {
     "remote",
     "report",
     "rubric",
+    "run",
     "scan",
     "scoring",
     "seccomp",

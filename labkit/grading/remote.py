@@ -27,7 +27,6 @@ import sys
 import time
 
 from . import backends, forkserver, protocol, refusals
-from .backends.base import remove_tree  # noqa: F401 - where callers have found it
 from .options import GradeOptions
 
 WORKER = (sys.executable, "-I", "-m", "labkit.grading.worker")  # the worker's command, run inside the sandbox

@@ -683,7 +683,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         The grades in name order; its ``replaced`` lists the results a later folder replaced, which
         ``merge.json`` in `out_dir` records as well, and its ``refused`` the result files not merged.
     """
-    from .progress import Progress
+    from .run.progress import Progress
 
     out = Path(out_dir)
     if out.resolve() in {Path(folder).resolve() for folder in folders}:
