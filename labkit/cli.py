@@ -446,7 +446,7 @@ def _export(args):
 
 def _report(args):
     from .grading import class_report, similarity
-    from .grading.progress import Progress
+    from .grading.run.progress import Progress
 
     start = time.perf_counter()
     threshold = args.similarity_threshold
