@@ -127,7 +127,7 @@ def test_a_worker_killed_in_the_middle_of_a_run_loses_nothing_and_counts_nothing
 
 
 def test_dask_bad_input_is_refused_saying_what_to_do(monkeypatch, tmp_path):
-    from labkit.grading import distributed as engine
+    from labkit.grading.run import dask as engine
 
     monkeypatch.setattr(engine, "CONNECT_TIMEOUT", "1s")
     with pytest.raises(ValueError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9 .*--dask local"):

@@ -194,7 +194,7 @@ def _peak_bytes():
 @functools.cache
 def _profiles_text(exercises):
     """The refusals of the exercises' registry as JSON, computed once per worker process."""
-    from ..exercises.registry import load as load_registry
+    from ...exercises.registry import load as load_registry
 
     return json.dumps(refusals.wire(load_registry(exercises).refusals))
 
