@@ -7,7 +7,7 @@ release, and a few hostile ones from the test suite (tests/test_hostile.py's
 attacks that end by themselves, and a notebook that is not JSON). Each way is
 run as an instructor runs it, ``labkit grade`` in a process of its own, with
 one seed; the shards one after another, each with --jobs 2 (as the tasks of a
-Slurm array would run side by side on other machines), then ``--merge``.
+Slurm array would run side by side on other machines), then ``labkit merge``.
 Reported: the total time, seconds per submission, the peak memory of the
 grader (the `labkit grade` process, and one submission's grading process, from
 ``run.json``) and of a Dask worker, and whether the three grades.csv are
@@ -78,12 +78,12 @@ def _class(tmp, count):
     return sorted(folder.iterdir(), key=grading.submission.scoring.submission_name)
 
 
-def _grade(*args):
-    """`labkit grade ARGS` in a process of its own; its wall time. It must succeed: no submission of this
-    class makes grading fail, hostile ones included."""
+def _grade(*args, command="grade"):
+    """`labkit grade ARGS` (or another `command`) in a process of its own; its wall time. It must succeed: no
+    submission of this class makes grading fail, hostile ones included."""
     start = time.perf_counter()
     run = subprocess.run(
-        [sys.executable, "-m", "labkit.cli", "grade", *map(str, args), "--quiet"], capture_output=True, text=True
+        [sys.executable, "-m", "labkit.cli", command, *map(str, args), "--quiet"], capture_output=True, text=True
     )
     elapsed = time.perf_counter() - start
     if run.returncode != 0:
@@ -122,7 +122,7 @@ def main():
             _grade(*submissions, "--out", part, "--seed", SEED, "--jobs", 2, "--shard", f"{index}/{SHARDS}")
             for index, part in enumerate(parts, start=1)
         )
-        seconds += _grade("--merge", *parts, "--out", tmp / "merged")
+        seconds += _grade(*parts, "--out", tmp / "merged", command="merge")
         figures[f"{SHARDS} shards merged"] = (seconds, tmp / "merged", parts)
         print(f"{'':<24} {'total':>8} {'s/submission':>13} {'grader':>9} {'one grading':>12} {'Dask worker':>12}")
         for label, (seconds, _, runs) in figures.items():
@@ -137,7 +137,7 @@ def main():
         print(f"load average after: {_load()}")
         print(
             f"shards: {SHARDS} runs of --jobs 2 one after another (an array's tasks would run side by side), "
-            "then --merge"
+            "then labkit merge"
         )
         print(
             "peak memory: grader = the `labkit grade` process; one grading = one submission's grading process "

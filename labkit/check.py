@@ -54,6 +54,4 @@ def exercise(number, namespace, seed=None):
     return _LAB.check(number, namespace, seed)
 
 
-grade = exercise  # its name before 0.2; ``labkit.grading.grade`` is the grader's entry point
-
-__all__ = sorted({*_FACADE, *_LAB.self_checks} - {"grade"})  # grade: the old name, kept but not advertised
+__all__ = sorted({*_FACADE, *_LAB.self_checks})

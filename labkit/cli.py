@@ -5,7 +5,7 @@
 ``labkit execute DIR``                     re-run the instructor notebooks of DIR and save them clean
 ``labkit release DIR --out DIR``           write the student version of the instructor notebooks
 ``labkit grade SUBMISSION... --out DIR``   grade submitted notebooks (or folders of them) in a sandbox
-``labkit grade --merge DIR... --out DIR``  combine the results of several grading runs
+``labkit merge DIR... --out DIR``          combine the results of several grading runs
 ``labkit report OUT``                      write OUT/report.html: the class at a glance, from a grading run
 ``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
 ``labkit export DIR --canvas FILE ...``    the totals into the course's Canvas gradebook (or --moodle)
@@ -157,7 +157,7 @@ def _times_notes(grades, rubric, times):
     if times and rubric.late is None:
         print(
             "labkit grade: the rubric has no [late] table, so the times cost nothing; they are saved with the "
-            "results for a --merge with a rubric that has one.",
+            "results for a `labkit merge` with a rubric that has one.",
             file=sys.stderr,
         )
     stray = set(times or ()) - graded
@@ -178,7 +178,7 @@ def _times_notes(grades, rubric, times):
     if unknown:
         print(
             f"labkit grade: {len(unknown)} submission(s) have no known time, so no late penalty; give their times "
-            "in --times TIMES.csv (submission,time) and merge again (labkit grade --merge DIR --times TIMES.csv "
+            "in --times TIMES.csv (submission,time) and merge again (labkit merge DIR --times TIMES.csv "
             "--out NEW).",
             file=sys.stderr,
         )
@@ -201,7 +201,10 @@ def _resumed(out):
     else:
         print(f"graded {record.get('graded now', 0)} submission(s) now")
     if record.get("shard"):
-        print(f"shard {record['shard']}: {record.get('submissions')} submission(s); combine the shards with --merge")
+        print(
+            f"shard {record['shard']}: {record.get('submissions')} submission(s); combine the shards with "
+            "`labkit merge`"
+        )
 
 
 def grade_options(args):
@@ -225,52 +228,65 @@ def grade_options(args):
     )
 
 
-def _dask_engine(args):
-    """The Dask engine of ``--dask`` (labkit.grading.distributed), or None: grade here."""
+def _engine(args):
+    """The engine of `labkit grade`'s arguments (labkit.grading.run.engines): ``--dask``'s, else ``--jobs``
+    grading processes here."""
     if args.dask is None:
-        return None
-    from .grading import distributed
+        from .grading.run.engines import LocalEngine
 
-    return distributed.engine(args.dask, 2 if args.dask_workers is None else args.dask_workers)
+        return LocalEngine(args.jobs)
+    from .grading.run.dask import DaskEngine
+
+    return DaskEngine(args.dask, 2 if args.dask_workers is None else args.dask_workers)
+
+
+def _merge(args):
+    from .grading import merge
+    from .grading.results.late import read_times
+    from .grading.run.classrun import report_failures
+
+    start = time.perf_counter()
+    given = [flag for flag, value in (("--shard", args.shard), ("--dask", args.dask), ("--fresh", args.fresh)) if value]
+    if given:
+        raise ValueError(f"{', '.join(given)} grade(s) submissions, which `labkit merge` does not; merge without them.")
+    for flag in ("times_from_mtime", "times_from_submission", "times_from_exchange"):
+        if getattr(args, flag):
+            raise ValueError(
+                f"--{flag.replace('_', '-')} reads the submissions' files or the exchange, which `labkit merge` does "
+                "not: give the times in --times TIMES.csv (the results keep the times they were graded with)."
+            )
+    times = read_times(args.times) if args.times else None
+    grades = merge(args.folders, args.out, args.rubric, times=times, progress=not args.quiet)
+    _summary(grades, args.out, start, "merged")
+    _replaced(grades.replaced)
+    _refused(grades, "the merge")
+    unreadable = _times_notes(grades, grades.rubric, times)
+    return 1 if report_failures(grades) or unreadable or grades.refused else 0
 
 
 def _grade(args):
-    from .grading import grade, merge
-    from .grading.batch import report_failures
+    from .grading import grade
     from .grading.results.late import read_exchange, read_times
+    from .grading.run.classrun import report_failures
 
+    if args.merge is not None:
+        raise ValueError(
+            "`labkit grade --merge` is now a command of its own: labkit merge DIR... --out DIR [--rubric R] "
+            "[--times T]."
+        )
     start = time.perf_counter()
     times = read_times(args.times) if args.times else None
-    if args.merge:
-        if args.submissions:
-            raise ValueError("--merge takes output folders of earlier runs, not submissions; give one or the other.")
-        given = [
-            flag for flag, value in (("--shard", args.shard), ("--dask", args.dask), ("--fresh", args.fresh)) if value
-        ]
-        if given:
-            raise ValueError(f"{', '.join(given)} grade(s) submissions, which --merge does not; merge without them.")
-        for flag in ("times_from_mtime", "times_from_submission", "times_from_exchange"):
-            if getattr(args, flag):
-                raise ValueError(
-                    f"--{flag.replace('_', '-')} reads the submissions' files or the exchange, which --merge does not: "
-                    "give the times in --times TIMES.csv (the results keep the times they were graded with)."
-                )
-        grades = merge(args.merge, args.out, args.rubric, times=times, progress=not args.quiet)
-        _summary(grades, args.out, start, "merged")
-        _replaced(grades.replaced)
-        _refused(grades, "--merge")
-        unreadable = _times_notes(grades, grades.rubric, times)
-        return 1 if report_failures(grades) or unreadable or grades.refused else 0
     if not args.submissions:
         raise ValueError(
             "give the submissions: the class folder (or zip) the LMS gave you, or each submission (notebooks or "
-            "folders), or --merge DIR... to combine runs."
+            "folders); `labkit merge DIR...` combines runs."
         )
     if args.dask_workers is not None and args.dask != "local":
         raise ValueError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
     options = grade_options(args)
+    engine = _engine(args)
     if args.shard is not None:
-        from .grading.batch import parse_shard
+        from .grading.run.resume import parse_shard
 
         parse_shard(args.shard)  # a bad one is refused before anything is read
     exchange = None
@@ -290,15 +306,13 @@ def _grade(args):
         grades = grade(
             found.paths,
             args.out,
-            jobs=args.jobs,
+            options,
+            engine=engine,
             progress=not args.quiet,
-            rubric=args.rubric,
-            options=options,
             times=times,
             times_from_mtime=args.times_from_mtime,
             shard=args.shard,
             fresh=args.fresh,
-            engine=_dask_engine(args),
             names=found.names,
             ungradable=found.ungradable,
             times_from_submission=args.times_from_submission,
@@ -336,8 +350,8 @@ class _Class:
 
 
 def _class(args, workspace):
-    """One class folder or zip as the LMS gives it (labkit.grading.intake), or the submissions one by one."""
-    from .grading import intake
+    """One class folder or zip as the LMS gives it (labkit.grading.run.intake), or the submissions one by one."""
+    from .grading.run import intake
 
     paths = args.submissions
     if len(paths) != 1 or not intake.is_class(paths[0]):
@@ -431,8 +445,8 @@ def _export(args):
 
 
 def _report(args):
-    from .grading.progress import Progress
     from .grading.reports import class_report, similarity
+    from .grading.run.progress import Progress
 
     start = time.perf_counter()
     threshold = args.similarity_threshold
@@ -537,7 +551,7 @@ def build_parser():
         help="grade submitted notebooks",
         description="Run each submission (a notebook, or a folder with a student's notebooks) in a sandbox, "
         "check every exercise from outside it, and write grades.csv, feedback/<submission>.txt, "
-        "results/<submission>.json and seed.txt. With --merge, combine earlier runs' results instead.",
+        "results/<submission>.json and seed.txt. `labkit merge` combines earlier runs' results.",
         epilog="Each submission's result is written as soon as it is graded. Resuming is automatic: when --out "
         "already holds results of an earlier run (same rubric and labkit version), only the submissions without "
         "one are graded, with that run's seed from seed.txt (a different --seed is refused), and a submission that "
@@ -552,14 +566,7 @@ def build_parser():
         "`--` before them when a name could start with '-'",
     )
     grd.add_argument("--out", type=Path, required=True, help="folder for grades.csv, feedback/ and results/")
-    grd.add_argument(
-        "--merge",
-        nargs="+",
-        type=Path,
-        metavar="DIR",
-        help="combine the results/ of these earlier --out folders into one grades.csv; a later folder's result "
-        "replaces an earlier one's for the same submission (a regrade goes last)",
-    )
+    grd.add_argument("--merge", nargs="*", help=argparse.SUPPRESS)  # now `labkit merge`: refused, saying so
     grd.add_argument(
         "--jobs", type=int, default=2, help="submissions graded at once on this machine (default 2; not with --dask)"
     )
@@ -567,7 +574,7 @@ def build_parser():
         "--shard",
         metavar="I/N",
         help="grade only the I-th of N equal parts of the submissions (in name order, I from 1): one task of a "
-        "batch array each (give every part the same --seed), then --merge the parts",
+        "batch array each (give every part the same --seed), then `labkit merge` the parts",
     )
     grd.add_argument(
         "--fresh",
@@ -650,7 +657,7 @@ def build_parser():
         action="append",
         metavar="NAME",
         help="grade only this student of the class folder (its name in grades.csv; repeat for more): a regrade, "
-        "merged over the class's run with --merge",
+        "merged over the class's run with `labkit merge`",
     )
     grd.add_argument(
         "--assignment",
@@ -701,6 +708,37 @@ def build_parser():
     grd.add_argument("--quiet", action="store_true", help="no progress bar")
     grd.set_defaults(handler=_grade)
 
+    mrg = commands.add_parser(
+        "merge",
+        help="combine the results of several grading runs",
+        description="Combine the results/ of earlier `labkit grade` --out folders (the shards of a class, a "
+        "regrade after the class's run) into one grades.csv, feedback/ and results/ in --out; a later folder's "
+        "result replaces an earlier one's for the same submission (a regrade goes last). Only results each "
+        "folder's run record vouches for are read.",
+    )
+    mrg.add_argument("folders", nargs="+", type=Path, metavar="DIR", help="the --out folders of earlier runs")
+    mrg.add_argument("--out", type=Path, required=True, help="folder for the merged grades.csv, feedback/ and results/")
+    mrg.add_argument(
+        "--rubric",
+        type=Path,
+        help="TOML rubric to score the results with (default: the one the runs recorded); it may differ from "
+        "theirs only in its [late] and [held] tables",
+    )
+    mrg.add_argument(
+        "--times",
+        type=Path,
+        metavar="TIMES.csv",
+        help="submission times for the rubric's [late] table (submission,time; ISO 8601 with a UTC offset), in "
+        "place of those the results were graded with",
+    )
+    mrg.add_argument("--quiet", action="store_true", help="no progress bar")
+    for flag in ("--shard", "--dask"):  # grading's, refused with a message saying so
+        mrg.add_argument(flag, help=argparse.SUPPRESS)
+    for flag in ("--fresh", "--times-from-mtime", "--times-from-submission"):
+        mrg.add_argument(flag, action="store_true", help=argparse.SUPPRESS)
+    mrg.add_argument("--times-from-exchange", type=Path, help=argparse.SUPPRESS)
+    mrg.set_defaults(handler=_merge)
+
     exp = commands.add_parser(
         "export",
         help="put the grades into the course's Canvas gradebook or a Moodle grade import file",
@@ -712,7 +750,7 @@ def build_parser():
         "listed, 2 for bad input (then nothing is written).",
     )
     exp.add_argument(
-        "results", type=Path, metavar="OUT", help="the --out folder of `labkit grade` (or of `labkit grade --merge`)"
+        "results", type=Path, metavar="OUT", help="the --out folder of `labkit grade` (or of `labkit merge`)"
     )
     lms_choice = exp.add_mutually_exclusive_group(required=True)
     lms_choice.add_argument(
@@ -769,7 +807,7 @@ def build_parser():
     rep = commands.add_parser(
         "report",
         help="write OUT/report.html: totals, pass rates, slips, problems and similar code of a grading run",
-        description="Read the results/ of a `labkit grade` run (or of `labkit grade --merge`) in OUT and write "
+        description="Read the results/ of a `labkit grade` run (or of `labkit merge`) in OUT and write "
         "OUT/report.html, one self-contained page: the distribution of totals, each exercise's and part's "
         "pass rate, the slips the checks named with who made them, the problems (time limits, crashes, "
         "errors, refused references), the students with the most failed parts, and similar code side by "

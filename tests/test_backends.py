@@ -140,23 +140,22 @@ def test_the_cli_offers_the_registry_and_refuses_other_names():
         assert f"{name}{' (the default)' if name == backends.DEFAULT else ''}: {summary}" in help_text
 
 
-def test_the_old_switch_of_the_library_is_the_none_backend():
-    assert GradeOptions.build(sandboxed=False).backend == "none"
-    assert GradeOptions.build(confined=False).backend == "none"
-    assert GradeOptions.build(sandboxed=True).backend == "bwrap"  # True never overrides the options
-    assert GradeOptions.build(GradeOptions(backend="none"), sandboxed=True).backend == "none"
-    with pytest.raises(ValueError, match="give one or the other"):
-        GradeOptions.build(sandboxed=False, backend="bwrap")
+def test_the_old_switch_of_the_library_is_gone():
+    """``sandboxed=False`` was the ``none`` backend before any release; the options name the backend now."""
+    assert GradeOptions(backend="none").backend == "none"
+    with pytest.raises(TypeError, match="sandboxed"):
+        GradeOptions(sandboxed=False)  # type: ignore[call-arg]
+    with pytest.raises(TypeError, match="sandboxed"):
+        grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], "out", sandboxed=False)  # type: ignore[call-arg]
+    assert not hasattr(GradeOptions, "build")
 
 
 def test_a_backend_defined_in_a_test_module_is_all_grading_needs(tmp_path, monkeypatch, capsys):
     """Subclass, register, name it in the options: the grading processes import this module and use it."""
     record = tmp_path / "record.jsonl"
     monkeypatch.setenv(RECORD, str(record))
-    options = GradeOptions(backend="recording", limits=Limits(memory=3 * 1024**3))
-    [grade] = grading.grade(
-        [NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", jobs=1, progress=False, seed=7, options=options
-    )
+    options = GradeOptions(backend="recording", limits=Limits(memory=3 * 1024**3), seed=7)
+    [grade] = grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", options, jobs=1, progress=False)
     assert grade.graded and grade.total == 8, grade.feedback()
     assert "recording backend: student code runs unconfined" in capsys.readouterr().err
     entries = [json.loads(line) for line in record.read_text().splitlines()]
@@ -233,15 +232,10 @@ def test_no_module_outside_the_backends_names_the_bwrap_tool():
 
 
 def test_the_grading_modules_reach_a_sandbox_only_through_the_interface():
-    """remote.py and batch.py name no backend module, only the registry and the base interface."""
-    for name in (
-        "sandbox/remote.py",
-        "batch.py",
-        "submission/scoring.py",
-        "sandbox/worker.py",
-        "options.py",
-        "../cli.py",
-    ):
+    """remote.py and the run's modules name no backend module, only the registry and the base interface."""
+    run = sorted(path.relative_to(LABKIT / "grading").as_posix() for path in (LABKIT / "grading" / "run").glob("*.py"))
+    assert "run/processes.py" in run and "run/engines.py" in run
+    for name in ("sandbox/remote.py", *run, "submission/scoring.py", "sandbox/worker.py", "options.py", "../cli.py"):
         code, _ = _code_and_text(LABKIT / "grading" / name)
         assert not re.search(r"backends \. (bwrap|none)\b|backends import (bwrap|none)\b", code), name
 

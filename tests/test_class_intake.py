@@ -95,7 +95,7 @@ def test_times_inside_a_submission_count_only_when_asked_and_are_marked_student_
 
 
 def test_a_result_a_submission_writes_into_its_own_output_folder_is_never_merged(submissions, tmp_path):
-    """The pod deployment of docs/scaling.md: one run per student, --sandbox none, then --merge."""
+    """The pod deployment of docs/scaling.md: one run per student, --sandbox none, then `labkit merge`."""
     forged = SubmissionGrade("bob", {}, [], 1, default()).as_dict()  # bob with nothing at all
     out_alice, out_bob = tmp_path / "out-alice", tmp_path / "out-bob"
     target = out_alice / "results" / f"{safe_name('bob')}.json"
@@ -120,7 +120,7 @@ def test_a_result_a_submission_writes_into_its_own_output_folder_is_never_merged
     assert pod.returncode == 0, pod.stderr
     assert target.exists()  # the attack ran: the file is there
     assert sorted(json.loads((out_alice / "record.json").read_text())["submissions"]) == ["alice"]
-    merged = cli("grade", "--merge", out_bob, out_alice, "--out", tmp_path / "final", "--quiet")
+    merged = cli("merge", out_bob, out_alice, "--out", tmp_path / "final", "--quiet")
     assert merged.returncode == 1 and f"not read: {target}" in merged.stderr
     assert "record names no such result" in merged.stderr and "replaced" not in merged.stdout
     assert rows(tmp_path / "final")["bob"]["total"] == rows(out_bob)["bob"]["total"] == "7"

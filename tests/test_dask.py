@@ -127,7 +127,7 @@ def test_a_worker_killed_in_the_middle_of_a_run_loses_nothing_and_counts_nothing
 
 
 def test_dask_bad_input_is_refused_saying_what_to_do(monkeypatch, tmp_path):
-    from labkit.grading import distributed as engine
+    from labkit.grading.run import dask as engine
 
     monkeypatch.setattr(engine, "CONNECT_TIMEOUT", "1s")
     with pytest.raises(ValueError, match="cannot reach the Dask scheduler at tcp://127.0.0.1:9 .*--dask local"):
@@ -142,6 +142,6 @@ def test_dask_bad_input_is_refused_saying_what_to_do(monkeypatch, tmp_path):
 
 
 def test_the_core_never_imports_dask():
-    code = "import sys, labkit.cli, labkit.grading.batch, labkit.grading.results.report; print(sorted({'dask', 'distributed'} & set(sys.modules)))"
+    code = "import sys, labkit.cli, labkit.grading.run.classrun, labkit.grading.run.dask, labkit.grading.results.report; print(sorted({'dask', 'distributed'} & set(sys.modules)))"
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr

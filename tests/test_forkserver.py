@@ -173,7 +173,7 @@ def test_the_plain_way_and_the_fork_server_give_the_same_grades(tmp_path):
     slip = plant(entry, tmp_path / "slip").parent
     runs = {}
     for label, fork in (("forked", True), ("plain", False)):
-        grade([solved, slip], tmp_path / label, seed=5, progress=False, options=GradeOptions(fork_server=fork))
+        grade([solved, slip], tmp_path / label, GradeOptions(fork_server=fork, seed=5), progress=False)
         runs[label] = json.loads((tmp_path / label / "run.json").read_text())
     assert runs["plain"]["fork server"] is False and runs["plain"]["forked grading processes"] is False
     if os.geteuid() == 0:

@@ -252,7 +252,9 @@ def graded(tmp_path_factory, released):
     not_json.write_text("{ this is not json")
     subs["not_json"] = not_json
     out = tmp / "grades"
-    results = grading.grade(list(subs.values()), out, jobs=2, cell_timeout=10, total_timeout=120, progress=False)
+    results = grading.grade(
+        list(subs.values()), out, grading.GradeOptions(cell_timeout=10, total_timeout=120), jobs=2, progress=False
+    )
     return {name: r for name, r in zip(subs, results)}, out, sentinel, subs
 
 
@@ -375,7 +377,7 @@ def test_total_time_limit_stops_a_slow_notebook(tmp_path):
     path = tmp_path / "slow.ipynb"
     nbformat.write(nb, path)
     start = time.perf_counter()
-    results, problems = grading.grade_notebook(path, cell_timeout=60, total_timeout=3)
+    results, problems = grading.grade_notebook(path, grading.GradeOptions(cell_timeout=60, total_timeout=3))
     # unstopped, the cells take 150 s; the limit is 3 s, and the rest is slack for a busy machine
     assert time.perf_counter() - start < 90
     assert results == {} and "the submission's time limit of 3 s" in problems[0]
@@ -448,15 +450,15 @@ def two_runs(tmp_path_factory, released):
     solved, bare = tmp / "alice.ipynb", tmp / "bob.ipynb"
     shutil.copy(NOTEBOOKS / "06_bilinear.ipynb", solved)
     shutil.copy(released / "06_bilinear.ipynb", bare)
-    first = grading.grade([solved], tmp / "job1", jobs=1, seed=4242, progress=False)
-    second = grading.grade([bare], tmp / "job2", jobs=1, seed=4242, progress=False)
-    again = grading.grade([solved], tmp / "job3", jobs=1, seed=4242, progress=False)
+    first = grading.grade([solved], tmp / "job1", grading.GradeOptions(seed=4242), jobs=1, progress=False)
+    second = grading.grade([bare], tmp / "job2", grading.GradeOptions(seed=4242), jobs=1, progress=False)
+    again = grading.grade([solved], tmp / "job3", grading.GradeOptions(seed=4242), jobs=1, progress=False)
     return tmp, first + second, again
 
 
 def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
     tmp, graded_apart, _ = two_runs
-    run = _cli("grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp / "merged"))
+    run = _cli("merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp / "merged"))
     assert run.returncode == 0, run.stderr
     with open(tmp / "merged" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}
@@ -494,16 +496,14 @@ def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp
     rubric = tmp_path / "rubric.toml"
     rubric.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n')
     for path, job in ((solved, "job1"), (bare, "job2")):
-        grading.grade([path], tmp_path / job, jobs=1, seed=4242, progress=False, rubric=rubric)
+        grading.grade([path], tmp_path / job, grading.GradeOptions(seed=4242, rubric=rubric), jobs=1, progress=False)
     tmp = tmp_path
     other = tmp_path / "other.toml"
     other.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 10\n')
-    refused = _cli(
-        "grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"), "--rubric", str(other)
-    )
+    refused = _cli("merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"), "--rubric", str(other))
     assert refused.returncode == 2 and "results of different rubrics" in refused.stderr
     assert not (tmp_path / "m").exists()
-    run = _cli("grade", "--merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"))
+    run = _cli("merge", str(tmp / "job1"), str(tmp / "job2"), "--out", str(tmp_path / "m"))
     assert run.returncode == 0, run.stderr
     with open(tmp_path / "m" / "grades.csv", newline="") as handle:
         rows = {row[0]: row for row in csv.reader(handle)}
@@ -523,7 +523,7 @@ def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp
     assert "Rubric: bilinear only" in feedback.read_text()
     bad = tmp_path / "bad.toml"
     bad.write_text("[points]\n17 = 5\n")
-    run = _cli("grade", "--merge", str(tmp / "job1"), "--out", str(tmp_path / "m2"), "--rubric", str(bad))
+    run = _cli("merge", str(tmp / "job1"), "--out", str(tmp_path / "m2"), "--rubric", str(bad))
     assert run.returncode == 2 and "exercise '17', which labkit does not grade" in run.stderr
 
 
@@ -550,10 +550,11 @@ def test_no_sandbox_warns_loudly_and_still_grades(tmp_path, switch):
     assert f"06_bilinear{' ' * 20}" in run.stdout and run.stdout.split("06_bilinear")[1].split()[0] == "8"
 
 
-def test_cli_grade_needs_submissions_or_merge(tmp_path):
+def test_cli_grade_needs_submissions_and_points_the_old_merge_to_its_command(tmp_path):
     run = _cli("grade", "--out", str(tmp_path))
-    assert run.returncode == 2 and "give the submissions" in run.stderr
+    assert run.returncode == 2 and "give the submissions" in run.stderr and "labkit merge DIR" in run.stderr
     run = _cli("grade", str(NOTEBOOKS), "--merge", str(tmp_path), "--out", str(tmp_path))
-    assert run.returncode == 2 and "not submissions" in run.stderr
+    assert run.returncode == 2 and "is now a command of its own: labkit merge DIR... --out DIR" in run.stderr
+    assert not (tmp_path / "grades.csv").exists()
     run = _cli("grade", str(NOTEBOOKS), "--jobs", "0", "--out", str(tmp_path))
     assert run.returncode == 2 and "--jobs must be at least 1" in run.stderr

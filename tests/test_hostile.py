@@ -32,7 +32,7 @@ import labkit.piecewise
 from labkit import grading
 from labkit.grading.results.report import safe_name
 from labkit.grading.results.rubric import default
-from labkit.grading.sandbox import remote
+from labkit.grading.sandbox.backends.base import remove_tree
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -71,7 +71,7 @@ def _grading_processes():
     """(pid, what it grades) of every submission's grading process: forked by the launcher, they all have its
     command line, so they are told apart by their log (stderr), which is named after the submission."""
     found = []
-    for pid, _ in _processes_with("labkit.grading.launcher") + _processes_with("labkit.grading.submission.scoring"):
+    for pid, _ in _processes_with("labkit.grading.run.launcher") + _processes_with("labkit.grading.submission.scoring"):
         try:
             log = os.readlink(f"/proc/{pid}/fd/2")
         except OSError:
@@ -556,9 +556,8 @@ def attacked(tmp_path_factory):
     before = _tree_hash(outside, leave_out=[out])
     leftovers = _temporary_leftovers()
     start = time.perf_counter()
-    results = grading.grade(
-        list(subs.values()), out, jobs=2, cell_timeout=CELL_TIMEOUT, total_timeout=TOTAL_TIMEOUT, progress=False
-    )
+    options = grading.GradeOptions(cell_timeout=CELL_TIMEOUT, total_timeout=TOTAL_TIMEOUT)
+    results = grading.grade(list(subs.values()), out, options, jobs=2, progress=False)
     elapsed = time.perf_counter() - start
     time.sleep(0.5)
     try:
@@ -684,7 +683,9 @@ def test_no_process_outlives_grading(attacked):
         _processes_with("labkit.grading.sandbox.worker") == []
         and _processes_with("labkit.grading.submission.scoring") == []
     )
-    assert _processes_with("labkit.grading.sandbox.zygote") == [] and _processes_with("labkit.grading.launcher") == []
+    assert (
+        _processes_with("labkit.grading.sandbox.zygote") == [] and _processes_with("labkit.grading.run.launcher") == []
+    )
     assert _processes_with("bwrap") == []
 
 
@@ -757,8 +758,7 @@ def test_names_reach_the_terminal_without_escape_sequences(attacked, tmp_path):
             sys.executable,
             "-m",
             "labkit.cli",
-            "grade",
-            "--merge",
+            "merge",
             str(attacked["out"]),
             "--out",
             str(tmp_path / "merged"),
@@ -856,7 +856,7 @@ def test_an_uninterruptible_loop_is_stopped_by_the_total_limit(tmp_path):
         ["import time\nwhile True:\n    try:\n        time.sleep(100)\n    except BaseException:\n        pass"],
     )
     start = time.perf_counter()
-    results, problems = grading.grade_notebook(path, cell_timeout=1, total_timeout=6)
+    results, problems = grading.grade_notebook(path, grading.GradeOptions(cell_timeout=1, total_timeout=6))
     # the limit is 6 s; unstopped, only the grader's grace would end it (126 s): the rest is slack for a busy machine
     assert time.perf_counter() - start < 100
     assert results == {} and "the submission's time limit of 6 s" in problems[0]
@@ -875,7 +875,7 @@ def test_deep_folders_are_removed_without_recursion(tmp_path):
         os.chmod(".", 0o500)  # a folder the student made unwritable
     finally:
         os.chdir(ROOT)
-    remote.remove_tree(top)
+    remove_tree(top)
     assert not top.exists()
 
 

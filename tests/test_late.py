@@ -550,7 +550,7 @@ def test_the_merge_command_lists_replacements_unknown_times_and_refuses_mtime(tm
     times = tmp_path / "times.csv"
     times.write_text("submission,time\ncarl,2026-12-01T20:00:00Z\n")
     run = _cli(
-        "grade", "--merge", str(first), str(regrade), "--out", str(tmp_path / "m"), "--rubric", str(rubric_file),
+        "merge", str(first), str(regrade), "--out", str(tmp_path / "m"), "--rubric", str(rubric_file),
         "--times", str(times),
     )  # fmt: skip
     assert run.returncode == 1, run.stderr  # a time could not be read
@@ -560,9 +560,9 @@ def test_the_merge_command_lists_replacements_unknown_times_and_refuses_mtime(tm
     assert "time unreadable for bob: its submission time could not be read" in run.stderr and "\x1b" not in run.stderr
     assert "the times file names submission(s) not in this run: 'carl'" in run.stderr
     assert "[late.extensions] name submission(s) not in this run: 'zed'" in run.stderr
-    run = _cli("grade", "--merge", str(first), "--out", str(tmp_path / "m2"), "--times-from-mtime")
+    run = _cli("merge", str(first), "--out", str(tmp_path / "m2"), "--times-from-mtime")
     assert run.returncode == 2 and "--times-from-mtime reads the submissions' files" in run.stderr
-    run = _cli("grade", "--merge", str(first), "--out", str(tmp_path / "m3"), "--times", str(tmp_path / "no.csv"))
+    run = _cli("merge", str(first), "--out", str(tmp_path / "m3"), "--times", str(tmp_path / "no.csv"))
     assert run.returncode == 2 and "the times file" in run.stderr and "does not exist" in run.stderr
 
 

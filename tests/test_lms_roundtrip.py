@@ -255,7 +255,7 @@ def test_the_resumed_command_grades_again_only_the_changed_notebook(class_run):
 
 def test_the_regrade_replaces_one_result_and_the_merge_equals_a_fresh_run(class_run, tmp_path):
     root, _, runs = class_run
-    (merge,) = _run_of(runs, "labkit grade --merge")
+    (merge,) = _run_of(runs, "labkit merge")
     assert merge.returncode == 1 and "1 result(s) replaced" in merge.stdout and "Ada Lovelace_101" in merge.stdout
     final = _rows(root / "moodle-final" / "grades.csv")
     seed = (root / "moodle-grades" / "seed.txt").read_text().strip()

@@ -304,7 +304,7 @@ def test_an_answer_can_carry_rubric_lines_that_the_page_shows_beside_the_model_a
 
 
 def test_a_regraded_submission_keeps_the_marks_that_still_apply():
-    from labkit.grading.batch import carried_marks
+    from labkit.grading.run.resume import carried_marks
 
     answer, other = list(LAB.answers)[:2]
     mark = {"points": 1.0, "comment": "", "time": "2026-12-01T10:00:00+00:00"}

@@ -136,7 +136,7 @@ def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
     # every notebook starts a worker: what it imports is paid once per notebook graded
     code = (
         "import sys, labkit.grading.sandbox.worker\n"
-        "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.batch', "
+        "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.run.classrun', "
         "'labkit.grading.submission.scoring', 'labkit.grading.results.report', 'concurrent.futures.process'}))"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)

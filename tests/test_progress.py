@@ -1,10 +1,10 @@
-"""The progress bar of `labkit grade` and `--merge`: counts and an ETA on a terminal, nothing anywhere else."""
+"""The progress bar of `labkit grade` and `labkit merge`: counts and an ETA on a terminal, nothing anywhere else."""
 
 import io
 
 from rich.console import Console
 
-from labkit.grading.progress import Progress
+from labkit.grading.run.progress import Progress
 
 
 class Clock:

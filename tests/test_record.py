@@ -54,7 +54,7 @@ def test_another_rubric_is_refused_with_a_command_that_runs(tmp_path):
     other.write_text(
         DEFAULT.read_text() + '\n[late]\ndeadline = "2026-12-01T23:59Z"\nper = "day"\npercent = 5\ncap = 9\n'
     )
-    with pytest.raises(ValueError, match=f"labkit grade --merge {out} --rubric {other} --out NEW"):
+    with pytest.raises(ValueError, match=f"labkit merge {out} --rubric {other} --out NEW"):
         record.rubric_for([out], other, "labkit report")
     assert record.rubric_for([out], DEFAULT, "labkit report").same_as(default())  # the same rubric, named again
     assert record.rubric_for([out], None, "labkit report").text == DEFAULT.read_text()

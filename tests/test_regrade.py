@@ -76,7 +76,7 @@ def regraded(tmp_path_factory):
     assert again.returncode == 0, again.stderr
     # 3. the two runs merged: the later folder's result for alice replaces the class's
     merged = _cli(
-        "grade", "--merge", str(tmp / "class"), str(tmp / "regrade-alice"), "--out", str(tmp / "final"),
+        "merge", str(tmp / "class"), str(tmp / "regrade-alice"), "--out", str(tmp / "final"),
         "--rubric", str(rubric),
     )  # fmt: skip
     return tmp, first, merged
@@ -128,18 +128,18 @@ def test_results_of_another_rubric_or_another_labkit_version_are_refused(regrade
     # the same result as `labkit grade --rubric OTHER` writes it: another rubric's points
     other = rubrics.from_dict({"title": "bilinear, 20 points", "required": [16], "points": {"16": 20}}, "other.toml")
     write_report(tmp / "other-rubric", [SubmissionGrade.from_dict(data, str(later), other)])
-    run = _cli("grade", "--merge", str(tmp / "class"), str(tmp / "other-rubric"), "--out", str(tmp / "m1"))
+    run = _cli("merge", str(tmp / "class"), str(tmp / "other-rubric"), "--out", str(tmp / "m1"))
     assert run.returncode == 2 and "results of different rubrics" in run.stderr
     assert "'bilinear, 20 points'" in run.stderr and "'bilinear, with a deadline'" in run.stderr
     # written by another labkit
     shutil.copytree(tmp / "regrade-alice", tmp / "old-labkit")
     data["labkit"] = "0.0.9"
     (tmp / "old-labkit" / "results" / later.name).write_text(json.dumps(data))
-    run = _cli("grade", "--merge", str(tmp / "class"), str(tmp / "old-labkit"), "--out", str(tmp / "m2"))
+    run = _cli("merge", str(tmp / "class"), str(tmp / "old-labkit"), "--out", str(tmp / "m2"))
     assert run.returncode == 1 and "not read" in run.stderr and "changed since the run wrote it" in run.stderr
     (tmp / "m2").rename(tmp / "m2-refused")
     record_file = tmp / "old-labkit" / "record.json"
     record_file.write_text(json.dumps({**json.loads(record_file.read_text()), "labkit": "0.0.9"}))
-    run = _cli("grade", "--merge", str(tmp / "class"), str(tmp / "old-labkit"), "--out", str(tmp / "m2"))
+    run = _cli("merge", str(tmp / "class"), str(tmp / "old-labkit"), "--out", str(tmp / "m2"))
     assert run.returncode == 2 and "was graded by labkit 0.0.9, and this is labkit" in run.stderr
     assert not (tmp / "m1").exists() and not (tmp / "m2").exists()

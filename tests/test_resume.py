@@ -14,9 +14,9 @@ import pytest
 from helpers import processes_with
 from small_class import SEED, cli, files
 
-from labkit.grading.batch import resumed
 from labkit.grading.results import rubric as rubrics
 from labkit.grading.results.report import safe_name
+from labkit.grading.run.resume import resumed
 from labkit.grading.submission.scoring import submission_name
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
@@ -105,7 +105,7 @@ def test_resuming_refuses_another_seed_rubric_or_class_and_fresh_starts_over(sma
     late = rubrics.from_dict(
         {**rubrics.default().data, "late": {"deadline": "2026-12-01T23:59:00Z", "per": "day", "percent": 10, "cap": 50}}
     )
-    with pytest.raises(ValueError, match="differs from it in a \\[late\\] table.*labkit grade --merge"):
+    with pytest.raises(ValueError, match="differs from it in a \\[late\\] table.*labkit merge"):
         resumed(out, names, None, late)  # a late rule added afterwards: the merge applies it, a resume never
     with pytest.raises(ValueError, match="which is not among the submissions of this run"):
         resumed(out, ["alice"], None, rubrics.default())  # the others' results would stay out of grades.csv

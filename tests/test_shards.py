@@ -1,5 +1,5 @@
 """``labkit grade --shard I/N``: the I-th of N parts of a class, for a batch array; the parts merged with
-``--merge`` are the class graded in one run."""
+``labkit merge`` are the class graded in one run."""
 
 import json
 import os
@@ -11,7 +11,7 @@ from small_class import SEED, cli, files, rows
 
 from labkit import grading
 from labkit.grading import merge
-from labkit.grading.batch import parse_shard, shard
+from labkit.grading.run.resume import parse_shard, shard
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 
@@ -40,8 +40,11 @@ def test_the_cli_refuses_a_bad_shard_before_grading(tmp_path):
     run = cli("grade", tmp_path / "class", "--out", tmp_path / "out", "--shard", "0/50")
     assert run.returncode == 2 and "give --shard I/N with 1 <= I <= N" in run.stderr and "got 0/50" in run.stderr
     assert not (tmp_path / "out").exists()
-    run = cli("grade", "--merge", tmp_path, "--out", tmp_path / "out", "--shard", "1/2")
-    assert run.returncode == 2 and "--shard grade(s) submissions, which --merge does not" in run.stderr
+    run = cli("merge", tmp_path, "--out", tmp_path / "out", "--shard", "1/2")
+    assert (
+        run.returncode == 2
+        and "labkit merge: --shard grade(s) submissions, which `labkit merge` does not" in run.stderr
+    )
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +54,9 @@ def shards(small_class, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("shards")
     for index in range(1, 5):  # each shard is given the whole class, in another order, as each array task is
         given = submissions[index % len(submissions) :] + submissions[: index % len(submissions)]
-        grading.grade(given, tmp / f"part{index}", shard=f"{index}/4", seed=int(SEED), progress=False)
+        grading.grade(
+            given, tmp / f"part{index}", grading.GradeOptions(seed=int(SEED)), shard=f"{index}/4", progress=False
+        )
     run = cli("grade", *submissions, "--out", tmp / "empty", "--shard", "1/7", "--seed", SEED, "--quiet")
     assert run.returncode == 0, run.stderr
     assert "shard 1/7: 0 submission(s)" in run.stdout
@@ -63,7 +68,7 @@ def test_four_shards_merged_are_the_class_graded_in_one_run(small_class, shards)
     sizes = [json.loads((shards / f"part{i}" / "run.json").read_text())["submissions"] for i in range(1, 5)]
     assert sizes == [1, 1, 1, 2]
     folders = [shards / f"part{i}" for i in (3, 1, 4, 2)] + [shards / "empty"]  # in any order, an empty part too
-    run = cli("grade", "--merge", *folders, "--out", shards / "merged", "--quiet")
+    run = cli("merge", *folders, "--out", shards / "merged", "--quiet")
     assert run.returncode == 0, run.stderr
     assert (shards / "merged" / "grades.csv").read_bytes() == (reference / "grades.csv").read_bytes()
     assert files(shards / "merged", "feedback") == files(reference, "feedback")

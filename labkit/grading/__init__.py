@@ -3,15 +3,15 @@
 One subpackage per process and job (CONTRIBUTING.md draws the process tree):
 
 * :mod:`~labkit.grading.authoring` - handing the lab out: the student release, nbgrader's markup;
-* :mod:`~labkit.grading.batch`, :mod:`~labkit.grading.launcher`, :mod:`~labkit.grading.distributed`,
-  :mod:`~labkit.grading.options`, :mod:`~labkit.grading.progress`, :mod:`~labkit.grading.intake` - the
-  grader's own process: the class as the LMS gives it, the run's limits, its jobs, resume, shards, Dask;
+* :mod:`~labkit.grading.run` - the grader's own process: the class as the LMS gives it, the class run, its
+  engines (here or on Dask), each submission's grading process and the launcher, resume, shards, merge;
 * :mod:`~labkit.grading.submission` - one submission's grading process: its notebooks, the source scan,
   the refusals, copied code, scoring;
 * :mod:`~labkit.grading.sandbox` - isolation: backends, cgroup, seccomp, the protocol, the grader's handle,
   the fork server and, inside the sandbox, the zygote, the worker and its watch;
 * :mod:`~labkit.grading.results` - what a run writes and reads back: results, the record, the rubric, lateness;
-* :mod:`~labkit.grading.reports` - what a person reads afterwards: the class report, similarity, marking, LMS.
+* :mod:`~labkit.grading.reports` - what a person reads afterwards: the class report, similarity, marking, LMS;
+* :mod:`~labkit.grading.options` - the limits of a run, built once at its edge and passed to every process.
 
 Student code never runs in the grading process: see docs/grading-security.md.
 """
@@ -23,7 +23,7 @@ from .authoring.release import release, release_notebook, strip_solutions  # lig
 # Names are imported on first use (PEP 562), so that the sandboxed worker, started as
 # ``python -m labkit.grading.sandbox.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {
-    "grade": "batch",
+    "grade": "run.classrun",
     "SubmissionGrade": "results.report",
     "merge": "results.report",
     "Rubric": "results.rubric",
@@ -35,19 +35,7 @@ _EXPORTS = {
     "GradeOptions": "options",
     "get_backend": "sandbox.backends",
 }
-_MODULES = {
-    "authoring",
-    "batch",
-    "distributed",
-    "intake",
-    "launcher",
-    "options",
-    "progress",
-    "reports",
-    "results",
-    "sandbox",
-    "submission",
-}
+_MODULES = {"authoring", "options", "reports", "results", "run", "sandbox", "submission"}
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]
 

@@ -1,14 +1,16 @@
 """How a grading run is bounded: one options object, its defaults defined once.
 
-:class:`GradeOptions` travels from the command line (``labkit grade``, whose
-defaults are read from here) or :func:`labkit.grading.grade` to each
+:class:`GradeOptions` is built once, at the edge: by the command line (``labkit grade``, whose
+defaults are read from here) or by the caller of :func:`labkit.grading.grade`.
+Inside, it is frozen and passed on as it is (the class run settles its seed
+and rubric once, :mod:`labkit.grading.run.classrun`), as plain data to each
 submission's grading process (:mod:`labkit.grading.submission.scoring`) and into the
 sandbox (:class:`labkit.grading.sandbox.remote.Notebook`). No other module spells out
 a default of its own: they take the options object, or values from it.
 """
 
 import os
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields
 
 from .sandbox import backends
 from .sandbox.backends.base import Limits
@@ -57,38 +59,21 @@ class GradeOptions:
         if not isinstance(self.limits, Limits):
             raise ValueError(f"limits must be a labkit.grading.sandbox.backends.base.Limits; got {self.limits!r}.")
 
-    @classmethod
-    def build(cls, options=None, *, sandboxed=None, confined=None, **given):
-        """`options` (the defaults when None) with each keyword in `given` that is not None in its place.
-
-        `sandboxed` and `confined` are the old names of the switch: False
-        means ``backend="none"`` (True changes nothing)."""
-        if options is not None and not isinstance(options, cls):
-            raise ValueError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(given) - known)
-        if unknown:
-            raise ValueError(
-                f"unknown grading option(s) {', '.join(unknown)}; the options are "
-                f"{', '.join(sorted(known))} (and sandboxed=False, the old name of "
-                f"backend={backends.UNCONFINED!r})."
-            )
-        given = {key: value for key, value in given.items() if value is not None}
-        if sandboxed is False or confined is False:
-            if given.get("backend", backends.UNCONFINED) != backends.UNCONFINED:
-                raise ValueError(
-                    f"sandboxed=False means backend={backends.UNCONFINED!r}, but "
-                    f"backend={given['backend']!r} was given too; give one or the other."
-                )
-            given["backend"] = backends.UNCONFINED
-        return replace(options if options is not None else cls(), **given)
-
     def as_dict(self):
+        """The options as plain data (JSON): how they travel to each submission's grading process."""
         return asdict(self)
 
     @classmethod
     def from_dict(cls, data):
+        """The options :meth:`as_dict` wrote, read back once at the receiving process's edge; ValueError for
+        a field that is not an option."""
         data = dict(data)
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(
+                f"unknown grading option(s) {', '.join(unknown)}; the options are {', '.join(sorted(known))}."
+            )
         data["limits"] = Limits(**data.get("limits", {}))
         return cls(**data)
 

@@ -346,7 +346,7 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
     Parameters
     ----------
     folder : str or Path
-        The ``--out`` folder of ``labkit grade`` (or of ``labkit grade --merge``).
+        The ``--out`` folder of ``labkit grade`` (or of ``labkit merge``).
     rubric : Rubric, optional
         The rubric the run was scored with (the lab's when None).
 
@@ -1000,7 +1000,7 @@ def _late_section(summary):
     if unknown:
         out.append(
             "<p>Graded and not penalised. Give their times in <code>--times TIMES.csv</code> and merge again "
-            "(<code>labkit grade --merge</code>) to apply the rule.</p>"
+            "(<code>labkit merge</code>) to apply the rule.</p>"
         )
         rows = [(_e(e.student, MAX_NAME), (TEXT, _e(e.note))) for e in unknown]
         out.append(_table("Submissions with no known time", ["student", "why"], rows))
@@ -1198,7 +1198,7 @@ def _held_section(summary):
         f"{THRESHOLD:.2f} or more of the part's own code; see <code>docs/grading-security.md</code>). Its points "
         "are not in the total until you release them: list the student and the exercise in the rubric's "
         '<code>[held]</code> table (<code>release = {"ada" = [2]}</code>) and run '
-        "<code>labkit grade --merge OUT --rubric RUBRIC --out NEW</code>.</p>"
+        "<code>labkit merge OUT --rubric RUBRIC --out NEW</code>.</p>"
     )
     if not summary.held:
         out.append("<p>No part of this class is held.</p></section>")

@@ -116,7 +116,7 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
         notebook (all their code cells), or the code texts themselves. None
         (the default) is the lab's packaged student release
         (``labkit/student_notebooks``).
-    progress : labkit.grading.progress.Progress, optional
+    progress : labkit.grading.run.progress.Progress, optional
         Advanced by one after each graded function (the functions named in
         the grades' sources).
 

@@ -15,7 +15,7 @@ the grader alone and replaced whole each time it changes:
 
 Every later command reads the folder through this record
 (:func:`read_results`): ``labkit report``, ``labkit export``, a resumed
-``labkit grade`` and ``--merge`` take the recorded rubric when none is given,
+``labkit grade`` and ``labkit merge`` take the recorded rubric when none is given,
 refuse one that grades differently, and take a result file only when the
 record names it with that hash. So a result file that the run did not write
 (a submission's code writing into an output folder, where the sandbox is
@@ -303,7 +303,7 @@ def rubric_for(folders, given, command):
                 f"{folder} was graded under the rubric {other.title!r} and {first_folder} under {recorded.title!r} "
                 f"({' and '.join(recorded.differences(other))} differ): results of different rubrics are not read "
                 "together. Grade again under one rubric; when only the [late] or [held] tables differ, merge them "
-                "under one (labkit grade --merge ... --rubric FILE --out NEW)."
+                "under one (labkit merge ... --rubric FILE --out NEW)."
             )
     if given is None:
         return recorded
@@ -315,7 +315,7 @@ def rubric_for(folders, given, command):
             f"{first_folder} was graded under the rubric recorded in {first_folder / RECORD} "
             f"({recorded.title!r}), and {chosen.source} differs from it in {' and '.join(differ)}; {command} shows "
             f"grades.csv as graded, so leave --rubric out. To score the class under {chosen.source}: "
-            f"`labkit grade --merge {first_folder} --rubric {file} --out NEW` when only the [late] or [held] "
+            f"`labkit merge {first_folder} --rubric {file} --out NEW` when only the [late] or [held] "
             f"table differs, else grade again with it into a new --out."
         )
     return recorded

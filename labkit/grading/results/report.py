@@ -6,10 +6,10 @@ Layout of an output folder::
                              counted, the extra credit, the total (under the rubric); with a
                              [late] table also the raw total, the time, the lateness and penalty
     feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
-    results/<name>.json      the same grade as data: merged by ``labkit grade --merge``
+    results/<name>.json      the same grade as data: merged by ``labkit merge``
     seed.txt                 the seed of the run's random test data
     record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.results.record)
-    merge.json               (--merge only) the folders merged and the results a later one replaced
+    merge.json               (labkit merge only) the folders merged and the results a later one replaced
 
 Every file here is written by the grader from its own results; nothing in
 it comes from a student's process but plain numbers and short texts, and
@@ -636,7 +636,7 @@ def read_results(folders, rubric=None, replaced=None):
                 f"{folder} was graded under the rubric {recorded.title!r} ({recorded.digest}), not "
                 f"{rubric.title!r} ({rubric.digest}): results of different rubrics (their exercises, groups or "
                 "points) are not merged. Grade again with the --rubric of the class's run; the [late] table may "
-                "differ, as --merge applies the one it is given."
+                "differ, as labkit merge applies the one it is given."
             )
         found, bad = records.results(folder, record)
         refused += bad
@@ -680,7 +680,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         {submission name: datetime} (:func:`labkit.grading.results.late.read_times`): these times replace the
         stored ones of the submissions they name.
     progress : bool
-        Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).
+        Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.run.progress`).
 
     Returns
     -------
@@ -688,7 +688,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         The grades in name order; its ``replaced`` lists the results a later folder replaced, which
         ``merge.json`` in `out_dir` records as well, and its ``refused`` the result files not merged.
     """
-    from ..progress import Progress
+    from ..run.progress import Progress
 
     out = Path(out_dir)
     if out.resolve() in {Path(folder).resolve() for folder in folders}:

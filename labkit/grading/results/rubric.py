@@ -110,7 +110,7 @@ class Rubric:
         """A fingerprint of what the rubric grades and how: its title, exercises, groups and points.
 
         Results graded under different rubrics are not merged (:func:`labkit.grading.results.report.read_results`).
-        The ``[late]`` table is left out: ``--merge`` applies the late rule of the rubric it is given to the
+        The ``[late]`` table is left out: ``labkit merge`` applies the late rule of the rubric it is given to the
         submission times the results carry.
         """
         described = {

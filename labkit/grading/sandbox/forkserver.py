@@ -10,7 +10,7 @@ from every other notebook before any student code runs (namespaces of its
 own, empty private folders, its own uid, cgroup and rlimits; the zygote's
 description says how).
 
-A grading run (:func:`labkit.grading.batch.grade`) starts one server and
+A grading run (:func:`labkit.grading.run.classrun.grade`) starts one server and
 hands its socket to every submission's grading process: the descriptor's
 number is in the environment variable :data:`ENV`. In that process
 :func:`box` makes a :class:`ForkedBox`, a :class:`~.backends.base.Box`

@@ -29,7 +29,7 @@ import time
 from typing import Protocol
 
 from . import backends, forkserver, protocol
-from .backends.base import Limits, remove_tree  # noqa: F401 - where callers have found it
+from .backends.base import Limits
 
 WORKER = (sys.executable, "-I", "-m", "labkit.grading.sandbox.worker")  # the worker's command, run inside the sandbox
 SETUP_TIMEOUT = 120  # seconds for a new worker to import what notebooks need and answer its setup

@@ -16,7 +16,7 @@ exercise counts from the first notebook (in name order) that defines its
 names; later notebooks are not checked for it.
 
 ``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a
-process of its own and writes its result file: :mod:`labkit.grading.batch`
+process of its own and writes its result file: :mod:`labkit.grading.run.processes`
 starts one per submission, so whatever one submission does to the grader's
 memory or time costs only its own grade.
 """
@@ -316,17 +316,16 @@ def graded_functions(exercise):
     return [name for name in dict.fromkeys(names) if name.isidentifier()]
 
 
-def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None, **single):
+def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None):
     """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
 
-    `options` (a :class:`GradeOptions`, the defaults when None) bound it, with
-    any single option given as a keyword (``cell_timeout=10``) in its place;
+    `options` (a :class:`GradeOptions`, the defaults when None) bound it;
     `deadline` (monotonic) is the submission's; exercises in `skip` are not
     checked here. The notebook's answers in words go into `answers`
     ({grade id: text}) when it is given, and the source of each graded
     function it defines (read with ``ast``, never run) into `sources`
     ({function name: text}), unless an earlier notebook gave it."""
-    options = GradeOptions.build(options, **single)
+    options = _options(options)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     registry = load_registry(options.exercises)
     profiles = profiles or _profiles(registry)
@@ -417,6 +416,15 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
     return results, problems
 
 
+def _options(options):
+    """`options`, or the defaults when None; ValueError for anything else."""
+    if options is None:
+        return GradeOptions()
+    if not isinstance(options, GradeOptions):
+        raise ValueError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
+    return options
+
+
 def submission_name(path):
     """A submission's name: its folder's or notebook's, bytes that are not UTF-8 spelled out as escapes."""
     path = Path(path)
@@ -424,16 +432,14 @@ def submission_name(path):
     return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
-def grade_submission(path, options=None, *, rubric=None, profiles=None, **single):
-    """Grade one submission (a notebook or a folder of them), scored with `rubric` (else the options' rubric,
-    else the lab's).
+def grade_submission(path, options=None, *, profiles=None):
+    """Grade one submission (a notebook or a folder of them), scored with the options' rubric (else the lab's).
 
-    `options` (a :class:`GradeOptions`, the defaults when None) bound it, with
-    any single option given as a keyword in its place (``confined=False``,
-    the old switch, means ``backend="none"``). One time limit covers every
-    notebook of the submission."""
-    options = GradeOptions.build(options, **single)
-    if rubric is None and options.rubric is not None:
+    `options` (a :class:`GradeOptions`, the defaults when None) bound it. One
+    time limit covers every notebook of the submission."""
+    options = _options(options)
+    rubric = None
+    if options.rubric is not None:
         from ..results.rubric import load
 
         rubric = load(options.rubric)
@@ -467,13 +473,14 @@ def grade_submission(path, options=None, *, rubric=None, profiles=None, **single
 
 
 def main(argv=None):
-    """Grade the submission a spec file describes; write its result file. Used by :mod:`labkit.grading.batch`."""
+    """Grade the submission a spec file describes; write its result file (started by
+    :mod:`labkit.grading.run.processes`)."""
     argv = sys.argv[1:] if argv is None else argv
     spec = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     profiles = json.loads(Path(spec["profiles"]).read_text(encoding="utf-8"))
     if spec.get("backend_origin"):  # a backend registered outside labkit: its module registers it here too
         backends.import_origin(*spec["backend_origin"])
-    options = GradeOptions.from_dict(spec["options"])
+    options = GradeOptions.from_dict(spec["options"])  # the run's options, read once at this process's edge
     grade = grade_submission(spec["submission"], options=options, profiles=profiles)
     grade.name = spec["name"]
     result = Path(spec["result"])

@@ -35,7 +35,7 @@ BUILTIN = tuple(
         (m.name for m in pkgutil.iter_modules(__path__) if m.name != "base"), key=lambda name: (name != DEFAULT, name)
     )
 )
-UNCONFINED = "none"  # the backend the old switches (--no-sandbox, sandboxed=False, confined=False) stand for
+UNCONFINED = "none"  # the backend the old switch --no-sandbox stands for
 
 _registered: dict = {}  # name -> Backend subclass
 

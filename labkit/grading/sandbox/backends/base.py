@@ -1,7 +1,7 @@
 """What every sandbox backend provides, and what backends share.
 
 The grader's handle on a notebook (:class:`labkit.grading.sandbox.remote.Notebook`)
-and a grading run (:func:`labkit.grading.batch.grade`) use a backend only
+and a grading run (:func:`labkit.grading.run.classrun.grade`) use a backend only
 through :class:`Backend`:
 
 * :meth:`Backend.available` raises :class:`SandboxUnavailable`, saying what

@@ -3,7 +3,7 @@
 Meant for grading where the outer system already isolates each submission:
 one ``labkit grade`` per submission, each in a container of its own that is
 thrown away afterwards (a Kubernetes pod, a batch job's container), the runs
-combined with ``labkit grade --merge``. That container is the sandbox. The
+combined with ``labkit merge``. That container is the sandbox. The
 worker then runs as a plain process in
 a session of its own, with a private temporary folder as its home and
 working directory (removed afterwards, whatever the notebook left in it),

@@ -96,7 +96,7 @@ import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .results.report import one_line, safe_name
+from ..results.report import one_line, safe_name
 
 MAX_FILES = 5_000  # entries looked at in one folder walk (as scoring's walk of a submission)
 MAX_DEPTH = 8  # folder levels looked into

@@ -1,7 +1,7 @@
-"""Grading a class on a Dask cluster: ``labkit grade --dask ADDRESS`` (or ``--dask local``).
+"""Grading a class on a Dask cluster: :class:`DaskEngine`, ``labkit grade --dask ADDRESS`` (or ``--dask local``).
 
 One task per submission. In a Dask worker the task grades the submission as
-``labkit grade --jobs`` does on one machine (:func:`labkit.grading.batch.grade_one`):
+``labkit grade --jobs`` does on one machine (:func:`.engines.grade_one`):
 in a grading process of its own, started with :mod:`subprocess`, under the same
 memory and time limits, whose notebooks run in the sandbox of the worker's
 machine. (A Dask worker is a daemonic process, and Python's multiprocessing
@@ -9,7 +9,7 @@ refuses such a process children: the process pool an earlier ``labkit grade``
 used failed there with "daemonic processes are not allowed to have children".)
 The task sends back the result file's data; the client scores it under the
 rubric and writes ``results/<name>.json`` and the feedback as each arrives
-(:func:`labkit.grading.batch.grade`), so a run that stops is resumed by
+(:mod:`.classrun`), so a run that stops is resumed by
 running it again.
 
 What the workers need: the same labkit version (a result written by another
@@ -38,15 +38,17 @@ import resource
 import secrets
 import shutil
 import tempfile
+from collections.abc import Generator
 from dataclasses import replace
 from pathlib import Path
 
-from . import batch
-from .options import GradeOptions
-from .results.report import SubmissionGrade, one_line, safe_name
-from .sandbox import backends
-from .sandbox.backends.base import SandboxUnavailable
-from .submission import refusals
+from ..options import GradeOptions
+from ..results.report import one_line, safe_name
+from ..sandbox import backends
+from ..sandbox.backends.base import SandboxUnavailable
+from ..submission import refusals
+from .engines import Batch, Engine, Outcome, grade_one
+from .processes import low_space, settled
 
 LOCAL = "local"  # --dask local: a LocalCluster on this machine
 CONNECT_TIMEOUT = "30s"  # to reach a scheduler
@@ -99,83 +101,90 @@ def connect(address, workers=2):
     return client, client.close
 
 
-def engine(address, workers=2):
-    """The engine :func:`labkit.grading.batch.grade` takes to grade on the Dask cluster at `address` ("local": a
-    LocalCluster of `workers` workers): :func:`schedule` with these two given."""
-    return functools.partial(schedule, address, workers=workers)
+class DaskEngine(Engine):
+    """Grade on the Dask cluster at `address` (``"local"``: a LocalCluster of `workers` worker processes), one
+    task per submission: ``labkit grade --dask ADDRESS``. Connects when :meth:`grade` starts, and closes the
+    client (and the LocalCluster) when it ends."""
 
+    name = "dask"
 
-def schedule(address, todo, options, profiles_file, rubric, out, bar, peaks, arrived, workers=2):
-    """Grade the (path, name) pairs of `todo` on the Dask cluster at `address` ("local": a LocalCluster of
-    `workers` workers), one task per submission; each grade goes to `arrived` as it comes back.
+    def __init__(self, address: str, workers: int = 2):
+        if address != LOCAL and (not isinstance(address, str) or not address.strip()):
+            raise ValueError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
+        self.address, self.workers = address, workers
+        self._record: dict = {"engine": self.name}
 
-    Returns ({name: SubmissionGrade}, what ``run.json`` records about the run: the engine, the workers
-    that graded and how many each, duplicate arrivals ignored, the workers' peak memory)."""
-    del profiles_file  # each worker computes the refusals itself, once (they are 250 kB: not sent per task)
-    distributed = _dask()
-    client, close = connect(address, workers)
-    token = secrets.token_hex(4)
-    payload = {"options": options.as_dict(), "rubric": None}
-    if options.rubric is not None:
-        payload["rubric"] = Path(options.rubric).read_text(encoding="utf-8")
-    grades, duplicates, by_worker, stopped = {}, 0, {}, None
-    record = {"engine": "dask", "dask scheduler": client.scheduler.address}
-    try:
-        futures = {}
-        for path, name in todo:
-            key = f"labkit-grade-{safe_name(name)}-{token}"
-            future = client.submit(
-                _task, os.path.abspath(path), name, payload, key=key, pure=False, retries=1
-            )  # abspath, not resolve: a submission that is a link stays one (and is refused)
-            futures[future.key] = (future, name)
-        pending = distributed.as_completed([future for future, _ in futures.values()])
-        for future in pending:
-            name = futures[future.key][1]
-            try:
-                message = future.result()
-            except Exception as exc:  # noqa: BLE001 - KilledWorker, or what the task raised twice
-                why = (
-                    "the Dask workers grading it died"
-                    if isinstance(exc, distributed.KilledWorker)
-                    else "its Dask task failed"
-                )
-                message = {"name": name, "result": None, "failure": f"{why} ({type(exc).__name__}: {one_line(exc)})"}
-            future.release()
-            if name in grades:  # a submission is recorded once
-                duplicates += 1
-                continue
-            message["name"] = name  # the name is the client's, whatever came back
-            worker = message.get("worker")
-            if worker:
-                by_worker[worker] = by_worker.get(worker, 0) + 1
-            peaks.append(message.get("peak"))
-            grades[name] = batch.settled(message, rubric, options.seed)
-            arrived(grades[name])
-            bar.advance()
-            stopped = stopped or batch._low_space(out)
-            if stopped is not None:
-                break
-        if stopped is not None:  # as --jobs does: the rest are reported, and a resumed run grades them
-            left = [(future, name) for future, name in futures.values() if name not in grades]
-            client.cancel([future for future, _ in left])
-            for _, name in left:
-                grades[name] = SubmissionGrade(name, seed=options.seed, rubric=rubric, failure=stopped)
-                arrived(grades[name])
-                bar.advance()
+    def record(self) -> dict:
+        """The engine, its scheduler, the workers that graded and how many each, the duplicate arrivals ignored,
+        the workers' peak memory."""
+        return dict(self._record)
+
+    def grade(self, batch: Batch) -> Generator[Outcome, None, None]:
+        # each worker computes the refusals itself, once (they are 250 kB: not sent per task)
+        distributed = _dask()
+        options = batch.options
+        client, close = connect(self.address, self.workers)
+        token = secrets.token_hex(4)
+        payload = {"options": options.as_dict(), "rubric": None}
+        if options.rubric is not None:
+            payload["rubric"] = Path(options.rubric).read_text(encoding="utf-8")
+        seen: set[str] = set()
+        by_worker: dict[str, int] = {}
+        duplicates, stopped = 0, None
+        self._record = {"engine": self.name, "dask scheduler": client.scheduler.address}
         try:
-            worker_peaks = client.run(_peak_bytes)
-        except Exception:  # noqa: BLE001 - a worker that went away while asked
-            worker_peaks = {}
-    finally:
-        close()
-    record.update(
-        {
-            "dask workers": dict(sorted(by_worker.items())),
-            "dask duplicates ignored": duplicates,
-            "dask worker peak bytes": max(worker_peaks.values(), default=None),
-        }
-    )
-    return grades, record
+            futures = {}
+            for path, name in batch.todo:
+                key = f"labkit-grade-{safe_name(name)}-{token}"
+                future = client.submit(
+                    _task, os.path.abspath(path), name, payload, key=key, pure=False, retries=1
+                )  # abspath, not resolve: a submission that is a link stays one (and is refused)
+                futures[future.key] = (future, name)
+            for future in distributed.as_completed([future for future, _ in futures.values()]):
+                name = futures[future.key][1]
+                try:
+                    message = future.result()
+                except Exception as exc:  # noqa: BLE001 - KilledWorker, or what the task raised twice
+                    why = (
+                        "the Dask workers grading it died"
+                        if isinstance(exc, distributed.KilledWorker)
+                        else "its Dask task failed"
+                    )
+                    message = {
+                        "name": name, "result": None, "failure": f"{why} ({type(exc).__name__}: {one_line(exc)})"
+                    }  # fmt: skip
+                future.release()
+                if name in seen:  # a submission is recorded once
+                    duplicates += 1
+                    continue
+                seen.add(name)
+                message["name"] = name  # the name is the client's, whatever came back
+                worker = message.get("worker")
+                if worker:
+                    by_worker[worker] = by_worker.get(worker, 0) + 1
+                yield Outcome(settled(message, batch.rubric, options.seed), message.get("peak"))
+                stopped = stopped or low_space(batch.out)
+                if stopped is not None:
+                    break
+            if stopped is not None:  # as the local engine does: the rest are reported, and a resumed run grades them
+                left = [(future, name) for future, name in futures.values() if name not in seen]
+                client.cancel([future for future, _ in left])
+                for _, name in left:
+                    seen.add(name)
+                    yield Outcome(batch.not_graded(name, stopped))
+            try:
+                worker_peaks = client.run(_peak_bytes)
+            except Exception:  # noqa: BLE001 - a worker that went away while asked
+                worker_peaks = {}
+        finally:
+            close()
+        self._record.update(
+            {
+                "dask workers": dict(sorted(by_worker.items())),
+                "dask duplicates ignored": duplicates,
+                "dask worker peak bytes": max(worker_peaks.values(), default=None),
+            }
+        )
 
 
 def _peak_bytes():
@@ -186,7 +195,7 @@ def _peak_bytes():
 @functools.cache
 def _profiles_text(exercises):
     """The refusals of the exercises' registry as JSON, computed once per worker process."""
-    from ..exercises.registry import load as load_registry
+    from ...exercises.registry import load as load_registry
 
     return json.dumps(refusals.wire(load_registry(exercises).refusals))
 
@@ -202,7 +211,7 @@ def _sandbox_problem(backend):
 
 
 def _task(path, name, payload):
-    """In a Dask worker: grade one submission (:func:`labkit.grading.batch.grade_one`); its outcome as plain
+    """In a Dask worker: grade one submission (:func:`.engines.grade_one`); its outcome as plain
     data, with the worker's address."""
     from distributed import get_worker
 
@@ -229,7 +238,7 @@ def _task(path, name, payload):
         if payload.get("rubric") is not None:
             (work / "rubric.toml").write_text(payload["rubric"], encoding="utf-8")
             options = replace(options, rubric=str(work / "rubric.toml"))
-        outcome.update(batch.grade_one(path, name, options, profiles_file, work))
+        outcome.update(grade_one(path, name, options, profiles_file, work))
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return outcome

@@ -1,4 +1,4 @@
-"""A progress bar with counts and an ETA, for the instructor's long commands (``labkit grade``, ``--merge``).
+"""A progress bar with counts and an ETA, for the instructor's long commands (``labkit grade``, ``labkit merge``).
 
 :class:`Progress` draws with `rich <https://rich.readthedocs.io>`_ on standard
 error, and only on a terminal: in a batch job's log, a pipe or a file it

@@ -1,0 +1,264 @@
+"""The launcher: one warm Python that forks each submission's grading process; its client and its server.
+
+A grading run grades every submission in a process of its own
+(:mod:`.processes`), so that a submission that makes its grading crash, run
+out of memory or hang costs only its own grade. Started as
+``python -m labkit.grading.submission.scoring SPEC``, each of those processes would
+import labkit's checks, numpy and scipy again. The client, :class:`Launcher`,
+starts ``python -m labkit.grading.run.launcher`` once per run instead: the
+server (:func:`main`) imports all that, then forks one child per submission,
+which puts itself in a session, cgroup and address-space limit of its own
+(what ``Popen``'s ``preexec_fn`` does otherwise) and runs
+:func:`labkit.grading.submission.scoring.main`. No student code runs here: student code
+runs only in the sandboxes the child starts.
+
+The server reads one request per line on stdin
+(``{"spec", "log", "memory", "cgroups", "environment", "id"}``) and writes one
+line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id": i}``
+and ``{"ended": pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid
+can be used again once its process has ended), ``c`` as Popen's returncode.
+When its stdin closes (the run is over, or the grader died) it stops every
+child still running and ends.
+"""
+
+import json
+import os
+import resource
+import secrets
+import select
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+from .processes import die_with
+
+LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
+LAUNCHER_READY = 120  # seconds for the launcher to import the grader
+REQUEST_LIMIT = 1 << 16  # bytes of one request line
+
+
+# The client: in the grader's process (or a Dask worker's).
+
+
+class _Launched:
+    """The part of a Popen that :class:`.processes.Job` uses, for a grading process the :class:`Launcher` forked."""
+
+    def __init__(self, launcher, pid, key):
+        self.launcher, self.pid, self.key = launcher, pid, key  # `key`: its request's id, never used twice
+
+    @property
+    def returncode(self):
+        return self.launcher.ended.get(self.key)
+
+    def poll(self):
+        self.launcher.pump(0)
+        return self.returncode
+
+    def wait(self, timeout=None):
+        until = None if timeout is None else time.monotonic() + timeout
+        while self.returncode is None:
+            if until is not None and time.monotonic() > until:
+                raise subprocess.TimeoutExpired("grading process", timeout)
+            if not self.launcher.pump(0.05) and self.launcher.process.poll() is not None:
+                self.launcher.ended.setdefault(self.key, -signal.SIGKILL)  # the launcher is gone, and its children
+        return self.returncode
+
+
+class Launcher:
+    """One warm process that forks each submission's grading process (its server: :func:`main`)."""
+
+    def __init__(self, options, server=None, wait=True):
+        self.ended, self._buffer, self._lock = {}, b"", threading.RLock()
+        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        parent = os.getpid()
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "labkit.grading.run.launcher", options.exercises or ""],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+            env=environment,
+            pass_fds=(server.fd,) if server is not None else (),
+            preexec_fn=lambda: die_with(parent),
+        )
+        if wait:
+            self.wait_ready()
+
+    def wait_ready(self):
+        """Wait until the launcher has imported the grader; OSError (and the launcher stopped) when it does not."""
+        if self._next(time.monotonic() + LAUNCHER_READY) != {"ready": True}:
+            self.stop()
+            raise OSError("the launcher of grading processes did not start")
+
+    def _next(self, until):
+        """The launcher's next message, or None when `until` passes or it is gone."""
+        try:
+            fd = self.process.stdout.fileno()
+        except ValueError:  # stopped
+            return None
+        while b"\n" not in self._buffer:
+            remaining = until - time.monotonic()
+            if not select.select([fd], [], [], max(0.0, remaining))[0]:
+                return None
+            chunk = os.read(fd, 1 << 16)
+            if not chunk:
+                return None
+            self._buffer += chunk
+        line, _, self._buffer = self._buffer.partition(b"\n")
+        return json.loads(line)
+
+    def pump(self, wait):
+        """File every ended process the launcher reported (waiting up to `wait` s for one); whether any."""
+        with self._lock:
+            message = self._next(time.monotonic() + wait)
+            found = False
+            while message is not None:
+                if "ended" in message:
+                    self.ended[message.get("id")] = int(message["code"])
+                    found = True
+                message = self._next(time.monotonic())
+            return found
+
+    def launch(self, request):
+        """Fork a grading process for `request`; a :class:`_Launched` (OSError when the launcher is gone)."""
+        with self._lock:
+            key = request["id"] = secrets.token_hex(8)
+            try:
+                self.process.stdin.write((json.dumps(request) + "\n").encode())
+                self.process.stdin.flush()
+            except ValueError:  # closed: stopped
+                raise OSError("the launcher of grading processes was stopped") from None
+            while True:
+                message = self._next(time.monotonic() + LAUNCH_TIMEOUT)
+                if message is None:
+                    raise OSError("the launcher of grading processes stopped answering")
+                if "ended" in message:
+                    self.ended[message.get("id")] = int(message["code"])
+                elif "started" in message and message.get("id") == key:
+                    return _Launched(self, int(message["started"]), key)
+
+    def stop(self):
+        try:
+            self.process.stdin.close()  # it stops every grading process still running, then ends
+        except OSError:
+            pass
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        self.process.stdout.close()
+
+
+# The server: ``python -m labkit.grading.run.launcher [EXERCISES]``, a process of its own.
+
+
+def _import_grader(exercises):
+    """Import what grading a submission needs, once."""
+    from ..submission import scoring
+
+    scoring.load_registry(exercises)
+    import scipy.interpolate  # the checks compare with it
+    import scipy.linalg  # noqa: F401
+
+
+def _child(request):
+    """The submission's grading process; never returns."""
+    code = 1
+    try:
+        os.setsid()
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: die with the launcher
+        if os.getppid() != request["launcher"]:  # it died before the line above
+            os._exit(1)
+        for procs in request.get("cgroups", ()):
+            with open(procs, "w") as handle:
+                handle.write(str(os.getpid()))
+        memory = int(request["memory"])
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        null = os.open(os.devnull, os.O_RDWR)
+        log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        os.dup2(null, 0)
+        os.dup2(null, 1)
+        os.dup2(log, 2)
+        os.close(null)
+        os.close(log)
+        sys.stdin = open(os.devnull)  # noqa: SIM115 - for the rest of this process's life
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115
+        sys.stderr = os.fdopen(2, "w", buffering=1)
+        os.environ.clear()
+        os.environ.update(request["environment"])
+        from ..submission import scoring
+
+        code = int(scoring.main([request["spec"]]) or 0)
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 1
+    except BaseException:  # noqa: BLE001 - written to the log, as an unforked process would have
+        import traceback
+
+        try:
+            traceback.print_exc()
+            sys.stderr.flush()
+        except Exception:  # noqa: BLE001
+            pass
+    os._exit(code)
+
+
+def _say(message):
+    os.write(1, (json.dumps(message) + "\n").encode())
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    _import_grader(argv[0] if argv and argv[0] else None)
+    _say({"ready": True})
+    children, buffer = {}, b""  # pid -> the request's id
+    try:
+        while True:
+            readable = select.select([0], [], [], 0.05)[0]
+            for pid in list(children):
+                try:
+                    done, status = os.waitpid(pid, os.WNOHANG)
+                except ChildProcessError:
+                    done, status = pid, 0
+                if done and pid in children:
+                    _say({"ended": pid, "id": children.pop(pid), "code": os.waitstatus_to_exitcode(status)})
+            if not readable:
+                continue
+            chunk = os.read(0, 1 << 16)
+            if not chunk:
+                return 0
+            buffer += chunk
+            if len(buffer) > REQUEST_LIMIT and b"\n" not in buffer:
+                return 1
+            *lines, buffer = buffer.split(b"\n")
+            for line in lines:
+                request = json.loads(line)
+                request["launcher"] = os.getpid()
+                pid = os.fork()
+                if pid == 0:
+                    _child(request)
+                children[pid] = request.get("id")
+                _say({"started": pid, "id": request.get("id")})
+    finally:
+        for pid in children:
+            try:
+                os.killpg(pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+        deadline = time.monotonic() + 5
+        while children and time.monotonic() < deadline:
+            for pid in list(children):
+                try:
+                    if os.waitpid(pid, os.WNOHANG)[0]:
+                        children.pop(pid)
+                except ChildProcessError:
+                    children.pop(pid)
+            time.sleep(0.02)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

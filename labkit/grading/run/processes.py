@@ -1,0 +1,261 @@
+"""Each submission's grading process, as the grader supervises it: its limits, its end, its outcome.
+
+A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` for one
+submission (or has the run's launcher fork it: :mod:`.launcher`), inside an
+address-space limit and a memory cgroup of its own (:mod:`labkit.grading.sandbox.cgroup`),
+set to die with the thread that started it (``PR_SET_PDEATHSIG``), and stops
+it when it overruns the submission's time limit plus a grace for the checks.
+A grading process that breaks is started once more (:data:`ATTEMPTS`); its
+outcome is plain data (:meth:`Job.message`), which :func:`settled` scores
+under the run's rubric. No student code runs here.
+"""
+
+import ctypes
+import json
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from ..results import record as records
+from ..results.report import FORMAT, SubmissionGrade, one_line, safe_name
+from ..sandbox import backends, cgroup, forkserver
+
+MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
+ATTEMPTS = 2  # a grading process that breaks is started once more
+
+
+def low_space(out):
+    """Why grading cannot go on (a folder with too little free space), or None."""
+    for folder in (Path(tempfile.gettempdir()), out):
+        try:
+            free = shutil.disk_usage(folder).free
+        except OSError:
+            continue
+        if free < MIN_FREE:
+            return (
+                f"only {free / 1024**2:.0f} MiB free in {folder} (grading needs {MIN_FREE // 1024**2} MiB); "
+                "free some space and grade these submissions again, then combine the runs with `labkit merge`"
+            )
+    return None
+
+
+class Job:
+    """One submission's grading process."""
+
+    def __init__(self, path, name, work, options, profiles_file, server=None, launcher=None):
+        self.path, self.name, self.attempt = Path(path), name, 0
+        self.work, self.options, self.profiles_file = work, options, profiles_file
+        self.server = server  # the run's fork server (labkit.grading.sandbox.forkserver), or None
+        self.launcher = launcher  # the run's Launcher of grading processes, or None (each one a new Python)
+        self.process, self.cgroup, self.started = None, None, None
+
+    def start(self):
+        self.attempt += 1
+        self.result = self.work / f"{safe_name(self.name)}-{self.attempt}.json"
+        spec = self.work / f"{safe_name(self.name)}-{self.attempt}.spec.json"
+        origin = None if self.options.backend in backends.BUILTIN else backends.origin(self.options.backend)
+        spec.write_text(
+            json.dumps(
+                {
+                    "submission": str(self.path),
+                    "name": self.name,
+                    "result": str(self.result),
+                    "profiles": str(self.profiles_file),
+                    "options": self.options.as_dict(),
+                    "backend_origin": origin,
+                }
+            ),
+            encoding="utf-8",
+        )
+        memory = self.options.grader_memory
+        self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
+        group = self.cgroup
+
+        parent = os.getpid()
+
+        def prepare():
+            if group is not None:
+                group.join()
+            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            die_with(parent)
+
+        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        environment.update(process_environment())
+        if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
+            environment.update(group.sibling_environment())
+        environment.pop(forkserver.ENV, None)
+        if self.server is not None:
+            environment.update(self.server.environment())
+        self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
+        if self.launcher is not None:
+            folders = [group.path, group.cpu_path] if group is not None else []
+            try:
+                self.process = self.launcher.launch(
+                    {
+                        "spec": str(spec),
+                        "log": str(self.log),
+                        "memory": memory,
+                        "cgroups": [str(folder / "cgroup.procs") for folder in folders if folder is not None],
+                        "environment": environment,
+                    }
+                )
+                self.started = time.monotonic()
+                return
+            except OSError:  # the launcher is gone: this submission and the next start the plain way
+                self.launcher = None
+        with open(self.log, "wb") as log:
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "labkit.grading.submission.scoring", str(spec)],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=log,
+                start_new_session=True,
+                preexec_fn=prepare,
+                env=environment,
+                pass_fds=(self.server.fd,) if self.server is not None else (),
+            )
+        self.started = time.monotonic()
+
+    @property
+    def limit(self):
+        return self.options.total_timeout + self.options.grader_grace
+
+    def overdue(self):
+        return time.monotonic() - self.started > self.limit
+
+    def stop(self):
+        """Kill the grading process and everything it started (its sandboxes die with it)."""
+        try:
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        self.process.wait()
+        self.finish()
+
+    def last_words(self):
+        """The last line the grading process wrote to stderr (a Python error's summary), as one printable line."""
+        try:
+            with open(self.log, "rb") as log:
+                log.seek(max(0, os.path.getsize(self.log) - 4096))
+                lines = log.read().decode("utf-8", "replace").strip().splitlines()
+        except OSError:
+            return ""
+        return f": {one_line(lines[-1], 200)}" if lines else ""
+
+    def finish(self):
+        self.out_of_memory, self.peak = False, None
+        if self.cgroup is not None:
+            self.out_of_memory = self.cgroup.out_of_memory()
+            self.peak = self.cgroup.peak()
+            self.cgroup.remove()
+
+    def poll(self):
+        """Whether this attempt is over (its process ended, or it overran its limit and was stopped)."""
+        if self.process.poll() is None:
+            if not self.overdue():
+                return False
+            self.stop()
+            self.timed_out = True
+        else:
+            self.finish()
+            self.timed_out = False
+        return True
+
+    def wait(self):
+        """Wait until this attempt is over (its process ends, or it overruns its limit and is stopped)."""
+        try:
+            self.process.wait(timeout=max(0.0, self.limit - (time.monotonic() - self.started)))
+        except subprocess.TimeoutExpired:
+            self.stop()
+            self.timed_out = True
+        else:
+            self.finish()
+            self.timed_out = False
+
+    def conclude(self):
+        """After an attempt: True when the submission is done (:meth:`message`), False when its grading
+        process is to be started once more."""
+        self.peaks = [*getattr(self, "peaks", []), self.peak]
+        self.data, self.why = self.read(self.timed_out)
+        return self.data is not None or self.attempt >= ATTEMPTS
+
+    def message(self):
+        """The submission's outcome as plain data (what a Dask task sends back): its result file's data, or
+        why it could not be graded."""
+        return {
+            "name": self.name,
+            "result": self.data,
+            "failure": None if self.data is not None else f"{self.why} (tried {self.attempt} times)",
+            "attempts": self.attempt,
+            "peak": max((p for p in self.peaks if p), default=None),
+        }
+
+    def read(self, timed_out):
+        """(the result file's data, None), or (None, why the grading process failed)."""
+        code = self.process.returncode
+        if timed_out:
+            return None, (
+                f"its grading took longer than {self.limit} s (the submission's time limit plus "
+                f"{self.options.grader_grace} s for the checks) and was stopped"
+            )
+        if code != 0 or not self.result.exists():
+            if getattr(self, "out_of_memory", False) or code in (-signal.SIGKILL, -signal.SIGSEGV):
+                return None, (
+                    "its grading ran out of memory (the grader's limit of "
+                    f"{self.options.grader_memory // 1024**2} MiB) and was stopped"
+                    if getattr(self, "out_of_memory", False) or code == -signal.SIGKILL
+                    else f"its grading process crashed ({signal.Signals(-code).name})"
+                )
+            if code is not None and code < 0:
+                name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else str(-code)
+                return None, f"its grading process was killed by {name}"
+            return None, f"its grading process ended with status {code} without a result{self.last_words()}"
+        try:
+            if self.result.stat().st_size > records.MAX_RESULT:
+                return None, "its result was larger than the grader accepts"
+            data = json.loads(self.result.read_text(encoding="utf-8"))
+            if not isinstance(data, dict) or data.get("format") != FORMAT:
+                raise ValueError(f"format {data.get('format') if isinstance(data, dict) else data!r:.60}")
+        except (OSError, ValueError) as exc:
+            return None, f"its result could not be read ({str(exc)[:200]})"
+        return data, None
+
+
+def process_environment():
+    """What each grading process gets in its environment beyond the grader's own (nothing yet).
+
+    Called in the process that starts the grading process: the grader with ``--jobs``, a Dask worker
+    with ``--dask``; the place for whatever a grading process must be handed (the fork server's address)."""
+    return {}
+
+
+_LIBC = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None
+
+
+def die_with(parent):
+    """In a grading process before it runs: be killed when the thread that started it dies (the grader, or
+    a Dask worker killed mid-task), so no grading outlives its grader; Linux only."""
+    if _LIBC is not None:
+        _LIBC.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # the grader died before the line above
+            os._exit(1)
+
+
+def settled(message, rubric, seed):
+    """The :class:`SubmissionGrade` of :func:`grade_one`'s outcome, scored with `rubric`; a result that cannot be
+    read (another labkit version's, say) makes a submission that could not be graded, saying why."""
+    name = message["name"]
+    if message.get("result") is not None:
+        try:
+            grade = SubmissionGrade.from_dict(message["result"], one_line(name, 80), rubric)
+        except ValueError as exc:
+            return SubmissionGrade(name, seed=seed, rubric=rubric, failure=f"its result could not be read ({exc})")
+        grade.name = name
+        return grade
+    return SubmissionGrade(name, seed=seed, rubric=rubric, failure=str(message.get("failure")))

@@ -1,0 +1,200 @@
+"""What a run into an output folder takes over from the one before it there, and which part of a class it grades.
+
+:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.results.record`)
+and keeps the submissions graded there whose notebooks did not change since;
+:func:`carried_marks` keeps a person's marks that still apply to a
+submission graded again. :func:`shard` picks the I-th of N parts of a class,
+for batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
+"""
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..results import record as records
+from ..results.report import SubmissionGrade, labkit_version, one_line
+from ..results.rubric import DEFAULT as DEFAULT_RUBRIC
+from ..results.rubric import Rubric
+from ..results.rubric import default as default_rubric
+from ..submission.scoring import submission_notebooks
+
+
+def content(path):
+    """The digest of a submission's notebooks (:func:`labkit.grading.results.record.content_digest`)."""
+    path = Path(path)
+    return records.content_digest(notebooks(path), path if path.is_dir() else path.parent)
+
+
+def notebooks(path):
+    """The submission's notebooks, or none when it has none to offer."""
+    try:
+        return submission_notebooks(path)
+    except ValueError:
+        return []
+
+
+@dataclass
+class Resumed:
+    """What an earlier run into the same output folder leaves to this one (:func:`resumed`).
+
+    Attributes
+    ----------
+    done : dict
+        {name: SubmissionGrade} kept: graded there, and its notebooks unchanged since.
+    seed : int or None
+        The seed to grade with (the earlier run's).
+    rubric : Rubric
+        The rubric to grade with (the earlier run's, when none was given).
+    record : RunRecord or None
+        The earlier run's record, which this run goes on writing.
+    changed : list
+        The submissions graded there whose notebooks changed since: graded again.
+    refused : list
+        (path, why) of result files in the folder that its record does not vouch for: never read.
+    """
+
+    done: dict
+    seed: object
+    rubric: Rubric
+    record: object = None
+    changed: list = field(default_factory=list)
+    refused: list = field(default_factory=list)
+    # {name: its earlier grade} of the changed submissions: the marks a person gave them carry over where they apply
+    earlier: dict = field(default_factory=dict)
+
+
+def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
+    """What the earlier run in `out` leaves to this one: a :class:`Resumed`.
+
+    An output folder with a run record (:mod:`labkit.grading.results.record`) is resumed: the submissions graded
+    there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
+    digest}: they changed since, and are graded again), and the run grades the others with the earlier
+    run's seed, which `seed` may repeat but not change, and under the earlier run's rubric, which `rubric`
+    (a Rubric, or None for the recorded one) may repeat but not change. A submission that could not be
+    graded is graded again (such failures are the grader's: a crash, a stopped run, a lost worker). A
+    folder of another labkit version, a merge's folder, results without a record, a different rubric or
+    seed, or a submission graded there that is not in `names` are refused with a ValueError saying what to
+    do, as nothing of them would fit this run's grades.csv. `fresh` deletes the earlier results, feedback
+    and record instead: every submission is graded, with `seed` (a fresh one when None)."""
+    out = Path(out)
+    files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
+    if fresh:
+        for path in [*files, *sorted((out / "feedback").glob("*.txt"))]:
+            path.unlink()
+        for name in (records.RECORD, records.RUBRIC_COPY):
+            (out / name).unlink(missing_ok=True)
+        return Resumed({}, seed, rubric if rubric is not None else default_rubric())
+    if not (out / records.RECORD).exists():
+        if files:
+            raise ValueError(
+                f"{out} holds results but no run record ({records.RECORD}; an older labkit wrote none): give "
+                "--fresh to grade every submission again there, or choose a new --out."
+            )
+        return Resumed({}, seed, rubric if rubric is not None else default_rubric())
+    how = "give --fresh to grade every submission again, or choose a new --out"
+    record = records.read(out)
+    if record.kind != "grade":
+        raise ValueError(
+            f"{out} holds a merge ({records.RECORD} says so), which is not resumed: grade into a new --out, or {how}."
+        )
+    if record.labkit != labkit_version():
+        raise ValueError(
+            f"{out} was graded by labkit {one_line(record.labkit, 40)}, and this is labkit {labkit_version()}: "
+            f"{how} with this version."
+        )
+    recorded = record.rubric_object(out)
+    if rubric is None:
+        rubric = recorded
+    elif not recorded.same_as(rubric):
+        raise ValueError(
+            f"{out} was graded under the rubric recorded there ({recorded.title!r}), and {rubric.source} differs "
+            f"from it in {' and '.join(recorded.differences(rubric))}: leave --rubric out to resume that run. "
+            f"To grade under {rubric.source}, {how}; to apply only another [late] or [held] table to these results, "
+            f"`labkit merge {out} --rubric {_file_of(rubric)} --out NEW`."
+        )
+    if seed is not None and record.seed is not None and int(seed) != int(record.seed):
+        raise ValueError(
+            f"{out} holds results of a run with seed {record.seed}, not --seed {seed}: leave --seed out to resume "
+            f"it, {how}."
+        )
+    stray = sorted(set(record.submissions) - set(names))
+    if stray:
+        raise ValueError(
+            f"{out} holds the result of {one_line(stray[0], 80)!r}, which is not among the submissions of this "
+            "run: give the submissions (and --shard) of the run that wrote it to resume it, give --fresh to grade "
+            "only these, or choose a new --out."
+        )
+    found, refused = records.results(out, record)
+    done, changed, before = {}, [], {}
+    for name, (path, data) in found.items():
+        grade = SubmissionGrade.from_dict(data, str(path), rubric)  # ValueError: another labkit version's
+        if not grade.graded:
+            continue
+        if contents is not None and record.submissions[name].get("content") != contents.get(name):
+            changed.append(name)
+            before[name] = grade
+            continue
+        done[name] = grade
+    seed = record.seed if record.seed is not None else seed
+    return Resumed(done, seed, rubric, record, sorted(changed), refused, earlier=before)
+
+
+def carried_marks(earlier, grade):
+    """The marks of `earlier` (a submission's grade before its notebooks changed) that still apply to its new
+    `grade`: an answer's while its text is the same, a held part's while it is still held, an exercise's
+    excuse always; and how many no longer apply."""
+    kept, dropped = {}, 0
+    held = {f"exercise{number}/{part}" for number, part, _, _ in grade.held()}
+    for item, mark in earlier.marks.items():
+        if item in grade.rubric.registry.answers:
+            same = str(earlier.answers.get(item, "")) == str(grade.answers.get(item, ""))
+        else:
+            same = "/" not in item or item in held
+        if same:
+            kept[item] = mark
+        else:
+            dropped += 1
+    return kept, dropped
+
+
+def _file_of(rubric):
+    """The TOML file a rubric was read from, for a command to show (the lab's own when it names none)."""
+    source = Path(str(rubric.source))
+    return source if source.suffix == ".toml" else DEFAULT_RUBRIC
+
+
+def parse_shard(spec):
+    """``(I, N)`` from ``"I/N"`` (or a pair): the I-th of N parts, counted from 1; ValueError says how to write it.
+
+    >>> parse_shard("3/50")
+    (3, 50)
+    """
+    how = "give --shard I/N with 1 <= I <= N, e.g. 3/50 for the third of 50 parts (a Slurm array: --array=1-50)"
+    try:
+        index, count = spec.split("/") if isinstance(spec, str) else spec
+        index, count = int(index), int(count)
+    except (TypeError, ValueError):
+        raise ValueError(f"{how}; got {one_line(spec, 40)!r}.") from None
+    if not 1 <= index <= count:
+        raise ValueError(f"{how}; got {index}/{count}.")
+    return index, count
+
+
+def shard(names, index, count):
+    """The `index`-th (from 1) of `count` parts of `names`, in name order: every name is in exactly one part,
+    the parts' sizes differ by at most one, and with more parts than names some parts are empty.
+
+    >>> [shard(["d", "a", "c", "b", "e"], i, 2) for i in (1, 2)]
+    [['a', 'b'], ['c', 'd', 'e']]
+    >>> shard(["a"], 2, 3)
+    []
+    """
+    index, count = parse_shard((index, count))
+    ordered = sorted(names)
+    return ordered[(index - 1) * len(ordered) // count : index * len(ordered) // count]
+
+
+def shard_of(submissions, names, part):
+    """The submissions (and their names) of `part`, ``(I, N)``, in name order (:func:`shard`)."""
+    by_name = dict(zip(names, submissions))
+    chosen = shard(names, *part)
+    return [by_name[name] for name in chosen], chosen
