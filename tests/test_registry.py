@@ -245,3 +245,11 @@ def test_the_self_check_facade_keeps_the_notebooks_names():
     assert called <= set(labkit.check.__all__)
     for name in called:
         assert inspect.isfunction(getattr(labkit.check, name)), name
+
+
+def test_the_old_name_of_check_exercise_is_gone():
+    """``labkit.check.grade`` was ``exercise``'s name before any release; ``labkit.grading.grade`` grades a class."""
+    import labkit.check
+
+    assert not hasattr(labkit.check, "grade") and "grade" not in labkit.check.__all__
+    assert callable(labkit.check.exercise)

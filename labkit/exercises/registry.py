@@ -36,7 +36,6 @@ FACADE = (
     "TOLERANCE",
     "driver",
     "exercise",
-    "grade",
     "rate",
     "table",
 )
