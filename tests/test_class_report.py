@@ -228,7 +228,8 @@ def page_of(grades, pairs=None, **options):
         (crashed("eval_pherm", ended(1)), "crash"),
         (crashed("eval_pherm", ended(None, out_of_memory=True)), "crash"),
         (crashed("eval_pherm", ended(None)), "crash"),
-        (called("eval_pherm", remote.Tampered("the notebook used threads")), "tampered"),
+        (called("eval_pherm", remote.CallEnded("WorkerError", ended(7))), "crash"),  # the supervisor's, for a call
+        (called("eval_pherm", remote.Tampered("Tampered", "the notebook used threads")), "tampered"),
         (scoring._voided(LAB.exercises[2].parts[0], "it patched labkit.check"), "tampered"),
         # a student's exceptions, whatever their names or words, are errors raised
         (called("eval_pherm", ValueError("it ran past the time limit")), "raised"),

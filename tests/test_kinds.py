@@ -7,15 +7,21 @@ limit, a crash or tampering. The real workers here run with the none backend (no
 """
 
 import json
+import shutil
 
 import nbformat
 import pytest
+from catalog import Planted, plant
+from conftest import sandbox_or_skip
+from small_class import cli, rows
 
+from labkit.cli import main
 from labkit.exercises import result as results
+from labkit.exercises.registry import LAB
 from labkit.exercises.result import ABOUT_THE_NOTEBOOK, KINDS, CheckResult, call
 from labkit.grading import class_report, remote, scoring
 from labkit.grading.options import GradeOptions
-from labkit.grading.report import FORMAT, ProblemText, SubmissionGrade
+from labkit.grading.report import FORMAT, ProblemText, SubmissionGrade, merge
 
 UNCONFINED = GradeOptions(backend="none", cell_timeout=2)
 
@@ -199,17 +205,34 @@ def test_a_results_problems_keep_their_kinds_through_its_file_and_old_formats_ar
         ),
         (("crash", "b.ipynb: it stopped."),),
     ]
-    with pytest.raises(ValueError, match="ada.json is not a labkit grade result .format is 'labkit-grade/2'"):
-        SubmissionGrade.from_dict({**data, "format": "labkit-grade/2"}, "ada.json")
+    for old in ("labkit-grade/2", "labkit-grade/1"):
+        with pytest.raises(ValueError, match=f"ada.json is in the results format {old}, .* Grade those submissions"):
+            SubmissionGrade.from_dict({**data, "format": old}, "ada.json")
     for bad in ([[]], [[["crash"]], [["crash", "y"]]], [[["killed", "x"]], [["crash", "y"]]]):
         with pytest.raises(ValueError, match="ada.json is not a labkit grade result"):
             SubmissionGrade.from_dict({**data, "problem_kinds": bad}, "ada.json")
 
 
+def test_the_report_on_a_folder_of_the_old_format_says_to_grade_again(tmp_path, capsys):
+    import hashlib
+
+    from labkit.grading.report import write_report
+
+    write_report(tmp_path, [SubmissionGrade("ada", {}, [ProblemText.one("a.ipynb: it stopped.", "crash")], 1)])
+    [path] = (tmp_path / "results").iterdir()
+    text = path.read_text().replace(f'"format": "{FORMAT}"', '"format": "labkit-grade/2"')
+    path.write_text(text)
+    record = json.loads((tmp_path / "record.json").read_text())  # vouching for the old file, as its run would
+    record["submissions"]["ada"]["sha256"] = hashlib.sha256(text.encode()).hexdigest()
+    (tmp_path / "record.json").write_text(json.dumps(record))
+    assert main(["report", str(tmp_path), "--quiet"]) == 2
+    said = capsys.readouterr().err
+    assert "in the results format labkit-grade/2" in said and "Grade those submissions again" in said, said
+    assert not (tmp_path / "report.html").exists()
+
+
 def test_a_stubbed_driver_leaves_its_table_and_rate_not_done_not_slipped():
     # the rate's check takes the table's failed steps: their kinds come along
-    from labkit.exercises.registry import LAB
-
     def stub(*args):
         raise NotImplementedError()
 
@@ -219,3 +242,163 @@ def test_a_stubbed_driver_leaves_its_table_and_rate_not_done_not_slipped():
     assert {check["name"]: class_report.check_outcome(check) for check in checks} == dict.fromkeys(
         exercise.names, "not done"
     )
+
+
+# ---------------------------------------------------------------- a class graded in the sandbox, end to end
+
+HOSTILE_CLASSES = (
+    "class Timeout(Exception):\n    pass\n"
+    "class Tampered(Exception):\n    pass\n"
+    "class WorkerError(Exception):\n    pass\n"
+    "def runge2d(x, y):\n    raise Timeout('interrupted: it ran longer than the time limit')\n"
+    "def eval_pbilin(f, xdata, ydata, xval, yval):\n"
+    '    raise Tampered("the grader\'s watch reported tampering; none of its answers count")\n'
+    "def test_pbilin_interpolate(ndata, f=None, interpolate=None):\n"
+    '    raise WorkerError("the notebook\'s process was killed by SIGKILL (a resource limit, or os.kill)")\n'
+)
+# every phrase the report once matched, in the student's own messages
+HOSTILE_WORDS = (
+    "def runge2d(x, y):\n    raise ValueError('stopped after the time limit: it ran past the time limit')\n"
+    "def eval_pbilin(f, xdata, ydata, xval, yval):\n"
+    "    raise RuntimeError(\"the notebook's process was killed by SIGKILL; exited with status 9; stopped answering;"
+    ' ran out of memory; answered out of protocol; larger than the protocol allows; crashed")\n'
+    "def test_pbilin_interpolate(ndata, f=None, interpolate=None):\n"
+    "    raise ValueError('called numpy.interp, which is switched off while this exercise is graded; not implemented"
+    " yet; not defined when the notebook finished; the check failed inside labkit; none of its answers count')\n"
+)
+# a real time limit and a real end of the process, for contrast
+ENDS = (
+    "import os\n"
+    "def runge2d(x, y):\n    while True:\n        pass\n"
+    "def eval_pbilin(f, xdata, ydata, xval, yval):\n    os._exit(3)\n"
+)
+FUNCTIONS = ("runge2d", "eval_pbilin", "test_pbilin_interpolate")
+
+
+def _planted(folder, *cells):
+    """Exercise 16 as the instructor solved it, with `cells` appended (they run after the solution's)."""
+    path = plant(Planted("as handed out", "06_bilinear.ipynb", ()), folder)
+    nb = nbformat.read(path, as_version=4)
+    nb.cells += [nbformat.v4.new_code_cell(cell) for cell in cells]
+    nbformat.write(nb, path)
+
+
+@pytest.fixture(scope="module")
+def graded_class(tmp_path_factory):
+    """A class of four graded in one sandboxed run: an honest student, one whose graded functions raise
+    exceptions of classes named Timeout, Tampered and WorkerError (and whose cells raise two of them), one whose
+    exceptions' messages hold every phrase the report once matched, and one whose functions really run past the
+    time limit and end their process. Its output folder."""
+    sandbox_or_skip()
+    root = tmp_path_factory.mktemp("kinds")
+    submissions = root / "submissions"
+    _planted(submissions / "honest")
+    _planted(
+        submissions / "named",
+        HOSTILE_CLASSES,
+        "raise Tampered('none of its answers count')",
+        "raise Timeout('interrupted: it ran longer than the time limit')",
+    )
+    _planted(submissions / "worded", HOSTILE_WORDS, "raise ValueError('ran out of memory; time limit; killed by')")
+    _planted(submissions / "ends", ENDS)
+    out = root / "out"
+    run = cli("grade", submissions, "--out", out, "--seed", "20261203", "--cell-timeout", "3", "--quiet")
+    assert run.returncode == 0, run.stderr
+    return submissions, out
+
+
+def _outcomes(grade, number=16):
+    return {check["name"]: class_report.check_outcome(check) for check in grade.results[number]["checks"]}
+
+
+def _kinds_by_student(summary):
+    return {(kind, p.student) for kind, rows in summary.problems.items() for p in rows}
+
+
+def test_in_a_sandboxed_class_a_students_own_timeout_tampered_and_workererror_are_errors_raised(graded_class):
+    _, out = graded_class
+    grades = {grade.name: grade for grade in class_report.read(out)}
+    named = grades["named"]
+    assert {name: _outcomes(named)[name] for name in FUNCTIONS} == dict.fromkeys(FUNCTIONS, "raised")
+    assert _outcomes(named)["phi_table"] == "passed"  # nothing voided: the answers that are right count
+    feedback = out / "feedback" / next(p.name for p in (out / "feedback").iterdir() if "named" in p.name)
+    text = feedback.read_text()
+    assert "see what the feedback says about the notebook above" not in text  # no notebook-timeout hint
+    assert "raised Timeout: interrupted: it ran longer than the time limit (in runge2d" in text
+    assert "the error happened in eval_pbilin" in text and "the error happened in test_pbilin_interpolate" in text
+    summary = class_report.summarise(grades.values())
+    assert {kind for kind, student in _kinds_by_student(summary) if student == "named"} == {"raised"}
+    # its two raising cells are errors raised, each named, not a time limit and not a voided notebook
+    [cells] = [p for p in summary.problems["raised"] if p.student == "named"]
+    assert any("cell 18 raised Timeout" in line for line in cells.texts), cells.texts
+    assert any("cell 17 raised Tampered" in line for line in cells.texts), cells.texts
+
+
+def test_in_a_sandboxed_class_the_old_phrases_in_a_students_messages_are_errors_raised(graded_class):
+    _, out = graded_class
+    grades = {grade.name: grade for grade in class_report.read(out)}
+    assert {name: _outcomes(grades["worded"])[name] for name in FUNCTIONS} == dict.fromkeys(FUNCTIONS, "raised")
+    summary = class_report.summarise(grades.values())
+    assert {kind for kind, student in _kinds_by_student(summary) if student == "worded"} == {"raised"}
+
+
+def test_in_a_sandboxed_class_a_real_time_limit_and_a_real_end_of_the_process_keep_their_kinds(graded_class):
+    _, out = graded_class
+    grades = {grade.name: grade for grade in class_report.read(out)}
+    outcomes = _outcomes(grades["ends"])
+    assert (outcomes["runge2d"], outcomes["eval_pbilin"]) == ("timeout", "crash")
+    assert outcomes["phi_table"] == "passed"  # the call that ended the process cost only itself
+
+
+def test_the_honest_classmate_gets_full_marks(graded_class):
+    _, out = graded_class
+    [honest] = [grade for grade in class_report.read(out) if grade.name == "honest"]
+    assert set(_outcomes(honest).values()) == {"passed"} and honest.problems == []
+    assert honest.points[16] == LAB.exercises[16].points == 8
+    assert rows(out)["honest"]["exercise 16"] == "8" and rows(out)["honest"]["status"] == "graded"
+
+
+def test_the_report_reads_the_same_kinds_from_a_resumed_run_and_a_merge(graded_class, tmp_path):
+    submissions, out = graded_class
+    first = class_report.summarise(class_report.read(out))
+    resumed = tmp_path / "resumed"
+    shutil.copytree(out, resumed)
+    run = cli("grade", submissions, "--out", resumed, "--cell-timeout", "3")
+    assert run.returncode == 0 and "4 submission(s) were graded there already and kept, 0 graded now" in run.stdout, (
+        run.stdout + run.stderr
+    )
+    merge([resumed], tmp_path / "merged")
+    for folder in (resumed, tmp_path / "merged"):
+        assert main(["report", str(folder), "--quiet"]) == 0
+        again = class_report.summarise(class_report.read(folder))
+        assert again.problems == first.problems and again.parts == first.parts
+        html = (folder / "report.html").read_text()
+        assert "Errors raised" in html and "Answers voided" not in html
+
+
+def test_rewording_every_message_changes_nothing_the_report_says(graded_class):
+    """The grader's words may change: scrambled, every failed step's detail and every problem's text, the
+    report's outcomes and problem kinds are the same."""
+    _, out = graded_class
+    grades = class_report.read(out)
+
+    def scrambled(text):
+        return str(text)[::-1].swapcase()
+
+    reworded = []
+    for grade in grades:
+        copy = SubmissionGrade.from_dict(json.loads(json.dumps(grade.as_dict())), grade.name, grade.rubric)
+        for verdict in copy.results.values():
+            for check in verdict["checks"]:
+                for step in check["steps"]:
+                    step["detail"] = scrambled(step["detail"])
+                    step["step"] = scrambled(step["step"])
+        copy.problems = [ProblemText(scrambled(p), [(k, scrambled(d)) for k, d in p.kinds]) for p in copy.problems]
+        reworded.append(copy)
+    before, after = class_report.summarise(grades), class_report.summarise(reworded)
+    assert [(g.name, _outcomes(g)) for g in grades] == [(g.name, _outcomes(g)) for g in reworded]
+    assert _kinds_by_student(before) == _kinds_by_student(after)
+    assert {kind for kind, _ in _kinds_by_student(before)} >= {"raised", "timeout", "crash"}
+    assert [(r.passed, r.slipped, r.problem, r.not_done) for r in before.parts] == [
+        (r.passed, r.slipped, r.problem, r.not_done) for r in after.parts
+    ]

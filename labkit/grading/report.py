@@ -37,6 +37,7 @@ from .scan import MAX_SOURCE_CHARS
 from .text import points_text
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
+OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again (SubmissionGrade.from_dict)
 
 
 class ProblemText(str):
@@ -338,7 +339,16 @@ class SubmissionGrade:
 
     @classmethod
     def from_dict(cls, data, source="a result file", rubric=None):
-        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file."""
+        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file.
+
+        A result of an earlier format is refused, saying to grade again: ``labkit-grade/2`` kept its problems as
+        words only, and guessing their kinds from the words is what format 3 ended."""
+        if isinstance(data, dict) and data.get("format") in OLD_FORMATS:
+            raise ValueError(
+                f"{source} is in the results format {data['format']}, which keeps a problem's words but not its "
+                f"kind (a time limit, a crash, an error raised, ...); this labkit reads {FORMAT} only. Grade "
+                "those submissions again with this version: `labkit grade` with --fresh, or into a new --out."
+            )
         try:
             if data.get("format") != FORMAT:
                 raise ValueError(f"format is {data.get('format')!r}, not {FORMAT!r}")
