@@ -8,7 +8,9 @@
 times the student supplied, :class:`LateSummary`), each exercise's and part's
 pass rate, the slips the checks named (most frequent first, with who made
 them), the problems (time limits, crashes, cells that raised, refused
-references, ...), the students with the most failed parts, and pairs of
+references, ...; each read from the kind code the grader set where it made
+the failed step or the problem, :data:`labkit.exercises.result.KINDS`, never
+from its words), the students with the most failed parts, and pairs of
 similar code side by side (:mod:`labkit.grading.similarity`; similarity never
 changes a grade, it is for a person to judge). Without copydetect, which the
 similarity search needs, the page is written all the same and its similar code
