@@ -28,7 +28,7 @@ from pathlib import Path
 
 from . import notebook as _notebook
 from .exercises.model import sections
-from .exercises.result import NOT_IMPLEMENTED
+from .exercises.result import NOT_DONE, NOT_IMPLEMENTED
 
 DONE, FAILING, NOT_STARTED = "done, passes its self-check", "done but failing", "not started"
 ANSWER_STUB = "YOUR ANSWER HERE"  # what labkit release (and nbgrader) leave in an answer in words
@@ -236,8 +236,11 @@ def _status(number: int, part, check: Mapping, namespace: Mapping, stubbed: set,
     if check["passed"]:
         return PartStatus(number, part.name, DONE)
     steps = [s for s in check["steps"] if not s["passed"]]
-    if any(s["detail"] == NOT_IMPLEMENTED for s in steps):
-        return PartStatus(number, part.name, NOT_STARTED, "it still raises NotImplementedError")
+    left = [s for s in steps if s.get("kind") == NOT_DONE]  # a stub called, or a name the check reads not defined
+    if left:
+        stub = left[0]["detail"] == NOT_IMPLEMENTED  # which of the two, for the words only
+        why = "it still raises NotImplementedError" if stub else f"{left[0]['step']}: {left[0]['detail']}"
+        return PartStatus(number, part.name, NOT_STARTED, why)
     hint = check["hint"] or (f"{steps[0]['step']}: {steps[0]['detail']}" if steps else "")
     return PartStatus(number, part.name, FAILING, " ".join(str(hint).split()))
 

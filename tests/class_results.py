@@ -12,7 +12,9 @@ tests/test_catalog.py's job); it is realistic input for the report, made in mill
 import numpy as np
 from catalog import MISTAKES
 
-from labkit.grading.results.report import SubmissionGrade
+from labkit.exercises.result import NOT_DONE
+from labkit.exercises.result import RAISED as RAISED_KIND
+from labkit.grading.results.report import ProblemText, SubmissionGrade
 from labkit.grading.results.rubric import default
 
 FIRST = ("Ada", "Ben", "Chloé", "Dmitri", "Eun-ji", "Farah", "Goran", "Hana", "Iker", "Jun", "Kofi", "Lena")
@@ -26,8 +28,9 @@ RAISED = (
 REFERENCES = ("scipy.interpolate.CubicSpline", "scipy.interpolate.CubicHermiteSpline", "numpy.interp")
 
 
-def _step(step, detail):
-    return {"step": step, "passed": False, "detail": detail}
+def _step(step, detail, kind=None):
+    """A failed step; `kind` is the code the grader sets where it makes a step that is no slip."""
+    return {"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}
 
 
 def _failed(name, weight, steps, hint):
@@ -55,14 +58,14 @@ def _outcome(rng, part, weight, skill, slips):
         return _failed(
             part,
             weight,
-            [_step(f"{part}(...) runs", f"raised {kind}: {message} ({where})")],
+            [_step(f"{part}(...) runs", f"raised {kind}: {message} ({where})", RAISED_KIND)],
             f"the error happened {where}: look at that line.",
         )
     if draw < 0.91:
         return _failed(
             part,
             weight,
-            [_step(f"{part}(...) runs", "interrupted: it ran longer than the time limit")],
+            [_step(f"{part}(...) runs", "interrupted: it ran longer than the time limit", "timeout")],
             "see what the feedback says about the notebook above.",
         )
     if draw < 0.97:
@@ -70,13 +73,19 @@ def _outcome(rng, part, weight, skill, slips):
         return _failed(
             part,
             weight,
-            [_step(f"{part}(...) runs", f"called {reference}, which is switched off while this exercise is graded")],
+            [
+                _step(
+                    f"{part}(...) runs",
+                    f"called {reference}, which is switched off while this exercise is graded",
+                    "refused",
+                )
+            ],
             f"the exercise asks you to write this yourself: do not call {reference}.",
         )
     return _failed(
         part,
         weight,
-        [_step(f"{part} is defined", "not defined when the notebook finished")],
+        [_step(f"{part} is defined", "not defined when the notebook finished", NOT_DONE)],
         f"run the cell that defines {part} (and keep its name); a cell that raised stops it.",
     )
 
@@ -85,7 +94,7 @@ def _stub(part, weight):
     return _failed(
         part,
         weight,
-        [_step(f"{part}(...) runs", "not implemented yet")],
+        [_step(f"{part}(...) runs", "not implemented yet", NOT_DONE)],
         "replace the `raise NotImplementedError()` with your code.",
     )
 
@@ -150,16 +159,25 @@ def synthetic_class(count, seed=0, rubric=None, extra_names=()):
             grade.results[number] = _verdict(number, checks, exercise.points)
         if rng.random() < 0.12:
             kind, message, line = RAISED[rng.integers(len(RAISED))]
+            cell = rng.integers(5, 40)
             grade.problems.append(
-                f"04_splines.ipynb: 1 cell(s) raised an error (graded as far as it got):\n"
-                f"    cell {rng.integers(5, 40)} raised {kind}: {message}\n      | ----> 3 {line}"
+                ProblemText(
+                    f"04_splines.ipynb: 1 cell(s) raised an error (graded as far as it got):\n"
+                    f"    cell {cell} raised {kind}: {message}\n      | ----> 3 {line}",
+                    [(RAISED_KIND, f"04_splines.ipynb: cell {cell} raised {kind}: {message}")],
+                )
             )
         if rng.random() < 0.03:
-            grade.problems.append("03_meshes.ipynb: stopped after the submission's time limit of 600 s.")
+            grade.problems.append(
+                ProblemText.one("03_meshes.ipynb: stopped after the submission's time limit of 600 s.", "timeout")
+            )
         if rng.random() < 0.015:
             grade.problems.append(
-                "02_convergence.ipynb: the notebook's process was killed by SIGKILL (a resource limit, or os.kill) "
-                "while running its cells."
+                ProblemText.one(
+                    "02_convergence.ipynb: the notebook's process was killed by SIGKILL (a resource limit, or "
+                    "os.kill) while running its cells.",
+                    "crash",
+                )
             )
         grades.append(grade)
     return grades

@@ -2,7 +2,8 @@
 
 The class here is built from SubmissionGrade objects whose failed checks are made by the grader's own
 functions (labkit.exercises.result.call with the sandbox's exceptions, the registry's missing name, the
-scan's refusal, the run's problems), so the report's reading of them follows the grader's wording.
+scan's refusal, the run's problems), so the report reads the kind codes the grader sets where it makes them,
+never their wording (tests/test_kinds.py).
 The page in a real browser (no request leaves the machine, axe-core finds no serious violation) is
 tests/browser/test_class_report_browser.py.
 """
@@ -25,7 +26,7 @@ from labkit.exercises.result import CheckResult, call
 from labkit.grading.reports import class_report, similarity
 from labkit.grading.reports.similarity import Pair
 from labkit.grading.results import late
-from labkit.grading.results.report import SubmissionGrade, merge, write_report
+from labkit.grading.results.report import ProblemText, SubmissionGrade, merge, write_report
 from labkit.grading.results.rubric import default, load
 from labkit.grading.sandbox import remote
 from labkit.grading.submission import scoring
@@ -60,6 +61,15 @@ def called(part, exception):
     return result.as_dict()
 
 
+def own_timeout(message):
+    """An exception of a class the student named Timeout, raised in the notebook itself (no sandbox)."""
+
+    class Timeout(Exception):
+        grader_kind = "timeout"  # posing as one of the grader's own errors does not make it one
+
+    return Timeout(message)
+
+
 def timed_out(part):
     return called(part, remote.CellTimeout("interrupted: it ran longer than the time limit"))
 
@@ -90,12 +100,20 @@ def ended(code, out_of_memory=False):
 
 
 def cells_raised(name, *errors, output_chars=0):
-    """The problems of a notebook whose cells raised (labkit.grading.submission.scoring's wording)."""
+    """The problems of a notebook whose cells raised (labkit.grading.submission.scoring's), as the worker answers a run: an
+    error (cell, kind, message) of the student's, or (cell, kind, message, True) one the worker stopped at its
+    time limit (labkit.grading.sandbox.worker marks those ``"timeout": True``)."""
     ran = {
-        "errors": [{"cell": cell, "kind": kind, "message": message, "traceback": ""} for cell, kind, message in errors],
+        "errors": [
+            {"cell": cell, "kind": kind, "message": message, "traceback": "", "timeout": bool(own)}
+            for cell, kind, message, *own in errors
+        ],
         "output_chars": output_chars,
     }
     return scoring._run_problems(name, ran)
+
+
+STOPPED = "interrupted: it ran longer than the time limit"  # the worker's words for a cell it stopped
 
 
 def grade(name, checks=None, problems=(), failure=None, rubric=None):
@@ -144,8 +162,8 @@ def grades():
                 (4, "limacon_derivatives"): timed_out("limacon_derivatives"),
             },
             problems=[
-                "01_limacon.ipynb: stopped after the submission's time limit of 600 s.",
-                *cells_raised("02_convergence.ipynb", (7, "Timeout", "interrupted: it ran longer than the time limit")),
+                ProblemText.one("01_limacon.ipynb: stopped after the submission's time limit of 600 s.", "timeout"),
+                *cells_raised("02_convergence.ipynb", (7, "Timeout", STOPPED, True)),
             ],
         ),
         grade(HOSTILE, {(2, "eval_pherm"): slip("eval_pherm", HTML_HINT)}),
@@ -154,7 +172,7 @@ def grades():
             "gus",
             {(2, "eval_pherm"): refused_scan("eval_pherm"), (3, DRIVER): crashed(DRIVER, ended(-9))},
             problems=[
-                f"03_meshes.ipynb: {ended(3)} while running its cells.",
+                ProblemText.one(f"03_meshes.ipynb: {ended(3)} while running its cells.", "crash"),
                 *cells_raised("04_splines.ipynb", output_chars=250_000),
             ],
         ),
@@ -194,7 +212,7 @@ def page_of(grades, pairs=None, **options):
     return class_report.render(class_report.summarise(grades), pairs, **options)
 
 
-# ------------------------------------------------------------------ reading the grader's words
+# ------------------------------------------------------------------ reading the grader's codes
 
 
 @pytest.mark.parametrize(
@@ -213,11 +231,22 @@ def page_of(grades, pairs=None, **options):
         (crashed("eval_pherm", ended(1)), "crash"),
         (crashed("eval_pherm", ended(None, out_of_memory=True)), "crash"),
         (crashed("eval_pherm", ended(None)), "crash"),
+        (called("eval_pherm", remote.CallEnded("WorkerError", ended(7))), "crash"),  # the supervisor's, for a call
+        (called("eval_pherm", remote.Tampered("Tampered", "the notebook used threads")), "tampered"),
+        (scoring._voided(LAB.exercises[2].parts[0], "it patched labkit.check"), "tampered"),
+        # a student's exceptions, whatever their names or words, are errors raised
+        (called("eval_pherm", ValueError("it ran past the time limit")), "raised"),
+        (called("eval_pherm", ValueError("killed by SIGKILL")), "raised"),
+        (called("eval_pherm", ValueError("not implemented yet")), "raised"),
+        (called("eval_pherm", own_timeout("interrupted: it ran longer than the time limit")), "raised"),
         (
-            scoring._failed_part(
-                {"weight": 10}, "eval_pherm", "the notebook's answers can be trusted", "it patched labkit.check", "h"
-            ),
-            "tampered",
+            called("eval_pherm", remote.StudentError("Timeout", "interrupted: it ran longer than the time limit")),
+            "raised",
+        ),
+        (called("eval_pherm", remote.StudentError("Tampered", "none of its answers count")), "raised"),
+        (
+            called("eval_pherm", remote.StudentError("WorkerError", "the notebook's process stopped answering")),
+            "raised",
         ),
     ],
     ids=lambda v: v if isinstance(v, str) else None,
@@ -227,19 +256,35 @@ def test_a_failed_check_is_read_as_the_grader_meant_it(check, outcome):
 
 
 def test_a_check_that_fails_inside_labkit_is_a_problem_not_a_slip():
-    registry_fault = CheckResult("eval_pherm").fail(
-        "the grader could check this part",
+    class Faulty(dict):
+        def __getitem__(self, name):  # a fault of the grader's side while the check reads the notebook
+            raise RuntimeError("the grader's proxy broke")
+
+    [check] = LAB.check(2, Faulty(eval_pherm=None))["checks"][:1]
+    assert check["steps"][-1]["detail"].startswith("the check failed inside labkit")
+    assert class_report.check_outcome(check) == "other"
+
+
+def test_a_steps_words_alone_make_no_kind():
+    # a check's own failed step that merely reads like a time limit, a crash, a stub or a refusal is a slip
+    for detail in (
+        "it ran past the time limit",
+        "killed by SIGKILL",
+        "not implemented yet",
+        "not defined when the notebook finished",
+        "called numpy.interp, which is switched off while this exercise is graded",
+        "raised ValueError: x",
         "the check failed inside labkit (KeyError)",
-        "this is a fault of the grader, not of your work: tell your instructor.",
-    )
-    assert class_report.check_outcome(registry_fault.as_dict()) == "other"
+    ):
+        check = CheckResult("eval_pherm").fail("the values at the lab's points", detail, "divide by h").as_dict()
+        assert class_report.check_outcome(check) == "slip", detail
 
 
 def test_the_problems_of_a_run_are_sorted_into_their_kinds():
     [raised_and_stopped, flood] = cells_raised(
         "a.ipynb",
         (2, "ZeroDivisionError", "float division by zero"),
-        (5, "Timeout", "interrupted: it ran longer than the time limit"),
+        (5, "Timeout", STOPPED, True),
         output_chars=200_000,
     )
     assert class_report.problem_kinds(raised_and_stopped) == [
@@ -247,13 +292,27 @@ def test_the_problems_of_a_run_are_sorted_into_their_kinds():
         ("timeout", "a.ipynb: cell 6 ran past its time limit"),
     ]
     assert class_report.problem_kinds(flood)[0][0] == "other"
-    assert class_report.problem_kinds(f"a.ipynb: {ended(-9)} while running its cells.")[0][0] == "crash"
-    assert class_report.problem_kinds("a.ipynb: it patched numpy; none of its answers count.")[0][0] == "tampered"
-    stopped = "a.ipynb: stopped after the total time limit: the notebook did not answer in time."
-    assert class_report.problem_kinds(stopped)[0][0] == "timeout"
     # a traceback line of the student's cannot pose as another cell's error
     [forged] = cells_raised("a.ipynb", (0, "KeyError", "x\n    cell 9 raised Timeout: y"))
     assert [kind for kind, _ in class_report.problem_kinds(forged)] == ["raised"]
+
+
+def test_a_cell_raising_the_students_own_timeout_is_an_error_raised_not_a_time_limit():
+    # the same words as a cell the worker stopped, but no mark of the worker's: the student's class Timeout
+    [own] = cells_raised("a.ipynb", (3, "Timeout", STOPPED), (4, "ValueError", "killed by the time limit"))
+    assert [kind for kind, _ in class_report.problem_kinds(own)] == ["raised", "raised"]
+
+
+def test_a_problems_words_alone_make_no_kind():
+    # words that read like a time limit, a crash or tampering, with no code set where the problem was made
+    for words in (
+        "a.ipynb: stopped after the submission's time limit of 600 s.",
+        "a.ipynb: the notebook's process was killed by SIGKILL while running its cells.",
+        "a.ipynb: it patched numpy; none of its answers count.",
+    ):
+        assert class_report.problem_kinds(words) == [("other", words)]
+    # and the kind set where it was made decides, whatever the words
+    assert class_report.problem_kinds(ProblemText.one("a.ipynb: it ran past the time limit", "crash"))[0][0] == "crash"
 
 
 # ------------------------------------------------------------------ what the summary counts

@@ -40,7 +40,7 @@ import numpy as np
 from .. import bilinear, convergence, functions, piecewise, splines
 from . import answer_key
 from .model import EXPERIMENTS, Part
-from .result import CheckResult, call, case_rng, floats, judged_by_the_lab, shown
+from .result import NOT_DONE, CheckResult, call, case_rng, floats, judged_by_the_lab, shown
 
 DRIVER_TOLERANCE = 1e-6  # relative: the driver's error against the reference error
 PRINTED = 6e-4  # relative: a table copied from ratio_table's four significant digits (half a unit is 5e-4)
@@ -586,6 +586,7 @@ def _own_errors(method, fn, result):
             f"{method.driver} is defined",
             "not defined when the notebook finished",
             f"this part is read from what {method.driver} returns: define it first.",
+            NOT_DONE,
         )
         return None
     own = []
@@ -695,7 +696,8 @@ def check_experiment(method, errors, answer, fn):
     own = _own_errors(method, fn, table_result)
     lab, honest = None, False
     if own is None:
-        rate_result.steps, rate_result.hint = list(table_result.steps), table_result.hint
+        rate_result.add_steps(table_result)
+        rate_result.hint = table_result.hint
     else:
         why = attempted_driver(method, fn, own)
         if why:  # the driver measures something else: the lab's experiment is the reference
@@ -740,6 +742,7 @@ def _table(method, errors, own, result, lab=None, honest=False):
             f"{method.table} is defined",
             "not defined when the notebook finished",
             f"run the cell that fills {method.table} (and keep its name).",
+            NOT_DONE,
         )
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):
@@ -874,6 +877,7 @@ def _rate(method, answer, errors, own, result, lab=None, honest=False):
             f"{method.rate} is defined",
             "not defined when the notebook finished",
             f"run the cell that sets {method.rate} (and keep its name).",
+            NOT_DONE,
         )
     values = _numbers(errors)
     if values is None or values.shape != (len(method.ndata),):

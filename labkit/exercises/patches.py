@@ -326,10 +326,10 @@ def check_two_patches(fn, corners, coons=None):
                     True,
                 )
                 continue
-            result.steps.extend(trial.steps)
+            result.add_steps(trial)
             result.hint = trial.hint
             return result
-        result.steps.extend(trial.steps)
+        result.add_steps(trial)
     return result
 
 

@@ -23,7 +23,7 @@ from typing import Any
 
 from . import bilinear, hermite, monotone, patches, splines
 from .model import Exercise
-from .result import CheckResult
+from .result import NOT_DONE, OTHER, CheckResult
 
 TOPICS = (hermite, patches, splines, monotone, bilinear)  # in the order of the exercises they declare
 # names labkit.check defines itself: no part's check may take one
@@ -207,6 +207,7 @@ class Registry:
                     "the grader could check this part",
                     f"the check failed inside labkit ({type(exc).__name__})",
                     "this is a fault of the grader, not of your work: tell your instructor.",
+                    OTHER,
                 )
             checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # as the student names it
         points = sum(check["weight"] for check in checks if check["passed"])
@@ -265,6 +266,7 @@ def _missing(name: str) -> CheckResult:
         f"{name} is defined",
         "not defined when the notebook finished",
         f"run the cell that defines {name} (and keep its name); a cell that raised stops it.",
+        NOT_DONE,
     )
 
 

@@ -19,6 +19,18 @@ NOT_IMPLEMENTED = "not implemented yet"  # the failed step of a function that st
 STUB = "replace the `raise NotImplementedError()` with your code."
 ABOUT_THE_NOTEBOOK = "see what the feedback says about the notebook above."  # timed out, tampered, worker failed
 
+# What became of a part, and the kind of a failed step or of a submission's problem, as codes: set where the
+# step or the problem is made, and read by the class report (never its words, which may change)
+PASSED, SLIP = "passed", "slip"  # a part passed; a part failed with the check's hint
+NOT_DONE = "not done"  # a stub left as released, or a name not defined
+RAISED = "raised"  # the student's code raised an exception
+REFUSED = "refused"  # the student's code called, or its source reached for, a refused reference
+TIMEOUT = "timeout"  # a cell, a call or the submission ran past its time limit
+CRASH = "crash"  # the notebook's process died or stopped answering the grader
+TAMPERED = "tampered"  # the notebook interfered with the grader's watch
+OTHER = "other"  # a fault of the check itself, or a problem of none of the kinds above
+KINDS = (NOT_DONE, RAISED, REFUSED, TIMEOUT, CRASH, TAMPERED, OTHER)  # of a failed step or a problem
+
 
 @dataclass
 class CheckResult:
@@ -30,20 +42,33 @@ class CheckResult:
     # why the part was judged against labkit's reference rather than the student's earlier work: said with the
     # hint when the part fails (see :func:`judged_by_the_lab`)
     note: str = ""
+    # the kind (one of KINDS) of a failed step that is not a slip, by the step's index in `steps`
+    kinds: dict = field(default_factory=dict)
 
     @property
     def passed(self):
         return bool(self.steps) and all(ok for _, ok, _ in self.steps)
 
-    def step(self, description, ok, detail=""):
-        """Record a step; the detail explains a failure, so a passed step drops it."""
+    def step(self, description, ok, detail="", kind=None):
+        """Record a step; the detail explains a failure, so a passed step drops it. A failed step that is not
+        a slip the check names (a stub, an error raised, a time limit, ...) gives its `kind`, one of
+        :data:`KINDS`."""
+        if kind is not None and kind not in KINDS:
+            raise ValueError(f"a failed step's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
         self.steps.append((description, bool(ok), "" if ok else detail))
+        if kind is not None and not ok:
+            self.kinds[len(self.steps) - 1] = kind
         return bool(ok)
 
-    def fail(self, description, detail, hint):
-        self.step(description, False, detail)
+    def fail(self, description, detail, hint, kind=None):
+        self.step(description, False, detail, kind)
         self.hint = hint
         return self
+
+    def add_steps(self, other):
+        """Record `other`'s steps after this result's own, each failed one with its kind."""
+        for index, (description, ok, detail) in enumerate(other.steps):
+            self.step(description, ok, detail, other.kinds.get(index))
 
     @property
     def advice(self):
@@ -66,7 +91,10 @@ class CheckResult:
             "name": self.name,
             "passed": self.passed,
             "hint": self.advice,
-            "steps": [{"step": d, "passed": ok, "detail": det} for d, ok, det in self.steps],
+            "steps": [
+                {"step": d, "passed": ok, "detail": det, **({"kind": self.kinds[i]} if i in self.kinds else {})}
+                for i, (d, ok, det) in enumerate(self.steps)
+            ],
         }
 
 
@@ -115,23 +143,29 @@ def call(result, description, fn, *args):
     Returns ``(True, value)``, or ``(False, None)`` after recording the failure.
     Errors that come back from a sandboxed notebook carry the student's
     exception type in ``kind``; a refused reference implementation carries
-    ``refused``.
+    ``refused``. The grader's own errors (a time limit, a notebook that died or
+    was tampered with) are exceptions of labkit's sandbox whose class gives the
+    step's kind in ``grader_kind`` (:func:`grader_kind`); no exception of the
+    student's, whatever its name or message, passes for one: it is an error
+    raised.
     """
     try:
         return True, fn(*args)
     except NotImplementedError:
-        result.fail(description, NOT_IMPLEMENTED, STUB)
+        result.fail(description, NOT_IMPLEMENTED, STUB, NOT_DONE)
     except Exception as exc:  # noqa: BLE001 - any student error is reported, not raised
         kind = getattr(exc, "kind", type(exc).__name__)
         refused = getattr(exc, "refused", None)
-        if refused:
+        own = grader_kind(exc)
+        if own is None and refused:
             result.fail(
                 description,
                 f"called {refused}, which is switched off while this exercise is graded",
                 f"the exercise asks you to write this yourself: do not call {refused}.",
+                REFUSED,
             )
-        elif kind in ("Tampered", "Timeout", "WorkerError"):
-            result.fail(description, _text(exc), ABOUT_THE_NOTEBOOK)
+        elif own is not None:
+            result.fail(description, _text(exc), ABOUT_THE_NOTEBOOK, own)
         else:
             where, slip = _where(exc), _raised_slip(kind, _text(exc))
             result.fail(
@@ -145,8 +179,28 @@ def call(result, description, fn, *args):
                     if where
                     else "run the cell with the error on its own: the traceback shows where it happened."
                 ),
+                RAISED,
             )
     return False, None
+
+
+def grader_kind(exc):
+    """The kind of a failed step an exception of the grader's own sandbox stands for (a time limit, a notebook
+    that died or was tampered with), None for any other exception: the class of one of
+    :mod:`labkit.grading.sandbox.remote`'s errors says it in ``grader_kind``, which no student's exception carries
+    (an exception the student's code raised in the sandbox comes back as a plain ``StudentError``, whatever
+    its name; the grader's own verdicts on a call come from the supervisor's marked answers, never a name).
+
+    Examples
+    --------
+    >>> class Timeout(Exception):  # a student's own
+    ...     grader_kind = TIMEOUT
+    >>> grader_kind(Timeout("it ran past the time limit")) is None
+    True
+    """
+    kind = getattr(type(exc), "grader_kind", None)
+    own = type(exc).__module__.startswith("labkit.grading.")
+    return kind if own and kind in KINDS else None
 
 
 def gave_up(result):

@@ -8,7 +8,9 @@
 times the student supplied, :class:`LateSummary`), each exercise's and part's
 pass rate, the slips the checks named (most frequent first, with who made
 them), the problems (time limits, crashes, cells that raised, refused
-references, ...), the students with the most failed parts, and pairs of
+references, ...; each read from the kind code the grader set where it made
+the failed step or the problem, :data:`labkit.exercises.result.KINDS`, never
+from its words), the students with the most failed parts, and pairs of
 similar code side by side (:mod:`labkit.grading.reports.similarity`; similarity never
 changes a grade, it is for a person to judge). Without copydetect, which the
 similarity search needs, the page is written all the same and its similar code
@@ -28,7 +30,6 @@ import base64
 import html
 import io
 import os
-import re
 import statistics
 import tempfile
 from collections import defaultdict
@@ -37,9 +38,11 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
+from ...exercises.result import CRASH, NOT_DONE, OTHER, PASSED, RAISED, REFUSED, SLIP, TAMPERED, TIMEOUT
 from ..results import late as lateness
 from ..results.record import rubric_for
 from ..results.report import SubmissionGrade, one_line, printable, read_results
+from ..results.report import problem_kinds as kinds_of
 from ..results.rubric import Rubric
 from ..results.text import points_text
 from ..submission.known import THRESHOLD
@@ -59,16 +62,9 @@ MAX_LINE = 160  # characters of one line of code shown
 MAX_LABEL = 64  # characters of a part's label in the list of a student's failed parts
 MAX_FAILED_SHOWN = 50  # failed parts listed per student
 
-PASSED, SLIP, NOT_DONE = "passed", "slip", "not done"
-TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, NOT_GRADED, OTHER = (
-    "timeout",
-    "crash",
-    "raised",
-    "refused",
-    "tampered",
-    "not graded",
-    "other",
-)
+NOT_GRADED = "not graded"  # a submission whose grading failed (its `failure`): no points, not zero
+# what a failed part's steps say became of it, the first kind found winning (no kind at all: a slip)
+OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER, NOT_DONE)
 # the kinds of problem, in the order the page lists them: (heading, what it means)
 KINDS = {
     TIMEOUT: ("Time limits", "A cell, a call of a graded function or the whole submission ran past its time limit"),
@@ -91,28 +87,6 @@ KINDS = {
         "A flood of output, a notebook too large to grade, a sandbox that could not start, a fault of a check",
     ),
 }
-
-# How the grader words what went wrong (labkit.exercises.result.call, labkit.exercises.registry,
-# labkit.grading.submission.scoring, labkit.grading.sandbox.remote, labkit.grading.sandbox.worker);
-# tests/test_class_report.py produces each wording with the grader's own functions, so a change of words fails there.
-NOT_DONE_DETAILS = ("not implemented yet", "not defined when the notebook finished")
-REFUSED_WORDS = ("switched off while this exercise is graded",)
-REFUSED_STEP = "calls no reference implementation"
-TAMPERED_STEP = "the notebook's answers can be trusted"
-TAMPERED_WORDS = ("none of its answers count",)
-TIMEOUT_WORDS = ("time limit",)
-CRASH_WORDS = (
-    "killed by",
-    "exited with status",
-    "ran out of memory",
-    "stopped answering",
-    "out of protocol",
-    "larger than the protocol allows",
-    "crashed",
-)
-GRADER_FAULT = "the check failed inside labkit"
-CELLS_RAISED = "cell(s) raised an error"
-CELL_LINE = re.compile(r"^    cell (\d+) raised ([^:\n]*): ?(.*)$")
 
 
 @dataclass(frozen=True)
@@ -388,7 +362,8 @@ def check_outcome(check: dict) -> str:
     Parameters
     ----------
     check : dict
-        One entry of an exercise's ``checks`` in a result: ``name``, ``passed``, ``hint``, ``steps``.
+        One entry of an exercise's ``checks`` in a result: ``name``, ``passed``, ``hint``, ``steps`` (a
+        failed step that is not a slip has its ``kind``, :data:`labkit.exercises.result.KINDS`).
 
     Returns
     -------
@@ -400,8 +375,11 @@ def check_outcome(check: dict) -> str:
     Examples
     --------
     >>> check_outcome({"passed": False, "hint": "h", "steps": [{"step": "s", "passed": False,
-    ...     "detail": "not implemented yet"}]})
+    ...     "detail": "not implemented yet", "kind": "not done"}]})
     'not done'
+    >>> check_outcome({"passed": False, "hint": "h", "steps": [{"step": "s", "passed": False,
+    ...     "detail": "ran past the time limit"}]})  # the words alone: no kind, so the check's slip
+    'slip'
     >>> check_outcome({"passed": False, "hint": "divide by the interval's length", "steps": [
     ...     {"step": "the values at 5 points", "passed": False, "detail": "off by 0.3"}]})
     'slip'
@@ -410,36 +388,25 @@ def check_outcome(check: dict) -> str:
         raise ValueError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
     if check.get("passed"):
         return PASSED
-    failed = [s for s in _steps(check) if not s.get("passed")]
-    names = [str(s.get("step", "")) for s in failed]
-    details = [str(s.get("detail", "")) for s in failed]
-    text = " ".join(details)
-    if REFUSED_STEP in names or any(words in text for words in REFUSED_WORDS):
-        return REFUSED
-    if TAMPERED_STEP in names:
-        return TAMPERED
-    if any(words in text for words in TIMEOUT_WORDS):
-        return TIMEOUT
-    if any(words in text for words in CRASH_WORDS):
-        return CRASH
-    if any(detail.startswith("raised ") for detail in details):
-        return RAISED
-    if GRADER_FAULT in text:
-        return OTHER
-    if any(detail in NOT_DONE_DETAILS for detail in details):
-        return NOT_DONE
+    kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}  # each failed step's code, set where made
+    for kind in OUTCOMES:
+        if kind in kinds:
+            return kind
     return SLIP
 
 
-def problem_kinds(text: str) -> list[tuple[str, str]]:
-    """The kinds of a problem the grader wrote for a submission, each with the words to show.
+def problem_kinds(problem: str) -> list[tuple[str, str]]:
+    """The kinds of a problem the grader recorded for a submission, each with the words to show.
 
-    A notebook whose cells raised has one problem listing the cells; a cell stopped at its time limit
-    counts as a time limit, the others as errors raised.
+    The kinds are the codes the grader set where it made the problem (a
+    :class:`labkit.grading.results.report.ProblemText`), never read from its words: a
+    notebook whose cells raised has one (kind, description) per cell, a cell
+    the worker stopped at its time limit a time limit, the others errors
+    raised. A bare text, with no codes, is "other".
 
     Parameters
     ----------
-    text : str
+    problem : str
         One of a submission's ``problems``.
 
     Returns
@@ -449,39 +416,13 @@ def problem_kinds(text: str) -> list[tuple[str, str]]:
 
     Examples
     --------
-    >>> problem_kinds("a.ipynb: stopped after the submission's time limit of 600 s.")
+    >>> from labkit.grading.results.report import ProblemText
+    >>> problem_kinds(ProblemText.one("a.ipynb: stopped after the submission's time limit of 600 s.", "timeout"))
     [('timeout', "a.ipynb: stopped after the submission's time limit of 600 s.")]
-    >>> problem_kinds("a.ipynb: 2 cell(s) raised an error (graded as far as it got):\\n"
-    ...     "    cell 3 raised ZeroDivisionError: division by zero\\n"
-    ...     "    cell 5 raised Timeout: interrupted: it ran longer than the time limit")
-    ... # doctest: +NORMALIZE_WHITESPACE
-    [('raised', 'a.ipynb: cell 3 raised ZeroDivisionError: division by zero'),
-     ('timeout', 'a.ipynb: cell 5 ran past its time limit')]
+    >>> problem_kinds("a.ipynb: it ran past the time limit")
+    [('other', 'a.ipynb: it ran past the time limit')]
     """
-    lines = str(text).split("\n")
-    first = lines[0]
-    if CELLS_RAISED in first:
-        notebook = first.split(": ")[0]
-        found = []
-        for line in lines[1:]:
-            match = CELL_LINE.match(line)
-            if not match:
-                continue
-            cell, kind, message = match.groups()
-            if kind == "Timeout":
-                found.append((TIMEOUT, one_line(f"{notebook}: cell {cell} ran past its time limit", MAX_TEXT)))
-            else:
-                found.append((RAISED, one_line(f"{notebook}: cell {cell} raised {kind}: {message}", MAX_TEXT)))
-        return found or [(RAISED, one_line(first, MAX_TEXT))]
-    if any(words in first for words in TAMPERED_WORDS):
-        kind = TAMPERED
-    elif any(words in first for words in TIMEOUT_WORDS):
-        kind = TIMEOUT
-    elif any(words in first for words in CRASH_WORDS):
-        kind = CRASH
-    else:
-        kind = OTHER
-    return [(kind, one_line(first, MAX_TEXT))]
+    return [(kind, one_line(description, MAX_TEXT)) for kind, description in kinds_of(problem)]
 
 
 def _steps(check):

@@ -29,13 +29,57 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...exercises.result import KINDS, OTHER
 from ..submission.scan import MAX_SOURCE_CHARS
 from . import record as records
 from . import rubric as rubrics
 from .late import FROM_CSV, SubmissionTime, time_text
 from .text import points_text
 
-FORMAT = "labkit-grade/2"
+FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
+OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again (SubmissionGrade.from_dict)
+
+
+class ProblemText(str):
+    """A problem of a submission: its text as the feedback shows it, and its ``kinds``, the codes of what went
+    wrong (:data:`labkit.exercises.result.KINDS`), set where the problem is made: (kind, one-line
+    description) pairs, one per thing that went wrong (each cell that raised, say). The class report reads the
+    kinds, never the words.
+
+    Examples
+    --------
+    >>> p = ProblemText("a.ipynb: it stopped.", [("crash", "a.ipynb: it stopped.")])
+    >>> p, p.kinds
+    ('a.ipynb: it stopped.', (('crash', 'a.ipynb: it stopped.'),))
+    >>> ProblemText("a.ipynb: it stopped.", [("stopped", "?")])
+    Traceback (most recent call last):
+    ...
+    ValueError: a problem's kind is one of 'not done', 'raised', 'refused', 'timeout', 'crash', 'tampered', \
+'other', not 'stopped'.
+    """
+
+    kinds: tuple
+
+    def __new__(cls, text, kinds):
+        self = super().__new__(cls, text)
+        pairs = []
+        for kind, description in kinds:
+            if kind not in KINDS:
+                raise ValueError(f"a problem's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
+            pairs.append((str(kind), str(description)))
+        self.kinds = tuple(pairs)
+        return self
+
+    @classmethod
+    def one(cls, text, kind):
+        """A problem of one kind, described by its first line."""
+        return cls(text, [(kind, str(text).split("\n")[0])])
+
+
+def problem_kinds(problem):
+    """The kinds of a submission's problem: its own (a :class:`ProblemText`), or "other" for a bare text."""
+    kinds = getattr(problem, "kinds", None)
+    return kinds if kinds else ((OTHER, str(problem).split("\n")[0]),)
 
 
 @dataclass
@@ -280,7 +324,8 @@ class SubmissionGrade:
             "submitted": None if self.time is None else self.time.as_dict(),
             "name": self.name,
             "seed": self.seed,
-            "problems": list(self.problems),
+            "problems": [str(p) for p in self.problems],
+            "problem_kinds": [[list(pair) for pair in problem_kinds(p)] for p in self.problems],
             "failure": self.failure,
             "answers": dict(self.answers),
             "sources": dict(self.sources),
@@ -296,7 +341,16 @@ class SubmissionGrade:
 
     @classmethod
     def from_dict(cls, data, source="a result file", rubric=None):
-        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file."""
+        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file.
+
+        A result of an earlier format is refused, saying to grade again: ``labkit-grade/2`` kept its problems as
+        words only, and guessing their kinds from the words is what format 3 ended."""
+        if isinstance(data, dict) and data.get("format") in OLD_FORMATS:
+            raise ValueError(
+                f"{source} is in the results format {data['format']}, which keeps a problem's words but not its "
+                f"kind (a time limit, a crash, an error raised, ...); this labkit reads {FORMAT} only. Grade "
+                "those submissions again with this version: `labkit grade` with --fresh, or into a new --out."
+            )
         try:
             if data.get("format") != FORMAT:
                 raise ValueError(f"format is {data.get('format')!r}, not {FORMAT!r}")
@@ -306,7 +360,7 @@ class SubmissionGrade:
             grade = cls(
                 str(data["name"]),
                 results,
-                [str(p) for p in data["problems"]],
+                _problems(data["problems"], data["problem_kinds"]),
                 data.get("seed"),
                 rubric or rubrics.default(),
                 data.get("failure"),
@@ -382,6 +436,13 @@ def _held_lines(check, released):
         lines.append("      your lines that are the same, names aside:")
         lines += [f"      {one_line(mine, 2 * SIDE)}" for mine, _ in pairs]
     return lines
+
+
+def _problems(texts, kinds):
+    """A result file's problems, each with its kinds (ValueError when the two lists do not pair up)."""
+    if not isinstance(texts, list) or not isinstance(kinds, list) or len(texts) != len(kinds):
+        raise ValueError("its problems and their kinds do not pair up")
+    return [ProblemText(str(text), [(str(k), str(d)) for k, d in pairs]) for text, pairs in zip(texts, kinds)]
 
 
 def _problem_lines(problem):

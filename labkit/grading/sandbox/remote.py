@@ -28,6 +28,7 @@ import sys
 import time
 from typing import Protocol
 
+from ...exercises.result import CRASH, TAMPERED, TIMEOUT
 from . import backends, forkserver, protocol
 from .backends.base import Limits
 
@@ -39,12 +40,14 @@ class WorkerError(RuntimeError):
     """The sandboxed notebook stopped, hung or answered out of protocol: the grading error of one notebook."""
 
     kind = "WorkerError"
+    grader_kind = CRASH  # the kind of a failed step (labkit.exercises.result.grader_kind): no StudentError has one
 
 
 class WorkerTimeout(WorkerError):
     """The notebook did not answer in time (one of the two kinds below)."""
 
     kind = "Timeout"
+    grader_kind = TIMEOUT
     total = False  # whether the submission's whole time is used up
 
 
@@ -59,13 +62,33 @@ class NotebookTimeout(WorkerTimeout):
 
 
 class StudentError(Exception):
-    """An exception the student's code raised in the sandbox (its type name in ``kind``)."""
+    """An exception the student's code raised in the sandbox (its type name in ``kind``), or one of its calls
+    that the grader ended (the subclasses below, each with its ``grader_kind``): either way it costs that call."""
+
+    grader_kind: str | None = None  # an exception the student's code raised: whatever its name, no kind of the grader's
 
     def __init__(self, kind, message, refused=None, traceback=""):
         super().__init__(message)
         self.kind = kind
         self.refused = refused
         self.traceback = traceback
+
+
+class CallEnded(StudentError):
+    """A call of the student's function that its process never answered: the process ended (``os._exit``, a
+    signal, a resource limit) or could answer no more. The supervisor says so in an answer it marks as its own
+    (:func:`labkit.grading.sandbox.worker._grader_error`), never through an exception's name; the call costs only
+    itself, as the supervisor starts the notebook again for the next request (up to its restarts)."""
+
+    grader_kind = CRASH  # the kind of a failed step (labkit.exercises.result.grader_kind)
+
+
+class Tampered(StudentError):
+    """A call whose answer the grader's watch cannot vouch for (the notebook switched it off, went round it or
+    wrote to its pipe): the supervisor's own marked answer, and the notebook's answers are void
+    (:attr:`Notebook.tampered`)."""
+
+    grader_kind = TAMPERED
 
 
 class Settings(Protocol):
@@ -95,6 +118,7 @@ class Notebook:
         self.deadline = deadline if deadline is not None else time.monotonic() + self.options.total_timeout
         self.passables = frozenset(passables)  # functions the checks may hand to student code, by name
         self.stopped = None  # why the worker can no longer answer
+        self.stopped_kind = CRASH  # the kind of problem it is (labkit.exercises.result.KINDS), once stopped
         self.tampered = None  # what the notebook did that voids its answers
         self._buffer = b""
         self.backend = backends.get_backend(self.options.backend)
@@ -148,6 +172,7 @@ class Notebook:
         self.box.stop()
         if self.stopped is None and not self.box.closed and self.box.out_of_memory():
             self.stopped = "the notebook ran out of memory"
+            self.stopped_kind = CRASH
         self.box.close()
         self._selector.close()
         for pipe in (self.process.stdin, self.process.stdout):
@@ -157,7 +182,7 @@ class Notebook:
                 pass
 
     def _stop(self, why, error=WorkerError):
-        self.stopped = why
+        self.stopped, self.stopped_kind = why, error.grader_kind
         self.close()
         raise error(why)
 
@@ -180,7 +205,7 @@ class Notebook:
                 self._stop(f"the notebook's process answered out of protocol ({exc})")
             if answer.get("id") == rid:
                 error = answer.get("error") if isinstance(answer.get("error"), dict) else {}
-                if error.get("kind") == "Tampered":
+                if error.get("kind") == "Tampered" and error.get("grader"):  # the supervisor's word, not a name
                     self.tampered = str(error.get("message", "tampering"))[:500]
                 return answer
 
@@ -249,8 +274,10 @@ def _value(answer):
         error = answer["error"] if isinstance(answer["error"], dict) else {}
         kind, message = str(error.get("kind", "Error"))[:100], str(error.get("message", ""))[:500]
         refused = error.get("refused")
-        if kind == WorkerTimeout.kind and error.get("timeout"):  # the worker stopped the call at its time limit
-            raise CellTimeout(message)
+        if error.get("grader") is True:  # the supervisor's own errors, marked as such (never a name's say-so)
+            if error.get("timeout") is True:  # it stopped the call at its time limit
+                raise CellTimeout(message)
+            raise (Tampered if kind == Tampered.__name__ else CallEnded)(kind, message)
         if kind == "NotImplementedError" and not refused:
             raise NotImplementedError(message)
         raise StudentError(

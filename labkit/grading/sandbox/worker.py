@@ -80,6 +80,15 @@ def _error(kind, message, refused=None):
     return {"error": {"kind": kind, "message": message, "refused": refused}}
 
 
+def _grader_error(kind, message):
+    """An error of the supervisor's own (the notebook died, was tampered with or ran out of time), marked as the
+    grader's: :func:`labkit.grading.sandbox.remote._value` trusts the mark, never the kind's name, which a student's
+    exception may share."""
+    answer = _error(kind, message)
+    answer["error"]["grader"] = True
+    return answer
+
+
 def _describe(exc):
     kind = type(exc).__name__
     if isinstance(exc, _Interrupted):
@@ -179,7 +188,15 @@ class Notebook:
             failure = (result.error_before_exec or result.error_in_exec) if result is not None else failure
             if failure is not None:
                 kind, text = _describe(failure)
-                errors.append({"cell": index, "kind": kind, "message": text, "traceback": _tail(failure)})
+                errors.append(
+                    {
+                        "cell": index,
+                        "kind": kind,
+                        "message": text,
+                        "traceback": _tail(failure),
+                        "timeout": isinstance(failure, _Interrupted),  # the worker's own time limit, not a name
+                    }
+                )
             plt.close("all")  # as the inline backend does after each cell
         return {
             "errors": errors,
@@ -356,12 +373,12 @@ class Supervisor:
             return _error("ProtocolError", "the first request must be setup")
         if self.run_request is not None and op != "run":
             if self.restarts >= RESTARTS:
-                return _error("WorkerError", f"{self.ended}; no more answers from this notebook")
+                return _grader_error("WorkerError", f"{self.ended}; no more answers from this notebook")
             self.restarts += 1
             self.start()
             replayed = self._exchange(self.run_request, None)  # the cells again, in a new process
             if self.child is None:
-                return _error("WorkerError", f"{self.ended} while its cells ran again")
+                return _grader_error("WorkerError", f"{self.ended} while its cells ran again")
             if "errors" not in replayed and "error" in replayed:
                 return replayed
             return None
@@ -371,7 +388,7 @@ class Supervisor:
     def forward(self, request):
         op = request.get("op")
         if self.tampered:
-            return _error("Tampered", self._tamper_text())
+            return _grader_error("Tampered", self._tamper_text())
         if op == "run":
             self.run_request = request
         problem = self._ensure_child(op)
@@ -395,7 +412,7 @@ class Supervisor:
                 view = view[os.write(self.child["requests"], view) :]
         except OSError:
             self.stop()
-            return _error("WorkerError", self.ended)
+            return _grader_error("WorkerError", self.ended)
         until = None if timeout is None else time.monotonic() + float(timeout) + 1.0
         answers, verdicts = self.child["answers"], self.child["verdicts"]
         while True:
@@ -410,21 +427,21 @@ class Supervisor:
                         verdicts.pump()
                         if self._read_verdicts():
                             self.stop("the grader's watch reported tampering")
-                            return _error("Tampered", self._tamper_text())
+                            return _grader_error("Tampered", self._tamper_text())
                     if answers.fd in ready:
                         break
                 line = answers.readline(until)
             except TimeoutError:
                 self.stop("stopped after the time limit: the notebook did not answer in time")
-                answer = _error("Timeout", "interrupted: it ran longer than the time limit")
+                answer = _grader_error("Timeout", "interrupted: it ran longer than the time limit")
                 answer["error"]["timeout"] = True  # the grader raises its CellTimeout for this mark, not the words
                 return answer
             except protocol.ProtocolError as exc:
                 self.stop(f"the notebook's process answered out of protocol ({exc})")
-                return _error("WorkerError", self.ended)
+                return _grader_error("WorkerError", self.ended)
             if line is None:
                 self.stop()
-                return _error("WorkerError", self.ended)
+                return _grader_error("WorkerError", self.ended)
             try:
                 answer = protocol.loads(line)
             except protocol.ProtocolError:
@@ -455,13 +472,13 @@ class Supervisor:
         expected = guard.attestation_text(rid, profile, passables, None, hashlib.sha256(payload).hexdigest())
         if self._read_verdicts():
             self.stop("the grader's watch reported tampering")
-            return _error("Tampered", self._tamper_text())
+            return _grader_error("Tampered", self._tamper_text())
         pending, self.child["attestations"] = self.child["attestations"], []
         # exactly one line may speak for this request, and it must be the watch's: a second one, or one
         # that does not verify, means the notebook found the request's id and wrote to the watch's pipe
         mine = [text.split("\t") for text in pending if text.split("\t", 1)[0] == expected[0]]
         if len(mine) != 1:
-            return _error(
+            return _grader_error(
                 "Tampered",
                 "the answer came without the grader's watch (it was switched off, or the answer was forged)"
                 if not mine
@@ -475,11 +492,14 @@ class Supervisor:
             expected[2],
             expected[4],
         ) or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
-            return _error(
+            return _grader_error(
                 "Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers"
             )
         status = fields[3]
         if status == "clean":
+            if isinstance(answer.get("error"), dict):  # only the supervisor speaks as the grader
+                answer["error"].pop("grader", None)
+                answer["error"].pop("timeout", None)
             return answer
         what, _, detail = status.partition(":")
         if what == "refused":
@@ -487,7 +507,7 @@ class Supervisor:
                 "RefusedReference", f"called {detail}, which is switched off while this part is graded", detail
             )
         self.tampered = self.tampered or detail
-        return _error("Tampered", self._tamper_text())
+        return _grader_error("Tampered", self._tamper_text())
 
 
 def _ended(status):

@@ -32,8 +32,9 @@ from pathlib import Path
 from ...exercises.model import sections
 from ...exercises.registry import LAB
 from ...exercises.registry import load as load_registry
+from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT
 from ..options import GradeOptions
-from ..results.report import HELD_STEP, SubmissionGrade, one_line, printable
+from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from ..sandbox import backends, remote
 from . import known, refusals, scan
 
@@ -146,14 +147,27 @@ def submission_notebooks(path):
     return sorted(found)[:MAX_NOTEBOOKS]
 
 
-def _failed_part(check, name, step, detail, hint):
+def _failed_part(check, name, step, detail, hint, kind=None):
+    """The part's check, failed at one step (of `kind`, :data:`labkit.exercises.result.KINDS`, unless a slip)."""
     return {
         "name": name,
         "passed": False,
         "hint": hint,
         "weight": check.get("weight", 0),
-        "steps": [{"step": step, "passed": False, "detail": detail}],
+        "steps": [{"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}],
     }
+
+
+def _voided(part, tampered):
+    """The check of a part of a notebook that tampered with the grader's watch: none of its answers count."""
+    return _failed_part(
+        {"weight": part.weight},
+        part.name,
+        "the notebook's answers can be trusted",
+        tampered,
+        "remove what the message names and hand it in again.",
+        TAMPERED,
+    )
 
 
 def _own_code(check, findings):
@@ -165,7 +179,7 @@ def _own_code(check, findings):
         **check,
         "passed": False,
         "steps": list(check.get("steps", []))
-        + [{"step": "calls no reference implementation", "passed": False, "detail": details}],
+        + [{"step": "calls no reference implementation", "passed": False, "detail": details, "kind": REFUSED}],
         "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names "
         "stay available.",
     }
@@ -219,25 +233,26 @@ def _run_problems(name, ran):
     problems = []
     errors = ran.get("errors") if isinstance(ran.get("errors"), list) else []
     if errors:
-        shown = []
+        shown, kinds = [], []
         for error in errors[:SHOWN_ERRORS]:
             error = error if isinstance(error, dict) else {}
-            text = (
-                f"cell {int(error.get('cell', -1)) + 1} raised {one_line(error.get('kind'), 100)}: "
-                f"{one_line(error.get('message', ''), 300)}"
-            )
+            cell = int(error.get("cell", -1)) + 1
+            text = f"cell {cell} raised {one_line(error.get('kind'), 100)}: {one_line(error.get('message', ''), 300)}"
+            # the worker marks a cell it stopped at its own time limit; an exception named Timeout is the student's
+            if error.get("timeout") is True:
+                kinds.append((TIMEOUT, f"{name}: cell {cell} ran past its time limit"))
+            else:
+                kinds.append((RAISED, f"{name}: {text}"))
             tail = _student_frames(str(error.get("traceback", ""))[-4000:])
             if tail:
                 text += "\n" + "\n".join(f"      | {line}" for line in tail[-6:])
             shown.append(text)
         more = f"\n    and {len(errors) - SHOWN_ERRORS} more" if len(errors) > SHOWN_ERRORS else ""
-        problems.append(
-            f"{name}: {len(errors)} cell(s) raised an error (graded as far as it got):\n    "
-            + "\n    ".join(shown)
-            + more
-        )
+        text = f"{name}: {len(errors)} cell(s) raised an error (graded as far as it got):\n    "
+        problems.append(ProblemText(text + "\n    ".join(shown) + more, kinds))
     if int(ran.get("output_chars", 0) or 0) > OUTPUT_LIMIT:
-        problems.append(f"{name}: printed {int(ran['output_chars']):,} characters of output (none of it is kept).")
+        text = f"{name}: printed {int(ran['output_chars']):,} characters of output (none of it is kept)."
+        problems.append(ProblemText.one(text, OTHER))
     return problems
 
 
@@ -333,62 +348,58 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
     try:
         code, markdown = read_cells(path, answers, registry)
     except (ValueError, OSError) as exc:
-        return {}, [f"{name}: {exc}" if name not in str(exc) else str(exc)]
+        return {}, [ProblemText.one(f"{name}: {exc}" if name not in str(exc) else str(exc), OTHER)]
     numbers = [n for n in exercises_in(markdown, registry) if n not in skip]
     if not numbers:
         return {}, []
     size = sum(len(source.encode("utf-8", "surrogatepass")) for source in code)
     if size > scan.MAX_CODE_BYTES:
-        return {}, [
+        text = (
             f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
             "notebook needs; it was not graded."
-        ]
+        )
+        return {}, [ProblemText.one(text, OTHER)]
     if sources is not None:
         wanted = [n for number in numbers for n in graded_functions(registry.exercises[number]) if n not in sources]
         for function, text in scan.function_sources(code, wanted).items():
             sources[function] = printable(text)[: scan.MAX_SOURCE_CHARS]
     if deadline - time.monotonic() <= 1:
-        return {}, [
+        text = (
             f"{name}: not run: the submission's time limit of {options.total_timeout} s was used up "
             "by the notebooks before it."
-        ]
+        )
+        return {}, [ProblemText.one(text, TIMEOUT)]
     problems, results = [], {}
     try:
         notebook = remote.Notebook(options, deadline, _for_sandbox(profiles), registry.passable)
     except remote.NotebookTimeout:  # its sandbox was still starting when the submission's time ran out
-        return {}, [f"{name}: stopped after the submission's time limit of {options.total_timeout} s."]
+        text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
+        return {}, [ProblemText.one(text, TIMEOUT)]
     except remote.WorkerError as exc:
-        return {}, [f"{name}: the sandbox could not start ({exc})."]
+        return {}, [ProblemText.one(f"{name}: the sandbox could not start ({exc}).", OTHER)]
     with notebook:
         try:
             ran = notebook.request(
                 {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
             )
         except remote.NotebookTimeout:
-            return {}, [f"{name}: stopped after the submission's time limit of {options.total_timeout} s."]
+            text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
+            return {}, [ProblemText.one(text, TIMEOUT)]
         except remote.CellTimeout as exc:
-            return {}, [f"{name}: {exc}."]
+            return {}, [ProblemText.one(f"{name}: {exc}.", TIMEOUT)]
         except remote.WorkerError as exc:
-            return {}, [f"{name}: {exc} while running its cells."]
+            return {}, [ProblemText.one(f"{name}: {exc} while running its cells.", exc.grader_kind)]
         if "error" in ran and not notebook.tampered:  # the notebook's process died while its cells ran
             error = ran["error"] if isinstance(ran["error"], dict) else {}
-            return {}, [f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."]
+            text = f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."
+            return {}, [ProblemText.one(text, CRASH)]
         problems += _run_problems(name, ran)
         if notebook.tampered:
-            problems.append(f"{name}: {notebook.tampered}; none of its answers count.")
+            problems.append(ProblemText.one(f"{name}: {notebook.tampered}; none of its answers count.", TAMPERED))
         for number in numbers:
             exercise = registry.exercises[number]
             if notebook.tampered:
-                checks = [
-                    _failed_part(
-                        {"weight": part.weight},
-                        part.name,
-                        "the notebook's answers can be trusted",
-                        notebook.tampered,
-                        "remove what the message names and hand it in again.",
-                    )
-                    for part in exercise.parts
-                ]
+                checks = [_voided(part, notebook.tampered) for part in exercise.parts]
                 results[number] = _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
                 continue
             verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed)
@@ -412,7 +423,8 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                     verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
             results[number] = _rescore(verdict, registry)
         if notebook.stopped:
-            problems.append(f"{name}: {notebook.stopped} while its functions were being checked.")
+            text = f"{name}: {notebook.stopped} while its functions were being checked."
+            problems.append(ProblemText.one(text, notebook.stopped_kind))
     return results, problems
 
 
@@ -450,7 +462,7 @@ def grade_submission(path, options=None, *, profiles=None):
     try:
         notebooks = submission_notebooks(path)
     except ValueError as exc:
-        grade.problems.append(str(exc))
+        grade.problems.append(ProblemText.one(str(exc), OTHER))
         return grade
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
