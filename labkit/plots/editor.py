@@ -43,6 +43,7 @@ from .explorers import (
 )
 from .figures import PatchView
 from .labels import label_sliders
+from .scene import Scene
 
 NAMES = "ABCD"
 ARROW = 0.25  # an arrow is this fraction of its derivative, so the handles stay near the patch
@@ -192,8 +193,6 @@ class Editor:
         self.ratio = 1.0  # the static picture's and, until the page says otherwise, the live one's
         self._draw_mesh()
         freeze_layout(self.figure)
-        from .scene import Scene
-
         self.painter = Painter(self.figure, self.view)
         self.scene = Scene(self.figure, self.view)
         self.coalescer = Coalescer(self._send)

@@ -34,9 +34,7 @@ is one line, e.g. ``plots.limacon_explorer()``.
 import base64
 import functools
 import pathlib
-import struct
 import time
-import zlib
 
 import numpy as np
 
@@ -44,6 +42,7 @@ from .._alt import figure_alt, img_tag
 from ..notebook import HEADLESS, headless
 from ..patches import Corner
 from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
+from .scene import Scene, animated, encode_png
 
 
 class NotShown:
@@ -104,8 +103,6 @@ class Painter:
             return
         key = (self.view.static_key(), self.figure.dpi)
         if key != self.key or self.background is None:
-            from .scene import animated
-
             with animated(dynamic):
                 canvas.draw()  # everything but the changing artists
             self.background, self.key = canvas.copy_from_bbox(self.figure.bbox), key
@@ -122,39 +119,6 @@ def png(figure, painter=None):
     (painter or Painter(figure)).draw()
     width, height = canvas.get_width_height()
     return encode_png(np.asarray(canvas.buffer_rgba()).reshape(height, width, 4))
-
-
-def _chunk(kind, data):
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-
-def encode_png(pixels):
-    """A lossless PNG of an (height, width, 3 or 4) uint8 array, its colours as RGB (alpha dropped).
-
-    Written here rather than with Pillow, whose choice of a filter for each row took half of a 2x
-    picture's time: every row is stored unfiltered and the whole compressed at zlib's fastest level,
-    which suits a plot's flat colours (about the size Pillow writes, in half the time).
-
-    >>> picture = encode_png(np.zeros((2, 3, 4), dtype=np.uint8))
-    >>> picture[:8] == b"\\x89PNG\\r\\n\\x1a\\n", int.from_bytes(picture[16:20], "big")
-    (True, 3)
-    """
-    pixels = np.asarray(pixels)
-    if pixels.dtype != np.uint8 or pixels.ndim != 3 or pixels.shape[2] not in (3, 4) or 0 in pixels.shape[:2]:
-        raise ValueError(
-            f"encode_png takes a non-empty (height, width, 3 or 4) array of uint8; got {pixels.dtype} of shape "
-            f"{pixels.shape}: pass a figure canvas's buffer_rgba() reshaped to (height, width, 4)."
-        )
-    height, width = pixels.shape[:2]
-    rows = np.zeros((height, 1 + 3 * width), dtype=np.uint8)  # each row: filter 0 (none), then its RGB bytes
-    rows[:, 1:] = pixels[:, :, :3].reshape(height, 3 * width)
-    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8 bits per channel, RGB
-    return (
-        b"\x89PNG\r\n\x1a\n"
-        + _chunk(b"IHDR", header)
-        + _chunk(b"IDAT", zlib.compress(rows.tobytes(), 1))
-        + _chunk(b"IEND", b"")
-    )
 
 
 def freeze_layout(figure):
@@ -259,8 +223,6 @@ class Explorer:
 
     def __init__(self, figure, update, controls, view=None):
         import ipywidgets as widgets
-
-        from .scene import Scene
 
         self.figure, self._update, self.controls = figure, update, dict(controls)
         self.painter = Painter(figure, view)

@@ -23,6 +23,8 @@ ratio. The static picture of the notebook (the mimebundle's PNG) is not made her
 """
 
 import contextlib
+import struct
+import zlib
 
 import numpy as np
 
@@ -40,6 +42,39 @@ def _rgba(color, alpha=None):
 
 def _float32(points):
     return np.ascontiguousarray(points, dtype="<f4").tobytes()
+
+
+def _chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+
+def encode_png(pixels):
+    """A lossless PNG of an (height, width, 3 or 4) uint8 array, its colours as RGB (alpha dropped).
+
+    Written here rather than with Pillow, whose choice of a filter for each row took half of a 2x
+    picture's time: every row is stored unfiltered and the whole compressed at zlib's fastest level,
+    which suits a plot's flat colours (about the size Pillow writes, in half the time).
+
+    >>> picture = encode_png(np.zeros((2, 3, 4), dtype=np.uint8))
+    >>> picture[:8] == b"\\x89PNG\\r\\n\\x1a\\n", int.from_bytes(picture[16:20], "big")
+    (True, 3)
+    """
+    pixels = np.asarray(pixels)
+    if pixels.dtype != np.uint8 or pixels.ndim != 3 or pixels.shape[2] not in (3, 4) or 0 in pixels.shape[:2]:
+        raise ValueError(
+            f"encode_png takes a non-empty (height, width, 3 or 4) array of uint8; got {pixels.dtype} of shape "
+            f"{pixels.shape}: pass a figure canvas's buffer_rgba() reshaped to (height, width, 4)."
+        )
+    height, width = pixels.shape[:2]
+    rows = np.zeros((height, 1 + 3 * width), dtype=np.uint8)  # each row: filter 0 (none), then its RGB bytes
+    rows[:, 1:] = pixels[:, :, :3].reshape(height, 3 * width)
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8 bits per channel, RGB
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + _chunk(b"IHDR", header)
+        + _chunk(b"IDAT", zlib.compress(rows.tobytes(), 1))
+        + _chunk(b"IEND", b"")
+    )
 
 
 @contextlib.contextmanager
@@ -79,8 +114,6 @@ class Scene:
 
     def frame(self, ratio, dpi):
         """(background PNG or None if unchanged, items) of the figure drawn at `dpi` (`ratio` device px per CSS px)."""
-        from .explorers import encode_png
-
         figure, canvas = self.figure, self.figure.canvas
         if figure.dpi != dpi:
             figure.set_dpi(dpi)
