@@ -1,11 +1,17 @@
-"""In-process time of one slider move, before and after the explorers (one run, same machine).
+"""In-process time of one slider move: a new figure, the 2x PNG of a figure updated in place, and the scene.
 
-Run: ``.venv/bin/python benchmarks/bench_sliders.py``. "Before" is what a slider
-did until now: build a new figure with the ``plot_*`` function and render it to
-PNG at 100 dpi, as the inline backend does. "After" is what an explorer of
-:mod:`labkit.plots.explorers` does: change a control, update the same artists,
-render one PNG. The browser adds the trip to the page: see
-``benchmarks/bench_browser_latency.py``.
+Run: ``.venv/bin/python benchmarks/bench_sliders.py``. Three ways to answer a move, timed on the
+same machine in one run:
+
+* "new figure": build a new figure with the ``plot_*`` function and render it to PNG at 100 dpi, as
+  the inline backend does (what the sliders did before the explorers);
+* "2x PNG": update the explorer's artists in place and render its 2x PNG by blitting (what every move
+  sent until the scenes; still how the static picture is made, :meth:`Explorer.png`);
+* "scene": what a move does now: update the artists, and turn the changing ones into the
+  :class:`labkit.plots.scene.Scene` the browser draws (at the page's pixel ratio, 2 here), whose
+  size is the last column.
+
+The browser adds the trip to the page: see ``benchmarks/bench_browser_latency.py``.
 """
 
 import io
@@ -91,15 +97,39 @@ def _old(draw):
     return redraw
 
 
+def _sent_kb(scene):
+    """Kilobytes of a scene's binary buffers (its JSON adds little)."""
+
+    def size(value):
+        if isinstance(value, bytes):
+            return len(value)
+        if isinstance(value, dict):
+            return sum(size(v) for v in value.values())
+        if isinstance(value, list):
+            return sum(size(v) for v in value)
+        return 0
+
+    return size(scene) / 1024
+
+
 def main():
-    print(f"{'slider':<30}{'before':>10}{'after':>10}")
+    print(f"{'slider':<30}{'new figure':>12}{'2x PNG':>10}{'scene':>10}{'sent':>10}")
     for name, (draw, factory, control, values) in SLIDERS.items():
         explorer = factory()
+
+        def png_move(v, e=explorer, c=control):
+            e._update(**{**e.values(), c: v})
+            e.png()
+
+        picture = _median_ms(png_move, values)
         after = _median_ms(lambda v, e=explorer, c=control: setattr(e.controls[c], "value", v), values)
-        print(f"{name:<30}{_median_ms(_old(draw), values):8.0f} ms{after:7.0f} ms")
+        print(
+            f"{name:<30}{_median_ms(_old(draw), values):10.0f} ms{picture:7.0f} ms{after:7.0f} ms"
+            f"{_sent_kb(explorer.image.scene):7.0f} KB"
+        )
     editor = plots.patch_editor()
     step = _median_ms(lambda v: setattr(editor.widget_, "drag", {"index": 1, "x": 1 + v, "y": 0.0}), (0.0, 0.05))
-    print(f"{'03 patch editor drag step':<30}{'-':>10}{step:7.0f} ms")
+    print(f"{'03 patch editor drag step':<30}{'-':>12}{'-':>10}{step:7.0f} ms{_sent_kb(editor.widget_.scene):7.0f} KB")
 
 
 if __name__ == "__main__":

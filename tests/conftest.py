@@ -97,7 +97,7 @@ def pytest_terminal_summary(terminalreporter):
     module = sys.modules.get("test_jupyterlab")
     latencies = getattr(module, "LATENCIES", {})
     if latencies:
-        terminalreporter.section("JupyterLab: key press or drag step -> new picture")
+        terminalreporter.section("JupyterLab: key press or drag step -> new picture shown")
         for name, (median, p90, moves) in latencies.items():
             terminalreporter.write_line(
                 f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)"

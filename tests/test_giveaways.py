@@ -115,11 +115,20 @@ def drawn(where, draw):
     return texts
 
 
+def scene_texts(widget, where):
+    """What the browser draws and reads of a live picture: the texts of its scene (titles, tick labels) and
+    its description (the alt text)."""
+    items = widget.scene.get("items", [])
+    yield f"{where} (drawn texts)", " | ".join(item["text"] for item in items if item["kind"] == "text")
+    yield f"{where} (alt text shown)", getattr(widget, "description", "") or getattr(widget, "alt", "")
+
+
 def explorer_texts(name, explorer):
-    """An explorer's figure at its first state and at every choice of each menu and box."""
+    """An explorer's figure, and the live picture the browser draws of it, at its first state and at every
+    choice of each menu and box."""
     import ipywidgets as widgets
 
-    texts = list(figure_texts(explorer.figure, f"{name}()"))
+    texts = list(figure_texts(explorer.figure, f"{name}()")) + list(scene_texts(explorer.image, f"{name}()"))
     for control_name, control in explorer.controls.items():
         start = control.value
         if isinstance(control, widgets.Dropdown):
@@ -131,6 +140,7 @@ def explorer_texts(name, explorer):
         for choice in choices or control.options:
             control.value = choice
             texts += figure_texts(explorer.figure, f"{name}() with {control_name} = {choice!r}")
+            texts += scene_texts(explorer.image, f"{name}() with {control_name} = {choice!r}")
         control.value = start
     return texts
 
@@ -156,6 +166,7 @@ def labkit_figures():
     editor = plots.patch_editor()  # the corner data it opens on, as its readout shows them, and its figure
     texts += [("plots.patch_editor() readout", editor.widget_.readout)]
     texts += figure_texts(editor.figure, "plots.patch_editor()")
+    texts += scene_texts(editor.widget_, "plots.patch_editor()")
     plt.close("all")
     return texts
 
@@ -360,6 +371,9 @@ def test_labkits_figures_and_explorers_name_methods_never_their_orders():
     texts = labkit_figures()
     legends = " ".join(text for where, text in texts if "(legend)" in where)
     assert "Natural Cubic Spline" in legends  # the methods keep their names
+    drawn_live = " ".join(text for where, text in texts if "(drawn texts)" in where)
+    assert "Interpolation error, 81 equally spaced points" in drawn_live  # the scan reads what the browser draws
+    assert "worst quality" in drawn_live and "Bilinear error, 41 x 41 data" in drawn_live
     assert_clean(texts)
 
 

@@ -1,7 +1,10 @@
-// The browser side of labkit.plots.patch_editor (an anywidget module).
-// The kernel sends the mesh picture, the handles in data coordinates and where the axes lie in
-// the picture; this module draws the handles over the picture, moves them under the mouse at once,
-// and sends the dragged handle's position to the kernel, one request at a time (the newest wins).
+// The browser side of labkit.plots.patch_editor (an anywidget module; scene.js comes before this file).
+// The kernel sends a background picture and the mesh as a scene (both at the page's devicePixelRatio,
+// which this module reports in `pixel_ratio`), the handles in data coordinates and where the axes lie in
+// the picture (CSS pixels); this module paints the scene on a canvas over the background (in
+// requestAnimationFrame, the newest scene only; each paint raises data-labkit-shown and reports the scene's
+// seq in `shown`), draws the handles over it, moves them under the mouse at once, and sends the dragged
+// handle's position to the kernel, one request at a time (the newest wins).
 // Keyboard: Tab enters and leaves the editor like any control (never trapped, WCAG 2.1.2); n / p select
 // the next / previous handle; the arrow keys move it (Shift: 5 times further). The picture and handles
 // form an ARIA "application" named by the model's label; a polite live region speaks the model's status
@@ -37,6 +40,12 @@ function render({ model, el }) {
   const img = document.createElement("img");
   img.className = "labkit-editor-image";
   img.draggable = false;
+  img.style.cssText = "display:block";
+  const canvas = document.createElement("canvas");
+  canvas.className = "labkit-editor-canvas";
+  canvas.setAttribute("aria-hidden", "true");
+  canvas.style.cssText = "position:absolute; left:0; top:0; pointer-events:none";
+  stage.dataset.labkitShown = "0";
   const svg = make("svg", { class: "labkit-editor-handles", "aria-hidden": "true", focusable: "false" });
   svg.style.cssText = "position:absolute; left:0; top:0; touch-action:none; cursor:default";
   const side = document.createElement("div");
@@ -54,13 +63,14 @@ function render({ model, el }) {
   keys.className = "labkit-editor-keys";
   keys.style.cssText = "font-size:12px";
   keys.textContent = "Keys: " + model.get("key_help");
-  stage.append(img, svg);
+  stage.append(img, canvas, svg);
   side.append(readout, live, keys);
   root.append(style, stage, side);
   el.appendChild(root);
 
   let positions = model.get("handles").map((p) => p.slice());
   let dragging = null, selected = model.get("selected"), waiting = false, queued = null, seq = 0, url = null, timer = null;
+  let ready = Promise.resolve(), painting = false, alive = true, media = null;
 
   const frame = () => model.get("frame");
   function toPixels([x, y]) {
@@ -79,6 +89,9 @@ function render({ model, el }) {
     svg.setAttribute("width", f.width);
     svg.setAttribute("height", f.height);
     img.style.width = f.width + "px";
+    img.style.height = f.height + "px";
+    canvas.style.width = f.width + "px";
+    canvas.style.height = f.height + "px";
     svg.replaceChildren();
     for (let c = 0; c < 4; c++) {
       const [cx, cy] = toPixels(positions[c]);
@@ -179,11 +192,43 @@ function render({ model, el }) {
     event.stopPropagation();
   });
 
-  function showImage() {
-    const blob = new Blob([model.get("image")], { type: "image/png" });
-    if (url) URL.revokeObjectURL(url);
-    url = URL.createObjectURL(blob);
+  function showBackground() {
+    const bytes = sceneBytes(model.get("background"));
+    if (!bytes.length) return;
+    const old = url;
+    url = URL.createObjectURL(new Blob([bytes], { type: "image/png" }));
     img.src = url;
+    ready = img.decode().catch(() => {}); // the scene waits for its background: both show in one frame
+    if (old) ready.then(() => URL.revokeObjectURL(old));
+  }
+  function paint() {
+    painting = false;
+    if (!alive) return;
+    const scene = model.get("scene") || {};
+    const [width, height] = scene.size || [0, 0];
+    if (canvas.width !== width) canvas.width = width;
+    if (canvas.height !== height) canvas.height = height;
+    drawScene(canvas, scene.items || []);
+    stage.dataset.labkitShown = String(Number(stage.dataset.labkitShown) + 1);
+    if (typeof scene.seq === "number" && scene.seq > model.get("shown")) {
+      model.set("shown", scene.seq);
+      model.save_changes();
+    }
+  }
+  function schedule() {
+    if (painting) return;
+    painting = true;
+    ready.then(() => requestAnimationFrame(paint));
+  }
+  function reportRatio() {
+    const ratio = window.devicePixelRatio || 1;
+    if (media) media.removeEventListener("change", reportRatio);
+    media = window.matchMedia(`(resolution: ${ratio}dppx)`);
+    media.addEventListener("change", reportRatio);
+    if (model.get("pixel_ratio") !== ratio) {
+      model.set("pixel_ratio", ratio);
+      model.save_changes();
+    }
   }
   function showReadout() {
     readout.textContent = model.get("readout");
@@ -195,7 +240,8 @@ function render({ model, el }) {
     if (dragging === null) live.textContent = model.get("status");
   }
 
-  model.on("change:image", showImage);
+  model.on("change:background", showBackground);
+  model.on("change:scene", schedule);
   model.on("change:ack", answered);
   model.on("change:readout", showReadout);
   model.on("change:status", announce);
@@ -206,11 +252,18 @@ function render({ model, el }) {
     if (dragging === null && !waiting) { positions = model.get("handles").map((p) => p.slice()); draw(); }
   });
   model.on("change:frame", draw);
-  showImage();
+  showBackground();
+  schedule();
   showReadout();
   announce();
   draw();
-  return () => { if (url) URL.revokeObjectURL(url); clearTimeout(timer); };
+  reportRatio();
+  return () => {
+    alive = false;
+    if (media) media.removeEventListener("change", reportRatio);
+    if (url) URL.revokeObjectURL(url);
+    clearTimeout(timer);
+  };
 }
 
 export default { render };

@@ -4,9 +4,12 @@
 colour-safe map (folded elements hatched and outlined), with twelve handles drawn over it in the browser: the four
 corners, and the tips of each corner's d/ds and d/dt arrows. Dragging a
 handle moves it at once in the browser and sends its position to the kernel,
-which rebuilds the mesh and sends the new picture, the worst quality and the
-corner data as ``Corner(...)`` lines to copy into an exercise cell. Sliders
-set the mesh size and the twist.
+which rebuilds the mesh and sends it as a scene (:mod:`labkit.plots.scene`: the
+mesh's polygons and colours, drawn on a canvas over a background picture, both
+at the page's devicePixelRatio), the worst quality and the corner data as
+``Corner(...)`` lines to copy into an exercise cell. Sliders set the mesh size
+and the twist. Moves that pile up while a picture is on its way are coalesced
+(:class:`labkit.plots.explorers.Coalescer`).
 
 Without a mouse (:data:`KEYS`): Tab reaches the editor and leaves it as it
 leaves any control; ``n`` and ``p`` select the next and the previous handle,
@@ -22,14 +25,25 @@ The handles' logic is plain Python, tested without a browser
 side is ``editor.js`` beside this file, an anywidget module.
 """
 
-import pathlib
-
 import numpy as np
 
 from ..patches import Corner
-from .explorers import Painter, freeze_layout, headless, new_figure, png, shown_only, widget_with_picture
+from .explorers import (
+    DPI,
+    Coalescer,
+    Painter,
+    esm,
+    freeze_layout,
+    headless,
+    live_ratio,
+    new_figure,
+    shown_only,
+    static_png,
+    widget_with_picture,
+)
 from .figures import PatchView
 from .labels import label_sliders
+from .scene import Scene
 
 NAMES = "ABCD"
 ARROW = 0.25  # an arrow is this fraction of its derivative, so the handles stay near the patch
@@ -135,8 +149,11 @@ def _editor_class():
     class PatchEditor(anywidget.AnyWidget):
         """The editor's widget: picture, handles and readout synced with editor.js."""
 
-        _esm = pathlib.Path(__file__).with_name("editor.js")
-        image = traitlets.Bytes(b"").tag(sync=True)
+        _esm = esm("editor.js")
+        background = traitlets.Bytes(b"").tag(sync=True)  # PNG of what does not change with a move
+        scene = traitlets.Dict({}).tag(sync=True)  # the mesh and title, drawn over it (scene.py)
+        pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
+        shown = traitlets.Int(0).tag(sync=True)  # the seq of the last scene a browser painted
         handles = traitlets.List([]).tag(sync=True)  # [[x, y], ...] in data coordinates
         frame = traitlets.Dict({}).tag(sync=True)  # where the axes lie in the picture, for mouse -> data
         drag = traitlets.Dict({}).tag(sync=True)  # {"index", "x", "y", "seq"} from the browser
@@ -173,9 +190,14 @@ class Editor:
         self.widget_ = _editor_class()()
         self.limits = limits or self._fit_limits()
         self.redraws = 0
+        self.ratio = 1.0  # the static picture's and, until the page says otherwise, the live one's
         self._draw_mesh()
         freeze_layout(self.figure)
         self.painter = Painter(self.figure, self.view)
+        self.scene = Scene(self.figure, self.view)
+        self.coalescer = Coalescer(self._send)
+        self.widget_.observe(lambda change: self.coalescer.was_shown(change["new"]), names="shown")
+        self.widget_.observe(self._new_ratio, names="pixel_ratio")
         self.widget_.observe(self._dragged, names="drag")
         self.widget_.observe(self._selected, names="selected")
         self.elements.observe(lambda change: self.refresh(), names="value")
@@ -218,14 +240,26 @@ class Editor:
         self.ax.set_ylim(*self.limits[2:])
         self.ax.set_aspect("equal")
 
+    def _new_ratio(self, change):
+        ratio = live_ratio(change["new"])
+        if ratio != self.ratio:
+            self.ratio = ratio
+            self.coalescer.request()
+
     def refresh(self):
-        """Rebuild the mesh from the corners; send the picture, handles, readout, worst quality, alt and status."""
+        """Rebuild the mesh from the corners and send it: now, or once the picture on its way is shown."""
+        if headless():  # nothing will show the picture, its readout or its handles
+            self._draw_mesh()
+            self.quality = self.view.mesh.quality()
+            return
+        self.coalescer.request()
+
+    def _send(self, seq):
+        """Rebuild the mesh; send its scene, handles, readout, worst quality, alt and status."""
         self._draw_mesh()
         self.quality = self.view.mesh.quality()
         worst = float(self.quality.min())
-        if headless():  # nothing will show the picture, its readout or its handles
-            return
-        picture = png(self.figure, self.painter)
+        background, items = self.scene.frame(self.ratio, DPI * self.ratio)
         self.widget_.frame = self._frame()
         self.widget_.handles = handle_positions(self.corners).round(6).tolist()
         folded = int(np.sum(self.quality <= 0))
@@ -239,31 +273,38 @@ class Editor:
             f"{worst:.2f}" + (f", {folded} folded" if folded else "") + "."
         )
         self.widget_.status = status_text(self.corners, self.widget_.selected, self.quality)
-        self.widget_.image = picture
+        width, height = self.figure.canvas.get_width_height()
+        with self.widget_.hold_sync():
+            if background is not None:
+                self.widget_.background = background
+            self.widget_.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}
         self.redraws += 1
 
     def _frame(self):
-        """The axes' data limits and pixel box in the last picture, so the browser can map the mouse."""
+        """The axes' data limits and box in the last picture (CSS pixels), so the browser can map the mouse."""
         width, height = self.figure.canvas.get_width_height()
-        box = self.ax.get_window_extent()  # pixels, as drawn (after the equal aspect was applied)
+        box = self.ax.get_window_extent()  # device pixels, as drawn (after the equal aspect was applied)
+        r = self.figure.dpi / DPI  # device pixels per CSS pixel
         (x0, x1), (y0, y1) = self.ax.get_xlim(), self.ax.get_ylim()
         return {
-            "width": width,
-            "height": height,
-            "left": float(box.x0),
-            "right": float(box.x1),
-            "top": float(height - box.y1),
-            "bottom": float(height - box.y0),
+            "width": round(width / r),
+            "height": round(height / r),
+            "left": float(box.x0 / r),
+            "right": float(box.x1 / r),
+            "top": float((height - box.y1) / r),
+            "bottom": float((height - box.y0) / r),
             "x0": float(x0),
             "x1": float(x1),
             "y0": float(y0),
             "y1": float(y1),
         }
 
+    def png(self):
+        """The mesh now as the static picture: a PNG at DPI (one device pixel per CSS pixel)."""
+        return static_png(self.figure, self.painter, DPI)
+
     def _repr_mimebundle_(self, **kwargs):
-        return widget_with_picture(
-            self.widget, self.widget_.image, self.widget_.readout, alt=self.widget_.alt, **kwargs
-        )
+        return widget_with_picture(self.widget, self.png(), self.widget_.readout, alt=self.widget_.alt, **kwargs)
 
 
 def _size_slider(elements):

@@ -2,28 +2,39 @@
 
 An :class:`Explorer` holds ipywidgets controls and a view of
 :mod:`labkit.plots.figures`. Every change of a control (while it is being
-dragged, not only when it is let go) updates the view's artists in place
-and sends one PNG into an ``ipywidgets.Image``: no new figure, no output area
-cleared and redrawn. Shown in a notebook it is the widget; where widgets
-cannot run (nbval, ``jupyter nbconvert --execute``, GitHub's or nbviewer's
-static view, ``labkit grade``) the same output carries a PNG of the first
-picture, so a static copy of the notebook still shows the figure.
+dragged, not only when it is let go) updates the view's artists in place and
+sends them to the browser as a :class:`~labkit.plots.scene.Scene`: the parts
+of the figure that stay (axes, ticks, labels, legend) as a background picture,
+rendered again only when they change, and the changing artists (curves,
+points, mesh, colour map; a title or colour bar as the pixels of its box) as
+a few kilobytes of data that ``image.js`` draws on a ``<canvas>`` over the
+background. Both are at the page's own ``devicePixelRatio`` (the browser
+reports it in ``pixel_ratio``), so text and lines are sharp on every screen.
+No new figure, no output area cleared and redrawn.
+
+Moves that pile up while a picture is on its way are coalesced: once a browser
+has shown a picture (it reports the picture's number in ``shown``), the
+kernel draws the next only when that picture is shown (or after
+``STALE_S``), from the controls' latest values; the moves in between are
+never drawn. The browser paints at most once an animation frame, the newest
+scene.
+
+Where widgets cannot run (nbval, ``jupyter nbconvert --execute``, GitHub's or
+nbviewer's static view, ``labkit grade``) the same output carries a PNG of the
+first picture (:meth:`Explorer.png`, rendered at ``PIXEL_RATIO`` (2) device
+pixels per CSS pixel and shown at its CSS size), so a static copy of the
+notebook still shows the figure. The picture's alternative text (and the
+widget's ``description``) says what the figure shows, in numbers, and follows
+the controls.
 
 One function per notebook builds its explorer, so a notebook's Explore cell
 is one line, e.g. ``plots.limacon_explorer()``.
-
-The pictures are rendered at ``PIXEL_RATIO`` (2) device pixels per CSS pixel
-and shown at their CSS size (``DPI`` CSS pixels per inch of figure), so their
-text stays sharp on HiDPI screens and at the width JupyterLab gives them. The
-picture's alternative text (and the image widget's ``description``) says what
-the figure shows, in numbers, and follows the controls.
 """
 
 import base64
 import functools
 import pathlib
-import struct
-import zlib
+import time
 
 import numpy as np
 
@@ -31,6 +42,7 @@ from .._alt import figure_alt, img_tag
 from ..notebook import HEADLESS, headless
 from ..patches import Corner
 from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
+from .scene import Scene, animated, encode_png
 
 
 class NotShown:
@@ -59,7 +71,9 @@ def shown_only(factory):
 
 
 DPI = 80  # CSS pixels per inch of the slider pictures (what they measure on the page)
-PIXEL_RATIO = 2  # device pixels rendered per CSS pixel: crisp on HiDPI screens and when zoomed
+PIXEL_RATIO = 2  # device pixels per CSS pixel of the static picture (and of the live one until the page says)
+MAX_PIXEL_RATIO = 4  # a page's devicePixelRatio is taken between 1 and this
+STALE_S = 0.5  # a picture not reported shown after this long no longer holds the next one back
 
 
 def new_figure(size, dpi=DPI):
@@ -87,11 +101,10 @@ class Painter:
         if not dynamic:  # a view that names no changing artists is drawn in full
             canvas.draw()
             return
-        key = self.view.static_key()
+        key = (self.view.static_key(), self.figure.dpi)
         if key != self.key or self.background is None:
-            for artist in dynamic:
-                artist.set_animated(True)
-            canvas.draw()  # everything but the changing artists
+            with animated(dynamic):
+                canvas.draw()  # everything but the changing artists
             self.background, self.key = canvas.copy_from_bbox(self.figure.bbox), key
         else:
             canvas.restore_region(self.background)
@@ -108,43 +121,28 @@ def png(figure, painter=None):
     return encode_png(np.asarray(canvas.buffer_rgba()).reshape(height, width, 4))
 
 
-def _chunk(kind, data):
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-
-def encode_png(pixels):
-    """A lossless PNG of an (height, width, 3 or 4) uint8 array, its colours as RGB (alpha dropped).
-
-    Written here rather than with Pillow, whose choice of a filter for each row took half of a 2x
-    picture's time: every row is stored unfiltered and the whole compressed at zlib's fastest level,
-    which suits a plot's flat colours (about the size Pillow writes, in half the time).
-
-    >>> picture = encode_png(np.zeros((2, 3, 4), dtype=np.uint8))
-    >>> picture[:8] == b"\\x89PNG\\r\\n\\x1a\\n", int.from_bytes(picture[16:20], "big")
-    (True, 3)
-    """
-    pixels = np.asarray(pixels)
-    if pixels.dtype != np.uint8 or pixels.ndim != 3 or pixels.shape[2] not in (3, 4) or 0 in pixels.shape[:2]:
-        raise ValueError(
-            f"encode_png takes a non-empty (height, width, 3 or 4) array of uint8; got {pixels.dtype} of shape "
-            f"{pixels.shape}: pass a figure canvas's buffer_rgba() reshaped to (height, width, 4)."
-        )
-    height, width = pixels.shape[:2]
-    rows = np.zeros((height, 1 + 3 * width), dtype=np.uint8)  # each row: filter 0 (none), then its RGB bytes
-    rows[:, 1:] = pixels[:, :, :3].reshape(height, 3 * width)
-    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8 bits per channel, RGB
-    return (
-        b"\x89PNG\r\n\x1a\n"
-        + _chunk(b"IHDR", header)
-        + _chunk(b"IDAT", zlib.compress(rows.tobytes(), 1))
-        + _chunk(b"IEND", b"")
-    )
-
-
 def freeze_layout(figure):
     """Lay the figure out once (constrained layout) and keep those positions: later draws skip the solver."""
     figure.canvas.draw()
     figure.set_layout_engine("none")
+
+
+def live_ratio(value):
+    """A page's reported devicePixelRatio as the ratio the live picture is drawn at: between 1 and
+    MAX_PIXEL_RATIO, in quarters (a zoom of 110 % draws at 1.25), PIXEL_RATIO if it is no number."""
+    try:
+        ratio = float(value)
+    except (TypeError, ValueError):
+        return float(PIXEL_RATIO)
+    if not np.isfinite(ratio) or ratio <= 0:
+        return float(PIXEL_RATIO)
+    return float(min(MAX_PIXEL_RATIO, max(1.0, np.ceil(4 * ratio - 1e-9) / 4)))
+
+
+def esm(name):
+    """The anywidget module `name` (image.js, editor.js) with scene.js, which draws the scenes, before it."""
+    folder = pathlib.Path(__file__).parent
+    return (folder / "scene.js").read_text() + "\n" + (folder / name).read_text()
 
 
 @functools.cache
@@ -153,19 +151,55 @@ def _image_class():
     import traitlets
 
     class ExplorerImage(anywidget.AnyWidget):
-        """The explorer's picture (``image.js``): a PNG shown at its CSS size, with its description as alt text."""
+        """The explorer's picture (``image.js``): the background PNG with the scene drawn over it, shown at
+        its CSS size, with its description as alt text."""
 
-        _esm = pathlib.Path(__file__).with_name("image.js")
-        value = traitlets.Bytes(b"").tag(sync=True)
+        _esm = esm("image.js")
+        background = traitlets.Bytes(b"").tag(sync=True)  # PNG of what does not change with a move
+        scene = traitlets.Dict({}).tag(sync=True)  # {"seq", "size" (device px), "items"}: see scene.py
         css_size = traitlets.List([0, 0]).tag(sync=True)  # [width, height] in CSS pixels
         description = traitlets.Unicode("").tag(sync=True)
+        pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
+        shown = traitlets.Int(0).tag(sync=True)  # the seq of the last scene a browser painted
 
     return ExplorerImage
 
 
 def explorer_image():
-    """A new image widget of the explorers: ``value`` (PNG bytes), ``css_size`` and ``description``."""
+    """A new image widget of the explorers: ``background``, ``scene``, ``css_size``, ``description``,
+    ``pixel_ratio`` and ``shown``."""
     return _image_class()()
+
+
+class Coalescer:
+    """Sends a widget's pictures one at a time: while the last one sent is not yet shown, a new request
+    only marks the picture stale, and the report that it was shown (or the next request after STALE_S)
+    sends one picture of the latest state. Until a browser has reported a picture shown (tests,
+    nbconvert, a view not open yet) every request is drawn at once."""
+
+    def __init__(self, draw):
+        self.draw = draw
+        self.seq, self.shown, self.sent_at = 0, 0, 0.0
+        self.reported = False  # has a browser ever said it showed a picture?
+        self.pending = False
+        self.coalesced = 0  # requests that were never drawn, a newer one drawn instead
+
+    def request(self):
+        waiting = self.reported and self.shown < self.seq and time.monotonic() - self.sent_at < STALE_S
+        if waiting:
+            self.coalesced += int(self.pending)
+            self.pending = True
+            return
+        self.pending = False
+        self.seq += 1
+        self.sent_at = time.monotonic()
+        self.draw(self.seq)
+
+    def was_shown(self, seq):
+        self.reported = True
+        self.shown = max(self.shown, int(seq))
+        if self.pending and self.shown >= self.seq:
+            self.request()
 
 
 class Explorer:
@@ -174,14 +208,17 @@ class Explorer:
     Parameters
     ----------
     figure : matplotlib.figure.Figure
-        Drawn into by `update`; rendered to PNG after every change, and
-        shown at ``DPI`` CSS pixels per inch: a figure of ``DPI * PIXEL_RATIO``
-        dots per inch (:func:`new_figure`'s ``ratio``) is sharp on HiDPI screens.
+        Drawn into by `update`, shown at ``DPI`` CSS pixels per inch: live as a
+        :class:`~labkit.plots.scene.Scene` at the page's pixel ratio, and as a PNG
+        at ``PIXEL_RATIO`` for the static copy (:meth:`png`).
     update : callable
         ``update(**values)`` with the controls' current values by name; it
         changes the figure's artists in place.
     controls : dict of str to ipywidgets widget
         Each control's ``value`` is passed to `update` under its name.
+    view : labkit.plots.figures.View, optional
+        Names the artists that change (``dynamic``) and a key of the rest
+        (``static_key``); without one, every move sends a whole new background.
     """
 
     def __init__(self, figure, update, controls, view=None):
@@ -189,13 +226,18 @@ class Explorer:
 
         self.figure, self._update, self.controls = figure, update, dict(controls)
         self.painter = Painter(figure, view)
+        self.scene = Scene(figure, view if view is not None else _NothingDynamic())
         self.image = explorer_image()
         self.redraws = 0
+        self.ratio = float(PIXEL_RATIO)
+        self.coalescer = Coalescer(self._send)
         for control in self.controls.values():
             control.observe(self.refresh, names="value")
         self._update(**self.values())
         freeze_layout(figure)
         self.image.css_size = list(self.css_size())
+        self.image.observe(lambda change: self.coalescer.was_shown(change["new"]), names="shown")
+        self.image.observe(self._new_ratio, names="pixel_ratio")
         self.refresh()
         self.widget = widgets.VBox([*self.controls.values(), self.image])
         self.widget.add_class("labkit-explorer")
@@ -207,15 +249,29 @@ class Explorer:
         return {name: control.value for name, control in self.controls.items()}
 
     def refresh(self, change=None):
-        """Update the figure from the controls and send its new picture and description (one message)."""
-        self._update(**self.values())
+        """Bring the figure and its picture up to the controls: now, or once the picture on its way is shown."""
         if headless():
+            self._update(**self.values())
             return
-        picture = self.png()
+        self.coalescer.request()
+
+    def _send(self, seq):
+        """Update the figure from the controls and send its scene and description (one message)."""
+        self._update(**self.values())
+        background, items = self.scene.frame(self.ratio, DPI * self.ratio)
+        width, height = self.figure.canvas.get_width_height()
         with self.image.hold_sync():
             self.image.description = self.description
-            self.image.value = picture
+            if background is not None:
+                self.image.background = background
+            self.image.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}
         self.redraws += 1
+
+    def _new_ratio(self, change):
+        ratio = live_ratio(change["new"])
+        if ratio != self.ratio:
+            self.ratio = ratio
+            self.coalescer.request()
 
     @property
     def description(self):
@@ -229,17 +285,41 @@ class Explorer:
         return round(width / ratio), round(height / ratio)
 
     def png(self):
-        return png(self.figure, self.painter)
+        """The figure now as the static picture: a PNG at PIXEL_RATIO (whatever the live picture's ratio)."""
+        return static_png(self.figure, self.painter, DPI * PIXEL_RATIO)
 
     def _repr_mimebundle_(self, **kwargs):
+        picture = self.png()
         return widget_with_picture(
             self.widget,
-            self.png(),
+            picture,
             f"<{type(self).__name__}: {', '.join(self.controls)}>",
             alt=self.description,
             size=self.css_size(),
             **kwargs,
         )
+
+
+class _NothingDynamic:
+    """The view of an explorer made without one: nothing is drawn in the browser, the background is all."""
+
+    def dynamic(self):
+        return ()
+
+    def static_key(self):
+        return object()  # never equal: a new background on every move
+
+
+def static_png(figure, painter, dpi):
+    """The figure as a PNG at `dpi` (the static picture's), its live dpi put back after."""
+    live = figure.dpi
+    if live != dpi:
+        figure.set_dpi(dpi)
+    try:
+        return png(figure, painter)
+    finally:
+        if figure.dpi != live:
+            figure.set_dpi(live)
 
 
 def widget_with_picture(widget, picture, text, alt=None, size=None, **kwargs):

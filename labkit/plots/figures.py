@@ -307,6 +307,11 @@ class BilinearErrorView(View):
         """The map, the title and the colour bar (its scale follows the error): see PatchView.dynamic."""
         return [self.image, self.ax.title, self.colorbar.ax]
 
+    def live_dynamic(self):
+        """What a live picture draws at each move (labkit.plots.scene): the colour bar's axis only, since
+        its colours are the same at every symmetric scale."""
+        return [self.image, self.ax.title, self.colorbar.ax.yaxis]
+
     def static_key(self):
         return self.ax.get_xlim(), self.ax.get_ylim()
 

@@ -1,20 +1,55 @@
-// The browser side of the explorers' picture (labkit.plots.explorers.ExplorerImage, an anywidget module).
-// The kernel renders the PNG at `ratio` times its CSS size (2x: sharp on HiDPI screens and when the page
-// is zoomed); the <img> is shown at that CSS size, never wider than the output area, and its alt text is
-// the figure's description in numbers, updated with every new picture.
+// The browser side of the explorers' picture (labkit.plots.explorers.ExplorerImage, an anywidget module;
+// scene.js, which draws a scene, comes before this file). The kernel renders what does not change with a
+// move (axes, ticks, labels, legend) as a background PNG at the page's devicePixelRatio, which this module
+// reports in `pixel_ratio`; every move sends the changing artists as a scene, drawn here on a <canvas> over
+// the background in the same device pixels. Both are shown at the figure's CSS size, never wider than the
+// output area; the <img>'s alt text is the figure's description in numbers, updated with every move.
+// Paints happen inside requestAnimationFrame, at most one a frame, always of the newest scene (the moves that
+// arrived in between are never drawn); each paint raises data-labkit-shown and tells the kernel the scene's
+// seq in `shown`, so the kernel sends its next picture only once this one is on the page.
 function render({ model, el }) {
+  const box = document.createElement("div");
+  box.className = "labkit-explorer-picture";
+  box.style.cssText = "position:relative; display:inline-block; max-width:100%; line-height:0";
+  box.dataset.labkitShown = "0";
   const img = document.createElement("img");
   img.className = "labkit-explorer-image";
   img.draggable = false;
   img.style.cssText = "display:block; max-width:100%; height:auto";
-  let url = null;
+  const canvas = document.createElement("canvas");
+  canvas.className = "labkit-explorer-canvas";
+  canvas.setAttribute("aria-hidden", "true"); // the <img>'s alt describes the whole picture
+  canvas.style.cssText = "position:absolute; left:0; top:0; width:100%; height:100%; pointer-events:none";
+  box.append(img, canvas);
+  let url = null, ready = Promise.resolve(), queued = false, alive = true, media = null;
 
-  function showImage() {
-    const blob = new Blob([model.get("value")], { type: "image/png" });
+  function showBackground() {
+    const bytes = sceneBytes(model.get("background"));
+    if (!bytes.length) return;
     const old = url;
-    url = URL.createObjectURL(blob);
+    url = URL.createObjectURL(new Blob([bytes], { type: "image/png" }));
     img.src = url;
-    if (old) URL.revokeObjectURL(old);
+    ready = img.decode().catch(() => {}); // the scene waits for its background, so both show in one frame
+    if (old) ready.then(() => URL.revokeObjectURL(old));
+  }
+  function paint() {
+    queued = false;
+    if (!alive) return;
+    const scene = model.get("scene") || {};
+    const [width, height] = scene.size || [0, 0];
+    if (canvas.width !== width) canvas.width = width;
+    if (canvas.height !== height) canvas.height = height;
+    drawScene(canvas, scene.items || []);
+    box.dataset.labkitShown = String(Number(box.dataset.labkitShown) + 1);
+    if (typeof scene.seq === "number" && scene.seq > model.get("shown")) {
+      model.set("shown", scene.seq);
+      model.save_changes();
+    }
+  }
+  function schedule() {
+    if (queued) return;
+    queued = true;
+    ready.then(() => requestAnimationFrame(paint));
   }
   function showSize() {
     const [width, height] = model.get("css_size");
@@ -25,15 +60,33 @@ function render({ model, el }) {
   function showDescription() {
     img.alt = model.get("description");
   }
+  // the kernel draws at the page's pixel ratio: say it now and whenever it changes (zoom, another screen)
+  function reportRatio() {
+    const ratio = window.devicePixelRatio || 1;
+    if (media) media.removeEventListener("change", reportRatio);
+    media = window.matchMedia(`(resolution: ${ratio}dppx)`);
+    media.addEventListener("change", reportRatio);
+    if (model.get("pixel_ratio") !== ratio) {
+      model.set("pixel_ratio", ratio);
+      model.save_changes();
+    }
+  }
 
-  model.on("change:value", showImage);
+  model.on("change:background", showBackground);
+  model.on("change:scene", schedule);
   model.on("change:css_size", showSize);
   model.on("change:description", showDescription);
   showSize();
   showDescription();
-  showImage();
-  el.appendChild(img);
-  return () => { if (url) URL.revokeObjectURL(url); };
+  showBackground();
+  schedule();
+  el.appendChild(box);
+  reportRatio();
+  return () => {
+    alive = false;
+    if (media) media.removeEventListener("change", reportRatio);
+    if (url) URL.revokeObjectURL(url);
+  };
 }
 
 export default { render };

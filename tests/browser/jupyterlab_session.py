@@ -226,27 +226,41 @@ def show_explorers(page):
     return panel
 
 
-NEW_PICTURE_NTH = """([e, old, framesBefore]) => {
-  // a new picture: an <img> in explorer e whose src changed, or (a canvas backend such as ipympl)
-  // image data that arrived on the kernel's websocket
-  const node = window.jupyterapp.shell.currentWidget.node.querySelectorAll('.labkit-explorer, .labkit-patch-editor')[e];
-  const img = node && node.querySelector('img');
-  if (img) return img.src !== old;
+EXPLORERS = "window.jupyterapp.shell.currentWidget.node.querySelectorAll('.labkit-explorer, .labkit-patch-editor')"
+
+PICTURE_STATE_NTH = f"""e => {{
+  // what explorer e shows now: the count of pictures its widget has painted (data-labkit-shown, set by
+  // image.js and editor.js inside requestAnimationFrame once the new picture is on the page), or, for a
+  // widget that keeps no count, its <img>'s src
+  const node = {EXPLORERS}[e];
+  if (!node) return {{shown: null, src: null}};
+  const counter = node.querySelector('[data-labkit-shown]');
+  const img = node.querySelector('img');
+  return {{shown: counter ? Number(counter.dataset.labkitShown) : null, src: img ? img.src : null}};
+}}"""
+
+NEW_PICTURE_SHOWN_NTH = f"""([e, old, framesBefore]) => {{
+  // a new picture SHOWN in explorer e: its painted count went up; or an <img> whose src changed and is
+  // decoded (complete: the next frame paints it); or (a canvas backend such as ipympl) image data arrived
+  const now = ({PICTURE_STATE_NTH})(e);
+  if (now.shown !== null && old.shown !== null) return now.shown > old.shown;
+  const img = {EXPLORERS}[e] && {EXPLORERS}[e].querySelector('img');
+  if (img) return img.src !== old.src && img.complete && img.naturalWidth > 0;
   return window.__labkitImageFrames > framesBefore;
-}"""
+}}"""
 
 
-def _picture_src_nth(page, e):
-    return page.evaluate(
-        "e => { const n = window.jupyterapp.shell.currentWidget.node"
-        ".querySelectorAll('.labkit-explorer, .labkit-patch-editor')[e];"
-        " const img = n && n.querySelector('img'); return img ? img.src : null; }",
-        e,
-    )
+def _picture_state_nth(page, e):
+    return page.evaluate(PICTURE_STATE_NTH, e)
+
+
+def _wait_until_shown(page, e, old, frames_before):
+    """Wait until explorer e shows a picture newer than `old` (polled at every animation frame)."""
+    page.wait_for_function(NEW_PICTURE_SHOWN_NTH, arg=[e, old, frames_before], timeout=10_000, polling="raf")
 
 
 def move_every_slider(page, panel, name):
-    """Press the arrow keys on each explorer slider; {slider: [seconds from key press to new picture]}."""
+    """Press the arrow keys on each explorer slider; {slider: [seconds from key press to new picture shown]}."""
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
     timings = {}
@@ -263,7 +277,7 @@ def move_every_slider(page, panel, name):
             key = "ArrowRight"
             for _ in range(MOVES):
                 old_readout = readout.inner_text()
-                old_src, frames_before = _picture_src_nth(page, e), frames(page)
+                old, frames_before = _picture_state_nth(page, e), frames(page)
                 handle.focus()
                 start = time.perf_counter()
                 page.keyboard.press(key)
@@ -276,7 +290,7 @@ def move_every_slider(page, panel, name):
                 except PlaywrightTimeout:  # at the end of its range: go back
                     key = "ArrowLeft" if key == "ArrowRight" else "ArrowRight"
                     continue
-                page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
+                _wait_until_shown(page, e, old, frames_before)
                 times.append(time.perf_counter() - start)
             assert len(times) >= MOVES - 1, f"{label}: the slider did not move"
             timings[label] = times
@@ -284,7 +298,8 @@ def move_every_slider(page, panel, name):
 
 
 def drag_a_corner(page, panel):
-    """Drag corner B of the patch editor in steps and let go; (seconds per step, readout before, readout after)."""
+    """Drag corner B of the patch editor in steps and let go; (seconds from each step to its picture shown,
+    readout before, readout after)."""
     editor = panel.locator(".labkit-patch-editor").first
     e = page.evaluate(
         "() => [...window.jupyterapp.shell.currentWidget.node"
@@ -301,10 +316,10 @@ def drag_a_corner(page, panel):
     page.mouse.down()
     steps = []
     for k in range(1, MOVES + 1):
-        old_src, frames_before = _picture_src_nth(page, e), frames(page)
+        old, frames_before = _picture_state_nth(page, e), frames(page)
         start = time.perf_counter()
         page.mouse.move(x + 6 * k, y + 3 * k)
-        page.wait_for_function(NEW_PICTURE_NTH, arg=[e, old_src, frames_before], timeout=10_000)
+        _wait_until_shown(page, e, old, frames_before)
         steps.append(time.perf_counter() - start)
     page.mouse.up()
     page.wait_for_function(

@@ -3,10 +3,14 @@
 For every notebook: open it, Run All, wait for the kernel to go idle, then check
 that no cell failed, the browser logged no error, nothing was requested from
 outside localhost, every slider rendered as a widget, and that moving every
-slider with the keyboard changes its readout and redraws the plot; in 03_meshes,
-drag a corner of the patch editor with the mouse. The times from key press (or
-drag step) to the new picture are printed per slider, never asserted: the 100 ms
-limit is `make bench`'s (benchmarks/bench_browser_latency.py).
+slider with the keyboard changes its readout, its picture's alt text and redraws the
+plot; in 03_meshes, drag a corner of the patch editor with the mouse. The page is a
+HiDPI one (deviceScaleFactor 2): each explorer's background picture and canvas must
+have two device pixels per CSS pixel, and the live picture the browser draws (the
+background with the scene over it) must be the static picture of the same state,
+within the differences of two rasterizers. The times from key press (or drag step)
+to the new picture shown are printed per slider, never asserted: the limits are
+`make bench`'s (benchmarks/bench_browser_latency.py).
 
 Run alone: ``.venv/bin/python -m pytest tests/browser -s``.
 """
@@ -58,19 +62,82 @@ def _nudge_with_keys(page, panel, after_drag):
 
 
 def _explorer_pictures(page, panel):
-    """Each explorer picture's natural width (device pixels), displayed CSS width and alt text, once loaded."""
-    images = panel.locator(".labkit-explorer img")
-    for k in range(images.count()):
-        images.nth(k).scroll_into_view_if_needed()
-        page.wait_for_function("img => img.complete && img.naturalWidth > 0", arg=images.nth(k).element_handle())
-    return images.evaluate_all(
-        "imgs => imgs.map(img => ({natural: img.naturalWidth, shown: img.getBoundingClientRect().width, alt: img.alt}))"
+    """Each explorer picture's background (natural width, device pixels), canvas (backing width, device pixels),
+    displayed CSS width, alt text and the page's devicePixelRatio, once loaded and painted."""
+    boxes = panel.locator(".labkit-explorer .labkit-explorer-picture")
+    for k in range(boxes.count()):
+        boxes.nth(k).scroll_into_view_if_needed()
+        page.wait_for_function(
+            "box => { const img = box.querySelector('img'); return img.complete && img.naturalWidth > 0"
+            " && Number(box.dataset.labkitShown) > 0; }",
+            arg=boxes.nth(k).element_handle(),
+        )
+    return boxes.evaluate_all(
+        """boxes => boxes.map(box => { const img = box.querySelector('img'), canvas = box.querySelector('canvas');
+        return {natural: img.naturalWidth, shown: img.getBoundingClientRect().width, alt: img.alt,
+                canvas: canvas.width, canvasHeight: canvas.height, canvasShown: canvas.getBoundingClientRect().width,
+                canvasShownHeight: canvas.getBoundingClientRect().height, ratio: window.devicePixelRatio}; })"""
     )
+
+
+LIVE_PICTURES = """() => [...window.jupyterapp.shell.currentWidget.node.querySelectorAll('.labkit-explorer-picture')]
+  .map(box => { // what the page shows of each explorer: its background with its canvas over it, as a PNG
+    const img = box.querySelector('img'), canvas = box.querySelector('canvas');
+    const both = document.createElement('canvas');
+    both.width = canvas.width; both.height = canvas.height;
+    const ctx = both.getContext('2d');
+    ctx.drawImage(img, 0, 0, canvas.width, canvas.height);
+    const background = both.toDataURL('image/png');
+    ctx.drawImage(canvas, 0, 0);
+    return {background, live: both.toDataURL('image/png')};
+  })"""
+
+STATIC_PICTURES = """() => window.jupyterapp.shell.currentWidget.content.model.sharedModel.cells
+  .filter(c => c.cell_type === 'code').flatMap(c => c.outputs)
+  .filter(o => o.data && o.data['image/png'] && String(o.data['text/plain']).startsWith('<Explorer:'))
+  .map(o => o.data['image/png'])"""
+
+
+def _pixels(data_url_or_base64):
+    import base64
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    data = data_url_or_base64.split(",", 1)[-1]
+    return np.asarray(Image.open(io.BytesIO(base64.b64decode(data))).convert("RGB")).astype(float)
+
+
+def _unmatched(drawn, expected, reach=2, tolerance=96):
+    """The fraction of `expected`'s pixels that no pixel of `drawn` within `reach` pixels matches (every channel
+    within `tolerance`): two rasterizers' anti-aliasing and a text a pixel wider match, a missing curve does not."""
+    import numpy as np
+
+    best = np.full(expected.shape[:2], np.inf)
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            shifted = np.roll(drawn, (dy, dx), axis=(0, 1))
+            best = np.minimum(best, np.abs(shifted - expected).max(axis=2))
+    return float(np.mean(best > tolerance))
+
+
+def _live_is_static(page):
+    """The live picture of every explorer (before any move) is its static picture: every pixel of the static one
+    is drawn, give or take two pixels, where the background alone misses the changing artists."""
+    live, static = page.evaluate(LIVE_PICTURES), page.evaluate(STATIC_PICTURES)
+    assert len(live) == len(static) > 0, (len(live), len(static))
+    for k, (shown, picture) in enumerate(zip(live, static)):
+        expected = _pixels(picture)
+        drawn, background = _pixels(shown["live"]), _pixels(shown["background"])
+        assert drawn.shape == expected.shape, (k, drawn.shape, expected.shape)
+        missed, without_scene = _unmatched(drawn, expected), _unmatched(background, expected)
+        assert without_scene > 0.002 and missed < 0.1 * without_scene and missed < 0.002, (k, missed, without_scene)
 
 
 @pytest.mark.parametrize("notebook", NOTEBOOKS, ids=lambda p: p.name)
 def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
-    context = browser.new_context(viewport={"width": 1400, "height": 1000})
+    context = browser.new_context(viewport={"width": 1400, "height": 1000}, device_scale_factor=2)
     outside, console_errors = [], []
 
     def guard(route):
@@ -98,14 +165,20 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
     output.wait_for(timeout=30_000)
     pictures = _explorer_pictures(page, panel)
     assert pictures, "no explorer picture"
-    for picture in pictures:  # crisp: at least two device pixels per CSS pixel shown, and described
-        assert picture["natural"] >= 2 * picture["shown"] > 0, picture
+    for picture in pictures:  # crisp on this HiDPI page: the page's device pixels, and described
+        assert picture["ratio"] == 2 and picture["natural"] >= 2 * picture["shown"] > 0, picture
+        assert picture["canvas"] == round(picture["canvasShown"] * picture["ratio"]) > 0, picture
+        assert picture["canvasHeight"] == round(picture["canvasShownHeight"] * picture["ratio"]) > 0, picture
         assert picture["alt"] and any(ch.isdigit() for ch in picture["alt"]), picture
+    _live_is_static(page)
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     stem = notebook.stem
     page.screenshot(path=str(SCREENSHOTS / f"{stem}-before.png"))
 
+    alts = [picture["alt"] for picture in pictures]
     timings = move_every_slider(page, panel, stem)
+    moved = [picture["alt"] for picture in _explorer_pictures(page, panel)]
+    assert all(after != before for before, after in zip(alts, moved)), (alts, moved)  # the alt text follows
     if stem == "03_meshes":
         steps, before, after = drag_a_corner(page, panel)
         assert steps, "the mesh picture did not change while the corner was being dragged"

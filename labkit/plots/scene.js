@@ -1,0 +1,156 @@
+// Draws an explorer's scene (labkit/plots/scene.py) on a <canvas> in the figure's device pixels: the kernel
+// sends the changing artists as data (lines, polygons, a colour-mapped image, pixel patches of a title or a
+// colour bar) and this draws them over the background picture. Shared by image.js and editor.js (the kernel
+// puts this file before theirs).
+function sceneBytes(value) {
+  // a binary buffer of the widget's state arrives as a DataView (or an ArrayBuffer)
+  if (!value) return new Uint8Array(0);
+  if (value instanceof ArrayBuffer) return new Uint8Array(value);
+  return new Uint8Array(value.buffer, value.byteOffset, value.byteLength);
+}
+function sceneFloats(value) {
+  const bytes = sceneBytes(value);
+  const copy = new Uint8Array(bytes.length); // aligned for Float32Array
+  copy.set(bytes);
+  return new Float32Array(copy.buffer);
+}
+function sceneColor(c) {
+  return c ? `rgba(${c[0]},${c[1]},${c[2]},${c[3]})` : null;
+}
+function sceneClip(ctx, clip) {
+  if (!clip) return;
+  ctx.beginPath();
+  ctx.rect(clip[0], clip[1], clip[2], clip[3]);
+  ctx.clip();
+}
+function sceneLine(ctx, item) {
+  const xy = sceneFloats(item.xy);
+  if (item.stroke) {
+    ctx.beginPath();
+    let pen = false;
+    for (let k = 0; k < xy.length; k += 2) {
+      const x = xy[k], y = xy[k + 1];
+      if (!Number.isFinite(x) || !Number.isFinite(y)) { pen = false; continue; }
+      if (pen) ctx.lineTo(x, y); else { ctx.moveTo(x, y); pen = true; }
+    }
+    ctx.strokeStyle = sceneColor(item.stroke);
+    ctx.lineWidth = item.width;
+    ctx.lineCap = item.cap;
+    ctx.lineJoin = item.join;
+    ctx.setLineDash(item.dashes);
+    ctx.lineDashOffset = item.offset;
+    ctx.stroke();
+    ctx.setLineDash([]);
+  }
+  const m = item.marker;
+  if (!m) return;
+  const outline = sceneFloats(m.outline);
+  ctx.lineWidth = m.width;
+  ctx.lineJoin = "miter";
+  ctx.lineCap = "butt";
+  for (let k = 0; k < xy.length; k += 2) {
+    const x = xy[k], y = xy[k + 1];
+    if (!Number.isFinite(x) || !Number.isFinite(y)) continue;
+    ctx.beginPath();
+    let at = 0;
+    for (const count of m.counts) {
+      for (let j = 0; j < count; j++) {
+        const px = x + outline[2 * (at + j)], py = y + outline[2 * (at + j) + 1];
+        if (j === 0) ctx.moveTo(px, py); else ctx.lineTo(px, py);
+      }
+      if (m.closed) ctx.closePath();
+      at += count;
+    }
+    if (m.fill) { ctx.fillStyle = sceneColor(m.fill); ctx.fill(); }
+    if (m.stroke && m.width > 0) { ctx.strokeStyle = sceneColor(m.stroke); ctx.stroke(); }
+  }
+}
+function sceneHatch(ctx, xy, start, count, hatch) {
+  let left = Infinity, right = -Infinity, top = Infinity, bottom = -Infinity;
+  for (let j = 0; j < count; j++) {
+    const x = xy[2 * (start + j)], y = xy[2 * (start + j) + 1];
+    left = Math.min(left, x); right = Math.max(right, x); top = Math.min(top, y); bottom = Math.max(bottom, y);
+  }
+  ctx.save();
+  ctx.clip();
+  ctx.beginPath();
+  const s = hatch.spacing, h = bottom - top;
+  for (let x = Math.floor((left - h) / s) * s; x <= right; x += s) { // lines rising to the right ("/")
+    ctx.moveTo(x, bottom);
+    ctx.lineTo(x + h, top);
+  }
+  ctx.strokeStyle = sceneColor(hatch.stroke);
+  ctx.lineWidth = hatch.width;
+  ctx.stroke();
+  ctx.restore();
+}
+function scenePolygons(ctx, item) {
+  const xy = sceneFloats(item.xy), faces = sceneBytes(item.faces);
+  let at = 0;
+  ctx.lineJoin = "miter";
+  item.counts.forEach((count, k) => {
+    ctx.beginPath();
+    for (let j = 0; j < count; j++) {
+      const x = xy[2 * (at + j)], y = xy[2 * (at + j) + 1];
+      if (j === 0) ctx.moveTo(x, y); else ctx.lineTo(x, y);
+    }
+    ctx.closePath();
+    if (item.face_count) {
+      const f = 4 * (item.face_count === 1 ? 0 : k);
+      if (faces[f + 3] > 0) {
+        ctx.fillStyle = `rgba(${faces[f]},${faces[f + 1]},${faces[f + 2]},${faces[f + 3] / 255})`;
+        ctx.fill();
+      }
+    }
+    if (item.edge && item.width > 0) {
+      ctx.strokeStyle = sceneColor(item.edge);
+      ctx.lineWidth = item.width;
+      ctx.stroke();
+    }
+    if (item.hatch) sceneHatch(ctx, xy, at, count, item.hatch);
+    at += count;
+  });
+}
+function sceneImage(ctx, item) {
+  const [w, h] = item.size;
+  if (!w || !h) return;
+  const source = document.createElement("canvas");
+  source.width = w;
+  source.height = h;
+  const pixels = sceneBytes(item.rgba);
+  source.getContext("2d").putImageData(new ImageData(new Uint8ClampedArray(pixels), w, h), 0, 0);
+  ctx.imageSmoothingEnabled = item.smooth;
+  ctx.drawImage(source, item.box[0], item.box[1], item.box[2], item.box[3]);
+  ctx.imageSmoothingEnabled = true;
+}
+function scenePatch(ctx, item) {
+  const [x, y, w, h] = item.box;
+  if (!w || !h) return;
+  ctx.putImageData(new ImageData(new Uint8ClampedArray(sceneBytes(item.rgba)), w, h), x, y);
+}
+function sceneText(ctx, item) {
+  ctx.font = item.font;
+  ctx.fillStyle = sceneColor(item.fill);
+  ctx.textAlign = item.align;
+  ctx.textBaseline = "alphabetic";
+  ctx.translate(item.x, item.y);
+  if (item.angle) ctx.rotate((-item.angle * Math.PI) / 180);
+  ctx.fillText(item.text, 0, 0);
+}
+// draw `items` on `canvas` (already the size of the picture in device pixels), cleared first
+function drawScene(canvas, items) {
+  const ctx = canvas.getContext("2d");
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  for (const item of items) if (item.kind === "patch") scenePatch(ctx, item); // opaque boxes: under the data
+  for (const item of items) {
+    if (item.kind === "patch") continue;
+    ctx.save();
+    sceneClip(ctx, item.clip);
+    if (item.kind === "line") sceneLine(ctx, item);
+    else if (item.kind === "polygons") scenePolygons(ctx, item);
+    else if (item.kind === "image") sceneImage(ctx, item);
+    else if (item.kind === "text") sceneText(ctx, item);
+    ctx.restore();
+  }
+}
