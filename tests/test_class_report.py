@@ -92,11 +92,11 @@ def crashed(part, why):
 
 
 def ended(code, out_of_memory=False):
-    """The grader's words for a notebook process that ended (labkit.grading.sandbox.remote.Notebook._ended)."""
+    """The grader's words for a notebook process that ended (labkit.grading.sandbox.remote.NotebookHandle._ended)."""
     fake = types.SimpleNamespace(
         process=types.SimpleNamespace(poll=lambda: code), box=types.SimpleNamespace(out_of_memory=lambda: out_of_memory)
     )
-    return remote.Notebook._ended(fake)
+    return remote.NotebookHandle._ended(fake)
 
 
 def cells_raised(name, *errors, output_chars=0):

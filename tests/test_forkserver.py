@@ -103,7 +103,7 @@ def _run(notebook, cells):
 
 
 def test_two_notebooks_from_one_server_share_no_file_socket_process_or_descriptor(server):
-    with remote.Notebook(GradeOptions()) as first, remote.Notebook(GradeOptions()) as second:
+    with remote.NotebookHandle(GradeOptions()) as first, remote.NotebookHandle(GradeOptions()) as second:
         assert isinstance(first.box, forkserver.ForkedBox) and isinstance(second.box, forkserver.ForkedBox)
         ours = _run(first, [FIRST])
         left = ours["left"]
@@ -121,15 +121,15 @@ def test_two_notebooks_from_one_server_share_no_file_socket_process_or_descripto
 
 
 def test_a_notebook_after_another_finds_nothing_it_left(server):
-    with remote.Notebook(GradeOptions()) as first:
+    with remote.NotebookHandle(GradeOptions()) as first:
         assert _run(first, [FIRST])["left"]
-    with remote.Notebook(GradeOptions()) as second:
+    with remote.NotebookHandle(GradeOptions()) as second:
         assert _run(second, [SECOND])["found"] == []
 
 
 def test_the_notebooks_limits_hold_in_a_forked_worker(server):
     options = GradeOptions(limits=Limits(memory=600 * 1024**2))
-    with remote.Notebook(options) as notebook:
+    with remote.NotebookHandle(options) as notebook:
         assert isinstance(notebook.box, forkserver.ForkedBox)
         ns = _run(
             notebook,
@@ -146,12 +146,12 @@ def test_without_a_server_or_with_a_dead_one_a_notebook_gets_a_sandbox_of_its_ow
     backend = backends.get_backend("bwrap")
     if backend.zygote_box(["true"], Limits(), ()) is None:
         pytest.skip("no fork server here")
-    with remote.Notebook(GradeOptions(fork_server=False)) as plain:
+    with remote.NotebookHandle(GradeOptions(fork_server=False)) as plain:
         assert not isinstance(plain.box, forkserver.ForkedBox)
     started = forkserver.ForkServer(backend, Limits()).start()
     try:
         started.box.stop()  # the server dies; its socket is still held here
-        with remote.Notebook(GradeOptions()) as notebook:
+        with remote.NotebookHandle(GradeOptions()) as notebook:
             assert not isinstance(notebook.box, forkserver.ForkedBox)
             assert _run(notebook, ["x = 6 * 7"])["x"] == 42
     finally:
@@ -200,7 +200,7 @@ def test_a_forked_notebook_holds_no_descriptor_a_sandbox_of_its_own_would_not(se
     that put it in its cgroup, nor the server's socket."""
     held = {}
     for label, fork in (("forked", True), ("plain", False)):
-        with remote.Notebook(GradeOptions(fork_server=fork)) as notebook:
+        with remote.NotebookHandle(GradeOptions(fork_server=fork)) as notebook:
             assert isinstance(notebook.box, forkserver.ForkedBox) == fork
             held[label] = _run(notebook, [DESCRIPTORS])["held"]
     assert held["forked"] == held["plain"]

@@ -106,7 +106,7 @@ def test_labkits_own_errors_give_their_kinds(exception, kind):
 
 @pytest.fixture
 def notebook():
-    started = remote.Notebook(UNCONFINED, None)
+    started = remote.NotebookHandle(UNCONFINED, None)
     yield started
     started.close()
 
@@ -142,7 +142,7 @@ def test_through_the_worker_a_cell_stopped_at_its_limit_is_a_time_limit_and_a_ce
 
 
 class _Stub:
-    """Stands for remote.Notebook: its run request raises what the test gives."""
+    """Stands for remote.NotebookHandle: its run request raises what the test gives."""
 
     error = None
 
@@ -173,7 +173,7 @@ def test_a_notebooks_problems_carry_the_kind_set_where_they_are_made(error, kind
     nb = nbformat.v4.new_notebook()
     nb.cells = [nbformat.v4.new_markdown_cell("## Exercise 16"), nbformat.v4.new_code_cell("x = 1")]
     nbformat.write(nb, tmp_path / "work.ipynb")
-    monkeypatch.setattr(remote, "Notebook", _Stub)
+    monkeypatch.setattr(remote, "NotebookHandle", _Stub)
     _Stub.error = error
     _, [problem] = scoring.grade_notebook(tmp_path / "work.ipynb", GradeOptions(total_timeout=321))
     assert problem.kinds == ((kind, str(problem)),)

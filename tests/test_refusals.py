@@ -51,7 +51,7 @@ def open_notebooks():
 
 
 def _notebook(open_notebooks, *cells, clean=True):
-    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
+    notebook = remote.NotebookHandle(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": list(cells), "cell_timeout": 30}, 120)
     if clean:
@@ -300,7 +300,7 @@ def test_switching_the_watch_off_or_going_round_it_voids_the_answer(open_noteboo
     ],
 )
 def test_threads_signal_handlers_and_anonymous_memory_are_refused_even_without_the_sandbox(open_notebooks, cell, error):
-    notebook = remote.Notebook(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
+    notebook = remote.NotebookHandle(UNCONFINED, profiles=PROFILES, passables=LAB.passable)
     open_notebooks.append(notebook)
     ran = notebook.request({"op": "run", "cells": [cell], "cell_timeout": 30}, 120)
     assert ran["errors"] and error in ran["errors"][0]["message"], ran

@@ -31,7 +31,7 @@ def worker():
     notebooks = []
 
     def start(deadline=None):
-        notebook = remote.Notebook(UNCONFINED, deadline)
+        notebook = remote.NotebookHandle(UNCONFINED, deadline)
         notebooks.append(notebook)
         return notebook
 
@@ -71,7 +71,7 @@ def test_a_call_past_its_limit_is_a_cell_timeout_and_a_students_own_timeout_is_n
 
 
 class _Stub:
-    """Stands for remote.Notebook: its run request raises what the test gives."""
+    """Stands for remote.NotebookHandle: its run request raises what the test gives."""
 
     error = None
 
@@ -94,7 +94,7 @@ def stubbed(tmp_path, monkeypatch):
     nb.cells = [nbformat.v4.new_markdown_cell("## Exercise 16"), nbformat.v4.new_code_cell("x = 1")]
     path = tmp_path / "work.ipynb"
     nbformat.write(nb, path)
-    monkeypatch.setattr(remote, "Notebook", _Stub)
+    monkeypatch.setattr(remote, "NotebookHandle", _Stub)
 
     def problems(error):
         _Stub.error = error

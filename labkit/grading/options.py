@@ -5,7 +5,7 @@ defaults are read from here) or by the caller of :func:`labkit.grading.grade`.
 Inside, it is frozen and passed on as it is (the class run settles its seed
 and rubric once, :mod:`labkit.grading.run.classrun`), as plain data to each
 submission's grading process (:mod:`labkit.grading.submission.scoring`) and into the
-sandbox (:class:`labkit.grading.sandbox.remote.Notebook`). No other module spells out
+sandbox (:class:`labkit.grading.sandbox.remote.NotebookHandle`). No other module spells out
 a default of its own: they take the options object, or values from it.
 """
 

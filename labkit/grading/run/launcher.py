@@ -32,6 +32,7 @@ import sys
 import threading
 import time
 
+from ..sandbox import protocol
 from .processes import die_with
 
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
@@ -70,7 +71,7 @@ class Launcher:
     """One warm process that forks each submission's grading process (its server: :func:`main`)."""
 
     def __init__(self, options, server=None, wait=True):
-        self.ended, self._buffer, self._lock = {}, b"", threading.RLock()
+        self.ended, self._lines, self._lock = {}, None, threading.RLock()
         environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         parent = os.getpid()
         self.process = subprocess.Popen(
@@ -98,16 +99,13 @@ class Launcher:
             fd = self.process.stdout.fileno()
         except ValueError:  # stopped
             return None
-        while b"\n" not in self._buffer:
-            remaining = until - time.monotonic()
-            if not select.select([fd], [], [], max(0.0, remaining))[0]:
-                return None
-            chunk = os.read(fd, 1 << 16)
-            if not chunk:
-                return None
-            self._buffer += chunk
-        line, _, self._buffer = self._buffer.partition(b"\n")
-        return json.loads(line)
+        if self._lines is None or self._lines.fd != fd:
+            self._lines = protocol.Lines(fd, REQUEST_LIMIT)
+        try:
+            line = self._lines.readline(until)
+        except (TimeoutError, protocol.ProtocolError):  # nothing yet, or not the launcher's message
+            return None
+        return None if line is None else json.loads(line)
 
     def pump(self, wait):
         """File every ended process the launcher reported (waiting up to `wait` s for one); whether any."""

@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 from ..results import record as records
+from ..results.late import read_small
 from ..results.report import FORMAT, SubmissionGrade, one_line, safe_name
 from ..sandbox import backends, cgroup, forkserver
 
@@ -217,9 +218,8 @@ class Job:
                 return None, f"its grading process was killed by {name}"
             return None, f"its grading process ended with status {code} without a result{self.last_words()}"
         try:
-            if self.result.stat().st_size > records.MAX_RESULT:
-                return None, "its result was larger than the grader accepts"
-            data = json.loads(self.result.read_text(encoding="utf-8"))
+            raw = read_small(self.result, records.MAX_RESULT)  # ValueError when larger than the grader accepts
+            data = json.loads(raw.decode("utf-8"))
             if not isinstance(data, dict) or data.get("format") != FORMAT:
                 raise ValueError(f"format {data.get('format') if isinstance(data, dict) else data!r:.60}")
         except (OSError, ValueError) as exc:

@@ -176,7 +176,7 @@ def box(backend, limits):
 
 
 class ForkedProcess:
-    """The part of a Popen that :class:`labkit.grading.sandbox.remote.Notebook` uses, for a forked worker."""
+    """The part of a Popen that :class:`labkit.grading.sandbox.remote.NotebookHandle` uses, for a forked worker."""
 
     pid = None
 

@@ -29,6 +29,9 @@ evaluated. The notebook side encodes with :func:`encode`.
 import base64
 import json
 import math
+import os
+import select
+import time
 
 import numpy as np
 
@@ -286,3 +289,44 @@ def decode(tag, depth=0, functions=None):
             raise ProtocolError(f"{tag[1]!r} was not handed over for this request")
         return functions[tag[1]]
     raise ProtocolError(f"unknown value tag {kind!r}")
+
+
+class Lines:
+    """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError): the one line reader of
+    the grader, the supervisor, the notebook's process and the launcher."""
+
+    def __init__(self, fd, limit=MAX_LINE):
+        self.fd, self.limit, self.buffer = fd, limit, b""
+
+    def readline(self, until=None):
+        """The next line (without its newline), None at the end, TimeoutError after `until` (monotonic)."""
+        while b"\n" not in self.buffer:
+            if until is not None:
+                remaining = until - time.monotonic()
+                if not select.select([self.fd], [], [], max(0.0, remaining))[0]:  # a last look when it has passed
+                    raise TimeoutError()
+            chunk = os.read(self.fd, 1 << 20)
+            if not chunk:
+                return None
+            self.buffer += chunk
+            if len(self.buffer) > self.limit:
+                raise ProtocolError(f"a line longer than {self.limit} bytes")
+        line, _, self.buffer = self.buffer.partition(b"\n")
+        return line
+
+    def pump(self):
+        """Read what is there now (one chunk); ProtocolError when more piles up than `limit`."""
+        if select.select([self.fd], [], [], 0)[0]:
+            chunk = os.read(self.fd, 1 << 16)
+            self.buffer += chunk
+            if len(self.buffer) > self.limit:
+                raise ProtocolError(f"more than {self.limit} bytes written to the grader's watch")
+            return bool(chunk)
+        return False
+
+    def available(self):
+        """Every whole line that can be read now without waiting."""
+        while self.pump():
+            pass
+        *lines, self.buffer = self.buffer.split(b"\n")
+        return lines

@@ -1,6 +1,6 @@
 """The grader's handle on one sandboxed notebook: start it, run it, call into it, stop it.
 
-:class:`Notebook` starts the worker (:mod:`labkit.grading.sandbox.worker`) inside the
+:class:`NotebookHandle` starts the worker (:mod:`labkit.grading.sandbox.worker`) inside the
 sandbox of the backend its settings name (a :class:`~labkit.grading.options.GradeOptions`, or
 anything with the same fields: :class:`Settings`)
 (:mod:`labkit.grading.sandbox.backends`), tells it what the watch refuses, sends it
@@ -19,9 +19,7 @@ A time limit is an exception of its own type, raised where it is detected:
 function ran past its own limit. Callers tell them apart by type.
 """
 
-import os
 import secrets
-import selectors
 import signal
 import subprocess
 import sys
@@ -86,7 +84,7 @@ class CallEnded(StudentError):
 class Tampered(StudentError):
     """A call whose answer the grader's watch cannot vouch for (the notebook switched it off, went round it or
     wrote to its pipe): the supervisor's own marked answer, and the notebook's answers are void
-    (:attr:`Notebook.tampered`)."""
+    (:attr:`NotebookHandle.tampered`)."""
 
     grader_kind = TAMPERED
 
@@ -106,7 +104,7 @@ class Settings(Protocol):
     def total_timeout(self) -> float: ...  # seconds
 
 
-class Notebook:
+class NotebookHandle:
     """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest.
 
     `profiles` are what the watch refuses (:func:`labkit.grading.submission.refusals.wire`; none when
@@ -120,7 +118,6 @@ class Notebook:
         self.stopped = None  # why the worker can no longer answer
         self.stopped_kind = CRASH  # the kind of problem it is (labkit.exercises.result.KINDS), once stopped
         self.tampered = None  # what the notebook did that voids its answers
-        self._buffer = b""
         self.backend = backends.get_backend(self.options.backend)
         self.box = self._forked() if self.options.fork_server else None
         if self.box is None:
@@ -134,8 +131,7 @@ class Notebook:
                 self.box.stop()
                 self.box.close()
                 raise
-        self._selector = selectors.DefaultSelector()
-        self._selector.register(self.process.stdout, selectors.EVENT_READ)
+        self._lines = protocol.Lines(self.process.stdout.fileno())  # each answer at most protocol.MAX_LINE
         self.request(
             {
                 "op": "setup",
@@ -174,7 +170,6 @@ class Notebook:
             self.stopped = "the notebook ran out of memory"
             self.stopped_kind = CRASH
         self.box.close()
-        self._selector.close()
         for pipe in (self.process.stdin, self.process.stdout):
             try:
                 pipe.close()
@@ -221,27 +216,20 @@ class Notebook:
         return f"the notebook's process exited with status {code} (os._exit or a crash)"
 
     def _read_line(self, until):
-        while b"\n" not in self._buffer:
-            remaining = until - time.monotonic()
-            if remaining <= 0:
-                if until >= self.deadline:
-                    self._stop(
-                        "stopped after the total time limit: the notebook did not answer in time", NotebookTimeout
-                    )
-                self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
-            if not self._selector.select(remaining):
-                continue
-            chunk = os.read(self.process.stdout.fileno(), 1 << 20)
-            if not chunk:
-                try:
-                    self.process.wait(timeout=5)
-                except subprocess.TimeoutExpired:
-                    pass
-                self._stop(self._ended())
-            self._buffer += chunk
-            if len(self._buffer) > protocol.MAX_LINE:
-                self._stop("the notebook's process sent an answer larger than the protocol allows")
-        line, _, self._buffer = self._buffer.partition(b"\n")
+        try:
+            line = self._lines.readline(until)
+        except TimeoutError:
+            if until >= self.deadline:
+                self._stop("stopped after the total time limit: the notebook did not answer in time", NotebookTimeout)
+            self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
+        except protocol.ProtocolError:
+            self._stop("the notebook's process sent an answer larger than the protocol allows")
+        if line is None:
+            try:
+                self.process.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                pass
+            self._stop(self._ended())
         return line
 
 

@@ -112,50 +112,10 @@ def _tail(exc, lines=40):
     return "\n".join(text.rstrip().splitlines()[-lines:])[-4000:]
 
 
-class _Lines:
-    """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError)."""
-
-    def __init__(self, fd, limit=protocol.MAX_LINE):
-        self.fd, self.limit, self.buffer = fd, limit, b""
-
-    def readline(self, until=None):
-        """The next line (without its newline), None at the end, TimeoutError after `until` (monotonic)."""
-        while b"\n" not in self.buffer:
-            if until is not None:
-                remaining = until - time.monotonic()
-                if remaining <= 0 or not select.select([self.fd], [], [], remaining)[0]:
-                    raise TimeoutError()
-            chunk = os.read(self.fd, 1 << 20)
-            if not chunk:
-                return None
-            self.buffer += chunk
-            if len(self.buffer) > self.limit:
-                raise protocol.ProtocolError(f"a line longer than {self.limit} bytes")
-        line, _, self.buffer = self.buffer.partition(b"\n")
-        return line
-
-    def pump(self):
-        """Read what is there now (one chunk); ProtocolError when more piles up than `limit`."""
-        if select.select([self.fd], [], [], 0)[0]:
-            chunk = os.read(self.fd, 1 << 16)
-            self.buffer += chunk
-            if len(self.buffer) > self.limit:
-                raise protocol.ProtocolError(f"more than {self.limit} bytes written to the grader's watch")
-            return bool(chunk)
-        return False
-
-    def available(self):
-        """Every whole line that can be read now without waiting."""
-        while self.pump():
-            pass
-        *lines, self.buffer = self.buffer.split(b"\n")
-        return lines
-
-
 # -- the notebook's process -----------------------------------------------------
 
 
-class Notebook:
+class NotebookProcess:
     """The student's namespace in an IPython shell, and the answers to the grader's requests about it."""
 
     def __init__(self, shell, output):
@@ -280,7 +240,7 @@ def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles,
         chain=(_serve_one.__code__, _serve.__code__, _notebook_main.__code__),
     )
     os.close(key_fd)
-    _serve(Notebook(shell, output), _Lines(requests_fd), answers_fd)
+    _serve(NotebookProcess(shell, output), protocol.Lines(requests_fd), answers_fd)
 
 
 # -- the supervisor -------------------------------------------------------------
@@ -290,7 +250,7 @@ class Supervisor:
     """Holds the grader's pipes, forks and watches the notebook's process, forwards attested answers."""
 
     def __init__(self, requests_fd, answers_fd, shell):
-        self.requests, self.answers, self.shell = _Lines(requests_fd), answers_fd, shell
+        self.requests, self.answers, self.shell = protocol.Lines(requests_fd), answers_fd, shell
         self.setup, self.run_request = None, None
         self.child, self.restarts, self.ended = None, 0, None
         self.tampered = None  # what the watch reported: from then on no answer of this notebook counts
@@ -349,8 +309,8 @@ class Supervisor:
         self.child = {
             "pid": pid,
             "requests": pipes["requests"][1],
-            "answers": _Lines(pipes["answers"][0]),
-            "verdicts": _Lines(pipes["verdict"][0], 1 << 16),
+            "answers": protocol.Lines(pipes["answers"][0]),
+            "verdicts": protocol.Lines(pipes["verdict"][0], 1 << 16),
         }
 
     def stop(self, why=None):
@@ -536,7 +496,7 @@ def not_dumpable():
         pass
 
 
-def warm(everything=False):
+def preload(everything=False):
     """What every notebook imports, once, in the supervisor: each notebook's process starts with it; with
     `everything`, what the lab's notebooks import as well."""
     import matplotlib
@@ -571,7 +531,7 @@ def warm(everything=False):
     return shell
 
 
-def serve(requests, answers, shell):
+def supervise(requests, answers, shell):
     """Answer the grader on the descriptors `requests` and `answers` until it says bye; the student's code
     gets /dev/null for 0, 1 and 2 and the working folder on its path, as in a kernel."""
     given = (requests, answers)
@@ -597,7 +557,7 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     drop_privileges(int(argv[0]) if argv else 0)
     not_dumpable()
-    serve(0, 1, warm())
+    supervise(0, 1, preload())
 
 
 if __name__ == "__main__":

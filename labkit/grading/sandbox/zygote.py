@@ -4,7 +4,7 @@ Started by the grader (:mod:`labkit.grading.sandbox.forkserver`) as
 ``python -I -m labkit.grading.sandbox.zygote FD`` inside a sandbox its backend made
 (:meth:`labkit.grading.sandbox.backends.base.Backend.zygote_box`), with the
 capabilities to make namespaces and to change uid. It imports what notebooks
-need (:func:`labkit.grading.sandbox.worker.warm`), says ``ready`` on stdout and then
+need (:func:`labkit.grading.sandbox.worker.preload`), says ``ready`` on stdout and then
 waits on the socket `FD` for requests, one datagram each: a small JSON text
 (the notebook's uid and limits) and, passed along with it, the descriptors
 of the new worker (its requests and answers pipes, a control pipe, a status
@@ -179,7 +179,7 @@ def _keeper(fds, uid, limits, home, shell):
         try:
             requests, answers = _become_worker(fds, uid, limits)
             running = True
-            worker.serve(requests, answers, shell)
+            worker.supervise(requests, answers, shell)
         except BaseException as exc:  # noqa: BLE001 - the worker's end, whatever it is, is its status
             code = 1
             for fd in () if running else (FIRST_FD + 2, status):  # why it could not start, if it can still say
@@ -246,7 +246,7 @@ def _parse(data, fds):
     return named, uid, limits
 
 
-def serve(server, shell, home):
+def serve_forks(server, shell, home):
     """Fork an isolated worker for each request until the grader closes its end of the socket."""
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # keepers are reaped by the kernel
     while True:
@@ -293,10 +293,10 @@ def main(argv=None):
     ready = os.dup(1)
     for fd in (0, 1, 2):
         os.dup2(null, fd)
-    shell = worker.warm(everything=True)
+    shell = worker.preload(everything=True)
     os.write(ready, b"ready\n")
     os.close(ready)
-    serve(server, shell, os.getcwd())
+    serve_forks(server, shell, os.getcwd())
 
 
 if __name__ == "__main__":

@@ -371,7 +371,7 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
         return {}, [ProblemText.one(text, TIMEOUT)]
     problems, results = [], {}
     try:
-        notebook = remote.Notebook(options, deadline, _for_sandbox(profiles), registry.passable)
+        notebook = remote.NotebookHandle(options, deadline, _for_sandbox(profiles), registry.passable)
     except remote.NotebookTimeout:  # its sandbox was still starting when the submission's time ran out
         text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
         return {}, [ProblemText.one(text, TIMEOUT)]

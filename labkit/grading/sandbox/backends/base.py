@@ -1,6 +1,6 @@
 """What every sandbox backend provides, and what backends share.
 
-The grader's handle on a notebook (:class:`labkit.grading.sandbox.remote.Notebook`)
+The grader's handle on a notebook (:class:`labkit.grading.sandbox.remote.NotebookHandle`)
 and a grading run (:func:`labkit.grading.run.classrun.grade`) use a backend only
 through :class:`Backend`:
 
