@@ -3,7 +3,7 @@
 Run: ``.venv/bin/python benchmarks/bench_class.py [--count 300] [--keep DIR]``.
 The class is a mix of solved submissions (all six notebooks), half-solved
 ones (the first three notebooks solved, the others as released), the bare
-release, and a few hostile ones from the test suite (tests/test_hostile.py's
+release, and a few hostile ones from the test suite (tests/grading/test_hostile.py's
 attacks that end by themselves, and a notebook that is not JSON). Each way is
 run as an instructor runs it, ``labkit grade`` in a process of its own, with
 one seed; the shards one after another, each with --jobs 2 (as the tasks of a

@@ -1,5 +1,5 @@
 """Grade the catalog class of tests/catalog.py (15 correct variations, the typical mistakes, one MATLAB-style
-solution set) with one seed, as tests/test_catalog.py does, and write grades.csv into OUT.
+solution set) with one seed, as tests/exercises/test_catalog.py does, and write grades.csv into OUT.
 
 Run it from any checkout of labkit to compare two versions' grades, e.g. before and after a refactoring:
 

@@ -1262,7 +1262,7 @@ def summary():
 
     "before" is what the feedback said before issue 30 (`was`; the slips of issue 30's block graded by the
     checks of then), "now" what it says: "named" when the hint names the slip, "generic" when it says what
-    is verified and what to look at (tests/test_catalog.py checks both, and that none misleads)."""
+    is verified and what to look at (tests/exercises/test_catalog.py checks both, and that none misleads)."""
     count = lambda kinds: {kind: sum(k == kind for k in kinds) for kind in KINDS}
     return {
         "slips": len(MISTAKES),
@@ -1330,7 +1330,7 @@ GOLDEN = Path(__file__).with_name("data") / f"catalog_grades_seed{SEED}.csv"
 
 
 def grade_class(folder):
-    """Plant the catalog class in `folder` and grade it in the sandbox with :data:`SEED`, as tests/test_catalog.py
+    """Plant the catalog class in `folder` and grade it in the sandbox with :data:`SEED`, as tests/exercises/test_catalog.py
     does; ({submission name: its grade}, the run's output folder)."""
     from labkit import grading
 

@@ -6,7 +6,7 @@ released, slips named with the catalog's hints (``tests/catalog.py``), errors ra
 refused references, cells that raised, a crash and a submission that could not be graded, all worded
 as the grader words them. :func:`synthetic_sources` makes each student's source of a few graded
 functions: independent variants, plus a few copies. Nothing here is graded for real (that is
-tests/test_catalog.py's job); it is realistic input for the report, made in milliseconds.
+tests/exercises/test_catalog.py's job); it is realistic input for the report, made in milliseconds.
 """
 
 import numpy as np

@@ -106,3 +106,19 @@ def test_each_subpackage_of_grading_says_its_job_and_its_process():
         first = doc.splitlines()[0]
         assert first.endswith(".") and len(first) <= 120, f"{init}: the first line is its job, in one line"
         assert "process" in doc, f"{init} does not say which process its code runs in"
+
+
+def test_the_tests_mirror_the_packages():
+    """tests/<package path>/ holds the tests of labkit/<package path>/ (tests/library/ those of labkit/*.py);
+    tests/browser/ drives a real browser, and the files at the top are about the whole repository."""
+    tests = Path(__file__).resolve().parent
+    folders = sorted(
+        p.relative_to(tests).as_posix()
+        for p in tests.rglob("*")
+        if p.is_dir() and p.name != "__pycache__" and p.relative_to(tests).parts[0] not in ("data", "browser")
+    )
+    assert {"library", "exercises", "plots", "grading/run", "grading/sandbox"} <= set(folders)
+    for folder in folders:
+        package = ROOT if folder == "library" else ROOT / folder
+        assert (package / "__init__.py").is_file(), f"tests/{folder}/ mirrors no package of labkit"
+        assert any((tests / folder).glob("test_*.py")), f"tests/{folder}/ holds no test"

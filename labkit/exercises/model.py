@@ -224,7 +224,7 @@ class Exercise:
     ``notebook`` is the notebook the exercise is in. ``withheld`` is what the
     student is asked to find, written as it would appear in a text (an order,
     a derived formula, a worked value): no string the student can see may
-    contain one (``tests/test_giveaways.py``). An entry is a string, or a
+    contain one (``tests/exercises/test_giveaways.py``). An entry is a string, or a
     function of no arguments returning strings (values computed from labkit's
     references only when the answer key is asked for).
     """

@@ -1,4 +1,4 @@
-"""Figures of the lab, shared by the notebooks and tested in tests/test_plots.py.
+"""Figures of the lab, shared by the notebooks and tested in tests/plots/test_plots.py.
 
 * :mod:`~labkit.plots.figures` - each figure as a view built once and updated in place,
   and the one-call ``plot_*`` functions;

@@ -19,7 +19,7 @@ region announces :func:`status_text`, the selected handle and the worst
 quality, after every change.
 
 The handles' logic is plain Python, tested without a browser
-(``tests/test_plots.py``, ``tests/test_editor_access.py``):
+(``tests/plots/test_plots.py``, ``tests/plots/test_editor_access.py``):
 :func:`handle_positions`, :func:`nearest_handle`, :func:`move_handle`,
 :func:`corner_code`, :func:`handle_name`, :func:`status_text`. The browser
 side is ``editor.js`` beside this file, an anywidget module.

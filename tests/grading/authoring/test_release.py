@@ -18,7 +18,7 @@ ANSWERS = LAB.answers
 from labkit.grading.authoring.nbgrader import answer_ids, mark
 from labkit.grading.authoring.release import BEGIN_SOLUTION, END_SOLUTION, strip_solutions
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 STUDENT = ROOT / "labkit" / "student_notebooks"
 

@@ -20,7 +20,7 @@ from labkit.grading.sandbox import backends
 from labkit.grading.sandbox.backends import bwrap, none
 from labkit.grading.sandbox.backends.base import Backend, Limits
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 LABKIT = ROOT / "labkit"
 BACKENDS = LABKIT / "grading" / "sandbox" / "backends"
 NOTEBOOKS = ROOT / "notebooks"

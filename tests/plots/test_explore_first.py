@@ -20,7 +20,7 @@ from labkit.execute import RAISES
 
 nbclient = pytest.importorskip("nbclient")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 STUDENT = sorted((ROOT / "labkit" / "student_notebooks").glob("*.ipynb"))
 EXPLORE = re.compile(r"plots\.(\w+_explorer|patch_editor)\(")
 PROMPT = "**Predict, then explore.**"

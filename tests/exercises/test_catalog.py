@@ -105,7 +105,7 @@ def test_the_same_seed_gives_the_same_grades_csv_as_before_the_exercises_were_de
 
 
 def test_no_feedback_gives_an_answer_away(graded):
-    """The release scan (tests/test_giveaways.py) over the feedback of every graded slip and variation: step names,
+    """The release scan (tests/exercises/test_giveaways.py) over the feedback of every graded slip and variation: step names,
     details and hints, the student's own values ("got ...") left out; the answers in words are the student's."""
     from test_giveaways import OWN, giveaways
 

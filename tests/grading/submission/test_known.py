@@ -34,7 +34,7 @@ from labkit.grading.submission.scoring import (
 )
 from labkit.student_notebooks import paths
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 NOTEBOOKS = ROOT / "notebooks"
 INDEPENDENT = ROOT / "tests" / "data" / "independent"
 STYLES = sorted(p.name for p in INDEPENDENT.iterdir() if p.is_dir())

@@ -23,7 +23,7 @@ from labkit.grading import release_notebook
 
 nbgrader_api = pytest.importorskip("nbgrader.api")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 PACKAGED = ROOT / "labkit" / "student_notebooks"
 STUDENTS = ("instructor", "untouched", "untouched-labkit")

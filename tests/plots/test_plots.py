@@ -11,7 +11,7 @@ import labkit
 from labkit import plots
 from labkit.plots.explorers import NotShown
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(autouse=True)

@@ -20,7 +20,7 @@ from labkit.exercises.registry import LAB
 ANSWERS = LAB.answers
 from labkit.grading.results.rubric import default
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"
 RUBRIC = default()
 FULL = RUBRIC.full_credit

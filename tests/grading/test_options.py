@@ -13,7 +13,7 @@ from labkit.grading.options import CPU_GRACE, DEFAULTS, MIB, GradeOptions
 from labkit.grading.sandbox import remote
 from labkit.grading.sandbox.backends.base import Limits
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 LABKIT = ROOT / "labkit"
 
 
@@ -147,7 +147,7 @@ def test_the_defaults_are_spelled_out_only_in_the_options():
 def test_exercises_that_disagree_with_the_rubric_are_refused_before_anything_is_graded(tmp_path):
     from labkit import grading
 
-    notebook = Path(__file__).resolve().parents[1] / "notebooks" / "01_limacon.ipynb"
+    notebook = Path(__file__).resolve().parents[2] / "notebooks" / "01_limacon.ipynb"
     options = GradeOptions(exercises="some_course:REGISTRY", backend="none")
     with pytest.raises(ValueError, match="name the course's exercises in its rubric"):
         grading.grade([notebook], tmp_path / "out", options=options, progress=False)

@@ -17,7 +17,7 @@ import labkit
 from labkit import plots
 from labkit.plots import editor as editor_module
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 SQUARE = [labkit.Corner(p, [1.0, 0.0], [0.0, 1.0]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
 STATUS = re.compile(
     r"^(?P<name>.+) at \((?P<x>[-\d.]+), (?P<y>[-\d.]+)\)\. Worst quality (?P<worst>[-\d.]+)(, (?P<folded>\d+) folded)?\.$"

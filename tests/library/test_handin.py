@@ -23,13 +23,13 @@ from labkit.cli import main
 from labkit.exercises.registry import LAB
 from labkit.handin import DONE, FAILING, NOT_STARTED
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 INSTRUCTOR = ROOT / "notebooks"
 RELEASE = ROOT / "labkit" / "student_notebooks"
 NAME = "02_convergence.ipynb"
 SLIP = next(m for m in MISTAKES if m.name == "runge_derivative_sign")
 TYPO = ("for n in ndata]", "for n in n_data]")  # the table's cell raises NameError
-DOCS_MARKER = "<!-- ready to hand in: the half-done notebook's table, checked by tests/test_handin.py -->"
+DOCS_MARKER = "<!-- ready to hand in: the half-done notebook's table, checked by tests/library/test_handin.py -->"
 
 
 def _solved(source):

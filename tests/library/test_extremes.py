@@ -192,7 +192,7 @@ CALLS = {
 NO_NUMBERS = {
     "ConvergenceTable": "a record built by convergence_table and bilinear_convergence, which are in CALLS",
     "ready": "takes a version text; tested in labkit/notebook.py's doctest",
-    "ready_to_hand_in": "takes a notebook's name and its variables; bad ones are tested in tests/test_handin.py",
+    "ready_to_hand_in": "takes a notebook's name and its variables; bad ones are tested in tests/library/test_handin.py",
 }
 
 

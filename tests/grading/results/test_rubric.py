@@ -208,7 +208,7 @@ def test_the_points_example_the_rubric_and_the_docs_give_is_one_a_rubric_accepts
     import re
     from pathlib import Path
 
-    docs = (Path(__file__).resolve().parents[1] / "docs" / "instructors.md").read_text(encoding="utf-8")
+    docs = (Path(__file__).resolve().parents[3] / "docs" / "instructors.md").read_text(encoding="utf-8")
     comment = "\n".join(line.lstrip("# ") for line in rubrics.DEFAULT.read_text(encoding="utf-8").splitlines())
     examples = re.findall(r"\[points\]\s*\n\s*(\d+ = \d+)", comment) + re.findall(
         r"`\[points\]` table \(`(\d+ = \d+)`", docs

@@ -24,7 +24,7 @@ from labkit.grading.authoring.nbgrader import CHECK_CALL
 from labkit.grading.results.rubric import default
 from labkit.grading.sandbox import protocol
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = {path.name: path for path in sorted((ROOT / "notebooks").glob("*.ipynb"))}
 
 

@@ -26,7 +26,7 @@ from labkit._alt import figure_alt
 from labkit.exercises import answer_key, experiments, patches, splines
 from labkit.exercises.registry import LAB
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RELEASE = ROOT / "labkit" / "student_notebooks"
 INSTRUCTOR = ROOT / "notebooks"
 KEY = [

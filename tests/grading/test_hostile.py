@@ -34,7 +34,7 @@ from labkit.grading.results.report import safe_name
 from labkit.grading.results.rubric import default
 from labkit.grading.sandbox.backends.base import remove_tree
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"
 LABKIT = ROOT / "labkit"
 MARK = "labkit-hostile-7777"

@@ -1,7 +1,7 @@
 """The fork server: workers forked from one warm process, each as isolated from the others as a sandbox of its own.
 
-The hostile class (tests/test_hostile.py) and the catalog's identical-grades
-test (tests/test_catalog.py) go through the fork server, since a grading run
+The hostile class (tests/grading/test_hostile.py) and the catalog's identical-grades
+test (tests/exercises/test_catalog.py) go through the fork server, since a grading run
 uses it by default; here two notebooks forked from one server at the same
 time try to reach each other, and the plain way is checked to give the same
 grades.
@@ -21,7 +21,9 @@ from labkit.grading.options import GradeOptions
 from labkit.grading.sandbox import backends, forkserver, remote
 from labkit.grading.sandbox.backends.base import Limits
 
-NOTEBOOKS = os.path.join(os.path.dirname(os.path.dirname(__file__)), "notebooks")
+NOTEBOOKS = os.path.join(
+    os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))), "notebooks"
+)
 
 WALK = """
 import os, socket, stat

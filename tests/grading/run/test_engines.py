@@ -8,7 +8,7 @@ import pytest
 from labkit import grading
 from labkit.grading.run.engines import Batch, Engine, LocalEngine, Outcome
 
-NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
+NOTEBOOKS = Path(__file__).resolve().parents[3] / "notebooks"
 
 
 class Declining(Engine):

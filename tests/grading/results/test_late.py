@@ -567,7 +567,7 @@ def test_the_merge_command_lists_replacements_unknown_times_and_refuses_mtime(tm
 
 
 def test_the_late_tables_shown_in_the_docs_and_in_the_lab_rubric_are_valid():
-    docs = (Path(__file__).resolve().parents[1] / "docs" / "instructors.md").read_text()
+    docs = (Path(__file__).resolve().parents[3] / "docs" / "instructors.md").read_text()
     block = next(b for b in docs.split("```toml\n")[1:] if b.startswith("[late]")).split("```")[0]
     commented = rubrics.DEFAULT.read_text().partition("# [late]\n")[2]
     example = "[late]\n" + "\n".join(line.removeprefix("# ").removeprefix("#") for line in commented.splitlines())

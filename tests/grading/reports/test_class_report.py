@@ -3,7 +3,7 @@
 The class here is built from SubmissionGrade objects whose failed checks are made by the grader's own
 functions (labkit.exercises.result.call with the sandbox's exceptions, the registry's missing name, the
 scan's refusal, the run's problems), so the report reads the kind codes the grader sets where it makes them,
-never their wording (tests/test_kinds.py).
+never their wording (tests/grading/submission/test_kinds.py).
 The page in a real browser (no request leaves the machine, axe-core finds no serious violation) is
 tests/browser/test_class_report_browser.py.
 """
@@ -712,7 +712,7 @@ def _cli(*args):
         capture_output=True,
         text=True,
         timeout=120,
-        cwd=Path(__file__).parent,
+        cwd=Path(__file__).resolve().parents[2],
     )
 
 
