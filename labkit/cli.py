@@ -110,7 +110,7 @@ def _execute(args):
 
 
 def _release(args):
-    from .grading.authoring import release
+    from .grading.authoring.release import release
 
     for path in release(args.notebooks, args.out):
         print(f"wrote {path}")
