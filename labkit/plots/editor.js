@@ -2,8 +2,8 @@
 // The kernel sends a background picture and the mesh as a scene (both at the page's devicePixelRatio,
 // which this module reports in `pixel_ratio`), the handles in data coordinates and where the axes lie in
 // the picture (CSS pixels); this module paints the scene on a canvas over the background (in
-// requestAnimationFrame, the newest scene only; each paint raises data-labkit-shown and reports the scene's
-// seq in `shown`), draws the handles over it, moves them under the mouse at once, and sends the dragged
+// requestAnimationFrame, the newest scene only; each paint raises data-labkit-shown once its frame is
+// rendered), draws the handles over it, moves them under the mouse at once, and sends the dragged
 // handle's position to the kernel, one request at a time (the newest wins).
 // Keyboard: Tab enters and leaves the editor like any control (never trapped, WCAG 2.1.2); n / p select
 // the next / previous handle; the arrow keys move it (Shift: 5 times further). The picture and handles
@@ -209,11 +209,7 @@ function render({ model, el }) {
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || []);
-    stage.dataset.labkitShown = String(Number(stage.dataset.labkitShown) + 1);
-    if (typeof scene.seq === "number" && scene.seq > model.get("shown")) {
-      model.set("shown", scene.seq);
-      model.save_changes();
-    }
+    sceneShown(stage);
   }
   function schedule() {
     if (painting) return;

@@ -9,7 +9,7 @@ mesh's polygons and colours, drawn on a canvas over a background picture, both
 at the page's devicePixelRatio), the worst quality and the corner data as
 ``Corner(...)`` lines to copy into an exercise cell. Sliders set the mesh size
 and the twist. Moves that pile up while a picture is on its way are coalesced
-(:class:`labkit.plots.explorers.Coalescer`).
+(see :mod:`labkit.plots.explorers`).
 
 Without a mouse (:data:`KEYS`): Tab reaches the editor and leaves it as it
 leaves any control; ``n`` and ``p`` select the next and the previous handle,
@@ -30,7 +30,6 @@ import numpy as np
 from ..patches import Corner
 from .explorers import (
     DPI,
-    Coalescer,
     Painter,
     esm,
     freeze_layout,
@@ -153,7 +152,6 @@ def _editor_class():
         background = traitlets.Bytes(b"").tag(sync=True)  # PNG of what does not change with a move
         scene = traitlets.Dict({}).tag(sync=True)  # the mesh and title, drawn over it (scene.py)
         pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
-        shown = traitlets.Int(0).tag(sync=True)  # the seq of the last scene a browser painted
         handles = traitlets.List([]).tag(sync=True)  # [[x, y], ...] in data coordinates
         frame = traitlets.Dict({}).tag(sync=True)  # where the axes lie in the picture, for mouse -> data
         drag = traitlets.Dict({}).tag(sync=True)  # {"index", "x", "y", "seq"} from the browser
@@ -195,8 +193,7 @@ class Editor:
         freeze_layout(self.figure)
         self.painter = Painter(self.figure, self.view)
         self.scene = Scene(self.figure, self.view)
-        self.coalescer = Coalescer(self._send)
-        self.widget_.observe(lambda change: self.coalescer.was_shown(change["new"]), names="shown")
+        self.seq = 0  # the number of the last scene sent
         self.widget_.observe(self._new_ratio, names="pixel_ratio")
         self.widget_.observe(self._dragged, names="drag")
         self.widget_.observe(self._selected, names="selected")
@@ -218,12 +215,13 @@ class Editor:
             index, point = int(drag["index"]), (float(drag["x"]), float(drag["y"]))
         except (KeyError, TypeError, ValueError):
             return
-        if 0 <= index < 12 and all(np.isfinite(point)):
-            self.corners = move_handle(self.corners, index, point)
-            self.widget_.selected = index  # the browser selects a handle before it drags it: usually no change
-            self.refresh()
-        if isinstance(drag.get("seq"), int):
-            self.widget_.ack = drag["seq"]
+        with self.widget_.hold_sync():  # the picture and the acknowledgement in one message
+            if 0 <= index < 12 and all(np.isfinite(point)):
+                self.corners = move_handle(self.corners, index, point)
+                self.widget_.selected = index  # the browser selects a handle before it drags it: usually no change
+                self.refresh()
+            if isinstance(drag.get("seq"), int):
+                self.widget_.ack = drag["seq"]
 
     def _selected(self, change):
         if 0 <= change["new"] < 12:
@@ -244,15 +242,16 @@ class Editor:
         ratio = live_ratio(change["new"])
         if ratio != self.ratio:
             self.ratio = ratio
-            self.coalescer.request()
+            self.refresh()
 
     def refresh(self):
-        """Rebuild the mesh from the corners and send it: now, or once the picture on its way is shown."""
+        """Rebuild the mesh from the corners and send it."""
         if headless():  # nothing will show the picture, its readout or its handles
             self._draw_mesh()
             self.quality = self.view.mesh.quality()
             return
-        self.coalescer.request()
+        self.seq += 1
+        self._send(self.seq)
 
     def _send(self, seq):
         """Rebuild the mesh; send its scene, handles, readout, worst quality, alt and status."""
@@ -260,21 +259,24 @@ class Editor:
         self.quality = self.view.mesh.quality()
         worst = float(self.quality.min())
         background, items = self.scene.frame(self.ratio, DPI * self.ratio)
-        self.widget_.frame = self._frame()
-        self.widget_.handles = handle_positions(self.corners).round(6).tolist()
         folded = int(np.sum(self.quality <= 0))
-        self.widget_.readout = (
-            f"worst quality {worst:.2f}" + (f", {folded} folded" if folded else "") + "\n" + corner_code(self.corners)
-        )
-        self.widget_.worst = worst
         n = self.elements.value
-        self.widget_.alt = (
-            f"Mesh of the patch, {n} by {n} elements coloured by quality, with its 12 handles; worst quality "
-            f"{worst:.2f}" + (f", {folded} folded" if folded else "") + "."
-        )
-        self.widget_.status = status_text(self.corners, self.widget_.selected, self.quality)
         width, height = self.figure.canvas.get_width_height()
-        with self.widget_.hold_sync():
+        with self.widget_.hold_sync():  # one message a move: each message costs the browser a round of work
+            self.widget_.frame = self._frame()
+            self.widget_.handles = handle_positions(self.corners).round(6).tolist()
+            self.widget_.readout = (
+                f"worst quality {worst:.2f}"
+                + (f", {folded} folded" if folded else "")
+                + "\n"
+                + corner_code(self.corners)
+            )
+            self.widget_.worst = worst
+            self.widget_.alt = (
+                f"Mesh of the patch, {n} by {n} elements coloured by quality, with its 12 handles; worst quality "
+                f"{worst:.2f}" + (f", {folded} folded" if folded else "") + "."
+            )
+            self.widget_.status = status_text(self.corners, self.widget_.selected, self.quality)
             if background is not None:
                 self.widget_.background = background
             self.widget_.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}

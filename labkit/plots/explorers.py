@@ -12,12 +12,14 @@ background. Both are at the page's own ``devicePixelRatio`` (the browser
 reports it in ``pixel_ratio``), so text and lines are sharp on every screen.
 No new figure, no output area cleared and redrawn.
 
-Moves that pile up while a picture is on its way are coalesced: once a browser
-has shown a picture (it reports the picture's number in ``shown``), the
-kernel draws the next only when that picture is shown (or after
-``STALE_S``), from the controls' latest values; the moves in between are
-never drawn. The browser paints at most once an animation frame, the newest
-scene.
+Moves that pile up while a picture is on its way are coalesced without a
+message of labkit's own: a widget in the browser keeps one message on its way
+to the kernel at a time and merges the changes made meanwhile into the next
+(ipywidgets' ``WidgetModel.sync``), so a held key or a fast drag sends its
+latest value once the kernel has answered the last, and the kernel draws every
+request it gets at once. The browser paints at most once an animation frame,
+the newest scene. (A report from the browser of each picture shown, which the
+kernel waited for, cost a second round trip per move: ``docs/performance.md``.)
 
 Where widgets cannot run (nbval, ``jupyter nbconvert --execute``, GitHub's or
 nbviewer's static view, ``labkit grade``) the same output carries a PNG of the
@@ -34,7 +36,6 @@ is one line, e.g. ``plots.limacon_explorer()``.
 import base64
 import functools
 import pathlib
-import time
 
 import numpy as np
 
@@ -73,7 +74,6 @@ def shown_only(factory):
 DPI = 80  # CSS pixels per inch of the slider pictures (what they measure on the page)
 PIXEL_RATIO = 2  # device pixels per CSS pixel of the static picture (and of the live one until the page says)
 MAX_PIXEL_RATIO = 4  # a page's devicePixelRatio is taken between 1 and this
-STALE_S = 0.5  # a picture not reported shown after this long no longer holds the next one back
 
 
 def new_figure(size, dpi=DPI):
@@ -160,46 +160,14 @@ def _image_class():
         css_size = traitlets.List([0, 0]).tag(sync=True)  # [width, height] in CSS pixels
         description = traitlets.Unicode("").tag(sync=True)
         pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
-        shown = traitlets.Int(0).tag(sync=True)  # the seq of the last scene a browser painted
 
     return ExplorerImage
 
 
 def explorer_image():
-    """A new image widget of the explorers: ``background``, ``scene``, ``css_size``, ``description``,
-    ``pixel_ratio`` and ``shown``."""
+    """A new image widget of the explorers: ``background``, ``scene``, ``css_size``, ``description`` and
+    ``pixel_ratio``."""
     return _image_class()()
-
-
-class Coalescer:
-    """Sends a widget's pictures one at a time: while the last one sent is not yet shown, a new request
-    only marks the picture stale, and the report that it was shown (or the next request after STALE_S)
-    sends one picture of the latest state. Until a browser has reported a picture shown (tests,
-    nbconvert, a view not open yet) every request is drawn at once."""
-
-    def __init__(self, draw):
-        self.draw = draw
-        self.seq, self.shown, self.sent_at = 0, 0, 0.0
-        self.reported = False  # has a browser ever said it showed a picture?
-        self.pending = False
-        self.coalesced = 0  # requests that were never drawn, a newer one drawn instead
-
-    def request(self):
-        waiting = self.reported and self.shown < self.seq and time.monotonic() - self.sent_at < STALE_S
-        if waiting:
-            self.coalesced += int(self.pending)
-            self.pending = True
-            return
-        self.pending = False
-        self.seq += 1
-        self.sent_at = time.monotonic()
-        self.draw(self.seq)
-
-    def was_shown(self, seq):
-        self.reported = True
-        self.shown = max(self.shown, int(seq))
-        if self.pending and self.shown >= self.seq:
-            self.request()
 
 
 class Explorer:
@@ -230,13 +198,12 @@ class Explorer:
         self.image = explorer_image()
         self.redraws = 0
         self.ratio = float(PIXEL_RATIO)
-        self.coalescer = Coalescer(self._send)
+        self.seq = 0  # the number of the last scene sent
         for control in self.controls.values():
             control.observe(self.refresh, names="value")
         self._update(**self.values())
         freeze_layout(figure)
         self.image.css_size = list(self.css_size())
-        self.image.observe(lambda change: self.coalescer.was_shown(change["new"]), names="shown")
         self.image.observe(self._new_ratio, names="pixel_ratio")
         self.refresh()
         self.widget = widgets.VBox([*self.controls.values(), self.image])
@@ -249,11 +216,12 @@ class Explorer:
         return {name: control.value for name, control in self.controls.items()}
 
     def refresh(self, change=None):
-        """Bring the figure and its picture up to the controls: now, or once the picture on its way is shown."""
+        """Bring the figure and its picture up to the controls."""
         if headless():
             self._update(**self.values())
             return
-        self.coalescer.request()
+        self.seq += 1
+        self._send(self.seq)
 
     def _send(self, seq):
         """Update the figure from the controls and send its scene and description (one message)."""
@@ -271,7 +239,7 @@ class Explorer:
         ratio = live_ratio(change["new"])
         if ratio != self.ratio:
             self.ratio = ratio
-            self.coalescer.request()
+            self.refresh()
 
     @property
     def description(self):

@@ -82,6 +82,18 @@ def _fit(ax, x, y, margin=0.05):
         setter(low - pad, high + pad)
 
 
+def _fills(ax, x, y, share=0.75):
+    """Whether the points (x, y) lie inside the axes' limits and span at least `share` of each: the limits
+    may then stay as they are (a small move of a slider leaves the axes still, and only the curves are redrawn)."""
+    for (low, high), values in ((ax.get_xlim(), np.asarray(x)), (ax.get_ylim(), np.asarray(y))):
+        values = values[np.isfinite(values)]
+        if values.size == 0 or values.min() < low or values.max() > high:
+            return False
+        if values.max() - values.min() < share * (high - low):
+            return False
+    return True
+
+
 class View:
     """What every view of the lab's figures is, and what the explorers rely on.
 
@@ -134,7 +146,8 @@ class LimaconView(View):
         if self._r0 != r0:  # the exact curve depends on r0 only
             exact = limacon(np.linspace(0, 2 * np.pi, 2001), r0)
             self.exact.set_data(exact[0], exact[1])
-            _fit(self.ax, exact[0], exact[1])
+            if self._r0 is None or not _fills(self.ax, exact[0], exact[1]):
+                _fit(self.ax, exact[0], exact[1], margin=0.05 if self._r0 is None else 0.12)
             self._r0 = r0
         self.curve.set_data(xval, yval)
         label = METHOD_TITLES[method].lower()
@@ -154,11 +167,11 @@ class LimaconView(View):
         return self.ax
 
     def dynamic(self):
-        """The artists a move of the interval count changes (see PatchView.dynamic)."""
-        return [self.curve, self.data, self.ax.title]
+        """The artists a move of the interval count or of r0 changes (see PatchView.dynamic)."""
+        return [self.exact, self.curve, self.data, self.ax.title]
 
     def static_key(self):
-        return self.ax.get_xlim(), self.ax.get_ylim(), self.curve.get_label(), self._r0
+        return self.ax.get_xlim(), self.ax.get_ylim(), self.curve.get_label()
 
 
 class ErrorCurvesView(View):
@@ -325,6 +338,7 @@ class PatchView(View):
         self.cells = None
         self.folded = None  # the hatched outlines of the folded elements, when coloured by quality
         self.mesh = None
+        self._fitted = False  # have the axes been fitted to a mesh yet?
 
     def update(self, corners, ns=11, nt=11, s=None, t=None, title=None):
         s = np.linspace(0, 1, ns) if s is None else s
@@ -345,7 +359,10 @@ class PatchView(View):
                 self.cells.set_array(quality)
                 self.folded.set_verts(polygons[quality <= 0])
             self.ax.set_title(title)
-        _fit(self.ax, self.mesh.points[:, 0], self.mesh.points[:, 1])
+        x, y = self.mesh.points[:, 0], self.mesh.points[:, 1]
+        if not self._fitted or not _fills(self.ax, x, y):  # a move that keeps the mesh inside keeps the axes
+            _fit(self.ax, x, y, margin=0.12 if self._fitted else 0.05)
+            self._fitted = True
         folded = int(np.sum(quality <= 0))
         describe(
             self.ax,

@@ -4,9 +4,9 @@
 // reports in `pixel_ratio`; every move sends the changing artists as a scene, drawn here on a <canvas> over
 // the background in the same device pixels. Both are shown at the figure's CSS size, never wider than the
 // output area; the <img>'s alt text is the figure's description in numbers, updated with every move.
-// Paints happen inside requestAnimationFrame, at most one a frame, always of the newest scene (the moves that
-// arrived in between are never drawn); each paint raises data-labkit-shown and tells the kernel the scene's
-// seq in `shown`, so the kernel sends its next picture only once this one is on the page.
+// Paints happen inside requestAnimationFrame, at most one a frame, always of the newest scene (the scenes that
+// arrived in between are never drawn); each paint raises data-labkit-shown once its frame is rendered. Nothing
+// goes back to the kernel: a second message per move would cost a second trip (see explorers.py).
 function render({ model, el }) {
   const box = document.createElement("div");
   box.className = "labkit-explorer-picture";
@@ -40,11 +40,7 @@ function render({ model, el }) {
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || []);
-    box.dataset.labkitShown = String(Number(box.dataset.labkitShown) + 1);
-    if (typeof scene.seq === "number" && scene.seq > model.get("shown")) {
-      model.set("shown", scene.seq);
-      model.save_changes();
-    }
+    sceneShown(box);
   }
   function schedule() {
     if (queued) return;

@@ -137,6 +137,19 @@ function sceneText(ctx, item) {
   if (item.angle) ctx.rotate((-item.angle * Math.PI) / 180);
   ctx.fillText(item.text, 0, 0);
 }
+// a new picture is on the page: called inside the requestAnimationFrame that drew it, this waits for the end
+// of that frame's rendering (a message posted now is handled after it), then raises `node`'s
+// data-labkit-shown and notes the time in data-labkit-shown-at (performance.now(), the clock of an event's
+// timeStamp): the browser test and benchmarks/bench_browser_latency.py time a move to its picture shown
+function sceneShown(node) {
+  const channel = new MessageChannel();
+  channel.port1.onmessage = () => {
+    channel.port1.close();
+    node.dataset.labkitShownAt = String(performance.now());
+    node.dataset.labkitShown = String(Number(node.dataset.labkitShown) + 1);
+  };
+  channel.port2.postMessage(null);
+}
 // draw `items` on `canvas` (already the size of the picture in device pixels), cleared first
 function drawScene(canvas, items) {
   const ctx = canvas.getContext("2d");

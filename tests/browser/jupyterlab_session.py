@@ -66,8 +66,9 @@ def api(base, path):
 
 
 @contextlib.contextmanager
-def jupyterlab(home, served):
-    """A JupyterLab server on 127.0.0.1 serving the folder `served`; yields its base URL."""
+def jupyterlab(home, served, *options):
+    """A JupyterLab server on 127.0.0.1 serving the folder `served` (more command-line `options` after the
+    harness's own); yields its base URL. Its log is `home`/server.log."""
     home = Path(home)
     settings = home / "settings"
     for name, values in LAB_SETTINGS.items():
@@ -93,6 +94,7 @@ def jupyterlab(home, served):
         "--LabApp.extension_manager=readonly",
         "--LabApp.expose_app_in_browser=True",
         "--allow-root",
+        *options,
     ]
     log = open(home / "server.log", "w")
     server = subprocess.Popen(command, env=env, stdout=log, stderr=subprocess.STDOUT)
@@ -229,15 +231,26 @@ def show_explorers(page):
 EXPLORERS = "window.jupyterapp.shell.currentWidget.node.querySelectorAll('.labkit-explorer, .labkit-patch-editor')"
 
 PICTURE_STATE_NTH = f"""e => {{
-  // what explorer e shows now: the count of pictures its widget has painted (data-labkit-shown, set by
-  // image.js and editor.js inside requestAnimationFrame once the new picture is on the page), or, for a
-  // widget that keeps no count, its <img>'s src
+  // what explorer e shows now: the count of pictures its widget has shown (data-labkit-shown, raised by
+  // image.js and editor.js once the frame that drew the new picture is rendered) and when (data-labkit-shown-at),
+  // or, for a widget that keeps no count, its <img>'s src
   const node = {EXPLORERS}[e];
-  if (!node) return {{shown: null, src: null}};
+  if (!node) return {{shown: null, at: null, src: null}};
   const counter = node.querySelector('[data-labkit-shown]');
   const img = node.querySelector('img');
-  return {{shown: counter ? Number(counter.dataset.labkitShown) : null, src: img ? img.src : null}};
+  return {{shown: counter ? Number(counter.dataset.labkitShown) : null,
+           at: counter && counter.dataset.labkitShownAt ? Number(counter.dataset.labkitShownAt) : null,
+           src: img ? img.src : null}};
 }}"""
+
+# the page notes when its last key press or mouse move happened (the event's timeStamp, on the clock of
+# data-labkit-shown-at), so a move's time is measured inside the browser: no round trip of Playwright's in it
+NOTE_INPUT = """() => {
+  if (window.__labkitNotingInput) return;
+  window.__labkitNotingInput = true;
+  for (const type of ['keydown', 'pointermove'])
+    document.addEventListener(type, (event) => { window.__labkitInputAt = event.timeStamp; }, true);
+}"""
 
 NEW_PICTURE_SHOWN_NTH = f"""([e, old, framesBefore]) => {{
   // a new picture SHOWN in explorer e: its painted count went up; or an <img> whose src changed and is
@@ -254,15 +267,23 @@ def _picture_state_nth(page, e):
     return page.evaluate(PICTURE_STATE_NTH, e)
 
 
-def _wait_until_shown(page, e, old, frames_before):
-    """Wait until explorer e shows a picture newer than `old` (polled at every animation frame)."""
+def _wait_until_shown(page, e, old, frames_before, start):
+    """Wait until explorer e shows a picture newer than `old` (polled at every animation frame); the seconds from
+    the last key press or mouse move to that picture shown, measured in the page when the widget notes when it
+    showed it (else from `start`, a time.perf_counter(), to now)."""
     page.wait_for_function(NEW_PICTURE_SHOWN_NTH, arg=[e, old, frames_before], timeout=10_000, polling="raf")
+    now = time.perf_counter()
+    shown, pressed = page.evaluate(f"e => [({PICTURE_STATE_NTH})(e).at, window.__labkitInputAt ?? null]", e)
+    if shown is not None and pressed is not None and shown >= pressed:
+        return (shown - pressed) / 1000
+    return now - start
 
 
 def move_every_slider(page, panel, name):
     """Press the arrow keys on each explorer slider; {slider: [seconds from key press to new picture shown]}."""
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
+    page.evaluate(NOTE_INPUT)
     timings = {}
     explorers = panel.locator(".labkit-explorer, .labkit-patch-editor")
     for e in range(explorers.count()):
@@ -290,8 +311,7 @@ def move_every_slider(page, panel, name):
                 except PlaywrightTimeout:  # at the end of its range: go back
                     key = "ArrowLeft" if key == "ArrowRight" else "ArrowRight"
                     continue
-                _wait_until_shown(page, e, old, frames_before)
-                times.append(time.perf_counter() - start)
+                times.append(_wait_until_shown(page, e, old, frames_before, start))
             assert len(times) >= MOVES - 1, f"{label}: the slider did not move"
             timings[label] = times
     return timings
@@ -312,6 +332,7 @@ def drag_a_corner(page, panel):
     before_readout = readout.inner_text()
     box = corner.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.evaluate(NOTE_INPUT)
     page.mouse.move(x, y)
     page.mouse.down()
     steps = []
@@ -319,8 +340,7 @@ def drag_a_corner(page, panel):
         old, frames_before = _picture_state_nth(page, e), frames(page)
         start = time.perf_counter()
         page.mouse.move(x + 6 * k, y + 3 * k)
-        _wait_until_shown(page, e, old, frames_before)
-        steps.append(time.perf_counter() - start)
+        steps.append(_wait_until_shown(page, e, old, frames_before, start))
     page.mouse.up()
     page.wait_for_function(
         "([node, old]) => node.innerText !== old", arg=[readout.element_handle(), before_readout], timeout=10_000

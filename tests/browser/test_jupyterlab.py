@@ -24,6 +24,7 @@ from jupyterlab_session import (  # the lab and browser fixtures are in tests/co
     NOTEBOOKS,
     close_sessions,
     drag_a_corner,
+    frames,
     latencies,
     move_every_slider,
     open_and_run,
@@ -59,6 +60,24 @@ def _nudge_with_keys(page, panel, after_drag):
     keyed = readout.inner_text()
     assert keyed.splitlines()[2].split(", ds=")[0] == nudged.splitlines()[2].split(", ds=")[0]
     assert keyed.splitlines()[2] != nudged.splitlines()[2]
+
+
+def _held_key_ends_on_the_latest_value(page, panel, presses=12):
+    """A held key (presses as fast as the browser takes them, no waiting for pictures): the moves that pile up are
+    merged on their way to the kernel, and the picture left on the page is the one of the slider's last value."""
+    slider = panel.locator(".labkit-explorer .widget-slider").first  # y at t=1
+    readout, handle = slider.locator(".widget-readout"), slider.locator(".noUi-handle")
+    before = frames(page)
+    handle.focus()
+    for _ in range(presses):
+        page.keyboard.press("ArrowLeft")
+    value = float(readout.inner_text())
+    page.wait_for_function(
+        "([box, text]) => box.querySelector('img').alt.includes(text)",
+        arg=[panel.locator(".labkit-explorer .labkit-explorer-picture").first.element_handle(), f"(1, {value:g})"],
+        timeout=10_000,
+    )
+    print(f"\nheld key: {presses} presses, {frames(page) - before} pictures arrived, the last of y = {value:g}")
 
 
 def _explorer_pictures(page, panel):
@@ -185,6 +204,8 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
         assert after != before and after.splitlines()[2] != before.splitlines()[2], "corner B's readout did not change"
         _nudge_with_keys(page, panel, after)
         timings[f"{stem} editor drag step"] = steps
+    if stem == "05_monotone":
+        _held_key_ends_on_the_latest_value(page, panel)
     page.screenshot(path=str(SCREENSHOTS / f"{stem}-after.png"))
     measured = latencies(timings)
     LATENCIES.update(measured)

@@ -119,8 +119,23 @@ def test_a_view_updates_its_own_artists_instead_of_drawing_new_ones():
     x, y, _, _ = labkit.limacon(tdata, 0.8)
     np.testing.assert_allclose(view.data.get_xydata(), np.column_stack((x, y)))
     assert "0.8" in view.ax.get_title() and "20 intervals" in view.ax.get_title()
-    # the new limits hold the smaller curve
-    assert view.ax.get_xlim()[1] < 2.0
+    # the limits hold the smaller curve, and it fills three quarters of them or more
+    for (low, high), values in zip((view.ax.get_xlim(), view.ax.get_ylim()), view.exact.get_data()):
+        assert low <= values.min() and values.max() <= high
+        assert values.max() - values.min() >= 0.75 * (high - low)
+
+
+def test_a_small_move_of_r0_keeps_the_limaçon_axes_and_a_large_one_refits_them():
+    view = plots.LimaconView()
+    view.update(20, 1.15, "pherm")
+    key = view.static_key()
+    view.update(20, 1.2, "pherm")  # one step of the explorer's r0 slider: only the curves change
+    assert view.static_key() == key
+    x, y = view.exact.get_data()
+    np.testing.assert_allclose(x, labkit.limacon(np.linspace(0, 2 * np.pi, 2001), 1.2)[0])
+    view.update(20, 2.0, "pherm")  # the curve no longer fits: new limits around it
+    assert view.static_key() != key
+    assert view.ax.get_xlim()[1] >= 3.0
 
 
 def test_error_curves_view_hides_unselected_methods_and_rescales():

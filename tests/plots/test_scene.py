@@ -1,5 +1,5 @@
 """The explorers' live pictures (labkit/plots/scene.py): what the browser is sent to draw, at which pixel
-ratio, and how moves that pile up are coalesced. Where the browser draws it is tests/browser/test_jupyterlab.py's
+ratio, and that every move is drawn at once. Where the browser draws it is tests/browser/test_jupyterlab.py's
 (the drawn picture against the static one)."""
 
 import io
@@ -14,8 +14,7 @@ from PIL import Image
 
 import labkit
 from labkit import plots
-from labkit.plots import explorers
-from labkit.plots.explorers import Coalescer, live_ratio
+from labkit.plots.explorers import live_ratio
 
 
 def _floats(data):
@@ -125,35 +124,16 @@ def test_a_pixel_ratio_is_taken_between_1_and_4_in_quarters():
     assert [live_ratio(v) for v in (None, "big", float("nan"), -1, 0)] == [2.0] * 5
 
 
-def test_moves_that_pile_up_while_a_picture_is_on_its_way_are_drawn_once_with_the_latest_values():
+def test_every_move_the_kernel_gets_is_drawn_at_once_with_its_values_and_nothing_waits_for_the_browser():
     explorer = plots.pchip_explorer()
     slider = explorer.controls["y1"]
-    slider.value = 1.1
-    assert explorer.redraws == 2  # no browser has shown a picture yet: every move is drawn at once
-    explorer.image.shown = explorer.image.scene["seq"]  # a browser painted it
-    slider.value = 1.2  # drawn: nothing is on its way
-    assert explorer.redraws == 3
-    for value in (1.3, 1.4, 1.5):  # the picture of 1.2 is not shown yet: these wait
+    sent = []
+    explorer.image.observe(lambda change: sent.append(change["new"]["seq"]), names="scene")
+    for value in (1.1, 1.2, 1.3):  # no browser has said anything: each move is drawn and sent at once
         slider.value = value
-    assert explorer.redraws == 3 and explorer.coalescer.pending and explorer.coalescer.coalesced == 2
-    explorer.image.shown = explorer.image.scene["seq"]  # shown: one picture, of the latest value
-    assert explorer.redraws == 4 and not explorer.coalescer.pending
-    data = explorer.figure.axes[0].get_lines()[2]
-    assert data.get_ydata()[1] == 1.5 and "(1, 1.5)" in explorer.image.description
-
-
-def test_a_picture_never_shown_holds_the_next_back_only_a_moment(monkeypatch):
-    clock = [100.0]
-    monkeypatch.setattr(explorers.time, "monotonic", lambda: clock[0])
-    drawn = []
-    coalescer = Coalescer(drawn.append)
-    coalescer.request()
-    coalescer.was_shown(1)
-    coalescer.request()
-    coalescer.request()  # waits for seq 2
-    assert drawn == [1, 2] and coalescer.pending
-    clock[0] += explorers.STALE_S + 0.01  # its report was lost: the next move is drawn anyway
-    coalescer.request()
-    assert drawn == [1, 2, 3] and not coalescer.pending
-    coalescer.was_shown(1)  # a late, old report changes nothing
-    assert coalescer.shown == 1 and drawn == [1, 2, 3]
+        data = explorer.figure.axes[0].get_lines()[2]
+        assert data.get_ydata()[1] == value and f"(1, {value:g})" in explorer.image.description
+    assert sent == [2, 3, 4] and explorer.redraws == 4
+    # the picture's widget has no trait the browser would have to send back for the next move to be drawn
+    synced = explorer.image.keys
+    assert "shown" not in synced and set(synced) >= {"background", "scene", "pixel_ratio", "description"}
