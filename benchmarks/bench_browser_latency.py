@@ -5,9 +5,10 @@ Run: ``.venv/bin/python benchmarks/bench_browser_latency.py [--scale 2] [--pass 
 (``/usr/bin/chromium``, never a Playwright download) at ``deviceScaleFactor`` ``--scale`` (default 2:
 a HiDPI page) and drives each notebook's sliders with the browser test's code
 (``tests/browser/jupyterlab_session.py``): Run All, 8 arrow-key presses per slider and, in the patch
-editor, an 8-step drag of corner B. A time runs from the key press until the widget has painted the new
-picture (its painted count, set inside requestAnimationFrame, went up). The quiet pass runs alone;
-the busy pass first starts two CPU-bound processes (busy loops) and stops them after.
+editor, an 8-step drag of corner B. A time is read inside the page: from the key press's (or mouse move's)
+event timeStamp to the end of the frame that shows the new picture (the widget notes it in
+data-labkit-shown-at), so none of Playwright's round trips is in it. The quiet pass runs alone; the busy
+pass first starts two CPU-bound processes (busy loops) and stops them after.
 
 It prints the median and 90th percentile per slider and pass and exits non-zero if any slider's median is
 above QUIET_MEDIAN_MS quiet or BUSY_MEDIAN_MS busy, or its 90th percentile above QUIET_P90_MS quiet.
