@@ -22,7 +22,8 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[lab,grade,test]'
 	@# an editable install leaves out the config file a wheel brings, which enables labkit's server extension
-	install -D -m 644 jupyter/jupyter_server_config.d/labkit.json $(VENV)/etc/jupyter/jupyter_server_config.d/labkit.json
+	mkdir -p $(VENV)/etc/jupyter/jupyter_server_config.d
+	cp jupyter/jupyter_server_config.d/labkit.json $(VENV)/etc/jupyter/jupyter_server_config.d/labkit.json
 	touch $(STAMP)
 
 # The student copies (labkit notebooks) into $(WORK)/ on the first run only: an existing folder is never written to.

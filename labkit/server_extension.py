@@ -11,9 +11,9 @@ about a third of the moves when it was on (``docs/performance.md``).
 :func:`_load_jupyter_server_extension` therefore replaces the server's kernel websocket connection
 class by a subclass of it whose ``connect`` first switches Nagle off on that websocket. It subclasses
 whatever class the server was configured with (the default one, a gateway's or a course's own), so
-nothing else about the connection changes. Installing labkit enables the extension
-(``etc/jupyter/jupyter_server_config.d/labkit.json``); ``jupyter server extension disable
-labkit.server_extension`` turns it off.
+nothing else about the connection changes; a server without that setting (Jupyter Server 1) is left
+as it is. Installing labkit enables the extension (``etc/jupyter/jupyter_server_config.d/labkit.json``);
+``jupyter server extension disable labkit.server_extension`` turns it off.
 """
 
 from __future__ import annotations
@@ -26,29 +26,33 @@ def _jupyter_server_extension_points():
 
 
 def without_nagle(connection_class: type) -> type:
-    """A subclass of `connection_class` whose ``connect`` sets TCP_NODELAY on its websocket first.
-
-    Given a class this function already made, returns it unchanged.
+    """A subclass of `connection_class` (named ``NoNagle<its name>``) whose ``connect`` sets TCP_NODELAY on its
+    websocket first; a socket that refuses the option connects as before. Given a class this function already
+    made, returns it unchanged.
     """
     if getattr(connection_class, "_labkit_nodelay", False):
         return connection_class
 
     def connect(self):
         handler = getattr(self, "websocket_handler", None)
-        if handler is not None and hasattr(handler, "set_nodelay"):
-            handler.set_nodelay(True)
-            log = getattr(self, "log", None)
+        log = getattr(self, "log", None)
+        try:
+            if handler is not None:
+                handler.set_nodelay(True)
+                if log is not None:
+                    log.debug("labkit: this kernel websocket sends without Nagle's delay")
+        except (AttributeError, OSError) as exc:  # a handler without the call, a socket already closed
             if log is not None:
-                log.debug("labkit: this kernel websocket sends without Nagle's delay")
+                log.debug("labkit: Nagle's algorithm stays on for this kernel websocket (%s)", exc)
         return connection_class.connect(self)
 
     return type(
-        connection_class.__name__,
+        f"NoNagle{connection_class.__name__}",
         (connection_class,),
         {
             "connect": connect,
             "_labkit_nodelay": True,
-            "__module__": connection_class.__module__,
+            "__module__": __name__,
             "__doc__": f"{connection_class.__name__} with Nagle's algorithm off on its websocket (labkit).",
         },
     )
@@ -56,10 +60,13 @@ def without_nagle(connection_class: type) -> type:
 
 def _load_jupyter_server_extension(serverapp) -> None:
     settings = serverapp.web_app.settings
-    current = settings.get(SETTING) or serverapp.kernel_websocket_connection_class
+    current = settings.get(SETTING) or getattr(serverapp, SETTING, None)
     if isinstance(current, str):  # a class named in the configuration, not yet imported
         from traitlets.utils.importstring import import_item
 
         current = import_item(current)
+    if not isinstance(current, type):
+        serverapp.log.info("labkit: this server names no kernel websocket class; Nagle's algorithm is left as it is")
+        return
     settings[SETTING] = without_nagle(current)
     serverapp.log.info("labkit: kernel websockets send without Nagle's delay (%s)", current.__name__)

@@ -8,8 +8,10 @@ which rebuilds the mesh and sends it as a scene (:mod:`labkit.plots.scene`: the
 mesh's polygons and colours, drawn on a canvas over a background picture, both
 at the page's devicePixelRatio), the worst quality and the corner data as
 ``Corner(...)`` lines to copy into an exercise cell. Sliders set the mesh size
-and the twist. Moves that pile up while a picture is on its way are coalesced
-(see :mod:`labkit.plots.explorers`).
+and the twist. Moves that pile up while a picture is on its way are coalesced:
+``editor.js`` keeps one dragged position on its way until the kernel acknowledges
+it (``ack``) and sends only the newest after, and the sliders' messages are
+merged as the explorers' are (see :mod:`labkit.plots.explorers`).
 
 Without a mouse (:data:`KEYS`): Tab reaches the editor and leaves it as it
 leaves any control; ``n`` and ``p`` select the next and the previous handle,

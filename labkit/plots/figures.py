@@ -82,12 +82,14 @@ def _fit(ax, x, y, margin=0.05):
         setter(low - pad, high + pad)
 
 
-def _fills(ax, x, y, share=0.75):
-    """Whether the points (x, y) lie inside the axes' limits and span at least `share` of each: the limits
-    may then stay as they are (a small move of a slider leaves the axes still, and only the curves are redrawn)."""
+def _fills(ax, x, y, share=0.75, inset=0.03):
+    """Whether the points (x, y) lie inside the axes' limits, at least `inset` of each span from its edges (a
+    marker on a data point stays clear of the frame), and span at least `share` of each: the limits may then
+    stay as they are (a small move of a slider leaves the axes still, and only the curves are redrawn)."""
     for (low, high), values in ((ax.get_xlim(), np.asarray(x)), (ax.get_ylim(), np.asarray(y))):
         values = values[np.isfinite(values)]
-        if values.size == 0 or values.min() < low or values.max() > high:
+        room = inset * (high - low)
+        if values.size == 0 or values.min() < low + room or values.max() > high - room:
             return False
         if values.max() - values.min() < share * (high - low):
             return False
@@ -167,8 +169,10 @@ class LimaconView(View):
         return self.ax
 
     def dynamic(self):
-        """The artists a move of the interval count or of r0 changes (see PatchView.dynamic)."""
-        return [self.exact, self.curve, self.data, self.ax.title]
+        """The artists a move of the interval count or of r0 changes (see PatchView.dynamic), in the order they
+        are drawn: the exact curve under the legend, the interpolant and the data over it, as ever."""
+        legend = self.ax.get_legend()
+        return [self.exact, *([legend] if legend is not None else []), self.curve, self.data, self.ax.title]
 
     def static_key(self):
         return self.ax.get_xlim(), self.ax.get_ylim(), self.curve.get_label()

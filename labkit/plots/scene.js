@@ -128,6 +128,15 @@ function scenePatch(ctx, item) {
   if (!w || !h) return;
   ctx.putImageData(new ImageData(new Uint8ClampedArray(sceneBytes(item.rgba)), w, h), x, y);
 }
+function sceneOverlay(ctx, item) { // pixels with their transparency, blended over what is drawn under them
+  const [x, y, w, h] = item.box;
+  if (!w || !h) return;
+  const source = document.createElement("canvas");
+  source.width = w;
+  source.height = h;
+  source.getContext("2d").putImageData(new ImageData(new Uint8ClampedArray(sceneBytes(item.rgba)), w, h), 0, 0);
+  ctx.drawImage(source, x, y);
+}
 function sceneText(ctx, item) {
   ctx.font = item.font;
   ctx.fillStyle = sceneColor(item.fill);
@@ -164,6 +173,7 @@ function drawScene(canvas, items) {
     else if (item.kind === "polygons") scenePolygons(ctx, item);
     else if (item.kind === "image") sceneImage(ctx, item);
     else if (item.kind === "text") sceneText(ctx, item);
+    else if (item.kind === "overlay") sceneOverlay(ctx, item);
     ctx.restore();
   }
 }

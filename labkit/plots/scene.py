@@ -14,6 +14,9 @@ ticks, labels, the legend), which changes only when the view's ``static_key()`` 
   matplotlib's layout puts its baseline, drawn with the browser's DejaVu Sans (matplotlib's font) or the
   nearest sans-serif;
 * an axis (a colour bar's, whose scale follows the data): its tick marks as lines, its labels as texts;
+* a legend as an *overlay*: its own pixels with their transparency (RGBA, rendered here by Agg on a clear
+  picture), drawn in its place among the items, so what lies under it shows through its frame as it does
+  in matplotlib's drawing;
 * anything else (mathematics in a text, say) as a *patch*: the pixels of its box, rendered here by Agg over
   the background, sent raw (RGBA) so the browser draws them without decoding anything.
 
@@ -98,6 +101,7 @@ class Scene:
         self.key = None
         self.background = None  # Agg's saved copy of the background, for the patches
         self.backgrounds = 0  # how many backgrounds were rendered (a new one only when the static part changed)
+        self._overlays: dict = {}  # id(artist) -> (the background's key it was made under, its overlay item)
 
     def _device(self, xy):
         """Display coordinates (origin bottom left) -> the picture's device pixels (origin top left)."""
@@ -139,9 +143,12 @@ class Scene:
         from matplotlib.axis import Axis
         from matplotlib.collections import PolyCollection
         from matplotlib.image import AxesImage
+        from matplotlib.legend import Legend
         from matplotlib.lines import Line2D
         from matplotlib.text import Text
 
+        if isinstance(artist, Legend):
+            return [self._overlay(artist, renderer)]
         if isinstance(artist, Line2D):
             return [self._line(artist, renderer)]
         if isinstance(artist, Axis):
@@ -293,6 +300,31 @@ class Scene:
             "smooth": image.get_interpolation() not in ("nearest", "none"),
             "clip": self._clip(image),
         }
+
+    def _overlay(self, artist, renderer):
+        """The pixels of `artist` alone, with their transparency (Agg's RGBA is not premultiplied, as the browser's
+        ImageData), cut to its box; kept while the background's key stays (a legend changes with the axes)."""
+        from matplotlib.backends.backend_agg import RendererAgg
+
+        cached = self._overlays.get(id(artist))
+        if cached is not None and cached[0] == self.key:
+            return cached[1]
+        width, height = self.figure.canvas.get_width_height()
+        clear = RendererAgg(width, height, self.figure.dpi)
+        artist.draw(clear)
+        box = artist.get_window_extent(renderer)
+        left, right = max(0, int(np.floor(box.x0)) - 2), min(width, int(np.ceil(box.x1)) + 2)
+        top, bottom = max(0, int(np.floor(height - box.y1)) - 2), min(height, int(np.ceil(height - box.y0)) + 2)
+        item = {"kind": "overlay", "rgba": b"", "box": [0, 0, 0, 0]}
+        if right > left and bottom > top:
+            pixels = np.asarray(clear.buffer_rgba())[top:bottom, left:right]
+            item = {
+                "kind": "overlay",
+                "rgba": np.ascontiguousarray(pixels).tobytes(),
+                "box": [left, top, right - left, bottom - top],
+            }
+        self._overlays[id(artist)] = (self.key, item)
+        return item
 
     def _patch(self, artist, renderer):
         """The pixels of `artist`'s box, drawn by Agg over the background (a title, a colour bar)."""

@@ -253,7 +253,7 @@ NOTE_INPUT = """() => {
 }"""
 
 NEW_PICTURE_SHOWN_NTH = f"""([e, old, framesBefore]) => {{
-  // a new picture SHOWN in explorer e: its painted count went up; or an <img> whose src changed and is
+  // a new picture SHOWN in explorer e: its shown count went up; or an <img> whose src changed and is
   // decoded (complete: the next frame paints it); or (a canvas backend such as ipympl) image data arrived
   const now = ({PICTURE_STATE_NTH})(e);
   if (now.shown !== null && old.shown !== null) return now.shown > old.shown;

@@ -67,11 +67,12 @@ def _held_key_ends_on_the_latest_value(page, panel, presses=12):
     merged on their way to the kernel, and the picture left on the page is the one of the slider's last value."""
     slider = panel.locator(".labkit-explorer .widget-slider").first  # y at t=1
     readout, handle = slider.locator(".widget-readout"), slider.locator(".noUi-handle")
-    before = frames(page)
+    before, start = frames(page), float(readout.inner_text())
     handle.focus()
     for _ in range(presses):
         page.keyboard.press("ArrowLeft")
     value = float(readout.inner_text())
+    assert value < start, f"the held key did not move the slider ({start} -> {value})"
     page.wait_for_function(
         "([box, text]) => box.querySelector('img').alt.includes(text)",
         arg=[panel.locator(".labkit-explorer .labkit-explorer-picture").first.element_handle(), f"(1, {value:g})"],

@@ -57,7 +57,7 @@ class App:
 
 def test_the_websocket_sends_without_nagle_before_the_kernels_channels_open():
     wrapped = without_nagle(Connection)
-    assert issubclass(wrapped, Connection) and wrapped is not Connection and wrapped.__name__ == "Connection"
+    assert issubclass(wrapped, Connection) and wrapped is not Connection and wrapped.__name__ == "NoNagleConnection"
     handler = Handler()
     connection = wrapped(handler)
     assert connection.connect() == "connected"  # the class's own connect still runs, and its result is kept
@@ -75,7 +75,7 @@ def test_a_connection_without_a_websocket_handler_connects_as_before():
     assert without_nagle(Bare)().connect() == "bare"
 
 
-@pytest.mark.parametrize("configured", ["default", "custom", "named"])
+@pytest.mark.parametrize("configured", ["default", "custom", "named", "only on the app"])
 def test_the_extension_wraps_whatever_connection_class_the_server_has(configured):
     from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
 
@@ -84,12 +84,31 @@ def test_the_extension_wraps_whatever_connection_class_the_server_has(configured
         "custom": Connection,
         "named": "jupyter_server.services.kernels.connection.channels.ZMQChannelsWebsocketConnection",
     }
+    classes["only on the app"] = ZMQChannelsWebsocketConnection
     app = App(classes[configured])
+    if configured == "only on the app":  # the web app's settings lack it: the server's own trait is used
+        del app.web_app.settings[SETTING]
     _load_jupyter_server_extension(app)
     now = app.web_app.settings[SETTING]
     base = Connection if configured == "custom" else ZMQChannelsWebsocketConnection
     assert issubclass(now, base) and now is not base and getattr(now, "_labkit_nodelay", False)
     assert any("without Nagle's delay" in line for line in app.log.lines)
+
+
+def test_a_server_without_the_setting_is_left_as_it_is():
+    app = App(None)
+    app.web_app.settings.clear()
+    del app.kernel_websocket_connection_class
+    _load_jupyter_server_extension(app)
+    assert SETTING not in app.web_app.settings and "left as it is" in app.log.lines[-1]
+
+
+def test_a_socket_that_refuses_the_option_still_connects():
+    class Closed(Handler):
+        def set_nodelay(self, value):
+            raise OSError("socket closed")
+
+    assert without_nagle(Connection)(Closed()).connect() == "connected"
 
 
 def test_installing_labkit_enables_the_extension():
@@ -98,7 +117,7 @@ def test_installing_labkit_enables_the_extension():
     files = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["data-files"]
     assert files["etc/jupyter/jupyter_server_config.d"] == ["jupyter/jupyter_server_config.d/labkit.json"]
     target = "etc/jupyter/jupyter_server_config.d/labkit.json"
-    assert f"jupyter/jupyter_server_config.d/labkit.json $(VENV)/{target}" in (ROOT / "Makefile").read_text()
+    assert f"cp jupyter/jupyter_server_config.d/labkit.json $(VENV)/{target}" in (ROOT / "Makefile").read_text()
     assert "jupyter/jupyter_server_config.d/labkit.json" in (ROOT / "postBuild").read_text()
     assert server_extension._jupyter_server_extension_points() == [{"module": "labkit.server_extension"}]
 

@@ -125,16 +125,21 @@ def test_a_view_updates_its_own_artists_instead_of_drawing_new_ones():
         assert values.max() - values.min() >= 0.75 * (high - low)
 
 
-def test_a_small_move_of_r0_keeps_the_limaçon_axes_and_a_large_one_refits_them():
+def test_moves_of_r0_keep_the_limaçon_axes_mostly_and_the_curve_always_clear_of_the_frame():
     view = plots.LimaconView()
     view.update(20, 1.15, "pherm")
-    key = view.static_key()
-    view.update(20, 1.2, "pherm")  # one step of the explorer's r0 slider: only the curves change
-    assert view.static_key() == key
-    x, y = view.exact.get_data()
-    np.testing.assert_allclose(x, labkit.limacon(np.linspace(0, 2 * np.pi, 2001), 1.2)[0])
-    view.update(20, 2.0, "pherm")  # the curve no longer fits: new limits around it
-    assert view.static_key() != key
+    keys = [view.static_key()]
+    for r0 in np.arange(1.2, 1.56, 0.05):  # the explorer's slider, eight steps up
+        view.update(20, round(float(r0), 2), "pherm")
+        keys.append(view.static_key())
+        x, y = view.exact.get_data()
+        np.testing.assert_allclose(x, labkit.limacon(np.linspace(0, 2 * np.pi, 2001), round(float(r0), 2))[0])
+        for (low, high), values in zip((view.ax.get_xlim(), view.ax.get_ylim()), (x, y)):
+            room = 0.03 * (high - low)
+            assert low + room <= values.min() and values.max() <= high - room  # the data's markers clear the frame
+    changes = sum(a != b for a, b in zip(keys, keys[1:]))
+    assert 1 <= changes <= 2  # the axes grew with the curve, with room to spare: not at every step
+    view.update(20, 2.0, "pherm")  # far beyond: new limits around it
     assert view.ax.get_xlim()[1] >= 3.0
 
 

@@ -137,3 +137,23 @@ def test_every_move_the_kernel_gets_is_drawn_at_once_with_its_values_and_nothing
     # the picture's widget has no trait the browser would have to send back for the next move to be drawn
     synced = explorer.image.keys
     assert "shown" not in synced and set(synced) >= {"background", "scene", "pixel_ratio", "description"}
+
+
+def test_the_limacons_legend_is_an_overlay_between_the_exact_curve_and_the_interpolant():
+    """The exact curve changes with r0, so it is drawn live; the legend, which lay over it in the background,
+    comes as an overlay with its transparency, drawn after it and before the interpolant and the data (the
+    order of the static picture)."""
+    explorer = plots.limacon_explorer()
+    explorer.controls["r0"].value = 1.2
+    items = explorer.image.scene["items"]
+    kinds = [item["kind"] for item in items]
+    overlay = items[kinds.index("overlay")]
+    strokes = [item for item in items if item["kind"] == "line"]
+    assert kinds.index("overlay") == 1 and kinds[0] == "line" and kinds[2:4] == ["line", "line"]
+    assert strokes[0]["width"] > strokes[1]["width"]  # the exact curve (3 pt) first, then the interpolant
+    w, h = overlay["box"][2:]
+    rgba = np.frombuffer(overlay["rgba"], dtype=np.uint8).reshape(h, w, 4)
+    legend = explorer.figure.axes[0].get_legend().get_window_extent()
+    assert abs(overlay["box"][0] - legend.x0) <= 3 and abs(w - legend.width) <= 6  # its box, 2 px round it
+    alphas = set(np.unique(rgba[..., 3]))
+    assert 0 in alphas and 255 in alphas and any(0 < a < 255 for a in alphas)  # clear around, the frame see-through
