@@ -153,6 +153,7 @@ def _editor_class():
         _esm = esm("editor.js")
         background = traitlets.Bytes(b"").tag(sync=True)  # PNG of what does not change with a move
         scene = traitlets.Dict({}).tag(sync=True)  # the mesh and title, drawn over it (scene.py)
+        overlays = traitlets.Dict({}).tag(sync=True)  # the pixels the scene's overlay items name (sent on change)
         pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
         handles = traitlets.List([]).tag(sync=True)  # [[x, y], ...] in data coordinates
         frame = traitlets.Dict({}).tag(sync=True)  # where the axes lie in the picture, for mouse -> data
@@ -281,6 +282,7 @@ class Editor:
             self.widget_.status = status_text(self.corners, self.widget_.selected, self.quality)
             if background is not None:
                 self.widget_.background = background
+            self.widget_.overlays = self.scene.overlays
             self.widget_.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}
         self.redraws += 1
 

@@ -157,6 +157,7 @@ def _image_class():
         _esm = esm("image.js")
         background = traitlets.Bytes(b"").tag(sync=True)  # PNG of what does not change with a move
         scene = traitlets.Dict({}).tag(sync=True)  # {"seq", "size" (device px), "items"}: see scene.py
+        overlays = traitlets.Dict({}).tag(sync=True)  # the pixels the scene's overlay items name (sent on change)
         css_size = traitlets.List([0, 0]).tag(sync=True)  # [width, height] in CSS pixels
         description = traitlets.Unicode("").tag(sync=True)
         pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
@@ -232,6 +233,7 @@ class Explorer:
             self.image.description = self.description
             if background is not None:
                 self.image.background = background
+            self.image.overlays = self.scene.overlays
             self.image.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}
         self.redraws += 1
 

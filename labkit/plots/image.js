@@ -39,7 +39,7 @@ function render({ model, el }) {
     const [width, height] = scene.size || [0, 0];
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
-    drawScene(canvas, scene.items || []);
+    drawScene(canvas, scene.items || [], model.get("overlays") || {});
     sceneShown(box);
   }
   function schedule() {

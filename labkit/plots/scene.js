@@ -128,13 +128,23 @@ function scenePatch(ctx, item) {
   if (!w || !h) return;
   ctx.putImageData(new ImageData(new Uint8ClampedArray(sceneBytes(item.rgba)), w, h), x, y);
 }
-function sceneOverlay(ctx, item) { // pixels with their transparency, blended over what is drawn under them
-  const [x, y, w, h] = item.box;
+// an overlay's pixels (the widget's `overlays` trait, by the item's id) with their transparency, blended over
+// what is drawn under them; each overlay is turned into a canvas once and kept while its pixels stay the same
+const sceneOverlayCanvases = new WeakMap();
+function sceneOverlay(ctx, item, overlays) {
+  const overlay = overlays && overlays[item.id];
+  if (!overlay) return;
+  const [x, y, w, h] = overlay.box;
   if (!w || !h) return;
-  const source = document.createElement("canvas");
-  source.width = w;
-  source.height = h;
-  source.getContext("2d").putImageData(new ImageData(new Uint8ClampedArray(sceneBytes(item.rgba)), w, h), 0, 0);
+  let source = sceneOverlayCanvases.get(overlay);
+  if (!source) {
+    source = document.createElement("canvas");
+    source.width = w;
+    source.height = h;
+    const pixels = new Uint8ClampedArray(sceneBytes(overlay.rgba));
+    source.getContext("2d").putImageData(new ImageData(pixels, w, h), 0, 0);
+    sceneOverlayCanvases.set(overlay, source);
+  }
   ctx.drawImage(source, x, y);
 }
 function sceneText(ctx, item) {
@@ -159,8 +169,9 @@ function sceneShown(node) {
   };
   channel.port2.postMessage(null);
 }
-// draw `items` on `canvas` (already the size of the picture in device pixels), cleared first
-function drawScene(canvas, items) {
+// draw `items` on `canvas` (already the size of the picture in device pixels), cleared first; `overlays` holds
+// the pixels the overlay items name
+function drawScene(canvas, items, overlays) {
   const ctx = canvas.getContext("2d");
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.clearRect(0, 0, canvas.width, canvas.height);
@@ -173,7 +184,7 @@ function drawScene(canvas, items) {
     else if (item.kind === "polygons") scenePolygons(ctx, item);
     else if (item.kind === "image") sceneImage(ctx, item);
     else if (item.kind === "text") sceneText(ctx, item);
-    else if (item.kind === "overlay") sceneOverlay(ctx, item);
+    else if (item.kind === "overlay") sceneOverlay(ctx, item, overlays);
     ctx.restore();
   }
 }

@@ -16,7 +16,8 @@ ticks, labels, the legend), which changes only when the view's ``static_key()`` 
 * an axis (a colour bar's, whose scale follows the data): its tick marks as lines, its labels as texts;
 * a legend as an *overlay*: its own pixels with their transparency (RGBA, rendered here by Agg on a clear
   picture), drawn in its place among the items, so what lies under it shows through its frame as it does
-  in matplotlib's drawing;
+  in matplotlib's drawing. The item names the overlay; its pixels are in :attr:`Scene.overlays`, which the
+  widgets sync as a trait of their own, so they cross to the browser only when they change;
 * anything else (mathematics in a text, say) as a *patch*: the pixels of its box, rendered here by Agg over
   the background, sent raw (RGBA) so the browser draws them without decoding anything.
 
@@ -101,7 +102,8 @@ class Scene:
         self.key = None
         self.background = None  # Agg's saved copy of the background, for the patches
         self.backgrounds = 0  # how many backgrounds were rendered (a new one only when the static part changed)
-        self._overlays: dict = {}  # id(artist) -> (the background's key it was made under, its overlay item)
+        self.overlays: dict = {}  # an overlay's id -> {"rgba", "box"}: the pixels its scene items name
+        self._made: dict = {}  # an overlay's id -> the background's key it was rendered under
 
     def _device(self, xy):
         """Display coordinates (origin bottom left) -> the picture's device pixels (origin top left)."""
@@ -137,6 +139,10 @@ class Scene:
             if not artist.get_visible():
                 continue
             items.extend(self._items(artist, renderer))
+        named = {item["id"] for item in items if item["kind"] == "overlay"}
+        if set(self.overlays) - named:  # an overlay no item names any more (a legend replaced): gone
+            self.overlays = {name: pixels for name, pixels in self.overlays.items() if name in named}
+            self._made = {name: key for name, key in self._made.items() if name in named}
         return background, items
 
     def _items(self, artist, renderer):
@@ -306,24 +312,22 @@ class Scene:
         ImageData), cut to its box; kept while the background's key stays (a legend changes with the axes)."""
         from matplotlib.backends.backend_agg import RendererAgg
 
-        cached = self._overlays.get(id(artist))
-        if cached is not None and cached[0] == self.key:
-            return cached[1]
+        name = f"{type(artist).__name__.lower()}-{id(artist)}"
+        item = {"kind": "overlay", "id": name}
+        if self._made.get(name) == self.key:
+            return item
         width, height = self.figure.canvas.get_width_height()
         clear = RendererAgg(width, height, self.figure.dpi)
         artist.draw(clear)
         box = artist.get_window_extent(renderer)
         left, right = max(0, int(np.floor(box.x0)) - 2), min(width, int(np.ceil(box.x1)) + 2)
         top, bottom = max(0, int(np.floor(height - box.y1)) - 2), min(height, int(np.ceil(height - box.y0)) + 2)
-        item = {"kind": "overlay", "rgba": b"", "box": [0, 0, 0, 0]}
+        overlay = {"rgba": b"", "box": [0, 0, 0, 0]}
         if right > left and bottom > top:
             pixels = np.asarray(clear.buffer_rgba())[top:bottom, left:right]
-            item = {
-                "kind": "overlay",
-                "rgba": np.ascontiguousarray(pixels).tobytes(),
-                "box": [left, top, right - left, bottom - top],
-            }
-        self._overlays[id(artist)] = (self.key, item)
+            overlay = {"rgba": np.ascontiguousarray(pixels).tobytes(), "box": [left, top, right - left, bottom - top]}
+        self.overlays = {**self.overlays, name: overlay}  # a new dict: the widget's trait sees the change
+        self._made[name] = self.key
         return item
 
     def _patch(self, artist, renderer):

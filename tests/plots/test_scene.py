@@ -144,6 +144,8 @@ def test_the_limacons_legend_is_an_overlay_between_the_exact_curve_and_the_inter
     comes as an overlay with its transparency, drawn after it and before the interpolant and the data (the
     order of the static picture)."""
     explorer = plots.limacon_explorer()
+    sent = []
+    explorer.image.observe(lambda change: sent.append(change["new"]), names="overlays")
     explorer.controls["r0"].value = 1.2
     items = explorer.image.scene["items"]
     kinds = [item["kind"] for item in items]
@@ -151,9 +153,17 @@ def test_the_limacons_legend_is_an_overlay_between_the_exact_curve_and_the_inter
     strokes = [item for item in items if item["kind"] == "line"]
     assert kinds.index("overlay") == 1 and kinds[0] == "line" and kinds[2:4] == ["line", "line"]
     assert strokes[0]["width"] > strokes[1]["width"]  # the exact curve (3 pt) first, then the interpolant
+    overlay = explorer.image.overlays[overlay["id"]]  # its pixels travel in a trait of their own
     w, h = overlay["box"][2:]
     rgba = np.frombuffer(overlay["rgba"], dtype=np.uint8).reshape(h, w, 4)
     legend = explorer.figure.axes[0].get_legend().get_window_extent()
     assert abs(overlay["box"][0] - legend.x0) <= 3 and abs(w - legend.width) <= 6  # its box, 2 px round it
     alphas = set(np.unique(rgba[..., 3]))
     assert 0 in alphas and 255 in alphas and any(0 < a < 255 for a in alphas)  # clear around, the frame see-through
+    # the legend's pixels crossed once; moves that keep the axes send only the overlay's name
+    count = len(sent)
+    for intervals in (12, 14, 16):
+        explorer.controls["intervals"].value = intervals
+    assert len(sent) == count and "overlay" in [item["kind"] for item in explorer.image.scene["items"]]
+    explorer.controls["method"].value = "plin"  # a new legend: new pixels, and the old ones dropped
+    assert len(sent) == count + 1 and len(explorer.image.overlays) == 1
