@@ -82,6 +82,7 @@ bench: $(STAMP) chromium
 	$(PY) benchmarks/bench_sliders.py
 	$(PY) benchmarks/bench_grading.py
 	$(PY) benchmarks/bench_similarity.py
+	$(PY) benchmarks/bench_websocket.py
 	$(PY) benchmarks/bench_browser_latency.py
 	$(PY) benchmarks/bench_report.py
 	$(PY) benchmarks/bench_class.py $(CLASS_ARGS)  # a class of 300 three ways (CLASS_ARGS="--count 12" for a quick run)
