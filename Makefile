@@ -75,7 +75,8 @@ notebooks: $(STAMP)
 	$(VENV)/bin/labkit execute notebooks
 	$(VENV)/bin/labkit release notebooks --out labkit/student_notebooks
 
-# Speed limits live here, never in `make test`: the last step fails if a slider's median is above 100 ms.
+# Speed limits live here, never in `make test`: bench_browser_latency fails when a slider is above its limits
+# (median 50 ms and 90th percentile 100 ms quiet, median 100 ms with two CPU-bound processes running).
 bench: $(STAMP) chromium
 	$(PY) benchmarks/bench_core.py
 	$(PY) benchmarks/bench_2d.py
