@@ -9,6 +9,7 @@
 ``labkit report OUT``                      write OUT/report.html: the class at a glance, from a grading run
 ``labkit rubric``                          print the lab's rubric (TOML) to copy and edit for --rubric
 ``labkit export DIR --canvas FILE ...``    the totals into the course's Canvas gradebook (or --moodle)
+``labkit variants --new FILE``             a course's variants file: every student their own data
 """
 
 import argparse
@@ -109,11 +110,28 @@ def _execute(args):
     return 0
 
 
+def _roster_and_variants(args, purpose):
+    """(roster, variants file) of ``--roster`` and ``--variants``, both or neither (None, None)."""
+    if args.roster is None and args.variants is None:
+        return None, None
+    if args.roster is None or args.variants is None:
+        raise ValueError(f"give both --roster and --variants {purpose}, or neither.")
+    from .exercises import variants
+    from .grading.reports.lms import read_roster
+
+    return read_roster(args.roster), variants.read(args.variants)
+
+
 def _release(args):
     from .grading.authoring.release import release
 
-    for path in release(args.notebooks, args.out):
-        print(f"wrote {path}")
+    roster, variants = _roster_and_variants(args, "for a release per student")
+    written = release(args.notebooks, args.out, roster, variants)
+    if roster is None:
+        for path in written:
+            print(f"wrote {path}")
+    else:
+        print(f"wrote {len(written)} notebooks for {len(roster)} students into {args.out}, one folder each")
     return 0
 
 
@@ -285,6 +303,7 @@ def _grade(args):
         raise ValueError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
     options = grade_options(args)
     engine = _engine(args)
+    roster, variants = _roster_and_variants(args, "to grade each student against their own data")
     if args.shard is not None:
         from .grading.run.resume import parse_shard
 
@@ -317,6 +336,8 @@ def _grade(args):
             ungradable=found.ungradable,
             times_from_submission=args.times_from_submission,
             exchange_times=exchange,
+            roster=roster,
+            variants=variants,
         )
     rubric = grades.earlier.rubric
     _summary(grades, args.out, start, "listed")
@@ -325,6 +346,12 @@ def _grade(args):
     print(f"random test data from seed {(args.out / 'seed.txt').read_text().strip()} (repeat the run with --seed)")
     for line in found.notes:
         print(f"labkit grade: {line}", file=sys.stderr)
+    if variants is not None:
+        others = sum(any(v.get("other_variant") for v in g.results.values()) for g in grades if g.graded)
+        print(
+            f"each student graded against their own data; {others} submission(s) hold another's: see "
+            f"{args.out / 'variants.csv'}"
+        )
     _late_marks(grades, found.marked_late)
     unreadable = _times_notes(grades, rubric, times)
     failed = report_failures(grades)
@@ -544,6 +571,17 @@ def build_parser():
     )
     rel.add_argument("notebooks", type=Path, help="folder of instructor notebooks (the course repository's notebooks/)")
     rel.add_argument("--out", type=Path, required=True, help="folder for the student notebooks")
+    rel.add_argument(
+        "--roster",
+        type=Path,
+        help="CSV with the columns submission and id (as for labkit export): one folder per student, with --variants",
+    )
+    rel.add_argument(
+        "--variants",
+        type=Path,
+        metavar="SECRET_FILE",
+        help="the course's variants file (labkit variants --new): each student's notebooks hold their own data",
+    )
     rel.set_defaults(handler=_release)
 
     grd = commands.add_parser(
@@ -698,6 +736,17 @@ def build_parser():
         help="the instructor notebooks (the course repository's notebooks/): a graded part whose code is mostly "
         "theirs, names aside, is held for you like one that is labkit's or scipy's own (see "
         "docs/grading-security.md); recorded, and used again when the run resumes",
+    )
+    grd.add_argument(
+        "--roster",
+        type=Path,
+        help="CSV with the columns submission and id: with --variants, each student is graded against their own data",
+    )
+    grd.add_argument(
+        "--variants",
+        type=Path,
+        metavar="SECRET_FILE",
+        help="the course's variants file (labkit variants --new), as given to labkit release; recorded by its digest",
     )
     grd.add_argument(
         "--no-fork-server",
@@ -860,7 +909,78 @@ def build_parser():
     )
     rub.add_argument("--check", type=Path, metavar="FILE", help="validate this rubric and summarise it instead")
     rub.set_defaults(handler=_rubric)
+
+    var = commands.add_parser(
+        "variants",
+        help="every student their own data: make the variants file, redraw a student, show or check the draws",
+        description="A variants file holds the course's secret; each student's data (the limaçon's r0, ...) is "
+        "derived from it and the student's roster id, for `labkit release --roster --variants` and `labkit grade "
+        "--roster --variants`. Keep it private.",
+    )
+    action = var.add_mutually_exclusive_group(required=True)
+    action.add_argument("--new", type=Path, metavar="FILE", help="write a new variants file with a random secret")
+    action.add_argument(
+        "--redraw", metavar="ID", help="give the student with this roster id a fresh draw of --exercise"
+    )
+    action.add_argument("--show", action="store_true", help="print each roster student's data (needs --roster)")
+    action.add_argument(
+        "--check",
+        type=int,
+        metavar="N",
+        help="check N made-up students' draws (and the --roster's): the solutions earn full marks, the catalog's "
+        "slips are caught and named, a copy is caught; exits 1 naming every draw that is not",
+    )
+    var.add_argument("--variants", type=Path, metavar="SECRET_FILE", help="the course's variants file")
+    var.add_argument("--exercise", type=int, help="the exercise to redraw (with --redraw)")
+    var.add_argument("--roster", type=Path, help="CSV with the columns submission and id")
+    var.add_argument(
+        "--solutions", type=Path, default=Path("notebooks"), help="the instructor notebooks (default %(default)s)"
+    )
+    var.add_argument("--catalog", type=Path, help="a Python file of CORRECT variations and MISTAKES (slips) to check")
+    var.set_defaults(handler=_variants)
     return parser
+
+
+def _variants(args):
+    from .exercises import variants
+    from .exercises.registry import LAB
+    from .grading.reports.lms import read_roster
+    from .grading.results.report import one_line
+
+    if args.new is not None:
+        variants.new(args.new)
+        print(f"wrote {args.new}: keep it private; give it to `labkit release` and `labkit grade` as --variants")
+        return 0
+    if args.variants is None:
+        raise ValueError("give the course's variants file: --variants SECRET_FILE (make one with --new FILE).")
+    found = variants.read(args.variants)
+    roster = read_roster(args.roster) if args.roster is not None else None
+    if args.redraw is not None:
+        if args.exercise is None:
+            raise ValueError("--redraw needs --exercise N: the exercise whose data the student gets afresh.")
+        number = variants.redraw(args.variants, args.redraw, args.exercise, LAB)
+        values = variants.read(args.variants).values(LAB, args.redraw)[args.exercise]
+        print(f"{one_line(args.redraw, 60)} now has draw {number} of exercise {args.exercise}: {values}")
+        return 0
+    if args.show:
+        if roster is None:
+            raise ValueError("--show needs --roster: the students whose data to print.")
+        for name, key in roster.items():
+            values = found.values(LAB, key)
+            shown = "; ".join(
+                f"exercise {n}: " + ", ".join(f"{p} = {v}" for p, v in given.items()) for n, given in values.items()
+            )
+            print(f"{one_line(name, 40)} ({one_line(key, 30)}): {shown}")
+        return 0
+    from .grading.authoring.draws import check
+
+    troubles = check(
+        found, args.check, args.solutions, args.catalog, roster, progress=lambda line: print(line, flush=True)
+    )
+    for trouble in troubles:
+        print(f"not as it should be: {one_line(str(trouble), 300)}")
+    print(f"{len(troubles)} draw(s) not as they should be" if troubles else "every draw is as it should be")
+    return 1 if troubles else 0
 
 
 def _rubric(args):

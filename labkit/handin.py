@@ -24,6 +24,7 @@ import textwrap
 import warnings
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
+from numbers import Real
 from pathlib import Path
 
 from . import notebook as _notebook
@@ -219,10 +220,22 @@ def _parts(name: str, namespace: Mapping, raised: list) -> list:
         exercise = LAB.exercises[number]
         with warnings.catch_warnings(), contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
             warnings.simplefilter("ignore")  # the student's warnings were shown where their cells ran
-            found = LAB.check(number, namespace)  # seed None: the self-checks' own fixed data
+            # seed None: the self-checks' own fixed data; the notebook's own data where its exercise varies them
+            found = LAB.check(number, namespace, variant=_own_data(exercise, namespace))
         for part, check in zip(exercise.parts, found["checks"]):
             parts.append(_status(number, part, check, namespace, stubbed, failed))
     return parts
+
+
+def _own_data(exercise, namespace: Mapping) -> dict:
+    """The notebook's values of the data its exercise lets vary (a variant notebook's own, or the lab's), as
+    numbers; a name that is missing or not a number is left to the check's default, the lab's value."""
+    found = {}
+    for param in exercise.params:
+        value = namespace.get(param.name)
+        if isinstance(value, Real) and not isinstance(value, bool):
+            found[param.name] = float(value)
+    return found
 
 
 def _status(number: int, part, check: Mapping, namespace: Mapping, stubbed: set, failed: dict) -> PartStatus:

@@ -436,7 +436,7 @@ MISTAKES = (
         (
             (
                 "ax4.plot(xherm, yherm)",
-                "ax4.plot((1.15 + np.cos(tval)) * np.cos(tval), (1.15 + np.cos(tval)) * np.sin(tval))",
+                "ax4.plot((r0 + np.cos(tval)) * np.cos(tval), (r0 + np.cos(tval)) * np.sin(tval))",
             ),
         ),
         4,

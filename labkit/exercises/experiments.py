@@ -215,7 +215,7 @@ class ExperimentPart(Part):
     def self_check(self):
         return {check_driver: "driver", check_experiment: ("table" if self.index == 0 else "rate")}[self.check]
 
-    def run(self, namespace, seed=None):
+    def run(self, namespace, seed=None, variant=None):
         values = [
             namespace[name] if name in namespace or self.check is check_driver else MISSING for name in self.reads
         ]

@@ -13,8 +13,9 @@ import numpy as np
 from .. import functions, piecewise
 from .experiments import Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part, Together
-from .plotted import check_limacon_plot, derivative_slips
+from .plotted import LAB_R0, check_limacon_plot, derivative_slips
 from .result import CheckResult, call, case_rng, close, floats, gave_up, several, shown, worst
+from .variants import Param
 
 MONOMIAL_POINTS = np.array([-1.0, 0.5, 1.5, 3.0])
 
@@ -355,7 +356,7 @@ def _sign_slip(got, want):
 def check_limacon_derivatives(fn, seed=None):
     """Check ``limacon_derivatives(t, r0) -> (dxdt, dydt)`` of x = r cos t, y = r sin t, r = r0 + cos t."""
     result = CheckResult("limacon_derivatives")
-    cases = [(np.linspace(0, 2 * np.pi, 21), 1.15)]
+    cases = [(np.linspace(0, 2 * np.pi, 21), LAB_R0)]
     rng = case_rng(seed, "hermite.limacon_derivatives")
     cases.append((rng.uniform(-7.0, 7.0, 15), float(rng.uniform(0.3, 2.0)) if seed is not None else 0.5))
     for t, r0 in cases:
@@ -392,7 +393,7 @@ def check_limacon_derivatives(fn, seed=None):
                         "dr/dt is the derivative of cos t."
                     )
                     return result
-                if r0 != 1.15 and close(got, derivative_slips(t)[name][0][1]):
+                if r0 != LAB_R0 and close(got, derivative_slips(t)[name][0][1]):
                     result.hint = (
                         f"{name} is right for r0 = 1.15 but not for r0 = {r0:g}: use the r0 it is given "
                         "(r = r0 + cos t), not 1.15."
@@ -481,9 +482,12 @@ EXERCISES = (
                 check_limacon_plot,
                 ("ax4", Together(("tdata", "xdata", "ydata", "xpdata", "ypdata"), required=False)),
                 uses=("limacon_derivatives",),
+                varied=("r0",),
             ),
         ),
         notebook="01_limacon.ipynb",
         withheld=LIMACON_DERIVATIVES,
+        # the limaçon's offset: near 1 the curve nears the cardioid's cusp, and well above 1.3 its dimple flattens
+        params=(Param("r0", 1.05, 1.3, 3, lab=LAB_R0),),
     ),
 )

@@ -176,6 +176,7 @@ class Part:
     passes: tuple = ()
     keywords: tuple = ()  # (keyword, spec) pairs: notebook names handed to the check by keyword
     uses: tuple = ()  # the student's earlier functions this part relies on, each graded in a part of its own
+    varied: tuple = ()  # the exercise's parameters (Exercise.params) the check takes by keyword: the student's data
 
     def __post_init__(self):
         facade_name(self.check)
@@ -204,11 +205,16 @@ class Part:
         specs = tuple(self.reads) + tuple(spec for _, spec in self.keywords)
         return tuple(name for spec in specs for name in names_read(spec))
 
-    def run(self, namespace: Mapping, seed: int | None = None) -> Any:
+    def run(self, namespace: Mapping, seed: int | None = None, variant: Mapping | None = None) -> Any:
+        """The check's result on the notebook's names; `variant` ({parameter: value}) is the student's data,
+        the check's own defaults (the lab's) when None."""
         values = [read(namespace, spec) for spec in self.reads]
         keywords = {keyword: read(namespace, spec) for keyword, spec in self.keywords}
         if self.seeded:
             keywords["seed"] = seed
+        for name in self.varied:
+            if variant is not None and name in variant:
+                keywords[name] = variant[name]
         return self.check(*values, **keywords)
 
 
@@ -221,7 +227,9 @@ class Exercise:
     their weights. ``answers`` are the remarks and explanations the student
     writes in words: no check reads them, the feedback lists them for the
     instructor, and ``grades.csv`` has an empty column for each.
-    ``notebook`` is the notebook the exercise is in. ``withheld`` is what the
+    ``notebook`` is the notebook the exercise is in. ``params`` are the
+    data it lets vary per student (:mod:`labkit.exercises.variants`); the
+    parts that read them name them in :attr:`Part.varied`. ``withheld`` is what the
     student is asked to find, written as it would appear in a text (an order,
     a derived formula, a worked value): no string the student can see may
     contain one (``tests/exercises/test_giveaways.py``). An entry is a string, or a
@@ -236,6 +244,10 @@ class Exercise:
     answers: tuple = ()
     topic: str = field(default="", compare=False)
     withheld: tuple = field(default=(), compare=False)
+    # the data it lets vary per student (labkit.exercises.variants.Param), each assigned in a data cell
+    params: tuple = field(default=(), compare=False)
+    # why a draw of the params would not teach the exercise's lesson ('' when it does), for `labkit variants --check`
+    sound: Callable | None = field(default=None, compare=False)
 
     def __post_init__(self):
         seen = [part.name for part in self.parts]
@@ -245,6 +257,16 @@ class Exercise:
             raise ValueError(f"exercise {self.number} has no parts: give it at least one checked part.")
         if self.points <= 0:
             raise ValueError(f"exercise {self.number} is worth no points: give its parts positive weights.")
+        declared = [getattr(param, "name", None) for param in self.params]
+        if len(set(declared)) != len(declared):
+            raise ValueError(f"exercise {self.number} declares a parameter twice: give each its own name.")
+        for part in self.parts:
+            for name in part.varied:
+                if name not in declared:
+                    raise ValueError(
+                        f"part {part.name!r} of exercise {self.number} varies {name!r}, which the exercise does not "
+                        f"declare: add a Param named {name!r} to its params."
+                    )
 
     @property
     def points(self) -> int:

@@ -6,7 +6,8 @@ The plot is checked in :mod:`~labkit.exercises.plotted` and the experiment in
 
 from .experiments import Experiment
 from .model import Exercise, Part
-from .plotted import check_boiling_plot
+from .plotted import LAB_BOIL, LAB_RISE, boiling_sound, check_boiling_plot
+from .variants import Param
 
 PCHIP = Experiment("pchip", 2, "test_pchip_interpolate", "errors_pchip", "rate_pchip", weights=(4, 2, 2))
 
@@ -15,10 +16,13 @@ EXERCISES = (
         14,
         ("ax14",),
         tuple(
-            Part(name, 2, check_boiling_plot, ("ax14",), index=i)
+            Part(name, 2, check_boiling_plot, ("ax14",), index=i, varied=("rise", "boil"))
             for i, name in enumerate(("ax14: the data", "ax14: the not-a-knot spline", "ax14: pchip"))
         ),
         notebook="05_monotone.ipynb",
+        # the temperature at time 1 and the boiling point: rising, then flat, so the spline overshoots
+        params=(Param("rise", 0.6, 1.4, 2, lab=LAB_RISE), Param("boil", 1.8, 2.6, 2, lab=LAB_BOIL)),
+        sound=boiling_sound,
     ),
     Exercise(
         15,

@@ -43,25 +43,29 @@ def _no_plot(result, name, plot):
 # -- Exercise 4 ---------------------------------------------------------------
 
 
-def _distances(points, curve, bound):
+def _distances(points, curve, bound, neighbours=8):
     """For each of `points` (2, n) its distance to the polyline `curve` (2, m), or inf beyond `bound`.
 
-    The nearest vertex comes from a k-d tree; the distance is then taken to the
-    two segments at that vertex, so a dense polyline stands for the curve
-    to within its chord error (about 1e-7 here)."""
+    The nearest `neighbours` vertices come from a k-d tree; the distance is
+    then taken to the two segments at each of them, so a dense polyline
+    stands for the curve to within its chord error (about 1e-7 here), also
+    where the curve crosses itself (a vertex of the other branch may be the
+    nearest one)."""
     from scipy.spatial import cKDTree
 
-    near, index = cKDTree(curve.T).query(points.T, distance_upper_bound=bound)
-    found = np.isfinite(near)
-    best = near.copy()
+    near, index = cKDTree(curve.T).query(points.T, k=neighbours, distance_upper_bound=bound)
+    best = near.min(axis=1)
     last = curve.shape[1] - 1
+    found = np.isfinite(near)  # (n, k): the neighbours within the bound
+    rows, columns = np.nonzero(found)
+    vertex = index[rows, columns]
+    p = points[:, rows]
     for step in (-1, 1):
-        other = np.clip(index[found] + step, 0, last)
-        a, b, p = curve[:, np.minimum(index[found], last)], curve[:, other], points[:, found]
+        a, b = curve[:, vertex], curve[:, np.clip(vertex + step, 0, last)]
         ab = b - a
         length2 = np.maximum(np.sum(ab * ab, axis=0), 1e-300)
         u = np.clip(np.sum((p - a) * ab, axis=0) / length2, 0.0, 1.0)
-        best[found] = np.minimum(best[found], np.hypot(*(a + u * ab - p)))
+        np.minimum.at(best, rows, np.hypot(*(a + u * ab - p)))
     return best
 
 
@@ -78,16 +82,17 @@ def _hermite_curve(tdata, xdata, ydata, xpdata, ypdata, count=20001):
 
 
 NINTERVALS = 20  # the lab's: 21 points of the limaçon
+LAB_R0 = 1.15  # the lab's limaçon, r = 1.15 + cos t (a student's own with variants: labkit.exercises.variants)
 
 
-def _lab_hermite(r0=1.15, nintervals=NINTERVALS):
+def _lab_hermite(r0=LAB_R0, nintervals=NINTERVALS):
     """The lab's Hermite limaçon: 21 points of the curve with its exact derivatives."""
     tdata = np.linspace(0, 2 * np.pi, nintervals + 1)
     x, y, dx, dy = functions.limacon(tdata, r0=r0)
     return _hermite_curve(tdata, x, y, dx, dy)
 
 
-def derivative_slips(t, r0=1.15):
+def derivative_slips(t, r0=LAB_R0):
     """dx/dt and dy/dt of the limaçon at `t`, each with the slips Exercise 4's derivative check names:
     ``{"dx/dt": ((slip, values), ...), "dy/dt": ...}``, the right values first (slip ``""``)."""
     t = np.asarray(t, dtype=float)
@@ -112,7 +117,7 @@ def derivative_slips(t, r0=1.15):
     }
 
 
-def attempted_data(own, r0=1.15):
+def attempted_data(own, r0=LAB_R0):
     """Is the notebook's ``(tdata, xdata, ydata, xpdata, ypdata)`` an attempt at the lab's data?
 
     ``(data as floats, "")`` when it is: ``tdata``, ``xdata``, ``ydata`` are the lab's 21 points of the
@@ -131,11 +136,15 @@ def attempted_data(own, r0=1.15):
     tdata = np.linspace(0, 2 * np.pi, NINTERVALS + 1)
     x, y, _, _ = functions.limacon(tdata, r0=r0)
     if not (close(data[0], tdata) and close(data[1], x) and close(data[2], y)):
+        whose = "the lab's" if r0 == LAB_R0 else "your variant's"
+        given = "" if r0 == LAB_R0 else ", the r0 your notebook was given"
         return None, (
-            f"your tdata, xdata, ydata are not the lab's {NINTERVALS + 1} points of the limaçon "
-            f"(t from 0 to 2*pi, r0 = {r0:g})"
+            f"your tdata, xdata, ydata are not {whose} {NINTERVALS + 1} points of the limaçon "
+            f"(t from 0 to 2*pi, r0 = {r0:g}{given})"
         )
     slips = derivative_slips(tdata, r0)
+    if r0 != LAB_R0:  # a function that ignores its r0 for the lab's (the derivative check names it)
+        slips = {name: (*found, ("", derivative_slips(tdata)[name][0][1])) for name, found in slips.items()}
     for name, got in (("dx/dt", data[3]), ("dy/dt", data[4])):
         if not any(close(got, values) for _, values in slips[name]):
             return None, (
@@ -145,7 +154,7 @@ def attempted_data(own, r0=1.15):
     return data, ""
 
 
-def check_limacon_plot(plot, own=None, r0=1.15):
+def check_limacon_plot(plot, own=None, r0=LAB_R0):
     """Check Exercise 4's plot: the Hermite interpolant of the limaçon, drawn all the way round.
 
     The curve must be the piecewise cubic Hermite interpolant itself (to
@@ -173,7 +182,8 @@ def check_limacon_plot(plot, own=None, r0=1.15):
     curves = [("the Hermite interpolant of the lab's data", _lab_hermite(r0))]
     data, why = attempted_data(own, r0)
     if why:
-        judged_by_the_lab(result, why, "the lab's Hermite limaçon (its 21 points with the exact slopes)")
+        whose = "the lab's" if r0 == LAB_R0 else f"your variant's (r0 = {r0:g})"
+        judged_by_the_lab(result, why, f"{whose} Hermite limaçon (its 21 points with the exact slopes)")
     own_curve = _own_hermite(data)
     if own_curve is not None:
         curves.insert(0, ("the Hermite interpolant of your tdata, xdata, ydata, xpdata, ypdata", own_curve))
@@ -238,7 +248,7 @@ def check_limacon_plot(plot, own=None, r0=1.15):
     return result
 
 
-def _plot_slip(long, data, r0=1.15):
+def _plot_slip(long, data, r0=LAB_R0):
     """The slip that explains Exercise 4's curve, in the student's words ('' for none): x and y swapped, y
     drawn against t, the slopes of x and y swapped, or straight segments; of the notebook's own data when they
     are an attempt at the lab's (`data`), else of the lab's."""
@@ -282,7 +292,7 @@ def _plot_slip(long, data, r0=1.15):
     return ""
 
 
-def _limacon_curve(r0=1.15, count=20001):
+def _limacon_curve(r0=LAB_R0, count=20001):
     x, y, _, _ = functions.limacon(np.linspace(0, 2 * np.pi, count), r0=r0)
     return np.stack((x, y))
 
@@ -301,16 +311,39 @@ def _own_hermite(own):
 
 # -- Exercise 14 ----------------------------------------------------------------
 
-BOILING = (np.array([0.0, 1.0, 2.0, 3.0, 4.0]), np.array([0.0, 1.0, 2.0, 2.0, 2.0]))
+LAB_RISE, LAB_BOIL = 1.0, 2.0  # the lab's temperatures at times 1 and 2 (boiling from time 2 on)
+
+
+def boiling_data(rise=LAB_RISE, boil=LAB_BOIL):
+    """Exercise 14's data: times 0 to 4, the temperature 0 at time 0, `rise` at 1, and `boil` from 2 on."""
+    return np.array([0.0, 1.0, 2.0, 3.0, 4.0]), np.array([0.0, rise, boil, boil, boil], dtype=float)
+
+
+BOILING = boiling_data()
+
+
+def boiling_sound(values):
+    """Why a draw of Exercise 14's data would not teach its lesson ('' when it does): the spline must overshoot
+    the boiling point and dip below it, pchip must stay monotone and flat, and the two must differ visibly."""
+    xdata, ydata = boiling_data(values["rise"], values["boil"])
+    x = np.linspace(0, 4, 401)
+    spline, pchip = splines.spline(xdata, ydata, x), monotone.pchip(xdata, ydata, x)
+    boil = values["boil"]
+    if not (spline.max() > boil + 0.02 and spline[x >= 2].min() < boil - 0.02):
+        return "the spline neither overshoots the boiling point nor dips below it visibly"
+    if np.any(np.diff(pchip) < -1e-12) or np.abs(pchip[x >= 2] - boil).max() > 1e-12:
+        return "pchip is not monotone and flat after boiling starts"
+    return ""
 
 
 def _matches(line, values):
     return bool(np.allclose(line.y, values, rtol=0, atol=1e-6))
 
 
-def check_boiling_plot(plot):
-    """Check Exercise 14's plot: data circles without lines, then the spline and pchip curves."""
-    xdata, ydata = BOILING
+def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
+    """Check Exercise 14's plot: data circles without lines, then the spline and pchip curves, of the data
+    with the temperature `rise` at time 1 and `boil` from time 2 on (the lab's, or a student's variant)."""
+    xdata, ydata = boiling_data(rise, boil)
     results = Results()
     lines = lines_of(plot)
     if lines is None:

@@ -173,7 +173,7 @@ class Registry:
             key[exercise.number] = tuple(dict.fromkeys(texts))
         return key
 
-    def check(self, number: int, namespace: Mapping, seed: int | None = None) -> dict:
+    def check(self, number: int, namespace: Mapping, seed: int | None = None, variant: Mapping | None = None) -> dict:
         """Run the checks of exercise `number` on a notebook's variables; a dict for the grader.
 
         `namespace` is any mapping of names to the student's functions and
@@ -183,6 +183,13 @@ class Registry:
         part's ``weight``; ``fraction`` is the share of the weight that passed
         and ``points`` the weights that passed. `seed` draws the random test
         data afresh (see :func:`labkit.exercises.result.case_rng`).
+
+        `variant` ({parameter: value}) is the student's own data
+        (:mod:`labkit.exercises.variants`): the parts that vary are checked
+        against it, and ``other_variant`` lists, as {parameter: [the notebook's
+        value, the student's]}, each parameter whose value in the notebook is
+        not the student's (a notebook worked on another student's data). With
+        no `variant` the checks use the lab's data and nothing is compared.
         """
         exercise = self.exercises[number]
         defined = any(name in namespace for name in exercise.names)
@@ -193,10 +200,10 @@ class Registry:
                 refusing(part.refused)
             try:
                 if part.index is None:
-                    result = part.run(namespace, seed)
+                    result = part.run(namespace, seed, variant)
                 else:
                     if part.shared not in shared:
-                        shared[part.shared] = part.run(namespace, seed)
+                        shared[part.shared] = part.run(namespace, seed, variant)
                     result = shared[part.shared][part.index]
             except KeyError as exc:
                 result = _missing(str(exc).strip("'\""))
@@ -211,7 +218,14 @@ class Registry:
                 )
             checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # as the student names it
         points = sum(check["weight"] for check in checks if check["passed"])
+        other = {}
+        for param in exercise.params:
+            if variant is not None and param.name in variant and param.name in namespace:
+                found = namespace[param.name]
+                if not param.holds(found, variant[param.name]):
+                    other[param.name] = [_shown(found), variant[param.name]]
         return {
+            **({"other_variant": other} if other else {}),
             "exercise": number,
             "passed": points == exercise.points,
             "points": points,
@@ -219,6 +233,15 @@ class Registry:
             "defined": defined,
             "checks": checks,
         }
+
+
+def _shown(value) -> Any:
+    """A notebook's value of a varied parameter, as plain data for the feedback: a number, or a short text."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError, OverflowError):
+        return str(type(value).__name__)[:40]
+    return number if number == number and abs(number) < 1e300 else str(number)
 
 
 def _dependencies(parts) -> list:

@@ -29,7 +29,8 @@ TIMEOUT = "timeout"  # a cell, a call or the submission ran past its time limit
 CRASH = "crash"  # the notebook's process died or stopped answering the grader
 TAMPERED = "tampered"  # the notebook interfered with the grader's watch
 OTHER = "other"  # a fault of the check itself, or a problem of none of the kinds above
-KINDS = (NOT_DONE, RAISED, REFUSED, TIMEOUT, CRASH, TAMPERED, OTHER)  # of a failed step or a problem
+VARIANT = "another variant"  # the notebook holds data other than its student's own (labkit.exercises.variants)
+KINDS = (NOT_DONE, RAISED, REFUSED, TIMEOUT, CRASH, TAMPERED, OTHER, VARIANT)  # of a failed step or a problem
 
 
 @dataclass

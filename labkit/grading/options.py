@@ -38,6 +38,9 @@ class GradeOptions:
     )
     # the instructor notebooks' folder, a known source (labkit.grading.submission.known); None: left out
     solutions: str | None = None
+    # each student's own data (labkit.exercises.variants), derived by the class run from the roster and the
+    # variants file: {submission name: {exercise (text): {parameter: value}}}; None: the lab's data for all
+    variants: dict | None = None
 
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):
@@ -56,6 +59,10 @@ class GradeOptions:
                     f"solutions must be the folder of the instructor notebooks (or None); got {self.solutions!r}."
                 )
             object.__setattr__(self, "solutions", os.path.abspath(os.fspath(self.solutions)))
+        if self.variants is not None and not (
+            isinstance(self.variants, dict) and all(isinstance(v, dict) for v in self.variants.values())
+        ):
+            raise ValueError("variants must map each submission name to its data, {exercise: {parameter: value}}.")
         if not isinstance(self.limits, Limits):
             raise ValueError(f"limits must be a labkit.grading.sandbox.backends.base.Limits; got {self.limits!r}.")
 

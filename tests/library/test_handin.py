@@ -231,7 +231,9 @@ def test_only_the_self_checks_run_never_the_grader(monkeypatch):
     monkeypatch.setitem(sys.modules, "labkit.grading", None)
     seeds = []
     real = LAB.check
-    monkeypatch.setattr(LAB, "check", lambda number, ns, seed=None: seeds.append(seed) or real(number, ns, seed))
+    monkeypatch.setattr(
+        LAB, "check", lambda number, ns, seed=None, variant=None: seeds.append(seed) or real(number, ns, seed, variant)
+    )
     result = labkit.ready_to_hand_in("02_convergence", namespace=namespace, path=INSTRUCTOR / NAME)
     assert set(_statuses(result).values()) == {DONE}
     assert seeds == [None, None]  # exercises 2 and 3, on the self-checks' fixed data (a seed draws the grader's)

@@ -12,12 +12,21 @@ leave undefined) carry the tag ``raises-exception``, which :func:`tag_raising`
 gives the instructor notebook (``labkit execute`` calls it): Run All then goes on to
 the Explore section of a notebook nobody has written in yet, the self-checks saying
 what fails on the way, and nbgrader's release (which keeps tags) does the same.
+
+With a roster and a variants file (:mod:`labkit.exercises.variants`),
+:func:`release` writes one folder per student instead, each notebook's data
+cells (tagged ``variant-data``) holding that student's values
+(:func:`with_values`); every other cell is the same for the whole class.
 """
 
+import ast
 import json
+import re
 from pathlib import Path
 
 from ...execute import RAISES, notebook_paths, raising_cells, read_notebook, set_tag
+from ...exercises import variants as variant_data
+from ...exercises.registry import LAB
 
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
 BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
@@ -77,19 +86,104 @@ def tag_raising(nb, folder, name="notebook", timeout=300):
     return sorted(raising)
 
 
-def release(notebook_dir, out_dir):
-    """Write the student version of every notebook of `notebook_dir` into `out_dir`."""
+def with_values(nb, values, name="notebook", registry=LAB):
+    """Notebook `nb` (a new object) with its data cells holding `values` ({exercise: {parameter: value}}).
+
+    The data cells are the code cells tagged ``variant-data``; in them each
+    parameter of the notebook's exercises is a plain ``name = number``
+    assignment, whose number is replaced by the value as the notebook shows it
+    (comments and everything else stay). A notebook whose exercises vary but
+    whose data cells lack an assignment is refused (ValueError), so no student
+    is ever given the lab's data by mistake. The cell's metadata gets nothing:
+    the grader derives each student's values from the roster, never from the
+    notebook.
+    """
     import nbformat
 
+    copy = nbformat.from_dict(json.loads(json.dumps(nb)))
+    wanted = {}
+    for number, given in values.items():
+        exercise = registry.exercises.get(int(number))
+        if exercise is None or exercise.notebook != name:
+            continue
+        for param in exercise.params:
+            if param.name in given:
+                wanted[param.name] = (param, given[param.name])
+    done = set()
+    for index, cell in enumerate(copy.cells):
+        if cell.cell_type != "code" or variant_data.DATA_TAG not in cell.metadata.get("tags", []):
+            continue
+        try:
+            tree = ast.parse(cell.source)
+        except SyntaxError:
+            raise ValueError(f"{name}, cell {index}: a data cell must be plain Python assignments.") from None
+        lines = cell.source.split("\n")
+        edits = []
+        for node in tree.body:
+            if (
+                isinstance(node, ast.Assign)
+                and len(node.targets) == 1
+                and isinstance(node.targets[0], ast.Name)
+                and node.targets[0].id in wanted
+            ):
+                target = node.targets[0].id
+                value = node.value
+                if value.lineno != value.end_lineno or not isinstance(value, (ast.Constant, ast.UnaryOp)):
+                    raise ValueError(f"{name}, cell {index}: {target} must be assigned a number on one line.")
+                param, number = wanted[target]
+                edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, param.shown(number)))
+                done.add(target)
+        for line, start, end, text in sorted(edits, reverse=True):
+            row = lines[line].encode("utf-8")  # ast's offsets count bytes
+            lines[line] = (row[:start] + text.encode("utf-8") + row[end:]).decode("utf-8")
+        cell.source = "\n".join(lines)
+    missing = sorted(set(wanted) - done)
+    if missing:
+        raise ValueError(
+            f"{name} has no data cell assigning {', '.join(missing)}: add a code cell tagged "
+            f"{variant_data.DATA_TAG!r} with `{missing[0]} = <the lab's value>`."
+        )
+    return copy
+
+
+def folder_name(name):
+    """A student's release folder: the roster's submission name when it is a plain file name, else a safe one."""
+    from ..results.report import safe_name
+
+    name = str(name)
+    return name if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,59}", name) else safe_name(name)
+
+
+def release(notebook_dir, out_dir, roster=None, variants=None, registry=LAB):
+    """Write the student version of every notebook of `notebook_dir` into `out_dir`.
+
+    With `roster` ({submission name: roster id}, :func:`labkit.grading.reports.lms.read_roster`)
+    and `variants` (a :class:`labkit.exercises.variants.VariantsFile`), each
+    student gets a folder ``out_dir/<submission name>/`` whose notebooks hold
+    that student's data. Returns the paths written."""
+    import nbformat
+
+    if (roster is None) != (variants is None):
+        raise ValueError("give both --roster and --variants for a release per student, or neither.")
     paths = notebook_paths(notebook_dir)
     out = Path(out_dir)
     if out.resolve() == Path(notebook_dir).resolve():
         raise ValueError("--out must differ from the notebook folder; the release would overwrite the solutions.")
-    out.mkdir(parents=True, exist_ok=True)
+    students = (
+        {None: None} if roster is None else {name: variants.values(registry, key) for name, key in roster.items()}
+    )
+    folders = [folder_name(name) for name in students if name is not None]
+    if len(set(folders)) != len(folders):
+        raise ValueError("two roster entries would share a release folder; give each submission its own name.")
+    released = {path: release_notebook(read_notebook(path), path.name) for path in paths}
     written = []
-    for path in paths:
-        student = release_notebook(read_notebook(path), path.name)
-        target = out / path.name
-        nbformat.write(student, target)
-        written.append(target)
+    for name, values in students.items():
+        folder = out if name is None else out / folder_name(name)
+        folder.mkdir(parents=True, exist_ok=True)
+        for path, student in released.items():
+            if values is not None:
+                student = with_values(student, values, path.name, registry)
+            target = folder / path.name
+            nbformat.write(student, target)
+            written.append(target)
     return written

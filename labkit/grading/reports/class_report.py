@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
-from ...exercises.result import CRASH, NOT_DONE, OTHER, PASSED, RAISED, REFUSED, SLIP, TAMPERED, TIMEOUT
+from ...exercises.result import CRASH, NOT_DONE, OTHER, PASSED, RAISED, REFUSED, SLIP, TAMPERED, TIMEOUT, VARIANT
 from ..results import late as lateness
 from ..results.record import rubric_for
 from ..results.report import SubmissionGrade, one_line, printable, read_results
@@ -78,6 +78,10 @@ KINDS = {
         "A graded function called, or its source reached for, a reference implementation the exercise switches off",
     ),
     TAMPERED: ("Answers voided", "The notebook interfered with the grader's watch, so none of its answers count"),
+    VARIANT: (
+        "Another variant's data",
+        "The notebook holds data other than its student's variant: copied, or worked on another's notebook",
+    ),
     NOT_GRADED: (
         "Could not be graded",
         "The grading itself failed twice; these submissions have no points (not zero) and no other row here",

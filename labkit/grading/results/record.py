@@ -10,6 +10,8 @@ the grader alone and replaced whole each time it changes:
 * ``rubric``: the rubric in force, in full (its TOML as JSON data, the
   ``[late]`` table and its extensions included), also copied to
   ``rubric.toml`` beside it for a person to read;
+* ``variants``: with a variants file, its digest (never its secret) and
+  each student's data as graded;
 * ``submissions``: for each submission graded, its result file's name and
   SHA-256, and the digest of its notebooks' content (:func:`content_digest`).
 
@@ -73,6 +75,9 @@ class RunRecord:
     # the known sources graded parts were compared with (labkit.grading.submission.known):
     # {"digest": ..., "solutions": path}
     known: dict = field(default_factory=dict)
+    # the students' own data (labkit.exercises.variants): {"digest": the variants file's, "students": {name:
+    # {exercise: {parameter: value}}}}, empty for a run without variants
+    variants: dict = field(default_factory=dict)
 
     def given_times(self, source):
         """{name: datetime} of the times the run was given from `source` (``"csv"``: ``--times``; ``"exchange"``)."""
@@ -92,6 +97,7 @@ class RunRecord:
             "times": self.times,
             "flags": self.flags,
             "known": self.known,
+            "variants": self.variants,
         }
 
     def rubric_object(self, folder):
@@ -190,13 +196,16 @@ def read(folder):
         known = data.get("known") or {}
         if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
             raise ValueError("its known sources are not named by text")
+        variants = data.get("variants") or {}
+        if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
+            raise ValueError("its variants are not a table of students")
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
     return RunRecord(
         data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags,
-        known,
+        known, variants,
     )  # fmt: skip
 
 

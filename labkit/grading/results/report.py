@@ -55,7 +55,7 @@ class ProblemText(str):
     Traceback (most recent call last):
     ...
     ValueError: a problem's kind is one of 'not done', 'raised', 'refused', 'timeout', 'crash', 'tampered', \
-'other', not 'stopped'.
+'other', 'another variant', not 'stopped'.
     """
 
     kinds: tuple

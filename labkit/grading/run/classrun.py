@@ -65,6 +65,8 @@ def grade(
     exchange_times=None,
     times_from_submission: bool = False,
     times_from_mtime: bool = False,
+    roster=None,
+    variants=None,
 ):
     """Grade submissions; write grades.csv, feedback/, results/, seed.txt and the run's record into `out_dir`.
 
@@ -92,6 +94,13 @@ def grade(
     only with `times_from_mtime`, from its notebooks' modification time
     (:func:`labkit.grading.results.late.submission_time`); the last two are written
     by the student and marked "student-supplied" wherever they are shown.
+
+    With `variants` (a :class:`labkit.exercises.variants.VariantsFile`) and
+    `roster` ({submission name: roster id}), each submission is graded against
+    its student's own data, derived here from the roster id (never from the
+    notebook); a submission the roster lacks could not be graded. The run
+    records the file's digest and each student's data; resuming it needs the
+    same file again.
 
     Each submission's result and feedback are written as soon as it is
     graded, and entered in ``record.json`` (:mod:`labkit.grading.results.record`).
@@ -148,6 +157,19 @@ def grade(
     given_rubric = None if options.rubric is None else load_rubric(options.rubric)
     earlier = resumed(out, [*names, *ungradable], options.seed, given_rubric, fresh, contents)
     done, rubric = earlier.done, earlier.rubric
+    students = _variants(rubric.registry, names, roster, variants, ungradable)
+    kept = [(path, name) for path, name in zip(submissions, names) if name not in ungradable]
+    submissions, names = [path for path, _ in kept], [name for _, name in kept]
+    recorded_variants = earlier.record.variants if earlier.record is not None else {}
+    if earlier.record is not None and earlier.done:
+        digest = variants.digest if variants is not None else None
+        if recorded_variants.get("digest") != digest:
+            before = f"with the variants {recorded_variants['digest']}" if recorded_variants else "without variants"
+            now = f"with {digest}" if digest else "without"
+            raise ValueError(
+                f"{out} was graded {before}, and now {now}: grade with the same --variants (and --roster) as "
+                "before, into a new --out, or again with --fresh."
+            )
     seed = secrets.randbits(63) if earlier.seed is None else int(earlier.seed)
     if options.exercises not in (None, rubric.registry.source):
         raise ValueError(
@@ -192,6 +214,11 @@ def grade(
     }
     record.flags = {"times from submission": bool(times_from_submission), "times from mtime": bool(times_from_mtime)}
     record.known = {"digest": known.digest, "solutions": solutions}
+    if variants is not None:
+        record.variants = {
+            "digest": variants.digest,
+            "students": {**recorded_variants.get("students", {}), **students},
+        }
     records.write(out, record)
     # The options every grading process gets, settled once: the seed drawn, the rubric's exercises loaded
     # there, and the rubric read from the record's copy (the one the results are scored with here).
@@ -201,6 +228,7 @@ def grade(
         exercises=rubric.registry.source,
         solutions=solutions,
         rubric=str((out / records.RUBRIC_COPY).resolve()) if rubric.text is not None else options.rubric,
+        variants=students if variants is not None else None,
     )
     (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
     when = dict(zip(names, handed_in))
@@ -239,6 +267,8 @@ def grade(
     for grade in ordered:
         grade.time = when[grade.name]
     write_report(out, ordered, record)
+    if variants is not None:
+        _write_variants(out, ordered, record.variants["students"], roster, rubric.registry)
     for name, lost in dropped:
         sys.stderr.write(
             f"labkit grade: {one_line(name, 80)}'s notebooks changed; {lost} of the marks given to it no longer "
@@ -265,6 +295,67 @@ def grade(
         encoding="utf-8",
     )
     return Graded(ordered, earlier)
+
+
+def _variants(registry, names, roster, variants, ungradable):
+    """{name: {exercise (text): {parameter: value}}} of the submissions a roster names; the others go into
+    `ungradable` with the reason. Empty without variants; ValueError for a roster without variants or the reverse."""
+    if (roster is None) != (variants is None):
+        raise ValueError("give both --roster and --variants to grade each student against their own data, or neither.")
+    if variants is None:
+        return {}
+    found = {}
+    for name in names:
+        if name not in roster:
+            ungradable[name] = (
+                "no roster entry, so its data cannot be worked out: add the submission to the roster (the "
+                "columns submission and id) and grade again."
+            )
+            continue
+        values = variants.values(registry, roster[name])
+        found[name] = {str(number): dict(given) for number, given in values.items()}
+    return found
+
+
+VARIANTS_CSV = "variants.csv"
+
+
+def _write_variants(out, grades, students, roster, registry):
+    """``variants.csv``, for the instructor only: each submission's roster id and data, and the classmates
+    whose data its notebooks hold instead (``another variant`` when no one in the class has them)."""
+    import csv
+
+    from ..results.report import csv_cell
+
+    varied = [e for e in registry if e.params]
+    rows = []
+    for grade in grades:
+        mine = students.get(grade.name)
+        if mine is None:
+            continue
+        holds = []
+        for exercise in varied:
+            other = (grade.results.get(exercise.number) or {}).get("other_variant") or {}
+            if not other:
+                continue
+            params = {p.name: p for p in exercise.params}
+            whose = [
+                name
+                for name, data in students.items()
+                if name != grade.name
+                and all(
+                    param in params and params[param].holds(found, data.get(str(exercise.number), {}).get(param))
+                    for param, (found, _) in other.items()
+                )
+            ]
+            holds.append(f"exercise {exercise.number}: " + (", ".join(whose) if whose else "another variant"))
+        shown = [", ".join(f"{p} = {v}" for p, v in mine.get(str(e.number), {}).items()) for e in varied]
+        rows.append([grade.name, roster.get(grade.name, ""), *shown, "; ".join(holds)])
+    with open(Path(out) / VARIANTS_CSV, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["submission", "id", *(f"exercise {e.number}" for e in varied), "holds the data of"])
+        for row in rows:
+            writer.writerow([csv_cell(cell) for cell in row])
 
 
 class Graded(list):

@@ -32,7 +32,7 @@ from pathlib import Path
 from ...exercises.model import sections
 from ...exercises.registry import LAB
 from ...exercises.registry import load as load_registry
-from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT
+from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from ..sandbox import backends, remote
@@ -331,7 +331,9 @@ def graded_functions(exercise):
     return [name for name in dict.fromkeys(names) if name.isidentifier()]
 
 
-def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None):
+def grade_notebook(
+    path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None, variant=None
+):
     """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
 
     `options` (a :class:`GradeOptions`, the defaults when None) bound it;
@@ -339,7 +341,9 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
     checked here. The notebook's answers in words go into `answers`
     ({grade id: text}) when it is given, and the source of each graded
     function it defines (read with ``ast``, never run) into `sources`
-    ({function name: text}), unless an earlier notebook gave it."""
+    ({function name: text}), unless an earlier notebook gave it. `variant`
+    ({exercise (text): {parameter: value}}) is the student's own data; a
+    notebook holding another's is named as a problem of its own."""
     options = _options(options)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     registry = load_registry(options.exercises)
@@ -402,7 +406,19 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
                 checks = [_voided(part, notebook.tampered) for part in exercise.parts]
                 results[number] = _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
                 continue
-            verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed)
+            mine = None if variant is None else variant.get(str(number), {})
+            verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed, variant=mine)
+            other = verdict.get("other_variant")  # kept in the result: the class run names whose data they are
+            if other:
+                shown = "; ".join(
+                    f"{param} = {_number(found)} where yours is {_number(value)}"
+                    for param, (found, value) in sorted(other.items())
+                )
+                text = (
+                    f"{name}: exercise {number}: this notebook holds the data of another variant ({shown}); "
+                    "its parts that depend on the data were checked against your own."
+                )
+                problems.append(ProblemText.one(text, VARIANT))
             for index, part in enumerate(exercise.parts):
                 if part.refused is None:
                     continue
@@ -428,6 +444,11 @@ def grade_notebook(path, options=None, *, deadline=None, skip=(), profiles=None,
     return results, problems
 
 
+def _number(value):
+    """A notebook's value for the feedback: a number as printed, anything else by its kind, on one short line."""
+    return f"{value:g}" if isinstance(value, (int, float)) else one_line(str(value), 40)
+
+
 def _options(options):
     """`options`, or the defaults when None; ValueError for anything else."""
     if options is None:
@@ -444,11 +465,12 @@ def submission_name(path):
     return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
-def grade_submission(path, options=None, *, profiles=None):
+def grade_submission(path, options=None, *, profiles=None, name=None):
     """Grade one submission (a notebook or a folder of them), scored with the options' rubric (else the lab's).
 
     `options` (a :class:`GradeOptions`, the defaults when None) bound it. One
-    time limit covers every notebook of the submission."""
+    time limit covers every notebook of the submission. `name` is the submission's name in the run (its
+    folder's by default): with variants, its data are the options' for that name."""
     options = _options(options)
     rubric = None
     if options.rubric is not None:
@@ -456,7 +478,13 @@ def grade_submission(path, options=None, *, profiles=None):
 
         rubric = load(options.rubric)
     deadline = time.monotonic() + options.total_timeout
-    grade = SubmissionGrade(submission_name(path), seed=options.seed)
+    grade = SubmissionGrade(submission_name(path) if name is None else str(name), seed=options.seed)
+    variant = None
+    if options.variants is not None:
+        variant = options.variants.get(grade.name)
+        if variant is None:
+            grade.failure = "no variant in this run's roster: add the submission to the roster and grade again."
+            return grade
     if rubric is not None:
         grade.rubric = rubric
     try:
@@ -474,6 +502,7 @@ def grade_submission(path, options=None, *, profiles=None):
             profiles=profiles,
             answers=grade.answers,
             sources=grade.sources,
+            variant=variant,
         )
         grade.problems.extend(problems)
         for number, verdict in results.items():
@@ -493,8 +522,7 @@ def main(argv=None):
     if spec.get("backend_origin"):  # a backend registered outside labkit: its module registers it here too
         backends.import_origin(*spec["backend_origin"])
     options = GradeOptions.from_dict(spec["options"])  # the run's options, read once at this process's edge
-    grade = grade_submission(spec["submission"], options=options, profiles=profiles)
-    grade.name = spec["name"]
+    grade = grade_submission(spec["submission"], options=options, profiles=profiles, name=spec["name"])
     result = Path(spec["result"])
     partial = result.with_suffix(".partial")
     partial.write_text(json.dumps(grade.as_dict()), encoding="utf-8")

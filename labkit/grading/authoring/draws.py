@@ -1,0 +1,222 @@
+"""Every draw checked before it is handed out: ``labkit variants --check N``.
+
+For N made-up students (and, with a roster, for the class itself) this
+derives each one's data from the course's variants file, puts it in the
+instructor notebooks' data cells, runs each notebook's code here and checks
+its varied exercises with that student's data:
+
+* the instructor's solution earns full marks;
+* each correct variation of a catalog (``CORRECT``) earns full marks;
+* each slip of a catalog (``MISTAKES``) costs exactly its part (and the
+  parts its entry names in ``also``), and that part's feedback names it (its
+  entry's ``hint``);
+* the solution worked on another student's data is caught: its varied parts
+  fail, and the notebook is named as holding another variant;
+* the data still teach the exercise's lesson (its ``sound`` says why not:
+  a spline that no longer overshoots, say).
+
+A catalog is a Python file of the instructor's (a course's ``tests/catalog.py``)
+with lists ``CORRECT`` and ``MISTAKES`` whose entries have ``name``,
+``notebook``, ``replace`` ((old, new) pairs of code, each old once in the
+notebook), ``exercise``, ``part``, ``hint``, ``also`` and ``full``. Only the
+entries of varied exercises are run.
+
+The code run is the instructor's own (the solutions and the catalog), so it
+runs in this process, with matplotlib drawing off screen: no student code is
+ever run here. Every draw where something is not as it should be is
+reported with its values: narrow the parameter's range (its
+:class:`~labkit.exercises.variants.Param`) until none is left.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import io
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+from ...execute import read_notebook
+from ...exercises.registry import LAB
+from .release import BEGIN_HIDDEN, END_HIDDEN, with_values
+
+
+@dataclass(frozen=True)
+class Trouble:
+    """One draw where something is not as it should be."""
+
+    student: str
+    values: dict  # {exercise: {parameter: value}}
+    entry: str  # the solution, a catalog entry, or the copy check
+    what: str
+
+    def __str__(self):
+        shown = ", ".join(f"{p} = {v}" for given in self.values.values() for p, v in given.items())
+        return f"{self.student} ({shown}): {self.entry}: {self.what}"
+
+
+def load_catalog(path):
+    """(CORRECT, MISTAKES) of the catalog file at `path`; ValueError when it is not one."""
+    path = Path(path)
+    spec = importlib.util.spec_from_file_location(f"labkit_catalog_{abs(hash(str(path)))}", path)
+    if spec is None or spec.loader is None or not path.is_file():
+        raise ValueError(f"{path} is not a Python file; give the catalog of correct variations and slips (.py).")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    found = getattr(module, "CORRECT", None), getattr(module, "MISTAKES", None)
+    if not all(isinstance(entries, (list, tuple)) for entries in found):
+        raise ValueError(f"{path} defines no lists CORRECT and MISTAKES; it is not a catalog of variations and slips.")
+    return tuple(found[0]), tuple(found[1])
+
+
+def _planted(nb, replace, name):
+    """Notebook `nb` with the (old, new) code replacements of a catalog entry (each old once in one code cell)."""
+    import json
+
+    import nbformat
+
+    nb = nbformat.from_dict(json.loads(json.dumps(nb)))
+    for old, new in replace:
+        hits = [cell for cell in nb.cells if cell.cell_type == "code" and old in cell.source]
+        if len(hits) != 1 or hits[0].source.count(old) != 1:
+            raise ValueError(f"catalog entry {name!r}: {old[:60]!r} is not in one code cell once; fix the entry.")
+        hits[0].source = hits[0].source.replace(old, new)
+    return nb
+
+
+def _without_hidden_tests(source):
+    kept, hidden = [], False
+    for line in source.split("\n"):
+        marker = line.strip()
+        if marker == BEGIN_HIDDEN:
+            hidden = True
+        elif marker == END_HIDDEN:
+            hidden = False
+        elif not hidden and not marker.startswith("%"):
+            kept.append(line)
+    return "\n".join(kept)
+
+
+def run_cells(nb, names):
+    """The names a notebook defines once its code cells have run here, up to the last that mentions `names`.
+
+    A cell that raises is noted and the next one runs, as in the grader; hidden tests and magics are left out.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+
+    cells = [_without_hidden_tests(cell.source) for cell in nb.cells if cell.cell_type == "code"]
+    last = max((i for i, source in enumerate(cells) if any(name in source for name in names)), default=-1)
+    namespace = {"__name__": "__main__"}
+    with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
+        warnings.simplefilter("ignore")
+        for source in cells[: last + 1]:
+            try:
+                exec(compile(source, "<cell>", "exec"), namespace)  # noqa: S102 - the instructor's own code
+            except Exception:  # noqa: BLE001 - a slip may raise; the checks say what it costs
+                pass
+    return namespace
+
+
+def _close_figures():
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def _failed(verdict):
+    return {check["name"] for check in verdict["checks"] if not check["passed"]}
+
+
+def _said(verdict, part):
+    for check in verdict["checks"]:
+        if check["name"] == part:
+            return " ".join([check.get("hint") or ""] + [f"{s['step']}: {s['detail']}" for s in check["steps"]])
+    return ""
+
+
+def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, seed=0, progress=None):
+    """Check `count` made-up students' draws (and the `roster`'s, {name: id}) of every varied exercise.
+
+    `variants` is a :class:`~labkit.exercises.variants.VariantsFile`, `solutions` the instructor notebooks'
+    folder, `catalog` a catalog file (or None). Returns the :class:`Trouble` found, an empty list when every
+    draw is as it should be. `progress` (a function of one text) hears of each draw."""
+    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise ValueError(f"--check needs a whole number of draws, at least 1; got {count!r}.")
+    correct, mistakes = load_catalog(catalog) if catalog is not None else ((), ())
+    varied = {e.number: e for e in registry if e.params}
+    if not varied:
+        raise ValueError("no exercise declares parameters (Exercise.params): there is nothing to draw.")
+    students = [f"draw-{i}" for i in range(count)] + [str(key) for key in (roster or {}).values()]
+    by_notebook: dict = {}
+    for exercise in varied.values():
+        by_notebook.setdefault(exercise.notebook, []).append(exercise)
+    originals = {name: read_notebook(Path(solutions) / name) for name in by_notebook}
+    troubles = []
+    for index, student in enumerate(students):
+        values = variants.values(registry, student)
+        other = variants.values(registry, students[index - 1] if len(students) > 1 else f"{student}-other")
+        mine = {n: values[n] for n in varied}
+        for exercise in varied.values():
+            why = exercise.sound(values[exercise.number]) if exercise.sound is not None else ""
+            if why:
+                troubles.append(Trouble(student, mine, f"exercise {exercise.number}'s data", why))
+        for notebook, exercises in by_notebook.items():
+            numbers = {e.number for e in exercises}
+            names = sorted({name for e in exercises for part in e.parts for name in (*e.names, *part.names())})
+            entries = [("the solution", (), None, None, (), numbers)]
+            entries += [
+                (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers)
+                for e in correct
+                if e.notebook == notebook and set(e.full) & numbers
+            ]
+            entries += [
+                (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise})
+                for e in mistakes
+                if e.notebook == notebook and e.exercise in numbers
+            ]
+            for label, replace, part, hint, also, judged in entries:
+                nb = with_values(_planted(originals[notebook], replace, label), values, notebook, registry)
+                namespace = run_cells(nb, names)
+                for number in sorted(judged):
+                    verdict = registry.check(number, namespace, seed=seed + index, variant=values[number])
+                    failed = _failed(verdict)
+                    if part is None and failed:
+                        troubles.append(Trouble(student, mine, label, f"exercise {number} lost {sorted(failed)}"))
+                    elif part is not None:
+                        expected = {part} | {p for n, p in also if n == number}
+                        if failed != expected:
+                            troubles.append(
+                                Trouble(student, mine, label, f"failed {sorted(failed)}, not {sorted(expected)}")
+                            )
+                        elif hint and hint not in _said(verdict, part):
+                            troubles.append(Trouble(student, mine, label, f"the feedback does not say {hint!r}"))
+                _close_figures()
+            # the solution on another student's data: caught, and its varied parts lost
+            if any(other[e.number] != values[e.number] for e in exercises):
+                nb = with_values(originals[notebook], other, notebook, registry)
+                namespace = run_cells(nb, names)
+                for exercise in exercises:
+                    if other[exercise.number] == values[exercise.number]:
+                        continue
+                    verdict = registry.check(
+                        exercise.number, namespace, seed=seed + index, variant=values[exercise.number]
+                    )
+                    dependent = {part.name for part in exercise.parts if part.varied}
+                    if not verdict.get("other_variant"):
+                        troubles.append(Trouble(student, mine, "a copy", "another student's data is not named"))
+                    if not dependent <= _failed(verdict):
+                        troubles.append(
+                            Trouble(
+                                student,
+                                mine,
+                                "a copy",
+                                f"{sorted(dependent - _failed(verdict))} pass on another's data",
+                            )
+                        )
+                _close_figures()
+        if progress is not None:
+            progress(f"draw {index + 1} of {len(students)}: {student}")
+    return troubles
