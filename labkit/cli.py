@@ -126,13 +126,41 @@ def _release(args):
     from .grading.authoring.release import release
 
     roster, variants = _roster_and_variants(args, "for a release per student")
-    written = release(args.notebooks, args.out, roster, variants)
+    registry = _course(args)
+    written = release(args.notebooks, args.out, roster, variants, registry)
     if roster is None:
         for path in written:
             print(f"wrote {path}")
-    else:
-        print(f"wrote {len(written)} notebooks for {len(roster)} students into {args.out}, one folder each")
+        return 0
+    print(f"wrote {len(written)} notebooks for {len(roster)} students into {args.out}, one folder each")
+    _ties(variants, registry, roster)
     return 0
+
+
+def _course(args):
+    """The exercises of ``--rubric`` (a course's own, named in its rubric), else the lab's."""
+    if getattr(args, "rubric", None) is None:
+        from .exercises.registry import LAB
+
+        return LAB
+    from .grading.results.rubric import load
+
+    return load(args.rubric).registry
+
+
+def _ties(variants, registry, roster):
+    """Name, on stderr, the roster's students who drew the same data of an exercise."""
+    from .exercises.variants import ties
+    from .grading.results.report import one_line
+
+    ids = {key: name for name, key in roster.items()}
+    for number, tied in ties(variants, registry, roster.values()):
+        names = ", ".join(one_line(ids[key], 40) for key in tied)
+        print(
+            f"labkit: {names} drew the same data of exercise {number}: a copy between them cannot be seen; give "
+            f"all but one a fresh draw (labkit variants --redraw ID --exercise {number}) and release again",
+            file=sys.stderr,
+        )
 
 
 def _summary(grades, out, start, what):
@@ -582,6 +610,7 @@ def build_parser():
         metavar="SECRET_FILE",
         help="the course's variants file (labkit variants --new): each student's notebooks hold their own data",
     )
+    rel.add_argument("--rubric", type=Path, help="a course's rubric: its exercises' variants (default: the lab's)")
     rel.set_defaults(handler=_release)
 
     grd = commands.add_parser(
@@ -937,16 +966,17 @@ def build_parser():
         "--solutions", type=Path, default=Path("notebooks"), help="the instructor notebooks (default %(default)s)"
     )
     var.add_argument("--catalog", type=Path, help="a Python file of CORRECT variations and MISTAKES (slips) to check")
+    var.add_argument("--rubric", type=Path, help="a course's rubric: its exercises' variants (default: the lab's)")
     var.set_defaults(handler=_variants)
     return parser
 
 
 def _variants(args):
     from .exercises import variants
-    from .exercises.registry import LAB
     from .grading.reports.lms import read_roster
     from .grading.results.report import one_line
 
+    course = _course(args)
     if args.new is not None:
         variants.new(args.new)
         print(f"wrote {args.new}: keep it private; give it to `labkit release` and `labkit grade` as --variants")
@@ -956,17 +986,25 @@ def _variants(args):
     found = variants.read(args.variants)
     roster = read_roster(args.roster) if args.roster is not None else None
     if args.redraw is not None:
-        if args.exercise is None:
-            raise ValueError("--redraw needs --exercise N: the exercise whose data the student gets afresh.")
-        number = variants.redraw(args.variants, args.redraw, args.exercise, LAB)
-        values = variants.read(args.variants).values(LAB, args.redraw)[args.exercise]
+        if args.exercise is None or roster is None:
+            raise ValueError(
+                "--redraw needs --exercise N (the exercise whose data the student gets afresh) and --roster (the "
+                "roster the id is in)."
+            )
+        args.redraw = args.redraw.strip()
+        if args.redraw not in roster.values():
+            raise ValueError(
+                f"{one_line(args.redraw, 60)} is no id of the roster {args.roster}: give an id as it has it."
+            )
+        number = variants.redraw(args.variants, args.redraw, args.exercise, course)
+        values = variants.read(args.variants).values(course, args.redraw)[args.exercise]
         print(f"{one_line(args.redraw, 60)} now has draw {number} of exercise {args.exercise}: {values}")
         return 0
     if args.show:
         if roster is None:
             raise ValueError("--show needs --roster: the students whose data to print.")
         for name, key in roster.items():
-            values = found.values(LAB, key)
+            values = found.values(course, key)
             shown = "; ".join(
                 f"exercise {n}: " + ", ".join(f"{p} = {v}" for p, v in given.items()) for n, given in values.items()
             )
@@ -975,7 +1013,13 @@ def _variants(args):
     from .grading.authoring.draws import check
 
     troubles = check(
-        found, args.check, args.solutions, args.catalog, roster, progress=lambda line: print(line, flush=True)
+        found,
+        args.check,
+        args.solutions,
+        args.catalog,
+        roster,
+        registry=course,
+        progress=lambda line: print(line, flush=True),
     )
     for trouble in troubles:
         print(f"not as it should be: {one_line(str(trouble), 300)}")

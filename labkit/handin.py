@@ -17,6 +17,7 @@ import ast
 import contextlib
 import io
 import json
+import math
 import os
 import re
 import sys
@@ -233,7 +234,7 @@ def _own_data(exercise, namespace: Mapping) -> dict:
     found = {}
     for param in exercise.params:
         value = namespace.get(param.name)
-        if isinstance(value, Real) and not isinstance(value, bool):
+        if isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value):
             found[param.name] = float(value)
     return found
 

@@ -489,7 +489,7 @@ MISTAKES = (
         (("twist = PA - PB + PC - PD", "twist = PB - PA + PD - PC"),),
         7,
         "straight",
-        "d2xdsdt = -1",
+        "the twists have the wrong sign",
         was="generic",
     ),
     Planted(
@@ -1012,7 +1012,7 @@ SLIPS = (
     Planted(
         "straight_c_with_x_and_y_swapped",
         "03_meshes.ipynb",
-        (("[1.0, 0.0], [1.0, 0.5], [0.0, 1.0]))", "[1.0, 0.0], [0.5, 1.0], [0.0, 1.0]))"),),
+        (("[1.0, 0.0], [xC, yC], [xD, yD]))", "[1.0, 0.0], [yC, xC], [xD, yD]))"),),
         7,
         "straight",
         "C has its x and y swapped",

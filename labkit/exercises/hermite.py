@@ -488,6 +488,6 @@ EXERCISES = (
         notebook="01_limacon.ipynb",
         withheld=LIMACON_DERIVATIVES,
         # the limaçon's offset: near 1 the curve nears the cardioid's cusp, and well above 1.3 its dimple flattens
-        params=(Param("r0", 1.05, 1.3, 3, lab=LAB_R0),),
+        params=(Param("r0", 1.05, 1.3, 4, lab=LAB_R0),),
     ),
 )

@@ -248,6 +248,9 @@ class Exercise:
     params: tuple = field(default=(), compare=False)
     # why a draw of the params would not teach the exercise's lesson ('' when it does), for `labkit variants --check`
     sound: Callable | None = field(default=None, compare=False)
+    # what the data cell shows that follows from the params ({params} -> {notebook name: Python text}): the lab
+    # gives a value worked out from the data (Exercise 7's twist), so a variant gives its own
+    derived: Callable | None = field(default=None, compare=False)
 
     def __post_init__(self):
         seen = [part.name for part in self.parts]

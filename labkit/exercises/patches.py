@@ -11,6 +11,7 @@ from .. import patches
 from ..mesh import QuadMesh, quad_mesh
 from .model import OWN_PATCH, Exercise, Optional, Part, Together
 from .result import CheckResult, call, case_rng, close, floats, judged_by_the_lab, worst
+from .variants import Param
 
 # the grader's work on a student's meshes is bounded by the lab's sizes (600 and 1170 nodes): far larger is refused
 MAX_NODES = 20_000
@@ -157,27 +158,65 @@ def check_graded_corners(corners):
     return result
 
 
-def check_straight_corners(corners):
-    """Exercise 7: A(-1,0), B(1,0), C(1,0.5), D(0,1); the patch must be the bilinear map."""
+LAB_QUAD = {"xC": 1.0, "yC": 0.5, "xD": 0.0, "yD": 1.0}  # Exercise 7's C = (1, 0.5) and D = (0, 1)
+QUAD_A, QUAD_B = (-1.0, 0.0), (1.0, 0.0)  # A and B, the same in every variant
+
+
+def quad_twist(values):
+    """Exercise 7's twist d2/dsdt at every corner, A - B + C - D, for C = (xC, yC) and D = (xD, yD)."""
+    return (
+        QUAD_A[0] - QUAD_B[0] + values["xC"] - values["xD"],
+        QUAD_A[1] - QUAD_B[1] + values["yC"] - values["yD"],
+    )
+
+
+def quad_shown(values):
+    """What Exercise 7's data cell shows besides C and D: the twist the lab gives, as numbers."""
+    tx, ty = quad_twist(values)
+    return {"twist7": f"({tx:.2f}, {ty:.2f})"}
+
+
+def quad_sound(values):
+    """Why a draw of Exercise 7's corners would not do ('' when it does): ABCD must be a convex quadrilateral,
+    counter-clockwise, whose bilinear map folds nowhere (its Jacobian well away from zero)."""
+    P = np.array([QUAD_A, QUAD_B, (values["xC"], values["yC"]), (values["xD"], values["yD"])])
+    edges = np.roll(P, -1, axis=0) - P
+    turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
+    if turns.min() <= 0.05:
+        return "ABCD is not a convex quadrilateral, counter-clockwise, with no corner nearly straight"
+    return ""
+
+
+def _point(P):
+    return f"({P[0]:g}, {P[1]:g})"
+
+
+def check_straight_corners(corners, xC=1.0, yC=0.5, xD=0.0, yD=1.0):
+    """Exercise 7: A(-1,0), B(1,0), C(xC,yC), D(xD,yD) (the lab's C(1,0.5), D(0,1)); the patch must be the
+    bilinear map."""
     result = CheckResult("exercise 7 corners")
     if not _corner_list(corners, result, "four corners"):
         return result
-    A, B, C, D = (np.array(p) for p in ([-1.0, 0.0], [1.0, 0.0], [1.0, 0.5], [0.0, 1.0]))
+    A, B, C, D = (np.array(p, dtype=float) for p in (QUAD_A, QUAD_B, (xC, yC), (xD, yD)))
+    where = f"A = {_point(A)}, B = {_point(B)}, C = {_point(C)}, D = {_point(D)}."
     if not result.step("corner points A, B, C, D", close([c.point for c in corners], [A, B, C, D])):
         swapped = [label for label, c, P in zip("ABCD", corners, (A, B, C, D)) if close(c.point, P[::-1])]
         result.hint = (
             f"{_and(swapped)} {'has its' if len(swapped) == 1 else 'have their'} x and y swapped: a point is "
-            "(x, y). A = (-1, 0), B = (1, 0), C = (1, 0.5), D = (0, 1)."
+            f"(x, y). {where}"
             if swapped
-            else "A = (-1, 0), B = (1, 0), C = (1, 0.5), D = (0, 1)."
+            else where
         )
         return result
-    if not result.step("twists d2x/dsdt = -1, d2y/dsdt = -0.5", close([c.dsdt for c in corners], [A - B + C - D] * 4)):
+    tx, ty = A - B + C - D
+    if not result.step(
+        f"twists d2x/dsdt = {tx:g}, d2y/dsdt = {ty:g}", close([c.dsdt for c in corners], [A - B + C - D] * 4)
+    ):
         turned = close([c.dsdt for c in corners], [-(A - B + C - D)] * 4)
         result.hint = (
-            "the twists have the wrong sign: set d2xdsdt = -1 and d2ydsdt = -0.5 at all four corners."
+            f"the twists have the wrong sign: set d2xdsdt = {tx:g} and d2ydsdt = {ty:g} at all four corners."
             if turned
-            else "set d2xdsdt = -1 and d2ydsdt = -0.5 at all four corners."
+            else f"set d2xdsdt = {tx:g} and d2ydsdt = {ty:g} at all four corners."
         )
         return result
     s, t = np.linspace(0, 1, 20), np.linspace(0, 1, 15)
@@ -675,10 +714,19 @@ EXERCISES = (
     Exercise(
         7,
         ("straight",),
-        (Part("straight", 10, check_straight_corners, ("straight",)),),
+        (Part("straight", 10, check_straight_corners, ("straight",), varied=tuple(LAB_QUAD)),),
         notebook="03_meshes.ipynb",
         answers=("why these corner data give straight, evenly divided sides",),
         withheld=STRAIGHT_RULE,
+        # C and D of the quadrilateral ABCD (A and B stay): kept convex, so its mesh never folds
+        params=(
+            Param("xC", 0.8, 1.3, 2, lab=LAB_QUAD["xC"]),
+            Param("yC", 0.3, 0.8, 2, lab=LAB_QUAD["yC"]),
+            Param("xD", -0.3, 0.3, 2, lab=LAB_QUAD["xD"]),
+            Param("yD", 0.8, 1.3, 2, lab=LAB_QUAD["yD"]),
+        ),
+        sound=quad_sound,
+        derived=quad_shown,
     ),
     Exercise(
         8,

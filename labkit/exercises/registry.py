@@ -15,11 +15,14 @@ grader (:mod:`labkit.grading.sandbox.remote`).
 from __future__ import annotations
 
 import importlib
+import math
 import sys
 import types
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from . import bilinear, hermite, monotone, patches, splines
 from .model import Exercise
@@ -221,9 +224,11 @@ class Registry:
         other = {}
         for param in exercise.params:
             if variant is not None and param.name in variant and param.name in namespace:
-                found = namespace[param.name]
-                if not param.holds(found, variant[param.name]):
-                    other[param.name] = [_shown(found), variant[param.name]]
+                found = _shown(namespace[param.name])
+                # only a number is data: a name the notebook no longer answers for (stopped, timed out) reads as
+                # a function proxy, and is no sign of anyone else's data
+                if isinstance(found, float) and not param.holds(found, variant[param.name]):
+                    other[param.name] = [found, variant[param.name]]
         return {
             **({"other_variant": other} if other else {}),
             "exercise": number,
@@ -236,12 +241,15 @@ class Registry:
 
 
 def _shown(value) -> Any:
-    """A notebook's value of a varied parameter, as plain data for the feedback: a number, or a short text."""
+    """A notebook's value of a varied parameter as plain data: a finite float when it is one number (a Python
+    or numpy number, or an array of one), else the name of its type."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number, np.ndarray)):
+        return str(type(value).__name__)[:40]
     try:
         number = float(value)
     except (TypeError, ValueError, OverflowError):
         return str(type(value).__name__)[:40]
-    return number if number == number and abs(number) < 1e300 else str(number)
+    return number if math.isfinite(number) else "not finite"
 
 
 def _dependencies(parts) -> list:

@@ -80,7 +80,13 @@ class Param:
             raise ValueError(
                 f"parameter {self.name!r}: the lab's value {self.lab} is outside [{self.low}, {self.high}]."
             )
-        if self.value(0.0) == self.value(1.0):
+        try:
+            one = self.value(0.0) == self.value(1.0)
+        except (OverflowError, ValueError):
+            raise ValueError(
+                f"parameter {self.name!r}: [{self.low}, {self.high}] at {self.digits} digits holds too many values."
+            ) from None
+        if one:
             raise ValueError(
                 f"parameter {self.name!r}: [{self.low}, {self.high}] holds one value at {self.digits} digits; "
                 "widen the range or show more digits."
@@ -160,10 +166,24 @@ class VariantsFile:
         }
 
 
+def ties(found: VariantsFile, registry, students) -> list:
+    """(exercise, [roster ids]) of the students who drew the same data of an exercise: a copy between them
+    cannot be told from their own work, so give all but one a fresh draw (:func:`redraw`)."""
+    by_data: dict = {}
+    for student in dict.fromkeys(str(s) for s in students):
+        for number, given in found.values(registry, student).items():
+            by_data.setdefault((number, tuple(sorted(given.items()))), []).append(student)
+    return [(number, group) for (number, _), group in sorted(by_data.items()) if len(group) > 1]
+
+
 def read(path) -> VariantsFile:
     """Read a variants file; ValueError saying what is wrong with it and how to make one."""
     path = Path(path)
-    fix = f"make one with `labkit variants --new {path}` and keep it private."
+    fix = (
+        "put back the copy you kept: its secret must stay the same, or every student's data changes."
+        if path.exists()
+        else f"make one with `labkit variants --new {path}` and keep it private."
+    )
     try:
         raw = path.read_bytes()[: MAX_FILE_BYTES + 1]
     except OSError as exc:
@@ -193,7 +213,8 @@ def read(path) -> VariantsFile:
             raise ValueError(f"in {path}, the redraws of {student!r} must be a table such as {{4 = 1}}.")
         found = {}
         for exercise, number in draws.items():
-            if not str(exercise).isdigit() or isinstance(number, bool) or not isinstance(number, int):
+            text = str(exercise)
+            if not (text.isascii() and text.isdecimal()) or isinstance(number, bool) or not isinstance(number, int):
                 raise ValueError(
                     f"in {path}, {student!r} = {{{exercise} = {number!r}}}: give an exercise number and a whole draw "
                     "number, such as {4 = 1}."
@@ -232,17 +253,38 @@ def redraw(path, student: str, exercise: int, registry) -> int:
         varied = sorted(e.number for e in registry if e.params)
         raise ValueError(f"exercise {exercise} has no variants; the varied exercises are {varied}.")
     student = str(student)
-    if not student or any(c in student for c in '"\\\n\r') or not student.isprintable():
+    if not student or not student.isprintable():
         raise ValueError(f"{student!r} is not a roster id this file can hold; give the id as the roster has it.")
-    draws = {**current.redraw.get(student, {})}
+    redraws = {key: dict(value) for key, value in current.redraw.items()}
+    draws = redraws.setdefault(student, {})
     draws[exercise] = draws.get(exercise, 0) + 1
-    lines = [
-        line for line in Path(path).read_text(encoding="utf-8").splitlines() if not line.startswith(f'"{student}" =')
-    ]
-    if not any(line.strip().startswith("[redraw]") for line in lines):
-        lines.append("[redraw]")
-    entry = ", ".join(f"{n} = {d}" for n, d in sorted(draws.items()))
-    lines.append(f'"{student}" = {{{entry}}}')
-    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
-    read(path)
+    write(path, current.secret, redraws)
     return draws[exercise]
+
+
+def write(path, secret: bytes, redraws: dict) -> VariantsFile:
+    """Write a variants file of `secret` and `redraws` ({roster id: {exercise: draw}}) whole, through a file
+    beside it that is read back first (the old file stays as it was if anything fails); read it back."""
+    import json
+
+    path = Path(path)
+    lines = [
+        "# labkit variants: keep this file private (who has it can work out every student's data)",
+        f'secret = "{secret.hex()}"',
+        "",
+        '[redraw]  # a student\'s fresh draw of an exercise: "<roster id>" = {<exercise> = <draw>}',
+    ]
+    for student, draws in sorted(redraws.items()):
+        entry = ", ".join(f"{n} = {d}" for n, d in sorted(draws.items()))
+        lines.append(f"{json.dumps(student)} = {{{entry}}}")  # a JSON string is a TOML basic string
+    partial = path.with_name(f".{path.name}.partial")
+    partial.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    try:
+        written = read(partial)
+        if written.secret != secret or written.redraw != redraws:
+            raise ValueError(f"{path} could not be written as it should be; it was left as it was.")
+        os.chmod(partial, 0o600)
+        os.replace(partial, path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return read(path)

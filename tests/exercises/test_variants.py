@@ -28,8 +28,12 @@ KEY = bytes(range(32))
 
 
 def test_the_lab_declares_the_limacon_offset_and_its_own_value_is_the_notebook_s():
-    assert variants.lab_values(LAB) == {4: {"r0": 1.15}, 14: {"rise": 1.0, "boil": 2.0}}
-    assert (R0.low, R0.high, R0.digits) == (1.05, 1.3, 3)
+    assert variants.lab_values(LAB) == {
+        4: {"r0": 1.15},
+        7: {"xC": 1.0, "yC": 0.5, "xD": 0.0, "yD": 1.0},
+        14: {"rise": 1.0, "boil": 2.0},
+    }
+    assert (R0.low, R0.high, R0.digits) == (1.05, 1.3, 4)
     assert LAB.exercises[14].sound({"rise": 1.0, "boil": 2.0}) == ""  # the lab's data teach the lesson
     assert "overshoots" in LAB.exercises[14].sound({"rise": 1.9, "boil": 2.0})  # nearly straight up to boiling
     nb = nbformat.read(NOTEBOOKS / "01_limacon.ipynb", as_version=4)
@@ -51,10 +55,10 @@ def test_a_draw_is_the_same_every_time_and_changes_with_the_secret_the_student_t
     redraws = [variants.draw(KEY, "1815", 4, params, n)["r0"] for n in range(400)]
     exercises = [variants.draw(KEY, "1815", n, params)["r0"] for n in range(400)]
     for values in (students, secrets_, redraws, exercises):
-        assert len(set(values)) > 150  # of the range's 251 values at three digits: spread, not stuck
+        assert len(set(values)) > 350  # of the range's 2501 values at four digits: spread, not stuck
         assert min(values) >= R0.low and max(values) <= R0.high
         assert min(values) < 1.07 and max(values) > 1.28  # both ends of the range are reached
-        assert all(v == round(v, 3) for v in values)  # rounded to what the notebook shows
+        assert all(v == round(v, 4) for v in values)  # rounded to what the notebook shows
 
 
 def test_a_parameter_rounds_into_its_range_and_refuses_a_range_it_cannot_draw_from():
@@ -107,7 +111,7 @@ def test_a_release_with_values_changes_the_data_cell_and_nothing_else():
     mine = with_values(nb, {4: {"r0": 1.237}}, "01_limacon.ipynb")
     changed = [i for i, (a, b) in enumerate(zip(nb.cells, mine.cells)) if a != b]
     assert len(mine.cells) == len(nb.cells) and len(changed) == 1
-    assert mine.cells[changed[0]].source == "r0 = 1.237  # the limaçon's offset: r = r0 + cos t"
+    assert mine.cells[changed[0]].source == "r0 = 1.2370  # the limaçon's offset: r = r0 + cos t"
     assert mine.metadata == nb.metadata  # the grader never reads the notebook for the data: nothing is written there
     other = copy.deepcopy(nb)
     for cell in other.cells:
@@ -170,4 +174,76 @@ def test_ready_to_hand_in_judges_a_variant_notebook_by_its_own_data():
     assert [p.status for p in ready_to_hand_in("01_limacon", namespace=own).parts] == [DONE, DONE]
     wrong = {**own, "r0": 1.15}  # the notebook says the lab's r0 but drew another limaçon
     assert [p.status for p in ready_to_hand_in("01_limacon", namespace=wrong).parts] == [DONE, FAILING]
+    plt.close("all")
+
+
+def test_only_a_number_in_the_notebook_can_be_another_variant_s_data():
+    """A name the notebook no longer answers for (a stopped notebook's proxy), text, an array or a value that is not
+    finite is no sign of another student's data: nothing is named, whatever the plot's part says."""
+
+    def deriv(t, r0):
+        return limacon(t, r0=r0)[2:]
+
+    own = {**_limacon_axes(1.2), "limacon_derivatives": deriv}
+    for held in (deriv, "1.3", np.array([1.3, 1.1]), math.nan, math.inf, None, True):
+        verdict = LAB.check(4, {**own, "r0": held}, seed=1, variant={"r0": 1.2})
+        assert "other_variant" not in verdict, held
+    for held in (np.float64(1.3), np.array(1.3), 1):  # numbers, as the sandbox hands them over
+        verdict = LAB.check(4, {**own, "r0": held}, seed=1, variant={"r0": 1.2})
+        assert verdict["other_variant"] == {"r0": [float(held), 1.2]}
+    plt.close("all")
+
+
+@pytest.mark.parametrize(
+    "layout",
+    ["[redraw]\n1815 = {4 = 1}", "[redraw]\n'1815' = {4 = 2}", '[redraw]\n  "1815"={14 = 1}', "redraw = {}", ""],
+)
+def test_a_redraw_keeps_a_hand_edited_file_readable_with_its_secret(tmp_path, layout):
+    path = tmp_path / "course.toml"
+    made = variants.new(path)
+    path.write_text(f'secret = "{made.secret.hex()}"\n{layout}\n')
+    before = variants.read(path).redraw.get("1815", {})
+    assert variants.redraw(path, "1815", 4, LAB) == before.get(4, 0) + 1
+    assert variants.redraw(path, 'odd "id" \\ ü', 7, LAB) == 1
+    after = variants.read(path)
+    assert after.secret == made.secret
+    assert after.redraw == {"1815": {**before, 4: before.get(4, 0) + 1}, 'odd "id" \\ ü': {7: 1}}
+    assert [p.name for p in tmp_path.iterdir()] == ["course.toml"]  # no partial file left beside it
+
+
+def test_bad_input_is_refused_with_what_to_do():
+    with pytest.raises(ValueError, match="too many values"):
+        variants.Param("x", 0, 1e300, 12, lab=1)
+    nb = nbformat.v4.new_notebook()
+    cell = nbformat.v4.new_code_cell("x = 1\rr0 = 1.15  # ü\r\ny = 2")  # ast counts a lone \r as a line break
+    cell.metadata["tags"] = [variants.DATA_TAG]
+    nb.cells = [cell]
+    assert with_values(nb, {4: {"r0": 1.2}}, "01_limacon.ipynb").cells[0].source == "x = 1\rr0 = 1.2000  # ü\r\ny = 2"
+    for source in ("r0 = -x", "r0 = 'abc'", "r0 = (1.2,\n 1.3)"):
+        cell.source = source
+        with pytest.raises(ValueError, match="r0 must be assigned"):
+            with_values(nb, {4: {"r0": 1.2}}, "01_limacon.ipynb")
+
+
+def test_students_who_drew_the_same_data_are_found():
+    made = variants.VariantsFile(Path("x"), KEY, {})
+    ids = [str(i) for i in range(300)]
+    found = variants.ties(made, LAB, ids)
+    by_r0: dict = {}
+    for key in ids:
+        by_r0.setdefault(made.values(LAB, key)[4]["r0"], []).append(key)
+    assert [group for number, group in found if number == 4] == sorted(
+        (g for g in by_r0.values() if len(g) > 1), key=lambda g: made.values(LAB, g[0])[4]["r0"]
+    )
+    assert found and all(len(group) > 1 for _, group in found)  # 300 students over 2501 values: some tie
+
+
+def test_ready_to_hand_in_leaves_a_value_that_is_not_finite_to_the_lab_s_data():
+    from labkit.handin import DONE, ready_to_hand_in
+
+    def deriv(t, r0):
+        return limacon(t, r0=r0)[2:]
+
+    lab = {**_limacon_axes(1.15), "limacon_derivatives": deriv, "r0": math.nan}
+    assert [p.status for p in ready_to_hand_in("01_limacon", namespace=lab).parts] == [DONE, DONE]
     plt.close("all")

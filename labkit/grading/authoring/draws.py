@@ -7,11 +7,15 @@ its varied exercises with that student's data:
 
 * the instructor's solution earns full marks;
 * each correct variation of a catalog (``CORRECT``) earns full marks;
+* no notebook on its own data (the solution, a variation, a slip) is named
+  as holding another variant;
 * each slip of a catalog (``MISTAKES``) costs exactly its part (and the
   parts its entry names in ``also``), and that part's feedback names it (its
   entry's ``hint``);
 * the solution worked on another student's data is caught: its varied parts
   fail, and the notebook is named as holding another variant;
+* no two students of the roster drew the same data of an exercise (a copy
+  between them could not be seen);
 * the data still teach the exercise's lesson (its ``sound`` says why not:
   a spline that no longer overshoots, say).
 
@@ -38,6 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ...execute import read_notebook
+from ...exercises import variants as variant_data
 from ...exercises.registry import LAB
 from .release import BEGIN_HIDDEN, END_HIDDEN, with_values
 
@@ -155,6 +160,16 @@ def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, s
         by_notebook.setdefault(exercise.notebook, []).append(exercise)
     originals = {name: read_notebook(Path(solutions) / name) for name in by_notebook}
     troubles = []
+    for number, tied in variant_data.ties(variants, registry, (roster or {}).values()):
+        troubles.append(
+            Trouble(
+                tied[0],
+                {number: variants.values(registry, tied[0])[number]},
+                "a tie",
+                f"exercise {number}: the same data as {', '.join(tied[1:])}, so a copy between them cannot be seen; "
+                f"give all but one a fresh draw (labkit variants --redraw ID --exercise {number})",
+            )
+        )
     for index, student in enumerate(students):
         values = variants.values(registry, student)
         other = variants.values(registry, students[index - 1] if len(students) > 1 else f"{student}-other")
@@ -183,6 +198,10 @@ def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, s
                 for number in sorted(judged):
                     verdict = registry.check(number, namespace, seed=seed + index, variant=values[number])
                     failed = _failed(verdict)
+                    if verdict.get("other_variant"):  # a notebook on its own data is never taken for a copy
+                        troubles.append(
+                            Trouble(student, mine, label, f"exercise {number}: its own data named another's")
+                        )
                     if part is None and failed:
                         troubles.append(Trouble(student, mine, label, f"exercise {number} lost {sorted(failed)}"))
                     elif part is not None:

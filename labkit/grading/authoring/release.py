@@ -91,8 +91,10 @@ def with_values(nb, values, name="notebook", registry=LAB):
 
     The data cells are the code cells tagged ``variant-data``; in them each
     parameter of the notebook's exercises is a plain ``name = number``
-    assignment, whose number is replaced by the value as the notebook shows it
-    (comments and everything else stay). A notebook whose exercises vary but
+    assignment, whose number is replaced by the value as the notebook shows it,
+    and each value an exercise derives from them (``Exercise.derived``) a
+    one-line ``name = ...`` assignment, replaced the same way (comments and
+    everything else stay). A notebook whose exercises vary but
     whose data cells lack an assignment is refused (ValueError), so no student
     is ever given the lab's data by mistake. The cell's metadata gets nothing:
     the grader derives each student's values from the roster, never from the
@@ -101,14 +103,18 @@ def with_values(nb, values, name="notebook", registry=LAB):
     import nbformat
 
     copy = nbformat.from_dict(json.loads(json.dumps(nb)))
-    wanted = {}
+    wanted = {}  # notebook name -> the text its assignment gets
+    params = set()  # those of them that are parameters: assigned a plain number
     for number, given in values.items():
         exercise = registry.exercises.get(int(number))
         if exercise is None or exercise.notebook != name:
             continue
         for param in exercise.params:
             if param.name in given:
-                wanted[param.name] = (param, given[param.name])
+                wanted[param.name] = param.shown(given[param.name])
+                params.add(param.name)
+        if exercise.derived is not None and all(param.name in given for param in exercise.params):
+            wanted.update(exercise.derived(given))
     done = set()
     for index, cell in enumerate(copy.cells):
         if cell.cell_type != "code" or variant_data.DATA_TAG not in cell.metadata.get("tags", []):
@@ -117,7 +123,8 @@ def with_values(nb, values, name="notebook", registry=LAB):
             tree = ast.parse(cell.source)
         except SyntaxError:
             raise ValueError(f"{name}, cell {index}: a data cell must be plain Python assignments.") from None
-        lines = cell.source.split("\n")
+        pieces = re.split(r"(\r\n|\r|\n)", cell.source)  # the line breaks ast counts, kept as they were
+        lines, breaks = pieces[0::2], pieces[1::2]
         edits = []
         for node in tree.body:
             if (
@@ -128,15 +135,16 @@ def with_values(nb, values, name="notebook", registry=LAB):
             ):
                 target = node.targets[0].id
                 value = node.value
-                if value.lineno != value.end_lineno or not isinstance(value, (ast.Constant, ast.UnaryOp)):
-                    raise ValueError(f"{name}, cell {index}: {target} must be assigned a number on one line.")
-                param, number = wanted[target]
-                edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, param.shown(number)))
+                if value.lineno != value.end_lineno:
+                    raise ValueError(f"{name}, cell {index}: {target} must be assigned on one line.")
+                if target in params and not _number(value):
+                    raise ValueError(f"{name}, cell {index}: {target} must be assigned a number, as `{target} = 1.15`.")
+                edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
                 done.add(target)
         for line, start, end, text in sorted(edits, reverse=True):
             row = lines[line].encode("utf-8")  # ast's offsets count bytes
             lines[line] = (row[:start] + text.encode("utf-8") + row[end:]).decode("utf-8")
-        cell.source = "\n".join(lines)
+        cell.source = "".join(line + brk for line, brk in zip(lines, [*breaks, ""]))
     missing = sorted(set(wanted) - done)
     if missing:
         raise ValueError(
@@ -144,6 +152,13 @@ def with_values(nb, values, name="notebook", registry=LAB):
             f"{variant_data.DATA_TAG!r} with `{missing[0]} = <the lab's value>`."
         )
     return copy
+
+
+def _number(node):
+    """Whether an expression is a plain number (``1.15``, ``-0.3``), as a data cell assigns a parameter."""
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+        node = node.operand
+    return isinstance(node, ast.Constant) and type(node.value) in (int, float)
 
 
 def folder_name(name):
@@ -172,8 +187,8 @@ def release(notebook_dir, out_dir, roster=None, variants=None, registry=LAB):
     students = (
         {None: None} if roster is None else {name: variants.values(registry, key) for name, key in roster.items()}
     )
-    folders = [folder_name(name) for name in students if name is not None]
-    if len(set(folders)) != len(folders):
+    folders = [folder_name(name).casefold() for name in students if name is not None]
+    if len(set(folders)) != len(folders):  # "Ada" and "ada" are one folder where case is not told apart
         raise ValueError("two roster entries would share a release folder; give each submission its own name.")
     released = {path: release_notebook(read_notebook(path), path.name) for path in paths}
     written = []

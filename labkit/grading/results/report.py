@@ -756,6 +756,12 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         raise ValueError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
     if rubric is not None and not isinstance(rubric, rubrics.Rubric):
         rubric = rubrics.load(rubric)
+    drawn = {records.read(folder).variants.get("digest") for folder in folders}
+    if len(drawn) > 1:
+        raise ValueError(
+            "the folders were graded with different variants (or some without): each student's data would differ "
+            "from one result to the next. Merge only runs graded with the same --variants file."
+        )
     replaced = []
     grades = read_results(folders, rubric, replaced)
     rubric = grades.rubric
@@ -773,6 +779,11 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         "digest": " ".join(sorted({k.get("digest") or "" for k in known} - {""})) or None,
         "solutions": " ".join(sorted({k.get("solutions") or "" for k in known} - {""})) or None,
     }
+    if drawn != {None}:
+        students: dict = {}
+        for folder in folders:  # a later folder's data replace an earlier one's, as its results do
+            students.update(records.read(folder).variants.get("students", {}))
+        record.variants = {"digest": drawn.pop(), "students": students}
     with Progress(len(grades), "merging", enabled=progress) as bar:
         for grade in grades:
             grade.rubric = rubric

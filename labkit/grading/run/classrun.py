@@ -170,6 +170,15 @@ def grade(
                 f"{out} was graded {before}, and now {now}: grade with the same --variants (and --roster) as "
                 "before, into a new --out, or again with --fresh."
             )
+        recorded = recorded_variants.get("students", {})
+        moved = sorted(
+            name for name in earlier.done if name in recorded and students.get(name, {}) != recorded[name]
+        )  # a roster entry changed or gone: the result kept would be of other data than the record says
+        if moved:
+            raise ValueError(
+                f"the roster gives {one_line(moved[0], 60)} other data than {out} was graded with (its id changed, "
+                "or it left the roster): grade with the roster of that run, into a new --out, or again with --fresh."
+            )
     seed = secrets.randbits(63) if earlier.seed is None else int(earlier.seed)
     if options.exercises not in (None, rubric.registry.source):
         raise ValueError(
@@ -214,11 +223,11 @@ def grade(
     }
     record.flags = {"times from submission": bool(times_from_submission), "times from mtime": bool(times_from_mtime)}
     record.known = {"digest": known.digest, "solutions": solutions}
-    if variants is not None:
-        record.variants = {
-            "digest": variants.digest,
-            "students": {**recorded_variants.get("students", {}), **students},
-        }
+    record.variants = (
+        {"digest": variants.digest, "students": {**recorded_variants.get("students", {}), **students}}
+        if variants is not None
+        else {}
+    )
     records.write(out, record)
     # The options every grading process gets, settled once: the seed drawn, the rubric's exercises loaded
     # there, and the rubric read from the record's copy (the one the results are scored with here).

@@ -408,6 +408,8 @@ def grade_notebook(
                 continue
             mine = None if variant is None else variant.get(str(number), {})
             verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed, variant=mine)
+            if notebook.stopped:  # what it held can no longer be read: no one is named for it
+                verdict.pop("other_variant", None)
             other = verdict.get("other_variant")  # kept in the result: the class run names whose data they are
             if other:
                 shown = "; ".join(

@@ -100,3 +100,19 @@ def test_every_answer_in_words_is_a_stub_marked_for_manual_grading_and_listed_in
     assert found == list(ANSWERS)
     for grade_id, (number, what) in ANSWERS.items():
         assert grade_id.startswith(f"exercise{number}-answer-") and what in EXERCISES[number].answers
+
+
+def test_a_release_per_student_refuses_two_folders_one_file_system_could_not_tell_apart(tmp_path):
+    from labkit.exercises import variants
+    from labkit.grading.authoring.release import folder_name, release
+
+    found = variants.write(tmp_path / "v.toml", bytes(range(32)), {})
+    notebooks = Path(__file__).resolve().parents[3] / "notebooks"
+    with pytest.raises(ValueError, match="share a release folder"):
+        release(notebooks, tmp_path / "out", {"Ada": "1", "ada": "2"}, found)
+    with pytest.raises(ValueError, match="both --roster and --variants"):
+        release(notebooks, tmp_path / "out", {"ada": "1"}, None)
+    assert folder_name("ada_lovelace-2") == "ada_lovelace-2"
+    for odd in ("../x", ".hidden", "a/b", "x" * 61, "Jane Doe", "ü"):  # never a path, nor hidden
+        name = folder_name(odd)
+        assert re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]*", name) and name != odd

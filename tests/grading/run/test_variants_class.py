@@ -23,7 +23,7 @@ pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux
 ROOT = Path(__file__).resolve().parents[3]
 NOTEBOOKS = ROOT / "notebooks"
 NOTEBOOK = "01_limacon.ipynb"
-VARIED = ("01_limacon.ipynb", "05_monotone.ipynb")  # the notebooks of exercises 4 and 14
+VARIED = ("01_limacon.ipynb", "03_meshes.ipynb", "05_monotone.ipynb")  # the notebooks of exercises 4, 7 and 14
 ROSTER = {"ada": "1815", "bob": "1816", "cy": "1817", "dan": "1818"}
 ANOTHER = "another variant"
 
@@ -52,7 +52,7 @@ def course(tmp_path_factory):
     assert _cli("variants", "--new", secret).returncode == 0
     roster = tmp / "roster.csv"
     roster.write_text("name,submission,id\n" + "".join(f"Student {n},{n},{i}\n" for n, i in ROSTER.items()))
-    # two students may draw the same r0 (1 in 251 for a pair): the instructor redraws one, as the docs say
+    # two students may draw the same r0 (1 in 2501 for a pair): the instructor redraws one, as the docs say
     while True:
         found = variants.read(secret)
         values = {name: found.values(LAB, key) for name, key in ROSTER.items()}
@@ -64,7 +64,7 @@ def course(tmp_path_factory):
             break
         else:
             number = 4
-        ran = _cli("variants", "--redraw", tied[-1], "--exercise", number, "--variants", secret)
+        ran = _cli("variants", "--redraw", tied[-1], "--exercise", number, "--variants", secret, "--roster", roster)
         assert ran.returncode == 0 and "now has draw" in ran.stdout, ran.stderr
     released = tmp / "released"
     ran = _cli("release", NOTEBOOKS, "--out", released, "--roster", roster, "--variants", secret)
@@ -87,7 +87,7 @@ def course(tmp_path_factory):
     (submitted / "dan").mkdir()
     for notebook in VARIED:
         dan = nbformat.read(submitted / "ada" / notebook, as_version=4)
-        dan.metadata["labkit"] = {"variant": {"student": "1818", **values["dan"][4], **values["dan"][14]}}
+        dan.metadata["labkit"] = {"variant": {"student": "1818", **values["dan"][4], **values["dan"][7]}}
         nbformat.write(dan, submitted / "dan" / notebook)
     out = tmp / "graded"
     folders = [submitted / n for n in ROSTER]
@@ -108,12 +108,17 @@ def test_the_release_gives_each_student_a_folder_whose_notebooks_hold_their_own_
             mine = nbformat.read(path, as_version=4)
             assert with_values(common[path.name], values, path.name) == mine  # only the data cells differ
             if path.name == NOTEBOOK:
-                assert _data_cell(mine).startswith(f"r0 = {values[4]['r0']:.3f}  #")
+                assert _data_cell(mine).startswith(f"r0 = {values[4]['r0']:.4f}  #")
                 others = [c.source for c in mine.cells if variants.DATA_TAG not in c.metadata.get("tags", [])]
                 assert not re.search(r"(?<![\d.])1\.15(?!\d)", "\n".join(others))  # the lab's r0 is nowhere else
             elif path.name == "05_monotone.ipynb":
                 cell = _data_cell(mine)
                 assert f"rise = {values[14]['rise']:.2f}  #" in cell and f"boil = {values[14]['boil']:.2f}  #" in cell
+            elif path.name == "03_meshes.ipynb":
+                cell, quad = _data_cell(mine), values[7]
+                assert f"xC = {quad['xC']:.2f}  #" in cell and f"yD = {quad['yD']:.2f}\n" in cell
+                twist = (-2 + quad["xC"] - quad["xD"], quad["yC"] - quad["yD"])  # A - B + C - D, as the lab gives it
+                assert f"twist7 = ({twist[0]:.2f}, {twist[1]:.2f})  #" in cell
             else:
                 assert mine == common[path.name]  # nothing else differs from the class's release
 
@@ -121,7 +126,7 @@ def test_the_release_gives_each_student_a_folder_whose_notebooks_hold_their_own_
 def test_each_solution_earns_full_marks_on_its_own_variant_whatever_its_metadata_says(course):
     for name in ("ada", "bob", "cy"):
         row = course["rows"][name]
-        for number in (4, 14, 15):  # 15: pchip's experiment, in the same notebook, does not vary
+        for number in (4, 5, 6, 7, 8, 9, 14, 15):  # 5, 6, 8, 9 and 15 do not vary: each beside one that does
             assert float(row[f"exercise {number}"]) == LAB.exercises[number].points, (number, row)
         feedback = (course["out"] / "feedback" / f"{safe_name(name)}.txt").read_text(encoding="utf-8")
         assert ANOTHER not in feedback
@@ -132,6 +137,9 @@ def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
     parts = {p.name: p.weight for p in LAB.exercises[4].parts}
     assert float(row["exercise 4"]) == parts["limacon_derivatives"], row  # the plot of ada's limaçon is lost
     assert float(row["exercise 14"]) == 0, row  # every part of the boiling plot is of ada's data
+    assert float(row["exercise 7"]) == 0, row  # the straight quadrilateral is ada's
+    for number in (5, 6, 8, 9):  # the same for everyone: kept
+        assert float(row[f"exercise {number}"]) == LAB.exercises[number].points, (number, row)
     assert float(row["exercise 15"]) == LAB.exercises[15].points, row  # the same for everyone: kept
     feedback = (course["out"] / "feedback" / f"{safe_name('dan')}.txt").read_text(encoding="utf-8")
     assert "this notebook holds the data of another variant" in feedback
@@ -140,7 +148,7 @@ def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
     assert "exercise 14: this notebook holds the data of another variant (boil = " in feedback
     with open(course["out"] / "variants.csv", newline="", encoding="utf-8") as handle:
         rows = {row["submission"]: row for row in csv.DictReader(handle)}
-    assert rows["dan"]["holds the data of"] == "exercise 4: ada; exercise 14: ada"  # for the instructor only
+    assert rows["dan"]["holds the data of"] == "exercise 4: ada; exercise 7: ada; exercise 14: ada"  # instructor's
     assert rows["dan"]["id"] == "1818" and rows["dan"]["exercise 4"] == f"r0 = {dan}"
     assert [rows[n]["holds the data of"] for n in ("ada", "bob", "cy")] == ["", "", ""]
     assert not re.search(r"\bada\b", feedback)  # the student's feedback never names the classmate
@@ -185,3 +193,24 @@ def test_a_roster_without_variants_or_the_reverse_is_refused_with_what_to_give(c
             assert ran.returncode != 0 and "give both --roster and --variants" in ran.stderr, ran.stderr
     ran = _cli("variants", "--show", "--variants", course["secret"])
     assert ran.returncode != 0 and "--show needs --roster" in ran.stderr
+
+
+def test_a_resume_with_another_roster_and_a_merge_with_other_variants_are_refused(course):
+    changed = course["tmp"] / "changed.csv"
+    changed.write_text("submission,id\n" + "".join(f"{n},{i}\n" for n, i in ROSTER.items()).replace("1816", "9999"))
+    ran = _cli("grade", *course["folders"], "--out", course["out"], "--roster", changed, "--variants", course["secret"])
+    assert ran.returncode != 0 and "the roster gives bob other data" in ran.stderr, ran.stderr
+    shrunk = course["tmp"] / "shrunk.csv"
+    shrunk.write_text("submission,id\nada,1815\ncy,1817\ndan,1818\n")
+    ran = _cli("grade", *course["folders"], "--out", course["out"], "--roster", shrunk, "--variants", course["secret"])
+    assert ran.returncode != 0 and "the roster gives bob other data" in ran.stderr, ran.stderr
+    # a merge keeps each student's data; runs graded without variants (or with others) are not merged with it
+    merged = course["tmp"] / "merged"
+    assert _cli("merge", course["out"], "--out", merged).returncode == 0
+    record = json.loads((merged / "record.json").read_text(encoding="utf-8"))
+    assert record["variants"] == json.loads((course["out"] / "record.json").read_text(encoding="utf-8"))["variants"]
+    plain = course["tmp"] / "plain"
+    ran = _cli("grade", course["folders"][0], "--out", plain, "--quiet")
+    assert ran.returncode in (0, 1), ran.stderr
+    ran = _cli("merge", course["out"], plain, "--out", course["tmp"] / "mixed")
+    assert ran.returncode != 0 and "graded with different variants" in ran.stderr, ran.stderr
