@@ -18,13 +18,12 @@ import statistics
 import sys
 import tempfile
 import time
-import urllib.request
 import uuid
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "browser"))
-from jupyterlab_session import TOKEN, jupyterlab
+from jupyterlab_session import jupyterlab, kernel_channels
 
 SETUP = "from labkit import plots\nexplorer = plots.pchip_explorer()\nprint(explorer.controls['y1'].model_id)"
 SLOW_MS = 30
@@ -38,14 +37,7 @@ def _message(kind, content):
 async def _moves(base, count):
     from tornado.websocket import websocket_connect
 
-    request = urllib.request.Request(
-        f"{base}/api/kernels",
-        data=b'{"name": "python3"}',
-        method="POST",
-        headers={"Authorization": f"token {TOKEN}", "Content-Type": "application/json"},
-    )
-    kernel = json.loads(urllib.request.urlopen(request, timeout=30).read())
-    socket = await websocket_connect(f"{base.replace('http', 'ws')}/api/kernels/{kernel['id']}/channels?token={TOKEN}")
+    socket = await websocket_connect(kernel_channels(base))
     run = _message("execute_request", {"code": SETUP, "silent": False})
     await socket.write_message(json.dumps(run))
     model = None

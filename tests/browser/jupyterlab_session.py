@@ -65,6 +65,19 @@ def api(base, path):
         return json.loads(response.read())
 
 
+def kernel_channels(base):
+    """Start a python3 kernel through the server at `base`'s REST API; the URL of its channels websocket."""
+    request = urllib.request.Request(
+        f"{base}/api/kernels",
+        data=b'{"name": "python3"}',
+        method="POST",
+        headers={"Authorization": f"token {TOKEN}", "Content-Type": "application/json"},
+    )
+    with urllib.request.urlopen(request, timeout=30) as response:
+        kernel = json.loads(response.read())
+    return f"{base.replace('http', 'ws')}/api/kernels/{kernel['id']}/channels?token={TOKEN}"
+
+
 @contextlib.contextmanager
 def jupyterlab(home, served, *options):
     """A JupyterLab server on 127.0.0.1 serving the folder `served` (more command-line `options` after the

@@ -126,13 +126,12 @@ def test_installing_labkit_enables_the_extension():
 def test_a_real_server_in_this_environment_loads_it_and_a_kernels_websocket_connects_through_it(tmp_path):
     """JupyterLab started as `make lab` starts it (this environment's configuration, nothing on its command line)
     loads the extension, and a kernel's websocket connects through the wrapped class and is answered."""
-    import urllib.request
 
     from tornado.websocket import websocket_connect
 
     sys.path.insert(0, str(ROOT / "tests" / "browser"))
     try:
-        from jupyterlab_session import TOKEN, jupyterlab
+        from jupyterlab_session import jupyterlab, kernel_channels
     finally:
         sys.path.pop(0)
     if not (Path(sys.prefix) / "etc/jupyter/jupyter_server_config.d/labkit.json").exists():
@@ -140,16 +139,9 @@ def test_a_real_server_in_this_environment_loads_it_and_a_kernels_websocket_conn
     served = tmp_path / "served"
     served.mkdir()
     with jupyterlab(tmp_path, served, "--log-level=DEBUG") as base:
-        request = urllib.request.Request(
-            f"{base}/api/kernels",
-            data=b'{"name": "python3"}',
-            method="POST",
-            headers={"Authorization": f"token {TOKEN}", "Content-Type": "application/json"},
-        )
-        kernel = json.loads(urllib.request.urlopen(request, timeout=30).read())
+        url = kernel_channels(base)
 
         async def kernel_info():
-            url = f"{base.replace('http', 'ws')}/api/kernels/{kernel['id']}/channels?token={TOKEN}"
             socket = await websocket_connect(url)
             header = {"msg_id": "labkit-1", "msg_type": "kernel_info_request", "username": "", "session": "s"}
             request = {"header": header, "parent_header": {}, "metadata": {}, "content": {}, "channel": "shell"}
