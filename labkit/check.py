@@ -36,14 +36,16 @@ def driver(key, fn, seed=None):
     return _experiments.check_driver(_LAB.experiment(key), fn, seed)
 
 
-def table(key, errors, fn):
-    """Check the error table of experiment `key` against what the student's driver `fn` returns."""
-    return _experiments.check_table(_LAB.experiment(key), errors, fn)
+def table(key, errors, fn, runge_a=None):
+    """Check the error table of experiment `key` against what the student's driver `fn` returns
+    (`runge_a`: the scale of the notebook's Runge function, when its data cell has one)."""
+    return _experiments.check_table(_LAB.experiment(key), errors, fn, runge_a)
 
 
-def rate(key, answer, errors, fn):
-    """Check the rate answer of experiment `key`, read from the table `errors` of the driver `fn`."""
-    return _experiments.check_rate(_LAB.experiment(key), answer, errors, fn)
+def rate(key, answer, errors, fn, runge_a=None):
+    """Check the rate answer of experiment `key`, read from the table `errors` of the driver `fn`
+    (`runge_a`: the scale of the notebook's Runge function, when its data cell has one)."""
+    return _experiments.check_rate(_LAB.experiment(key), answer, errors, fn, runge_a)
 
 
 def exercise(number, namespace, seed=None):

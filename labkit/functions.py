@@ -8,28 +8,43 @@ from numpy.typing import ArrayLike, NDArray
 from ._validate import as_float_array, as_scalar, scalar_or_array
 
 
-def runge(x: ArrayLike) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
-    """The Runge function ``1 / (1 + x**2)`` and its derivative.
+def runge(x: ArrayLike, a: float = 1.0) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
+    """The Runge function ``1 / (1 + a x**2)`` and its derivative.
 
     Parameters
     ----------
     x : array_like
         Points, any shape.
+    a : float, optional
+        The positive scale of ``x**2``; the lab's function has ``a = 1``, and a
+        student's own variant of the lab may have another
+        (:mod:`labkit.exercises.variants`).
 
     Returns
     -------
     y, yprime : float or ndarray, same shape as `x`
-        ``y = 1/(1+x^2)`` and ``y' = -2x/(1+x^2)^2``.
+        ``y = 1/(1+a x^2)`` and ``y' = -2ax/(1+a x^2)^2``.
+
+    Raises
+    ------
+    ValueError
+        If `a` is not one positive finite number.
 
     Examples
     --------
     >>> from labkit import runge
     >>> [float(v) for v in runge(1.0)]
     [0.5, -0.5]
+    >>> [float(v) for v in runge(1.0, a=3.0)]
+    [0.25, -0.375]
     """
     xa = as_float_array(x, "x")
-    y = 1.0 / (1.0 + xa * xa)
-    yprime = -2.0 * xa * y * y
+    scale = as_scalar(a, "a")
+    if not scale > 0:
+        raise ValueError(f"a is the positive scale in 1/(1 + a x^2); got {scale}. Give a number above 0.")
+    # the lab's a = 1 multiplies exactly, so its values are the same bits as 1/(1+x^2)
+    y = 1.0 / (1.0 + scale * (xa * xa))
+    yprime = -2.0 * xa * (scale * y) * y  # finite for any finite scale
     return scalar_or_array(y, x), scalar_or_array(yprime, x)
 
 

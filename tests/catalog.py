@@ -9,25 +9,18 @@
   the words of ``hint``.
 
 A planted notebook reads its rates off its own tables (as a student who reads the printout would),
-so a slip in a function a table is built on is not charged again through the rate. The same code
-is in :func:`plant`.
+so a slip in a function a table is built on is not charged again through the rate
+(:func:`labkit.grading.authoring.draws.reading_rates`, which ``labkit variants --check`` uses too).
 """
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import nbformat
 
+from labkit.grading.authoring.draws import reading_rates
+
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
-RATES = {
-    "pherm": "errors_pherm",
-    "complete": "errors_complete",
-    "natural": "errors_natural",
-    "notaknot": "errors_notaknot",
-    "pchip": "errors_pchip",
-    "bilinear": "errors_bilinear",
-}
 
 
 @dataclass(frozen=True)
@@ -56,17 +49,7 @@ def plant(entry, folder):
         assert len(hits) == 1 and hits[0].source.count(old) == 1, (entry.name, old, len(hits))
         hits[0].source = hits[0].source.replace(old, new)
     if not entry.keep_rates:
-        for key, table in RATES.items():
-            for cell in nb.cells:
-                if cell.cell_type == "code":
-                    # the mean of the last three log2 ratios, rounded: how the printout is read
-                    cell.source = re.sub(
-                        rf"^rate_{key} = \d+$",
-                        f"rate_{key} = int(np.rint(np.mean(np.log2(np.asarray({table}[-4:-1]) "
-                        f"/ np.asarray({table}[-3:])))))",
-                        cell.source,
-                        flags=re.MULTILINE,
-                    )
+        reading_rates(nb)  # each rate read off the student's own table, as labkit variants --check reads it
     path = Path(folder) / entry.notebook
     path.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, path)
@@ -296,7 +279,7 @@ MISTAKES = (
     Planted(
         "runge_derivative_sign",
         "02_convergence.ipynb",
-        (("yprime = -2.0 * x", "yprime = 2.0 * x"),),
+        (("yprime = -2.0 * runge_a * x", "yprime = 2.0 * runge_a * x"),),
         3,
         "runge",
         "yprime has the wrong sign",
@@ -854,7 +837,12 @@ SLIPS = (
     Planted(
         "runge_derivative_not_squared",
         "02_convergence.ipynb",
-        (("yprime = -2.0 * x / (1.0 + x**2) ** 2", "yprime = -2.0 * x / (1.0 + x**2)"),),
+        (
+            (
+                "yprime = -2.0 * runge_a * x / (1.0 + runge_a * x**2) ** 2",
+                "yprime = -2.0 * runge_a * x / (1.0 + runge_a * x**2)",
+            ),
+        ),
         3,
         "runge",
         "yprime's denominator",

@@ -30,6 +30,12 @@ spline's slopes) are handed to it by the check, from labkit, so a mistake in
 an earlier exercise is not counted again here. The functions handed over are
 module-level functions, so ``labkit grade`` can name them to the sandboxed
 notebook: the declaration lists them (:attr:`Experiment.passes`).
+
+With variants (:mod:`labkit.exercises.variants`) every table on the Runge
+function is on the student's own scale of it, :data:`RUNGE_A`: the table and
+the rate are judged against the driver run on ``labkit.runge`` with that scale
+bound (a partial with one float keyword, which crosses into the sandbox by
+name too), while the driver itself is checked on labkit's functions as always.
 """
 
 import functools
@@ -41,6 +47,7 @@ from .. import bilinear, convergence, functions, piecewise, splines
 from . import answer_key
 from .model import EXPERIMENTS, Part
 from .result import NOT_DONE, CheckResult, call, case_rng, floats, judged_by_the_lab, shown
+from .variants import Param
 
 DRIVER_TOLERANCE = 1e-6  # relative: the driver's error against the reference error
 PRINTED = 6e-4  # relative: a table copied from ratio_table's four significant digits (half a unit is 5e-4)
@@ -49,6 +56,11 @@ MIN_ORDER = 0.5  # observed order across the table below which it shows no exper
 # divide the shift of 1, so the shifted function's relative error is not the Runge function's (at 11 or 21
 # points the shift is a whole number of intervals and the two errors coincide)
 SHIFTED_PROBE = 9
+# the scale a of the Runge function 1/(1 + a x^2) a student's tables measure: one datum for every experiment on
+# it, drawn with Exercise 3 (where the student writes runge). Over [0.5, 2] every table shows the lab's orders
+# (tests/exercises/test_variants.py), and 4 decimals give 15001 values: a class of 100 has a tie about one time
+# in four, which release and `labkit variants --check` name for a redraw
+RUNGE_A = Param("runge_a", 0.5, 2.0, 4, lab=1.0, drawn_with=3)
 
 
 def scaled_runge(x):
@@ -69,18 +81,36 @@ def scaled_runge2d(x, y):
     return 3.0 / (1.0 + s * s)
 
 
-def runge_sign_slip(x):
-    """The Runge function with the sign slip in its derivative (+2x/(1+x^2)^2), as Exercise 3's check names it:
-    what a driver's own `f` may be and still count as an attempt at the experiment. Written out (see
-    :func:`scaled_runge`)."""
+def runge_sign_slip(x, a=1.0):
+    """The Runge function 1/(1 + a x^2) with the sign slip in its derivative (+2ax/(1+ax^2)^2), as Exercise 3's
+    check names it: what a driver's own `f` may be and still count as an attempt at the experiment. Written
+    out (see :func:`scaled_runge`)."""
     x = np.asarray(x, dtype=float)
-    return 1.0 / (1.0 + x * x), 2.0 * x / (1.0 + x * x) ** 2
+    return 1.0 / (1.0 + a * x * x), 2.0 * a * x / (1.0 + a * x * x) ** 2
 
 
-def runge_unsquared(x):
-    """The Runge function with -2x/(1+x^2) as its derivative: the chain-rule slip Exercise 3's check names."""
+def runge_unsquared(x, a=1.0):
+    """The Runge function with -2ax/(1+ax^2) as its derivative: the chain-rule slip Exercise 3's check names."""
     x = np.asarray(x, dtype=float)
-    return 1.0 / (1.0 + x * x), -2.0 * x / (1.0 + x * x)
+    return 1.0 / (1.0 + a * x * x), -2.0 * a * x / (1.0 + a * x * x)
+
+
+def runge_inner_a_left_out(x, a=1.0):
+    """The Runge function 1/(1 + a x^2) with -2x/(1+ax^2)^2 as its derivative: the chain rule's inner factor a
+    left out, the slip Exercise 3's check names when a student has their own scale."""
+    x = np.asarray(x, dtype=float)
+    return 1.0 / (1.0 + a * x * x), -2.0 * x / (1.0 + a * x * x) ** 2
+
+
+# every Runge function with a slip a driver's own f may be (at the student's scale, or ignoring it): the checks
+# hand them to the driver, so they are declared to cross into the sandbox (Part.passes)
+RUNGE_SLIPS = (runge_sign_slip, runge_unsquared, runge_inner_a_left_out)
+
+
+def _at(function, a):
+    """`function` of the Runge function's scale at `a`: itself at the lab's scale, else bound to `a` (a partial of a
+    module-level function with one float keyword crosses into the sandbox by name)."""
+    return function if a is None or a == RUNGE_A.lab else functools.partial(function, a=float(a))
 
 
 def runge2d_product(x, y):
@@ -121,26 +151,59 @@ class Experiment:
             return "Piecewise Bilinear"
         return convergence.METHOD_TITLES[self.key]
 
-    def f(self, scaled=False):
+    @property
+    def varied(self):
+        """The student's data the table and the rate are checked against (the Runge function's scale)."""
+        return () if self.key == "bilinear" else (RUNGE_A.name,)
+
+    def f(self, scaled=False, a=None):
+        """The test function: the lab's (the Runge function with scale `a`, the lab's when None), or the moved,
+        scaled one the driver check tells a relative error by."""
         if self.key == "bilinear":
             return scaled_runge2d if scaled else functions.runge2d
-        return scaled_runge if scaled else functions.runge
+        return scaled_runge if scaled else _at(functions.runge, a)
 
     @property
     def passes(self):
         """Every function the checks hand the driver: the pieces and both test functions."""
         return tuple(self.pieces) + (self.f(), self.f(scaled=True))
 
-    @property
-    def f_slips(self):
-        """The test function with each slip its own check names: a driver's own `f` may be one of them."""
-        return (runge2d_product,) if self.key == "bilinear" else (runge_sign_slip, runge_unsquared)
+    def f_slips(self, a=None):
+        """The test function (with scale `a`) with each slip its own check names: a driver's own `f` may be one
+        of them. With a student's own scale, and a driver whose default `f` is the student's own runge
+        (Exercise 3), the lab's function, with or without those slips, is one too: a runge that ignores the
+        scale is marked in runge's own part. Where the notebook gives runge (exercises 11 to 15), a notebook on
+        the lab's function is not the student's experiment."""
+        if self.key == "bilinear":
+            return (runge2d_product,)
+        if self.f(a=a) is functions.runge:
+            return (runge_sign_slip, runge_unsquared)
+        slips = tuple(_at(slip, a) for slip in RUNGE_SLIPS)
+        return slips + ((functions.runge, runge_sign_slip, runge_unsquared) if "runge" in self.uses else ())
 
-    def reference(self, ndata, scaled=False, interval=(0.0, 5.0), ntest=None):
-        """The relative errors labkit's experiment gives for `ndata` (a sequence of sizes)."""
+    @property
+    def slip_functions(self):
+        """Every function :meth:`f_slips` may hand a driver, whatever the student's scale."""
+        return (runge2d_product,) if self.key == "bilinear" else RUNGE_SLIPS + (functions.runge,)
+
+    def reference(self, ndata, scaled=False, interval=(0.0, 5.0), ntest=None, a=None):
+        """The relative errors labkit's experiment gives for `ndata` (a sequence of sizes), on the Runge function
+        with scale `a` (the lab's when None)."""
         # computed once per process: the driver's check and the table's ask for the same ones, and a driver's
         # slips are looked for at each size (a bilinear one at 4001 x 4001 test points takes seconds)
-        return _reference(self, tuple(int(n) for n in ndata), scaled, tuple(interval), ntest or self.ntest).copy()
+        a = None if a is None or self.key == "bilinear" or float(a) == RUNGE_A.lab else float(a)
+        return _reference(self, tuple(int(n) for n in ndata), scaled, tuple(interval), ntest or self.ntest, a).copy()
+
+    def sound(self, values):
+        """Why the Runge function's scale in `values` would not teach this experiment's lesson ('' when it does):
+        its table must show the lab's order."""
+        a = values.get(RUNGE_A.name) if self.key != "bilinear" else None
+        shown = convergence.ConvergenceTable(self.title, np.array(self.ndata), self.reference(self.ndata, a=a)).order
+        if shown != self.order:
+            return (
+                f"with runge_a = {a} the {self.title.lower()}'s table shows order {shown}, not the lab's {self.order}"
+            )
+        return ""
 
     @property
     def observed_order(self):
@@ -181,9 +244,10 @@ class Experiment:
                 reads=both,
                 index=0,
                 refused=EXPERIMENTS,
-                passes=self.passes + self.f_slips,
+                passes=self.passes + self.slip_functions,
                 functions=(self.table, self.driver),
                 uses=self.uses,
+                varied=self.varied,
                 experiment=self,
             ),
             ExperimentPart(
@@ -193,9 +257,10 @@ class Experiment:
                 reads=both,
                 index=1,
                 refused=EXPERIMENTS,
-                passes=self.passes + self.f_slips,
+                passes=self.passes + self.slip_functions,
                 functions=(self.rate, self.driver),
                 uses=self.uses,
+                varied=self.varied,
                 experiment=self,
             ),
         )
@@ -221,17 +286,18 @@ class ExperimentPart(Part):
         ]
         if self.check is check_driver:
             return check_driver(self.experiment, *values, seed=seed)
-        return check_experiment(self.experiment, *values)
+        a = (variant or {}).get(RUNGE_A.name) if RUNGE_A.name in self.varied else None
+        return check_experiment(self.experiment, *values, runge_a=a)
 
 
-@functools.lru_cache(maxsize=256)
-def _reference(method, ndata, scaled, interval, ntest):
+@functools.lru_cache(maxsize=1024)  # a grading run asks for each student's scale where a table is judged by it
+def _reference(method, ndata, scaled, interval, ntest, a=None):
     """:meth:`Experiment.reference`, computed."""
     sizes = list(ndata) * 2 if len(ndata) == 1 else list(ndata)  # the tables want two sizes
     if method.key == "bilinear":
         found = convergence.bilinear_convergence(sizes, method.f(scaled), interval, ntest)
     else:
-        found = convergence.convergence_table(method.key, sizes, method.f(scaled), interval, ntest)
+        found = convergence.convergence_table(method.key, sizes, method.f(scaled, a), interval, ntest)
     return found.errors[: len(ndata)]
 
 
@@ -511,7 +577,7 @@ def check_driver(method, fn, seed=None):
             _agrees(err, expected),
             f"got {shown(err)}, {_how_far(err, expected)}",
         ):
-            slip = _diagnosis(method, err, ndata)
+            slip = _diagnosis(method, err, ndata) or _ignores_f(method, fn, ndata, err)
             result.hint = (
                 slip
                 if slip
@@ -536,9 +602,24 @@ def check_driver(method, fn, seed=None):
             "the error is absolute, not relative to max|f|: divide the largest error by max|f| over "
             "the test points (for the Runge function on [0, 5] that is 1, which hides the slip)."
             if tripled
-            else "compute f from the function passed in as `f`, not from runge itself."
+            else IGNORES_F
         )
     return result
+
+
+IGNORES_F = "compute f from the function passed in as `f`, not from runge itself."
+
+
+def _ignores_f(method, fn, ndata, err):
+    """The hint for a driver that gives the same error whatever `f` it is passed (it computes its own), or None.
+    With the lab's data its own Runge function is labkit's, so only the moved, scaled one shows it; with a
+    student's own scale the lab's f already does. At a size where the two functions' errors coincide (the
+    shift a whole number of intervals) nothing can be told."""
+    if _agrees(method.reference([ndata])[0], method.reference([ndata], scaled=True)[0]):
+        return None
+    ok, moved = call(CheckResult(method.driver), "the driver with another f", fn, ndata, method.f(scaled=True),
+                     *method.pieces)  # fmt: skip
+    return IGNORES_F if ok and _same(err, moved) else None
 
 
 def _how_far(err, expected):
@@ -559,16 +640,17 @@ def table_order(method, errors):
     return float(np.log(values[0] / values[-1]) / np.log((method.ndata[-1] - 1) / (method.ndata[0] - 1)))
 
 
-def check_table(method, errors, fn):
+def check_table(method, errors, fn, runge_a=None):
     """Check the error list of an experiment against what the student's driver `fn` returns
-    (the notebook's self-check; see :func:`experiment`)."""
-    return check_experiment(method, errors, MISSING, fn)[0]
+    (the notebook's self-check; see :func:`experiment`); `runge_a` is the notebook's Runge scale."""
+    return check_experiment(method, errors, MISSING, fn, runge_a)[0]
 
 
-def check_rate(method, answer, errors, fn):
+def check_rate(method, answer, errors, fn, runge_a=None):
     """Check the rate answer of an experiment: the exponent p with Err(n)/Err(2n-1) close to 2**p, read
-    from the table `errors` of the student's driver `fn` (the notebook's self-check; see :func:`experiment`)."""
-    return check_experiment(method, errors, answer, fn)[1]
+    from the table `errors` of the student's driver `fn` (the notebook's self-check; see :func:`experiment`);
+    `runge_a` is the notebook's Runge scale."""
+    return check_experiment(method, errors, answer, fn, runge_a)[1]
 
 
 def _no_experiment(method, values, whose="the", verdict="this table shows no experiment"):
@@ -634,7 +716,7 @@ def _measures(method, fn, scratch):
     return first is not None and second is not None and not _agrees(first, second)
 
 
-def attempted_driver(method, fn, own):
+def attempted_driver(method, fn, own, a=None):
     """Why the student's driver `fn` is no attempt at the lab's experiment ('' when it is one).
 
     `own` is what it returned, with its own defaults, for the lab's sizes. It is an attempt when, given
@@ -643,7 +725,8 @@ def attempted_driver(method, fn, own):
     for a slip no check names, it still measures an experiment (:func:`_measures`), and
     when the `f` it uses by default is the test function or one with a slip its own check names (the
     derivative's sign, a missing square; a product in ``runge2d``): so a driver, or a Runge function,
-    that measures something else is no reference for the table and the rate read from it.
+    that measures something else is no reference for the table and the rate read from it. `a` is the
+    student's scale of the Runge function (the lab's when None): the test function the default `f` must be.
     """
     scratch = CheckResult(method.driver)
     for index, ndata in enumerate(method.ndata[:2]):
@@ -658,21 +741,23 @@ def attempted_driver(method, fn, own):
                 "nor the lab's experiment with one of the usual slips"
             )
     ndata = method.ndata[1]
-    ok, given = call(scratch, "the driver with the lab's f", fn, ndata, method.f())
+    ok, given = call(scratch, "the driver with the lab's f", fn, ndata, method.f(a=a))
     if not ok or _same(own[1], given):
         return ""
-    for slip in method.f_slips:
+    for slip in method.f_slips(a):
         ok, given = call(scratch, "the driver with a slip in f", fn, ndata, slip)
         if ok and _same(own[1], given):
             return ""
     name = "runge2d" if method.key == "bilinear" else "Runge"
+    own_scale = method.key != "bilinear" and method.f(a=a) is not functions.runge
+    yours = f" 1/(1 + runge_a x^2) with your runge_a = {RUNGE_A.shown(a)}" if own_scale else ""
     return (
-        f"the f your {method.driver} uses when it is given none is not the {name} function, not even with one "
-        "of the slips its own check names"
+        f"the f your {method.driver} uses when it is given none is not the {name} function{yours}, not even with "
+        "one of the slips its own check names"
     )
 
 
-def check_experiment(method, errors, answer, fn):
+def check_experiment(method, errors, answer, fn, runge_a=None):
     """Check the table and the rate answer of an experiment against one run of the student's driver
     `fn` at the lab's sizes: ``[table result, rate result]``.
 
@@ -691,6 +776,10 @@ def check_experiment(method, errors, answer, fn):
     is marked in their own part: the table keeps its points, and the rate is
     right when it is the order read off that table's ratios (as the lab reads
     them) or the order the lab's experiment shows.
+
+    `runge_a` is the student's own scale of the Runge function (a variant,
+    :mod:`labkit.exercises.variants`; the lab's when None): the driver's
+    default `f` must be that function, and the lab's experiment is on it.
     """
     table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
     own = _own_errors(method, fn, table_result)
@@ -699,9 +788,9 @@ def check_experiment(method, errors, answer, fn):
         rate_result.add_steps(table_result)
         rate_result.hint = table_result.hint
     else:
-        why = attempted_driver(method, fn, own)
+        why = attempted_driver(method, fn, own, runge_a)
         if why:  # the driver measures something else: the lab's experiment is the reference
-            lab = method.reference(method.ndata)
+            lab = method.reference(method.ndata, a=runge_a)
             for result in (table_result, rate_result):
                 judged_by_the_lab(result, why, LAB_EXPERIMENT)
         else:

@@ -11,7 +11,7 @@ polynomials a cubic Hermite interpolant must reproduce exactly.
 import numpy as np
 
 from .. import functions, piecewise
-from .experiments import Experiment
+from .experiments import RUNGE_A, Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part, Together
 from .plotted import LAB_R0, check_limacon_plot, derivative_slips
 from .result import CheckResult, call, case_rng, close, floats, gave_up, several, shown, worst
@@ -299,8 +299,9 @@ def _constant_factor(got, want):
 # -- Exercise 3 ---------------------------------------------------------------
 
 
-def check_runge(fn, seed=None):
-    """Check ``runge(x) -> (y, yprime)`` against 1/(1+x^2) and its derivative."""
+def check_runge(fn, seed=None, runge_a=RUNGE_A.lab):
+    """Check ``runge(x) -> (y, yprime)`` against 1/(1 + a x^2) and its derivative, a = `runge_a` (the
+    notebook's data cell; the lab's function has a = 1)."""
     result = CheckResult("runge")
     x = np.linspace(-3.0, 3.0, 13)
     if seed is not None:  # the grader's fresh points besides the fixed ones
@@ -313,28 +314,41 @@ def check_runge(fn, seed=None):
         return result.fail(
             "runge(x) returns (y, yprime)", f"got {shown(got)}", "return both values: `return y, yprime`."
         )
-    y, yprime = functions.runge(x)
-    if not result.step("y = 1/(1+x^2)", close(out[0], y), "" if close(out[0], y) else worst(out[0], y)):
-        result.hint = "use componentwise operations: 1 / (1 + x**2)."
+    lab = runge_a == RUNGE_A.lab
+    formula = "1/(1+x^2)" if lab else f"1/(1 + runge_a x^2), runge_a = {RUNGE_A.shown(runge_a)}"
+    y, yprime = functions.runge(x, a=runge_a)
+    if not result.step(f"y = {formula}", close(out[0], y), "" if close(out[0], y) else worst(out[0], y)):
+        result.hint = (
+            "your runge leaves out runge_a: the function is 1 / (1 + runge_a * x**2), with runge_a from the "
+            "notebook's data cell."
+            if not lab and close(out[0], functions.runge(x)[0])
+            else f"use componentwise operations: 1 / (1 + {'' if lab else 'runge_a * '}x**2)."
+        )
         return result
     if _sign_slip(out[1], yprime):
         return result.fail(
-            "yprime is the derivative of 1/(1+x^2)",
+            f"yprime is the derivative of {formula}",
             "yprime has the wrong sign",
-            "yprime has the wrong sign: 1/(1+x^2) falls for x > 0, so its derivative must be negative there; "
-            "check the sign the chain rule gives for the derivative of 1/u.",
+            "yprime has the wrong sign: the Runge function falls for positive x, so its derivative must be negative "
+            "there; check the sign the chain rule gives for the derivative of 1/u.",
         )
     if not result.step(
-        "yprime is the derivative of 1/(1+x^2)",
+        f"yprime is the derivative of {formula}",
         close(out[1], yprime),
         "" if close(out[1], yprime) else worst(out[1], yprime),
     ):
-        unsquared = close(out[1], yprime * (1 + x**2))  # -2x / (1 + x^2): the chain rule's square left out
+        unsquared = close(out[1], yprime * (1 + runge_a * x**2))  # the chain rule's square left out
+        inner = not lab and close(out[1], yprime / runge_a)  # the chain rule's inner factor runge_a left out
+        square = "1 + x**2" if lab else "1 + runge_a * x**2"
         result.hint = (
-            "yprime's denominator lacks a square: the chain rule, applied to 1/u with u = 1 + x**2, puts u "
-            "squared in the denominator."
+            "yprime's denominator lacks a square: the chain rule, applied to 1/u with u = "
+            f"{square}, puts u squared in the denominator."
             if unsquared
-            else "differentiate 1/(1+x^2) with the chain rule, then compare yprime with a centred difference of y."
+            else "yprime lacks the factor runge_a: the chain rule multiplies by the derivative of u = 1 + runge_a "
+            "* x**2, which has runge_a in it."
+            if inner
+            else f"differentiate {formula.split(',')[0]} with the chain rule, then compare yprime with a centred "
+            "difference of y."
         )
     return result
 
@@ -419,6 +433,11 @@ RUNGE_DERIVATIVE = (
     "-\\frac{2x}{(1+x^2)^2}",
     "-2x/(x^2+1)^2",
     "2x/(1+x^2)^2",  # the sign alone would still give the rest away
+    # with the student's own scale a of 1/(1 + a x^2), as the notebook names it and as a text would write it
+    "-2*runge_a*x/(1 + runge_a*x**2)**2",
+    "2*runge_a*x/(1 + runge_a*x**2)**2",
+    "-2ax/(1+ax^2)^2",
+    "-2*a*x/(1 + a*x**2)**2",
 )
 LIMACON_DERIVATIVES = (
     "-sin t cos t - r sin t",
@@ -459,10 +478,14 @@ EXERCISES = (
     Exercise(
         3,
         ("runge",) + PHERM.names(),
-        (Part("runge", 3, check_runge, ("runge",), seeded=True, refused=OWN_FUNCTIONS),) + PHERM.parts(),
+        (Part("runge", 3, check_runge, ("runge",), seeded=True, refused=OWN_FUNCTIONS, varied=(RUNGE_A.name,)),)
+        + PHERM.parts(),
         notebook="02_convergence.ipynb",
         answers=("the order the table shows, against piecewise linear",),
         withheld=RUNGE_DERIVATIVE + PHERM.withheld,
+        # the Runge function's scale: every convergence table measures the student's own function
+        params=(RUNGE_A,),
+        sound=PHERM.sound,
     ),
     Exercise(
         4,

@@ -4,7 +4,7 @@ The plot is checked in :mod:`~labkit.exercises.plotted` and the experiment in
 :mod:`~labkit.exercises.experiments`; this module declares the exercises.
 """
 
-from .experiments import Experiment
+from .experiments import RUNGE_A, Experiment
 from .model import Exercise, Part
 from .plotted import LAB_BOIL, LAB_RISE, boiling_sound, check_boiling_plot
 from .variants import Param
@@ -31,5 +31,7 @@ EXERCISES = (
         notebook="05_monotone.ipynb",
         answers=("pchip's order against the spline's, and when to choose pchip",),
         withheld=PCHIP.withheld,
+        params=(RUNGE_A,),  # the scale of the Runge function, drawn with Exercise 3
+        sound=PCHIP.sound,
     ),
 )

@@ -102,6 +102,7 @@ class Registry:
         for part in parts:
             for function in part.passes:
                 _check_passable(function, part.name)
+        _check_shared_params(self.exercises)
         self.passable = frozenset(function_name(f) for p in parts for f in p.passes)
         self.dependencies = _dependencies(parts)
         self.experiments: dict = {}
@@ -271,6 +272,32 @@ def _dependencies(parts) -> list:
             if graded[name] != part.name and pair not in found:
                 found.append(pair)
     return found
+
+
+def _check_shared_params(exercises: dict) -> None:
+    """Parameters of one name are one datum: declared alike by every exercise, and a shared one is drawn with an
+    exercise that declares it (its draw, and a redraw of it, give every exercise the same value). A course that
+    takes only some of the sharing exercises still draws the datum under the drawing exercise's number."""
+    by_name: dict = {}
+    for number, exercise in exercises.items():
+        for param in exercise.params:
+            first = by_name.setdefault(param.name, (number, param))
+            if first[1] != param:
+                raise ValueError(
+                    f"exercises {first[0]} and {number} both declare {param.name!r} but not alike: a name is one "
+                    "datum, so declare one Param (with drawn_with) and use it in both."
+                )
+            if first[0] != number and param.drawn_with is None:
+                raise ValueError(
+                    f"exercises {first[0]} and {number} both declare {param.name!r}, each drawing its own: give the "
+                    "Param drawn_with=<the exercise that draws it>, or give the two data different names."
+                )
+            drawing = exercises.get(param.drawn_with)
+            if drawing is not None and not any(p == param for p in drawing.params):
+                raise ValueError(
+                    f"{param.name!r} is drawn with exercise {param.drawn_with}, which does not declare it: declare "
+                    "it there too."
+                )
 
 
 def _check_passable(function, part: str) -> None:

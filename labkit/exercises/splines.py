@@ -9,7 +9,7 @@ must reproduce exactly.
 import numpy as np
 
 from .. import piecewise, splines
-from .experiments import Experiment
+from .experiments import RUNGE_A, Experiment
 from .model import INTERPOLANTS, Exercise, Optional, Part
 from .result import CheckResult, call, case_rng, close, floats, judged_by_the_lab, shown, worst
 
@@ -519,6 +519,8 @@ EXERCISES = (
         notebook="04_splines.ipynb",
         answers=("the order, with f' used only at the ends",),
         withheld=COMPLETE.withheld,
+        params=(RUNGE_A,),  # the scale of the Runge function, drawn with Exercise 3
+        sound=COMPLETE.sound,
     ),
     Exercise(
         12,
@@ -539,6 +541,8 @@ EXERCISES = (
         notebook="04_splines.ipynb",
         answers=("why the natural spline's order is lower",),
         withheld=NATURAL_ROWS + NATURAL_WHY + NATURAL.withheld,
+        params=(RUNGE_A,),  # the scale of the Runge function, drawn with Exercise 3
+        sound=NATURAL.sound,
     ),
     Exercise(
         13,
@@ -547,5 +551,7 @@ EXERCISES = (
         notebook="04_splines.ipynb",
         answers=("the three splines compared",),
         withheld=NOTAKNOT.withheld,
+        params=(RUNGE_A,),  # the scale of the Runge function, drawn with Exercise 3
+        sound=NOTAKNOT.sound,
     ),
 )

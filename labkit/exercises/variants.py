@@ -23,6 +23,11 @@ The course's secret lives in a small TOML file the instructor keeps
 (a bad draw can be changed, which login-seeded variants cannot). Release and
 grading both read the same file, so they always agree.
 
+A datum several exercises use (the Runge function's scale, which every
+convergence table measures) is one :class:`Param` with ``drawn_with`` naming
+the exercise whose draw gives it, so a student has one value of it, and a
+redraw of that exercise changes it everywhere.
+
 Without a variants file nothing changes: the lab's values (:func:`lab_values`)
 are what the notebooks hold and what the checks use.
 """
@@ -65,6 +70,9 @@ class Param:
     high: float
     digits: int
     lab: float
+    # the exercise whose draw gives the value, when several exercises share one datum (the Runge function's
+    # scale, which every convergence table uses); None: each exercise declaring it draws its own
+    drawn_with: int | None = None
 
     def __post_init__(self):
         if not str(self.name).isidentifier():
@@ -72,6 +80,8 @@ class Param:
         values = (self.low, self.high, self.lab)
         if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values):
             raise ValueError(f"parameter {self.name!r}: low, high and lab must be finite numbers; got {values}.")
+        if self.drawn_with is not None and (isinstance(self.drawn_with, bool) or not isinstance(self.drawn_with, int)):
+            raise ValueError(f"parameter {self.name!r}: drawn_with is an exercise number; got {self.drawn_with!r}.")
         if not self.low < self.high:
             raise ValueError(f"parameter {self.name!r}: its range [{self.low}, {self.high}] is empty; give low < high.")
         if isinstance(self.digits, bool) or not isinstance(self.digits, int) or not 0 <= self.digits <= 12:
@@ -159,20 +169,44 @@ class VariantsFile:
         """Exercise number -> {parameter: value} of `student` (the roster id) for every varied exercise."""
         student = str(student)
         redraws = self.redraw.get(student, {})
-        return {
-            e.number: draw(self.secret, student, e.number, e.params, redraws.get(e.number, 0))
-            for e in registry
-            if e.params
-        }
+        found = {}
+        for e in registry:
+            if e.params:
+                found[e.number] = {}
+                for p in e.params:
+                    key = drawn_with(e.number, p)
+                    found[e.number].update(draw(self.secret, student, key, (p,), redraws.get(key, 0)))
+        return found
+
+
+def drawn_with(exercise: int, param: Param) -> int:
+    """The exercise whose draw gives `param`'s value in exercise `exercise` (itself, unless the datum is shared)."""
+    return exercise if param.drawn_with is None else param.drawn_with
+
+
+def drawing(registry) -> dict:
+    """Exercise number -> the parameters drawn with it: each datum once, shared ones with the exercise that
+    draws them (what a redraw of that exercise changes)."""
+    found: dict = {}
+    for e in registry:
+        for p in e.params:
+            names = found.setdefault(drawn_with(e.number, p), [])
+            if p.name not in names:
+                names.append(p.name)
+    return found
 
 
 def ties(found: VariantsFile, registry, students) -> list:
     """(exercise, [roster ids]) of the students who drew the same data of an exercise: a copy between them
-    cannot be told from their own work, so give all but one a fresh draw (:func:`redraw`)."""
+    cannot be told from their own work, so give all but one a fresh draw (:func:`redraw`). A datum several
+    exercises share is reported once, under the exercise that draws it."""
     by_data: dict = {}
+    drawn = drawing(registry)
     for student in dict.fromkeys(str(s) for s in students):
-        for number, given in found.values(registry, student).items():
-            by_data.setdefault((number, tuple(sorted(given.items()))), []).append(student)
+        values = {name: value for given in found.values(registry, student).values() for name, value in given.items()}
+        for number, names in drawn.items():
+            given = tuple((name, values[name]) for name in sorted(names))
+            by_data.setdefault((number, given), []).append(student)
     return [(number, group) for (number, _), group in sorted(by_data.items()) if len(group) > 1]
 
 
@@ -249,9 +283,19 @@ def redraw(path, student: str, exercise: int, registry) -> int:
     """Give `student` the next draw of `exercise` in the variants file at `path`; the new draw number."""
     current = read(path)
     exercise = int(exercise)
-    if exercise not in registry.exercises or not registry.exercises[exercise].params:
-        varied = sorted(e.number for e in registry if e.params)
-        raise ValueError(f"exercise {exercise} has no variants; the varied exercises are {varied}.")
+    drawn = drawing(registry)
+    if exercise not in drawn:
+        shared = sorted(
+            {drawn_with(exercise, p) for p in registry.exercises[exercise].params}
+            if exercise in registry.exercises
+            else ()
+        )
+        if shared:
+            raise ValueError(
+                f"exercise {exercise}'s data are drawn with exercise {shared[0]}'s (they share them): "
+                f"redraw exercise {shared[0]}."
+            )
+        raise ValueError(f"exercise {exercise} has no variants; the varied exercises are {sorted(drawn)}.")
     student = str(student)
     if not student or not student.isprintable():
         raise ValueError(f"{student!r} is not a roster id this file can hold; give the id as the roster has it.")

@@ -28,11 +28,19 @@ KEY = bytes(range(32))
 
 
 def test_the_lab_declares_the_limacon_offset_and_its_own_value_is_the_notebook_s():
+    runge = {"runge_a": 1.0}
     assert variants.lab_values(LAB) == {
+        3: runge,
         4: {"r0": 1.15},
         7: {"xC": 1.0, "yC": 0.5, "xD": 0.0, "yD": 1.0},
+        11: runge,
+        12: runge,
+        13: runge,
         14: {"rise": 1.0, "boil": 2.0},
+        15: runge,
     }
+    # the Runge function's scale is one datum, drawn with Exercise 3 for every table on it
+    assert variants.drawing(LAB) == {3: ["runge_a"], 4: ["r0"], 7: ["xC", "yC", "xD", "yD"], 14: ["rise", "boil"]}
     assert (R0.low, R0.high, R0.digits) == (1.05, 1.3, 4)
     assert LAB.exercises[14].sound({"rise": 1.0, "boil": 2.0}) == ""  # the lab's data teach the lesson
     assert "overshoots" in LAB.exercises[14].sound({"rise": 1.9, "boil": 2.0})  # nearly straight up to boiling
@@ -247,3 +255,129 @@ def test_ready_to_hand_in_leaves_a_value_that_is_not_finite_to_the_lab_s_data():
     lab = {**_limacon_axes(1.15), "limacon_derivatives": deriv, "r0": math.nan}
     assert [p.status for p in ready_to_hand_in("01_limacon", namespace=lab).parts] == [DONE, DONE]
     plt.close("all")
+
+
+RUNGE_EXPERIMENTS = ("pherm", "complete", "natural", "notaknot", "pchip")
+
+
+def test_the_runge_scale_is_one_datum_drawn_with_exercise_3_and_redrawn_there(tmp_path):
+    path = tmp_path / "course.toml"
+    made = variants.new(path)
+    ids = [str(i) for i in range(40)]
+    for student in ids:
+        values = made.values(LAB, student)
+        scales = {values[n]["runge_a"] for n in (3, 11, 12, 13, 15)}
+        assert len(scales) == 1  # every table of a student is on the same function
+    assert len({made.values(LAB, s)[3]["runge_a"] for s in ids}) > 30  # and students differ
+    before = made.values(LAB, "7")
+    variants.redraw(path, "7", 3, LAB)
+    after = variants.read(path).values(LAB, "7")
+    assert after[3]["runge_a"] != before[3]["runge_a"] or "a rare tie"
+    assert all(after[n]["runge_a"] == after[3]["runge_a"] for n in (11, 12, 13, 15))
+    assert after[4] == before[4]  # the other exercises' data stay
+    with pytest.raises(ValueError, match="drawn with exercise 3"):
+        variants.redraw(path, "7", 12, LAB)
+    # a tie in the shared datum is reported once, under the exercise that draws it
+    tied = variants.ties(variants.VariantsFile(Path("x"), KEY, {}), LAB, [str(i) for i in range(400)])
+    assert tied and not any(number in (11, 12, 13, 15) for number, _ in tied)
+
+
+def test_two_exercises_cannot_declare_one_datum_two_ways():
+    from labkit.exercises.experiments import RUNGE_A
+
+    three, eleven = LAB.exercises[3], LAB.exercises[11]
+    other = dataclasses.replace(RUNGE_A, high=3.0)
+    with pytest.raises(ValueError, match="not alike"):
+        Registry([three, dataclasses.replace(eleven, params=(other,))])
+    with pytest.raises(ValueError, match="drawn_with"):
+        Registry([three, dataclasses.replace(eleven, params=(dataclasses.replace(RUNGE_A, drawn_with=None),))])
+    # a course that takes exercise 11 without 3 still draws the scale under exercise 3's number
+    alone = Registry([LAB.exercises[10], eleven])
+    made = variants.VariantsFile(Path("x"), KEY, {})
+    assert made.values(alone, "s1")[11] == made.values(LAB, "s1")[3] and variants.drawing(alone) == {3: ["runge_a"]}
+
+
+@pytest.mark.parametrize("a", [0.5, 0.73, 1.0, 1.5, 2.0])
+def test_every_table_on_the_range_of_scales_shows_the_lab_s_order(a):
+    """The orders are the lab's question: over the whole range of the Runge function's scale, labkit's table of
+    every experiment on it shows the order the lab expects (4, 4, 2, 4, 2), so only the data change."""
+    from labkit import convergence
+    from labkit.exercises.experiments import RUNGE_A
+
+    assert RUNGE_A.low <= a <= RUNGE_A.high
+    for key in RUNGE_EXPERIMENTS:
+        method = LAB.experiment(key)
+        f = lambda x, a=a: (
+            1 / (1 + a * np.asarray(x) ** 2),
+            -2 * a * np.asarray(x) / (1 + a * np.asarray(x) ** 2) ** 2,
+        )
+        table = convergence.convergence_table(key, list(method.ndata), f)
+        assert table.order == method.order, (key, a)
+        assert method.sound({"runge_a": a}) == ""
+    # far outside the range (a sharp peak the lab's sizes barely resolve) Hermite's table no longer shows its
+    # order: sound can say no
+    assert "shows order 3, not the lab's 4" in LAB.experiment("pherm").sound({"runge_a": 400.0})
+
+
+def _convergence_notebook(a, runge_source=None):
+    """Notebook 02's solution with `a` in its data cell, run here (its runge replaced by `runge_source`)."""
+    from labkit.grading.authoring.draws import reading_rates, run_cells
+
+    nb = with_values(
+        nbformat.read(NOTEBOOKS / "02_convergence.ipynb", as_version=4), {3: {"runge_a": a}}, "02_convergence.ipynb"
+    )
+    if runge_source is not None:
+        cell = next(c for c in nb.cells if c.cell_type == "code" and c.source.startswith("def runge(x):"))
+        cell.source = runge_source + cell.source[cell.source.index("\n\ndef test_pherm_interpolate") :]
+        reading_rates(nb)  # the student reads the rate off their own table, as the printout shows it
+    return run_cells(nb, ("rate_pherm",))
+
+
+def test_a_variant_s_tables_are_its_own_function_s_and_a_copy_loses_them():
+    mine = _convergence_notebook(1.437)
+    assert mine["runge_a"] == 1.437
+    verdict = LAB.check(3, mine, seed=3, variant={"runge_a": 1.437})
+    assert verdict["passed"] and "other_variant" not in verdict
+    # the table differs from the lab's: it is the student's own experiment
+    lab_table = LAB.experiment("pherm").reference(LAB.experiment("pherm").ndata)
+    assert not np.allclose(mine["errors_pherm"], lab_table, rtol=1e-3)
+    # the same notebook handed in by a student whose scale is 0.812: named, and its data-dependent parts lost
+    verdict = LAB.check(3, mine, seed=3, variant={"runge_a": 0.812})
+    assert verdict["other_variant"] == {"runge_a": [1.437, 0.812]}
+    assert _failed(verdict) == {"runge", "errors_pherm", "rate_pherm"}  # the driver is checked on labkit's f
+    table = next(c for c in verdict["checks"] if c["name"] == "errors_pherm")
+    assert "runge_a = 0.812" in table["hint"] + str(table.get("steps", ""))
+
+
+RUNGE_SLIPS = {
+    "leaves out runge_a": "    return 1.0 / (1.0 + x**2), -2.0 * x / (1.0 + x**2) ** 2\n",
+    "lacks the factor runge_a": "    return 1.0 / (1.0 + runge_a * x**2), -2.0 * x / (1.0 + runge_a * x**2) ** 2\n",
+    # the scale left out and the derivative's sign wrong: runge's first failing step is the values
+    "leaves out runge_a ": "    return 1.0 / (1.0 + x**2), 2.0 * x / (1.0 + x**2) ** 2\n",
+}
+
+
+@pytest.mark.parametrize("named", sorted(RUNGE_SLIPS))
+def test_a_runge_slip_with_the_scale_costs_only_runge(named):
+    """A slip in runge on a student's own scale is marked in runge, named, and not charged again through the
+    table and the rate, which are the driver's honest measurement of the student's function."""
+    source = "def runge(x):\n    x = np.asarray(x, dtype=float)\n" + RUNGE_SLIPS[named]
+    slipped = _convergence_notebook(1.4372, source)
+    verdict = LAB.check(3, slipped, seed=3, variant={"runge_a": 1.4372})
+    assert _failed(verdict) == {"runge"} and "other_variant" not in verdict
+    runge = next(c for c in verdict["checks"] if c["name"] == "runge")
+    assert named.strip() in runge["hint"]
+
+
+def test_a_splines_notebook_on_the_lab_s_function_is_not_the_student_s_experiment():
+    """Where the notebook gives runge (04, 05), a table on the lab's function (an old notebook, or the data cell
+    changed back) is not the student's experiment: it loses the table and the rate."""
+    from labkit.grading.authoring.draws import run_cells
+
+    nb = nbformat.read(NOTEBOOKS / "04_splines.ipynb", as_version=4)
+    namespace = run_cells(nb, ("rate_complete",))
+    assert namespace["runge_a"] == 1.0
+    verdict = LAB.check(11, namespace, seed=3, variant={"runge_a": 1.4372})
+    assert verdict["other_variant"] == {"runge_a": [1.0, 1.4372]}
+    assert _failed(verdict) == {"errors_complete", "rate_complete"}
+    assert LAB.check(11, namespace, seed=3)["passed"]  # without variants it is the lab's work, full marks

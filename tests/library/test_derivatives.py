@@ -116,3 +116,32 @@ def test_derivative_order_out_of_range_is_refused(call, highest, offset):
     for bad in (-1, 1.0, True, "1", None):
         with pytest.raises(ValueError, match="der must be a whole number"):
             call(bad)
+
+
+@pytest.mark.parametrize("a", [0.5, 1.0, 1.837, 4.0])
+def test_runge_scale_is_the_function_and_its_derivative(a):
+    """runge(x, a) is 1/(1 + a x^2): its value at x = 1/sqrt(a) is 1/2 whatever a is, and its derivative is
+    the central difference of its values (the derivative's exactness, not labkit against itself)."""
+    y, _ = labkit.runge(1.0 / np.sqrt(a), a=a)
+    assert y == pytest.approx(0.5, rel=1e-15)
+    x = np.linspace(-3.0, 3.0, 61)
+    h = 1e-5
+    central = (labkit.runge(x + h, a=a)[0] - labkit.runge(x - h, a=a)[0]) / (2 * h)
+    np.testing.assert_allclose(labkit.runge(x, a=a)[1], central, rtol=1e-8, atol=1e-10)
+    # scaling x by sqrt(a) turns it into the lab's function: runge(x, a) = runge(sqrt(a) x)
+    np.testing.assert_allclose(labkit.runge(x, a=a)[0], labkit.runge(np.sqrt(a) * x)[0], rtol=1e-14)
+
+
+def test_runge_lab_scale_keeps_its_bits():
+    """a = 1 gives exactly the lab's 1/(1+x^2) and -2x/(1+x^2)^2 (the committed outputs depend on it)."""
+    x = np.linspace(-5.0, 5.0, 1001)
+    y, yp = labkit.runge(x, a=1.0)
+    assert np.array_equal(y, 1.0 / (1.0 + x * x))
+    assert np.array_equal(yp, -2.0 * x * y * y)
+    assert np.array_equal(labkit.runge(x)[1], yp)
+
+
+@pytest.mark.parametrize("a", [0.0, -1.0, np.nan, np.inf, [1.0, 2.0], "two"])
+def test_runge_scale_refuses_what_is_no_scale(a):
+    with pytest.raises(ValueError, match="a"):
+        labkit.runge(0.5, a=a)

@@ -121,7 +121,7 @@ def test_a_half_done_notebook_says_what_is_left(half):
     }
     runge = next(p for p in half.parts if p.part == "runge")
     assert SLIP.hint in runge.detail  # the self-check's hint for this slip
-    wrong = {"np": np, "eval_pherm": None}
+    wrong = {"np": np, "eval_pherm": None, "runge_a": 1.0}  # the data cell, as released
     exec(_instructor_cell("def runge(")[1].replace(*SLIP.replace[0]), wrong)  # the slip, run here
     assert runge.detail == labkit.check.runge(wrong["runge"]).hint
     # the typo's cell and the untouched rate cell raised; nothing else did

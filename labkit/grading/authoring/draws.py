@@ -37,6 +37,8 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import io
+import linecache
+import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -57,7 +59,8 @@ class Trouble:
     what: str
 
     def __str__(self):
-        shown = ", ".join(f"{p} = {v}" for given in self.values.values() for p, v in given.items())
+        data = {p: v for given in self.values.values() for p, v in given.items()}  # a shared datum once
+        shown = ", ".join(f"{p} = {v}" for p, v in data.items())
         return f"{self.student} ({shown}): {self.entry}: {self.what}"
 
 
@@ -90,6 +93,21 @@ def _planted(nb, replace, name):
     return nb
 
 
+def reading_rates(nb, registry=LAB):
+    """Notebook `nb` (in place) with each experiment's rate answer, a whole number ``rate_... = 4``, read off the
+    student's own table instead, the way the printout is read (the mean of the last three log2 ratios, rounded):
+    a slip upstream changes the table, and a student who reads their own table answers what it shows."""
+    for experiment in registry.experiments.values():
+        reading = (
+            f"{experiment.rate} = int(np.rint(np.mean(np.log2(np.asarray({experiment.table}[-4:-1]) "
+            f"/ np.asarray({experiment.table}[-3:])))))"
+        )
+        for cell in nb.cells:
+            if cell.cell_type == "code":
+                cell.source = re.sub(rf"^{experiment.rate} = \d+$", reading, cell.source, flags=re.MULTILINE)
+    return nb
+
+
 def _without_hidden_tests(source):
     kept, hidden = [], False
     for line in source.split("\n"):
@@ -117,12 +135,19 @@ def run_cells(nb, names):
     namespace = {"__name__": "__main__"}
     with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
         warnings.simplefilter("ignore")
-        for source in cells[: last + 1]:
+        for index, source in enumerate(cells[: last + 1]):
+            # the cell's lines where a traceback looks for them (as in a kernel), so a hint can quote the line
+            name = f"<labkit draws cell {index}>"
+            linecache.cache[name] = (len(source), None, source.splitlines(True), name)
             try:
-                exec(compile(source, "<cell>", "exec"), namespace)  # noqa: S102 - the instructor's own code
+                exec(compile(source, name, "exec"), namespace)  # noqa: S102 - the instructor's own code
             except Exception:  # noqa: BLE001 - a slip may raise; the checks say what it costs
                 pass
     return namespace
+
+
+def _keeps_rates(entry):
+    return bool(getattr(entry, "keep_rates", False))
 
 
 def _close_figures():
@@ -181,19 +206,21 @@ def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, s
         for notebook, exercises in by_notebook.items():
             numbers = {e.number for e in exercises}
             names = sorted({name for e in exercises for part in e.parts for name in (*e.names, *part.names())})
-            entries = [("the solution", (), None, None, (), numbers)]
+            # the catalog's students read their rates off their own tables, unless the entry keeps them as written
+            entries = [("the solution", (), None, None, (), numbers, False)]
             entries += [
-                (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers)
+                (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not _keeps_rates(e))
                 for e in correct
                 if e.notebook == notebook and set(e.full) & numbers
             ]
             entries += [
-                (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise})
+                (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not _keeps_rates(e))
                 for e in mistakes
                 if e.notebook == notebook and e.exercise in numbers
             ]
-            for label, replace, part, hint, also, judged in entries:
-                nb = with_values(_planted(originals[notebook], replace, label), values, notebook, registry)
+            for label, replace, part, hint, also, judged, reads in entries:
+                planted = _planted(originals[notebook], replace, label)
+                nb = with_values(reading_rates(planted, registry) if reads else planted, values, notebook, registry)
                 namespace = run_cells(nb, names)
                 for number in sorted(judged):
                     verdict = registry.check(number, namespace, seed=seed + index, variant=values[number])

@@ -16,7 +16,11 @@ Both directions use one format, one JSON object per line:
 * towards the notebook only, a function of labkit's that the checks hand to
   student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``. Only the
   functions the exercises declare (``Registry.passable``) are named; the
-  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.sandbox.guard`);
+  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.sandbox.guard`).
+  Such a function with float keywords bound (a ``functools.partial``, as a
+  student's variant of the Runge function is) is
+  ``["fn", "labkit.functions:runge", {"a": 1.25}]``, at most
+  :data:`MAX_KEYWORDS` finite floats, rebuilt as a partial of the trusted copy;
 * from the notebook only, ``["obj", description]`` for anything else.
 
 The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
@@ -27,6 +31,7 @@ evaluated. The notebook side encodes with :func:`encode`.
 """
 
 import base64
+import functools
 import json
 import math
 import os
@@ -44,6 +49,7 @@ MAX_TEXT = 2_000
 MAX_LINE = 48 * 1024 * 1024  # bytes in one message: enforced while reading, before any parsing
 MAX_CONTAINERS = 250_000  # JSON lists and objects in one message: bounds what parsing it allocates
 MAX_LINES = 1_000  # Line2D objects of one plot
+MAX_KEYWORDS = 8  # float keywords bound to a function handed to student code
 
 
 class ProtocolError(ValueError):
@@ -109,6 +115,11 @@ def encode(value, passable=frozenset(), depth=0):
         return _lines_tag(value)
     if callable(value) and f"{getattr(value, '__module__', '')}:{getattr(value, '__qualname__', '')}" in passable:
         return ["fn", f"{value.__module__}:{value.__qualname__}"]
+    if type(value) is functools.partial and not value.args:
+        bound = _bound(value.keywords)
+        function = encode(value.func, passable, depth + 1)
+        if bound is not None and function[0] == "fn" and len(function) == 2:
+            return ["fn", function[1], bound]
     if type(value) in (tuple, list):
         return ["t" if type(value) is tuple else "l", [encode(item, passable, depth + 1) for item in value[:100_000]]]
     return ["obj", f"a {type(value).__name__} object"]
@@ -140,13 +151,32 @@ def _lines_tag(plot):
     ]
 
 
+def _bound(keywords):
+    """The float keywords of a partial as a plain dict, or None if they are not at most MAX_KEYWORDS finite
+    floats under identifiers."""
+    if not isinstance(keywords, dict) or not 0 < len(keywords) <= MAX_KEYWORDS:
+        return None
+    bound = {}
+    for key, value in keywords.items():
+        if not (type(key) is str and key.isidentifier()) or type(value) not in (int, float):
+            return None
+        try:
+            number = float(value)
+        except OverflowError:  # an integer too large for a float
+            return None
+        if not math.isfinite(number):
+            return None
+        bound[key] = number
+    return bound
+
+
 def function_names(tags):
     """The names of every ``["fn", name]`` in encoded values (the functions a request hands over)."""
     found, todo = set(), list(tags)
     while todo:
         tag = todo.pop()
         if isinstance(tag, list) and tag:
-            if tag[0] == "fn" and len(tag) == 2 and isinstance(tag[1], str):
+            if tag[0] == "fn" and len(tag) in (2, 3) and isinstance(tag[1], str):
                 found.add(tag[1])
             elif tag[0] in ("t", "l") and len(tag) == 2 and isinstance(tag[1], list):
                 todo.extend(tag[1])
@@ -284,10 +314,15 @@ def decode(tag, depth=0, functions=None):
         return [_line(item) for item in tag[1]]
     if kind == "obj" and len(tag) == 2 and isinstance(tag[1], str):
         return NotNumbers(tag[1])
-    if kind == "fn" and functions is not None and len(tag) == 2 and isinstance(tag[1], str):
+    if kind == "fn" and functions is not None and len(tag) in (2, 3) and isinstance(tag[1], str):
         if tag[1] not in functions:
             raise ProtocolError(f"{tag[1]!r} was not handed over for this request")
-        return functions[tag[1]]
+        if len(tag) == 2:
+            return functions[tag[1]]
+        bound = _bound(tag[2])
+        if bound is None:
+            raise ProtocolError(f"the keywords bound to {tag[1]!r} are not at most {MAX_KEYWORDS} finite floats")
+        return functools.partial(functions[tag[1]], **bound)
     raise ProtocolError(f"unknown value tag {kind!r}")
 
 

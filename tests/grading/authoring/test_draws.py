@@ -31,7 +31,9 @@ def test_a_check_that_ignores_the_student_s_data_fails_the_solution_and_is_repor
     whats = {(t.entry, t.what) for t in troubles}
     # on its own data the solution passes only when the data are the lab's: the blind check judges it by the lab's
     assert any(entry == "the solution" and "['ax4']" in what for entry, what in whats), whats
-    assert str(troubles[0]).startswith("draw-0 (r0 = ")
+    said = str(troubles[0])
+    assert said.startswith("draw-0 (") and f"r0 = {found.values(LAB, 'draw-0')[4]['r0']}" in said
+    assert said.count("runge_a = ") == 1  # the datum exercises 3, 11, 12, 13 and 15 share, said once
     assert draws.check(found, 1, NOTEBOOKS) == []  # the lab's own exercise 4: nothing to report
 
 

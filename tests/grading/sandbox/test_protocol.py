@@ -146,3 +146,35 @@ def test_dumps_is_one_line_of_json():
     line = protocol.dumps({"value": protocol.encode("two\nlines")})
     assert line.endswith(b"\n") and line.count(b"\n") == 1
     assert json.loads(line)["value"] == ["s", "two\nlines"]
+
+
+def test_a_passable_function_with_float_keywords_crosses_as_a_partial_and_nothing_else_does():
+    """A student's variant of the Runge function is labkit.runge with a bound: it crosses by name with its float
+    keywords and is rebuilt around the function handed over; a partial of anything else, or with positional,
+    non-float or too many keywords, does not cross."""
+    import functools
+
+    from labkit.exercises.registry import LAB
+
+    scaled = functools.partial(labkit.runge, a=1.25)
+    tag = protocol.encode(scaled, LAB.passable)
+    assert tag == ["fn", "labkit.functions:runge", {"a": 1.25}]
+    assert protocol.function_names([["l", [tag]]]) == {"labkit.functions:runge"}
+    line = protocol.loads(protocol.dumps({"value": tag}))["value"]
+    got = protocol.decode(line, functions={"labkit.functions:runge": labkit.runge})
+    x = np.linspace(-2, 2, 9)
+    assert np.array_equal(got(x)[0], 1 / (1 + 1.25 * x**2))  # the handed function, with the student's scale
+    for other in (
+        functools.partial(np.sin),  # not a labkit function
+        functools.partial(labkit.runge, 1.0),  # positional
+        functools.partial(labkit.runge, a="1.25"),  # not a float
+        functools.partial(labkit.runge, a=np.inf),
+        functools.partial(labkit.runge, **{f"k{i}": 1.0 for i in range(protocol.MAX_KEYWORDS + 1)}),
+    ):
+        assert protocol.encode(other, LAB.passable)[0] == "obj"
+    with pytest.raises(protocol.ProtocolError, match="finite floats"):
+        protocol.decode(
+            ["fn", "labkit.functions:runge", {"a": "os"}], functions={"labkit.functions:runge": labkit.runge}
+        )
+    with pytest.raises(protocol.ProtocolError, match="not handed over"):
+        protocol.decode(["fn", "labkit.piecewise:eval_pherm", {"a": 1.0}], functions={})
