@@ -118,6 +118,14 @@ def as_scalar(value, name):
     return float(v)
 
 
+def as_positive_scalar(value, name, what):
+    """Validate one positive finite number (a scale); `what` says what it is, for the message."""
+    v = as_scalar(value, name)
+    if not v > 0:
+        raise ValueError(f"{name} is {what}; got {v}. Give a number above 0.")
+    return v
+
+
 def require_finite(arr, name):
     if not np.all(np.isfinite(arr)):
         k = np.flatnonzero(~np.isfinite(np.ravel(arr)))[0]

@@ -36,16 +36,32 @@ def driver(key, fn, seed=None):
     return _experiments.check_driver(_LAB.experiment(key), fn, seed)
 
 
-def table(key, errors, fn, runge_a=None):
+def _scale(experiment, data):
+    """The notebook's scale of the experiment's test function, given as ``runge_a=...`` (``runge2d_a=...`` for
+    the bilinear one); None (the lab's) when not given."""
+    name = experiment.scale.name
+    unknown = sorted(set(data) - {name})
+    if unknown:
+        raise ValueError(
+            f"the {experiment.key!r} experiment's check takes {name}= (the notebook's data cell), not "
+            f"{', '.join(unknown)}=: pass {name}={name}."
+        )
+    return data.get(name)
+
+
+def table(key, errors, fn, **data):
     """Check the error table of experiment `key` against what the student's driver `fn` returns
-    (`runge_a`: the scale of the notebook's Runge function, when its data cell has one)."""
-    return _experiments.check_table(_LAB.experiment(key), errors, fn, runge_a)
+    (``runge_a=runge_a``, or ``runge2d_a=runge2d_a`` for the bilinear table: the scale of the notebook's test
+    function, when its data cell has one)."""
+    experiment = _LAB.experiment(key)
+    return _experiments.check_table(experiment, errors, fn, _scale(experiment, data))
 
 
-def rate(key, answer, errors, fn, runge_a=None):
+def rate(key, answer, errors, fn, **data):
     """Check the rate answer of experiment `key`, read from the table `errors` of the driver `fn`
-    (`runge_a`: the scale of the notebook's Runge function, when its data cell has one)."""
-    return _experiments.check_rate(_LAB.experiment(key), answer, errors, fn, runge_a)
+    (the scale as for :func:`table`)."""
+    experiment = _LAB.experiment(key)
+    return _experiments.check_rate(experiment, answer, errors, fn, _scale(experiment, data))
 
 
 def exercise(number, namespace, seed=None):

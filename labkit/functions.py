@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import as_float_array, as_scalar, scalar_or_array
+from ._validate import as_float_array, as_positive_scalar, as_scalar, scalar_or_array
 
 
 def runge(x: ArrayLike, a: float = 1.0) -> tuple[float | NDArray[np.float64], float | NDArray[np.float64]]:
@@ -39,29 +39,32 @@ def runge(x: ArrayLike, a: float = 1.0) -> tuple[float | NDArray[np.float64], fl
     [0.25, -0.375]
     """
     xa = as_float_array(x, "x")
-    scale = as_scalar(a, "a")
-    if not scale > 0:
-        raise ValueError(f"a is the positive scale in 1/(1 + a x^2); got {scale}. Give a number above 0.")
+    scale = as_positive_scalar(a, "a", "the positive scale of the Runge function's square")
     # the lab's a = 1 multiplies exactly, so its values are the same bits as 1/(1+x^2)
     y = 1.0 / (1.0 + scale * (xa * xa))
     yprime = -2.0 * xa * (scale * y) * y  # finite for any finite scale
     return scalar_or_array(y, x), scalar_or_array(yprime, x)
 
 
-def runge2d(x: ArrayLike, y: ArrayLike) -> float | NDArray[np.float64]:
-    """The two-dimensional Runge function ``1 / (1 + (x + y)**2)``.
+def runge2d(x: ArrayLike, y: ArrayLike, a: float = 1.0) -> float | NDArray[np.float64]:
+    """The two-dimensional Runge function ``1 / (1 + a (x + y)**2)``.
 
     `x` and `y` broadcast against each other, so ``runge2d(X, Y)`` on
-    ``np.meshgrid(..., indexing='ij')`` grids gives a table of values.
+    ``np.meshgrid(..., indexing='ij')`` grids gives a table of values. `a` is
+    the positive scale (the lab's function has ``a = 1``; a student's own
+    variant of the lab may have another).
 
     Examples
     --------
     >>> from labkit import runge2d
     >>> float(runge2d(0.5, 0.5))
     0.5
+    >>> float(runge2d(0.5, 0.5, a=3.0))
+    0.25
     """
     s = as_float_array(x, "x") + as_float_array(y, "y")
-    return scalar_or_array(1.0 / (1.0 + s * s), s)
+    scale = as_positive_scalar(a, "a", "the positive scale of the Runge function's square")
+    return scalar_or_array(1.0 / (1.0 + scale * (s * s)), s)
 
 
 def limacon(

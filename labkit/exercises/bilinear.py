@@ -12,7 +12,7 @@ sandboxed notebook: the declaration lists them (``passes``).
 import numpy as np
 
 from .. import bilinear, functions
-from .experiments import Experiment
+from .experiments import RUNGE2D_A, Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part
 from .result import CheckResult, call, case_rng, close, floats, gave_up, worst
 
@@ -63,20 +63,28 @@ def corner_4(x, y):
 CORNERS = (corner_1, corner_2, corner_3, corner_4)  # f(P_n) = 1 at one corner: which phi_m it is multiplied by
 
 
-def check_runge2d(fn, seed=None):
-    """Check ``runge2d(x, y)`` = 1/(1+(x+y)^2), on arrays."""
+def check_runge2d(fn, seed=None, runge2d_a=RUNGE2D_A.lab):
+    """Check ``runge2d(x, y)`` = 1/(1 + a (x+y)^2), a = `runge2d_a` (the notebook's data cell; the lab's function
+    has a = 1), on arrays."""
     result = CheckResult("runge2d")
     X, Y = np.meshgrid(np.linspace(-2, 2, 5), np.linspace(0, 3, 4), indexing="ij")
     if seed is not None:
         X, Y = case_rng(seed, "bilinear.runge2d").uniform(-3, 3, (2, 5, 4))
     ok, out = call(result, "runge2d on a grid", fn, X, Y)
-    if ok and not result.step(
-        "1/(1+(x+y)^2) on arrays", close(out, functions.runge2d(X, Y)), worst(out, functions.runge2d(X, Y))
-    ):
+    lab = runge2d_a == RUNGE2D_A.lab
+    want = functions.runge2d(X, Y, a=runge2d_a)
+    formula = "1/(1+(x+y)^2)" if lab else f"1/(1 + runge2d_a (x+y)^2), runge2d_a = {RUNGE2D_A.shown(runge2d_a)}"
+    yours = "" if lab else ", with your runge2d_a: 1 / (1 + runge2d_a * (x + y)**2)"
+    if ok and not result.step(f"{formula} on arrays", close(out, want), worst(out, want)):
         result.hint = (
-            "your runge2d squares the product x*y, not the sum x + y: the lab's function is 1 / (1 + (x + y)**2)."
-            if close(out, 1 / (1 + (X * Y) ** 2))
-            else "compare it with the lab's function, 1 / (1 + (x + y)**2), written with componentwise operations."
+            "your runge2d squares the product x*y, not the sum x + y: the lab's function is 1 / (1 + (x + y)**2)"
+            f"{yours}."
+            if close(out, 1 / (1 + runge2d_a * (X * Y) ** 2))
+            else "your runge2d leaves out runge2d_a: the function is 1 / (1 + runge2d_a * (x + y)**2), with "
+            "runge2d_a from the notebook's data cell."
+            if not lab and close(out, functions.runge2d(X, Y))
+            else f"compare it with the lab's function, 1 / (1 + (x + y)**2){yours}, written with componentwise "
+            "operations."
         )
     return result
 
@@ -253,7 +261,9 @@ EXERCISES = (
         ("phi_table", "runge2d", "eval_pbilin") + BILINEAR.names(),
         (
             Part("phi_table", 1, check_phi_table, ("phi_table",)),
-            Part("runge2d", 1, check_runge2d, ("runge2d",), seeded=True, refused=OWN_FUNCTIONS),
+            Part(
+                "runge2d", 1, check_runge2d, ("runge2d",), seeded=True, refused=OWN_FUNCTIONS, varied=(RUNGE2D_A.name,)
+            ),
             Part(
                 "eval_pbilin",
                 3,
@@ -271,5 +281,8 @@ EXERCISES = (
             "the order, against piecewise linear in one dimension",
         ),
         withheld=PHI_RULE + BILINEAR.withheld,
+        # the two-dimensional Runge function's scale: the student's runge2d and the bilinear table use it
+        params=(RUNGE2D_A,),
+        sound=BILINEAR.sound,
     ),
 )

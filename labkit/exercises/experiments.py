@@ -61,6 +61,9 @@ SHIFTED_PROBE = 9
 # (tests/exercises/test_variants.py), and 4 decimals give 15001 values: a class of 100 has a tie about one time
 # in four, which release and `labkit variants --check` name for a redraw
 RUNGE_A = Param("runge_a", 0.5, 2.0, 4, lab=1.0, drawn_with=3)
+# the scale a of the two-dimensional Runge function 1/(1 + a (x+y)^2) of Exercise 16, which the student writes and
+# the bilinear table measures: over [0.5, 2] the table shows order 2
+RUNGE2D_A = Param("runge2d_a", 0.5, 2.0, 4, lab=1.0)
 
 
 def scaled_runge(x):
@@ -113,10 +116,10 @@ def _at(function, a):
     return function if a is None or a == RUNGE_A.lab else functools.partial(function, a=float(a))
 
 
-def runge2d_product(x, y):
-    """1 / (1 + (x y)^2): the slip in ``runge2d`` the catalog of typical mistakes plants (a product for the sum)."""
+def runge2d_product(x, y, a=1.0):
+    """1 / (1 + a (x y)^2): the slip in ``runge2d`` the catalog of typical mistakes plants (a product for the sum)."""
     p = np.asarray(x, dtype=float) * np.asarray(y, dtype=float)
-    return 1.0 / (1.0 + p * p)
+    return 1.0 / (1.0 + a * p * p)
 
 
 @dataclass(frozen=True)
@@ -152,16 +155,26 @@ class Experiment:
         return convergence.METHOD_TITLES[self.key]
 
     @property
+    def scale(self):
+        """The student's datum the table and the rate are checked against: the test function's scale."""
+        return RUNGE2D_A if self.key == "bilinear" else RUNGE_A
+
+    @property
     def varied(self):
-        """The student's data the table and the rate are checked against (the Runge function's scale)."""
-        return () if self.key == "bilinear" else (RUNGE_A.name,)
+        return (self.scale.name,)
 
     def f(self, scaled=False, a=None):
         """The test function: the lab's (the Runge function with scale `a`, the lab's when None), or the moved,
         scaled one the driver check tells a relative error by."""
         if self.key == "bilinear":
-            return scaled_runge2d if scaled else functions.runge2d
+            return scaled_runge2d if scaled else _at(functions.runge2d, a)
         return scaled_runge if scaled else _at(functions.runge, a)
+
+    def formula(self, a):
+        """The student's test function in words, with their scale."""
+        if self.key == "bilinear":
+            return f"1/(1 + runge2d_a (x+y)^2) with your runge2d_a = {self.scale.shown(a)}"
+        return f"1/(1 + runge_a x^2) with your runge_a = {self.scale.shown(a)}"
 
     @property
     def passes(self):
@@ -174,34 +187,35 @@ class Experiment:
         (Exercise 3), the lab's function, with or without those slips, is one too: a runge that ignores the
         scale is marked in runge's own part. Where the notebook gives runge (exercises 11 to 15), a notebook on
         the lab's function is not the student's experiment."""
-        if self.key == "bilinear":
-            return (runge2d_product,)
-        if self.f(a=a) is functions.runge:
-            return (runge_sign_slip, runge_unsquared)
-        slips = tuple(_at(slip, a) for slip in RUNGE_SLIPS)
-        return slips + ((functions.runge, runge_sign_slip, runge_unsquared) if "runge" in self.uses else ())
+        lab_slips = (runge2d_product,) if self.key == "bilinear" else (runge_sign_slip, runge_unsquared)
+        if self.f(a=a) is self.f():
+            return lab_slips
+        slips = tuple(_at(slip, a) for slip in ((runge2d_product,) if self.key == "bilinear" else RUNGE_SLIPS))
+        own = "runge2d" if self.key == "bilinear" else "runge"
+        return slips + ((self.f(),) + lab_slips if own in self.uses else ())
 
     @property
     def slip_functions(self):
         """Every function :meth:`f_slips` may hand a driver, whatever the student's scale."""
-        return (runge2d_product,) if self.key == "bilinear" else RUNGE_SLIPS + (functions.runge,)
+        return (runge2d_product, functions.runge2d) if self.key == "bilinear" else RUNGE_SLIPS + (functions.runge,)
 
     def reference(self, ndata, scaled=False, interval=(0.0, 5.0), ntest=None, a=None):
         """The relative errors labkit's experiment gives for `ndata` (a sequence of sizes), on the Runge function
         with scale `a` (the lab's when None)."""
         # computed once per process: the driver's check and the table's ask for the same ones, and a driver's
         # slips are looked for at each size (a bilinear one at 4001 x 4001 test points takes seconds)
-        a = None if a is None or self.key == "bilinear" or float(a) == RUNGE_A.lab else float(a)
+        a = None if a is None or float(a) == self.scale.lab else float(a)
         return _reference(self, tuple(int(n) for n in ndata), scaled, tuple(interval), ntest or self.ntest, a).copy()
 
     def sound(self, values):
         """Why the Runge function's scale in `values` would not teach this experiment's lesson ('' when it does):
         its table must show the lab's order."""
-        a = values.get(RUNGE_A.name) if self.key != "bilinear" else None
+        a = values.get(self.scale.name)
         shown = convergence.ConvergenceTable(self.title, np.array(self.ndata), self.reference(self.ndata, a=a)).order
         if shown != self.order:
             return (
-                f"with runge_a = {a} the {self.title.lower()}'s table shows order {shown}, not the lab's {self.order}"
+                f"with {self.scale.name} = {a} the {self.title.lower()}'s table shows order {shown}, not the lab's "
+                f"{self.order}"
             )
         return ""
 
@@ -286,8 +300,8 @@ class ExperimentPart(Part):
         ]
         if self.check is check_driver:
             return check_driver(self.experiment, *values, seed=seed)
-        a = (variant or {}).get(RUNGE_A.name) if RUNGE_A.name in self.varied else None
-        return check_experiment(self.experiment, *values, runge_a=a)
+        a = (variant or {}).get(self.experiment.scale.name) if self.experiment.scale.name in self.varied else None
+        return check_experiment(self.experiment, *values, scale=a)
 
 
 @functools.lru_cache(maxsize=1024)  # a grading run asks for each student's scale where a table is judged by it
@@ -640,17 +654,17 @@ def table_order(method, errors):
     return float(np.log(values[0] / values[-1]) / np.log((method.ndata[-1] - 1) / (method.ndata[0] - 1)))
 
 
-def check_table(method, errors, fn, runge_a=None):
+def check_table(method, errors, fn, scale=None):
     """Check the error list of an experiment against what the student's driver `fn` returns
-    (the notebook's self-check; see :func:`experiment`); `runge_a` is the notebook's Runge scale."""
-    return check_experiment(method, errors, MISSING, fn, runge_a)[0]
+    (the notebook's self-check; see :func:`experiment`); `scale` is the notebook's scale of its test function."""
+    return check_experiment(method, errors, MISSING, fn, scale)[0]
 
 
-def check_rate(method, answer, errors, fn, runge_a=None):
+def check_rate(method, answer, errors, fn, scale=None):
     """Check the rate answer of an experiment: the exponent p with Err(n)/Err(2n-1) close to 2**p, read
     from the table `errors` of the student's driver `fn` (the notebook's self-check; see :func:`experiment`);
-    `runge_a` is the notebook's Runge scale."""
-    return check_experiment(method, errors, answer, fn, runge_a)[1]
+    `scale` is the notebook's scale of its test function."""
+    return check_experiment(method, errors, answer, fn, scale)[1]
 
 
 def _no_experiment(method, values, whose="the", verdict="this table shows no experiment"):
@@ -749,15 +763,14 @@ def attempted_driver(method, fn, own, a=None):
         if ok and _same(own[1], given):
             return ""
     name = "runge2d" if method.key == "bilinear" else "Runge"
-    own_scale = method.key != "bilinear" and method.f(a=a) is not functions.runge
-    yours = f" 1/(1 + runge_a x^2) with your runge_a = {RUNGE_A.shown(a)}" if own_scale else ""
+    yours = f" {method.formula(a)}" if method.f(a=a) is not method.f() else ""
     return (
         f"the f your {method.driver} uses when it is given none is not the {name} function{yours}, not even with "
         "one of the slips its own check names"
     )
 
 
-def check_experiment(method, errors, answer, fn, runge_a=None):
+def check_experiment(method, errors, answer, fn, scale=None):
     """Check the table and the rate answer of an experiment against one run of the student's driver
     `fn` at the lab's sizes: ``[table result, rate result]``.
 
@@ -777,7 +790,7 @@ def check_experiment(method, errors, answer, fn, runge_a=None):
     right when it is the order read off that table's ratios (as the lab reads
     them) or the order the lab's experiment shows.
 
-    `runge_a` is the student's own scale of the Runge function (a variant,
+    `scale` is the student's own scale of the test function (a variant,
     :mod:`labkit.exercises.variants`; the lab's when None): the driver's
     default `f` must be that function, and the lab's experiment is on it.
     """
@@ -788,9 +801,9 @@ def check_experiment(method, errors, answer, fn, runge_a=None):
         rate_result.add_steps(table_result)
         rate_result.hint = table_result.hint
     else:
-        why = attempted_driver(method, fn, own, runge_a)
+        why = attempted_driver(method, fn, own, scale)
         if why:  # the driver measures something else: the lab's experiment is the reference
-            lab = method.reference(method.ndata, a=runge_a)
+            lab = method.reference(method.ndata, a=scale)
             for result in (table_result, rate_result):
                 judged_by_the_lab(result, why, LAB_EXPERIMENT)
         else:

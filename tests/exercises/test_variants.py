@@ -38,9 +38,16 @@ def test_the_lab_declares_the_limacon_offset_and_its_own_value_is_the_notebook_s
         13: runge,
         14: {"rise": 1.0, "boil": 2.0},
         15: runge,
+        16: {"runge2d_a": 1.0},
     }
     # the Runge function's scale is one datum, drawn with Exercise 3 for every table on it
-    assert variants.drawing(LAB) == {3: ["runge_a"], 4: ["r0"], 7: ["xC", "yC", "xD", "yD"], 14: ["rise", "boil"]}
+    assert variants.drawing(LAB) == {
+        3: ["runge_a"],
+        4: ["r0"],
+        7: ["xC", "yC", "xD", "yD"],
+        14: ["rise", "boil"],
+        16: ["runge2d_a"],
+    }
     assert (R0.low, R0.high, R0.digits) == (1.05, 1.3, 4)
     assert LAB.exercises[14].sound({"rise": 1.0, "boil": 2.0}) == ""  # the lab's data teach the lesson
     assert "overshoots" in LAB.exercises[14].sound({"rise": 1.9, "boil": 2.0})  # nearly straight up to boiling
@@ -381,3 +388,63 @@ def test_a_splines_notebook_on_the_lab_s_function_is_not_the_student_s_experimen
     assert verdict["other_variant"] == {"runge_a": [1.0, 1.4372]}
     assert _failed(verdict) == {"errors_complete", "rate_complete"}
     assert LAB.check(11, namespace, seed=3)["passed"]  # without variants it is the lab's work, full marks
+
+
+@pytest.mark.parametrize("a", [0.5, 0.81, 1.0, 1.6543, 2.0])
+def test_the_bilinear_table_shows_order_two_over_the_range_of_its_scale(a):
+    from labkit import convergence
+    from labkit.exercises.experiments import RUNGE2D_A
+
+    assert RUNGE2D_A.low <= a <= RUNGE2D_A.high
+    method = LAB.experiment("bilinear")
+    f = lambda x, y: 1 / (1 + a * (np.asarray(x) + np.asarray(y)) ** 2)  # written out, not labkit's
+    table = convergence.bilinear_convergence(list(method.ndata), f, (0.0, 5.0), method.ntest)
+    assert convergence.ConvergenceTable("bilinear", np.array(method.ndata), table.errors).order == 2
+    assert method.sound({"runge2d_a": a}) == ""
+
+
+def _bilinear_notebook(a, runge2d_source=None):
+    from labkit.grading.authoring.draws import reading_rates, run_cells
+
+    nb = with_values(
+        nbformat.read(NOTEBOOKS / "06_bilinear.ipynb", as_version=4), {16: {"runge2d_a": a}}, "06_bilinear.ipynb"
+    )
+    if runge2d_source is not None:
+        cell = next(c for c in nb.cells if c.cell_type == "code" and c.source.startswith("def runge2d(x, y):"))
+        cell.source = runge2d_source + cell.source[cell.source.index("\n\ndef eval_pbilin") :]
+        reading_rates(nb)
+    return run_cells(nb, ("rate_bilinear",))
+
+
+def test_a_bilinear_variant_is_graded_on_its_own_function_and_a_copy_loses_its_table():
+    mine = _bilinear_notebook(1.6543)
+    verdict = LAB.check(16, mine, seed=5, variant={"runge2d_a": 1.6543})
+    assert verdict["passed"] and "other_variant" not in verdict
+    method = LAB.experiment("bilinear")
+    assert not np.allclose(mine["errors_bilinear"], method.reference(method.ndata), rtol=1e-3)
+    verdict = LAB.check(16, mine, seed=5, variant={"runge2d_a": 0.9021})
+    assert verdict["other_variant"] == {"runge2d_a": [1.6543, 0.9021]}
+    assert _failed(verdict) == {"runge2d", "errors_bilinear", "rate_bilinear"}  # phi, eval_pbilin, the driver kept
+
+
+@pytest.mark.parametrize(
+    "body, named",
+    [
+        ("    return 1.0 / (1.0 + (x + y) ** 2)\n", "leaves out runge2d_a"),
+        ("    return 1.0 / (1.0 + runge2d_a * (x * y) ** 2)\n", "squares the product"),
+    ],
+)
+def test_a_runge2d_slip_on_the_scale_costs_only_runge2d(body, named):
+    source = "def runge2d(x, y):\n    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)\n" + body
+    verdict = LAB.check(16, _bilinear_notebook(1.6543, source), seed=5, variant={"runge2d_a": 1.6543})
+    assert _failed(verdict) == {"runge2d"}
+    assert named in next(c for c in verdict["checks"] if c["name"] == "runge2d")["hint"]
+
+
+def test_the_experiment_checks_take_only_their_own_scale():
+    from labkit import check
+
+    with pytest.raises(ValueError, match="takes runge2d_a="):
+        check.table("bilinear", [1.0], lambda n: 1.0, runge_a=1.2)
+    with pytest.raises(ValueError, match="takes runge_a="):
+        check.rate("pherm", 4, [1.0], lambda n: 1.0, runge2d_a=1.2)

@@ -145,3 +145,14 @@ def test_runge_lab_scale_keeps_its_bits():
 def test_runge_scale_refuses_what_is_no_scale(a):
     with pytest.raises(ValueError, match="a"):
         labkit.runge(0.5, a=a)
+
+
+@pytest.mark.parametrize("a", [0.5, 1.0, 1.6543])
+def test_runge2d_scale_is_the_function_of_the_sum(a):
+    """runge2d(x, y, a) = 1/(1 + a (x+y)^2): 1/2 where x + y = 1/sqrt(a), and runge2d(sqrt(a) x, sqrt(a) y)."""
+    half = 0.5 / np.sqrt(a)
+    assert labkit.runge2d(half, half, a=a) == pytest.approx(0.5, rel=1e-15)
+    x, y = np.meshgrid(np.linspace(-2, 2, 9), np.linspace(0, 3, 7), indexing="ij")
+    np.testing.assert_allclose(labkit.runge2d(x, y, a=a), labkit.runge2d(np.sqrt(a) * x, np.sqrt(a) * y), rtol=1e-14)
+    with pytest.raises(ValueError, match="positive scale"):
+        labkit.runge2d(x, y, a=-a)

@@ -23,8 +23,8 @@ pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux
 ROOT = Path(__file__).resolve().parents[3]
 NOTEBOOKS = ROOT / "notebooks"
 NOTEBOOK = "01_limacon.ipynb"
-# the notebooks of exercises 3 (the Runge function's scale, and the tables on it: 15 too), 4, 7 and 14
-VARIED = ("01_limacon.ipynb", "02_convergence.ipynb", "03_meshes.ipynb", "05_monotone.ipynb")
+# the notebooks of exercises 3 (the Runge function's scale, and the tables on it: 15 too), 4, 7, 14 and 16
+VARIED = ("01_limacon.ipynb", "02_convergence.ipynb", "03_meshes.ipynb", "05_monotone.ipynb", "06_bilinear.ipynb")
 ROSTER = {"ada": "1815", "bob": "1816", "cy": "1817", "dan": "1818"}
 ANOTHER = "another variant"
 
@@ -63,6 +63,8 @@ def course(tmp_path_factory):
             tied, number = ["1818"], 14
         elif values["ada"][3]["runge_a"] == values["dan"][3]["runge_a"]:  # and another Runge function
             tied, number = ["1818"], 3
+        elif values["ada"][16]["runge2d_a"] == values["dan"][16]["runge2d_a"]:
+            tied, number = ["1818"], 16
         elif not tied:
             break
         else:
@@ -121,6 +123,8 @@ def test_the_release_gives_each_student_a_folder_whose_notebooks_hold_their_own_
                 assert len(scales) == 1 and scales[0].startswith(f"runge_a = {values[15]['runge_a']:.4f}  #")
             elif path.name in ("02_convergence.ipynb", "04_splines.ipynb"):
                 assert _data_cell(mine).startswith(f"runge_a = {values[3]['runge_a']:.4f}  #")
+            elif path.name == "06_bilinear.ipynb":
+                assert _data_cell(mine).startswith(f"runge2d_a = {values[16]['runge2d_a']:.4f}  #")
             elif path.name == "03_meshes.ipynb":
                 cell, quad = _data_cell(mine), values[7]
                 assert f"xC = {quad['xC']:.2f}  #" in cell and f"yD = {quad['yD']:.2f}\n" in cell
@@ -133,7 +137,7 @@ def test_the_release_gives_each_student_a_folder_whose_notebooks_hold_their_own_
 def test_each_solution_earns_full_marks_on_its_own_variant_whatever_its_metadata_says(course):
     for name in ("ada", "bob", "cy"):
         row = course["rows"][name]
-        for number in (2, 3, 4, 5, 6, 7, 8, 9, 14, 15):  # 2, 5, 6, 8 and 9 do not vary: each beside one that does
+        for number in (2, 3, 4, 5, 6, 7, 8, 9, 14, 15, 16):  # 2, 5, 6, 8 and 9 do not vary: each beside one that does
             assert float(row[f"exercise {number}"]) == LAB.exercises[number].points, (number, row)
         feedback = (course["out"] / "feedback" / f"{safe_name(name)}.txt").read_text(encoding="utf-8")
         assert ANOTHER not in feedback
@@ -148,9 +152,11 @@ def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
     for number in (2, 5, 6, 8, 9):  # the same for everyone: kept
         assert float(row[f"exercise {number}"]) == LAB.exercises[number].points, (number, row)
     # the tables (and runge) are of ada's Runge function; the drivers are checked on labkit's: kept
-    for number, experiment in ((3, "pherm"), (15, "pchip")):
+    for number, experiment in ((3, "pherm"), (15, "pchip"), (16, "bilinear")):
         driver = LAB.experiment(experiment).driver
-        kept = sum(p.weight for p in LAB.exercises[number].parts if p.name == driver)
+        # the bilinear exercise's phi table and eval_pbilin do not depend on the data either
+        same = {driver, "phi_table", "eval_pbilin"}
+        kept = sum(p.weight for p in LAB.exercises[number].parts if p.name in same)
         assert float(row[f"exercise {number}"]) == kept, (number, row)
     feedback = (course["out"] / "feedback" / f"{safe_name('dan')}.txt").read_text(encoding="utf-8")
     assert "this notebook holds the data of another variant" in feedback
@@ -160,7 +166,7 @@ def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
     with open(course["out"] / "variants.csv", newline="", encoding="utf-8") as handle:
         rows = {row["submission"]: row for row in csv.DictReader(handle)}
     assert rows["dan"]["holds the data of"] == (  # the instructor's file
-        "exercise 3: ada; exercise 4: ada; exercise 7: ada; exercise 14: ada; exercise 15: ada"
+        "exercise 3: ada; exercise 4: ada; exercise 7: ada; exercise 14: ada; exercise 15: ada; exercise 16: ada"
     )
     assert rows["dan"]["id"] == "1818" and rows["dan"]["exercise 4"] == f"r0 = {dan}"
     assert [rows[n]["holds the data of"] for n in ("ada", "bob", "cy")] == ["", "", ""]
