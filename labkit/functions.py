@@ -39,7 +39,7 @@ def runge(x: ArrayLike, a: float = 1.0) -> tuple[float | NDArray[np.float64], fl
     [0.25, -0.375]
     """
     xa = as_float_array(x, "x")
-    scale = as_positive_scalar(a, "a", "the positive scale of the Runge function's square")
+    scale = as_positive_scalar(a, "a", "the Runge function's scale, 1/(1 + a x^2)")
     # the lab's a = 1 multiplies exactly, so its values are the same bits as 1/(1+x^2)
     y = 1.0 / (1.0 + scale * (xa * xa))
     yprime = -2.0 * xa * (scale * y) * y  # finite for any finite scale
@@ -63,7 +63,7 @@ def runge2d(x: ArrayLike, y: ArrayLike, a: float = 1.0) -> float | NDArray[np.fl
     0.25
     """
     s = as_float_array(x, "x") + as_float_array(y, "y")
-    scale = as_positive_scalar(a, "a", "the positive scale of the Runge function's square")
+    scale = as_positive_scalar(a, "a", "the Runge function's scale, 1/(1 + a (x+y)^2)")
     return scalar_or_array(1.0 / (1.0 + scale * (s * s)), s)
 
 

@@ -181,18 +181,19 @@ class Experiment:
         """Every function the checks hand the driver: the pieces and both test functions."""
         return tuple(self.pieces) + (self.f(), self.f(scaled=True))
 
-    def f_slips(self, a=None):
+    def f_slips(self, a=None, own_data=True):
         """The test function (with scale `a`) with each slip its own check names: a driver's own `f` may be one
-        of them. With a student's own scale, and a driver whose default `f` is the student's own runge
-        (Exercise 3), the lab's function, with or without those slips, is one too: a runge that ignores the
-        scale is marked in runge's own part. Where the notebook gives runge (exercises 11 to 15), a notebook on
-        the lab's function is not the student's experiment."""
+        of them. With a student's own scale, a driver whose default `f` is the student's own function
+        (runge in Exercise 3, runge2d in 16) and a notebook holding the student's own scale (`own_data`), the
+        lab's function, with or without those slips, is one too: a function that ignores the scale is marked in
+        its own part. A notebook holding another scale (a copy, or the lab's release) is not the student's
+        experiment, nor is a notebook on the lab's function where the notebook gives it (exercises 11 to 15)."""
         lab_slips = (runge2d_product,) if self.key == "bilinear" else (runge_sign_slip, runge_unsquared)
         if self.f(a=a) is self.f():
             return lab_slips
         slips = tuple(_at(slip, a) for slip in ((runge2d_product,) if self.key == "bilinear" else RUNGE_SLIPS))
         own = "runge2d" if self.key == "bilinear" else "runge"
-        return slips + ((self.f(),) + lab_slips if own in self.uses else ())
+        return slips + ((self.f(),) + lab_slips if own in self.uses and own_data else ())
 
     @property
     def slip_functions(self):
@@ -300,8 +301,11 @@ class ExperimentPart(Part):
         ]
         if self.check is check_driver:
             return check_driver(self.experiment, *values, seed=seed)
-        a = (variant or {}).get(self.experiment.scale.name) if self.experiment.scale.name in self.varied else None
-        return check_experiment(self.experiment, *values, scale=a)
+        name = self.experiment.scale.name
+        a = (variant or {}).get(name) if name in self.varied else None
+        held = _number(namespace[name]) if a is not None and name in namespace else None
+        own_data = held is None or self.experiment.scale.holds(held, a)  # the data cell shows the student's scale
+        return check_experiment(self.experiment, *values, scale=a, own_data=own_data)
 
 
 @functools.lru_cache(maxsize=1024)  # a grading run asks for each student's scale where a table is judged by it
@@ -309,7 +313,7 @@ def _reference(method, ndata, scaled, interval, ntest, a=None):
     """:meth:`Experiment.reference`, computed."""
     sizes = list(ndata) * 2 if len(ndata) == 1 else list(ndata)  # the tables want two sizes
     if method.key == "bilinear":
-        found = convergence.bilinear_convergence(sizes, method.f(scaled), interval, ntest)
+        found = convergence.bilinear_convergence(sizes, method.f(scaled, a), interval, ntest)
     else:
         found = convergence.convergence_table(method.key, sizes, method.f(scaled, a), interval, ntest)
     return found.errors[: len(ndata)]
@@ -730,7 +734,7 @@ def _measures(method, fn, scratch):
     return first is not None and second is not None and not _agrees(first, second)
 
 
-def attempted_driver(method, fn, own, a=None):
+def attempted_driver(method, fn, own, a=None, own_data=True):
     """Why the student's driver `fn` is no attempt at the lab's experiment ('' when it is one).
 
     `own` is what it returned, with its own defaults, for the lab's sizes. It is an attempt when, given
@@ -740,7 +744,8 @@ def attempted_driver(method, fn, own, a=None):
     when the `f` it uses by default is the test function or one with a slip its own check names (the
     derivative's sign, a missing square; a product in ``runge2d``): so a driver, or a Runge function,
     that measures something else is no reference for the table and the rate read from it. `a` is the
-    student's scale of the Runge function (the lab's when None): the test function the default `f` must be.
+    student's scale of the Runge function (the lab's when None): the test function the default `f` must be;
+    `own_data` whether the notebook shows that scale (see :meth:`Experiment.f_slips`).
     """
     scratch = CheckResult(method.driver)
     for index, ndata in enumerate(method.ndata[:2]):
@@ -758,7 +763,7 @@ def attempted_driver(method, fn, own, a=None):
     ok, given = call(scratch, "the driver with the lab's f", fn, ndata, method.f(a=a))
     if not ok or _same(own[1], given):
         return ""
-    for slip in method.f_slips(a):
+    for slip in method.f_slips(a, own_data):
         ok, given = call(scratch, "the driver with a slip in f", fn, ndata, slip)
         if ok and _same(own[1], given):
             return ""
@@ -770,7 +775,7 @@ def attempted_driver(method, fn, own, a=None):
     )
 
 
-def check_experiment(method, errors, answer, fn, scale=None):
+def check_experiment(method, errors, answer, fn, scale=None, own_data=True):
     """Check the table and the rate answer of an experiment against one run of the student's driver
     `fn` at the lab's sizes: ``[table result, rate result]``.
 
@@ -793,6 +798,8 @@ def check_experiment(method, errors, answer, fn, scale=None):
     `scale` is the student's own scale of the test function (a variant,
     :mod:`labkit.exercises.variants`; the lab's when None): the driver's
     default `f` must be that function, and the lab's experiment is on it.
+    `own_data` is False when the notebook shows another scale than the
+    student's: then a function on the lab's scale is no slip of the student's.
     """
     table_result, rate_result = CheckResult(method.table), CheckResult(method.rate)
     own = _own_errors(method, fn, table_result)
@@ -801,7 +808,7 @@ def check_experiment(method, errors, answer, fn, scale=None):
         rate_result.add_steps(table_result)
         rate_result.hint = table_result.hint
     else:
-        why = attempted_driver(method, fn, own, scale)
+        why = attempted_driver(method, fn, own, scale, own_data)
         if why:  # the driver measures something else: the lab's experiment is the reference
             lab = method.reference(method.ndata, a=scale)
             for result in (table_result, rate_result):

@@ -448,3 +448,40 @@ def test_the_experiment_checks_take_only_their_own_scale():
         check.table("bilinear", [1.0], lambda n: 1.0, runge_a=1.2)
     with pytest.raises(ValueError, match="takes runge_a="):
         check.rate("pherm", 4, [1.0], lambda n: 1.0, runge2d_a=1.2)
+
+
+@pytest.mark.parametrize(
+    "notebook, number, lost",
+    [
+        ("02", 3, {"runge", "errors_pherm", "rate_pherm"}),
+        ("06", 16, {"runge2d", "errors_bilinear", "rate_bilinear"}),
+    ],
+)
+def test_the_class_release_on_the_lab_s_scale_handed_in_for_a_variant_loses_its_tables(notebook, number, lost):
+    """A notebook still on the lab's scale (last year's, or the release for everyone) is no slip of a student whose
+    scale is another: named, and its tables and rates lost, not forgiven as a function that ignores the scale."""
+    name = {"02": "runge_a", "06": "runge2d_a"}[notebook]
+    lab = _convergence_notebook(1.0) if notebook == "02" else _bilinear_notebook(1.0)
+    verdict = LAB.check(number, lab, seed=5, variant={name: 1.4372})
+    assert verdict["other_variant"] == {name: [1.0, 1.4372]}
+    assert _failed(verdict) == lost
+
+
+def test_a_bilinear_driver_that_ignores_its_f_costs_only_the_driver_on_a_variant():
+    from labkit.grading.authoring.draws import reading_rates, run_cells
+
+    nb = with_values(
+        nbformat.read(NOTEBOOKS / "06_bilinear.ipynb", as_version=4), {16: {"runge2d_a": 1.6543}}, "06_bilinear.ipynb"
+    )
+    cell = next(c for c in nb.cells if c.cell_type == "code" and "def test_pbilin_interpolate(" in c.source)
+    old = "    exact = f(XT, YT)\n    return np.max(np.abs(interpolate(f, grid, grid, test, test) - exact))"
+    assert old in cell.source
+    cell.source = cell.source.replace(
+        old,
+        "    exact = runge2d(XT, YT)\n    return np.max(np.abs(interpolate(runge2d, grid, grid, test, test) - exact))",
+    )
+    namespace = run_cells(reading_rates(nb), ("rate_bilinear",))
+    verdict = LAB.check(16, namespace, seed=5, variant={"runge2d_a": 1.6543})
+    assert _failed(verdict) == {"test_pbilin_interpolate"}
+    driver = next(c for c in verdict["checks"] if c["name"] == "test_pbilin_interpolate")
+    assert "passed in as `f`" in driver["hint"]

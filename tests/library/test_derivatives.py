@@ -154,5 +154,5 @@ def test_runge2d_scale_is_the_function_of_the_sum(a):
     assert labkit.runge2d(half, half, a=a) == pytest.approx(0.5, rel=1e-15)
     x, y = np.meshgrid(np.linspace(-2, 2, 9), np.linspace(0, 3, 7), indexing="ij")
     np.testing.assert_allclose(labkit.runge2d(x, y, a=a), labkit.runge2d(np.sqrt(a) * x, np.sqrt(a) * y), rtol=1e-14)
-    with pytest.raises(ValueError, match="positive scale"):
+    with pytest.raises(ValueError, match=r"a is the Runge function's scale, 1/\(1 \+ a \(x\+y\)\^2\); got -.*above 0"):
         labkit.runge2d(x, y, a=-a)
