@@ -169,7 +169,7 @@ class VariantsFile:
         """Exercise number -> {parameter: value} of `student` (the roster id) for every varied exercise."""
         student = str(student)
         redraws = self.redraw.get(student, {})
-        found = {}
+        found: dict = {}
         for e in registry:
             if e.params:
                 found[e.number] = {}
