@@ -279,11 +279,14 @@ FUNCTIONS = ("runge2d", "eval_pbilin", "test_pbilin_interpolate")
 
 
 def _planted(folder, *cells):
-    """Exercise 16 as the instructor solved it, with `cells` appended (they run after the solution's)."""
+    """Exercise 16 as the instructor solved it, with `cells` appended (they run after the solution's). The number
+    the report gives each appended cell: its place among the notebook's code cells, counted from 1."""
     path = plant(Planted("as handed out", "06_bilinear.ipynb", ()), folder)
     nb = nbformat.read(path, as_version=4)
+    before = sum(cell.cell_type == "code" for cell in nb.cells)
     nb.cells += [nbformat.v4.new_code_cell(cell) for cell in cells]
     nbformat.write(nb, path)
+    return [before + 1 + index for index in range(len(cells))]
 
 
 @pytest.fixture(scope="module")
@@ -296,7 +299,7 @@ def graded_class(tmp_path_factory):
     root = tmp_path_factory.mktemp("kinds")
     submissions = root / "submissions"
     _planted(submissions / "honest")
-    _planted(
+    numbers = _planted(
         submissions / "named",
         HOSTILE_CLASSES,
         "raise Tampered('none of its answers count')",
@@ -307,7 +310,7 @@ def graded_class(tmp_path_factory):
     out = root / "out"
     run = cli("grade", submissions, "--out", out, "--seed", "20261203", "--cell-timeout", "3", "--quiet")
     assert run.returncode == 0, run.stderr
-    return submissions, out
+    return submissions, out, numbers
 
 
 def _outcomes(grade, number=16):
@@ -319,7 +322,7 @@ def _kinds_by_student(summary):
 
 
 def test_in_a_sandboxed_class_a_students_own_timeout_tampered_and_workererror_are_errors_raised(graded_class):
-    _, out = graded_class
+    _, out, (_, tampered, timeout) = graded_class
     grades = {grade.name: grade for grade in class_report.read(out)}
     named = grades["named"]
     assert {name: _outcomes(named)[name] for name in FUNCTIONS} == dict.fromkeys(FUNCTIONS, "raised")
@@ -333,12 +336,12 @@ def test_in_a_sandboxed_class_a_students_own_timeout_tampered_and_workererror_ar
     assert {kind for kind, student in _kinds_by_student(summary) if student == "named"} == {"raised"}
     # its two raising cells are errors raised, each named, not a time limit and not a voided notebook
     [cells] = [p for p in summary.problems["raised"] if p.student == "named"]
-    assert any("cell 18 raised Timeout" in line for line in cells.texts), cells.texts
-    assert any("cell 17 raised Tampered" in line for line in cells.texts), cells.texts
+    assert any(f"cell {timeout} raised Timeout" in line for line in cells.texts), cells.texts
+    assert any(f"cell {tampered} raised Tampered" in line for line in cells.texts), cells.texts
 
 
 def test_in_a_sandboxed_class_the_old_phrases_in_a_students_messages_are_errors_raised(graded_class):
-    _, out = graded_class
+    _, out, _ = graded_class
     grades = {grade.name: grade for grade in class_report.read(out)}
     assert {name: _outcomes(grades["worded"])[name] for name in FUNCTIONS} == dict.fromkeys(FUNCTIONS, "raised")
     summary = class_report.summarise(grades.values())
@@ -346,7 +349,7 @@ def test_in_a_sandboxed_class_the_old_phrases_in_a_students_messages_are_errors_
 
 
 def test_in_a_sandboxed_class_a_real_time_limit_and_a_real_end_of_the_process_keep_their_kinds(graded_class):
-    _, out = graded_class
+    _, out, _ = graded_class
     grades = {grade.name: grade for grade in class_report.read(out)}
     outcomes = _outcomes(grades["ends"])
     assert (outcomes["runge2d"], outcomes["eval_pbilin"]) == ("timeout", "crash")
@@ -354,7 +357,7 @@ def test_in_a_sandboxed_class_a_real_time_limit_and_a_real_end_of_the_process_ke
 
 
 def test_the_honest_classmate_gets_full_marks(graded_class):
-    _, out = graded_class
+    _, out, _ = graded_class
     [honest] = [grade for grade in class_report.read(out) if grade.name == "honest"]
     assert set(_outcomes(honest).values()) == {"passed"} and honest.problems == []
     assert honest.points[16] == LAB.exercises[16].points == 8
@@ -362,7 +365,7 @@ def test_the_honest_classmate_gets_full_marks(graded_class):
 
 
 def test_the_report_reads_the_same_kinds_from_a_resumed_run_and_a_merge(graded_class, tmp_path):
-    submissions, out = graded_class
+    submissions, out, _ = graded_class
     first = class_report.summarise(class_report.read(out))
     resumed = tmp_path / "resumed"
     shutil.copytree(out, resumed)
@@ -382,7 +385,7 @@ def test_the_report_reads_the_same_kinds_from_a_resumed_run_and_a_merge(graded_c
 def test_rewording_every_message_changes_nothing_the_report_says(graded_class):
     """The grader's words may change: scrambled, every failed step's detail and every problem's text, the
     report's outcomes and problem kinds are the same."""
-    _, out = graded_class
+    _, out, _ = graded_class
     grades = class_report.read(out)
 
     def scrambled(text):
