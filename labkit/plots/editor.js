@@ -4,7 +4,9 @@
 // the picture (CSS pixels); this module paints the scene on a canvas over the background (in
 // requestAnimationFrame, the newest scene only; each paint raises data-labkit-shown once its frame is
 // rendered), draws the handles over it, moves them under the mouse at once, and sends the dragged
-// handle's position to the kernel, one request at a time (the newest wins).
+// handle's position to the kernel, one request at a time (the newest wins). A move of the mesh-size or twist
+// slider to the values of a picture the kernel sent ahead (scene.js's sceneAhead) shows it, its readout and
+// status at once; pictures drawn ahead are keyed by the last drag drawn (`ack`) too, and none is shown mid-drag.
 // Keyboard: Tab enters and leaves the editor like any control (never trapped, WCAG 2.1.2); n / p select
 // the next / previous handle; the arrow keys move it (Shift: 5 times further). The picture and handles
 // form an ARIA "application" named by the model's label; a polite live region speaks the model's status
@@ -70,7 +72,7 @@ function render({ model, el }) {
 
   let positions = model.get("handles").map((p) => p.slice());
   let dragging = null, selected = model.get("selected"), waiting = false, queued = null, seq = 0, url = null, timer = null;
-  let ready = Promise.resolve(), painting = false, alive = true, media = null;
+  let ready = Promise.resolve(), painting = false, alive = true, media = null, next = null;
 
   const frame = () => model.get("frame");
   function toPixels([x, y]) {
@@ -203,13 +205,30 @@ function render({ model, el }) {
   }
   function paint() {
     painting = false;
-    if (!alive) return;
-    const scene = model.get("scene") || {};
+    if (!alive || !next) return;
+    const picture = next;
+    next = null;
+    const scene = picture.scene;
     const [width, height] = scene.size || [0, 0];
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || [], model.get("overlays") || {});
+    showReadout(picture);
+    if (dragging === null) live.textContent = picture.status;
+    if (picture.ahead) stage.dataset.labkitDrawnAhead = String(Number(stage.dataset.labkitDrawnAhead || 0) + 1);
     sceneShown(stage);
+  }
+  function show(picture) {
+    next = picture;
+    schedule();
+  }
+  // a picture drawn ahead shows the corners of the last drag drawn: none is shown while a drag is on its way
+  const ahead = sceneAhead(model, stage, show, () =>
+    dragging === null && !waiting && queued === null ? { shape: model.get("ack") } : null);
+  function fromKernel() {
+    const scene = model.get("scene") || {};
+    const fields = Object.fromEntries(["readout", "worst", "alt", "status"].map((name) => [name, model.get(name)]));
+    ahead.fromKernel({ scene, ...fields, values: scene.values, background: scene.background });
   }
   function schedule() {
     if (painting) return;
@@ -226,10 +245,10 @@ function render({ model, el }) {
       model.save_changes();
     }
   }
-  function showReadout() {
-    readout.textContent = model.get("readout");
-    readout.style.borderColor = model.get("worst") <= 0 ? "#d62728" : "#767676";
-    img.alt = model.get("alt");
+  function showReadout(picture) {
+    readout.textContent = picture.readout;
+    readout.style.borderColor = picture.worst <= 0 ? "#d62728" : "#767676";
+    img.alt = picture.alt;
   }
   // the live region changes once a drag ends, not at every step of it (a screen reader would queue them all)
   function announce() {
@@ -237,9 +256,8 @@ function render({ model, el }) {
   }
 
   model.on("change:background", showBackground);
-  model.on("change:scene", schedule);
+  model.on("change:scene", fromKernel);
   model.on("change:ack", answered);
-  model.on("change:readout", showReadout);
   model.on("change:status", announce);
   model.on("change:selected", () => { // set by the kernel (a drag's handle)
     if (model.get("selected") !== selected) { selected = model.get("selected"); draw(); }
@@ -249,13 +267,14 @@ function render({ model, el }) {
   });
   model.on("change:frame", draw);
   showBackground();
-  schedule();
-  showReadout();
+  fromKernel();
+  showReadout({ readout: model.get("readout"), worst: model.get("worst"), alt: model.get("alt") });
   announce();
   draw();
   reportRatio();
   return () => {
     alive = false;
+    ahead.dispose();
     if (media) media.removeEventListener("change", reportRatio);
     if (url) URL.revokeObjectURL(url);
     clearTimeout(timer);

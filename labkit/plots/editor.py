@@ -11,7 +11,10 @@ at the page's devicePixelRatio), the worst quality and the corner data as
 and the twist. Moves that pile up while a picture is on its way are coalesced:
 ``editor.js`` keeps one dragged position on its way until the kernel acknowledges
 it (``ack``) and sends only the newest after, and the sliders' messages are
-merged as the explorers' are (see :mod:`labkit.plots.explorers`).
+merged as the explorers' are (see :mod:`labkit.plots.explorers`). After a move of
+either slider the kernel also sends its next moves' pictures, readouts and
+statuses, drawn ahead as the explorers' are; they are keyed by the last drag drawn
+(``ack``) as well, so a picture drawn before a drag is never shown after it.
 
 Without a mouse (:data:`KEYS`): Tab reaches the editor and leaves it as it
 leaves any control; ``n`` and ``p`` select the next and the previous handle,
@@ -27,17 +30,21 @@ The handles' logic is plain Python, tested without a browser
 side is ``editor.js`` beside this file, an anywidget module.
 """
 
+import functools
+
 import numpy as np
 
 from ..patches import Corner
 from .explorers import (
     DPI,
     Painter,
+    ahead_entry,
     esm,
     freeze_layout,
     headless,
     live_ratio,
     new_figure,
+    next_moves,
     shown_only,
     static_png,
     widget_with_picture,
@@ -166,6 +173,10 @@ def _editor_class():
         label = traitlets.Unicode(LABEL).tag(sync=True)  # the editor's aria-label, naming the keys
         key_help = traitlets.Unicode(KEYS).tag(sync=True)  # the keys, shown under the readout
         alt = traitlets.Unicode("").tag(sync=True)  # the picture's alt text
+        # pictures of the sliders' next moves, drawn ahead (see labkit.plots.explorers.AHEAD), and where the
+        # browser reads the sliders' values that key them: {name: [model id, "value"]}
+        ahead = traitlets.List([]).tag(sync=True)
+        controls = traitlets.Dict({}).tag(sync=True)
 
     return PatchEditor
 
@@ -189,6 +200,10 @@ class Editor:
             continuous_update=True,
         )
         self.widget_ = _editor_class()()
+        self.widget_.controls = {
+            "elements": [self.elements.model_id, "value"],
+            "twist": [self.twist.model_id, "value"],
+        }
         self.limits = limits or self._fit_limits()
         self.redraws = 0
         self.ratio = 1.0  # the static picture's and, until the page says otherwise, the live one's
@@ -200,7 +215,7 @@ class Editor:
         self.widget_.observe(self._new_ratio, names="pixel_ratio")
         self.widget_.observe(self._dragged, names="drag")
         self.widget_.observe(self._selected, names="selected")
-        self.elements.observe(lambda change: self.refresh(), names="value")
+        self.elements.observe(self._sized, names="value")
         self.twist.observe(self._twisted, names="value")
         self.refresh()
         self.widget = label_sliders(widgets.VBox([self.widget_, widgets.HBox([self.elements, self.twist])]))
@@ -219,24 +234,29 @@ class Editor:
         except (KeyError, TypeError, ValueError):
             return
         with self.widget_.hold_sync():  # the picture and the acknowledgement in one message
+            if isinstance(drag.get("seq"), int):
+                self.widget_.ack = drag["seq"]  # first: the picture's key names the drag it shows
             if 0 <= index < 12 and all(np.isfinite(point)):
                 self.corners = move_handle(self.corners, index, point)
                 self.widget_.selected = index  # the browser selects a handle before it drags it: usually no change
                 self.refresh()
-            if isinstance(drag.get("seq"), int):
-                self.widget_.ack = drag["seq"]
 
     def _selected(self, change):
         if 0 <= change["new"] < 12:
             self.widget_.status = status_text(self.corners, change["new"], self.quality)
 
+    def _sized(self, change):
+        self.refresh()
+        self._send_ahead(change)
+
     def _twisted(self, change):
         self.corners = with_twist(self.corners, change["new"])
         self.refresh()
+        self._send_ahead(change)
 
-    def _draw_mesh(self):
-        n = self.elements.value + 1
-        self.view.update(self.corners, n, n)
+    def _draw_mesh(self, corners=None, elements=None):
+        n = (self.elements.value if elements is None else elements) + 1
+        self.view.update(self.corners if corners is None else corners, n, n)
         self.ax.set_xlim(*self.limits[:2])
         self.ax.set_ylim(*self.limits[2:])
         self.ax.set_aspect("equal")
@@ -256,35 +276,85 @@ class Editor:
         self.seq += 1
         self._send(self.seq)
 
+    def _values(self, elements=None, twist=None):
+        """The sliders' values as the browser holds them, and the last drag drawn (``ack``): what keys a picture
+        drawn ahead (a drag changes the corners, so a picture drawn before it is not one to show after)."""
+        return {
+            "elements": self.elements.value if elements is None else elements,
+            "twist": self.twist.value if twist is None else twist,
+            "shape": self.widget_.ack,
+        }
+
+    def _fields(self, corners, quality, elements=None):
+        """The readout, worst quality, alt text and status of the mesh of `corners` with `quality`, `elements`
+        (default: the slider's) by as many elements."""
+        worst = float(quality.min())
+        folded = int(np.sum(quality <= 0))
+        n = self.elements.value if elements is None else elements
+        return {
+            "readout": f"worst quality {worst:.2f}"
+            + (f", {folded} folded" if folded else "")
+            + "\n"
+            + corner_code(corners),
+            "worst": worst,
+            "alt": (
+                f"Mesh of the patch, {n} by {n} elements coloured by quality, with its 12 handles; worst "
+                f"quality {worst:.2f}" + (f", {folded} folded" if folded else "") + "."
+            ),
+            "status": status_text(corners, self.widget_.selected, quality),
+        }
+
+    def _scene(self, seq, items, values):
+        width, height = self.figure.canvas.get_width_height()
+        return {
+            "seq": seq,
+            "size": [width, height],
+            "ratio": self.ratio,
+            "items": items,
+            "values": values,
+            "background": self.scene.backgrounds,
+        }
+
     def _send(self, seq):
         """Rebuild the mesh; send its scene, handles, readout, worst quality, alt and status."""
         self._draw_mesh()
         self.quality = self.view.mesh.quality()
-        worst = float(self.quality.min())
         background, items = self.scene.frame(self.ratio, DPI * self.ratio)
-        folded = int(np.sum(self.quality <= 0))
-        n = self.elements.value
-        width, height = self.figure.canvas.get_width_height()
+        fields = self._fields(self.corners, self.quality)
         with self.widget_.hold_sync():  # one message a move: each message costs the browser a round of work
             self.widget_.frame = self._frame()
             self.widget_.handles = handle_positions(self.corners).round(6).tolist()
-            self.widget_.readout = (
-                f"worst quality {worst:.2f}"
-                + (f", {folded} folded" if folded else "")
-                + "\n"
-                + corner_code(self.corners)
-            )
-            self.widget_.worst = worst
-            self.widget_.alt = (
-                f"Mesh of the patch, {n} by {n} elements coloured by quality, with its 12 handles; worst quality "
-                f"{worst:.2f}" + (f", {folded} folded" if folded else "") + "."
-            )
-            self.widget_.status = status_text(self.corners, self.widget_.selected, self.quality)
+            for name, value in fields.items():
+                setattr(self.widget_, name, value)
             if background is not None:
                 self.widget_.background = background
             self.widget_.overlays = self.scene.overlays
-            self.widget_.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}
+            self.widget_.scene = self._scene(seq, items, self._values())
         self.redraws += 1
+
+    def _send_ahead(self, change):
+        """Send the pictures of the moved slider's next moves (``AHEAD``), with their readouts."""
+        if headless():
+            return
+        name = "elements" if change.get("owner") is self.elements else "twist"
+        for batch in next_moves(change):
+            entries = []
+            for value in batch:
+                corners = with_twist(self.corners, value) if name == "twist" else self.corners
+                elements = value if name == "elements" else None
+                entry = ahead_entry(
+                    self.scene,
+                    functools.partial(self._draw_mesh, corners, elements),
+                    self._values(**{name: value}),
+                    DPI * self.ratio,
+                    lambda corners=corners, n=elements: self._fields(corners, self.view.mesh.quality(), n),
+                )
+                if entry is not None:
+                    entry["scene"] = self._scene(self.seq, entry.pop("items"), entry["values"])
+                    entries.append(entry)
+            if entries:
+                self.widget_.ahead = entries
+        self._draw_mesh()  # the figure shows the editor's mesh again
 
     def _frame(self):
         """The axes' data limits and box in the last picture (CSS pixels), so the browser can map the mouse."""

@@ -21,6 +21,17 @@ request it gets at once. The browser paints at most once an animation frame,
 the newest scene. (A report from the browser of each picture shown, which the
 kernel waited for, cost a second round trip per move: ``docs/performance.md``.)
 
+A key press needs no round trip at all when its picture was drawn ahead: after
+a slider's move the kernel also sends the pictures of that slider's next moves
+(``AHEAD``: the next step on first, alone, then the one after and the one
+back), each keyed by the controls' values it shows and the background it lies
+on. ``image.js`` keeps them and shows one in the next frame when the controls
+reach its values; the kernel's own scene of that move, when it comes, is not
+drawn again. Only pictures that lie on the background already sent are drawn
+ahead (a move that fits the axes again waits for the kernel), and drawing them
+changes nothing the explorer draws afterwards (the axes are put back, the
+figure updated to the controls again).
+
 Where widgets cannot run (nbval, ``jupyter nbconvert --execute``, GitHub's or
 nbviewer's static view, ``labkit grade``) the same output carries a PNG of the
 first picture (:meth:`Explorer.png`, rendered at ``PIXEL_RATIO`` (2) device
@@ -161,14 +172,71 @@ def _image_class():
         css_size = traitlets.List([0, 0]).tag(sync=True)  # [width, height] in CSS pixels
         description = traitlets.Unicode("").tag(sync=True)
         pixel_ratio = traitlets.Float(0.0).tag(sync=True)  # the page's devicePixelRatio, from the browser
+        # pictures drawn ahead: [{"values", "background", "scene", "description"}], for moves not made yet
+        ahead = traitlets.List([]).tag(sync=True)
+        # {name: [model id, attribute]}: where the browser reads the controls' values that key those pictures
+        controls = traitlets.Dict({}).tag(sync=True)
 
     return ExplorerImage
 
 
 def explorer_image():
-    """A new image widget of the explorers: ``background``, ``scene``, ``css_size``, ``description`` and
-    ``pixel_ratio``."""
+    """A new image widget of the explorers: ``background``, ``scene``, ``css_size``, ``description``,
+    ``pixel_ratio``, ``ahead`` and ``controls``."""
     return _image_class()()
+
+
+AHEAD = ((1,), (2, -1))  # after a slider's move, the pictures drawn ahead, in its steps along its last move: the
+# next first, sent alone, then the one after and the one back; each is drawn over the background already sent
+
+
+def _browser_attribute(control):
+    """Where the browser's model of `control` holds its value: a dropdown's is its ``index`` (its value
+    stays in the kernel), any other control's its ``value``."""
+    import ipywidgets as widgets
+
+    return "index" if isinstance(control, widgets.widget_selection._Selection) else "value"
+
+
+def _slider_step(control):
+    """The step of an ipywidgets IntSlider or FloatSlider (a slider moves by it at a key press), else None."""
+    import ipywidgets as widgets
+
+    if isinstance(control, (widgets.IntSlider, widgets.FloatSlider)) and control.step:
+        return control.step
+    return None
+
+
+def next_moves(change):
+    """The values of a slider's next moves after `change` (a traitlets change of its ``value``), in the batches
+    of ``AHEAD``: within its range, one step apart; nothing for another control or no move."""
+    control = change.get("owner")
+    step = _slider_step(control)
+    if step is None or change.get("new") == change.get("old"):
+        return []
+    direction = 1 if change["new"] > change["old"] else -1
+    batches = []
+    for steps in AHEAD:
+        values = [control.value + direction * k * step for k in steps]
+        values = [round(v, 12) if isinstance(v, float) else v for v in values]
+        batches.append([v for v in values if control.min <= v <= control.max])
+    return batches
+
+
+def ahead_entry(scene, draw, values, dpi, fields):
+    """A picture drawn ahead: the `scene`'s items once `draw()` has updated the figure to a move not made yet,
+    keyed by the controls' `values` there (as the browser holds them), with the widget's other `fields` (a
+    callable), or None if it does not lie on the background sent. The figure's axes are then put back as they
+    were before `draw`, so the figure's next update decides its limits as it would have."""
+    limits = [(ax, ax.get_xlim(), ax.get_ylim()) for ax in scene.figure.axes]
+    draw()
+    items = scene.ahead(dpi)
+    if items is None:
+        for ax, xlim, ylim in limits:
+            ax.set_xlim(xlim)
+            ax.set_ylim(ylim)
+        return None
+    return {"values": values, "background": scene.backgrounds, "items": items, **fields()}
 
 
 class Explorer:
@@ -202,10 +270,11 @@ class Explorer:
         self.seq = 0  # the number of the last scene sent
         for control in self.controls.values():
             control.observe(self.refresh, names="value")
-        self._update(**self.values())
+        self._draw(self.values())
         freeze_layout(figure)
         self.image.css_size = list(self.css_size())
         self.image.observe(self._new_ratio, names="pixel_ratio")
+        self.image.controls = {name: [c.model_id, _browser_attribute(c)] for name, c in self.controls.items()}
         self.refresh()
         self.widget = widgets.VBox([*self.controls.values(), self.image])
         self.widget.add_class("labkit-explorer")
@@ -216,26 +285,74 @@ class Explorer:
     def values(self):
         return {name: control.value for name, control in self.controls.items()}
 
+    def browser_values(self, values):
+        """`values` (the controls' by name) as the browser's models hold them (:func:`_browser_attribute`)."""
+        return {
+            name: self.controls[name].index if _browser_attribute(self.controls[name]) == "index" else v
+            for name, v in values.items()
+        }
+
+    def _draw(self, values):
+        self._update(**values)
+
     def refresh(self, change=None):
-        """Bring the figure and its picture up to the controls."""
+        """Bring the figure and its picture up to the controls; after a slider's move, send the pictures of
+        its next moves too (``AHEAD``), which the browser shows at a key press without asking the kernel."""
         if headless():
-            self._update(**self.values())
+            self._draw(self.values())
             return
         self.seq += 1
         self._send(self.seq)
+        if change is not None:
+            self._send_ahead(change)
+
+    def _scene(self, seq, items, values):
+        width, height = self.figure.canvas.get_width_height()
+        return {
+            "seq": seq,
+            "size": [width, height],
+            "ratio": self.ratio,
+            "items": items,
+            # the controls' values it shows, as the browser holds them: the browser tells it from one drawn ahead
+            "values": self.browser_values(values),
+            "background": self.scene.backgrounds,  # which background it lies on
+        }
 
     def _send(self, seq):
         """Update the figure from the controls and send its scene and description (one message)."""
-        self._update(**self.values())
+        values = self.values()
+        self._draw(values)
         background, items = self.scene.frame(self.ratio, DPI * self.ratio)
-        width, height = self.figure.canvas.get_width_height()
         with self.image.hold_sync():
             self.image.description = self.description
             if background is not None:
                 self.image.background = background
             self.image.overlays = self.scene.overlays
-            self.image.scene = {"seq": seq, "size": [width, height], "ratio": self.ratio, "items": items}
+            self.image.scene = self._scene(seq, items, values)
         self.redraws += 1
+
+    def _send_ahead(self, change):
+        """Send the pictures of the moved slider's next moves (``AHEAD``) that lie on the background sent."""
+        name = next((name for name, c in self.controls.items() if c is change.get("owner")), None)
+        values, batches = self.values(), next_moves(change) if name is not None else []
+        for batch in batches:
+            entries = []
+            for value in batch:
+                moved = {**values, name: value}
+                entry = ahead_entry(
+                    self.scene,
+                    functools.partial(self._draw, moved),
+                    self.browser_values(moved),
+                    DPI * self.ratio,
+                    lambda: {"description": figure_alt(self.figure)},
+                )
+                if entry is not None:
+                    entry["scene"] = self._scene(self.seq, entry.pop("items"), moved)
+                    entries.append(entry)
+            if entries:
+                self.image.ahead = entries
+        if batches:
+            self._draw(values)  # the figure shows the controls again (it is the notebook's to read or save)
 
     def _new_ratio(self, change):
         ratio = live_ratio(change["new"])

@@ -4,9 +4,11 @@
 // reports in `pixel_ratio`; every move sends the changing artists as a scene, drawn here on a <canvas> over
 // the background in the same device pixels. Both are shown at the figure's CSS size, never wider than the
 // output area; the <img>'s alt text is the figure's description in numbers, updated with every move.
-// Paints happen inside requestAnimationFrame, at most one a frame, always of the newest scene (the scenes that
+// Paints happen inside requestAnimationFrame, at most one a frame, always of the newest picture (the ones that
 // arrived in between are never drawn); each paint raises data-labkit-shown once its frame is rendered. Nothing
 // goes back to the kernel: a second message per move would cost a second trip (see explorers.py).
+// Pictures drawn ahead (scene.js's sceneAhead): a key press that brings the controls to the values of a picture
+// the kernel sent ahead shows it in the next frame, without waiting for the kernel.
 function render({ model, el }) {
   const box = document.createElement("div");
   box.className = "labkit-explorer-picture";
@@ -22,6 +24,7 @@ function render({ model, el }) {
   canvas.style.cssText = "position:absolute; left:0; top:0; width:100%; height:100%; pointer-events:none";
   box.append(img, canvas);
   let url = null, ready = Promise.resolve(), queued = false, alive = true, media = null;
+  let next = null;
 
   function showBackground() {
     const bytes = sceneBytes(model.get("background"));
@@ -34,13 +37,27 @@ function render({ model, el }) {
   }
   function paint() {
     queued = false;
-    if (!alive) return;
-    const scene = model.get("scene") || {};
+    if (!alive || !next) return;
+    const picture = next;
+    next = null;
+    const scene = picture.scene;
     const [width, height] = scene.size || [0, 0];
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || [], model.get("overlays") || {});
+    img.alt = picture.description;
+    // for the tests: how many pictures were drawn ahead, and how many are kept (data-labkit-kept)
+    if (picture.ahead) box.dataset.labkitDrawnAhead = String(Number(box.dataset.labkitDrawnAhead || 0) + 1);
     sceneShown(box);
+  }
+  function show(picture) {
+    next = picture;
+    schedule();
+  }
+  const ahead = sceneAhead(model, box, show, () => ({}));
+  function fromKernel() {
+    const scene = model.get("scene") || {};
+    ahead.fromKernel({ scene, description: model.get("description"), values: scene.values, background: scene.background });
   }
   function schedule() {
     if (queued) return;
@@ -69,17 +86,17 @@ function render({ model, el }) {
   }
 
   model.on("change:background", showBackground);
-  model.on("change:scene", schedule);
+  model.on("change:scene", fromKernel);
   model.on("change:css_size", showSize);
-  model.on("change:description", showDescription);
   showSize();
   showDescription();
   showBackground();
-  schedule();
+  fromKernel();
   el.appendChild(box);
   reportRatio();
   return () => {
     alive = false;
+    ahead.dispose();
     if (media) media.removeEventListener("change", reportRatio);
     if (url) URL.revokeObjectURL(url);
   };

@@ -188,3 +188,85 @@ function drawScene(canvas, items, overlays) {
     ctx.restore();
   }
 }
+// whether two pictures show the same controls' values ({name: value}; numbers equal to 1e-9 relative): a picture
+// drawn ahead is shown when the controls reach its values (image.js, editor.js)
+function sameValues(a, b) {
+  if (!a || !b) return false;
+  const names = Object.keys(b);
+  if (Object.keys(a).length !== names.length) return false;
+  for (const name of names) {
+    const x = a[name], y = b[name];
+    if (typeof x === "number" && typeof y === "number") {
+      if (!(Math.abs(x - y) <= 1e-9 * Math.max(1, Math.abs(x), Math.abs(y)))) return false;
+    } else if (x !== y) return false;
+  }
+  return true;
+}
+// Pictures drawn ahead (labkit.plots.explorers.AHEAD) for one widget (image.js, editor.js). After a slider's move
+// the kernel also sends the pictures of its next moves (`ahead`: each with the values it shows and the background
+// it lies on). This keeps the newest of them and watches the controls' models (`controls`: name -> [model id,
+// the attribute holding the value]); when the controls reach a kept picture's values it is shown at once, without
+// waiting for the kernel. A scene from the kernel is shown unless it is the one on the page already (drawn
+// ahead) or older than it. `show(picture)` paints a picture in the next frame; `extra()` gives what else keys a
+// picture (the editor's last drag drawn), or null while the values are in flux; `node` gets data-labkit-kept.
+const AHEAD_KEPT = 12; // pictures drawn ahead kept, newest first
+function sceneAhead(model, node, show, extra) {
+  const controls = {};
+  let kept = [], latest = null, alive = true;
+  function valuesNow() {
+    const more = extra();
+    if (!more) return null;
+    const values = {};
+    for (const name of Object.keys(model.get("controls") || {})) {
+      if (!controls[name]) return null; // a control's model is still on its way
+      values[name] = controls[name].model.get(controls[name].attribute);
+    }
+    return { ...values, ...more };
+  }
+  function offer(picture) {
+    latest = picture;
+    show(picture);
+  }
+  function fromKernel(picture) {
+    const scene = picture.scene, now = valuesNow();
+    if (latest && latest.background === scene.background && scene.values) {
+      if (sameValues(scene.values, latest.values)) return; // on the page already, drawn ahead
+      if (now && sameValues(latest.values, now) && !sameValues(scene.values, now)) return; // older than the page
+    }
+    offer(picture);
+  }
+  function fromAhead() {
+    const now = valuesNow();
+    if (!alive || !now || (latest && sameValues(latest.values, now))) return;
+    const background = (model.get("scene") || {}).background;
+    const entry = kept.find((e) => e.background === background && sameValues(e.values, now));
+    if (entry) offer({ ...entry, ahead: true });
+  }
+  function keep() {
+    for (const entry of model.get("ahead") || [])
+      kept = [entry, ...kept.filter((e) => !sameValues(e.values, entry.values))].slice(0, AHEAD_KEPT);
+    node.dataset.labkitKept = String(kept.length);
+    fromAhead();
+  }
+  function watch() {
+    for (const [name, [id, attribute]] of Object.entries(model.get("controls") || {})) {
+      if (controls[name]) continue;
+      model.widget_manager.get_model(id).then((control) => {
+        if (!alive || !control) return;
+        controls[name] = { model: control, attribute };
+        control.on(`change:${attribute}`, fromAhead);
+      }).catch(() => {}); // without the control's model the pictures come from the kernel, as ever
+    }
+  }
+  model.on("change:ahead", keep);
+  model.on("change:controls", watch);
+  watch();
+  return {
+    fromKernel,
+    fromAhead,
+    dispose() {
+      alive = false;
+      for (const c of Object.values(controls)) c.model.off(`change:${c.attribute}`, fromAhead);
+    },
+  };
+}

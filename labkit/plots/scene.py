@@ -133,17 +133,36 @@ class Scene:
             width, height = canvas.get_width_height()
             background = encode_png(np.asarray(canvas.buffer_rgba()).reshape(height, width, 4))
             self.backgrounds += 1
-        renderer = canvas.get_renderer()
-        items = []
-        for artist in dynamic:
-            if not artist.get_visible():
-                continue
-            items.extend(self._items(artist, renderer))
+        items = self._all_items(dynamic)
         named = {item["id"] for item in items if item["kind"] == "overlay"}
         if set(self.overlays) - named:  # an overlay no item names any more (a legend replaced): gone
             self.overlays = {name: pixels for name, pixels in self.overlays.items() if name in named}
             self._made = {name: key for name, key in self._made.items() if name in named}
         return background, items
+
+    def ahead(self, dpi):
+        """The items of the figure as it is now, to draw over the background last sent, or None where that
+        background does not fit it (the static part changed, the dpi is another, or an overlay would be new):
+        a picture the browser can show at once for a move not made yet. Changes nothing :meth:`frame` keeps."""
+        dynamic = list(getattr(self.view, "live_dynamic", self.view.dynamic)())
+        if not dynamic or self.background is None or self.figure.dpi != dpi:
+            return None
+        if (self.view.static_key(), dpi) != self.key:
+            return None
+        overlays, made = self.overlays, dict(self._made)
+        items = self._all_items(dynamic)
+        if self.overlays is not overlays:  # pixels the browser has not got: no picture ahead
+            self.overlays, self._made = overlays, made
+            return None
+        return items
+
+    def _all_items(self, dynamic):
+        renderer = self.figure.canvas.get_renderer()
+        items = []
+        for artist in dynamic:
+            if artist.get_visible():
+                items.extend(self._items(artist, renderer))
+        return items
 
     def _items(self, artist, renderer):
         from matplotlib.axis import Axis

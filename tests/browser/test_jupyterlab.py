@@ -81,6 +81,37 @@ def _held_key_ends_on_the_latest_value(page, panel, presses=12):
     print(f"\nheld key: {presses} presses, {frames(page) - before} pictures arrived, the last of y = {value:g}")
 
 
+def _a_key_press_is_drawn_ahead(page, box, slider):
+    """Once the kernel has answered a slider's move (and sent the pictures of its next moves), the next key press
+    is drawn from those at once: the drawn-ahead count goes up with the picture, and the kernel's own scene of
+    that move, when it comes, is not drawn again (nor its alt text changed)."""
+    box, slider = box.first, slider.first
+    readout, handle = slider.locator(".widget-readout"), slider.locator(".noUi-handle")
+    state = "b => [Number(b.dataset.labkitShown), Number(b.dataset.labkitDrawnAhead || 0), b.querySelector('img').alt]"
+    idle = "() => window.jupyterapp.shell.currentWidget.sessionContext.session.kernel.status === 'idle'"
+    handle.focus()
+    moved = "([n, old]) => n.innerText !== old"
+    for key, back in (("ArrowLeft", "ArrowRight"), ("ArrowRight", "ArrowLeft")):  # it may stand at an end
+        old = readout.inner_text()
+        page.keyboard.press(key)
+        try:
+            page.wait_for_function(moved, arg=[readout.element_handle(), old], timeout=2_000)
+        except playwright_api.TimeoutError:
+            continue
+        page.wait_for_function("b => Number(b.dataset.labkitKept || 0) > 0", arg=box.element_handle(), timeout=10_000)
+        page.wait_for_function(idle, timeout=10_000)  # both batches of pictures ahead came before the kernel's idle
+        shown, ahead, alt = box.evaluate(state)
+        page.keyboard.press(back)  # back to where it stood: the picture one step back was sent ahead
+        page.wait_for_function(f"b => Number(b.dataset.labkitShown) > {shown}", arg=box.element_handle())
+        after = box.evaluate(state)
+        assert after[1] == ahead + 1, (key, shown, ahead, alt, after)
+        page.wait_for_timeout(300)
+        page.wait_for_function(idle, timeout=10_000)
+        assert box.evaluate(state) == after  # the kernel's scene of the same move was not drawn over it
+        return
+    raise AssertionError("the slider did not move")
+
+
 def _explorer_pictures(page, panel):
     """Each explorer picture's background (natural width, device pixels), canvas (backing width, device pixels),
     displayed CSS width, alt text and the page's devicePixelRatio, once loaded and painted."""
@@ -207,6 +238,11 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
         timings[f"{stem} editor drag step"] = steps
     if stem == "05_monotone":
         _held_key_ends_on_the_latest_value(page, panel)
+    explorer = panel.locator(".labkit-explorer").first
+    _a_key_press_is_drawn_ahead(page, explorer.locator(".labkit-explorer-picture"), explorer.locator(".widget-slider"))
+    editor = panel.locator(".labkit-patch-editor")
+    if editor.count():  # its mesh size, drawn ahead with its readout
+        _a_key_press_is_drawn_ahead(page, editor.locator(".labkit-editor"), editor.locator(".widget-slider"))
     page.screenshot(path=str(SCREENSHOTS / f"{stem}-after.png"))
     measured = latencies(timings)
     LATENCIES.update(measured)
