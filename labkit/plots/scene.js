@@ -251,11 +251,17 @@ function sceneAhead(model, node, show, extra) {
   function watch() {
     for (const [name, [id, attribute]] of Object.entries(model.get("controls") || {})) {
       if (controls[name]) continue;
-      model.widget_manager.get_model(id).then((control) => {
-        if (!alive || !control) return;
-        controls[name] = { model: control, attribute };
-        control.on(`change:${attribute}`, fromAhead);
-      }).catch(() => {}); // without the control's model the pictures come from the kernel, as ever
+      // without the control's model (a front end that gives none) the pictures come from the kernel, as ever
+      const manager = model.widget_manager;
+      if (!manager || typeof manager.get_model !== "function") return;
+      Promise.resolve()
+        .then(() => manager.get_model(id))
+        .then((control) => {
+          if (!alive || !control || controls[name]) return;
+          controls[name] = { model: control, attribute };
+          control.on(`change:${attribute}`, fromAhead);
+        })
+        .catch(() => {});
     }
   }
   model.on("change:ahead", keep);
