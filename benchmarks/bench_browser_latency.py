@@ -28,6 +28,7 @@ from jupyterlab_session import (
     CHROMIUM,
     CHROMIUM_FLAGS,
     COUNT_IMAGE_FRAMES,
+    DRAWN_AHEAD,
     NOTEBOOKS,
     close_sessions,
     course_lab,
@@ -120,11 +121,12 @@ def main():
         name = "busy (two CPU-bound processes)" if busy else "quiet"
         measured = measure_all(args.scale, busy, args.only)
         print(f"\n{name}, devicePixelRatio {args.scale:g}: key press -> new picture shown")
-        print(f"{'slider':<40}{'median':>9}{'90th percentile':>18}{'moves':>7}")
+        print(f"{'slider':<40}{'median':>9}{'90th percentile':>18}{'moves':>7}{'drawn ahead':>13}")
         broken = over_limits(measured, busy)
         for label, (median_ms, p90_ms, moves) in measured.items():
             mark = f"  ({broken[label]})" if label in broken else ""
-            print(f"{label:<40}{median_ms:6.0f} ms{p90_ms:15.0f} ms{moves:7d}{mark}", flush=True)
+            ahead = DRAWN_AHEAD.get(label, 0)
+            print(f"{label:<40}{median_ms:6.0f} ms{p90_ms:15.0f} ms{moves:7d}{ahead:13d}{mark}", flush=True)
         slow.update({f"{label} ({'busy' if busy else 'quiet'})": why for label, why in broken.items()})
     if slow:
         sys.exit(f"key press -> new picture shown above the limits: {slow}")

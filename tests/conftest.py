@@ -98,9 +98,11 @@ def pytest_terminal_summary(terminalreporter):
     latencies = getattr(module, "LATENCIES", {})
     if latencies:
         terminalreporter.section("JupyterLab: key press or drag step -> new picture shown")
+        ahead = getattr(sys.modules.get("jupyterlab_session"), "DRAWN_AHEAD", {})
         for name, (median, p90, moves) in latencies.items():
             terminalreporter.write_line(
-                f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves)"
+                f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves, "
+                f"{ahead.get(name, 0)} drawn ahead)"
             )
     # the axe-core check's findings per notebook: what is in the notebooks' outputs (asserted to be nothing
     # serious) and what JupyterLab itself causes (named only)

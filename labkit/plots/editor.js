@@ -213,13 +213,13 @@ function render({ model, el }) {
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || [], model.get("overlays") || {});
-    showReadout(picture);
-    if (dragging === null) live.textContent = picture.status;
     if (picture.ahead) stage.dataset.labkitDrawnAhead = String(Number(stage.dataset.labkitDrawnAhead || 0) + 1);
     sceneShown(stage);
   }
-  function show(picture) {
+  function show(picture) { // the text at once, as the message comes; the picture in the next frame
     next = picture;
+    showReadout(picture);
+    if (dragging === null) live.textContent = picture.status;
     schedule();
   }
   // a picture drawn ahead shows the corners of the last drag drawn: none is shown while a drag is on its way

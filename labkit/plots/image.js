@@ -45,13 +45,13 @@ function render({ model, el }) {
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || [], model.get("overlays") || {});
-    img.alt = picture.description;
     // for the tests: how many pictures were drawn ahead, and how many are kept (data-labkit-kept)
     if (picture.ahead) box.dataset.labkitDrawnAhead = String(Number(box.dataset.labkitDrawnAhead || 0) + 1);
     sceneShown(box);
   }
   function show(picture) {
     next = picture;
+    img.alt = picture.description;
     schedule();
   }
   const ahead = sceneAhead(model, box, show, () => ({}));

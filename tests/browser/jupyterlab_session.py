@@ -253,6 +253,7 @@ PICTURE_STATE_NTH = f"""e => {{
   const img = node.querySelector('img');
   return {{shown: counter ? Number(counter.dataset.labkitShown) : null,
            at: counter && counter.dataset.labkitShownAt ? Number(counter.dataset.labkitShownAt) : null,
+           ahead: counter ? Number(counter.dataset.labkitDrawnAhead || 0) : 0,
            src: img ? img.src : null}};
 }}"""
 
@@ -292,8 +293,12 @@ def _wait_until_shown(page, e, old, frames_before, start):
     return now - start
 
 
+DRAWN_AHEAD: dict = {}  # slider -> how many of its moves move_every_slider saw drawn ahead (no round trip)
+
+
 def move_every_slider(page, panel, name):
-    """Press the arrow keys on each explorer slider; {slider: [seconds from key press to new picture shown]}."""
+    """Press the arrow keys on each explorer slider; {slider: [seconds from key press to new picture shown]}.
+    How many of each slider's moves were drawn ahead goes into DRAWN_AHEAD."""
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
     page.evaluate(NOTE_INPUT)
@@ -307,7 +312,7 @@ def move_every_slider(page, panel, name):
             slider = sliders.nth(k)
             label = f"{name} {kind}{slider.locator('.widget-label').inner_text() or k}"
             readout, handle = slider.locator(".widget-readout"), slider.locator(".noUi-handle")
-            times = []
+            times, ahead = [], 0
             key = "ArrowRight"
             for _ in range(MOVES):
                 old_readout = readout.inner_text()
@@ -325,8 +330,10 @@ def move_every_slider(page, panel, name):
                     key = "ArrowLeft" if key == "ArrowRight" else "ArrowRight"
                     continue
                 times.append(_wait_until_shown(page, e, old, frames_before, start))
+                ahead += _picture_state_nth(page, e)["ahead"] > old["ahead"]
             assert len(times) >= MOVES - 1, f"{label}: the slider did not move"
             timings[label] = times
+            DRAWN_AHEAD[label] = ahead
     return timings
 
 
