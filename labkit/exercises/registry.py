@@ -26,7 +26,7 @@ import numpy as np
 
 from . import bilinear, hermite, monotone, patches, splines
 from .model import Exercise
-from .result import NOT_DONE, OTHER, CheckResult
+from .result import NOT_DONE, OTHER, VARIANT, CheckResult
 
 TOPICS = (hermite, patches, splines, monotone, bilinear)  # in the order of the exercises they declare
 # names labkit.check defines itself: no part's check may take one
@@ -197,6 +197,14 @@ class Registry:
         """
         exercise = self.exercises[number]
         defined = any(name in namespace for name in exercise.names)
+        other = {}
+        for param in exercise.params:
+            if variant is not None and param.name in variant and param.name in namespace:
+                found = _shown(namespace[param.name])
+                # only a number is data: a name the notebook no longer answers for (stopped, timed out) reads as
+                # a function proxy, and is no sign of anyone else's data
+                if isinstance(found, float) and not param.holds(found, variant[param.name]):
+                    other[param.name] = [found, variant[param.name]]
         checks, shared = [], {}
         refusing = getattr(namespace, "refusing", None)  # the grader's proxy switches references off per part
         for part in exercise.parts:
@@ -220,16 +228,9 @@ class Registry:
                     "this is a fault of the grader, not of your work: tell your instructor.",
                     OTHER,
                 )
+            _on_another_variant(result, part, other)
             checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # as the student names it
         points = sum(check["weight"] for check in checks if check["passed"])
-        other = {}
-        for param in exercise.params:
-            if variant is not None and param.name in variant and param.name in namespace:
-                found = _shown(namespace[param.name])
-                # only a number is data: a name the notebook no longer answers for (stopped, timed out) reads as
-                # a function proxy, and is no sign of anyone else's data
-                if isinstance(found, float) and not param.holds(found, variant[param.name]):
-                    other[param.name] = [found, variant[param.name]]
         return {
             **({"other_variant": other} if other else {}),
             "exercise": number,
@@ -239,6 +240,22 @@ class Registry:
             "defined": defined,
             "checks": checks,
         }
+
+
+def _on_another_variant(result, part, other) -> None:
+    """Fail `part`'s `result` when the notebook holds another variant's value of data the part depends on
+    (`other`: {parameter: [the notebook's, the student's]}): work on someone else's data earns nothing, even
+    where it agrees with the student's own to the digits shown (two close draws)."""
+    shown = sorted(name for name in part.varied if name in other)
+    if not shown:
+        return
+    values = "; ".join(f"{name} = {other[name][0]:g} where yours is {other[name][1]:g}" for name in shown)
+    result.fail(
+        "worked on your own data",
+        f"the notebook holds another variant's data ({values})",
+        "set the data cell back to the values your notebook was handed out with, and run the notebook again.",
+        VARIANT,
+    )
 
 
 def _shown(value) -> Any:

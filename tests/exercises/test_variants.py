@@ -356,6 +356,29 @@ def test_a_variant_s_tables_are_its_own_function_s_and_a_copy_loses_them():
     assert "runge_a = 0.812" in table["hint"] + str(table.get("steps", ""))
 
 
+def test_a_copy_between_two_close_draws_loses_its_tables_though_they_agree_to_the_digits_shown():
+    """Two students whose scales are 1.4064 and 1.4073 (a pair a fresh course drew, in CI): the complete spline's
+    errors on the two differ by 2e-6 at the size where the driver check compares the driver's own f with the
+    student's, so the table on the one passed as the other's. The copy is named and every part that depends on
+    the data is lost, with the reason in the feedback."""
+    from labkit.grading.authoring.draws import run_cells
+
+    nb = with_values(nbformat.read(NOTEBOOKS / "04_splines.ipynb", as_version=4), {11: {"runge_a": 1.4064}},
+                     "04_splines.ipynb")  # fmt: skip
+    namespace = run_cells(nb, ("rate_complete",))
+    assert LAB.check(11, namespace, seed=3, variant={"runge_a": 1.4064})["passed"]
+    method = LAB.experiment("complete")
+    near = method.reference(method.ndata[1:2], a=1.4073)[0]
+    assert abs(namespace["errors_complete"][1] - near) < 2e-6 * near  # the size the driver check compares at
+    verdict = LAB.check(11, namespace, seed=3, variant={"runge_a": 1.4073})
+    assert verdict["other_variant"] == {"runge_a": [1.4064, 1.4073]}
+    varied = {part.name for part in LAB.exercises[11].parts if part.varied}
+    assert varied and _failed(verdict) == varied
+    for check in verdict["checks"]:
+        if check["name"] in varied:
+            assert check["hint"].startswith("set the data cell back") and "another variant" in str(check["steps"])
+
+
 RUNGE_SLIPS = {
     "leaves out runge_a": "    return 1.0 / (1.0 + x**2), -2.0 * x / (1.0 + x**2) ** 2\n",
     "lacks the factor runge_a": "    return 1.0 / (1.0 + runge_a * x**2), -2.0 * x / (1.0 + runge_a * x**2) ** 2\n",

@@ -418,7 +418,7 @@ def grade_notebook(
                 )
                 text = (
                     f"{name}: exercise {number}: this notebook holds the data of another variant ({shown}); "
-                    "its parts that depend on the data were checked against your own."
+                    "its parts that depend on the data earn nothing until they are worked on your own."
                 )
                 problems.append(ProblemText.one(text, VARIANT))
             for index, part in enumerate(exercise.parts):
