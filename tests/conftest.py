@@ -102,7 +102,7 @@ def pytest_terminal_summary(terminalreporter):
         for name, (median, p90, moves) in latencies.items():
             terminalreporter.write_line(
                 f"{name:<40} median {median:4.0f} ms   90th percentile {p90:4.0f} ms   ({moves} moves, "
-                f"{ahead.get(name, 0)} drawn ahead)"
+                f"{ahead.get(name, 0)} without a round trip: drawn ahead or in the page)"
             )
     # the axe-core check's findings per notebook: what is in the notebooks' outputs (asserted to be nothing
     # serious) and what JupyterLab itself causes (named only)

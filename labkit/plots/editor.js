@@ -7,6 +7,9 @@
 // handle's position to the kernel, one request at a time (the newest wins). A move of the mesh-size or twist
 // slider to the values of a picture the kernel sent ahead (scene.js's sceneAhead) shows it, its readout and
 // status at once; pictures drawn ahead are keyed by the last drag drawn (`ack`) too, and none is shown mid-drag.
+// A handle's move is drawn here at once (mesh.js, from the kernel's `sketch`: the mesh, its colours and title as the
+// kernel draws them); the kernel's picture of that move, when it comes, is drawn over it without counting as a
+// new picture, and an answer older than the page is not drawn at all.
 // Keyboard: Tab enters and leaves the editor like any control (never trapped, WCAG 2.1.2); n / p select
 // the next / previous handle; the arrow keys move it (Shift: 5 times further). The picture and handles
 // form an ARIA "application" named by the model's label; a polite live region speaks the model's status
@@ -73,6 +76,10 @@ function render({ model, el }) {
   let positions = model.get("handles").map((p) => p.slice());
   let dragging = null, selected = model.get("selected"), waiting = false, queued = null, seq = 0, url = null, timer = null;
   let ready = Promise.resolve(), painting = false, alive = true, media = null, next = null;
+  // the corner data the handles stand for (the kernel's, then moved here), the handles' moves made, the move
+  // whose mesh was sketched here and waits for the kernel's picture (0: none), and the moves each drag sent
+  let corners = null, moved = 0, sketched = 0;
+  const sentMoved = new Map();
 
   const frame = () => model.get("frame");
   function toPixels([x, y]) {
@@ -119,6 +126,7 @@ function render({ model, el }) {
     const [x, y] = positions[index];
     model.set("drag", { index, x, y, seq: ++seq });
     model.save_changes();
+    sentMoved.set(seq, moved);
     clearTimeout(timer);
     timer = setTimeout(answered, 2000); // never stall if an answer is lost
   }
@@ -136,8 +144,23 @@ function render({ model, el }) {
       for (const tip of [index + 4, index + 8]) positions[tip] = [positions[tip][0] + dx, positions[tip][1] + dy];
     }
     positions[index] = point;
+    const arrow = (model.get("sketch") || {}).arrow;
+    corners = corners && arrow ? meshMove(corners, index, point, arrow) : null;
+    moved += 1;
     draw();
     send(index);
+    sketch();
+  }
+
+  // the mesh of the handles' new place, drawn here, when the kernel's sketch is of the sliders' values and the
+  // background shown
+  function sketch() {
+    const plan = model.get("sketch") || {};
+    const now = ahead.controlsNow();
+    if (!corners || !plan.in_s || !now || !sameValues(plan.values, now)) return;
+    if (plan.background !== (model.get("scene") || {}).background) return;
+    sketched = moved;
+    show({ scene: { size: plan.size, items: meshItems(plan, corners).items }, sketched: true });
   }
 
   function mouse(event) {
@@ -214,12 +237,16 @@ function render({ model, el }) {
     if (canvas.height !== height) canvas.height = height;
     drawScene(canvas, scene.items || [], model.get("overlays") || {});
     if (picture.ahead) stage.dataset.labkitDrawnAhead = String(Number(stage.dataset.labkitDrawnAhead || 0) + 1);
-    sceneShown(stage);
+    if (picture.sketched) stage.dataset.labkitSketched = String(Number(stage.dataset.labkitSketched || 0) + 1);
+    if (!picture.quiet) sceneShown(stage); // the kernel's picture of a sketch shown is the same picture: not new
   }
   function show(picture) { // the text at once, as the message comes; the picture in the next frame
-    next = picture;
-    showReadout(picture);
-    if (dragging === null) live.textContent = picture.status;
+    // a picture not painted yet that was new to the page makes the one that replaces it new too
+    next = picture.quiet && next && !next.quiet ? { ...picture, quiet: false } : picture;
+    if (picture.readout !== undefined) {
+      showReadout(picture);
+      if (dragging === null) live.textContent = picture.status;
+    }
     schedule();
   }
   // a picture drawn ahead shows the corners of the last drag drawn: none is shown while a drag is on its way
@@ -227,8 +254,22 @@ function render({ model, el }) {
     dragging === null && !waiting && queued === null ? { shape: model.get("ack") } : null);
   function fromKernel() {
     const scene = model.get("scene") || {};
+    if (scene.corners && dragging === null && !waiting && queued === null) corners = scene.corners.map((c) => c.slice());
     const fields = Object.fromEntries(["readout", "worst", "alt", "status"].map((name) => [name, model.get(name)]));
-    ahead.fromKernel({ scene, ...fields, values: scene.values, background: scene.background });
+    const picture = { scene, ...fields, values: scene.values, background: scene.background };
+    const drag = scene.values ? scene.values.shape : undefined, at = sentMoved.get(drag);
+    if (sketched && at !== undefined) {
+      for (const k of [...sentMoved.keys()]) if (k <= drag) sentMoved.delete(k);
+      if (at < sketched) return; // older than the mesh sketched on the page: the answer to a newer move comes
+      const same = at === sketched;
+      sketched = 0;
+      if (same) { // the kernel's picture of the sketch on the page
+        ahead.note(picture);
+        show({ ...picture, quiet: true });
+        return;
+      }
+    }
+    ahead.fromKernel(picture);
   }
   function schedule() {
     if (painting) return;

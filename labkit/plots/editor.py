@@ -157,7 +157,7 @@ def _editor_class():
     class PatchEditor(anywidget.AnyWidget):
         """The editor's widget: picture, handles and readout synced with editor.js."""
 
-        _esm = esm("editor.js")
+        _esm = esm("mesh.js", "editor.js")
         background = traitlets.Bytes(b"").tag(sync=True)  # PNG of what does not change with a move
         scene = traitlets.Dict({}).tag(sync=True)  # the mesh and title, drawn over it (scene.py)
         overlays = traitlets.Dict({}).tag(sync=True)  # the pixels the scene's overlay items name (sent on change)
@@ -177,6 +177,9 @@ def _editor_class():
         # browser reads the sliders' values that key them: {name: [model id, "value"]}
         ahead = traitlets.List([]).tag(sync=True)
         controls = traitlets.Dict({}).tag(sync=True)
+        # what the page needs to draw a dragged handle's mesh itself (mesh.js), changed with the mesh size,
+        # the twist or the background only: see Editor._sketch
+        sketch = traitlets.Dict({}).tag(sync=True)
 
     return PatchEditor
 
@@ -304,15 +307,64 @@ class Editor:
             "status": status_text(corners, self.widget_.selected, quality),
         }
 
-    def _scene(self, seq, items, values):
+    def _scene(self, seq, items, values, corners=None):
         width, height = self.figure.canvas.get_width_height()
-        return {
+        scene = {
             "seq": seq,
             "size": [width, height],
             "ratio": self.ratio,
             "items": items,
             "values": values,
             "background": self.scene.backgrounds,
+        }
+        if corners is not None:  # the corner data it shows, at full precision: where the page's sketch starts
+            scene["corners"] = [[*c.point[:2], *c.ds[:2], *c.dt[:2], *c.dsdt[:2]] for c in corners]
+        return scene
+
+    def _sketch(self, items):
+        """What ``mesh.js`` needs to draw the mesh of a drag not yet answered, as this kernel would draw it:
+        the Hermite basis at the mesh's parameter values, the axes' transform to the picture's device pixels,
+        the colour map as bytes, and the scene items of the mesh, the title and the folded elements without
+        their data (:meth:`labkit.plots.figures.PatchView.dynamic`'s order). Empty (no sketch: every drag
+        waits for the kernel) when the scene is not of that shape."""
+        from ..piecewise import hermite_basis
+        from .figures import TITLE
+
+        view = self.view
+        kinds = [item["kind"] for item in items]
+        if kinds != ["polygons", "text", "polygons"] or view.s is None or not view.color_by_quality:
+            return {}
+        # the items without what the page computes: the elements' vertices and colours, the title's text, the
+        # folded elements' vertices (their faces are none whatever they are)
+        cells, title, folded = (
+            {k: v for k, v in item.items() if k not in data}
+            for item, data in zip(items, (("xy", "counts", "faces", "face_count"), ("text",), ("xy", "counts")))
+        )
+        cmap, norm = view.cells.get_cmap(), view.cells.norm
+        colors = np.vstack((cmap(np.arange(cmap.N)), cmap.get_under(), cmap.get_over()))
+        matrix = self.ax.transData.get_affine().get_matrix()
+        return {
+            "background": self.scene.backgrounds,
+            "values": {"elements": self.elements.value, "twist": self.twist.value},
+            "size": list(self.figure.canvas.get_width_height()),
+            "in_s": np.asarray(hermite_basis(0.0, 1.0, view.s), dtype="<f8").tobytes(),
+            "in_t": np.asarray(hermite_basis(0.0, 1.0, view.t), dtype="<f8").tobytes(),
+            "arrow": ARROW,
+            "matrix": [float(v) for v in matrix[:2].ravel()],  # display = [[a, c, e], [b, d, f]] @ [x, y, 1]
+            "height": float(self.figure.bbox.height),
+            "colors": np.round(255 * colors).astype(np.uint8).tobytes(),  # N colours, then under and over
+            "n_colors": int(cmap.N),
+            "vmin": float(norm.vmin),
+            "vmax": float(norm.vmax),
+            # the title with its worst quality left for the page to write (with two decimals, as Python does)
+            "title": {
+                **title,
+                "text": TITLE.replace("{worst:.2f}", "{worst}").format(
+                    ns=len(view.s) - 1, nt=len(view.t) - 1, worst="{worst}"
+                ),
+            },
+            "cells": cells,
+            "folded": folded,
         }
 
     def _send(self, seq):
@@ -329,7 +381,8 @@ class Editor:
             if background is not None:
                 self.widget_.background = background
             self.widget_.overlays = self.scene.overlays
-            self.widget_.scene = self._scene(seq, items, self._values())
+            self.widget_.sketch = self._sketch(items)
+            self.widget_.scene = self._scene(seq, items, self._values(), self.corners)
         self.redraws += 1
 
     def _send_ahead(self, change):

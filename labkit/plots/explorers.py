@@ -150,10 +150,11 @@ def live_ratio(value):
     return float(min(MAX_PIXEL_RATIO, max(1.0, np.ceil(4 * ratio - 1e-9) / 4)))
 
 
-def esm(name):
-    """The anywidget module `name` (image.js, editor.js) with scene.js, which draws the scenes, before it."""
+def esm(*names):
+    """The anywidget module of the files `names` (the last is the module: image.js, editor.js; before it, what
+    it uses besides scene.js) with scene.js, which draws the scenes, first."""
     folder = pathlib.Path(__file__).parent
-    return (folder / "scene.js").read_text() + "\n" + (folder / name).read_text()
+    return "\n".join((folder / name).read_text() for name in ("scene.js", *names))
 
 
 @functools.cache

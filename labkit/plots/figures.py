@@ -333,6 +333,9 @@ class BilinearErrorView(View):
         return self.ax.get_xlim(), self.ax.get_ylim()
 
 
+TITLE = "{ns} x {nt} elements, worst quality {worst:.2f}"  # a patch view's title (the editor's page writes it too)
+
+
 class PatchView(View):
     """A Coons patch's mesh, filled by element quality (folded elements hatched), with the worst in the title."""
 
@@ -342,6 +345,7 @@ class PatchView(View):
         self.cells = None
         self.folded = None  # the hatched outlines of the folded elements, when coloured by quality
         self.mesh = None
+        self.s = self.t = None  # the parameter values of the mesh's lines
         self._fitted = False  # have the axes been fitted to a mesh yet?
 
     def update(self, corners, ns=11, nt=11, s=None, t=None, title=None):
@@ -350,7 +354,8 @@ class PatchView(View):
         self.mesh = quad_mesh(*patch(*corners, s, t))
         quality = self.mesh.quality()
         worst = quality.min()
-        title = title or f"{len(s) - 1} x {len(t) - 1} elements, worst quality {worst:.2f}"
+        self.s, self.t = s, t
+        title = title or TITLE.format(ns=len(s) - 1, nt=len(t) - 1, worst=worst)
         if self.cells is None:
             self.mesh.plot(ax=self.ax, color_by_quality=self.color_by_quality, title=title, colorbar=self.colorbar)
             drawn = {c.get_gid(): c for c in self.ax.collections}

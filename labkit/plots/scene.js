@@ -213,15 +213,17 @@ const AHEAD_KEPT = 12; // pictures drawn ahead kept, newest first
 function sceneAhead(model, node, show, extra) {
   const controls = {};
   let kept = [], latest = null, alive = true;
-  function valuesNow() {
-    const more = extra();
-    if (!more) return null;
+  function controlsNow() { // null while a control's model is still on its way (or the front end gives none)
     const values = {};
     for (const name of Object.keys(model.get("controls") || {})) {
-      if (!controls[name]) return null; // a control's model is still on its way
+      if (!controls[name]) return null;
       values[name] = controls[name].model.get(controls[name].attribute);
     }
-    return { ...values, ...more };
+    return values;
+  }
+  function valuesNow() {
+    const more = extra(), values = more && controlsNow();
+    return values ? { ...values, ...more } : null;
   }
   function offer(picture) {
     latest = picture;
@@ -270,6 +272,8 @@ function sceneAhead(model, node, show, extra) {
   return {
     fromKernel,
     fromAhead,
+    controlsNow,
+    note(picture) { latest = picture; }, // a picture shown without offer(): the one on the page now
     dispose() {
       alive = false;
       for (const c of Object.values(controls)) c.model.off(`change:${c.attribute}`, fromAhead);

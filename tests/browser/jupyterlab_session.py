@@ -254,6 +254,7 @@ PICTURE_STATE_NTH = f"""e => {{
   return {{shown: counter ? Number(counter.dataset.labkitShown) : null,
            at: counter && counter.dataset.labkitShownAt ? Number(counter.dataset.labkitShownAt) : null,
            ahead: counter ? Number(counter.dataset.labkitDrawnAhead || 0) : 0,
+           sketched: counter ? Number(counter.dataset.labkitSketched || 0) : 0,
            src: img ? img.src : null}};
 }}"""
 
@@ -337,9 +338,16 @@ def move_every_slider(page, panel, name):
     return timings
 
 
+KEEP_SHOWN = """c => { window.__labkitShownPixels = null; new MutationObserver(() => {
+  window.__labkitShownPixels = c.toDataURL(); }).observe(c.parentElement, {attributeFilter: ["data-labkit-shown"]}); }"""
+KERNEL_IDLE = "() => window.jupyterapp.shell.currentWidget.sessionContext.session.kernel.status === 'idle'"
+
+
 def drag_a_corner(page, panel):
-    """Drag corner B of the patch editor in steps and let go; (seconds from each step to its picture shown,
-    readout before, readout after)."""
+    """Drag corner B of the patch editor in steps and let go. A dict: "steps" (seconds from each step to its
+    picture shown), "sketched" (how many steps the page drew itself, editor.js's sketch), the readout "before"
+    and "after", and the editor's canvas (a PNG data URL) as the page drew the last step ("last_step") and once
+    the kernel has answered every move ("settled")."""
     editor = panel.locator(".labkit-patch-editor").first
     e = page.evaluate(
         "() => [...window.jupyterapp.shell.currentWidget.node"
@@ -348,24 +356,37 @@ def drag_a_corner(page, panel):
     )
     corner = editor.locator("circle[data-handle='1']")
     corner.scroll_into_view_if_needed()
-    readout = editor.locator(".labkit-editor-readout")
+    readout, canvas = editor.locator(".labkit-editor-readout"), editor.locator("canvas")
     before_readout = readout.inner_text()
     box = corner.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.evaluate(NOTE_INPUT)
     page.mouse.move(x, y)
     page.mouse.down()
-    steps = []
+    steps, sketched = [], 0
     for k in range(1, MOVES + 1):
+        if k == MOVES:  # the canvas as the last step's picture is shown (a picture that is not new is not noted)
+            canvas.evaluate(KEEP_SHOWN)
         old, frames_before = _picture_state_nth(page, e), frames(page)
         start = time.perf_counter()
         page.mouse.move(x + 6 * k, y + 3 * k)
         steps.append(_wait_until_shown(page, e, old, frames_before, start))
+        sketched += _picture_state_nth(page, e)["sketched"] > old["sketched"]
+    last_step = page.evaluate("() => window.__labkitShownPixels")
     page.mouse.up()
     page.wait_for_function(
         "([node, old]) => node.innerText !== old", arg=[readout.element_handle(), before_readout], timeout=10_000
     )
-    return steps, before_readout, readout.inner_text()
+    page.wait_for_function(KERNEL_IDLE, timeout=10_000)
+    page.wait_for_timeout(200)  # the kernel's last picture painted
+    return {
+        "steps": steps,
+        "sketched": sketched,
+        "before": before_readout,
+        "after": readout.inner_text(),
+        "last_step": last_step,
+        "settled": canvas.evaluate("c => c.toDataURL()"),
+    }
 
 
 def percentile(values, fraction):

@@ -21,6 +21,8 @@ from urllib.parse import urlparse
 import pytest
 from jupyterlab_session import (  # the lab and browser fixtures are in tests/conftest.py
     COUNT_IMAGE_FRAMES,
+    DRAWN_AHEAD,
+    MOVES,
     NOTEBOOKS,
     close_sessions,
     drag_a_corner,
@@ -149,7 +151,7 @@ STATIC_PICTURES = """() => window.jupyterapp.shell.currentWidget.content.model.s
   .map(o => o.data['image/png'])"""
 
 
-def _pixels(data_url_or_base64):
+def _pixels(data_url_or_base64, mode="RGB"):
     import base64
     import io
 
@@ -157,7 +159,7 @@ def _pixels(data_url_or_base64):
     from PIL import Image
 
     data = data_url_or_base64.split(",", 1)[-1]
-    return np.asarray(Image.open(io.BytesIO(base64.b64decode(data))).convert("RGB")).astype(float)
+    return np.asarray(Image.open(io.BytesIO(base64.b64decode(data))).convert(mode)).astype(float)
 
 
 def _unmatched(drawn, expected, reach=2, tolerance=96):
@@ -231,11 +233,17 @@ def test_student_runs_the_notebook_and_moves_a_slider(lab, browser, notebook):
     moved = [picture["alt"] for picture in _explorer_pictures(page, panel)]
     assert all(after != before for before, after in zip(alts, moved)), (alts, moved)  # the alt text follows
     if stem == "03_meshes":
-        steps, before, after = drag_a_corner(page, panel)
-        assert steps, "the mesh picture did not change while the corner was being dragged"
+        drag = drag_a_corner(page, panel)
+        before, after = drag["before"], drag["after"]
+        assert drag["steps"], "the mesh picture did not change while the corner was being dragged"
         assert after != before and after.splitlines()[2] != before.splitlines()[2], "corner B's readout did not change"
+        # every step drawn in the page at once, and what it drew is the kernel's picture of the same corners
+        assert drag["sketched"] == len(drag["steps"]) == MOVES, drag["sketched"]
+        sketch, kernel = _pixels(drag["last_step"], "RGBA"), _pixels(drag["settled"], "RGBA")  # the canvas alone
+        assert sketch.shape == kernel.shape and (abs(sketch - kernel).max(axis=2) > 8).sum() <= 10
         _nudge_with_keys(page, panel, after)
-        timings[f"{stem} editor drag step"] = steps
+        timings[f"{stem} editor drag step"] = drag["steps"]
+        DRAWN_AHEAD[f"{stem} editor drag step"] = drag["sketched"]
     if stem == "05_monotone":
         _held_key_ends_on_the_latest_value(page, panel)
     explorer = panel.locator(".labkit-explorer").first
