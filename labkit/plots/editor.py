@@ -318,7 +318,7 @@ class Editor:
             "background": self.scene.backgrounds,
         }
         if corners is not None:  # the corner data it shows, at full precision: where the page's sketch starts
-            scene["corners"] = [[*c.point[:2], *c.ds[:2], *c.dt[:2], *c.dsdt[:2]] for c in corners]
+            scene["corners"] = [[float(v) for v in (*c.point[:2], *c.ds[:2], *c.dt[:2], *c.dsdt[:2])] for c in corners]
         return scene
 
     def _sketch(self, items):
@@ -403,7 +403,7 @@ class Editor:
                     lambda corners=corners, n=elements: self._fields(corners, self.view.mesh.quality(), n),
                 )
                 if entry is not None:
-                    entry["scene"] = self._scene(self.seq, entry.pop("items"), entry["values"])
+                    entry["scene"] = self._scene(self.seq, entry.pop("items"), entry["values"], corners)
                     entries.append(entry)
             if entries:
                 self.widget_.ahead = entries

@@ -188,7 +188,8 @@ def explorer_image():
 
 
 AHEAD = ((1,), (2, -1))  # after a slider's move, the pictures drawn ahead, in its steps along its last move: the
-# next first, sent alone, then the one after and the one back; each is drawn over the background already sent
+# next first, sent alone, then the one after and the one back; each is drawn over the background already sent, but
+# the next one's may be a new background (the axes fit again), rendered then and sent with it
 
 
 def _browser_attribute(control):
@@ -224,20 +225,24 @@ def next_moves(change):
     return batches
 
 
-def ahead_entry(scene, draw, values, dpi, fields):
+def ahead_entry(scene, draw, values, dpi, fields, render=False):
     """A picture drawn ahead: the `scene`'s items once `draw()` has updated the figure to a move not made yet,
-    keyed by the controls' `values` there (as the browser holds them), with the widget's other `fields` (a
-    callable), or None if it does not lie on the background sent. The figure's axes are then put back as they
-    were before `draw`, so the figure's next update decides its limits as it would have."""
+    keyed by the controls' `values` there (as the browser holds them) and by the background it was drawn from
+    (``base``: the one the page must show for it to be that move's picture), with the widget's other `fields`
+    (a callable). It lies on the background sent (``background`` is ``base``) or, where that does not fit and
+    `render` is true, on a new one sent with it (``picture``, ``overlays``: :meth:`Scene.ahead`); else None.
+    The figure's axes are then put back as they were before `draw`, so its next update decides its limits as
+    it would have."""
     limits = [(ax, ax.get_xlim(), ax.get_ylim()) for ax in scene.figure.axes]
-    draw()
-    items = scene.ahead(dpi)
-    if items is None:
+    base = scene.backgrounds
+    try:
+        draw()
+        picture = scene.ahead(dpi, render)
+        return None if picture is None else {"values": values, "base": base, **picture, **fields()}
+    finally:
         for ax, xlim, ylim in limits:
             ax.set_xlim(xlim)
             ax.set_ylim(ylim)
-        return None
-    return {"values": values, "background": scene.backgrounds, "items": items, **fields()}
 
 
 class Explorer:
@@ -307,7 +312,7 @@ class Explorer:
         if change is not None:
             self._send_ahead(change)
 
-    def _scene(self, seq, items, values):
+    def _scene(self, seq, items, values, background=None):
         width, height = self.figure.canvas.get_width_height()
         return {
             "seq": seq,
@@ -316,7 +321,7 @@ class Explorer:
             "items": items,
             # the controls' values it shows, as the browser holds them: the browser tells it from one drawn ahead
             "values": self.browser_values(values),
-            "background": self.scene.backgrounds,  # which background it lies on
+            "background": self.scene.backgrounds if background is None else background,  # which it lies on
         }
 
     def _send(self, seq):
@@ -336,7 +341,7 @@ class Explorer:
         """Send the pictures of the moved slider's next moves (``AHEAD``) that lie on the background sent."""
         name = next((name for name, c in self.controls.items() if c is change.get("owner")), None)
         values, batches = self.values(), next_moves(change) if name is not None else []
-        for batch in batches:
+        for first, batch in zip((True, False, False), batches):
             entries = []
             for value in batch:
                 moved = {**values, name: value}
@@ -346,9 +351,10 @@ class Explorer:
                     self.browser_values(moved),
                     DPI * self.ratio,
                     lambda: {"description": figure_alt(self.figure)},
+                    render=first,  # the next move only: it may bring a new background, rendered now
                 )
                 if entry is not None:
-                    entry["scene"] = self._scene(self.seq, entry.pop("items"), moved)
+                    entry["scene"] = self._scene(self.seq, entry.pop("items"), moved, entry["background"])
                     entries.append(entry)
             if entries:
                 self.image.ahead = entries

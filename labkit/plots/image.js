@@ -28,9 +28,11 @@ function render({ model, el }) {
 
   function showBackground() {
     const bytes = sceneBytes(model.get("background"));
-    if (!bytes.length) return;
+    if (bytes.length) showPicture(URL.createObjectURL(new Blob([bytes], { type: "image/png" })));
+  }
+  function showPicture(src) {
     const old = url;
-    url = URL.createObjectURL(new Blob([bytes], { type: "image/png" }));
+    url = src;
     img.src = url;
     ready = img.decode().catch(() => {}); // the scene waits for its background, so both show in one frame
     if (old) ready.then(() => URL.revokeObjectURL(old));
@@ -44,7 +46,7 @@ function render({ model, el }) {
     const [width, height] = scene.size || [0, 0];
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
-    drawScene(canvas, scene.items || [], model.get("overlays") || {});
+    drawScene(canvas, scene.items || [], picture.overlays || model.get("overlays") || {}, picture.bitmap);
     // for the tests: how many pictures were drawn ahead, and how many are kept (data-labkit-kept)
     if (picture.ahead) box.dataset.labkitDrawnAhead = String(Number(box.dataset.labkitDrawnAhead || 0) + 1);
     sceneShown(box);
@@ -53,6 +55,8 @@ function render({ model, el }) {
     next = picture;
     img.alt = picture.description;
     schedule();
+    // drawn ahead on a background of its own: painted with it on the canvas, and the <img> takes it for what follows
+    if (picture.bitmap) showPicture(URL.createObjectURL(picture.blob));
   }
   const ahead = sceneAhead(model, box, show, () => ({}));
   function fromKernel() {

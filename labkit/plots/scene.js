@@ -169,12 +169,13 @@ function sceneShown(node) {
   };
   channel.port2.postMessage(null);
 }
-// draw `items` on `canvas` (already the size of the picture in device pixels), cleared first; `overlays` holds
-// the pixels the overlay items name
-function drawScene(canvas, items, overlays) {
+// draw `items` on `canvas` (already the size of the picture in device pixels), cleared first, over `under` (a
+// background decoded ahead, an ImageBitmap) if given; `overlays` holds the pixels the overlay items name
+function drawScene(canvas, items, overlays, under) {
   const ctx = canvas.getContext("2d");
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.clearRect(0, 0, canvas.width, canvas.height);
+  if (under) ctx.drawImage(under, 0, 0);
   for (const item of items) if (item.kind === "patch") scenePatch(ctx, item); // opaque boxes: under the data
   for (const item of items) {
     if (item.kind === "patch") continue;
@@ -203,12 +204,14 @@ function sameValues(a, b) {
   return true;
 }
 // Pictures drawn ahead (labkit.plots.explorers.AHEAD) for one widget (image.js, editor.js). After a slider's move
-// the kernel also sends the pictures of its next moves (`ahead`: each with the values it shows and the background
-// it lies on). This keeps the newest of them and watches the controls' models (`controls`: name -> [model id,
-// the attribute holding the value]); when the controls reach a kept picture's values it is shown at once, without
-// waiting for the kernel. A scene from the kernel is shown unless it is the one on the page already (drawn
-// ahead) or older than it. `show(picture)` paints a picture in the next frame; `extra()` gives what else keys a
-// picture (the editor's last drag drawn), or null while the values are in flux; `node` gets data-labkit-kept.
+// the kernel also sends the pictures of its next moves (`ahead`: each with the values it shows, the background it
+// was drawn from, `base`, and the one it lies on; the next move's may lie on a new one, `picture`, decoded here as
+// it comes). This keeps the newest of them and watches the controls' models (`controls`: name -> [model id, the
+// attribute holding the value]); when the controls reach a kept picture's values, and the page shows its base, it
+// is shown at once, without waiting for the kernel. A scene from the kernel is shown unless it is the one on the
+// page already (drawn ahead) or older than it. `show(picture)` paints a picture in the next frame; `extra()` gives
+// what else keys a picture (the editor's last drag drawn), or null while the values are in flux; `node` gets
+// data-labkit-kept.
 const AHEAD_KEPT = 12; // pictures drawn ahead kept, newest first
 function sceneAhead(model, node, show, extra) {
   const controls = {};
@@ -240,13 +243,20 @@ function sceneAhead(model, node, show, extra) {
   function fromAhead() {
     const now = valuesNow();
     if (!alive || !now || (latest && sameValues(latest.values, now))) return;
-    const background = (model.get("scene") || {}).background;
-    const entry = kept.find((e) => e.background === background && sameValues(e.values, now));
+    // a picture drawn from the background on the page (a new background of its own decoded first)
+    const shown = latest ? latest.background : (model.get("scene") || {}).background;
+    const entry = kept.find((e) => e.base === shown && sameValues(e.values, now) && (!e.picture || e.bitmap));
     if (entry) offer({ ...entry, ahead: true });
   }
   function keep() {
-    for (const entry of model.get("ahead") || [])
+    for (const entry of model.get("ahead") || []) {
       kept = [entry, ...kept.filter((e) => !sameValues(e.values, entry.values))].slice(0, AHEAD_KEPT);
+      if (!entry.picture) continue;
+      entry.blob = new Blob([sceneBytes(entry.picture)], { type: "image/png" });
+      createImageBitmap(entry.blob)
+        .then((bitmap) => { entry.bitmap = bitmap; fromAhead(); })
+        .catch(() => {}); // not decoded: that move waits for the kernel
+    }
     node.dataset.labkitKept = String(kept.length);
     fromAhead();
   }

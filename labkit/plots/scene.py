@@ -33,6 +33,7 @@ import zlib
 import numpy as np
 
 CAPS = {"butt": "butt", "round": "round", "projecting": "square"}
+AHEAD_KEPT = 3  # backgrounds rendered ahead of a move and kept for it
 
 
 def _rgba(color, alpha=None):
@@ -101,9 +102,11 @@ class Scene:
         self.figure, self.view = figure, view
         self.key = None
         self.background = None  # Agg's saved copy of the background, for the patches
-        self.backgrounds = 0  # how many backgrounds were rendered (a new one only when the static part changed)
+        self.backgrounds = 0  # the number of the background the scene lies on (a new one when the static part changed)
+        self.rendered = 0  # how many backgrounds were rendered, for the figure or ahead of a move
         self.overlays: dict = {}  # an overlay's id -> {"rgba", "box"}: the pixels its scene items name
         self._made: dict = {}  # an overlay's id -> the background's key it was rendered under
+        self._ahead: dict = {}  # key -> a background rendered ahead of a move (:meth:`ahead`), newest last
 
     def _device(self, xy):
         """Display coordinates (origin bottom left) -> the picture's device pixels (origin top left)."""
@@ -120,19 +123,21 @@ class Scene:
 
     def frame(self, ratio, dpi):
         """(background PNG or None if unchanged, items) of the figure drawn at `dpi` (`ratio` device px per CSS px)."""
-        figure, canvas = self.figure, self.figure.canvas
+        figure = self.figure
         if figure.dpi != dpi:
             figure.set_dpi(dpi)
         dynamic = list(getattr(self.view, "live_dynamic", self.view.dynamic)())
         key = (self.view.static_key(), figure.dpi)
         background = None
         if not dynamic or key != self.key or self.background is None:  # nothing named: everything is new
-            with animated(dynamic):
-                canvas.draw()  # everything but the changing artists
-            self.background, self.key = canvas.copy_from_bbox(figure.bbox), key
-            width, height = canvas.get_width_height()
-            background = encode_png(np.asarray(canvas.buffer_rgba()).reshape(height, width, 4))
-            self.backgrounds += 1
+            kept = self._ahead.pop(key, None) if dynamic else None
+            if kept is not None:  # rendered ahead of this move, and sent with its picture: the same pixels
+                background = kept["png"]
+                self.background, self.key, self.backgrounds = kept["region"], key, kept["number"]
+                self.overlays, self._made = kept["overlays"], kept["made"]
+            else:
+                background = self._render(dynamic)
+                self.key, self.backgrounds = key, self.rendered
         items = self._all_items(dynamic)
         named = {item["id"] for item in items if item["kind"] == "overlay"}
         if set(self.overlays) - named:  # an overlay no item names any more (a legend replaced): gone
@@ -140,21 +145,55 @@ class Scene:
             self._made = {name: key for name, key in self._made.items() if name in named}
         return background, items
 
-    def ahead(self, dpi):
-        """The items of the figure as it is now, to draw over the background last sent, or None where that
-        background does not fit it (the static part changed, the dpi is another, or an overlay would be new):
-        a picture the browser can show at once for a move not made yet. Changes nothing :meth:`frame` keeps."""
+    def _render(self, dynamic):
+        """Draw everything but the `dynamic` artists, keep Agg's copy of it, and return it as a PNG."""
+        figure, canvas = self.figure, self.figure.canvas
+        with animated(dynamic):
+            canvas.draw()  # everything but the changing artists
+        self.background = canvas.copy_from_bbox(figure.bbox)
+        self.rendered += 1
+        width, height = canvas.get_width_height()
+        return encode_png(np.asarray(canvas.buffer_rgba()).reshape(height, width, 4))
+
+    def ahead(self, dpi, render=False):
+        """A picture the browser can show at once for a move not made yet: the items of the figure as it is now,
+        to draw over the background last sent; or, where that background does not fit it (the static part
+        changed, or an overlay would be new) and `render` is true, over a new background rendered now, with the
+        overlays its items name. ``{"items", "background"}`` (the number of the background they lie on) and,
+        for a new one, ``"picture"`` (its PNG) and ``"overlays"``; None where nothing fits or the dpi is another.
+
+        A background rendered here is kept: when the move is made, :meth:`frame` sends that one (the same pixels)
+        rather than draw it again. Nothing else :meth:`frame` keeps is changed."""
         dynamic = list(getattr(self.view, "live_dynamic", self.view.dynamic)())
         if not dynamic or self.background is None or self.figure.dpi != dpi:
             return None
-        if (self.view.static_key(), dpi) != self.key:
+        kept = (self.background, self.key, self.backgrounds, self.overlays, self._made)
+        key = (self.view.static_key(), dpi)
+        if key == self.key:
+            self._made = dict(self._made)
+            items = self._all_items(dynamic)
+            new_overlays = self.overlays is not kept[3]
+            self.background, self.key, self.backgrounds, self.overlays, self._made = kept
+            return None if new_overlays else {"items": items, "background": self.backgrounds}
+        if not render:
             return None
-        overlays, made = self.overlays, dict(self._made)
-        items = self._all_items(dynamic)
-        if self.overlays is not overlays:  # pixels the browser has not got: no picture ahead
-            self.overlays, self._made = overlays, made
-            return None
-        return items
+        try:
+            picture = self._render(dynamic)
+            self.key, self.backgrounds, self._made = key, self.rendered, dict(self._made)
+            items = self._all_items(dynamic)
+            self._ahead.pop(key, None)
+            self._ahead[key] = {
+                "region": self.background,
+                "png": picture,
+                "number": self.backgrounds,
+                "overlays": self.overlays,
+                "made": self._made,
+            }
+            while len(self._ahead) > AHEAD_KEPT:
+                self._ahead.pop(next(iter(self._ahead)))
+            return {"items": items, "background": self.backgrounds, "picture": picture, "overlays": self.overlays}
+        finally:
+            self.background, self.key, self.backgrounds, self.overlays, self._made = kept
 
     def _all_items(self, dynamic):
         renderer = self.figure.canvas.get_renderer()

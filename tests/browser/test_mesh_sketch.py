@@ -14,7 +14,7 @@ pytest.importorskip("playwright.sync_api", reason="playwright is not installed (
 pytest.importorskip("anywidget", reason="anywidget is not installed")
 skip_without_chromium()
 
-from labkit.plots.editor import FIRST_PATCH, Editor, handle_positions, with_twist  # noqa: E402
+from labkit.plots.editor import FIRST_PATCH, Editor, handle_positions, with_twist
 
 PLOTS = Path(__file__).resolve().parents[2] / "labkit" / "plots"
 # bytes cross to the page as {"b64": ...} and become Uint8Arrays there, as a widget's buffers do
@@ -108,9 +108,7 @@ def test_a_drag_of_several_steps_ends_where_the_kernel_does(page):
 
 
 def test_python_ties_and_signed_zero_in_the_title(page):
-    written = page.evaluate(
-        "() => [0.125, -0.125, 0.375, 0.625, -0.875, 0.955, -0.001, -0, 1, 0.5].map(meshFixed2)"
-    )
+    written = page.evaluate("() => [0.125, -0.125, 0.375, 0.625, -0.875, 0.955, -0.001, -0, 1, 0.5].map(meshFixed2)")
     assert written == [f"{v:.2f}" for v in (0.125, -0.125, 0.375, 0.625, -0.875, 0.955, -0.001, -0.0, 1.0, 0.5)]
 
 

@@ -11,7 +11,8 @@ from jupyterlab_session import skip_without_chromium
 pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 skip_without_chromium()
 
-SCENE_JS = (Path(__file__).resolve().parents[2] / "labkit" / "plots" / "scene.js").read_text()
+SCENE_JS_PATH = Path(__file__).resolve().parents[2] / "labkit" / "plots" / "scene.js"
+SCENE_JS = SCENE_JS_PATH.read_text()
 
 # a model as anywidget hands it over (get, set, on, off, widget_manager.get_model), and one control model
 STAND_INS = """
@@ -38,7 +39,8 @@ window.setUp = (extra) => {
     model.set("scene", scene);
     ahead.fromKernel({ scene, values, background, name });
   };
-  const picture = (name, values, background) => ({ name, values, background, scene: { values, background } });
+  const picture = (name, values, background, base = background) =>
+    ({ name, values, background, base, scene: { values, background } });
   window.t = { n, model, shown, node, ahead, kernel, picture, settle: (s) => { settled = s; } };
 };
 """
@@ -153,3 +155,107 @@ def test_after_dispose_the_controls_are_not_watched(page):
         t.n.set("value", 2)""",
     )
     assert shown == ["k1"]
+
+
+# a 1 x 1 PNG, as a new background drawn ahead carries its own
+PNG = "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4z8AAAAMBAQDJ/pLvAAAAAElFTkSuQmCC"
+ON_ITS_OWN = f"""const png = Uint8Array.from(atob("{PNG}"), (c) => c.charCodeAt(0));
+const own = (name, values, background, base) => ({{ ...t.picture(name, values, background, base), picture: png }});
+const decoded = () => new Promise((r) => setTimeout(r, 50));"""
+
+
+def test_a_picture_on_a_background_of_its_own_is_shown_once_decoded_and_only_from_its_base(page):
+    shown = run(
+        page,
+        ON_ITS_OWN
+        + """t.kernel("k1", {n: 1}, 0);
+        t.model.set("ahead", [own("a2", {n: 2}, 5, 0)]);  // the axes fit again at n = 2: background 5, sent with it
+        await decoded();
+        t.n.set("value", 2);
+        t.kernel("k2", {n: 2}, 5);  // the kernel's own, on that background: on the page already
+        t.model.set("ahead", [t.picture("a3", {n: 3}, 5)]);  // drawn from background 5
+        t.n.set("value", 3)""",
+    )
+    assert shown == ["k1", "a2", "a3"]
+    shown = run(
+        page,
+        ON_ITS_OWN
+        + """t.kernel("k1", {n: 1}, 0);
+        t.model.set("ahead", [own("a2", {n: 2}, 5, 0)]);
+        t.n.set("value", 2);  // not decoded yet: nothing shown at once ...
+        t.kernel("k2", {n: 2}, 5);  // ... and the kernel's picture, come first, is shown
+        await decoded()""",
+    )
+    assert shown == ["k1", "k2"]
+    shown = run(
+        page,
+        ON_ITS_OWN
+        + """t.kernel("k1", {n: 1}, 0);
+        t.model.set("ahead", [own("a2", {n: 2}, 5, 0)]);
+        t.n.set("value", 2);
+        await decoded();  // decoded before the kernel answers: shown then
+        t.kernel("k2", {n: 2}, 5)""",
+    )
+    assert shown == ["k1", "a2"]
+    shown = run(
+        page,
+        ON_ITS_OWN
+        + """t.kernel("k1", {n: 1}, 0);
+        t.model.set("ahead", [own("a3", {n: 3}, 5, 0)]);  // drawn from background 0 ...
+        await decoded();
+        t.kernel("k2", {n: 2}, 4);  // ... but the page shows background 4 now: its limits may be others
+        t.n.set("value", 3);
+        t.kernel("k3", {n: 3}, 4)""",
+    )
+    assert shown == ["k1", "k2", "k3"]
+
+
+def _png(rgb):
+    import base64
+
+    import numpy as np
+
+    from labkit.plots.scene import encode_png
+
+    return base64.b64encode(encode_png(np.full((4, 4, 3), rgb, dtype=np.uint8))).decode()
+
+
+def test_image_js_paints_a_picture_on_a_background_of_its_own_over_that_background(browser):
+    """image.js itself: the picture of a move whose axes fit again is drawn ahead over the new background it came
+    with (the canvas covers the old one until the <img> has the new one)."""
+    image_js = SCENE_JS + "\n" + (SCENE_JS_PATH.parent / "image.js").read_text().replace("export default", "//")
+    page = browser.new_page()
+    try:
+        page.set_content("<html><body><div id='out'></div></body></html>")
+        page.add_script_tag(content=image_js + STAND_INS + "window.renderImage = render;")
+        red, blue = _png([255, 0, 0]), _png([0, 0, 255])
+        result = page.evaluate(
+            f"""async () => {{
+            const bytes = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+            const frames = async (k) => {{ for (let i = 0; i < k; i++) await new Promise((r) => requestAnimationFrame(r)); }};
+            setUp({{}});
+            const model = t.model;
+            model.save_changes = () => {{}};
+            Object.assign(model.state, {{ background: bytes("{red}"), css_size: [4, 4], description: "red", overlays: {{}},
+              scene: {{ size: [4, 4], items: [], values: {{ n: 1 }}, background: 1 }} }});
+            const el = document.getElementById("out");
+            renderImage({{ model, el }});
+            await new Promise((r) => setTimeout(r, 50));
+            await frames(3);
+            const canvas = el.querySelector("canvas"), img = el.querySelector("img");
+            const pixel = () => Array.from(canvas.getContext("2d").getImageData(1, 1, 1, 1).data);
+            const before = [pixel(), img.src];
+            model.set("ahead", [{{ values: {{ n: 2 }}, base: 1, background: 2, picture: bytes("{blue}"), overlays: {{}},
+              description: "blue", scene: {{ size: [4, 4], items: [], values: {{ n: 2 }}, background: 2 }} }}]);
+            await new Promise((r) => setTimeout(r, 100));  // decoded
+            t.n.set("value", 2);
+            await frames(3);
+            return {{ before, after: pixel(), changed: img.src !== before[1], alt: img.alt,
+                      ahead: el.querySelector("[data-labkit-drawn-ahead]")?.dataset.labkitDrawnAhead }};
+        }}"""
+        )
+    finally:
+        page.close()
+    assert result["before"][0][3] == 0  # nothing on the canvas over the first background
+    assert result["after"] == [0, 0, 255, 255]  # the new background, on the canvas, under the picture's items
+    assert result["changed"] and result["alt"] == "blue" and result["ahead"] == "1"

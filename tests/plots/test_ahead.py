@@ -52,9 +52,9 @@ def _scene_without_seq(scene):
 
 def _comparable(scene):
     """A scene of one explorer comparable with another's: an overlay is named by its artist's id(), so by its
-    place here."""
+    place here; a background by its pixels (its number counts the backgrounds rendered, ahead of moves too)."""
     items = [{**item, "id": k} if item["kind"] == "overlay" else item for k, item in enumerate(scene["items"])]
-    return {**_scene_without_seq(scene), "items": items}
+    return {**_scene_without_seq(scene), "items": items, "background": None}
 
 
 def _pixels(png):
@@ -80,9 +80,12 @@ def test_a_picture_drawn_ahead_is_the_picture_the_kernel_draws_for_that_move(fac
         assert set(entry["values"]) == set(explorer.controls)
         others = {k: v for k, v in explorer.browser_values(explorer.values()).items() if k != name}
         assert {k: v for k, v in entry["values"].items() if k != name} == others
-        backgrounds = explorer.scene.backgrounds
+        assert entry["base"] == explorer.scene.backgrounds  # drawn from the background on the page
         slider.value = entry["values"][name]  # the move made: the kernel draws it
-        assert explorer.scene.backgrounds == backgrounds == entry["background"]  # on the background sent
+        assert explorer.scene.backgrounds == entry["background"]  # on the background sent, or sent with it
+        if "picture" in entry:
+            assert explorer.image.background == entry["picture"]
+            assert explorer.image.overlays == entry["overlays"]
         assert _scene_without_seq(explorer.image.scene) == _scene_without_seq(entry["scene"])
         assert explorer.image.description == entry["description"]
         slider.value = moved
@@ -106,7 +109,8 @@ def test_drawing_ahead_changes_nothing_the_explorer_draws(factory, name, monkeyp
             seen.append(
                 (
                     _comparable(explorer.image.scene),
-                    explorer.scene.backgrounds,
+                    explorer.image.background,  # its pixels (PNG), sent again only when they change
+                    list(explorer.image.overlays.values()),  # named by id() too
                     explorer.image.description,
                     explorer.description,
                 )
@@ -119,8 +123,10 @@ def test_drawing_ahead_changes_nothing_the_explorer_draws(factory, name, monkeyp
     assert np.array_equal(with_ahead[-1], without[-1])
 
 
-def test_a_move_that_needs_a_new_background_is_not_drawn_ahead(monkeypatch):
-    """The limaçon's axes fit again once a growing r0 leaves them: that move is never drawn ahead."""
+def test_the_next_move_that_needs_a_new_background_is_drawn_ahead_with_it(monkeypatch):
+    """The limaçon's axes fit again once a growing r0 leaves them. The move that does so is drawn ahead, when it is
+    the next one, on a new background sent with it (PNG and legend pixels), which the kernel then sends as its own
+    when the move is made, without rendering it again; the move after it (two steps on) is not drawn ahead."""
     ahead = explorers.AHEAD
     monkeypatch.setattr(explorers, "AHEAD", ())
     probe = plots.limacon_explorer()
@@ -128,22 +134,32 @@ def test_a_move_that_needs_a_new_background_is_not_drawn_ahead(monkeypatch):
     while slider.value + slider.step <= slider.max:
         before = probe.scene.backgrounds
         slider.value = round(slider.value + slider.step, 12)
-        moves.append((slider.value, probe.scene.backgrounds > before))
+        moves.append((slider.value, probe.scene.backgrounds > before, probe.image.background, probe.image.scene))
     # the first refit after a move that kept the axes (1.15 up to 2.0 grows the curve past its axes)
-    refit = next(value for (value, new), (_, refitted) in zip(moves[1:], moves) if new and not refitted)
+    refit, _, picture, scene = next(m for m, last in zip(moves[1:], moves) if m[1] and not last[1])
 
     monkeypatch.setattr(explorers, "AHEAD", ahead)
     explorer = plots.limacon_explorer()
     slider = explorer.controls["r0"]
     sent = Sent(explorer.image)
-    while round(slider.value + slider.step, 12) < refit:
-        sent.values.clear()
+    while round(slider.value + 2 * slider.step, 12) < refit:  # up to two steps before it: the refit is two on
         slider.value = round(slider.value + slider.step, 12)
-    drawn_ahead = [entry["values"]["r0"] for entry in sent.entries()]
-    assert drawn_ahead == pytest.approx([slider.value - slider.step])  # the one back; not the refit, nor past it
-    backgrounds = explorer.scene.backgrounds
+    assert refit not in [pytest.approx(e["values"]["r0"]) for e in sent.entries()]  # not from two steps before
+    sent.values.clear()
+    slider.value = round(slider.value + slider.step, 12)  # the refit is the next move now
+    first = sent.values[0][0]
+    assert first["values"]["r0"] == pytest.approx(refit)
+    assert first["base"] == explorer.scene.backgrounds != first["background"]  # drawn from the page's, on its own
+    assert first["picture"] == picture  # the background the kernel renders for that move, pixel for pixel
+    assert all("picture" not in e and e["base"] == e["background"] for batch in sent.values[1:] for e in batch)
+
+    rendered = explorer.scene.rendered
     slider.value = refit
-    assert explorer.scene.backgrounds == backgrounds + 1  # the kernel draws it, on a new background
+    assert explorer.scene.rendered == rendered  # not rendered again: the one drawn ahead is sent
+    assert explorer.scene.backgrounds == first["background"] and explorer.image.background == picture
+    assert _comparable(explorer.image.scene) == _comparable(scene) == _comparable(first["scene"])
+    assert list(explorer.image.overlays.values()) == list(first["overlays"].values())
+    assert explorer.image.description == first["description"]
 
 
 def test_a_checkbox_or_a_dropdown_draws_nothing_ahead():
