@@ -15,6 +15,9 @@ merged as the explorers' are (see :mod:`labkit.plots.explorers`). After a move o
 either slider the kernel also sends its next moves' pictures, readouts and
 statuses, drawn ahead as the explorers' are; they are keyed by the last drag drawn
 (``ack``) as well, so a picture drawn before a drag is never shown after it.
+A handle's move does not wait for the kernel at all: ``mesh.js`` draws its mesh
+in the page from the editor's ``sketch`` (:meth:`Editor._sketch`), item for item
+the scene the kernel sends for it, which is then drawn over it.
 
 Without a mouse (:data:`KEYS`): Tab reaches the editor and leaves it as it
 leaves any control; ``n`` and ``p`` select the next and the previous handle,

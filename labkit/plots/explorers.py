@@ -27,8 +27,9 @@ a slider's move the kernel also sends the pictures of that slider's next moves
 back), each keyed by the controls' values it shows and the background it lies
 on. ``image.js`` keeps them and shows one in the next frame when the controls
 reach its values; the kernel's own scene of that move, when it comes, is not
-drawn again. Only pictures that lie on the background already sent are drawn
-ahead (a move that fits the axes again waits for the kernel), and drawing them
+drawn again. The next move's picture may lie on a new background (the axes fit
+again): that background is rendered then and sent with it, and sent again as
+the kernel's own when the move is made (:meth:`Scene.ahead`). Drawing ahead
 changes nothing the explorer draws afterwards (the axes are put back, the
 figure updated to the controls again).
 

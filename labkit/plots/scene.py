@@ -33,7 +33,7 @@ import zlib
 import numpy as np
 
 CAPS = {"butt": "butt", "round": "round", "projecting": "square"}
-AHEAD_KEPT = 3  # backgrounds rendered ahead of a move and kept for it
+AHEAD_KEPT = 2  # backgrounds rendered ahead of a move and kept for it (each a few MB of Agg pixels)
 
 
 def _rgba(color, alpha=None):

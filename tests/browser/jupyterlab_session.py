@@ -365,7 +365,7 @@ def drag_a_corner(page, panel):
     page.mouse.down()
     steps, sketched = [], 0
     for k in range(1, MOVES + 1):
-        if k == MOVES:  # the canvas as the last step's picture is shown (a picture that is not new is not noted)
+        if k == MOVES and canvas.count():  # the canvas as the last step's picture is shown (not a picture not new)
             canvas.evaluate(KEEP_SHOWN)
         old, frames_before = _picture_state_nth(page, e), frames(page)
         start = time.perf_counter()
@@ -385,7 +385,7 @@ def drag_a_corner(page, panel):
         "before": before_readout,
         "after": readout.inner_text(),
         "last_step": last_step,
-        "settled": canvas.evaluate("c => c.toDataURL()"),
+        "settled": canvas.evaluate("c => c.toDataURL()") if canvas.count() else None,
     }
 
 

@@ -72,6 +72,7 @@ def _compare(page, editor, moves):
     assert sketch, "the editor sent no sketch"
     mine = page.evaluate("text => sketched(text)", _json({"sketch": sketch, "corners": corners, "moves": moves}))
     theirs = _drag(editor, moves)
+    assert editor.widget_.sketch == sketch  # a drag leaves the sketch as it was: it is not sent again
     assert [i["kind"] for i in mine["items"]] == [i["kind"] for i in theirs]
     for drawn, kernel in zip(mine["items"], theirs):
         assert set(drawn) == set(kernel)
