@@ -74,12 +74,14 @@ function render({ model, el }) {
   el.appendChild(root);
 
   let positions = model.get("handles").map((p) => p.slice());
-  let dragging = null, selected = model.get("selected"), waiting = false, queued = null, seq = 0, url = null, timer = null;
+  let dragging = null, selected = model.get("selected"), waiting = false, queued = [], seq = 0, url = null, timer = null;
   let ready = Promise.resolve(), painting = false, alive = true, media = null, next = null;
-  // the corner data the handles stand for (the kernel's, then moved here), the handles' moves made, the move
-  // whose mesh was sketched here and waits for the kernel's picture (0: none), and the moves each drag sent
-  let corners = null, moved = 0, sketched = 0;
+  // the corner data the handles stand for (the kernel's, then moved here) and the twist they were taken at; the
+  // handles' moves made; the move whose mesh was sketched here and waits for the kernel's picture (0: none); and,
+  // for each drag sent, the moves its answer shows (-1: not all, another handle's newest place is still to go)
+  let corners = null, cornersTwist = null, moved = 0, sketched = 0;
   const sentMoved = new Map();
+  const settled = () => dragging === null && !waiting && queued.length === 0; // nothing on its way to the kernel
 
   const frame = () => model.get("frame");
   function toPixels([x, y]) {
@@ -120,22 +122,35 @@ function render({ model, el }) {
     });
   }
 
+  // one drag message on its way at a time; meanwhile each moved handle waits in `queued`, sent in turn at its
+  // newest place, so no handle's last move is lost
   function send(index) {
-    if (waiting) { queued = index; return; }
+    if (waiting) { if (!queued.includes(index)) queued.push(index); return; }
     waiting = true;
     const [x, y] = positions[index];
     model.set("drag", { index, x, y, seq: ++seq });
     model.save_changes();
-    sentMoved.set(seq, moved);
+    sentMoved.set(seq, queued.length ? -1 : moved);
     clearTimeout(timer);
-    timer = setTimeout(answered, 2000); // never stall if an answer is lost
+    timer = setTimeout(lost, 2000); // never stall if an answer is lost
   }
 
   // the kernel acknowledges every position it has drawn (even one that leaves the picture unchanged)
   function answered() {
     clearTimeout(timer);
     waiting = false;
-    if (queued !== null) { const index = queued; queued = null; send(index); }
+    if (queued.length) send(queued.shift());
+  }
+  // no answer for 2 s: go on, and draw whatever the kernel sends next
+  function lost() {
+    sketched = 0;
+    sentMoved.clear();
+    answered();
+  }
+  function takeCorners(scene) {
+    if (!scene || !scene.corners || !scene.values) return;
+    corners = scene.corners.map((c) => c.slice());
+    cornersTwist = scene.values.twist;
   }
 
   function place(index, point) {
@@ -158,6 +173,7 @@ function render({ model, el }) {
     const plan = model.get("sketch") || {};
     const now = ahead.controlsNow();
     if (!corners || !plan.in_s || !now || !sameValues(plan.values, now)) return;
+    if (!sameValues({ twist: cornersTwist }, { twist: plan.values.twist })) return; // corners of another twist
     if (plan.background !== (model.get("scene") || {}).background) return;
     sketched = moved;
     show({ scene: { size: plan.size, items: meshItems(plan, corners).items }, sketched: true });
@@ -243,6 +259,7 @@ function render({ model, el }) {
   function show(picture) { // the text at once, as the message comes; the picture in the next frame
     // a picture not painted yet that was new to the page makes the one that replaces it new too
     next = picture.quiet && next && !next.quiet ? { ...picture, quiet: false } : picture;
+    if (settled()) takeCorners(picture.scene);
     if (picture.readout !== undefined) {
       showReadout(picture);
       if (dragging === null) live.textContent = picture.status;
@@ -250,24 +267,27 @@ function render({ model, el }) {
     schedule();
   }
   // a picture drawn ahead shows the corners of the last drag drawn: none is shown while a drag is on its way
-  const ahead = sceneAhead(model, stage, show, () =>
-    dragging === null && !waiting && queued === null ? { shape: model.get("ack") } : null);
+  const ahead = sceneAhead(model, stage, show, () => (settled() ? { shape: model.get("ack") } : null));
   function fromKernel() {
     const scene = model.get("scene") || {};
-    if (scene.corners && dragging === null && !waiting && queued === null) corners = scene.corners.map((c) => c.slice());
     const fields = Object.fromEntries(["readout", "worst", "alt", "status"].map((name) => [name, model.get(name)]));
     const picture = { scene, ...fields, values: scene.values, background: scene.background };
     const drag = scene.values ? scene.values.shape : undefined, at = sentMoved.get(drag);
-    if (sketched && at !== undefined) {
+    if (at === undefined ? settled() : at === moved) takeCorners(scene); // it shows every move made
+    if (at !== undefined) {
       for (const k of [...sentMoved.keys()]) if (k <= drag) sentMoved.delete(k);
-      if (at < sketched) return; // older than the mesh sketched on the page: the answer to a newer move comes
-      const same = at === sketched;
-      sketched = 0;
-      if (same) { // the kernel's picture of the sketch on the page
-        ahead.note(picture);
-        show({ ...picture, quiet: true });
-        return;
+      if (sketched) {
+        if (at < sketched) return; // older than the mesh sketched on the page: the answer to a newer move comes
+        const same = at === sketched;
+        sketched = 0;
+        if (same) { // the kernel's picture of the sketch on the page
+          ahead.note(picture);
+          show({ ...picture, quiet: true });
+          return;
+        }
       }
+    } else if (sketched && (drag < seq || queued.length)) {
+      return; // a scene of a drag older than those on their way (a slider's, or the pixel ratio's): theirs come
     }
     ahead.fromKernel(picture);
   }
@@ -304,7 +324,7 @@ function render({ model, el }) {
     if (model.get("selected") !== selected) { selected = model.get("selected"); draw(); }
   });
   model.on("change:handles", () => {
-    if (dragging === null && !waiting) { positions = model.get("handles").map((p) => p.slice()); draw(); }
+    if (settled()) { positions = model.get("handles").map((p) => p.slice()); draw(); }
   });
   model.on("change:frame", draw);
   showBackground();

@@ -55,7 +55,7 @@ from .._alt import figure_alt, img_tag
 from ..notebook import HEADLESS, headless
 from ..patches import Corner
 from .figures import BilinearErrorView, ErrorCurvesView, LimaconView, PatchView, SplinePchipView
-from .scene import Scene, animated, encode_png
+from .scene import Scene, animated, encode_png, fit_boxes
 
 
 class NotShown:
@@ -244,6 +244,7 @@ def ahead_entry(scene, draw, values, dpi, fields, render=False):
         for ax, xlim, ylim in limits:
             ax.set_xlim(xlim)
             ax.set_ylim(ylim)
+        fit_boxes(scene.figure)  # a background drawn ahead laid the boxes out for its limits
 
 
 class Explorer:

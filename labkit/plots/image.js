@@ -2,7 +2,8 @@
 // scene.js, which draws a scene, comes before this file). The kernel renders what does not change with a
 // move (axes, ticks, labels, legend) as a background PNG at the page's devicePixelRatio, which this module
 // reports in `pixel_ratio`; every move sends the changing artists as a scene, drawn here on a <canvas> over
-// the background in the same device pixels. Both are shown at the figure's CSS size, never wider than the
+// the background in the same device pixels (the background itself drawn first on the canvas, decoded as it comes,
+// so the canvas holds the whole picture). Both are shown at the figure's CSS size, never wider than the
 // output area; the <img>'s alt text is the figure's description in numbers, updated with every move.
 // Paints happen inside requestAnimationFrame, at most one a frame, always of the newest picture (the ones that
 // arrived in between are never drawn); each paint raises data-labkit-shown once its frame is rendered. Nothing
@@ -25,16 +26,28 @@ function render({ model, el }) {
   box.append(img, canvas);
   let url = null, ready = Promise.resolve(), queued = false, alive = true, media = null;
   let next = null;
+  // the backgrounds decoded (ImageBitmaps, by number, the newest few): each picture is painted over its own on the
+  // canvas, so what the <img> shows (the kernel's last, or one sent ahead) never puts a picture on another's axes
+  const decoded = new Map();
+  function keepDecoded(number, bitmap) {
+    decoded.delete(number);
+    decoded.set(number, bitmap);
+    while (decoded.size > 4) decoded.delete(decoded.keys().next().value);
+  }
 
   function showBackground() {
     const bytes = sceneBytes(model.get("background"));
-    if (bytes.length) showPicture(URL.createObjectURL(new Blob([bytes], { type: "image/png" })));
+    if (!bytes.length) return;
+    const blob = new Blob([bytes], { type: "image/png" }), number = (model.get("scene") || {}).background;
+    const decoding = createImageBitmap(blob).then((bitmap) => keepDecoded(number, bitmap)).catch(() => {});
+    showPicture(URL.createObjectURL(blob), decoding);
   }
-  function showPicture(src) {
+  function showPicture(src, decoding) {
     const old = url;
     url = src;
     img.src = url;
-    ready = img.decode().catch(() => {}); // the scene waits for its background, so both show in one frame
+    // the scene waits for its background, so both show in one frame
+    ready = Promise.all([img.decode().catch(() => {}), decoding]);
     if (old) ready.then(() => URL.revokeObjectURL(old));
   }
   function paint() {
@@ -46,7 +59,8 @@ function render({ model, el }) {
     const [width, height] = scene.size || [0, 0];
     if (canvas.width !== width) canvas.width = width;
     if (canvas.height !== height) canvas.height = height;
-    drawScene(canvas, scene.items || [], picture.overlays || model.get("overlays") || {}, picture.bitmap);
+    const under = picture.bitmap || decoded.get(scene.background); // its own background, or transparent: the <img>
+    drawScene(canvas, scene.items || [], picture.overlays || model.get("overlays") || {}, under);
     // for the tests: how many pictures were drawn ahead, and how many are kept (data-labkit-kept)
     if (picture.ahead) box.dataset.labkitDrawnAhead = String(Number(box.dataset.labkitDrawnAhead || 0) + 1);
     sceneShown(box);
@@ -56,7 +70,10 @@ function render({ model, el }) {
     img.alt = picture.description;
     schedule();
     // drawn ahead on a background of its own: painted with it on the canvas, and the <img> takes it for what follows
-    if (picture.bitmap) showPicture(URL.createObjectURL(picture.blob));
+    if (picture.bitmap) {
+      keepDecoded(picture.background, picture.bitmap);
+      showPicture(URL.createObjectURL(picture.blob), null);
+    }
   }
   const ahead = sceneAhead(model, box, show, () => ({}));
   function fromKernel() {

@@ -3,8 +3,9 @@
 // the corner data, so with the basis at the mesh's parameter values, the axes' transform and the colour map
 // (the editor's `sketch`, from labkit.plots.editor.Editor._sketch) the page computes the mesh, each element's
 // quality and the title as the kernel does (labkit.patches.patch, labkit.mesh.QuadMesh.quality, matplotlib's
-// colour mapping) and builds the same scene items. The kernel's own picture of the drag follows and is drawn
-// over it. tests/browser/test_mesh_sketch.py compares the two, item by item, in Chromium.
+// colour mapping) and builds the same scene items, to rounding (NumPy's products may fuse a multiply and an add).
+// The kernel's own picture of the drag follows and is drawn over it. tests/browser/test_mesh_sketch.py compares
+// the two, item by item, in Chromium.
 
 function meshFloat64(value) {
   const bytes = sceneBytes(value);

@@ -95,6 +95,15 @@ def animated(artists):
             artist.set_animated(was)
 
 
+def fit_boxes(figure, renderer=None):
+    """Put every axes' box where a draw of the figure would, for its limits now (Axes.draw's first step): an
+    equal-aspect box follows its limits, so one drawn for other limits (a move drawn ahead) is put back."""
+    renderer = renderer or figure.canvas.get_renderer()
+    for ax in figure.axes:
+        locator = ax.get_axes_locator()
+        ax.apply_aspect(locator(ax, renderer) if locator else None)
+
+
 class Scene:
     """A figure's live picture for one view: :meth:`frame` gives the background (when it changed) and the items."""
 
@@ -157,10 +166,11 @@ class Scene:
 
     def ahead(self, dpi, render=False):
         """A picture the browser can show at once for a move not made yet: the items of the figure as it is now,
-        to draw over the background last sent; or, where that background does not fit it (the static part
-        changed, or an overlay would be new) and `render` is true, over a new background rendered now, with the
-        overlays its items name. ``{"items", "background"}`` (the number of the background they lie on) and,
-        for a new one, ``"picture"`` (its PNG) and ``"overlays"``; None where nothing fits or the dpi is another.
+        to draw over the background last sent; or, where the static part changed and `render` is true, over a
+        new background rendered now, with the overlays its items name. ``{"items", "background"}`` (the number
+        of the background they lie on) and, for a new one, ``"picture"`` (its PNG) and ``"overlays"``. None
+        where the static part changed and `render` is false, where an overlay would be new on the background
+        sent (pixels the browser has not got), or where the dpi is another.
 
         A background rendered here is kept: when the move is made, :meth:`frame` sends that one (the same pixels)
         rather than draw it again. Nothing else :meth:`frame` keeps is changed."""
@@ -197,6 +207,7 @@ class Scene:
 
     def _all_items(self, dynamic):
         renderer = self.figure.canvas.get_renderer()
+        fit_boxes(self.figure, renderer)  # where the axes lie for their limits now, as a draw would put them
         items = []
         for artist in dynamic:
             if artist.get_visible():

@@ -400,3 +400,25 @@ def latencies(timings):
         label: (1000 * statistics.median(times), 1000 * percentile(times, 0.9), len(times))
         for label, times in timings.items()
     }
+
+
+# values with bytes (a widget's buffers) for a page of the tests' own: page_json(value) there, then
+# revive(text) in the page (after REVIVE is added) gives them back with Uint8Arrays, as the widget models hold them
+REVIVE = """window.revive = (text) => JSON.parse(text, (key, value) =>
+  value && typeof value === "object" && typeof value.b64 === "string"
+    ? Uint8Array.from(atob(value.b64), (c) => c.charCodeAt(0)) : value);"""
+
+
+def page_json(value):
+    import base64
+
+    def plain(v):
+        if isinstance(v, bytes):
+            return {"b64": base64.b64encode(v).decode()}
+        if isinstance(v, dict):
+            return {k: plain(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [plain(x) for x in v]
+        return v
+
+    return json.dumps(plain(value))

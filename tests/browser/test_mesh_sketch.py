@@ -2,13 +2,11 @@
 scene items must be the kernel's own for that move, vertex, colour and title, at every mesh size, pixel ratio and
 twist, for corner and arrow-tip moves, folded meshes and drags of several steps that the kernel gets as one."""
 
-import base64
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
-from jupyterlab_session import skip_without_chromium
+from jupyterlab_session import REVIVE, page_json, skip_without_chromium
 
 pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 pytest.importorskip("anywidget", reason="anywidget is not installed")
@@ -17,11 +15,7 @@ skip_without_chromium()
 from labkit.plots.editor import FIRST_PATCH, Editor, handle_positions, with_twist
 
 PLOTS = Path(__file__).resolve().parents[2] / "labkit" / "plots"
-# bytes cross to the page as {"b64": ...} and become Uint8Arrays there, as a widget's buffers do
-REVIVE = """window.revive = (text) => JSON.parse(text, (key, value) =>
-  value && typeof value === "object" && typeof value.b64 === "string"
-    ? Uint8Array.from(atob(value.b64), (c) => c.charCodeAt(0)) : value);
-window.sketched = (text) => {
+SKETCHED = """window.sketched = (text) => {
   const {sketch, corners, moves} = revive(text);
   let now = corners;
   for (const [index, x, y] of moves) now = meshMove(now, index, [x, y], sketch.arrow);
@@ -31,24 +25,11 @@ window.sketched = (text) => {
 };"""
 
 
-def _json(value):
-    def plain(v):
-        if isinstance(v, bytes):
-            return {"b64": base64.b64encode(v).decode()}
-        if isinstance(v, dict):
-            return {k: plain(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [plain(x) for x in v]
-        return v
-
-    return json.dumps(plain(value))
-
-
 @pytest.fixture(scope="module")
 def page(browser):
     page = browser.new_page()
     page.set_content("<html><body></body></html>")
-    page.add_script_tag(content=(PLOTS / "scene.js").read_text() + (PLOTS / "mesh.js").read_text() + REVIVE)
+    page.add_script_tag(content=(PLOTS / "scene.js").read_text() + (PLOTS / "mesh.js").read_text() + REVIVE + SKETCHED)
     yield page
     page.close()
 
@@ -70,7 +51,7 @@ def _drag(editor, moves):
 def _compare(page, editor, moves):
     sketch, corners = editor.widget_.sketch, editor.widget_.scene["corners"]
     assert sketch, "the editor sent no sketch"
-    mine = page.evaluate("text => sketched(text)", _json({"sketch": sketch, "corners": corners, "moves": moves}))
+    mine = page.evaluate("text => sketched(text)", page_json({"sketch": sketch, "corners": corners, "moves": moves}))
     theirs = _drag(editor, moves)
     assert editor.widget_.sketch == sketch  # a drag leaves the sketch as it was: it is not sent again
     assert [i["kind"] for i in mine["items"]] == [i["kind"] for i in theirs]

@@ -238,3 +238,38 @@ def test_drawing_ahead_changes_nothing_the_editor_draws(monkeypatch):
     with_ahead, without = run(explorers.AHEAD), run(())
     assert without[:-1] == with_ahead[:-1]
     assert np.array_equal(with_ahead[-1], without[-1])
+
+
+@pytest.mark.parametrize("factory, name", SLIDERS, ids=lambda v: getattr(v, "__name__", v))
+def test_drawing_ahead_changes_nothing_step_by_step(factory, name, monkeypatch):
+    """One step at a time, as a student's key presses go, across the axes' refits and back now and then: the same scenes,
+    backgrounds and descriptions with and without pictures drawn ahead (a background rendered ahead must leave
+    the axes' box where the figure's own limits put it: an equal-aspect box follows its limits)."""
+
+    def run(ahead):
+        monkeypatch.setattr(explorers, "AHEAD", ahead)
+        explorer = factory()
+        slider = explorer.controls[name]
+        steps = [1, 1, -1] * 12 + [1] * 12  # forward, with a step back now and then
+        seen = []
+        for step in steps:
+            value = round(slider.value + step * slider.step, 12)
+            if not slider.min <= value <= slider.max:
+                continue
+            slider.value = value
+            seen.append(
+                (
+                    _comparable(explorer.image.scene),
+                    explorer.image.background,
+                    list(explorer.image.overlays.values()),
+                    explorer.image.description,
+                )
+            )
+        seen.append(_pixels(explorer.png()))
+        return seen
+
+    with_ahead, without = run(explorers.AHEAD), run(())
+    assert len(without) > 10
+    for k, (a, b) in enumerate(zip(with_ahead[:-1], without[:-1])):
+        assert a == b, f"step {k} differs"
+    assert np.array_equal(with_ahead[-1], without[-1])
