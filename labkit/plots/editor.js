@@ -291,10 +291,10 @@ function render({ model, el }) {
     }
     ahead.fromKernel(picture);
   }
-  function schedule() {
+  function schedule() { // the next frame, once the newest background is decoded
     if (painting) return;
     painting = true;
-    ready.then(() => requestAnimationFrame(paint));
+    sceneDecoded(() => ready).then(() => requestAnimationFrame(paint));
   }
   function reportRatio() {
     const ratio = window.devicePixelRatio || 1;
@@ -318,7 +318,8 @@ function render({ model, el }) {
 
   model.on("change:background", showBackground);
   model.on("change:scene", fromKernel);
-  model.on("change:ack", answered);
+  // the answer to the drag on its way (an older one, late after `lost`, is not: the page is not settled by it)
+  model.on("change:ack", () => { if (model.get("ack") >= seq) answered(); });
   model.on("change:status", announce);
   model.on("change:selected", () => { // set by the kernel (a drag's handle)
     if (model.get("selected") !== selected) { selected = model.get("selected"); draw(); }

@@ -80,10 +80,10 @@ function render({ model, el }) {
     const scene = model.get("scene") || {};
     ahead.fromKernel({ scene, description: model.get("description"), values: scene.values, background: scene.background });
   }
-  function schedule() {
+  function schedule() { // the next frame, once the newest background is decoded (one drawn ahead already is)
     if (queued) return;
     queued = true;
-    ready.then(() => requestAnimationFrame(paint));
+    (next && next.bitmap ? Promise.resolve() : sceneDecoded(() => ready)).then(() => requestAnimationFrame(paint));
   }
   function showSize() {
     const [width, height] = model.get("css_size");

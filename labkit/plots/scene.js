@@ -169,6 +169,12 @@ function sceneShown(node) {
   };
   channel.port2.postMessage(null);
 }
+// a promise of the newest of a widget's background decodes (`current()` gives the one now): the change events of
+// one message come in any order, so a background set after its scene replaces the decode its paint waited for
+function sceneDecoded(current) {
+  const waited = current();
+  return waited.then(() => (waited === current() ? undefined : sceneDecoded(current)));
+}
 // draw `items` on `canvas` (already the size of the picture in device pixels), cleared first, over `under` (a
 // background decoded ahead, an ImageBitmap) if given; `overlays` holds the pixels the overlay items name
 function drawScene(canvas, items, overlays, under) {

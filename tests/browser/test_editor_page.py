@@ -125,3 +125,20 @@ def test_a_drag_is_not_drawn_here_from_corners_of_another_twist(page):
         [page_json(state), page_json(twisted), page_json(answer)],
     )
     assert sketched == [0, 0, 1]
+
+
+def test_a_late_answer_to_a_drag_given_up_on_does_not_free_the_next(page):
+    """No answer for 2 s: the page sends again. The late answer to the old drag, when it comes, is not the answer
+    to the new one: the page still sends one drag at a time."""
+    counts = page.evaluate(
+        """async () => { setUp();
+        t.key("ArrowRight");                                // drag 1: its answer is late
+        await new Promise((r) => setTimeout(r, 2200));      // given up on
+        t.key("ArrowRight");                                // drag 2: sent
+        t.model.set("ack", 1);                              // the late answer to drag 1
+        t.key("ArrowRight");                                // waits for drag 2's answer
+        const before = t.sent.length;
+        t.model.set("ack", 2);                              // drag 2's: the waiting move goes
+        return [before, t.sent.length]; }"""
+    )
+    assert counts == [2, 3]

@@ -231,7 +231,7 @@ def test_image_js_paints_a_picture_on_a_background_of_its_own_over_that_backgrou
     try:
         page.set_content("<html><body><div id='out'></div></body></html>")
         page.add_script_tag(content=image_js + STAND_INS + "window.renderImage = render;")
-        red, blue = _png([255, 0, 0]), _png([0, 0, 255])
+        red, blue, green = _png([255, 0, 0]), _png([0, 0, 255]), _png([0, 255, 0])
         result = page.evaluate(
             f"""async () => {{
             const bytes = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
@@ -258,7 +258,17 @@ def test_image_js_paints_a_picture_on_a_background_of_its_own_over_that_backgrou
             t.n.set("value", 1);
             model.set("scene", {{ size: [4, 4], items: [], values: {{ n: 1 }}, background: 1 }});
             await frames(3);
-            return {{ before, after, changed, back: pixel(), alt: img.alt,
+            const back = pixel();
+            // a new background whose scene's change event comes first (one message's events come in any order):
+            // the paint waits for the background set after it
+            const decode = window.createImageBitmap;  // a decode slower than a frame, as a big picture's is
+            window.createImageBitmap = (blob) => new Promise((r) => setTimeout(r, 100)).then(() => decode(blob));
+            model.set("scene", {{ size: [4, 4], items: [], values: {{ n: 1 }}, background: 3 }});
+            model.set("background", bytes("{green}"));
+            await new Promise((r) => setTimeout(r, 250));
+            await frames(2);
+            window.createImageBitmap = decode;
+            return {{ before, after, changed, back, green: pixel(), alt: img.alt,
                       ahead: el.querySelector("[data-labkit-drawn-ahead]")?.dataset.labkitDrawnAhead }};
         }}"""
         )
@@ -268,3 +278,4 @@ def test_image_js_paints_a_picture_on_a_background_of_its_own_over_that_backgrou
     assert result["after"] == [0, 0, 255, 255]  # the new background, on the canvas, under the picture's items
     assert result["changed"] and result["ahead"] == "1"
     assert result["back"] == [255, 0, 0, 255]  # the kernel's scene on its own background, not the one sent ahead
+    assert result["green"] == [0, 255, 0, 255]
