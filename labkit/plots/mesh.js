@@ -7,13 +7,6 @@
 // The kernel's own picture of the drag follows and is drawn over it. tests/browser/test_mesh_sketch.py compares
 // the two, item by item, in Chromium.
 
-function meshFloat64(value) {
-  const bytes = sceneBytes(value);
-  const copy = new Uint8Array(bytes.length); // aligned for Float64Array
-  copy.set(bytes);
-  return new Float64Array(copy.buffer);
-}
-
 // Python's f"{x:.2f}": toFixed(2) but for -0 and for ties (x an odd multiple of 1/8, exact in binary), which
 // Python rounds to the even neighbour and toFixed away from zero
 function meshFixed2(x) {
@@ -39,7 +32,7 @@ function meshMove(corners, index, point, arrow) {
 // the mesh of `corners` as the kernel's scene items (PatchView.dynamic's order: elements, title, folded
 // elements), and its worst quality
 function meshItems(sketch, corners) {
-  const S = meshFloat64(sketch.in_s), T = meshFloat64(sketch.in_t);
+  const S = sceneFloats(sketch.in_s, Float64Array), T = sceneFloats(sketch.in_t, Float64Array);
   const ns = S.length / 4, nt = T.length / 4;
   const [A, B, C, D] = corners;
   // a Hermite cubic in s of (left value, left slope, right value, right slope) at offsets into two corners

@@ -8,11 +8,11 @@ function sceneBytes(value) {
   if (value instanceof ArrayBuffer) return new Uint8Array(value);
   return new Uint8Array(value.buffer, value.byteOffset, value.byteLength);
 }
-function sceneFloats(value) {
+function sceneFloats(value, Type = Float32Array) { // little-endian floats (Float64Array for doubles)
   const bytes = sceneBytes(value);
-  const copy = new Uint8Array(bytes.length); // aligned for Float32Array
+  const copy = new Uint8Array(bytes.length); // aligned for Type
   copy.set(bytes);
-  return new Float32Array(copy.buffer);
+  return new Type(copy.buffer);
 }
 function sceneColor(c) {
   return c ? `rgba(${c[0]},${c[1]},${c[2]},${c[3]})` : null;
