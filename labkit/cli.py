@@ -500,8 +500,8 @@ def _export(args):
 
 
 def _report(args):
+    from .grading.progress import Progress
     from .grading.reports import class_report, similarity
-    from .grading.run.progress import Progress
 
     start = time.perf_counter()
     threshold = args.similarity_threshold

@@ -26,39 +26,36 @@ def sandbox_or_skip():
 
 
 # The fast tier (`make test-fast`, `pytest -m "not slow"`) leaves out what starts sandboxes, browsers, servers or
-# whole notebooks: the browser tests, these modules, and every test whose code or fixtures call sandbox_or_skip().
-SLOW_MODULES = {
-    "test_catalog",  # the catalog class, graded in one sandboxed run
-    "test_hostile",  # the hostile class
-    "test_make_lab",  # make lab in a fresh folder
-    "test_packaging",  # builds the package
-    "test_wheel",  # builds and installs a wheel
-    "test_dask",  # a Dask cluster
-    "test_nbgrader",  # nbgrader's own commands
-    "test_notebooks_clean",  # executes notebooks
-    "test_student_work",  # executes notebooks
-    "test_timeouts",  # waits for time limits
-    "test_grading",  # grades the instructor notebooks and small classes
-    "test_refusals",  # a worker process per case
-    "test_handin",  # executes notebooks
-}
-SLOW_CALLS = ("sandbox_or_skip(", "grading.grade(")  # a test or fixture calling one of these is slow
+# whole notebooks. Such tests say so themselves: `pytestmark = pytest.mark.slow` in their module, or
+# `@pytest.mark.slow` on the test; everything in tests/browser/ is slow by its folder. A test of the fast tier that
+# starts a sandbox or a grading process fails (the fixture below), so a missing mark is found, not guessed.
+def _starts_the_grader(argv):
+    """Whether a command starts bubblewrap or one of the grader's own processes (`python -m labkit.grading.…`)."""
+    words = [str(word) for word in ([argv] if isinstance(argv, (str, bytes, Path)) else argv)]
+    modules = [after for before, after in zip(words, words[1:]) if before == "-m"]
+    return bool(words) and Path(words[0]).name == "bwrap" or any(m.startswith("labkit.grading.") for m in modules)
 
 
-def _calls_the_sandbox(item):
-    import inspect
+@pytest.fixture(autouse=True)
+def _fast_tier_starts_no_sandbox(request, monkeypatch):
+    """Fail a test of the fast tier (not marked slow) the moment it starts a sandbox or a grading process."""
+    if request.node.get_closest_marker("slow") is not None:
+        return
+    import subprocess
 
-    functions = [getattr(item, "function", None)]
-    info = getattr(item, "_fixtureinfo", None)
-    for definitions in info.name2fixturedefs.values() if info else ():
-        functions += [definition.func for definition in definitions]
-    for function in functions:
-        try:
-            if function is not None and any(call in inspect.getsource(function) for call in SLOW_CALLS):
-                return True
-        except (OSError, TypeError):
-            continue
-    return False
+    real = subprocess.Popen
+
+    class Guarded(real):
+        def __init__(self, args, *rest, **kwargs):
+            if _starts_the_grader(args):
+                pytest.fail(
+                    f"{request.node.nodeid} starts a sandbox or a grading process ({args!r}) but is not marked slow: "
+                    "add @pytest.mark.slow (or pytestmark = pytest.mark.slow in its module)",
+                    pytrace=False,
+                )
+            super().__init__(args, *rest, **kwargs)
+
+    monkeypatch.setattr(subprocess, "Popen", Guarded)
 
 
 def pytest_configure(config):
@@ -67,9 +64,7 @@ def pytest_configure(config):
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        module = item.nodeid.split("::")[0]
-        name = Path(module).stem
-        if module.startswith("tests/browser/") or name in SLOW_MODULES or _calls_the_sandbox(item):
+        if item.nodeid.startswith("tests/browser/"):
             item.add_marker(pytest.mark.slow)
 
 

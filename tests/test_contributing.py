@@ -91,6 +91,7 @@ def test_the_toy_exercise_is_declared_once_and_everything_follows(course):
     assert not slip.passed and "divide each difference" in slip.hint
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_toy_exercise_is_executed_released_and_graded_right_and_wrong(course):
     sandbox_or_skip()
     ran = _labkit("execute", "notebooks", "--rubric", "toy.toml", cwd=course)

@@ -122,3 +122,120 @@ def test_the_tests_mirror_the_packages():
         package = ROOT if folder == "library" else ROOT / folder
         assert (package / "__init__.py").is_file(), f"tests/{folder}/ mirrors no package of labkit"
         assert any((tests / folder).glob("test_*.py")), f"tests/{folder}/ holds no test"
+
+
+def package_of(module, known):
+    """The subpackage a module belongs to: `labkit.grading.<room>` inside the grader, `labkit.<part>` elsewhere;
+    a top-level module (labkit/cli.py, labkit/grading/options.py) stands for itself."""
+    parts = module.split(".")
+    for depth in (3, 2):
+        prefix = ".".join(parts[:depth])
+        if len(parts) > depth - 1 and prefix in known and known[prefix][1] and prefix != "labkit.grading":
+            return prefix
+    return module
+
+
+def package_cycles(root):
+    """The cycles of the import graph between subpackages, each as the sorted list of the packages in it
+    (strongly connected components of more than one package, by Tarjan's method)."""
+    known = modules(root)
+    graph = {}
+    for name, targets in imports(root).items():
+        here = package_of(name, known)
+        graph.setdefault(here, set()).update(package_of(t, known) for t in targets if package_of(t, known) != here)
+    index, low, stack, on, cycles = {}, {}, [], set(), []
+
+    def visit(node):
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on.add(node)
+        for nxt in graph.get(node, ()):
+            if nxt not in index:
+                visit(nxt)
+                low[node] = min(low[node], low[nxt])
+            elif nxt in on:
+                low[node] = min(low[node], index[nxt])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                top = stack.pop()
+                on.discard(top)
+                component.append(top)
+                if top == node:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return sorted(cycles)
+
+
+def test_no_cycle_between_subpackages():
+    assert package_cycles(ROOT) == []
+
+
+def test_the_cycle_search_finds_a_cycle_of_three_packages_through_single_modules(tmp_path):
+    root = tmp_path / "labkit"
+    for folder in ("", "grading", "grading/a", "grading/b", "grading/c", "other"):
+        (root / folder).mkdir(parents=True, exist_ok=True)
+        (root / folder / "__init__.py").write_text("")
+    (root / "grading" / "a" / "x.py").write_text("from ..b import y\n")
+    (root / "grading" / "b" / "y.py").write_text("def f():\n    from ..c import z\n")
+    (root / "grading" / "c" / "z.py").write_text("from ...grading.a import x\n")
+    (root / "other" / "w.py").write_text("from ..grading.a import x\n")
+    assert package_cycles(root) == [["labkit.grading.a", "labkit.grading.b", "labkit.grading.c"]]
+    (root / "grading" / "c" / "z.py").write_text("")
+    assert package_cycles(root) == []
+
+
+# The grader's rooms in the order data flows through them, lowest first: a room imports only rooms below it.
+# (the class comes in and is planned and run: run; each submission is scored: submission; the store of a run: results;
+# what people read: reports and authoring, at the top.)
+FLOW = {
+    "labkit.grading.progress": 0,
+    "labkit.grading.sandbox": 1,
+    "labkit.grading.results": 2,
+    "labkit.grading.options": 2,
+    "labkit.grading.submission": 3,
+    "labkit.grading.run": 4,
+    "labkit.grading.authoring": 4,
+    "labkit.grading.reports": 5,
+}
+
+
+def imports_up_the_flow(root, flow):
+    """[(room, room it imports)] for every import from a room to one at its level or above it in `flow`."""
+    known = modules(root)
+    found = set()
+    for name, targets in imports(root).items():
+        here = package_of(name, known)
+        for target in targets:
+            there = package_of(target, known)
+            if here in flow and there in flow and here != there and flow[there] >= flow[here]:
+                found.add((here, there))
+    return sorted(found)
+
+
+def test_every_room_of_the_grader_is_placed_in_the_flow():
+    rooms = {f"labkit.grading.{p.stem if p.is_file() else p.name}" for p in (ROOT / "grading").iterdir()}
+    rooms = {r for r in rooms if not r.endswith(("__init__", "__pycache__", ".toml"))}
+    assert rooms - set(FLOW) == set()
+
+
+def test_no_room_imports_up_the_flow():
+    assert imports_up_the_flow(ROOT, FLOW) == []
+
+
+def test_the_flow_check_finds_an_import_upwards(tmp_path):
+    root = tmp_path / "labkit"
+    for folder in ("", "grading", "grading/low", "grading/high"):
+        (root / folder).mkdir(parents=True, exist_ok=True)
+        (root / folder / "__init__.py").write_text("")
+    (root / "grading" / "high" / "h.py").write_text("from ..low import l\n")
+    (root / "grading" / "low" / "l.py").write_text("")
+    flow = {"labkit.grading.low": 0, "labkit.grading.high": 1}
+    assert imports_up_the_flow(root, flow) == []
+    (root / "grading" / "low" / "l.py").write_text("def f():\n    from ..high import h\n")
+    assert imports_up_the_flow(root, flow) == [("labkit.grading.low", "labkit.grading.high")]

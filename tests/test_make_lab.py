@@ -36,7 +36,10 @@ LAB_EXTENSION = "@jupyter/nbgrader"
 TOKEN = "labkit-make-lab-test"
 SECRETS = ("BEGIN SOLUTION", "END SOLUTION", "BEGIN HIDDEN TESTS")
 
-pytestmark = pytest.mark.skipif(shutil.which("make") is None, reason="make is not installed")
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(shutil.which("make") is None, reason="make is not installed"),
+]  # slow: make lab in a fresh folder
 
 
 def _make(*args, dry=False, **env):

@@ -10,6 +10,8 @@ from docs_markdown import exercise_table
 from labkit.exercises.model import sections
 from labkit.exercises.registry import LAB
 
+pytestmark = pytest.mark.slow  # executes notebooks
+
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
 EXERCISES = [1, *LAB.exercises]  # exercise 1 (copying code) has a section but is not graded
 EXPLORE = re.compile(r"plots\.(\w+_explorer|patch_editor)\(")

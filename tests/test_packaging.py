@@ -13,6 +13,8 @@ import yaml
 from labkit.grading import release_notebook
 from labkit.student_notebooks import paths
 
+pytestmark = pytest.mark.slow  # builds the package
+
 ROOT = Path(__file__).resolve().parents[1]
 PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))

@@ -10,7 +10,10 @@ from conftest import sandbox_or_skip
 from labkit.check import EXERCISES
 from labkit.grading.results.rubric import default
 
-pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's"),
+]  # slow: the catalog class, graded in one sandboxed run
 RUBRIC = default()
 # grades.csv of this very class and seed (catalog.GOLDEN), first graded before the exercises were declared once
 # (issue 20: that refactoring changed where things are declared, not one grade); issue 30's slips added their rows

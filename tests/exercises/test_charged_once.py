@@ -139,6 +139,7 @@ GRADED = (
 )
 
 
+@pytest.mark.slow  # starts a sandbox
 @pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 def test_the_sandbox_charges_the_issues_three_slips_once(tmp_path):
     sandbox_or_skip()

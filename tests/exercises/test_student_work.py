@@ -19,6 +19,8 @@ from labkit.exercises import experiments, plotted
 from labkit.exercises.registry import LAB
 from labkit.grading.sandbox import protocol
 
+pytestmark = pytest.mark.slow  # executes notebooks
+
 # -- drivers ---------------------------------------------------------------------
 
 

@@ -17,6 +17,8 @@ from labkit import grading
 from labkit.check import EXERCISES
 from labkit.exercises.registry import LAB
 
+pytestmark = pytest.mark.slow  # grades the instructor notebooks and small classes
+
 ANSWERS = LAB.answers
 from labkit.grading.results.rubric import default
 

@@ -41,7 +41,10 @@ MARK = "labkit-hostile-7777"
 GRADER_MEMORY_BOUND = 1536 * 1024**2  # the grader's own work on one submission, attacks included
 TOTAL_TIMEOUT, CELL_TIMEOUT = 60, 5
 
-pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's"),
+]  # slow: the hostile class
 
 
 def _pasted(function):

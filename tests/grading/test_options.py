@@ -73,6 +73,7 @@ def test_every_grade_argument_lands_in_the_options():
         grade_options(_args("--total-timeout", "0"))
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_options_refuse_what_they_cannot_use():
     with pytest.raises(ValueError, match="cell-timeout must be at least 1 second"):
         GradeOptions(cell_timeout=0)
@@ -144,6 +145,7 @@ def test_the_defaults_are_spelled_out_only_in_the_options():
     assert len(modules) > 15
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_exercises_that_disagree_with_the_rubric_are_refused_before_anything_is_graded(tmp_path):
     from labkit import grading
 

@@ -23,6 +23,8 @@ from labkit.cli import main
 from labkit.exercises.registry import LAB
 from labkit.handin import DONE, FAILING, NOT_STARTED
 
+pytestmark = pytest.mark.slow  # executes notebooks
+
 ROOT = Path(__file__).resolve().parents[2]
 INSTRUCTOR = ROOT / "notebooks"
 RELEASE = ROOT / "labkit" / "student_notebooks"

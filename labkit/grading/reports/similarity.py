@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from ..results.report import one_line, printable
-from ..submission.scan import MAX_SOURCE_CHARS
+from ..results.text import MAX_SOURCE_CHARS
 
 DEFAULT_THRESHOLD = 0.8  # similarity (0..1) from which a pair is shown
 NOISE = 25  # normalised characters hashed into one fingerprint (copydetect's noise threshold): shorter runs never count
@@ -116,7 +116,7 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
         notebook (all their code cells), or the code texts themselves. None
         (the default) is the lab's packaged student release
         (``labkit/student_notebooks``).
-    progress : labkit.grading.run.progress.Progress, optional
+    progress : labkit.grading.progress.Progress, optional
         Advanced by one after each graded function (the functions named in
         the grades' sources).
 

@@ -30,11 +30,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...exercises.result import KINDS, OTHER
-from ..submission.scan import MAX_SOURCE_CHARS
 from . import record as records
 from . import rubric as rubrics
 from .late import FROM_CSV, SubmissionTime, time_text
-from .text import points_text
+from .text import MAX_SOURCE_CHARS, points_text
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
 OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again (SubmissionGrade.from_dict)
@@ -741,7 +740,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         {submission name: datetime} (:func:`labkit.grading.results.late.read_times`): these times replace the
         stored ones of the submissions they name.
     progress : bool
-        Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.run.progress`).
+        Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).
 
     Returns
     -------
@@ -749,7 +748,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         The grades in name order; its ``replaced`` lists the results a later folder replaced, which
         ``merge.json`` in `out_dir` records as well, and its ``refused`` the result files not merged.
     """
-    from ..run.progress import Progress
+    from ..progress import Progress
 
     out = Path(out_dir)
     if out.resolve() in {Path(folder).resolve() for folder in folders}:

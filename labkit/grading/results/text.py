@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+MAX_SOURCE_CHARS = 20_000  # characters kept of one graded function's source (a lab function is a few hundred)
+
 
 def points_text(value) -> str:
     """Points as text: whole numbers without a decimal point, others to two decimals at most.

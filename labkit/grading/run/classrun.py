@@ -36,6 +36,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..options import GradeOptions
+from ..progress import Progress
 from ..results import record as records
 from ..results.late import submission_time
 from ..results.report import SubmissionGrade, labkit_version, one_line, write_report, write_result
@@ -45,7 +46,6 @@ from ..sandbox.backends.base import SandboxUnavailable
 from ..submission import refusals
 from ..submission.scoring import known_sources, submission_name
 from .engines import Batch, Engine, LocalEngine
-from .progress import Progress
 from .resume import carried_marks, content, notebooks, parse_shard, resumed, shard_of
 
 

@@ -6,9 +6,10 @@ Both directions use one format, one JSON object per line:
 * an array ``["a", shape, base64 of little-endian float64]`` (integers and
   booleans are sent as floats; complex and object arrays are not numbers);
 * a tuple ``["t", [...]]`` or a list ``["l", [...]]``;
-* a :class:`labkit.Corner` ``["corner", point, ds, dt, dsdt]`` and a
+* a course type of :data:`labkit.wire.TYPES` as its tag and its fields, each an array:
+  a :class:`labkit.Corner` ``["corner", point, ds, dt, dsdt]`` and a
   :class:`labkit.QuadMesh` ``["mesh", points, quads]``, rebuilt (and
-  validated) by their constructors;
+  validated) by the table's ``rebuild``;
 * a plot (a matplotlib Axes or Figure) ``["lines", [[x, y, marker, linestyle], ...]]``:
   the data of its Line2D objects (:func:`labkit.plotdata.lines_of`),
   rebuilt as :class:`labkit.plotdata.Line` records, so plots are judged
@@ -39,6 +40,8 @@ import select
 import time
 
 import numpy as np
+
+from ... import wire
 
 MAX_DEPTH = 12
 # where a sandbox shows the course modules a rubric names (read-only); the worker puts it on the notebook's path
@@ -89,9 +92,6 @@ def encode(value, passable=frozenset(), depth=0):
 
     Used on both sides: the notebook's answers (which may be hostile, so they are re-checked) and the
     arguments the grader's checks pass."""
-    from ...mesh import QuadMesh
-    from ...patches import Corner
-
     if depth > MAX_DEPTH:
         return ["obj", "a value nested too deeply"]
     if value is None:
@@ -107,10 +107,9 @@ def encode(value, passable=frozenset(), depth=0):
         return ["s", value[:MAX_TEXT]]
     if isinstance(value, np.ndarray):
         return _array_tag(value)
-    if isinstance(value, Corner):
-        return ["corner"] + [_array_tag(getattr(value, name)) for name in ("point", "ds", "dt", "dsdt")]
-    if isinstance(value, QuadMesh):
-        return ["mesh", _array_tag(value.points), _array_tag(value.quads)]
+    for row in wire.TYPES:
+        if isinstance(value, row.kind()):
+            return [row.tag] + [_array_tag(getattr(value, name)) for name in row.fields]
     if _is_plot(value):
         return _lines_tag(value)
     if callable(value) and f"{getattr(value, '__module__', '')}:{getattr(value, '__qualname__', '')}" in passable:
@@ -258,30 +257,21 @@ def _line(item):
     return Line(x, y, item[2][:20], item[3][:20])
 
 
-def _corner(parts):
-    """A Corner from four arrays, checked here and built without running labkit.patches' code (which
-    the grader's watch may refuse while the student's function that receives it runs)."""
-    from ...patches import Corner
-
-    fields = [_array(part).ravel() if isinstance(part, list) and part[:1] == ["a"] else None for part in parts]
+def _course_type(row, parts):
+    """A course type of :data:`labkit.wire.TYPES` from its tagged fields, or a NotNumbers saying why not."""
+    fields = [_array(part) if isinstance(part, list) and part[:1] == ["a"] else None for part in parts]
     if any(f is None for f in fields):
-        return NotNumbers("a corner with a field that is not numbers")
-    if fields[0].size not in (2, 3) or any(f.size != fields[0].size for f in fields):
-        return NotNumbers("an invalid Corner (its fields must be vectors of 2 or 3 numbers, all the same size)")
-    if not all(np.all(np.isfinite(f)) for f in fields):
-        return NotNumbers("an invalid Corner (NaN or infinite numbers)")
-    corner = object.__new__(Corner)
-    for name, value in zip(("point", "ds", "dt", "dsdt"), fields):
-        object.__setattr__(corner, name, value.copy())
-    return corner
+        return NotNumbers(f"a {row.tag} with a field that is not numbers")
+    try:
+        return row.rebuild(*fields)
+    except ValueError as exc:
+        return NotNumbers(str(exc))
 
 
 def decode(tag, depth=0, functions=None):
     """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
     Corners, QuadMeshes, or a NotNumbers. On the notebook's side `functions` maps the
     names of ``["fn", name]`` to the functions handed over for this request."""
-    from ...mesh import QuadMesh
-
     if depth > MAX_DEPTH + 1:
         raise ProtocolError("nested too deeply")
     if not isinstance(tag, list) or not tag or not isinstance(tag[0], str):
@@ -300,16 +290,11 @@ def decode(tag, depth=0, functions=None):
     if kind in ("t", "l") and len(tag) == 2 and isinstance(tag[1], list):
         items = [decode(item, depth + 1, functions) for item in tag[1]]
         return tuple(items) if kind == "t" else items
-    if kind == "corner" and len(tag) == 5:
-        return _corner(tag[1:])
-    if kind == "mesh" and len(tag) == 3:
+    if kind in wire.BY_TAG and len(tag) == 1 + len(wire.BY_TAG[kind].fields):
         try:
-            points, quads = _array(tag[1]), _array(tag[2])
-            if not np.array_equal(quads, np.round(quads)):
-                return NotNumbers("a QuadMesh whose quads are not node numbers")
-            return QuadMesh(points, quads.astype(np.intp))
-        except (ValueError, TypeError, ProtocolError) as exc:
-            return NotNumbers(f"an invalid QuadMesh ({exc})")
+            return _course_type(wire.BY_TAG[kind], tag[1:])
+        except ProtocolError as exc:
+            return NotNumbers(f"an invalid {kind} ({exc})")
     if kind == "lines" and len(tag) == 2 and isinstance(tag[1], list) and len(tag[1]) <= MAX_LINES:
         return [_line(item) for item in tag[1]]
     if kind == "obj" and len(tag) == 2 and isinstance(tag[1], str):

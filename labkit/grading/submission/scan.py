@@ -29,9 +29,10 @@ import ast
 import re
 import time
 
+from ..results.text import MAX_SOURCE_CHARS
+
 MAX_CODE_BYTES = 512 * 1024  # a lab notebook's code is a few tens of kilobytes
 TIME_BUDGET = 20.0  # seconds to read one notebook's code
-MAX_SOURCE_CHARS = 20_000  # characters kept of one graded function's source (a lab function is a few hundred)
 
 PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
 # modules a graded function may reach without the scan asking what they are

@@ -21,6 +21,8 @@ import pytest
 from labkit.check import EXERCISES
 from labkit.grading import release_notebook
 
+pytestmark = pytest.mark.slow  # nbgrader's own commands
+
 nbgrader_api = pytest.importorskip("nbgrader.api")
 
 ROOT = Path(__file__).resolve().parents[3]

@@ -186,6 +186,7 @@ def _run_of(runs, start):
     return [run for line, run in runs if line.startswith(start)]
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_docs_commands_ran_and_never_wrote_into_what_the_lms_gave(class_run):
     root, given, runs = class_run
     assert len(runs) == 9
@@ -197,6 +198,7 @@ def test_the_docs_commands_ran_and_never_wrote_into_what_the_lms_gave(class_run)
     assert not [p for p in root.rglob(".labkit-unpacked-*")]  # the grader's own unpacking is gone
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_canvas_students_are_found_in_the_zip_and_the_export_is_grades_csvs_total(class_run):
     root, _, runs = class_run
     rows = _rows(root / "canvas-grades" / "grades.csv")
@@ -213,6 +215,7 @@ def test_canvas_students_are_found_in_the_zip_and_the_export_is_grades_csvs_tota
     assert report.returncode == 0 and (root / "canvas-grades" / "report.html").exists()
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_moodle_student_without_a_notebook_is_not_graded_and_gets_no_number(class_run):
     root, _, runs = class_run
     rows = _rows(root / "moodle-final" / "grades.csv")
@@ -224,6 +227,7 @@ def test_moodle_student_without_a_notebook_is_not_graded_and_gets_no_number(clas
     assert "S104" not in [row[0] for row in exported]  # no number, never a zero
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_late_work_extension_and_grace_are_what_grades_csv_and_the_export_say(class_run):
     root, _, _ = class_run
     rows = _rows(root / "moodle-final" / "grades.csv")
@@ -242,6 +246,7 @@ def test_late_work_extension_and_grace_are_what_grades_csv_and_the_export_say(cl
     assert "late" in by_id["S105"][2]  # Moodle's feedback states the penalty
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_resumed_command_grades_again_only_the_changed_notebook(class_run):
     root, _, runs = class_run
     (again,) = _run_of(runs, "labkit grade moodle-submissions/ --out moodle-grades/")
@@ -253,6 +258,7 @@ def test_the_resumed_command_grades_again_only_the_changed_notebook(class_run):
     assert rows["Eve Euler_105"]["total"] == "6.4"  # the late rule was not forgotten by the resumed command
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_regrade_replaces_one_result_and_the_merge_equals_a_fresh_run(class_run, tmp_path):
     root, _, runs = class_run
     (merge,) = _run_of(runs, "labkit merge")

@@ -335,6 +335,7 @@ def test_results_keep_the_sources_and_old_results_still_load():
             SubmissionGrade.from_dict(data, "ada.json")
 
 
+@pytest.mark.slow  # starts a sandbox
 @pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 def test_graded_results_carry_the_sources_and_a_copy_costs_no_points(tmp_path):
     sandbox_or_skip()

@@ -33,6 +33,7 @@ def submissions(tmp_path_factory):
     return root
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_class_folder_given_without_its_star_is_graded_as_the_class(submissions, tmp_path):
     out = tmp_path / "g"
     run = cli("grade", submissions, "--out", out, "--quiet")
@@ -49,6 +50,7 @@ def test_a_class_folder_given_without_its_star_is_graded_as_the_class(submission
     assert "could not be graded" in feedback and "nothing of this submission was scored" in feedback
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_submissions_listed_one_by_one_open_their_zips_too(submissions, tmp_path):
     out = tmp_path / "g"
     run = cli("grade", submissions / "carol", submissions / "dave", submissions / "alice", "--out", out, "--quiet")
@@ -57,6 +59,7 @@ def test_submissions_listed_one_by_one_open_their_zips_too(submissions, tmp_path
     assert (found["carol"]["total"], found["alice"]["total"], found["dave"]["total"]) == ("8", "8", "")
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_submission_named_like_an_option_is_refused_and_the_docs_way_grades_it(submissions, tmp_path):
     here = tmp_path / "class"
     shutil.copytree(submissions / "alice", here / "--sandbox=none")
@@ -72,6 +75,7 @@ def test_a_submission_named_like_an_option_is_refused_and_the_docs_way_grades_it
     assert sorted(record["submissions"]) == ["--sandbox=none", "bob"]
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_times_inside_a_submission_count_only_when_asked_and_are_marked_student_supplied(submissions, tmp_path):
     rubric = tmp_path / "course.toml"
     rubric.write_text(
@@ -94,6 +98,7 @@ def test_times_inside_a_submission_count_only_when_asked_and_are_marked_student_
     assert rows(tmp_path / "g2")["bob"]["time source"] == late.FROM_NBGRADER
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_result_a_submission_writes_into_its_own_output_folder_is_never_merged(submissions, tmp_path):
     """The pod deployment of docs/scaling.md: one run per student, --sandbox none, then `labkit merge`."""
     forged = SubmissionGrade("bob", {}, [], 1, default()).as_dict()  # bob with nothing at all

@@ -13,7 +13,10 @@ import pytest
 from helpers import processes_with
 from small_class import SEED, cli, files, rows
 
-pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's"),
+]  # slow: a Dask cluster
 distributed = pytest.importorskip("distributed")  # the labkit[dask] extra, which the test extra installs
 DASK = Path(sys.executable).with_name("dask")
 WAIT = 120  # seconds for a process to come up or a run to reach a point (bounded waits, never asserted)

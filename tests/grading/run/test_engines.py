@@ -28,6 +28,7 @@ class Declining(Engine):
         return {"engine": self.name, "batches": len(self.batches)}
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_class_run_writes_what_an_engine_yields_and_records_it(tmp_path):
     first, second = tmp_path / "ann.ipynb", tmp_path / "ben.ipynb"
     for path in (first, second):
@@ -51,6 +52,7 @@ def test_a_class_run_writes_what_an_engine_yields_and_records_it(tmp_path):
     assert [g.name for g in again] == ["ben", "ann"]  # not graded before: handed to the engine again
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_an_engine_is_an_engine_and_the_local_one_has_jobs():
     with pytest.raises(TypeError, match="abstract"):
         Engine()  # type: ignore[abstract]

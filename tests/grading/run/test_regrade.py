@@ -82,11 +82,13 @@ def regraded(tmp_path_factory):
     return tmp, first, merged
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_grading_prints_no_progress_bar_when_the_output_is_not_a_terminal(regraded):
     _, first, _ = regraded
     assert "━" not in first.stderr and "ETA" not in first.stderr and "grading" not in first.stderr
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_class_run_charges_the_slip_and_the_late_day_from_the_times_file_before_timestamp_txt(regraded):
     tmp, *_ = regraded
     rows = _rows(tmp / "class")
@@ -102,6 +104,7 @@ def test_the_class_run_charges_the_slip_and_the_late_day_from_the_times_file_bef
     assert "Total: 7.2 (8 less 0.8 for late work; full credit is 8)" in feedback["bob"]
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_merge_has_the_new_result_for_the_regraded_student_and_the_old_for_the_other(regraded):
     tmp, _, merged = regraded
     assert merged.returncode == 0, merged.stderr
@@ -121,6 +124,7 @@ def test_the_merge_has_the_new_result_for_the_regraded_student_and_the_old_for_t
     ]
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_results_of_another_rubric_or_another_labkit_version_are_refused(regraded):
     tmp, *_ = regraded
     later = tmp / "regrade-alice" / "results" / f"{safe_name('alice')}.json"

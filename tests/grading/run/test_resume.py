@@ -34,6 +34,7 @@ def _processes_with(marker):
     return [cmdline for _, cmdline in processes_with(marker)]
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_resumed_run_grades_only_the_missing_the_unreadable_and_the_not_graded(small_class, tmp_path):
     submissions, reference = small_class
     out = tmp_path / "grades"
@@ -60,6 +61,7 @@ def test_a_resumed_run_grades_only_the_missing_the_unreadable_and_the_not_graded
     assert sorted(files(out, "results")) == sorted(files(reference, "results"))  # no partial file left
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_an_interrupted_run_resumes_where_it_stopped(small_class, tmp_path):
     submissions, reference = small_class
     out, temporary = tmp_path / "grades", tmp_path / "tmp"
@@ -90,6 +92,7 @@ def test_an_interrupted_run_resumes_where_it_stopped(small_class, tmp_path):
     assert files(out, "feedback") == files(reference, "feedback")
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_resuming_refuses_another_seed_rubric_or_class_and_fresh_starts_over(small_class, tmp_path):
     submissions, reference = small_class
     out = tmp_path / "grades"

@@ -63,6 +63,7 @@ def shards(small_class, tmp_path_factory):
     return tmp
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_four_shards_merged_are_the_class_graded_in_one_run(small_class, shards):
     submissions, reference = small_class
     sizes = [json.loads((shards / f"part{i}" / "run.json").read_text())["submissions"] for i in range(1, 5)]
@@ -75,6 +76,7 @@ def test_four_shards_merged_are_the_class_graded_in_one_run(small_class, shards)
     assert len(rows(shards / "merged")) == len(submissions)
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_an_empty_shard_writes_a_folder_that_merges_but_is_never_the_whole_merge(shards, tmp_path):
     empty = shards / "empty"
     assert sorted(p.name for p in empty.iterdir()) == [

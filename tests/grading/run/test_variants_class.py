@@ -104,6 +104,7 @@ def course(tmp_path_factory):
     }  # fmt: skip
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_release_gives_each_student_a_folder_whose_notebooks_hold_their_own_data(course):
     common = {p.name: release_notebook(nbformat.read(p, as_version=4), p.name) for p in NOTEBOOKS.glob("*.ipynb")}
     for name, values in course["values"].items():
@@ -134,6 +135,7 @@ def test_the_release_gives_each_student_a_folder_whose_notebooks_hold_their_own_
                 assert mine == common[path.name]  # nothing else differs from the class's release
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_each_solution_earns_full_marks_on_its_own_variant_whatever_its_metadata_says(course):
     for name in ("ada", "bob", "cy"):
         row = course["rows"][name]
@@ -143,6 +145,7 @@ def test_each_solution_earns_full_marks_on_its_own_variant_whatever_its_metadata
         assert ANOTHER not in feedback
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
     row = course["rows"]["dan"]
     parts = {p.name: p.weight for p in LAB.exercises[4].parts}
@@ -177,6 +180,7 @@ def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
     assert "Another variant&#x27;s data" in page or "Another variant's data" in page
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_run_records_the_file_s_digest_and_each_student_s_data_never_the_secret(course):
     record = json.loads((course["out"] / "record.json").read_text(encoding="utf-8"))
     found = variants.read(course["secret"])
@@ -193,6 +197,7 @@ def test_the_run_records_the_file_s_digest_and_each_student_s_data_never_the_sec
     assert ran.returncode != 0 and "same --variants" in ran.stderr
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_labkit_variants_check_passes_over_the_lab(course):
     ran = _cli(
         "variants", "--check", 2, "--variants", course["secret"], "--roster", course["roster"],
@@ -202,6 +207,7 @@ def test_labkit_variants_check_passes_over_the_lab(course):
     assert "every draw is as it should be" in ran.stdout and ran.stdout.count("draw ") >= 6
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_roster_without_variants_or_the_reverse_is_refused_with_what_to_give(course):
     for command in (
         ["release", NOTEBOOKS, "--out", course["tmp"] / "x"],
@@ -214,6 +220,7 @@ def test_a_roster_without_variants_or_the_reverse_is_refused_with_what_to_give(c
     assert ran.returncode != 0 and "--show needs --roster" in ran.stderr
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_resume_with_another_roster_and_a_merge_with_other_variants_are_refused(course):
     changed = course["tmp"] / "changed.csv"
     changed.write_text("submission,id\n" + "".join(f"{n},{i}\n" for n, i in ROSTER.items()).replace("1816", "9999"))

@@ -140,6 +140,7 @@ def test_the_cli_offers_the_registry_and_refuses_other_names():
         assert f"{name}{' (the default)' if name == backends.DEFAULT else ''}: {summary}" in help_text
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_old_switch_of_the_library_is_gone():
     """``sandboxed=False`` was the ``none`` backend before any release; the options name the backend now."""
     assert GradeOptions(backend="none").backend == "none"
@@ -150,6 +151,7 @@ def test_the_old_switch_of_the_library_is_gone():
     assert not hasattr(GradeOptions, "build")
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_backend_defined_in_a_test_module_is_all_grading_needs(tmp_path, monkeypatch, capsys):
     """Subclass, register, name it in the options: the grading processes import this module and use it."""
     record = tmp_path / "record.jsonl"
@@ -262,6 +264,7 @@ def test_a_new_backend_is_one_new_module_in_the_package(tmp_path):
     assert builtin == "('bwrap', 'none', 'zzexample')" and found == "Example" and chosen == "zzexample"
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_course_module_is_shown_in_the_sandbox_alone_never_the_folder_around_it(tmp_path, monkeypatch):
     from conftest import sandbox_or_skip  # here, not at the top: grading processes import this module
 

@@ -104,6 +104,7 @@ def _run(notebook, cells):
     return remote.Namespace(notebook)
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_two_notebooks_from_one_server_share_no_file_socket_process_or_descriptor(server):
     with remote.NotebookHandle(GradeOptions()) as first, remote.NotebookHandle(GradeOptions()) as second:
         assert isinstance(first.box, forkserver.ForkedBox) and isinstance(second.box, forkserver.ForkedBox)
@@ -122,6 +123,7 @@ def test_two_notebooks_from_one_server_share_no_file_socket_process_or_descripto
         assert theirs["peeked"] == 0, "the notebook could read its supervisor's memory"
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_notebook_after_another_finds_nothing_it_left(server):
     with remote.NotebookHandle(GradeOptions()) as first:
         assert _run(first, [FIRST])["left"]
@@ -129,6 +131,7 @@ def test_a_notebook_after_another_finds_nothing_it_left(server):
         assert _run(second, [SECOND])["found"] == []
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_notebooks_limits_hold_in_a_forked_worker(server):
     options = GradeOptions(limits=Limits(memory=600 * 1024**2))
     with remote.NotebookHandle(options) as notebook:
@@ -143,6 +146,7 @@ def test_the_notebooks_limits_hold_in_a_forked_worker(server):
         assert ns["limit"] == 600 * 1024**2 and ns["held"] == 0
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_without_a_server_or_with_a_dead_one_a_notebook_gets_a_sandbox_of_its_own():
     sandbox_or_skip()
     backend = backends.get_backend("bwrap")
@@ -166,6 +170,7 @@ def _rows(path):
         return list(csv.reader(handle))
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_plain_way_and_the_fork_server_give_the_same_grades(tmp_path):
     sandbox_or_skip()
     solved = tmp_path / "solved"
@@ -197,6 +202,7 @@ held.sort()
 """
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_a_forked_notebook_holds_no_descriptor_a_sandbox_of_its_own_would_not(server):
     """Only the notebook's own pipes cross the fork: not the keeper's control or status pipes, nor the files
     that put it in its cgroup, nor the server's socket."""

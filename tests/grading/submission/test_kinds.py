@@ -112,6 +112,7 @@ def notebook():
     started.close()
 
 
+@pytest.mark.slow  # starts a worker process
 def test_through_the_worker_a_students_timeout_is_raised_and_the_workers_own_is_a_time_limit(notebook):
     cells = [
         "import time\ndef slow():\n    time.sleep(60)\n",
@@ -129,6 +130,7 @@ def test_through_the_worker_a_students_timeout_is_raised_and_the_workers_own_is_
     assert notebook.tampered is None  # a student's exception named Tampered voids nothing
 
 
+@pytest.mark.slow  # starts a worker process
 def test_through_the_worker_a_cell_stopped_at_its_limit_is_a_time_limit_and_a_cell_raising_timeout_is_not(notebook):
     cells = [
         "class Timeout(Exception):\n    pass\nraise Timeout('interrupted: it ran longer than the time limit')\n",
@@ -321,6 +323,7 @@ def _kinds_by_student(summary):
     return {(kind, p.student) for kind, rows in summary.problems.items() for p in rows}
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_in_a_sandboxed_class_a_students_own_timeout_tampered_and_workererror_are_errors_raised(graded_class):
     _, out, (_, tampered, timeout) = graded_class
     grades = {grade.name: grade for grade in class_report.read(out)}
@@ -340,6 +343,7 @@ def test_in_a_sandboxed_class_a_students_own_timeout_tampered_and_workererror_ar
     assert any(f"cell {tampered} raised Tampered" in line for line in cells.texts), cells.texts
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_in_a_sandboxed_class_the_old_phrases_in_a_students_messages_are_errors_raised(graded_class):
     _, out, _ = graded_class
     grades = {grade.name: grade for grade in class_report.read(out)}
@@ -348,6 +352,7 @@ def test_in_a_sandboxed_class_the_old_phrases_in_a_students_messages_are_errors_
     assert {kind for kind, student in _kinds_by_student(summary) if student == "worded"} == {"raised"}
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_in_a_sandboxed_class_a_real_time_limit_and_a_real_end_of_the_process_keep_their_kinds(graded_class):
     _, out, _ = graded_class
     grades = {grade.name: grade for grade in class_report.read(out)}
@@ -356,6 +361,7 @@ def test_in_a_sandboxed_class_a_real_time_limit_and_a_real_end_of_the_process_ke
     assert outcomes["phi_table"] == "passed"  # the call that ended the process cost only itself
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_honest_classmate_gets_full_marks(graded_class):
     _, out, _ = graded_class
     [honest] = [grade for grade in class_report.read(out) if grade.name == "honest"]
@@ -364,6 +370,7 @@ def test_the_honest_classmate_gets_full_marks(graded_class):
     assert rows(out)["honest"]["exercise 16"] == "8" and rows(out)["honest"]["status"] == "graded"
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_the_report_reads_the_same_kinds_from_a_resumed_run_and_a_merge(graded_class, tmp_path):
     submissions, out, _ = graded_class
     first = class_report.summarise(class_report.read(out))
@@ -382,6 +389,7 @@ def test_the_report_reads_the_same_kinds_from_a_resumed_run_and_a_merge(graded_c
         assert "Errors raised" in html and "Answers voided" not in html
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_rewording_every_message_changes_nothing_the_report_says(graded_class):
     """The grader's words may change: scrambled, every failed step's detail and every problem's text, the
     report's outcomes and problem kinds are the same."""

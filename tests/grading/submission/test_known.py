@@ -355,6 +355,7 @@ def test_a_run_is_released_by_merging_it_under_a_rubric_that_releases(tmp_path):
 # -- graded for real, honest classmates and copiers in one run ----------------------------------------------------
 
 
+@pytest.mark.slow  # starts a sandbox
 def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tmp_path):
     sandbox_or_skip()
     subs = [INDEPENDENT / style for style in STYLES]

@@ -18,6 +18,8 @@ from labkit.exercises import hermite
 from labkit.exercises.model import EXPERIMENTS, INTERPOLANTS, OWN_FUNCTIONS, OWN_PATCH
 from labkit.exercises.registry import LAB
 
+pytestmark = pytest.mark.slow  # a worker process per case
+
 REFUSALS = LAB.refusals
 from labkit.grading.options import GradeOptions
 from labkit.grading.sandbox import guard, remote

@@ -14,6 +14,8 @@ from labkit.grading.options import GradeOptions
 from labkit.grading.sandbox import remote
 from labkit.grading.submission import scoring
 
+pytestmark = pytest.mark.slow  # waits for time limits
+
 UNCONFINED = GradeOptions(backend="none", cell_timeout=2)
 
 

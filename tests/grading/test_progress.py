@@ -4,7 +4,7 @@ import io
 
 from rich.console import Console
 
-from labkit.grading.run.progress import Progress
+from labkit.grading.progress import Progress
 
 
 class Clock:
