@@ -445,11 +445,9 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
     if name is None:
         raise ValueError(f"{file.name} is not one of the lab's notebooks.")
     nb = nbformat.read(file, as_version=4)
-    nb.cells = [c for c in nb.cells if not (c.cell_type == "code" and "ready_to_hand_in(" in c.source)]
-    final = nbformat.v4.new_code_cell(
-        f'print({MARK!r} + __import__("json").dumps(__import__("labkit.handin", fromlist=["x"])'
-        f".ready_to_hand_in({name!r}, path={str(file.resolve())!r}).as_dict()))"
-    )
+    numbers = _notebook.prompt_numbers(nb.cells)  # the student's numbering, the hand-in cell still in place
+    ran = [(i, c) for i, c in enumerate(nb.cells) if not (c.cell_type == "code" and "ready_to_hand_in(" in c.source)]
+    nb.cells = [c for _, c in ran]
     client = NotebookClient(
         nb,
         timeout=timeout,
@@ -464,6 +462,7 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
             for index, cell in enumerate(nb.cells):
                 if cell.cell_type == "code":
                     client.execute_cell(cell, index)
+            final = _final_cell(name, file, _kernel_counts(ran, numbers))
             nb.cells.append(final)
             client.execute_cell(final, len(nb.cells) - 1, store_history=False)
     except Exception as exc:  # noqa: BLE001 - a kernel that died or never started is reported, not raised
@@ -479,6 +478,23 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
         f"{o.get('ename')}: {o.get('evalue')}" for o in final.get("outputs", []) if o.get("output_type") == "error"
     ]
     return HandIn(name, [], problem=errors[0] if errors else "the notebook's kernel gave no result")
+
+
+def _kernel_counts(ran: list, numbers: dict) -> dict:
+    """{the kernel's count of each (index, cell) that ran: its number in the notebook's order}; the kernel's
+    count is one ahead of Jupyter's (the hand-in's own setup ran first), so the table uses the notebook's."""
+    return {c.execution_count: numbers[i] for i, c in ran if c.get("execution_count") is not None and i in numbers}
+
+
+def _final_cell(name: str, file: Path, counts: dict):
+    """The cell that renumbers the cells that raised (:func:`_kernel_counts`) and prints the table as data."""
+    import nbformat
+
+    return nbformat.v4.new_code_cell(
+        f'__import__("labkit.notebook", fromlist=["x"]).CELLS.renumber({counts!r})\n'
+        f'print({MARK!r} + __import__("json").dumps(__import__("labkit.handin", fromlist=["x"])'
+        f".ready_to_hand_in({name!r}, path={str(file.resolve())!r}).as_dict()))"
+    )
 
 
 def _devnull():

@@ -14,7 +14,7 @@ import importlib.util
 import os
 import sys
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 class VersionWarning(UserWarning):
@@ -129,10 +129,41 @@ class CellErrors:
             _line_in_cell(error),
         )
 
+    def renumber(self, numbers: dict) -> None:
+        """Give each noted cell the number `numbers` maps its number to ({kernel's count: ``[n]``}), e.g. the
+        :func:`prompt_numbers` of the cells ``labkit handin`` ran in a kernel whose count had moved on."""
+        for key, cell in self.raised.items():
+            if cell.number in numbers:
+                self.raised[key] = replace(cell, number=int(numbers[cell.number]))
+
     def cells(self) -> list:
         """The cells that raised, in the order of their numbers (then of their runs)."""
         found = list(self.raised.values())
         return sorted(found, key=lambda cell: (cell.number is None, cell.number or 0))
+
+
+def prompt_numbers(cells) -> dict:
+    """{index in `cells`: the number Jupyter shows beside that code cell after Restart and Run All, ``[n]``}.
+
+    The one numbering labkit names cells by (``labkit handin``, the notebook's hand-in table, the grader's
+    feedback): code cells counted from 1 in the notebook's order, leaving out blank ones, which JupyterLab,
+    VS Code and nbclient do not run. `cells` are a notebook's cells (dicts or nbformat cells), or the
+    sources of its code cells only (strings).
+
+    >>> prompt_numbers([{"cell_type": "markdown", "source": "# A"}, {"cell_type": "code", "source": "x = 1"},
+    ...                 {"cell_type": "code", "source": ["  \\n"]}, "y = 2"])
+    {1: 1, 3: 2}
+    """
+    numbers, count = {}, 0
+    for index, cell in enumerate(cells):
+        if isinstance(cell, str):
+            cell = {"cell_type": "code", "source": cell}
+        source = cell.get("source", "")
+        source = "".join(source) if isinstance(source, list) else str(source)
+        if cell.get("cell_type") == "code" and source.strip():
+            count += 1
+            numbers[index] = count
+    return numbers
 
 
 CELLS: CellErrors | None = None  # set by track_cells() in an IPython kernel

@@ -36,6 +36,7 @@ SLOW_MODULES = {
     "test_dask",  # a Dask cluster
     "test_nbgrader",  # nbgrader's own commands
     "test_notebooks_clean",  # executes notebooks
+    "test_cell_numbers",  # executes a notebook
     "test_student_work",  # executes notebooks
     "test_timeouts",  # waits for time limits
     "test_grading",  # grades the instructor notebooks and small classes
