@@ -62,6 +62,7 @@ class HandIn:
     empty_answers: list | None = None
     answers_from: str = ""
     every_cell_ran: bool = False  # run by `labkit handin`: no cell was skipped after one raised
+    never_ran: list | None = None  # the saved notebook's code cells that did not run in this kernel, when known
     problem: str = ""  # `labkit handin` could not run the notebook: why
 
     @property
@@ -127,11 +128,8 @@ class HandIn:
                 f"{count[DONE]} of {len(self.parts)} parts pass their self-checks, {count[FAILING]} fail, "
                 f"{count[NOT_STARTED]} not started."
             )
-        if self.raised and not self.every_cell_ran:
-            lines.append(
-                "Run all stops at the first cell that raises, so the cells below it did not run: what they "
-                "define shows as not started. Fix that cell, then Restart and run all again."
-            )
+        if self.never_ran and not self.every_cell_ran:
+            lines.append(_not_run_advice(self.never_ran))
         lines.append(
             "Only the self-checks ran, on fixed data; the grader uses fresh data too, so your grade may differ."
         )
@@ -201,7 +199,26 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
     _notebook.track_cells()  # from now on, if the first cell did not
     cells, answers_from = _read_notebook(name, namespace, path)
     empty = _empty_answers(name, cells) if cells is not None else None
-    return HandIn(name, _parts(name, namespace, raised or []), raised, empty, answers_from)
+    result = HandIn(name, _parts(name, namespace, raised or []), raised, empty, answers_from)
+    if cells is not None and _notebook.CELLS is not None:
+        result.never_ran = [n for n in _notebook.CELLS.never_ran(cells) if n != _hand_in_cell(cells)]
+    return result
+
+
+def _hand_in_cell(cells: list) -> int | None:
+    """The number of the cell that calls ready_to_hand_in (it is running, not yet noted as run)."""
+    numbers = _notebook.prompt_numbers(cells)
+    found = [numbers[i] for i in numbers if "ready_to_hand_in(" in _text(cells[i])]
+    return found[-1] if found else None
+
+
+def _not_run_advice(numbers: list) -> str:
+    shown = ", ".join(f"[{n}]" for n in numbers[:8]) + (", ..." if len(numbers) > 8 else "")
+    return (
+        f"{len(numbers)} cell(s) of the saved notebook did not run in this kernel ({shown}): what they define "
+        "shows as not started. Restart and run all; if it stops at a cell that raises, fix that cell and run all "
+        "again."
+    )
 
 
 def _parts(name: str, namespace: Mapping, raised: list) -> list:

@@ -105,6 +105,7 @@ class CellErrors:
 
     def __init__(self):
         self.raised = {}
+        self.ran: set = set()  # the ids (or, without one, the sources) of every cell run since the kernel started
 
     def __call__(self, result=None) -> None:
         try:  # a hook that raises would print its traceback under every cell
@@ -116,6 +117,7 @@ class CellErrors:
         info = getattr(result, "info", None)
         source = str(getattr(info, "raw_cell", "") or "")
         key = getattr(info, "cell_id", None) or ("source", source)
+        self.ran.add(key)
         error = getattr(result, "error_before_exec", None) or getattr(result, "error_in_exec", None)
         if error is None:
             self.raised.pop(key, None)
@@ -128,6 +130,18 @@ class CellErrors:
             _first_line(error),
             _line_in_cell(error),
         )
+
+    def never_ran(self, cells) -> list:
+        """The numbers (:func:`prompt_numbers`) of the code cells of saved notebook `cells` that never ran in this
+        kernel (a cell is known by its id, or by its source where the front end sent no id)."""
+        sources = {key[1] for key in self.ran if isinstance(key, tuple)}
+        left = []
+        for index, number in prompt_numbers(cells).items():
+            source = cells[index].get("source", "")
+            source = "".join(source) if isinstance(source, list) else str(source)
+            if cells[index].get("id") not in self.ran and source not in sources:
+                left.append(number)
+        return left
 
     def renumber(self, numbers: dict) -> None:
         """Give each noted cell the number `numbers` maps its number to ({kernel's count: ``[n]``}), e.g. the
