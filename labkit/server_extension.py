@@ -79,7 +79,8 @@ def without_unsaved_views(notebook: dict) -> int:
     """
     saved, dropped = _saved_widget_models(notebook), 0
     for cell in notebook.get("cells") or []:
-        for output in cell.get("outputs") or [] if isinstance(cell, dict) else []:
+        outputs = cell.get("outputs") if isinstance(cell, dict) else None
+        for output in outputs if isinstance(outputs, list) else []:
             data = output.get("data") if isinstance(output, dict) else None
             if not isinstance(data, dict) or WIDGET_VIEW not in data or len(data) < 2:
                 continue

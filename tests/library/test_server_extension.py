@@ -205,3 +205,10 @@ def test_the_servers_contents_manager_saves_notebooks_without_unsaved_views(tmp_
     assert set(saved["cells"][0]["outputs"][0]["data"]) == {"image/png", "text/html", "text/plain"}
     manager.save({"type": "file", "format": "text", "content": "notes"}, "notes.txt")  # other files as they are
     assert (tmp_path / "notes.txt").read_text() == "notes"
+
+
+def test_a_notebook_of_odd_shape_is_saved_as_it_is():
+    odd = {"cells": ["text", {"outputs": "none"}, {"outputs": [1, {"data": []}, {"data": {"text/plain": "x"}}]}]}
+    before = json.dumps(odd)
+    assert server_extension.without_unsaved_views(odd) == 0 and json.dumps(odd) == before
+    server_extension.drop_unsaved_widget_views({"type": "notebook", "content": None}, "x.ipynb")  # nothing to do
