@@ -82,7 +82,11 @@ def _handin(args):
     ready = sum(result.ready for result in results)
     if skipped:
         print(f"Not lab notebooks, not run: {', '.join(skipped)}.")
-    print(f"Ready to hand in: {ready} of {len(results)} notebook(s), as far as the self-checks can tell.")
+    from .handin import _wrapped
+    from .handin_summary import folder_lines
+
+    for line in folder_lines([name for _, name in lab], ready):
+        print(_wrapped(line, ""))
     return 0 if ready == len(results) else 1
 
 

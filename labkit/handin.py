@@ -62,6 +62,7 @@ class HandIn:
     empty_answers: list | None = None
     answers_from: str = ""
     every_cell_ran: bool = False  # run by `labkit handin`: no cell was skipped after one raised
+    never_ran: list | None = None  # the saved notebook's code cells that did not run in this kernel, when known
     problem: str = ""  # `labkit handin` could not run the notebook: why
 
     @property
@@ -127,11 +128,8 @@ class HandIn:
                 f"{count[DONE]} of {len(self.parts)} parts pass their self-checks, {count[FAILING]} fail, "
                 f"{count[NOT_STARTED]} not started."
             )
-        if self.raised and not self.every_cell_ran:
-            lines.append(
-                "Run all stops at the first cell that raises, so the cells below it did not run: what they "
-                "define shows as not started. Fix that cell, then Restart and run all again."
-            )
+        if self.never_ran and not self.every_cell_ran:
+            lines.append(_not_run_advice(self.never_ran))
         lines.append(
             "Only the self-checks ran, on fixed data; the grader uses fresh data too, so your grade may differ."
         )
@@ -201,7 +199,26 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
     _notebook.track_cells()  # from now on, if the first cell did not
     cells, answers_from = _read_notebook(name, namespace, path)
     empty = _empty_answers(name, cells) if cells is not None else None
-    return HandIn(name, _parts(name, namespace, raised or []), raised, empty, answers_from)
+    result = HandIn(name, _parts(name, namespace, raised or []), raised, empty, answers_from)
+    if cells is not None and _notebook.CELLS is not None:
+        result.never_ran = [n for n in _notebook.CELLS.never_ran(cells) if n != _hand_in_cell(cells)]
+    return result
+
+
+def _hand_in_cell(cells: list) -> int | None:
+    """The number of the cell that calls ready_to_hand_in (it is running, not yet noted as run)."""
+    numbers = _notebook.prompt_numbers(cells)
+    found = [numbers[i] for i in numbers if "ready_to_hand_in(" in _text(cells[i])]
+    return found[-1] if found else None
+
+
+def _not_run_advice(numbers: list) -> str:
+    shown = ", ".join(f"[{n}]" for n in numbers[:8]) + (", ..." if len(numbers) > 8 else "")
+    return (
+        f"{len(numbers)} cell(s) of the saved notebook did not run in this kernel ({shown}): what they define "
+        "shows as not started. Restart and run all; if it stops at a cell that raises, fix that cell and run all "
+        "again."
+    )
 
 
 def _parts(name: str, namespace: Mapping, raised: list) -> list:
@@ -445,11 +462,9 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
     if name is None:
         raise ValueError(f"{file.name} is not one of the lab's notebooks.")
     nb = nbformat.read(file, as_version=4)
-    nb.cells = [c for c in nb.cells if not (c.cell_type == "code" and "ready_to_hand_in(" in c.source)]
-    final = nbformat.v4.new_code_cell(
-        f'print({MARK!r} + __import__("json").dumps(__import__("labkit.handin", fromlist=["x"])'
-        f".ready_to_hand_in({name!r}, path={str(file.resolve())!r}).as_dict()))"
-    )
+    numbers = _notebook.prompt_numbers(nb.cells)  # the student's numbering, the hand-in cell still in place
+    ran = [(i, c) for i, c in enumerate(nb.cells) if not (c.cell_type == "code" and "ready_to_hand_in(" in c.source)]
+    nb.cells = [c for _, c in ran]
     client = NotebookClient(
         nb,
         timeout=timeout,
@@ -464,6 +479,7 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
             for index, cell in enumerate(nb.cells):
                 if cell.cell_type == "code":
                     client.execute_cell(cell, index)
+            final = _final_cell(name, file, _kernel_counts(ran, numbers))
             nb.cells.append(final)
             client.execute_cell(final, len(nb.cells) - 1, store_history=False)
     except Exception as exc:  # noqa: BLE001 - a kernel that died or never started is reported, not raised
@@ -479,6 +495,23 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
         f"{o.get('ename')}: {o.get('evalue')}" for o in final.get("outputs", []) if o.get("output_type") == "error"
     ]
     return HandIn(name, [], problem=errors[0] if errors else "the notebook's kernel gave no result")
+
+
+def _kernel_counts(ran: list, numbers: dict) -> dict:
+    """{the kernel's count of each (index, cell) that ran: its number in the notebook's order}; the kernel's
+    count is one ahead of Jupyter's (the hand-in's own setup ran first), so the table uses the notebook's."""
+    return {c.execution_count: numbers[i] for i, c in ran if c.get("execution_count") is not None and i in numbers}
+
+
+def _final_cell(name: str, file: Path, counts: dict):
+    """The cell that renumbers the cells that raised (:func:`_kernel_counts`) and prints the table as data."""
+    import nbformat
+
+    return nbformat.v4.new_code_cell(
+        f'__import__("labkit.notebook", fromlist=["x"]).CELLS.renumber({counts!r})\n'
+        f'print({MARK!r} + __import__("json").dumps(__import__("labkit.handin", fromlist=["x"])'
+        f".ready_to_hand_in({name!r}, path={str(file.resolve())!r}).as_dict()))"
+    )
 
 
 def _devnull():

@@ -14,7 +14,7 @@ import importlib.util
 import os
 import sys
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 class VersionWarning(UserWarning):
@@ -105,6 +105,7 @@ class CellErrors:
 
     def __init__(self):
         self.raised = {}
+        self.ran: set = set()  # the ids (or, without one, the sources) of every cell run since the kernel started
 
     def __call__(self, result=None) -> None:
         try:  # a hook that raises would print its traceback under every cell
@@ -116,6 +117,7 @@ class CellErrors:
         info = getattr(result, "info", None)
         source = str(getattr(info, "raw_cell", "") or "")
         key = getattr(info, "cell_id", None) or ("source", source)
+        self.ran.add(key)
         error = getattr(result, "error_before_exec", None) or getattr(result, "error_in_exec", None)
         if error is None:
             self.raised.pop(key, None)
@@ -129,10 +131,53 @@ class CellErrors:
             _line_in_cell(error),
         )
 
+    def never_ran(self, cells) -> list:
+        """The numbers (:func:`prompt_numbers`) of the code cells of saved notebook `cells` that never ran in this
+        kernel (a cell is known by its id, or by its source where the front end sent no id)."""
+        sources = {key[1] for key in self.ran if isinstance(key, tuple)}
+        left = []
+        for index, number in prompt_numbers(cells).items():
+            source = cells[index].get("source", "")
+            source = "".join(source) if isinstance(source, list) else str(source)
+            if cells[index].get("id") not in self.ran and source not in sources:
+                left.append(number)
+        return left
+
+    def renumber(self, numbers: dict) -> None:
+        """Give each noted cell the number `numbers` maps its number to ({kernel's count: ``[n]``}), e.g. the
+        :func:`prompt_numbers` of the cells ``labkit handin`` ran in a kernel whose count had moved on."""
+        for key, cell in self.raised.items():
+            if cell.number in numbers:
+                self.raised[key] = replace(cell, number=int(numbers[cell.number]))
+
     def cells(self) -> list:
         """The cells that raised, in the order of their numbers (then of their runs)."""
         found = list(self.raised.values())
         return sorted(found, key=lambda cell: (cell.number is None, cell.number or 0))
+
+
+def prompt_numbers(cells) -> dict:
+    """{index in `cells`: the number Jupyter shows beside that code cell after Restart and Run All, ``[n]``}.
+
+    The one numbering labkit names cells by (``labkit handin``, the notebook's hand-in table, the grader's
+    feedback): code cells counted from 1 in the notebook's order, leaving out blank ones, which JupyterLab,
+    VS Code and nbclient do not run. `cells` are a notebook's cells (dicts or nbformat cells), or the
+    sources of its code cells only (strings).
+
+    >>> prompt_numbers([{"cell_type": "markdown", "source": "# A"}, {"cell_type": "code", "source": "x = 1"},
+    ...                 {"cell_type": "code", "source": ["  \\n"]}, "y = 2"])
+    {1: 1, 3: 2}
+    """
+    numbers, count = {}, 0
+    for index, cell in enumerate(cells):
+        if isinstance(cell, str):
+            cell = {"cell_type": "code", "source": cell}
+        source = cell.get("source", "")
+        source = "".join(source) if isinstance(source, list) else str(source)
+        if cell.get("cell_type") == "code" and source.strip():
+            count += 1
+            numbers[index] = count
+    return numbers
 
 
 CELLS: CellErrors | None = None  # set by track_cells() in an IPython kernel

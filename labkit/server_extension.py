@@ -14,11 +14,19 @@ whatever class the server was configured with (the default one, a gateway's or a
 nothing else about the connection changes; a server without that setting (Jupyter Server 1) is left
 as it is. Installing labkit enables the extension (``etc/jupyter/jupyter_server_config.d/labkit.json``);
 ``jupyter server extension disable labkit.server_extension`` turns it off.
+
+It also registers a pre-save hook (:func:`drop_unsaved_widget_views`): JupyterLab saves an explorer's
+output as a widget view beside its png and html picture, but not the widget's state, so a notebook
+reopened later would show "Error displaying widget: model not found" where the picture should be. The
+hook leaves out, in the saved file only, every widget view whose state the file does not hold; the
+open notebook keeps its live explorer, and the reopened one shows the picture.
 """
 
 from __future__ import annotations
 
 SETTING = "kernel_websocket_connection_class"
+WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
 
 
 def _jupyter_server_extension_points():
@@ -58,7 +66,46 @@ def without_nagle(connection_class: type) -> type:
     )
 
 
+def _saved_widget_models(notebook: dict) -> set:
+    """The ids of the widget models whose state a notebook's metadata holds."""
+    widgets = (notebook.get("metadata") or {}).get("widgets") or {}
+    state = (widgets.get(WIDGET_STATE) or {}).get("state") if isinstance(widgets, dict) else None
+    return set(state) if isinstance(state, dict) else set()
+
+
+def without_unsaved_views(notebook: dict) -> int:
+    """Leave out of `notebook` (nbformat 4 as JSON, in place) every output's widget view whose model's state
+    it does not hold, where the output has something else to show (a png, html, text); how many were left out.
+    """
+    saved, dropped = _saved_widget_models(notebook), 0
+    for cell in notebook.get("cells") or []:
+        outputs = cell.get("outputs") if isinstance(cell, dict) else None
+        for output in outputs if isinstance(outputs, list) else []:
+            data = output.get("data") if isinstance(output, dict) else None
+            if not isinstance(data, dict) or WIDGET_VIEW not in data or len(data) < 2:
+                continue
+            view = data[WIDGET_VIEW]
+            if not isinstance(view, dict) or view.get("model_id") not in saved:
+                del data[WIDGET_VIEW]
+                dropped += 1
+    return dropped
+
+
+def drop_unsaved_widget_views(model=None, path="", contents_manager=None, **kwargs) -> None:
+    """Jupyter Server's pre-save hook: a notebook is saved without widget views it cannot show again
+    (:func:`without_unsaved_views`); anything else is saved as it is."""
+    if not isinstance(model, dict) or model.get("type") != "notebook" or not isinstance(model.get("content"), dict):
+        return
+    dropped = without_unsaved_views(model["content"])
+    log = getattr(contents_manager, "log", None)
+    if dropped and log is not None:
+        log.debug("labkit: %s saved with its explorers' pictures instead of %d widget view(s)", path, dropped)
+
+
 def _load_jupyter_server_extension(serverapp) -> None:
+    register = getattr(getattr(serverapp, "contents_manager", None), "register_pre_save_hook", None)
+    if register is not None:  # Jupyter Server 2
+        register(drop_unsaved_widget_views)
     settings = serverapp.web_app.settings
     current = settings.get(SETTING) or getattr(serverapp, SETTING, None)
     if isinstance(current, str):  # a class named in the configuration, not yet imported

@@ -33,6 +33,8 @@ STUDENT_CONFIG = ROOT / "jupyter" / "student"
 VENV = Path(sys.prefix)
 JUPYTER = VENV / "bin" / "jupyter"
 LAB_EXTENSION = "@jupyter/nbgrader"
+# JupyterLab's plugin that asks "Would you like to get notified about official Jupyter news?" over every notebook
+ANNOUNCEMENTS = "@jupyterlab/apputils-extension:announcements"
 TOKEN = "labkit-make-lab-test"
 SECRETS = ("BEGIN SOLUTION", "END SOLUTION", "BEGIN HIDDEN TESTS")
 
@@ -257,6 +259,10 @@ def test_make_lab_serves_the_student_copies_without_nbgrader(sessions):
     assert not [s for s in SECRETS if s in student["first notebook"]]
     assert LAB_EXTENSION in student["lab extensions"] and LAB_EXTENSION in student["disabled"]
     assert student["nbgrader"] == dict.fromkeys(student["nbgrader"], 404), student["nbgrader"]
+    # the news popup is off, and its plugin is a real one of this JupyterLab (a renamed one would pop up again)
+    assert ANNOUNCEMENTS in student["disabled"] and ANNOUNCEMENTS not in seen["lab-instructor"]["disabled"]
+    static = Path(sys.prefix, "share", "jupyter", "lab", "static")
+    assert any(ANNOUNCEMENTS in p.read_text(errors="ignore") for p in static.glob("jlab_core*.js"))
     # every server extension nbgrader enables in the venv (the instructor's session loads them) is off here
     nbgrader = {name for name in seen["lab-instructor"]["server extensions"] if name.startswith("nbgrader.")}
     assert len(nbgrader) >= 4 and not nbgrader & student["server extensions"], student["server extensions"]

@@ -57,7 +57,8 @@ function render({ model, el }) {
   side.style.cssText = "display:flex; flex-direction:column; gap:6px; max-width:36em";
   const readout = document.createElement("pre");
   readout.className = "labkit-editor-readout";
-  readout.style.cssText = "font-size:12px; margin:0; padding:6px; border:1px solid #767676; user-select:text";
+  readout.style.cssText =
+    "font-size:12px; margin:0; padding:6px; border:1px solid #767676; user-select:text; white-space:pre-wrap";
   const live = document.createElement("div");
   live.className = "labkit-editor-status";
   live.setAttribute("role", "status");
@@ -307,7 +308,7 @@ function render({ model, el }) {
     }
   }
   function showReadout(picture) {
-    readout.textContent = picture.readout;
+    fillReadout(readout, picture.readout || "");
     readout.style.borderColor = picture.worst <= 0 ? "#d62728" : "#767676";
     img.alt = picture.alt;
   }
@@ -341,6 +342,22 @@ function render({ model, el }) {
     if (url) URL.revokeObjectURL(url);
     clearTimeout(timer);
   };
+}
+
+// The readout, one block per line; a narrow box wraps a `Corner(...)` line only between its items
+// (`ds=[1.2, -0.3],`), never inside a list, and the wrapped part is indented under the line's start.
+function fillReadout(box, text) {
+  box.replaceChildren(...text.split("\n").map((line) => {
+    const row = document.createElement("div");
+    row.style.cssText = "padding-left:4ch; text-indent:-4ch";
+    line.split(/(?<=,) (?![^[]*\])/).forEach((item, k) => { // at ", " outside brackets
+      const span = document.createElement("span");
+      span.style.whiteSpace = "nowrap";
+      span.textContent = item;
+      row.append(...(k ? [" ", span] : [span]));
+    });
+    return row;
+  }));
 }
 
 export default { render };

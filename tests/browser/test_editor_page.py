@@ -142,3 +142,29 @@ def test_a_late_answer_to_a_drag_given_up_on_does_not_free_the_next(page):
         return [before, t.sent.length]; }"""
     )
     assert counts == [2, 3]
+
+
+def test_a_narrow_readout_wraps_a_corner_line_between_its_items_never_inside_a_list(page):
+    text = (
+        "Corner data:\n"
+        "A = Corner([0, 0], ds=[1.2, -0.3], dt=[0.2, 1], dsdt=[0, 0])\n"
+        "B = Corner([1.2, 0.1], ds=[1, 0.4], dt=[-0.2, 1.1], dsdt=[0, 0])\n"
+        "worst quality 0.42"
+    )
+    seen = page.evaluate(
+        """(text) => { setUp(JSON.stringify({readout: text}));
+        const box = [...document.querySelectorAll('.labkit-editor-readout')].pop();  // this set-up's editor
+        box.style.width = '30ch';  // narrower than a Corner line
+        const rows = [...box.children];
+        const spans = [...box.querySelectorAll('span')];
+        const line = parseFloat(getComputedStyle(box).lineHeight) || 16;
+        return {text: box.innerText, rows: rows.length,
+                broken: spans.filter(s => s.getClientRects().length !== 1).map(s => s.textContent),
+                items: spans.map(s => s.textContent),
+                wrapped: rows.filter(r => r.getBoundingClientRect().height > 1.5 * line).length}; }""",
+        text,
+    )
+    assert seen["text"].splitlines() == text.splitlines() and seen["rows"] == 4
+    assert not seen["broken"], seen["broken"]  # every item on one visual line
+    assert "ds=[1.2, -0.3]," in seen["items"] and "dsdt=[0, 0])" in seen["items"]
+    assert seen["wrapped"] == 2  # the two Corner lines wrapped, between items

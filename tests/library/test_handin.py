@@ -300,7 +300,41 @@ def test_the_cells_that_raised_are_noted_by_the_first_cells_hook(monkeypatch):
         InteractiveShell.clear_instance()
     assert [(c.error, c.line) for c in result.raised] == [("ZeroDivisionError", 1), ("SyntaxError", 1)]
     assert "x = 1 / 0" in result.text() and "ZeroDivisionError: division by zero" in result.text()
-    assert "Run all stops at the first cell that raises" in result.text()
+    assert result.never_ran and "did not run in this kernel" in result.text()  # none of that notebook's cells ran
+
+
+def _hand_in_after_running(path, skip=()):
+    """The hand-in table of the saved notebook at `path` after its code cells ran in a fresh shell, each with its
+    id as JupyterLab sends it (those at indices `skip` left out), its last cell, the hand-in call, last."""
+    from IPython.core.interactiveshell import InteractiveShell
+
+    cells = nbformat.read(path, as_version=4).cells
+    shell = InteractiveShell.instance()
+    try:
+        for index, cell in enumerate(cells[:-1]):
+            if cell.cell_type == "code" and index not in skip:
+                shell.run_cell(cell.source.replace("%matplotlib inline", ""), cell_id=cell.id)
+        call = f"r = labkit.ready_to_hand_in('02_convergence', path={str(path)!r})"
+        shell.run_cell(call, cell_id=cells[-1].id)
+        return shell.user_ns["r"]
+    finally:
+        shell.events.unregister("post_run_cell", notebook.CELLS)
+        InteractiveShell.clear_instance()
+
+
+def test_the_run_all_advice_appears_only_when_a_cell_did_not_run(monkeypatch):
+    cells = nbformat.read(RELEASE / NAME, as_version=4).cells
+    numbers = notebook.prompt_numbers(cells)
+    code = sorted(numbers)
+    for skip in [(), (code[-3], code[-2])]:
+        monkeypatch.setattr(notebook, "CELLS", None)
+        result = _hand_in_after_running(RELEASE / NAME, skip)
+        assert result.raised  # the release's stubs raised, as in any Run All of it
+        assert result.never_ran == [numbers[i] for i in skip]
+        advice = (
+            f"2 cell(s) of the saved notebook did not run in this kernel ([{numbers[code[-3]]}], [{numbers[code[-2]]}])"
+        )
+        assert (advice in result.text()) == bool(skip) and ("did not run" in result.text()) == bool(skip)
 
 
 def test_a_stub_cell_leaves_its_names_not_started():
@@ -329,3 +363,39 @@ def test_where_nothing_is_seen_the_table_is_not_made(monkeypatch):
     monkeypatch.delenv("LABKIT_HEADLESS")
     labkit.handin.ready_to_hand_in("02_convergence", namespace={})
     assert len(calls) == 1
+
+
+# --- the folder's last lines: what it lacks, and whether that is needed ------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("present", "needs"),
+    [
+        (["02_convergence.ipynb"], "needed by everyone: 01_limacon.ipynb"),
+        (
+            ["01_limacon.ipynb", "02_convergence.ipynb"],
+            "a branch is still missing: 03_meshes, or 04_splines + 05_monotone",
+        ),
+        (["01_limacon.ipynb", "02_convergence.ipynb", "04_splines.ipynb"], "a branch is still missing"),
+        (["01_limacon.ipynb", "02_convergence.ipynb", "03_meshes.ipynb"], "not needed: the mesh generation branch"),
+        (["01_limacon.ipynb", "02_convergence.ipynb", "04_splines.ipynb", "05_monotone.ipynb"], "the splines branch"),
+    ],
+)
+def test_the_folders_summary_names_the_missing_notebooks_and_knows_the_branches(present, needs):
+    from labkit.handin_summary import folder_lines
+
+    lines = folder_lines(present, 0)
+    missing = sorted(set(LAB.notebooks()) - set(present))
+    assert lines[0].startswith(f"Ready to hand in: 0 of {len(present)} notebook(s)")
+    assert lines[-1].startswith(f"Not in this folder: {', '.join(missing)} (") and needs in lines[-1]
+    # the branches are the rubric's: its exercises, in the notebooks the exercises declare
+    for name, exercises in [("mesh generation", range(5, 10)), ("splines", range(10, 16))]:
+        notebooks = sorted({LAB.exercises[n].notebook for n in exercises})
+        assert f"{' + '.join(n[:-6] for n in notebooks)} ({name})" in lines[1]
+
+
+def test_a_whole_folder_lacks_nothing():
+    from labkit.handin_summary import folder_lines
+
+    lines = folder_lines(sorted(LAB.notebooks()), 6)
+    assert len(lines) == 2 and not any("Not in this folder" in line for line in lines)

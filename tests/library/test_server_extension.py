@@ -158,3 +158,57 @@ def test_a_real_server_in_this_environment_loads_it_and_a_kernels_websocket_conn
     log = (tmp_path / "server.log").read_text()
     assert "labkit: kernel websockets send without Nagle's delay (ZMQChannelsWebsocketConnection)" in log
     assert "labkit: this kernel websocket sends without Nagle's delay" in log
+
+
+# --- a saved notebook reopens with its explorers' pictures, never "Error displaying widget" ---------------------
+
+
+def _explorer_notebook(saved_state=False):
+    """A notebook whose one output is an explorer's: a widget view beside its png, html and text."""
+    data = {
+        server_extension.WIDGET_VIEW: {"model_id": "m1", "version_major": 2, "version_minor": 0},
+        "image/png": "iVBORw0KGgo=",
+        "text/html": '<img alt="a mesh">',
+        "text/plain": "Explorer()",
+    }
+    output = {"output_type": "display_data", "data": data, "metadata": {}}
+    cell = {"cell_type": "code", "id": "c1", "source": "plots.mesh_explorer()", "metadata": {}, "outputs": [output]}
+    cell["execution_count"] = 1
+    only_view = {"output_type": "display_data", "data": {server_extension.WIDGET_VIEW: {"model_id": "m2"}}}
+    cell["outputs"].append({**only_view, "metadata": {}})
+    metadata = {}
+    if saved_state:
+        metadata["widgets"] = {server_extension.WIDGET_STATE: {"state": {"m1": {"model_name": "X"}}}}
+    return {"cells": [cell], "metadata": metadata, "nbformat": 4, "nbformat_minor": 5}
+
+
+def test_a_widget_view_without_its_state_is_left_out_and_the_picture_kept():
+    notebook = _explorer_notebook()
+    assert server_extension.without_unsaved_views(notebook) == 1
+    first, only_view = notebook["cells"][0]["outputs"]
+    assert set(first["data"]) == {"image/png", "text/html", "text/plain"}
+    assert server_extension.WIDGET_VIEW in only_view["data"]  # nothing else to show: kept as it was
+    kept = _explorer_notebook(saved_state=True)  # the state saved ("Save Widget State Automatically")
+    assert server_extension.without_unsaved_views(kept) == 0
+    assert server_extension.WIDGET_VIEW in kept["cells"][0]["outputs"][0]["data"]
+
+
+def test_the_servers_contents_manager_saves_notebooks_without_unsaved_views(tmp_path):
+    from jupyter_server.services.contents.filemanager import FileContentsManager
+
+    manager = FileContentsManager(root_dir=str(tmp_path))
+    app = App(None)
+    app.contents_manager = manager
+    _load_jupyter_server_extension(app)
+    manager.save({"type": "notebook", "format": "json", "content": _explorer_notebook()}, "lab.ipynb")
+    saved = json.loads((tmp_path / "lab.ipynb").read_text())
+    assert set(saved["cells"][0]["outputs"][0]["data"]) == {"image/png", "text/html", "text/plain"}
+    manager.save({"type": "file", "format": "text", "content": "notes"}, "notes.txt")  # other files as they are
+    assert (tmp_path / "notes.txt").read_text() == "notes"
+
+
+def test_a_notebook_of_odd_shape_is_saved_as_it_is():
+    odd = {"cells": ["text", {"outputs": "none"}, {"outputs": [1, {"data": []}, {"data": {"text/plain": "x"}}]}]}
+    before = json.dumps(odd)
+    assert server_extension.without_unsaved_views(odd) == 0 and json.dumps(odd) == before
+    server_extension.drop_unsaved_widget_views({"type": "notebook", "content": None}, "x.ipynb")  # nothing to do

@@ -4,8 +4,9 @@ Code between ``### BEGIN SOLUTION`` / ``### END SOLUTION`` becomes a stub
 that raises ``NotImplementedError``; in a markdown cell the same region is
 an answer in words (a remark, an explanation) and becomes ``YOUR ANSWER
 HERE``, for the student to write and the instructor to read. Hidden tests
-between ``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS`` disappear,
-outputs are cleared. The markers and the stubs are nbgrader's.
+between ``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS`` disappear, leaving
+the cell's comment saying it is the grader's (and the cell read-only and not deletable, as nbgrader's
+release leaves it), outputs are cleared. The markers and the stubs are nbgrader's.
 
 The cells that raise in the release (the stubs, and the cells that use what the stubs
 leave undefined) carry the tag ``raises-exception``, which :func:`tag_raising`
@@ -66,6 +67,8 @@ def release_notebook(nb, name="notebook"):
     student.metadata.pop("widgets", None)
     for index, cell in enumerate(student.cells):
         if cell.cell_type == "code":
+            if BEGIN_HIDDEN in cell.source:  # the grader's cell: JupyterLab and Notebook 7 keep it read-only
+                cell.metadata.update(editable=False, deletable=False)
             cell.source = strip_solutions(cell.source, f"{name}, cell {index}")
             cell.outputs = []
             cell.execution_count = None

@@ -33,6 +33,7 @@ from ...exercises.model import sections
 from ...exercises.registry import LAB
 from ...exercises.registry import load as load_registry
 from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
+from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from ..sandbox import backends, remote
@@ -229,14 +230,15 @@ def _student_frames(traceback):
     return kept
 
 
-def _run_problems(name, ran):
-    problems = []
+def _run_problems(name, ran, code=()):
+    problems, numbers = [], prompt_numbers(code)  # a cell named as Jupyter numbers it: [n] after Run All
     errors = ran.get("errors") if isinstance(ran.get("errors"), list) else []
     if errors:
         shown, kinds = [], []
         for error in errors[:SHOWN_ERRORS]:
             error = error if isinstance(error, dict) else {}
-            cell = int(error.get("cell", -1)) + 1
+            index = int(error.get("cell", -1))
+            cell = numbers.get(index, index + 1)
             text = f"cell {cell} raised {one_line(error.get('kind'), 100)}: {one_line(error.get('message', ''), 300)}"
             # the worker marks a cell it stopped at its own time limit; an exception named Timeout is the student's
             if error.get("timeout") is True:
@@ -397,7 +399,7 @@ def grade_notebook(
             error = ran["error"] if isinstance(ran["error"], dict) else {}
             text = f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."
             return {}, [ProblemText.one(text, CRASH)]
-        problems += _run_problems(name, ran)
+        problems += _run_problems(name, ran, code)
         if notebook.tampered:
             problems.append(ProblemText.one(f"{name}: {notebook.tampered}; none of its answers count.", TAMPERED))
         for number in numbers:

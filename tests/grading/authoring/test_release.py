@@ -116,3 +116,21 @@ def test_a_release_per_student_refuses_two_folders_one_file_system_could_not_tel
     for odd in ("../x", ".hidden", "a/b", "x" * 61, "Jane Doe", "ü"):  # never a path, nor hidden
         name = folder_name(odd)
         assert re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]*", name) and name != odd
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_the_hidden_test_placeholders_are_read_only_and_say_they_are_the_graders(path):
+    """A student finds each hidden-test cell locked (read-only, not deletable, as nbgrader's release leaves it)
+    and saying it is the grader's; every other cell stays as editable as it was."""
+    from labkit.grading.authoring.release import release_notebook
+
+    teacher = nbformat.read(path, as_version=4)
+    student = release_notebook(teacher, path.name)
+    hidden = ["### BEGIN HIDDEN TESTS" in c.source for c in teacher.cells]
+    assert any(hidden)
+    for was_hidden, cell in zip(hidden, student.cells):
+        locked = cell.metadata.get("editable") is False and cell.metadata.get("deletable") is False
+        assert locked == was_hidden, cell.source
+        if was_hidden:
+            assert "grader" in cell.source and "nothing to write" in cell.source.lower(), cell.source
+    assert [c.source for c in student.cells] == [c.source for c in _student(path).cells]  # the packaged copy too
