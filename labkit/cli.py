@@ -540,11 +540,12 @@ def _mark(args):
 
 
 def build_parser():
+    from ._cli_parser import Parser
     from .grading.options import DEFAULTS, MIB
     from .grading.reports import similarity
     from .grading.sandbox import backends
 
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="labkit",
         description="Course kit tools for the higher-order interpolation lab.",
         epilog="Grading runs every notebook in a sandbox (`labkit grade --help` lists them: the default has no "
