@@ -104,7 +104,8 @@ def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
     for found in readings.values():
         if len(found) == 1:
             settled.setdefault(found[0].uid, set()).add(found[0].prefix)
-    chosen, notes = {}, []
+    chosen: dict = {}
+    notes: list[str] = []
     roster = set(roster_ids)
     for name, found in readings.items():
         chosen[name] = found[0] if len(found) == 1 else _choose(name, found, settled, roster, notes)
