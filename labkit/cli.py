@@ -415,7 +415,10 @@ def _class(args, workspace):
                 raise ValueError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
         found = intake.find_students(paths, workspace)
     else:
-        found = intake.find_class(paths[0], workspace, assignment=args.assignment)
+        from .grading.reports.lms import read_roster
+
+        roster = read_roster(args.roster) if args.roster is not None else None  # its ids decide whose a file is
+        found = intake.find_class(paths[0], workspace, assignment=args.assignment, roster=roster)
     if args.student:
         names = {student.name for student in found.students}
         unknown = [name for name in args.student if name not in names]

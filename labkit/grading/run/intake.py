@@ -86,6 +86,7 @@ student on disk is named with :func:`~labkit.grading.results.report.safe_name`.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import os
 import re
 import shutil
@@ -102,6 +103,7 @@ from .lms_names import canvas_readings, resolve_canvas
 MAX_FILES = 5_000  # entries looked at in one folder walk (as scoring's walk of a submission)
 MAX_DEPTH = 8  # folder levels looked into
 MAX_NAME = 255  # bytes of one file or folder name in a zip (what file systems take)
+SPARE = 256 << 20  # bytes the class zip leaves free where it is unpacked
 LONG_TOP = 200  # bytes of a class zip's top-level name beyond which it is written under a short name
 RATIO_FLOOR = 1 << 20  # the compression ratio is checked for members that grow past this many bytes
 CHUNK = 1 << 16
@@ -290,8 +292,9 @@ def _undo(root, written, made):
             pass
 
 
-def _member_parts(name, label):
-    """The parts of a member's name, or ValueError when it would leave the folder."""
+def _member_parts(name, label, skip=0):
+    """The parts of a member's name, or ValueError when it would leave the folder (or a part past the first
+    `skip` is longer than a file system takes)."""
     shown = one_line(name, 120)
     text = name.replace("\\", "/")
     if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
@@ -299,7 +302,7 @@ def _member_parts(name, label):
     parts = [p for p in text.split("/") if p not in ("", ".")]
     if ".." in parts:
         raise ValueError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
-    if any(len(p.encode("utf-8", "surrogateescape")) > MAX_NAME for p in parts):
+    if any(len(p.encode("utf-8", "surrogateescape")) > MAX_NAME for p in parts[skip:]):
         raise ValueError(
             f"{label}: member {shown!r} has a name longer than {MAX_NAME} bytes, more than a file system "
             "takes; rename it shorter."
@@ -471,6 +474,177 @@ def _size(n):
     return f"{n} GiB"  # pragma: no cover
 
 
+# ---------------------------------------------------------------------------------------------- the class zip
+
+
+def _class_zip(path, root, builder):
+    """Unpack the class's zip into the folder `root` student by student, each on their own budget; its layout.
+
+    The zip is a container: its members are sorted out by whose they are (from the LMS's part of their names)
+    before anything is written, and each student's are checked and extracted on that student's budget. A member
+    that breaks a rule refuses its student only (``builder.refused``), never the class."""
+    label = _text(path.name)
+    try:
+        archive = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError) as exc:
+        raise ValueError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
+    with archive:
+        members = [(i, _loose_parts(i.filename)) for i in archive.infolist()]
+        members, prefix = _unwrap([(i, p) for i, p in members if p and p[0] != "__MACOSX"])
+        tops = _zip_tops(members, builder)
+        layout = _detect_tops(sorted(tops.values()), label)
+        groups = _by_owner(layout, members, tops, builder)
+        plans = {key: _student_plan(key, items, builder, label, len(prefix)) for key, items in groups.items()}
+        _check_space(plans, root, label)
+        for key, plan in plans.items():
+            if plan is not None:
+                _extract_student(archive, key, plan, root, builder, label)
+            _placeholder(root, key, groups[key], layout, builder)
+    return layout
+
+
+def _loose_parts(name):
+    return [p for p in name.replace("\\", "/").split("/") if p not in ("", ".")]
+
+
+def _unwrap(members):
+    """The members without the folders all of them are in (a folder zipped whole), and those folders' names."""
+    prefix: list[str] = []
+    while members and all(len(p) > 1 or i.is_dir() for i, p in members):
+        top = members[0][1][0]
+        if any(p[0] != top for _, p in members) or top == "submitted" or MOODLE_FOLDER.match(top):
+            break
+        if any(len(p) == 2 and p[1].endswith(".ipynb") for _, p in members):
+            break  # a student's folder, not a folder around the class
+        prefix.append(top)
+        members = [(i, p[1:]) for i, p in members if len(p) > 1]
+    return members, prefix
+
+
+def _zip_tops(members, builder):
+    """{name: (name, kind)} of the top of the class zip, as the LMS gave them; a name too long to write gets a
+    short one on disk (``builder.aliases``)."""
+    kinds: dict = {}
+    for info, parts in members:
+        folder = len(parts) > 1 or info.is_dir()
+        kinds[parts[0]] = "dir" if folder or kinds.get(parts[0]) == "dir" else "file"
+    for number, name in enumerate(sorted(kinds)):
+        if len(name.encode("utf-8", "surrogateescape")) > LONG_TOP or name == "..":
+            suffix = Path(name).suffix if len(Path(name).suffix) <= 10 else ""
+            builder.aliases[f"long-name-{number}{suffix}"] = name
+    return {name: (name, kind) for name, kind in kinds.items()}
+
+
+def _by_owner(layout, members, tops, builder):
+    """{student's key: [(info, parts)]} of the members that are a student's; the rest are named in the notes."""
+    owners = _owners(layout, tops, builder)
+    groups: dict = {}
+    ignored = set()
+    for info, parts in members:
+        if layout == "nbgrader":
+            key = ("nbgrader", parts[1]) if parts[0] == "submitted" and len(parts) > 1 else None
+        else:
+            key = owners.get(parts[0])
+        if key is None and not (layout == "canvas" and canvas_readings(parts[0])):  # (those have their note)
+            ignored.add(parts[0] if layout != "nbgrader" or parts[0] != "submitted" else "/".join(parts[:2]))
+            continue
+        if key is not None:
+            groups.setdefault(key, []).append((info, parts))
+    for name in sorted(ignored):
+        builder.notes.append(f"ignored {one_line(name)}: not a student's, in {layout}'s layout")
+    return groups
+
+
+def _owners(layout, tops, builder):
+    """{top-level name: the key of the student it belongs to} by the LMS's part of the names."""
+    files = [name for name, kind in tops.values() if kind == "file"]
+    if layout == "canvas":
+        chosen, said = resolve_canvas(files, builder.roster_ids)
+        builder.notes += said
+        builder.canvas_noted = True  # the files filed to no one are never unpacked: their notes are said here
+        return {name: ("canvas", r.uid) for name, r in chosen.items() if r is not None}
+    if layout == "moodle":
+        found = {}
+        for name, kind in tops.values():
+            match = (MOODLE_FOLDER if kind == "dir" else MOODLE_FILE).match(name)
+            if match:
+                found[name] = ("moodle", match["name"], match["pid"])
+        return found
+    return {name: ("folders", name) for name, kind in tops.values() if kind == "dir" or name.endswith(".ipynb")}
+
+
+def _student_plan(key, items, builder, label, skip):
+    """The checked members of one student (see :func:`_checked`), or None when one breaks a limit (then
+    ``builder.refused[key]`` says why)."""
+    budget = builder.budget(key)
+    budget.in_class = True
+    budget.members += len(items)
+    disk = {name: alias for alias, name in builder.aliases.items()}
+    parts_of = {id(info): parts for info, parts in items}
+
+    def checked_parts(info):
+        _member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
+        parts = parts_of[id(info)]
+        return [disk.get(parts[0], parts[0]), *parts[1:]]
+
+    try:
+        if budget.members > budget.limits.max_members:
+            raise ValueError(
+                f"{label}: more than {budget.limits.max_members} members are this student's; labkit extracts at "
+                f"most {budget.limits.max_members} for one student."
+            )
+        return _checked([info for info, _ in items], budget, label, checked_parts)
+    except ValueError as exc:
+        builder.refused[key] = f"{exc} {FIX}"
+        return None
+
+
+def _check_space(plans, root, label):
+    """ValueError when the students' members would not fit in the free space of `root`, naming the largest."""
+    sizes = {key: sum(info.file_size for info, *_ in plan) for key, plan in plans.items() if plan is not None}
+    try:
+        free = shutil.disk_usage(root).free
+    except OSError:
+        return
+    if sum(sizes.values()) + SPARE <= free:
+        return
+    largest = sorted(sizes, key=lambda key: -sizes[key])[:SHOWN]
+    shown = ", ".join(f"{one_line(key[-1], 60)} ({_size(sizes[key])})" for key in largest)
+    raise ValueError(
+        f"{label} unpacks to {_size(sum(sizes.values()))}, and only {_size(free)} is free in {root} (labkit keeps "
+        f"{_size(SPARE)} spare); the largest students are {shown}. Free some space, or grade those students apart."
+    )
+
+
+def _extract_student(archive, key, plan, root, builder, label):
+    """Write one student's checked members under `root` on their budget; on a refusal remove them again."""
+    budget, written, made = builder.budget(key), [], []
+    try:
+        for info, parts, is_dir, shown in plan:
+            _make_dirs(root, parts if is_dir else parts[:-1], made, label, shown)
+            if not is_dir:
+                _extract(archive, info, root.joinpath(*parts), budget, label, shown, written)
+    except ValueError as exc:
+        _undo(None, written, made)
+        builder.refused[key] = f"{exc} {FIX}"
+
+
+def _placeholder(root, key, items, layout, builder):
+    """For a refused student, empty stand-ins of what names them at the top, so that the layout finds them."""
+    if key not in builder.refused:
+        return
+    disk = {name: alias for alias, name in builder.aliases.items()}
+    depth = 3 if layout == "nbgrader" else 1
+    folders = {tuple(p[:depth]) for info, p in items if len(p) > depth or (len(p) == depth and info.is_dir())}
+    files = {tuple(p) for _, p in items if len(p) == 1 and depth == 1} - folders
+    for parts in sorted(folders)[:SHOWN]:
+        (root / disk.get(parts[0], parts[0])).joinpath(*parts[1:]).mkdir(parents=True, exist_ok=True)
+    for (name,) in sorted(files)[:SHOWN]:
+        target = root / disk.get(name, name)
+        if not os.path.lexists(target):
+            target.touch()
+
+
 # ---------------------------------------------------------------------------------------------- folders
 
 
@@ -538,6 +712,7 @@ class _Builder:
         self.refused: dict = {}  # a student's key -> why the class zip's members of theirs were not extracted
         self.aliases: dict = {}  # a name written in the workspace -> the class zip's own (too long to write)
         self.roster_ids: tuple = ()  # the roster's ids, which settle a Canvas file name read two ways
+        self.canvas_noted = False  # the class zip's plan told already how each Canvas file name was read
 
     def budget(self, key):
         """The budget of the student `key` (fresh for one seen first): every limit is per student, in total."""
@@ -713,7 +888,7 @@ def _canvas_files(root, builder, notes):
         else:
             notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
     chosen, said = resolve_canvas(files, builder.roster_ids)
-    notes += said
+    notes += [] if builder.canvas_noted else said
     return {name: (reading, files[name]) for name, reading in chosen.items() if reading is not None}
 
 
@@ -732,7 +907,8 @@ def _canvas(root, builder, notes):
     students = []
     for (uid, group), login in zip(groups.items(), logins):
         if logins.count(login) > 1 or len(group["logins"]) > 1:  # namesakes: the user id parts them
-            notes.append(f"{one_line(login, 80)} names several Canvas students: each is named {one_line(login, 60)}_ID")
+            said = f"{one_line(login, 80)} names several Canvas students: each is named {one_line(login, 60)}_ID"
+            notes += [] if said in notes else [said]
             login = f"{login}_{uid}"
         pieces = _canvas_pieces(login, group["files"], notes)
         students.append(builder.from_files(login, pieces, "canvas", uid, group["late"], key=("canvas", uid)))
@@ -849,18 +1025,26 @@ def _detect_tops(tops, where):
     )
 
 
-def _unwrapped(root):
-    """A zip's top: its one folder when that is all it holds and it holds no notebook itself (a folder zipped)."""
-    while True:
-        entries = _entries(root)
-        if len(entries) != 1 or not entries[0].is_dir(follow_symlinks=False) or entries[0].is_symlink():
-            return root
-        inner = entries[0]
-        if inner.name == "submitted" or MOODLE_FOLDER.match(_text(inner.name)):
-            return root
-        if any(e.name.endswith(".ipynb") for e in _entries(inner.path)):
-            return root
-        root = Path(inner.path)
+def _by_roster(students, roster, notes):
+    """The students named by the roster wherever the LMS gave them an id the roster has (the id decides, never a
+    display name); one whose id it lacks keeps a name no roster entry has."""
+    names = {key: name for name, key in roster.items()}
+    with_ids = [s for s in students if s.lms_id is not None]
+    if not any(s.lms_id in names for s in with_ids):
+        if with_ids:
+            notes.append("the roster's ids are none of the LMS's ids in the download: students matched by name")
+        return students
+    renamed = []
+    for student in students:
+        name = names.get(student.lms_id) if student.lms_id is not None else student.name
+        if name is None:
+            name = student.name if student.name not in roster else f"{student.name}_{student.lms_id}"
+            notes.append(
+                f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)}) is not on the roster: "
+                f"graded as {one_line(name, 80)}"
+            )
+        renamed.append(dataclasses.replace(student, name=name))
+    return sorted(renamed, key=lambda s: (s.name.casefold(), s.name))
 
 
 def _inside(path, folder):
@@ -919,6 +1103,7 @@ def find_class(
     *,
     assignment: str | None = None,
     limits: UnpackLimits = UnpackLimits(),
+    roster: dict[str, str] | None = None,
 ) -> Intake:
     """The students of the class in `path`, one folder or one zip as the LMS gave it.
 
@@ -932,19 +1117,23 @@ def find_class(
     assignment : str, optional
         nbgrader's assignment to take when students have several.
     limits : UnpackLimits
-        What each zip may hold (:func:`unpack`).
+        What one student's zips may hold, in all (:func:`unpack`); the class's zip is only a container.
+    roster : dict, optional
+        {submission name: LMS id} (``--roster``): a student the LMS gives an id is named as the roster names
+        that id, whatever their display name; one whose id is not on it never takes a roster name.
 
     Returns
     -------
     Intake
         The students in name order; one that cannot be graded has ``path=None`` and the reason in
-        ``failure``. One student's bad zip never stops the others.
+        ``failure``. One student's upload never stops the others.
 
     Raises
     ------
     ValueError
         When no layout fits, the layouts are mixed, two students would share a name, nbgrader's
-        students have several assignments and `assignment` is None, or the class's own zip is unsafe.
+        students have several assignments and `assignment` is None, the class's zip cannot be read, or
+        there is no room to unpack it.
 
     Examples
     --------
@@ -974,21 +1163,20 @@ def find_class(
     workspace.mkdir(parents=True, exist_ok=True)
     own = Path(tempfile.mkdtemp(prefix="intake-", dir=workspace))
     notes: list[str] = []
-    zip_depth = 0
+    builder = _Builder(own, limits, notes, 1 if stat.S_ISREG(info.st_mode) else 0)
+    builder.roster_ids = tuple(roster.values()) if roster else ()
     if stat.S_ISREG(info.st_mode):
         if path.suffix.lower() != ".zip":
             raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip; give the class as one.")
         root = own / "class"
-        _unpack_top(path, root, limits, False)
-        notes.append(f"unpacked {one_line(_text(path.name))} into the workspace")
-        root = _unwrapped(root)
-        zip_depth = 1
+        root.mkdir()
+        layout = _class_zip(path, root, builder)
+        notes.append(f"unpacked {one_line(_text(path.name))} into the workspace, each student's files on their own")
     elif stat.S_ISDIR(info.st_mode):
         root = path
+        layout = _detect(root)
     else:
         raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip.")
-    layout = _detect(root)
-    builder = _Builder(own, limits, notes, zip_depth)
     if layout == "nbgrader":
         submitted = root if root.name == "submitted" and not (root / "submitted").is_dir() else root / "submitted"
         students = _nbgrader(submitted, assignment, builder, notes)
@@ -1000,6 +1188,7 @@ def find_class(
         students = _folders(root, builder, notes)
     if assignment is not None and layout != "nbgrader":
         notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
+    students = _by_roster(students, roster, notes) if roster else students
     by_name: dict = {}
     for student in students:
         if student.name in by_name:

@@ -130,6 +130,7 @@ def _choose(name, found, settled, roster, notes):
     readings = ", ".join(f"user {one_line(r.uid, 20)} ({one_line(r.login, 60)})" for r in left or found)
     notes.append(
         f"file {shown}: filed to no one: its name, which a student chooses, reads as {readings}, and nothing "
-        "tells which; give --roster, or ask the student to rename the file and grade it alone"
+        "tells which (a --roster settles it when only one of those users is on it); ask the student to rename the "
+        "file, and grade it alone"
     )
     return None
