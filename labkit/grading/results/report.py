@@ -550,6 +550,8 @@ def write_csv(path, grades):
     """One row per submission: points per exercise, the branch that counted, extra credit, total, status.
 
     A submission that could not be graded has empty points and says why in its status."""
+    from .names import name_cell  # the name whole: it is the key (names.py reads this module)
+
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         graded = grades[0].rubric.graded if grades else []
@@ -561,7 +563,7 @@ def write_csv(path, grades):
         for g in grades:
             if not g.graded:
                 writer.writerow(
-                    [csv_cell(g.name)]
+                    [name_cell(g.name)]
                     + [""] * (len(graded) + len(tail) - 1)
                     + [csv_cell(f"not graded: {g.failure}")]
                     + [""] * (len(held) + len(to_read))
@@ -570,7 +572,7 @@ def write_csv(path, grades):
             s = g.score
             lateness = g.lateness
             writer.writerow(
-                [csv_cell(g.name)]
+                [name_cell(g.name)]
                 + [points_text(s.points[n]) for n in graded]
                 + [points_text(s.required), csv_cell(s.branch), points_text(s.counted), points_text(s.extra_total)]
                 + (_late_cells(g, lateness) if lateness is not None else [])

@@ -1003,7 +1003,8 @@ def _detect_tops(tops, where):
     canvas = [n for n in files if _canvas_match(n)]
     either = set(moodle) & set(canvas)  # a Canvas name a student made look like Moodle's, or the reverse
     other_dirs = [n for n in dirs if not MOODLE_FOLDER.match(n)]
-    notebooks = [n for n in files if n.endswith(".ipynb") and n not in canvas and n not in moodle]
+    named = set(canvas) | set(moodle)
+    notebooks = [n for n in files if n.endswith(".ipynb") and n not in named]
     kinds = {
         "moodle": len(moodle) > len(either) or (bool(either) and len(canvas) == len(either)),
         "canvas": len(canvas) > len(either),

@@ -26,6 +26,7 @@ file whose reading depended on one is named in the notes.
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 
@@ -64,10 +65,16 @@ def canvas_readings(name: str) -> list[Reading]:
     >>> canvas_readings("Ada Lovelace.ipynb")
     []
     """
+    return list(_readings(name))
+
+
+@functools.lru_cache(maxsize=1 << 14)
+def _readings(name):
+    """The readings of canvas_readings, kept for the next look at the same name."""
     anon = _ANON.match(name)
     if anon:
         late = bool(anon[1] or anon[3])
-        return [Reading(f"{anon[2]}_{anon[4]}", late, anon[4], anon[5], anon[6])]
+        return (Reading(f"{anon[2]}_{anon[4]}", late, anon[4], anon[5], anon[6]),)
     stop = _NOT_WORD.search(name)
     end = len(name) if stop is None else stop.start()  # the name part holds word characters only
     found = []
@@ -80,7 +87,7 @@ def canvas_readings(name: str) -> list[Reading]:
             continue  # Canvas lower-cases the name, and writes its ids without leading zeros
         file = name[match.end(3) + 1 :]
         found.append(Reading(login, bool(match[1]), match[2], match[3], file))
-    return found
+    return tuple(found)
 
 
 def _padded(number):
