@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import hashlib
 
-from .report import CONTROL, FORMULA_START, one_line
+from .report import name_cell, one_line
+
+__all__ = ["name_cell", "name_from_cell", "shown_name"]
 
 
 def shown_name(name: str, limit: int = 80) -> str:
@@ -31,17 +33,6 @@ def shown_name(name: str, limit: int = 80) -> str:
         return line
     digest = hashlib.sha256(str(name).encode("utf-8", "surrogatepass")).hexdigest()[:8]
     return line[: max(limit - 10, 1)] + "\u2026" + f"#{digest}"
-
-
-def name_cell(name: str) -> str:
-    """`name` as a CSV cell: whole, with an apostrophe before a start a spreadsheet would run as a formula and
-    control characters (which no cell should carry) spelled ``\\xNN``.
-
-    >>> name_cell("=1+1 eve"), name_cell("a" * 600) == "a" * 600
-    ("'=1+1 eve", True)
-    """
-    text = CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", str(name))
-    return "'" + text if text.startswith(FORMULA_START) else text
 
 
 def name_from_cell(cell: str, names) -> str | None:

@@ -486,6 +486,17 @@ def csv_cell(value):
     return text
 
 
+def name_cell(name):
+    """A submission's name as a CSV cell: whole (it is the key: labkit.grading.results.names), with an apostrophe
+    before a start a spreadsheet would run as a formula and control characters spelled ``\\xNN``.
+
+    >>> name_cell("=1+1 eve"), name_cell("a" * 600) == "a" * 600
+    ("'=1+1 eve", True)
+    """
+    text = CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", str(name))
+    return "'" + text if text.startswith(FORMULA_START) else text
+
+
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
 # with a [late] table, between "extra credit" and "total" (which is then the total after the penalty)
 CSV_LATE = ["raw total", "submitted", "time source", "deadline", "hours late", "lateness", "penalty"]
@@ -550,8 +561,6 @@ def write_csv(path, grades):
     """One row per submission: points per exercise, the branch that counted, extra credit, total, status.
 
     A submission that could not be graded has empty points and says why in its status."""
-    from .names import name_cell  # the name whole: it is the key (names.py reads this module)
-
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         graded = grades[0].rubric.graded if grades else []
