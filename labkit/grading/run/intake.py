@@ -609,11 +609,18 @@ def _check_space(plans, root, label):
     if sum(sizes.values()) + SPARE <= free:
         return
     largest = sorted(sizes, key=lambda key: -sizes[key])[:SHOWN]
-    shown = ", ".join(f"{one_line(key[-1], 60)} ({_size(sizes[key])})" for key in largest)
+    shown = ", ".join(f"{_shown_key(key)} ({_size(sizes[key])})" for key in largest)
     raise ValueError(
         f"{label} unpacks to {_size(sum(sizes.values()))}, and only {_size(free)} is free in {root} (labkit keeps "
         f"{_size(SPARE)} spare); the largest students are {shown}. Free some space, or grade those students apart."
     )
+
+
+def _shown_key(key):
+    """A student's key as the instructor knows them: a folder's name, Canvas's user id, Moodle's prefix."""
+    if key[0] == "canvas":
+        return f"Canvas user {one_line(key[1], 40)}"
+    return one_line("_".join(key[1:]), 60)
 
 
 def _extract_student(archive, key, plan, root, builder, label):
@@ -1166,30 +1173,38 @@ def find_class(
     notes: list[str] = []
     builder = _Builder(own, limits, notes, 1 if stat.S_ISREG(info.st_mode) else 0)
     builder.roster_ids = tuple(roster.values()) if roster else ()
-    if stat.S_ISREG(info.st_mode):
-        if path.suffix.lower() != ".zip":
-            raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip; give the class as one.")
-        root = own / "class"
-        root.mkdir()
-        layout = _class_zip(path, root, builder)
-        notes.append(f"unpacked {one_line(_text(path.name))} into the workspace, each student's files on their own")
-    elif stat.S_ISDIR(info.st_mode):
-        root = path
-        layout = _detect(root)
-    else:
-        raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip.")
-    if layout == "nbgrader":
-        submitted = root if root.name == "submitted" and not (root / "submitted").is_dir() else root / "submitted"
-        students = _nbgrader(submitted, assignment, builder, notes)
-    elif layout == "canvas":
-        students = _canvas(root, builder, notes)
-    elif layout == "moodle":
-        students = _moodle(root, builder, notes)
-    else:
-        students = _folders(root, builder, notes)
+    root, layout = _class_root(path, info, own, builder)
+    students = _students(layout, root, builder, assignment)
     if assignment is not None and layout != "nbgrader":
         notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
     students = _by_roster(students, roster, notes) if roster else students
+    _one_name_each(students)
+    students.sort(key=lambda s: (s.name.casefold(), s.name))
+    return Intake(students, layout, notes)
+
+
+def _class_root(path, info, own, builder):
+    """(the folder to read the class from, its layout): the class folder itself, or its zip unpacked in `own`."""
+    if stat.S_ISDIR(info.st_mode):
+        return path, _detect(path)
+    if not stat.S_ISREG(info.st_mode) or path.suffix.lower() != ".zip":
+        raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip; give the class as one.")
+    root = own / "class"
+    root.mkdir()
+    layout = _class_zip(path, root, builder)
+    builder.notes.append(f"unpacked {one_line(_text(path.name))} into the workspace, each student's files on their own")
+    return root, layout
+
+
+def _students(layout, root, builder, assignment):
+    if layout == "nbgrader":
+        submitted = root if root.name == "submitted" and not (root / "submitted").is_dir() else root / "submitted"
+        return _nbgrader(submitted, assignment, builder, builder.notes)
+    reader = {"canvas": _canvas, "moodle": _moodle}.get(layout, _folders)
+    return reader(root, builder, builder.notes)
+
+
+def _one_name_each(students):
     by_name: dict = {}
     for student in students:
         if student.name in by_name:
@@ -1199,8 +1214,6 @@ def find_class(
                 f"({_origin(other)} and {_origin(student)}); rename one so that each name is one student."
             )
         by_name[student.name] = student
-    students.sort(key=lambda s: (s.name.casefold(), s.name))
-    return Intake(students, layout, notes)
 
 
 def find_students(paths, workspace, *, limits: UnpackLimits = UnpackLimits()) -> Intake:

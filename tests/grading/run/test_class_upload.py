@@ -38,7 +38,7 @@ def canvas_hostile(works):
         "sam_2001_60_spaces.txt": b" " * (3 << 20),
         f"sam_2001_61_{NOTEBOOK}": works["solved"],
         "lena_2002_62_" + "l" * 240 + ".ipynb": works["slip"],
-        "mo_2003_63_notes_12_assignsubmission_file_x.ipynb": notebook_text("mo"),
+        "mo_2003_63_notes_12_assignsubmission_file_x.ipynb": notebook_text("mo").encode(),
         f"alice_1001_9_00_2005_70_{NOTEBOOK}": works["bare"],  # names herself alice_1001_9_00
         f"alice_2006_71_{NOTEBOOK}": works["bare"],  # renamed herself Alice
     }
@@ -48,6 +48,7 @@ def canvas_hostile(works):
 
 def grade(given, out):
     run = cli("grade", given, "--out", out, "--seed", SEED, "--jobs", "2", "--quiet", timeout=900)
+    assert (Path(out) / "grades.csv").is_file(), run.stderr
     return run, rows(out)
 
 

@@ -179,3 +179,17 @@ def test_a_class_of_1000_students_comes_in_from_one_zip(tmp_path):
     print(f"intake of 1000 students x 6 notebooks: {seconds:.1f} s")
     assert len(intake.students) == 1000 and not [s for s in intake.students if s.failure]
     assert all(len(list(Path(s.path).glob("*.ipynb"))) == 6 for s in intake.students)
+
+
+def test_too_little_space_names_the_largest_students(tmp_path, monkeypatch):
+    import shutil
+    from collections import namedtuple
+
+    files = {f"big_3001_{i}_b{i}.bin": bytes(range(256)) * 4096 for i in range(1, 4)} | honest_files()
+    (tmp_path / "class.zip").write_bytes(zip_bytes(files))
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(1 << 40, 0, 258 << 20))  # 2 MiB over the spare
+    with pytest.raises(ValueError, match=r"the largest students are Canvas user 3001 \(3 MiB\), Canvas user 1001") as refused:
+        find_class(tmp_path / "class.zip", tmp_path / "work")
+    assert "Free some space" in str(refused.value)
+    assert not [p for p in (tmp_path / "work").rglob("*") if p.is_file()]  # nothing was unpacked
