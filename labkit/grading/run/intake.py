@@ -490,7 +490,7 @@ def _class_zip(path, root, builder):
         raise ValueError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
     with archive:
         members = [(i, _loose_parts(i.filename)) for i in archive.infolist()]
-        members, prefix = _unwrap([(i, p) for i, p in members if p and p[0] != "__MACOSX"])
+        members, prefix = _unwrap([(i, p) for i, p in members if p and p[0] not in ("__MACOSX", "..")])
         tops = _zip_tops(members, builder)
         layout = _detect_tops(sorted(tops.values()), label)
         groups = _by_owner(layout, members, tops, builder)
@@ -514,11 +514,15 @@ def _unwrap(members):
         top = members[0][1][0]
         if any(p[0] != top for _, p in members) or top == "submitted" or MOODLE_FOLDER.match(top):
             break
-        if any(len(p) == 2 and p[1].endswith(".ipynb") for _, p in members):
+        if any(len(p) == 2 and p[1].endswith(".ipynb") and not _lms_named(p[1]) for _, p in members):
             break  # a student's folder, not a folder around the class
         prefix.append(top)
         members = [(i, p[1:]) for i, p in members if len(p) > 1]
     return members, prefix
+
+
+def _lms_named(name):
+    return bool(MOODLE_FILE.match(name) or canvas_readings(name))
 
 
 def _zip_tops(members, builder):

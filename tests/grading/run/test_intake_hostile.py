@@ -193,3 +193,21 @@ def test_too_little_space_names_the_largest_students(tmp_path, monkeypatch):
         find_class(tmp_path / "class.zip", tmp_path / "work")
     assert "Free some space" in str(refused.value)
     assert not [p for p in (tmp_path / "work").rglob("*") if p.is_file()]  # nothing was unpacked
+
+
+def test_a_zipped_canvas_folder_and_members_that_leave_it(tmp_path):
+    members = {f"download/{name}": data for name, data in honest_files().items()}
+    members["../evil.ipynb"] = notebook_text("evil")
+    (tmp_path / "canvas.zip").write_bytes(zip_bytes(members))
+    intake = find_class(tmp_path / "canvas.zip", tmp_path / "work")
+    assert intake.layout == "canvas" and {s.lms_id for s in intake.gradable} == {"1001", "1002"}
+    folders = {
+        "class/alice/06_bilinear.ipynb": notebook_text("alice's own work"),
+        "class/bob/../../evil.ipynb": notebook_text("evil"),  # bob's member leaves his folder: bob's refusal only
+        "class/carol/" + "c" * 256 + ".ipynb": notebook_text("carol"),  # too long a name inside her folder
+    }
+    (tmp_path / "folders.zip").write_bytes(zip_bytes(folders))
+    students = {s.name: s for s in find_class(tmp_path / "folders.zip", tmp_path / "work2").students}
+    assert students["alice"].failure is None and "leaves the folder" in students["bob"].failure
+    assert "longer than 255 bytes" in students["carol"].failure and "rename it" in students["carol"].failure
+    assert not list(tmp_path.rglob("evil.ipynb"))
