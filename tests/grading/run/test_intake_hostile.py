@@ -189,7 +189,9 @@ def test_too_little_space_names_the_largest_students(tmp_path, monkeypatch):
     (tmp_path / "class.zip").write_bytes(zip_bytes(files))
     usage = namedtuple("usage", "total used free")
     monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(1 << 40, 0, 258 << 20))  # 2 MiB over the spare
-    with pytest.raises(ValueError, match=r"the largest students are Canvas user 3001 \(3 MiB\), Canvas user 1001") as refused:
+    with pytest.raises(
+        ValueError, match=r"the largest students are Canvas user 3001 \(3 MiB\), Canvas user 1001"
+    ) as refused:
         find_class(tmp_path / "class.zip", tmp_path / "work")
     assert "Free some space" in str(refused.value)
     assert not [p for p in (tmp_path / "work").rglob("*") if p.is_file()]  # nothing was unpacked
