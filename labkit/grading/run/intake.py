@@ -23,8 +23,9 @@ The layouts recognised (:func:`find_class` tells them apart by their names):
     Canvas's "Download Submissions": a flat folder of files named
     ``{name}_{userid}_{fileid}_{original name}``, late ones
     ``{name}_LATE_{userid}_{fileid}_{original name}``. The files are grouped per
-    student (name and user id) into a folder each, under their original
-    names; the student's name is ``{name}``, the LMS id ``{userid}``.
+    student by user id (read as :mod:`.lms_names` reads it, never from the
+    parts a student chooses) into a folder each, under their original names;
+    the student's name is ``{name}``, the LMS id ``{userid}``.
 ``moodle``
     Moodle's "Download all submissions": folders
     ``{Full Name}_{participant id}_assignsubmission_{plugin}_`` (``file``,
@@ -33,10 +34,16 @@ The layouts recognised (:func:`find_class` tells them apart by their names):
     The name is ``{Full Name}_{participant id}``, so two students of one name
     stay apart; the LMS id is the participant id.
 
-A zip given as the class (as Canvas and Moodle hand out their downloads) is
-unpacked into the workspace and read as one of these; a zip whose top holds
-just one folder without notebooks of its own (a folder zipped whole) is read
-from that folder.
+A zip given as the class (as Canvas and Moodle hand out their downloads) is a
+container, read as one of these: its members are sorted out by student from
+the LMS's part of their names before anything is written, and each student's
+are checked and unpacked into the workspace on that student's own budget
+(:class:`UnpackLimits`, counted over all of the student's files and zips). A
+member that breaks a rule makes its student one who could not be graded;
+nothing a student uploads refuses the class. A zip whose top holds just one
+folder without notebooks of its own (a folder zipped whole) is read from that
+folder. With a roster (``find_class(roster=...)``), a student the LMS gives an
+id the roster has takes the roster's name for it.
 
 What the LMSs write, as this module relies on it
 -------------------------------------------------
@@ -45,11 +52,11 @@ Canvas. The names in its download zip: the student's sortable name
 ("Lovelace, Ada"), lower-cased with everything but letters, digits and ``_``
 dropped (``lovelaceada``); ``LATE`` after it when Canvas counts the
 submission late; the Canvas user id; the id of the file (often called the
-submission id); and the file's display name. Sources: the naming code of
-Canvas's quiz-submissions zipper in instructure/canvas-lms
-(``question_attachment_filename``: last name first, spaces to ``_``, other
-non-word characters dropped, lower case, then ids and the display name; the
-assignment zipper itself was not in the sources read), and names of real
+submission id); and the file's display name. Sources: the assignment zipper
+of instructure/canvas-lms (``lib/content_zipper.rb``: ``get_filename``,
+``add_upload_submission``, ``sanitize_user_name``; see :mod:`.lms_names`), the
+naming code of its quiz-submissions zipper (``question_attachment_filename``),
+and names of real
 downloads quoted in the README of mikewesthad/canvas-unzipper
 (``smithbob_340934_208490284_BobsWork.zip``) and in instructure/canvas-lms issue
 #2406 (``studenttest_3143_207797_zipsubmission.zip``). When a student uploads
@@ -125,7 +132,8 @@ LAYOUTS = "a folder per student, nbgrader's submitted/, Canvas's or Moodle's dow
 
 @dataclass(frozen=True)
 class UnpackLimits:
-    """What :func:`unpack` extracts at most from one zip, the zips inside it included.
+    """What :func:`unpack` extracts at most from one zip, the zips inside it included; in :func:`find_class`,
+    what one student's files and zips may hold in all (the class's zip is only a container).
 
     Attributes
     ----------
