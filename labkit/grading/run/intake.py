@@ -632,7 +632,7 @@ def _shown_key(key):
     """A student's key as the instructor knows them: a folder's name, Canvas's user id, Moodle's prefix."""
     if key[0] == "canvas":
         return f"Canvas user {one_line(key[1], 40)}"
-    return one_line("_".join(key[1:]), 60)
+    return one_line("_".join(key[1:]), 64)
 
 
 def _extract_student(archive, key, plan, root, builder, label):
