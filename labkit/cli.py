@@ -419,7 +419,10 @@ def _class(args, workspace):
                 raise ValueError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
         found = intake.find_students(paths, workspace)
     else:
-        found = intake.find_class(paths[0], workspace, assignment=args.assignment)
+        from .grading.reports.lms import read_roster
+
+        roster = read_roster(args.roster) if args.roster is not None else None  # its ids decide whose a file is
+        found = intake.find_class(paths[0], workspace, assignment=args.assignment, roster=roster)
     if args.student:
         names = {student.name for student in found.students}
         unknown = [name for name in args.student if name not in names]
@@ -544,11 +547,12 @@ def _mark(args):
 
 
 def build_parser():
+    from ._cli_parser import Parser
     from .grading.options import DEFAULTS, MIB
     from .grading.reports import similarity
     from .grading.sandbox import backends
 
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="labkit",
         description="Course kit tools for the higher-order interpolation lab.",
         epilog="Grading runs every notebook in a sandbox (`labkit grade --help` lists them: the default has no "

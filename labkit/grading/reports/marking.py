@@ -23,6 +23,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ..results import record as records
+from ..results.names import name_cell, name_from_cell, shown_name
 from ..results.report import csv_cell, one_line, printable, read_results, write_csv, write_result
 from ..results.text import points_text
 
@@ -74,9 +75,9 @@ def read_marks(text, grades):
         if len(row) not in (3, 4):
             problems.append(f"line {line}: {len(row)} cells, not 4 ({','.join(HEADER)})")
             continue
-        name, item, points, comment = [*row, ""][:4]
-        name, item, points = name.strip(), item.strip(), points.strip()
-        name = name[1:] if name.startswith("'") and name[1:2] in "=+-@" and len(name) > 1 else name  # csv_cell's
+        cell, item, points, comment = [*row, ""][:4]
+        item, points = item.strip(), points.strip()
+        name = name_from_cell(cell, by_name) or cell.strip()  # the whole name, as the page wrote it
         grade = by_name.get(name)
         if grade is None:
             problems.append(f"line {line}: no submission {one_line(name, 80)!r} in this run")
@@ -177,7 +178,7 @@ def marks_csv(grades):
     for grade in grades:
         for item, mark in sorted(grade.marks.items()):
             points = mark["points"]
-            writer.writerow([csv_cell(grade.name), item, points if isinstance(points, str) else points_text(points),
+            writer.writerow([name_cell(grade.name), item, points if isinstance(points, str) else points_text(points),
                              csv_cell(mark["comment"])])  # fmt: skip
     return buffer.getvalue()
 
@@ -317,7 +318,11 @@ def tasks(grades, marker="instructor"):
             continue
         question, model = models.get(grade_id, ("", ""))
         entries = [
-            {"submission": one_line(g.name, 200), "html": render_markdown(g.answers.get(grade_id, "") or "")}
+            {
+                "submission": g.name,
+                "shown": shown_name(g.name, 200),
+                "html": render_markdown(g.answers.get(grade_id) or ""),
+            }
             for g in grades
             if g.graded
         ]
@@ -344,7 +349,7 @@ def tasks(grades, marker="instructor"):
                 f'the student\'s code</th><th scope="col">the known source</th></tr></thead>'
                 f"<tbody>{rows}</tbody></table>"
             )
-            held.setdefault(item, []).append({"submission": one_line(g.name, 200), "html": side})
+            held.setdefault(item, []).append({"submission": g.name, "shown": shown_name(g.name, 200), "html": side})
     for item, entries in sorted(held.items()):
         random.Random(f"{marker}\n{item}").shuffle(entries)
         found.append({
@@ -421,7 +426,7 @@ DATA.tasks.forEach(function(t, i){ t.answers.forEach(function(a, j){ order.push(
 var state = {pos: 0, marks: {}};
 try { var saved = JSON.parse(localStorage.getItem(KEY) || "null"); if (saved) state = saved; } catch (e) {}
 function save(){ try { localStorage.setItem(KEY, JSON.stringify(state)); } catch (e) {} }
-function id(t, a){ return a.submission + "\n" + t.item; }
+function id(t, a){ return JSON.stringify([a.submission, t.item]); }
 function $(x){ return document.getElementById(x); }
 function current(){ var p = order[state.pos]; return p ? [DATA.tasks[p[0]], DATA.tasks[p[0]].answers[p[1]]] : null; }
 function text(points, kind){ if (kind === "held") return points === 1 ? "release" : "keep"; return String(points); }
@@ -433,7 +438,7 @@ function show(){
   $("title").textContent = t.title + " (" + (state.pos + 1) + " of " + order.length + ")";
   $("question").innerHTML = t.question; $("model").innerHTML = t.model || "<p>(none)</p>";
   $("worth").textContent = t.kind === "held" ? "" : "(worth " + t.max + ")";
-  $("who").textContent = a.submission; $("answer").innerHTML = a.html;
+  $("who").textContent = a.shown; $("answer").innerHTML = a.html;
   $("given").textContent = m ? "Marked: " + text(m.points, t.kind) : "Not marked yet";
   $("comment").value = m ? m.comment : "";
   var seen = {}, list = $("comments"); list.textContent = "";

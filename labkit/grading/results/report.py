@@ -485,6 +485,17 @@ def csv_cell(value):
     return text
 
 
+def name_cell(name):
+    """A submission's name as a CSV cell: whole (it is the key: labkit.grading.results.names), with an apostrophe
+    before a start a spreadsheet would run as a formula and control characters spelled ``\\xNN``.
+
+    >>> name_cell("=1+1 eve"), name_cell("a" * 600) == "a" * 600
+    ("'=1+1 eve", True)
+    """
+    text = CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", str(name))
+    return "'" + text if text.startswith(FORMULA_START) else text
+
+
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
 # with a [late] table, between "extra credit" and "total" (which is then the total after the penalty)
 CSV_LATE = ["raw total", "submitted", "time source", "deadline", "hours late", "lateness", "penalty"]
@@ -560,7 +571,7 @@ def write_csv(path, grades):
         for g in grades:
             if not g.graded:
                 writer.writerow(
-                    [csv_cell(g.name)]
+                    [name_cell(g.name)]
                     + [""] * (len(graded) + len(tail) - 1)
                     + [csv_cell(f"not graded: {g.failure}")]
                     + [""] * (len(held) + len(to_read))
@@ -569,7 +580,7 @@ def write_csv(path, grades):
             s = g.score
             lateness = g.lateness
             writer.writerow(
-                [csv_cell(g.name)]
+                [name_cell(g.name)]
                 + [points_text(s.points[n]) for n in graded]
                 + [points_text(s.required), csv_cell(s.branch), points_text(s.counted), points_text(s.extra_total)]
                 + (_late_cells(g, lateness) if lateness is not None else [])
