@@ -15,6 +15,9 @@ from test_intake import notebook_text, zip_bytes
 
 from labkit import grading
 
+pytestmark = pytest.mark.slow  # grades a class in the sandbox
+
+
 NOTEBOOK = "06_bilinear.ipynb"
 
 
