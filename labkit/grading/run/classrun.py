@@ -35,6 +35,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from .. import timings
 from ..options import GradeOptions
 from ..results import record as records
 from ..results.late import submission_time
@@ -269,6 +270,7 @@ def grade(
                 arrived(outcome.grade)
                 bar.advance()
     finally:
+        timings.collect(work, out)  # where each submission's grading time went (never in its feedback)
         shutil.rmtree(work, ignore_errors=True)
     for name, why in ungradable.items():
         graded[name] = SubmissionGrade(name, seed=seed, rubric=rubric, failure=why)

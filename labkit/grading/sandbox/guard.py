@@ -462,6 +462,8 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             set_profile(None, None)  # the watch's own walk over the modules runs unprofiled (no student code runs)
             stub(profile)
             set_profile(hook_address, None)
+        else:
+            set_profile(None, None)  # nothing is refused in this request: nothing to note but tampering
 
     def end(args):
         if state["mode"] not in ("graded", RUN) or len(args) != 1 or type(args[0]) is not bytes_type:
