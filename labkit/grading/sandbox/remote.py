@@ -108,6 +108,7 @@ class Settings(Protocol):
 # benchmarks/bench_grading_styles.py only, set in its own process: calls ask for no refusal, so the watch has nothing
 # to watch (no profile hook, no switched-off functions). No option, variable or file of a grading run reaches it.
 _UNWATCHED = False
+MEMO_BYTES = 64 * 1024**2  # the calls whose answers a notebook's handle keeps, in bytes of the calls
 
 
 class NotebookHandle:
@@ -124,6 +125,8 @@ class NotebookHandle:
         self.stopped = None  # why the worker can no longer answer
         self.stopped_kind = CRASH  # the kind of problem it is (labkit.exercises.result.KINDS), once stopped
         self.tampered = None  # what the notebook did that voids its answers
+        self._answers: dict[bytes, dict] = {}  # the answers to calls, by the call (see answered)
+        self._kept = 0  # the bytes of the calls kept
         self.backend = backends.get_backend(self.options.backend)
         self.box = self._forked() if self.options.fork_server else None
         if self.box is None:
@@ -210,6 +213,19 @@ class NotebookHandle:
                     self.tampered = str(error.get("message", "tampering"))[:500]
                 return answer
 
+    def answered(self, call, timeout):
+        """The answer to a call request: the notebook's earlier answer to the very same call (function, arguments,
+        refusal, functions handed over), else a new one. The checks of several parts call the student's function
+        on the same sizes; it is computed once per notebook. An answer the grader gave up on is never kept."""
+        key = protocol.dumps(call)
+        if key not in self._answers:
+            with timings.phase("calls"):
+                answer = self.request(call, timeout)
+            if len(key) + self._kept > MEMO_BYTES:
+                return answer
+            self._answers[key], self._kept = answer, self._kept + len(key)
+        return self._answers[key]
+
     def _ended(self):
         code = self.process.poll()
         if self.box.out_of_memory():
@@ -256,8 +272,7 @@ class Function:
             "profile": self.refusal.name if self.refusal is not None and not _UNWATCHED else None,
             "passables": sorted(protocol.function_names(tags)),
         }
-        with timings.phase("calls"):
-            answer = self.notebook.request(request, self.timeout + 5)
+        answer = self.notebook.answered(request, self.timeout + 5)
         return _value(answer)
 
     def __repr__(self):
