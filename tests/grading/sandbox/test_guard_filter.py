@@ -1,5 +1,6 @@
 """The machine-code filter in front of the watch's profile hook (labkit.grading.sandbox.guard._call_filter): the
-hook sees every call of a Python function, exactly as ``sys.setprofile`` reports them, and nothing else."""
+hook sees every call of a Python function, exactly as ``sys.setprofile`` reports them, and nothing else, but the
+calls of the code objects in the filter's table (those the watch found clean in a request)."""
 
 import json
 import platform
@@ -40,7 +41,10 @@ callback = kind(hook)
 set_profile = ctypes.pythonapi.PyEval_SetProfile
 set_profile.argtypes, set_profile.restype = (ctypes.c_void_p, ctypes.c_void_p), None
 plain = ctypes.cast(callback, ctypes.c_void_p).value
-address, keep = guard._call_filter(plain) if sys.argv[1] == "filtered" else (plain, None)
+address, table, keep = guard._call_filter(plain) if sys.argv[1] != "plain" else (plain, None, None)
+if sys.argv[1] == "cached":  # f's code found clean: the filter passes over its calls
+    f_code = next(c for c in work.__code__.co_consts if getattr(c, "co_name", "") == "f")
+    table[(id(f_code) >> 4) & (guard.SLOTS - 1)] = id(f_code)
 
 reference = []
 def python_profile(frame, event, arg):
@@ -64,7 +68,9 @@ def _probe(mode):
     return json.loads(out.stdout)
 
 
-@pytest.mark.skipif(platform.machine() != "x86_64", reason="the filter is written for x86-64 only")
+@pytest.mark.skipif(
+    platform.machine() != "x86_64" or sys.version_info[:2] != (3, 11), reason="the filter is for x86-64 CPython 3.11"
+)
 def test_the_filter_passes_every_python_call_and_nothing_else():
     filtered, plain = _probe("filtered"), _probe("plain")
     assert filtered["filtered"] and filtered["same"] and plain["same"]
@@ -74,3 +80,5 @@ def test_the_filter_passes_every_python_call_and_nothing_else():
     # without the filter the hook also gets every return and every call and return of a built-in (max, abs, cos)
     assert plain["names"] == plain["reference"]
     assert sum(plain["events"].values()) > 4 * sum(filtered["events"].values())
+    cached = _probe("cached")
+    assert cached["same"] and cached["names"] == [n for n in cached["reference"] if n != "f"]
