@@ -16,7 +16,7 @@ style and each round:
 
 It prints the ratio grade / notebooks per style (the median over the rounds)
 and the split of the grading time the run recorded (``timings.json`` in the
-run's folder, :mod:`labkit.grading.timings`): sandbox starts, the notebooks'
+run's folder, :mod:`labkit.grading.sandbox.timings`): sandbox starts, the notebooks'
 own cells, the checks' calls of student code, reads of student variables,
 recognition of known code, the checks' own work and the grading process's
 start. The watch's share is the same submission graded once more with the
@@ -86,9 +86,8 @@ def _notebooks(submission):
 
 def _unwatched(submission):
     """The timings of grading `submission` in this process with the watch switched off (this benchmark only)."""
-    from labkit.grading import timings
     from labkit.grading.options import GradeOptions
-    from labkit.grading.sandbox import remote
+    from labkit.grading.sandbox import remote, timings
     from labkit.grading.submission import scoring
 
     remote._UNWATCHED = True

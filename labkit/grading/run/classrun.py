@@ -35,13 +35,12 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from .. import timings
 from ..options import GradeOptions
 from ..results import record as records
 from ..results.late import submission_time
 from ..results.report import SubmissionGrade, labkit_version, one_line, write_report, write_result
 from ..results.rubric import load as load_rubric
-from ..sandbox import backends
+from ..sandbox import backends, timings
 from ..sandbox.backends.base import SandboxUnavailable
 from ..submission import refusals
 from ..submission.scoring import known_sources, submission_name

@@ -239,7 +239,7 @@ _CALL_FILTER = {
         "ffe031c0c3",
     )
 }
-SLOTS = 4096  # the filter's table of code objects found clean: the slot of one is (its address >> 4) & (SLOTS - 1)
+SLOTS = 1 << 12  # the filter's table of code objects found clean: the slot of one is (its address >> 4) & (SLOTS - 1)
 
 
 def _frames_as_the_filter_reads_them():

@@ -27,8 +27,7 @@ import time
 from typing import Protocol
 
 from ...exercises.result import CRASH, TAMPERED, TIMEOUT
-from .. import timings
-from . import backends, forkserver, protocol
+from . import backends, forkserver, protocol, timings
 from .backends.base import Limits
 
 WORKER = (sys.executable, "-I", "-m", "labkit.grading.sandbox.worker")  # the worker's command, run inside the sandbox

@@ -33,10 +33,9 @@ from ...exercises.model import sections
 from ...exercises.registry import LAB
 from ...exercises.registry import load as load_registry
 from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
-from .. import timings
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
-from ..sandbox import backends, remote
+from ..sandbox import backends, remote, timings
 from . import known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so

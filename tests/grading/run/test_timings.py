@@ -1,10 +1,10 @@
-"""labkit.grading.timings: each phase's seconds add up in the grading process, and the run's folder gathers every
+"""labkit.grading.sandbox.timings: each phase's seconds add up in the grading process, and the run's folder gathers every
 grading process's figures into timings.json."""
 
 import json
 import time
 
-from labkit.grading import timings
+from labkit.grading.sandbox import timings
 
 
 def test_phases_add_up_and_the_run_gathers_them(tmp_path):

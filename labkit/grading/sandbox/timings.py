@@ -1,4 +1,5 @@
-"""Where a submission's grading time goes: seconds per phase, measured in the grading process.
+"""Where a submission's grading time goes: seconds per phase, measured in the grading process (beside the
+sandbox's client, :mod:`labkit.grading.sandbox.remote`, which times the requests).
 
 The grading process adds up the seconds of each phase (:func:`phase`):
 starting sandboxes, running the notebooks' cells, the checks' calls of
