@@ -82,6 +82,7 @@ bench: $(STAMP) chromium
 	$(PY) benchmarks/bench_2d.py
 	$(PY) benchmarks/bench_sliders.py
 	$(PY) benchmarks/bench_grading.py
+	$(PY) benchmarks/bench_grading_styles.py  # grading of one submission against its notebooks, two styles (limit 1.5x)
 	$(PY) benchmarks/bench_similarity.py
 	$(PY) benchmarks/bench_websocket.py
 	$(PY) benchmarks/bench_browser_latency.py

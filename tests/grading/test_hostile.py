@@ -672,6 +672,7 @@ def test_nothing_outside_the_sandbox_changed_and_nothing_is_left_behind(attacked
         "rubric.toml",
         "run.json",
         "seed.txt",
+        "timings.json",  # where each submission's grading time went (labkit.grading.sandbox.timings)
     ]
     before, after = attacked["leftovers"]
     assert after == before, f"left in {tempfile.gettempdir()}: {sorted(set(after) - set(before))}"

@@ -41,7 +41,7 @@ from ..results import record as records
 from ..results.late import submission_time
 from ..results.report import SubmissionGrade, labkit_version, one_line, write_report, write_result
 from ..results.rubric import load as load_rubric
-from ..sandbox import backends
+from ..sandbox import backends, timings
 from ..sandbox.backends.base import SandboxUnavailable
 from ..submission import refusals
 from ..submission.scoring import known_sources, submission_name
@@ -269,6 +269,7 @@ def grade(
                 arrived(outcome.grade)
                 bar.advance()
     finally:
+        timings.collect(work, out)  # where each submission's grading time went (never in its feedback)
         shutil.rmtree(work, ignore_errors=True)
     for name, why in ungradable.items():
         graded[name] = SubmissionGrade(name, seed=seed, rubric=rubric, failure=why)

@@ -27,7 +27,7 @@ import time
 from typing import Protocol
 
 from ...exercises.result import CRASH, TAMPERED, TIMEOUT
-from . import backends, forkserver, protocol
+from . import backends, forkserver, protocol, timings
 from .backends.base import Limits
 
 WORKER = (sys.executable, "-I", "-m", "labkit.grading.sandbox.worker")  # the worker's command, run inside the sandbox
@@ -104,6 +104,12 @@ class Settings(Protocol):
     def total_timeout(self) -> float: ...  # seconds
 
 
+# benchmarks/bench_grading_styles.py only, set in its own process: calls ask for no refusal, so the watch has nothing
+# to watch (no profile hook, no switched-off functions). No option, variable or file of a grading run reaches it.
+_UNWATCHED = False
+MEMO_BYTES = 64 * 1024**2  # the calls whose answers a notebook's handle keeps, in bytes of the calls
+
+
 class NotebookHandle:
     """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest.
 
@@ -118,6 +124,8 @@ class NotebookHandle:
         self.stopped = None  # why the worker can no longer answer
         self.stopped_kind = CRASH  # the kind of problem it is (labkit.exercises.result.KINDS), once stopped
         self.tampered = None  # what the notebook did that voids its answers
+        self._answers: dict[bytes, dict] = {}  # the answers to calls, by the call (see answered)
+        self._kept = 0  # the bytes of the calls kept
         self.backend = backends.get_backend(self.options.backend)
         self.box = self._forked() if self.options.fork_server else None
         if self.box is None:
@@ -204,6 +212,19 @@ class NotebookHandle:
                     self.tampered = str(error.get("message", "tampering"))[:500]
                 return answer
 
+    def answered(self, call, timeout):
+        """The answer to a call request: the notebook's earlier answer to the very same call (function, arguments,
+        refusal, functions handed over), else a new one. The checks of several parts call the student's function
+        on the same sizes; it is computed once per notebook. An answer the grader gave up on is never kept."""
+        key = protocol.dumps(call)
+        if key not in self._answers:
+            with timings.phase("calls"):
+                answer = self.request(call, timeout)
+            if len(key) + self._kept > MEMO_BYTES:
+                return answer
+            self._answers[key], self._kept = answer, self._kept + len(key)
+        return self._answers[key]
+
     def _ended(self):
         code = self.process.poll()
         if self.box.out_of_memory():
@@ -247,10 +268,10 @@ class Function:
             "name": self.name,
             "timeout": self.timeout,
             "args": tags,
-            "profile": self.refusal.name if self.refusal is not None else None,
+            "profile": self.refusal.name if self.refusal is not None and not _UNWATCHED else None,
             "passables": sorted(protocol.function_names(tags)),
         }
-        answer = self.notebook.request(request, self.timeout + 5)
+        answer = self.notebook.answered(request, self.timeout + 5)
         return _value(answer)
 
     def __repr__(self):
@@ -296,7 +317,8 @@ class Namespace:
     def _kind(self, name):
         if name not in self._kinds:
             try:
-                answer = self.notebook.request({"op": "names", "names": [name]}, self.timeout)
+                with timings.phase("reads"):
+                    answer = self.notebook.request({"op": "names", "names": [name]}, self.timeout)
                 kind = (
                     answer.get("names", {}).get(name, "missing") if isinstance(answer.get("names"), dict) else "missing"
                 )
@@ -315,7 +337,9 @@ class Namespace:
         if kind == "function":
             return Function(self.notebook, name, self.refusal, self.timeout)
         try:
-            return _value(self.notebook.request({"op": "get", "name": name, "timeout": self.timeout}, self.timeout + 5))
+            with timings.phase("reads"):
+                answer = self.notebook.request({"op": "get", "name": name, "timeout": self.timeout}, self.timeout + 5)
+            return _value(answer)
         except (StudentError, WorkerError) as exc:
             return protocol.NotNumbers(f"nothing readable ({exc})")
 

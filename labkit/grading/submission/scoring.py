@@ -36,7 +36,7 @@ from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
-from ..sandbox import backends, remote
+from ..sandbox import backends, remote, timings
 from . import known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
@@ -377,7 +377,8 @@ def grade_notebook(
         return {}, [ProblemText.one(text, TIMEOUT)]
     problems, results = [], {}
     try:
-        notebook = remote.NotebookHandle(options, deadline, _for_sandbox(profiles), registry.passable)
+        with timings.phase("sandbox start"):
+            notebook = remote.NotebookHandle(options, deadline, _for_sandbox(profiles), registry.passable)
     except remote.NotebookTimeout:  # its sandbox was still starting when the submission's time ran out
         text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
         return {}, [ProblemText.one(text, TIMEOUT)]
@@ -385,9 +386,10 @@ def grade_notebook(
         return {}, [ProblemText.one(f"{name}: the sandbox could not start ({exc}).", OTHER)]
     with notebook:
         try:
-            ran = notebook.request(
-                {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
-            )
+            with timings.phase("cells"):
+                ran = notebook.request(
+                    {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
+                )
         except remote.NotebookTimeout:
             text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
             return {}, [ProblemText.one(text, TIMEOUT)]
@@ -423,29 +425,35 @@ def grade_notebook(
                     "its parts that depend on the data earn nothing until they are worked on your own."
                 )
                 problems.append(ProblemText.one(text, VARIANT))
-            for index, part in enumerate(exercise.parts):
-                if part.refused is None:
-                    continue
-                try:
-                    findings = scan.scan(code, part.scanned, profiles[part.refused.name])
-                except scan.Unreadable as exc:
-                    verdict["checks"][index] = _failed_part(
-                        verdict["checks"][index],
-                        verdict["checks"][index]["name"],
-                        "its source can be read",
-                        str(exc),
-                        "keep the notebook's code to what the lab asks for.",
-                    )
-                    continue
-                if findings:
-                    verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
-                else:
-                    verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
+            with timings.phase("recognition"):
+                _judge_code(verdict, exercise, code, profiles, registry, options)
             results[number] = _rescore(verdict, registry)
         if notebook.stopped:
             text = f"{name}: {notebook.stopped} while its functions were being checked."
             problems.append(ProblemText.one(text, notebook.stopped_kind))
     return results, problems
+
+
+def _judge_code(verdict, exercise, code, profiles, registry, options):
+    """Each refused part of `verdict`: failed for a refused reference in its code, held when its code is known."""
+    for index, part in enumerate(exercise.parts):
+        if part.refused is None:
+            continue
+        try:
+            findings = scan.scan(code, part.scanned, profiles[part.refused.name])
+        except scan.Unreadable as exc:
+            verdict["checks"][index] = _failed_part(
+                verdict["checks"][index],
+                verdict["checks"][index]["name"],
+                "its source can be read",
+                str(exc),
+                "keep the notebook's code to what the lab asks for.",
+            )
+            continue
+        if findings:
+            verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
+        else:
+            verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
 
 
 def _number(value):
@@ -498,16 +506,17 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
         return grade
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
-        results, problems = grade_notebook(
-            notebook,
-            options=options,
-            deadline=deadline,
-            skip=claimed,
-            profiles=profiles,
-            answers=grade.answers,
-            sources=grade.sources,
-            variant=variant,
-        )
+        with timings.phase("notebooks"):
+            results, problems = grade_notebook(
+                notebook,
+                options=options,
+                deadline=deadline,
+                skip=claimed,
+                profiles=profiles,
+                answers=grade.answers,
+                sources=grade.sources,
+                variant=variant,
+            )
         grade.problems.extend(problems)
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)
@@ -526,11 +535,13 @@ def main(argv=None):
     if spec.get("backend_origin"):  # a backend registered outside labkit: its module registers it here too
         backends.import_origin(*spec["backend_origin"])
     options = GradeOptions.from_dict(spec["options"])  # the run's options, read once at this process's edge
+    timings.reset()
     grade = grade_submission(spec["submission"], options=options, profiles=profiles, name=spec["name"])
     result = Path(spec["result"])
     partial = result.with_suffix(".partial")
     partial.write_text(json.dumps(grade.as_dict()), encoding="utf-8")
     os.replace(partial, result)
+    timings.write_beside(result)  # where the time went, for the run's folder (never the student's feedback)
     return 0
 
 

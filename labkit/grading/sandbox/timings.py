@@ -1,0 +1,59 @@
+"""Where a submission's grading time goes: seconds per phase, measured in the grading process (beside the
+sandbox's client, :mod:`labkit.grading.sandbox.remote`, which times the requests).
+
+The grading process adds up the seconds of each phase (:func:`phase`):
+starting sandboxes, running the notebooks' cells, the checks' calls of
+student code, reading the student's variables, recognising known code, and
+the whole notebook. The class run keeps each submission's figures in its
+folder (``timings.json``) for the instructor and ``benchmarks/``; they are
+never part of a student's feedback.
+"""
+
+import contextlib
+import json
+import time
+from pathlib import Path
+
+PHASES = ("sandbox start", "cells", "calls", "reads", "recognition", "notebooks")
+SUFFIX = ".timings.json"  # beside a grading process's result file
+_seconds: dict[str, float] = {}
+_counts: dict[str, int] = {}
+
+
+@contextlib.contextmanager
+def phase(name):
+    """Add the seconds the block takes to phase `name` (one of :data:`PHASES`)."""
+    start = time.perf_counter()
+    try:
+        yield
+    finally:
+        _seconds[name] = _seconds.get(name, 0.0) + time.perf_counter() - start
+        _counts[name] = _counts.get(name, 0) + 1
+
+
+def reset():
+    _seconds.clear()
+    _counts.clear()
+
+
+def taken():
+    """{phase: {"seconds": s, "count": n}} of what this process measured since :func:`reset`."""
+    return {name: {"seconds": round(_seconds[name], 4), "count": _counts[name]} for name in _seconds}
+
+
+def write_beside(result):
+    """Write :func:`taken` beside a grading process's result file (`result`, a path)."""
+    Path(result).with_suffix(SUFFIX).write_text(json.dumps(taken()), encoding="utf-8")
+
+
+def collect(work, out):
+    """Gather the figures the grading processes left in `work` into `out`/timings.json ({submission file stem:
+    figures}); nothing is written when there are none."""
+    found = {}
+    for path in sorted(Path(work).glob("*" + SUFFIX)):
+        try:
+            found[path.name[: -len(SUFFIX)]] = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+    if found:
+        (Path(out) / "timings.json").write_text(json.dumps(found, indent=1), encoding="utf-8")

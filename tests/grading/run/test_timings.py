@@ -1,0 +1,35 @@
+"""labkit.grading.sandbox.timings: each phase's seconds add up in the grading process, and the run's folder gathers every
+grading process's figures into timings.json."""
+
+import json
+import time
+
+from labkit.grading.sandbox import timings
+
+
+def test_phases_add_up_and_the_run_gathers_them(tmp_path):
+    timings.reset()
+    for _ in range(3):
+        with timings.phase("calls"):
+            time.sleep(0.01)
+    try:
+        with timings.phase("cells"):
+            raise ValueError("a cell's failure still counts its time")
+    except ValueError:
+        pass
+    taken = timings.taken()
+    assert taken["calls"]["count"] == 3 and 0.03 <= taken["calls"]["seconds"] < 1.0
+    assert taken["cells"]["count"] == 1 and set(taken) == {"calls", "cells"}
+    work, out = tmp_path / "work", tmp_path / "out"
+    work.mkdir()
+    out.mkdir()
+    timings.write_beside(work / "ada-1.json")
+    (work / "bob-1.timings.json").write_text("not json")  # a process killed while writing: left out
+    timings.collect(work, out)
+    assert json.loads((out / "timings.json").read_text()) == {"ada-1": taken}
+    timings.reset()
+    assert timings.taken() == {}
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    timings.collect(empty, empty)
+    assert list(empty.iterdir()) == []  # nothing measured, nothing written
