@@ -36,7 +36,7 @@ from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from ..sandbox import backends, remote
-from . import known, refusals, scan
+from . import holding, known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -423,9 +423,13 @@ def grade_notebook(
                 problems.append(ProblemText.one(text, VARIANT))
             for index, part in enumerate(exercise.parts):
                 if part.refused is None:
+                    verdict["checks"][index] = holding.judge_plain(
+                        verdict["checks"][index], part, code, registry, options
+                    )
                     continue
                 try:
                     findings = scan.scan(code, part.scanned, profiles[part.refused.name])
+                    findings += scan.run_strings(code, part.scanned)
                 except scan.Unreadable as exc:
                     verdict["checks"][index] = _failed_part(
                         verdict["checks"][index],
@@ -440,6 +444,7 @@ def grade_notebook(
                 else:
                     verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
             results[number] = _rescore(verdict, registry)
+        holding.hold_dependents(results, registry, code)  # copied code earns nothing through what it draws
         if notebook.stopped:
             text = f"{name}: {notebook.stopped} while its functions were being checked."
             problems.append(ProblemText.one(text, notebook.stopped_kind))
