@@ -468,19 +468,36 @@ MIRROR_SLIPS = (
         "round the patch abcd as the lab's table of its points lists them.",
         lambda c: patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
         "ABCD",
+        (SIZES9[1], SIZES9[0]),
     ),
     (
         "in your second patch each corner's ds is the mirror image of ABCD's ds (and dt of dt), so its mesh lines "
         "do not meet the first patch's along dc: in the mirror image, which way does s run, and which way t?",
         lambda c: patches.Corner(c.point[::-1], c.ds[::-1], c.dt[::-1], c.dsdt[::-1]),
         "ADCB",
+        (SIZES9[1], SIZES9[0]),
     ),
     (
         "the second patch's derivatives are not mirrored: its corner points are the mirror images of ABCD's, but "
         "their derivative vectors are ABCD's own; reflecting in y = x changes a vector as it changes a point.",
         lambda c: patches.Corner(c.point[::-1], c.dt, c.ds, c.dsdt),
         "ADCB",
+        (SIZES9[1], SIZES9[0]),
     ),
+    (
+        "the mirror reflects the derivative vectors but not the points: your second patch's corners are ABCD's own "
+        "points; reflecting in y = x swaps a point's x and y as it swaps a vector's.",
+        lambda c: patches.Corner(c.point, c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
+        "ADCB",
+        (SIZES9[1], SIZES9[0]),
+    ),
+)
+COUNTS_SWAPPED = (  # the right mirror, meshed with the first patch's counts: s and t swapped
+    "the second patch's point counts in s and t are swapped: its edge dc runs in s and lies on the first "
+    "patch's edge BC, which runs in t with 30 points, so abcd needs 30 points in s and 20 in t.",
+    lambda c: patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
+    "ADCB",
+    (SIZES9[0], SIZES9[1]),
 )
 
 
@@ -495,9 +512,9 @@ def _mirror_slip(second, corners):
         return ""
     by_label = dict(zip("ABCD", corners))
     mine = nodes[np.lexsort(np.round(nodes[:, :2], 9).T[::-1])][:, :2]
-    for hint, mirrored, order in MIRROR_SLIPS:
+    for hint, mirrored, order, counts in MIRROR_SLIPS + (COUNTS_SWAPPED,):
         x, y = patches.patch(
-            *(mirrored(by_label[label]) for label in order), np.linspace(0, 1, SIZES9[1]), np.linspace(0, 1, SIZES9[0])
+            *(mirrored(by_label[label]) for label in order), np.linspace(0, 1, counts[0]), np.linspace(0, 1, counts[1])
         )
         theirs = np.stack((x.ravel(), y.ravel()), axis=1)
         if close(mine, theirs[np.lexsort(np.round(theirs, 9).T[::-1])], 1e-7):
@@ -537,15 +554,23 @@ def _corner_points(corners):
     return first, second
 
 
+def _missed(mesh, points):
+    nodes = np.asarray(mesh.points, dtype=float)[:, :2]
+    return [
+        f"{label} = ({point[0]:.3g}, {point[1]:.3g})"
+        for label, point in points.items()
+        if not nodes.size or np.min(np.hypot(*(nodes - point).T)) > ON_CORNER
+    ]
+
+
 def _corners_missed(meshes, corners):
     """The corner points (as 'B = (0.707, 0.707)') that no node of their mesh is on: ABCD's for the first
-    mesh, abcd's for the second."""
-    missed = []
-    for mesh, points in zip(meshes, _corner_points(corners)):
-        nodes = np.asarray(mesh.points, dtype=float)[:, :2]
-        for label, point in points.items():
-            if not nodes.size or np.min(np.hypot(*(nodes - point).T)) > ON_CORNER:
-                missed.append(f"{label} = ({point[0]:.3g}, {point[1]:.3g})")
+    mesh, abcd's for the second. A second mesh on ABCD's own points is a mirror that left the points where
+    they were: a slip of the mirror rule, charged in two_patches, so nothing is missed."""
+    first, second = _corner_points(corners)
+    missed = _missed(meshes[0], first)
+    if _missed(meshes[1], second) and _missed(meshes[1], first):
+        missed += _missed(meshes[1], second)
     return missed
 
 
