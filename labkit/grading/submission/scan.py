@@ -207,12 +207,13 @@ class _Reader:
                 if isinstance(child, ast.stmt):
                     self._record(child)
 
-    def reached(self, name):
-        """(definition name, definition node, its local names) of everything the definition of `name` reaches."""
+    def reached(self, name, stop=frozenset()):
+        """(definition name, definition node, its local names) of everything the definition of `name` reaches
+        (not through the names in `stop`)."""
         seen, todo, found = set(), [name], []
         while todo:
             current = todo.pop()
-            if current in seen or current not in self.definitions:
+            if current in seen or current not in self.definitions or (current in stop and current != name):
                 continue
             seen.add(current)
             node = self.definitions[current]
@@ -276,9 +277,9 @@ def run_strings(sources, names, deadline=None):
     return findings
 
 
-def reached_sources(sources, names, deadline=None):
+def reached_sources(sources, names, deadline=None, stop=frozenset()):
     """``[(name, source text)]`` of every definition in a notebook's code cells that the graded `names` reach
-    (the names themselves first), as :func:`scan` follows them; nothing is run.
+    (the names themselves first), as :func:`scan` follows them, not through the names in `stop`; nothing is run.
 
     Raises :class:`Unreadable` as :func:`scan` does.
 
@@ -296,7 +297,7 @@ def reached_sources(sources, names, deadline=None):
     reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
     found, seen = [], set()
     for name in names:
-        for owner, node, _ in reader.reached(name):
+        for owner, node, _ in reader.reached(name, frozenset(stop)):
             if id(node) in seen or id(node) not in reader.texts:
                 continue
             seen.add(id(node))
@@ -599,6 +600,31 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
             else:
                 for bound in _bound_names(node):
                     found.pop(bound, None)
+    return found
+
+
+def reached_function_sources(sources, names, graded=(), limit=MAX_SOURCE_CHARS):
+    """:func:`function_sources` of `names`, each followed by the definitions it reaches in the notebook (its
+    helpers, as :func:`reached_sources` follows them; other `graded` names are left to their own entries), so
+    that code moved into a helper is compared where the graded function uses it.
+
+    Examples
+    --------
+    >>> cells = ["def h(x):\\n    return x + 1", "def f(x):\\n    return h(x) * 2"]
+    >>> print(reached_function_sources(cells, ["f"])["f"])
+    def f(x):
+        return h(x) * 2
+    <BLANKLINE>
+    def h(x):
+        return x + 1
+    """
+    found = function_sources(sources, names, limit)
+    for name, text in found.items():
+        try:
+            helpers = [t for n, t in reached_sources(sources, [name], stop=set(graded))[1:] if n != name]
+        except Unreadable:
+            continue
+        found[name] = _clip("\n\n".join([text, *helpers]), limit)
     return found
 
 

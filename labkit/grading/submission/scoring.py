@@ -365,7 +365,7 @@ def grade_notebook(
         return {}, [ProblemText.one(text, OTHER)]
     if sources is not None:
         wanted = [n for number in numbers for n in graded_functions(registry.exercises[number]) if n not in sources]
-        for function, text in scan.function_sources(code, wanted).items():
+        for function, text in scan.reached_function_sources(code, wanted, registry_graded(registry)).items():
             sources[function] = printable(text)[: scan.MAX_SOURCE_CHARS]
     if deadline - time.monotonic() <= 1:
         text = (
