@@ -510,7 +510,7 @@ MISTAKES = (
         ),
         9,
         "region",
-        "appear once",
+        "each node of the shared edge once",
     ),
     Planted(
         "circle_sides_with_unit_derivatives",

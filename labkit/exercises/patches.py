@@ -616,13 +616,13 @@ def check_combined_mesh(region, corners, two_patches=None):
         return result.fail(
             "region is a QuadMesh",
             f"got {getattr(region, 'description', type(region).__name__)}",
-            "join the two patch meshes with +: region = first + second.",
+            "make region one QuadMesh of the two meshes two_patches returns.",
         )
     if max(len(region.points), len(region.quads)) > MAX_NODES:
         return result.fail(
             "region has the lab's size",
             f"{len(region.points):,} nodes and {len(region.quads):,} elements",
-            "mesh the two patches with 20 x 30 points each and join them with +.",
+            "mesh the two patches with 20 x 30 points each and make region of those two meshes.",
         )
     own = _own_meshes(two_patches, corners)
     why = attempted_meshes(own, corners) if own is not None else ""
@@ -648,8 +648,9 @@ def check_combined_mesh(region, corners, two_patches=None):
         f"got {len(region.points)} nodes and {len(region.quads)} elements",
     ):
         result.hint = (
-            "the shared edge's 30 nodes appear once in a conforming mesh: join the two meshes with "
-            "+, which merges them (20 x 30 + 30 x 20 - 30 nodes)."
+            f"a conforming mesh holds each node of the shared edge once, so region has {len(reference.points)} "
+            f"nodes where yours has {len(region.points)}: the edge's nodes are there "
+            f"{'twice' if len(region.points) > len(reference.points) else 'too few times'}."
         )
         return result
     order = np.lexsort(np.round(region.points, 9).T[::-1])
@@ -659,21 +660,21 @@ def check_combined_mesh(region, corners, two_patches=None):
         close(region.points[order], reference.points[expected], 1e-7),
         worst(region.points[order], reference.points[expected]),
     ):
-        result.hint = "make region from the two meshes two_patches returns: region = first + second."
+        result.hint = "make region from the two meshes two_patches returns, both whole."
         return result
     if not result.step(
         "conforming: no crack along the shared edge",
         _boundary_edges(region) == _boundary_edges(reference),
         f"{_boundary_edges(region)} boundary edges, {_boundary_edges(reference)} expected",
     ):
-        result.hint = "elements on both sides of the shared edge must use the same nodes: join the meshes with +."
+        result.hint = "elements on both sides of the shared edge must use the same nodes, not two copies of them."
         return result
     if not result.step(
         "no element folded by the join",
         _folded(region) <= _folded(reference),
         f"{_folded(region)} folded elements, {_folded(reference)} in the two meshes joined",
     ):
-        result.hint = "the join turned elements over: keep each mesh's node order when you join them with +."
+        result.hint = "the join turned elements over: keep each mesh's node order when you join them."
     return result
 
 
@@ -725,6 +726,15 @@ MIRROR_RULE = (  # 9: the mirror rule for abcd's corners
     "dt[::-1], c.ds[::-1]",
     "dt[::-1], corner.ds[::-1]",
     "point[::-1], dt[::-1], ds[::-1]",
+)
+
+JOIN_RULE = (  # 9(c): how two meshes become one conforming mesh
+    "+ merges",
+    "with +, which merges",
+    "merges nodes that coincide",
+    "merges coinciding nodes",
+    "merges the nodes that coincide",
+    "coinciding nodes are merged",
 )
 
 EXERCISES = (
@@ -783,6 +793,6 @@ EXERCISES = (
         ),
         notebook="03_meshes.ipynb",
         answers=("why the mirror image's corner data make the two patches match",),
-        withheld=MIRROR_RULE,
+        withheld=MIRROR_RULE + JOIN_RULE,
     ),
 )

@@ -388,7 +388,7 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
             "x and y are swapped: the data are drawn with the temperatures across and the times up. The first "
             "argument of ax14.plot is the horizontal coordinate: xdata, then ydata."
             if swapped
-            else "plot xdata, ydata themselves: ax14.plot(xdata, ydata, 'o')."
+            else "draw the data points themselves: the times across, the temperatures up."
         )
     elif data.step(
         "drawn as circles",
@@ -400,9 +400,9 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
             any(ln.marker == CIRCLE and not ln.joined for ln in at_data),
             "the circles are joined by lines",
         ):
-            data.hint = "circles only: marker 'o' with linestyle 'none' (the format string 'o')."
+            data.hint = "circles only: no line may join the data points."
     else:
-        data.hint = "use the marker 'o'."
+        data.hint = "draw each data point as a circle."
     results.append(data)
 
     curves = [ln for ln in lines if all(ln is not d for d in at_data)]
@@ -426,21 +426,21 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
                 f"x and y are swapped: {name} is drawn with its values across and xval up. The first argument "
                 "of ax14.plot is the horizontal coordinate: xval, then the values."
                 if swapped
-                else f"evaluate {name} of the data at many points xval and plot them: "
-                f"ax14.plot(xval, {'labkit.spline' if 'spline' in name else 'labkit.pchip'}(xdata, ydata, xval))."
+                else f"evaluate {name} of the data at many times from the first data point to the last, and draw "
+                "its values against those times."
             )
         else:
             most = max(matching, key=lambda ln: ln.x.size)
             if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS, f"only {most.x.size} points"):
-                check.hint = f"use at least {MIN_POINTS} points, e.g. xval = np.linspace(0, 4, 201)."
+                check.hint = f"evaluate it at {MIN_POINTS} points or more, so that the curve looks smooth."
             elif not check.step(
                 "over the whole data range [0, 4]",
                 most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
                 f"from {most.x.min():.3g} to {most.x.max():.3g}",
             ):
-                check.hint = "let xval run from the first data point to the last: np.linspace(0, 4, 201)."
+                check.hint = "let its times run from the first data point to the last."
             elif not check.step("drawn as a line", most.joined, "drawn as separate markers"):
-                check.hint = "draw the curve as a line (format string '-')."
+                check.hint = "draw the curve as a line, not as separate markers."
         results.append(check)
     return results
 

@@ -497,6 +497,9 @@ NATURAL_WHY = (
     "where the Runge function itself bends",
     "errs at the left end",
     "s'' = 0 at both ends, but",
+    "order lower",
+    "lower order",
+    "order is lower",
 )
 NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot", weights=(3, 2, 2))
 

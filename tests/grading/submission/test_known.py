@@ -523,3 +523,33 @@ def test_a_part_built_on_code_run_from_a_string_earns_nothing():
     holding.hold_dependents(results, LAB, cells)
     driver = {c["name"]: c for c in results[3]["checks"]}["test_pherm_interpolate"]
     assert not driver["passed"] and "cannot be read" in driver["steps"][-1]["detail"]
+
+
+def _with_cell(folder, notebook, source):
+    """The instructor notebook `notebook` with a code cell `source` added at its end, in `folder`."""
+    import nbformat
+
+    nb = nbformat.read(NOTEBOOKS / notebook, as_version=4)
+    nb.cells.append(nbformat.v4.new_code_cell(source))
+    folder.mkdir(parents=True)
+    nbformat.write(nb, folder / notebook)
+    return folder
+
+
+def test_rewritten_and_string_run_copies_are_held_or_refused_in_one_run_with_honest_classmates(tmp_path):
+    sandbox_or_skip()
+    copy = module_source("labkit.piecewise")
+    forms = {form: rewrite(copy) for form, rewrite in REWRITES.items()} | {"exec": exec_compressed(copy)}
+    subs = [_with_cell(tmp_path / form, "02_convergence.ipynb", cell) for form, cell in forms.items()]
+    subs += [INDEPENDENT / style for style in STYLES]
+    graded = {g.name: g for g in grading.grade(subs, tmp_path / "out", jobs=2, progress=False)}
+    for style in STYLES:
+        assert graded[style].total == rubric.default().maximum and not graded[style].held(), graded[style].feedback()
+    for form in forms:
+        grade = graded[form]
+        assert grade.points[2] == 0 and grade.points[3] == _part(3, "runge").weight, (form, grade.feedback())
+        if form == "exec":
+            assert "cannot be read" in grade.feedback() and not grade.held(), grade.feedback()
+        else:
+            held = {part for number, part, _, _ in grade.held() if number in (2, 3)}
+            assert held == {"eval_pherm", "test_pherm_interpolate", "errors_pherm", "rate_pherm"}, grade.feedback()
