@@ -3,7 +3,7 @@ whose code reaches a held definition is held with it (:func:`labkit.grading.subm
 
 Known code earns nothing through what it draws: the parts a refusal guards are judged for copied code where
 they are graded (:func:`labkit.grading.submission.scoring.judge_known`); the others (plots, tables of values)
-are judged here on what draws them (:func:`labkit.grading.submission.scan.drawn_with`), and every part whose
+are judged on what draws them (:func:`labkit.grading.submission.scan.drawn_with`), and every part whose
 code reaches a held definition, or a graded name that a string run as code may have defined
 (:func:`labkit.grading.submission.scan.run_strings`), waits or fails with it.
 """
@@ -12,18 +12,17 @@ from __future__ import annotations
 
 from ...exercises.result import REFUSED
 from ..results.report import HELD_STEP
-from . import known, scan
+from . import scan
 
 
 def _read(part):
     return [name for name in part.names() if name.isidentifier()]
 
 
-def judge_plain(check, part, code, registry, options):
-    """A part without a refusal (a plot, a table of values), held when the code that draws it is mostly known
-    code (:func:`labkit.grading.submission.known.match`); else as it was."""
-    from .scoring import _held, _release_grams, known_sources, registry_graded
-
+def judge_plain(check, part, code, graded, judge):
+    """A part without a refusal (a plot, a table of values), judged for known code on what draws it: `judge`
+    (check, [(name, source)]) is given the notebook's definitions that draw it, less the `graded` names (each
+    judged in its own part), and returns the check, held or as it was."""
     if not check["passed"]:
         return check
     try:
@@ -31,17 +30,14 @@ def judge_plain(check, part, code, registry, options):
         reached = scan.reached_sources(code, sorted(names))
     except scan.Unreadable:
         return check
-    reached = [(n, t) for n, t in reached if n not in registry_graded(registry)]  # judged in their own parts
-    found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
-    return check if found is None else _held(check, found)
+    return judge(check, [(n, t) for n, t in reached if n not in graded])
 
 
-def hold_dependents(results, registry, code):
+def hold_dependents(results, registry, code, graded, rescore):
     """Hold, in `results` ({exercise: verdict} of one notebook), every passed part whose code reaches a held
-    definition, and fail every one that reaches a graded name a string run as code may have defined."""
-    from .scoring import _rescore, registry_graded
-
-    held, strung = _held_names(results, registry), _strung(code, registry_graded(registry))
+    definition, and fail every one that reaches one of the `graded` names a string run as code may have
+    defined; `rescore` (verdict, registry) counts an exercise's points again."""
+    held, strung = _held_names(results, registry), _strung(code, graded)
     if not held and not strung:
         return results
     for number, verdict in results.items():
@@ -55,7 +51,7 @@ def hold_dependents(results, registry, code):
                 verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
             elif on_string:
                 verdict["checks"][index] = _refused_with(check, on_string[0], strung[on_string[0]])
-        _rescore(verdict, registry)
+        rescore(verdict, registry)
     return results
 
 
@@ -98,7 +94,17 @@ def _held_with(check, name, held):
     return {**check, "held": {**held, "through": name}, "steps": list(check.get("steps", [])) + [step], "hint": hint}
 
 
-def _refused_with(check, name, why):
-    step = {"step": "is built on the student's own code", "passed": False, "detail": why, "kind": REFUSED}
-    hint = f"define {name} with def in a code cell of its own, so that the grader can read it."
+def run_from_a_string(check, findings):
+    """The part's check, failed: a graded name may have been defined by code run from a string
+    (:func:`labkit.grading.submission.scan.run_strings` `findings`), which the grader cannot read."""
+    name, _, why = findings[0]
+    return _refused_with(check, name, why, step="its code can be read")
+
+
+def _refused_with(check, name, why, step="is built on the student's own code"):
+    step = {"step": step, "passed": False, "detail": why, "kind": REFUSED}
+    hint = (
+        f"define {name} with def in a code cell, after any exec, eval or compile of a string, so that the grader "
+        "can read it; code run from a string is never graded."
+    )
     return {**check, "passed": False, "steps": list(check.get("steps", [])) + [step], "hint": hint}

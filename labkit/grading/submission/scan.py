@@ -270,8 +270,9 @@ def run_strings(sources, names, deadline=None):
         late = [(c, line, what) for c, line, what in reader.strings if (c, line) >= bound]
         for cell, line, what in late[:1]:
             reason = (
-                f"{what} of a string built at run time in code cell {cell + 1} (line {line}), which may define "
-                f"{name}: code that arrives in a string cannot be read, so it is not graded"
+                f"code cell {cell + 1} (line {line}) runs a string built at run time as code ({what}), after "
+                f"the last definition of {name} the grader can read, so it may define {name}: code that "
+                "arrives in a string cannot be read, so it is not graded"
             )
             findings.append((name, line, reason))
     return findings

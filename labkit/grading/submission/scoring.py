@@ -300,8 +300,20 @@ def judge_known(check, part, code, registry, options):
         return check  # the refusal scan read the same cells in time: not reached here
     # a graded function another part judges (the driver's interpolant) is judged there, once
     reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
+    return _judge_reached(check, reached, registry, options)
+
+
+def _judge_reached(check, reached, registry, options):
+    """`check`, held when the definitions `reached` ([(name, source)]) are mostly known code."""
     found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
     return check if found is None else _held(check, found)
+
+
+def judge_plain(check, part, code, registry, options):
+    """A part without a refusal (a plot, a table of values), held when the code that draws it is mostly known
+    code (:func:`labkit.grading.submission.holding.judge_plain`)."""
+    judge = lambda check, reached: _judge_reached(check, reached, registry, options)
+    return holding.judge_plain(check, part, code, registry_graded(registry), judge)
 
 
 def registry_graded(registry):
@@ -423,13 +435,11 @@ def grade_notebook(
                 problems.append(ProblemText.one(text, VARIANT))
             for index, part in enumerate(exercise.parts):
                 if part.refused is None:
-                    verdict["checks"][index] = holding.judge_plain(
-                        verdict["checks"][index], part, code, registry, options
-                    )
+                    verdict["checks"][index] = judge_plain(verdict["checks"][index], part, code, registry, options)
                     continue
                 try:
                     findings = scan.scan(code, part.scanned, profiles[part.refused.name])
-                    findings += scan.run_strings(code, part.scanned)
+                    strung = scan.run_strings(code, part.scanned)
                 except scan.Unreadable as exc:
                     verdict["checks"][index] = _failed_part(
                         verdict["checks"][index],
@@ -441,10 +451,13 @@ def grade_notebook(
                     continue
                 if findings:
                     verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
+                elif strung:
+                    verdict["checks"][index] = holding.run_from_a_string(verdict["checks"][index], strung)
                 else:
                     verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
             results[number] = _rescore(verdict, registry)
-        holding.hold_dependents(results, registry, code)  # copied code earns nothing through what it draws
+        # copied code earns nothing through what it draws
+        holding.hold_dependents(results, registry, code, registry_graded(registry), _rescore)
         if notebook.stopped:
             text = f"{name}: {notebook.stopped} while its functions were being checked."
             problems.append(ProblemText.one(text, notebook.stopped_kind))
