@@ -679,7 +679,7 @@ MISTAKES = (
         ),
         14,
         "ax14: the data",
-        "linestyle 'none'",
+        "no line may join the data points",
     ),
     Planted(
         "boiling_spline_at_20_points",

@@ -368,10 +368,10 @@ def test_the_boiling_plot_passes_when_right():
 @pytest.mark.parametrize(
     "kwargs, failing, hint",
     [
-        ({"data": "o-"}, 0, "linestyle 'none'"),
-        ({"data": "s"}, 0, "marker 'o'"),
-        ({"spline_points": 20}, 1, "at least 100 points"),
-        ({"pchip_points": 5}, 2, "evaluate pchip of the data at many points"),
+        ({"data": "o-"}, 0, "no line may join the data points"),
+        ({"data": "s"}, 0, "as a circle"),
+        ({"spline_points": 20}, 1, "100 points or more"),
+        ({"pchip_points": 5}, 2, "evaluate pchip of the data at many times"),
         ({"spline_style": "."}, 1, "as a line"),
     ],
 )

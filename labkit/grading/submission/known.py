@@ -13,8 +13,14 @@ How code is compared (winnowing, Schleimer, Wilkerson and Aiken 2003, as
 copydetect and MOSS do it, with hashes of labkit's own so that they are the
 same in every process):
 
-1. :func:`normalise` tokenises a source with pygments (never parses or
-   runs it) and writes every token as one or a few characters: a variable or
+0. :func:`labkit.grading.submission.fingerprint.canonical` first writes each
+   definition back from its syntax tree with what does nothing taken out
+   (dead stores, statements with no effect, ``getattr`` with a literal name,
+   staticmethods and namespace classes), and
+   :func:`~labkit.grading.submission.fingerprint.units` splits a part's code
+   into functions, a class's methods each alone, trivial wrappers left out.
+1. :func:`normalise` tokenises a source with pygments (never runs it) and
+   writes every token as one or a few characters: a variable or
    argument name is ``V``, a function's name ``F``, a class's ``O``, a string
    ``S``; comments, docstrings and white space go. Keywords, operators,
    numbers, builtins and the attribute after a dot (``np.searchsorted``'s
