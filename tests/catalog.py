@@ -510,7 +510,7 @@ MISTAKES = (
         ),
         9,
         "region",
-        "appear once",
+        "each node of the shared edge once",
     ),
     Planted(
         "circle_sides_with_unit_derivatives",
@@ -679,7 +679,7 @@ MISTAKES = (
         ),
         14,
         "ax14: the data",
-        "linestyle 'none'",
+        "no line may join the data points",
     ),
     Planted(
         "boiling_spline_at_20_points",
@@ -1223,6 +1223,131 @@ SLIPS = (
     ),
 )
 MISTAKES += SLIPS
+
+# issue 47: slips its planning found charged twice, missed or hinted wrongly, and siblings of them (each its own
+# submission, so the earlier submissions' rows stay as they were). `was` is what the feedback said before it.
+PBILIN_SEARCH = "    i, j = labkit.bracket(xdata, xval), labkit.bracket(ydata, yval)\n"
+PHERM_TEST = "    xtest = np.linspace(0, 5, 4001)\n    exact = f(xtest)[0]\n"
+SECOND_MESH = "second = labkit.quad_mesh(*labkit.patch(a, b, c, d, np.linspace(0, 1, 30), np.linspace(0, 1, 20)))"
+ISSUE47 = (
+    Planted(
+        "h4_times_the_slope_at_xk",
+        "02_convergence.ipynb",
+        ((COMBINATION, COMBINATION.replace("ypdata[k + 1] * h4", "ypdata[k] * h4")),),
+        2,
+        "eval_pherm",
+        "h4 is multiplied by y'_k where equation (4) has y'_{k+1}",
+        was="misleading",
+    ),
+    Planted(
+        "h3_times_the_value_at_xk",
+        "02_convergence.ipynb",
+        ((COMBINATION, COMBINATION.replace("ydata[k + 1] * h3", "ydata[k] * h3")),),
+        2,
+        "eval_pherm",
+        "h3 is multiplied by y_k where equation (4) has y_{k+1}",
+        was="misleading",
+    ),
+    Planted(
+        "driver_scaled_by_f_at_the_data",
+        "02_convergence.ipynb",
+        ((PHERM_RETURN, PHERM_RETURN.replace("np.max(np.abs(exact))\n", "np.max(np.abs(ydata))\n")),),
+        3,
+        "test_pherm_interpolate",
+        "divided by max|f| at the data points",
+        was="misleading",
+    ),
+    Planted(
+        "driver_without_the_first_test_point",
+        "02_convergence.ipynb",
+        ((PHERM_TEST, PHERM_TEST.replace("4001)\n", "4001)[1:]\n")),),
+        3,
+        "test_pherm_interpolate",
+        "leaves out the first test point",
+        was="generic",
+    ),
+    Planted(
+        "dydt_second_term_with_sin",
+        "01_limacon.ipynb",
+        (("dydt = -np.sin(t) ** 2 + r * np.cos(t)", "dydt = -np.sin(t) ** 2 + r * np.sin(t)"),),
+        4,
+        "limacon_derivatives",
+        "the second term of your dy/dt",
+        was="generic",  # and the plot was charged too, judged against labkit's limaçon
+    ),
+    Planted(
+        "dxdt_first_term_with_sin",
+        "01_limacon.ipynb",
+        (("dxdt = -np.sin(t) * np.cos(t) - r * np.sin(t)", "dxdt = -np.sin(t) * np.sin(t) - r * np.sin(t)"),),
+        4,
+        "limacon_derivatives",
+        "the first term of your dx/dt",
+        was="generic",
+    ),
+    Planted(
+        "mirror_leaves_the_points",
+        "03_meshes.ipynb",
+        (("return Corner(corner.point[::-1], corner.dt[::-1]", "return Corner(corner.point, corner.dt[::-1]"),),
+        9,
+        "two_patches",
+        "reflects the derivative vectors but not the points",
+        was="generic",  # and region was charged too, judged against the lab's patches
+    ),
+    Planted(
+        "second_patch_counts_swapped",
+        "03_meshes.ipynb",
+        ((SECOND_MESH, SECOND_MESH.replace("0, 1, 30), np.linspace(0, 1, 20)", "0, 1, 20), np.linspace(0, 1, 30)")),),
+        9,
+        "two_patches",
+        "point counts in s and t are swapped",
+        was="misleading",
+    ),
+    Planted(
+        "natural_end_slopes_set_to_zero",
+        "04_splines.ipynb",
+        (
+            (
+                "    sprime[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]  # equation (9)\n",
+                "    sprime[-1] = M[-1] * h[-1] / 3 + M[-2] * h[-1] / 6 + secant[-1]  # equation (9)\n"
+                "    sprime[0], sprime[-1] = 0.0, 0.0\n",
+            ),
+        ),
+        12,
+        "ncspline",
+        "your end slopes are 0",
+        was="misleading",
+    ),
+    Planted(
+        "pbilin_one_cell_for_every_point",
+        "06_bilinear.ipynb",
+        ((PBILIN_SEARCH, "    i, j = labkit.bracket(xdata, xval[:1]), labkit.bracket(ydata, yval[:1])\n"),),
+        16,
+        "eval_pbilin",
+        "every point is interpolated in the same cell",
+        was="generic",  # it passed: 1, x, y and xy come out right from any one cell
+    ),
+)
+MISTAKES += ISSUE47
+# issue 47's judgement call: the errata let Exercise 8's sides bow either way ("choose one, say which") and keep the
+# two-fold symmetry; four sides all bowing outwards keep it (four-fold), so they are correct work
+CIRCLE = (
+    "circle_sides = [Corner([0, 0], [q, -q], [q, q]), Corner([1, 0], [q, q], [-q, q]),\n"
+    "                Corner([1, 1], [q, -q], [q, q]), Corner([0, 1], [q, q], [-q, q])]"
+)
+CORRECT += (
+    Planted(
+        "circle_sides_all_bowing_outwards",
+        "03_meshes.ipynb",
+        (
+            (
+                CIRCLE,
+                "circle_sides = [Corner([0, 0], [q, -q], [-q, q]), Corner([1, 0], [q, q], [q, q]),\n"
+                "                Corner([1, 1], [q, -q], [-q, q]), Corner([0, 1], [q, q], [q, q])]",
+            ),
+        ),
+        full=(8,),
+    ),
+)
 
 
 def submissions():

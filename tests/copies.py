@@ -86,3 +86,77 @@ def renamed_cells(cells):
                 _Renamer(dummy=True).visit(node)
         found.append(ast.unparse(tree))
     return found
+
+
+# -- one further mechanical rewrite of a copy (issue 47): each defeats a comparison of token runs --------------
+
+
+def _functions(tree):
+    return [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]
+
+
+def dead_stores(cell):
+    """A dead assignment after every statement of every function (``z7 = 7``)."""
+    tree = ast.parse(cell)
+    count = 0
+    for function in _functions(tree):
+        for node in [function, *ast.walk(function)]:
+            for field in ("body", "orelse"):
+                block = getattr(node, field, None)
+                if not (isinstance(block, list) and block and isinstance(block[0], ast.stmt)):
+                    continue
+                padded = []
+                for statement in block:
+                    count += 1
+                    filler = ast.parse(f"z{count} = {count}").body[0]
+                    padded += [filler, statement] if isinstance(statement, ast.Return) else [statement, filler]
+                setattr(node, field, padded)
+    return ast.unparse(ast.fix_missing_locations(tree))
+
+
+class _Getattr(ast.NodeTransformer):
+    def visit_Attribute(self, node):
+        self.generic_visit(node)
+        if not isinstance(node.ctx, ast.Load):
+            return node
+        call = ast.Call(ast.Name("getattr", ast.Load()), [node.value, ast.Constant(node.attr)], [])
+        return ast.copy_location(call, node)
+
+
+def getattr_reads(cell):
+    """Every attribute read spelled ``getattr(obj, "name")``."""
+    return ast.unparse(ast.fix_missing_locations(_Getattr().visit(ast.parse(cell))))
+
+
+def staticmethods(cell, box="Tools"):
+    """Every top-level function a staticmethod of one class, called through it; each graded name bound after."""
+    tree = ast.parse(cell)
+    functions = [n for n in tree.body if isinstance(n, ast.FunctionDef)]
+    names = {f.name for f in functions}
+
+    class Through(ast.NodeTransformer):
+        def visit_Name(self, node):
+            if node.id in names and isinstance(node.ctx, ast.Load):
+                return ast.copy_location(ast.Attribute(ast.Name(box, ast.Load()), node.id, ast.Load()), node)
+            return node
+
+    for function in functions:
+        Through().visit(function)
+        function.decorator_list.insert(0, ast.Name("staticmethod", ast.Load()))
+    rest = [n for n in tree.body if not isinstance(n, ast.FunctionDef)]
+    holder = ast.ClassDef(name=box, bases=[], keywords=[], body=functions, decorator_list=[], type_params=[])
+    bound = [ast.parse(f"{name} = {box}.{name}").body[0] for name in sorted(names)]
+    tree.body = rest + [holder] + bound
+    return ast.unparse(ast.fix_missing_locations(tree))
+
+
+def exec_compressed(cell):
+    """The code compressed into a string and ``exec``'d at the top level of the notebook."""
+    import base64
+    import zlib
+
+    packed = base64.b64encode(zlib.compress(cell.encode())).decode()
+    return f"import base64, zlib\nexec(zlib.decompress(base64.b64decode('{packed}')).decode())"
+
+
+REWRITES = {"dead-stores": dead_stores, "getattr": getattr_reads, "staticmethods": staticmethods}

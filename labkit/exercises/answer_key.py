@@ -51,6 +51,8 @@ def orders(order: int, rate: str | None = None) -> tuple:
         f"h^{p}",
         f"h**{p}",
         f"slope of -{p}",
+        f"slope -{p}",
+        f"slopes -{p}",
         f"{2**p} = 2^p",
         f"2^p = {2**p}",
         f"2^{p} = {2**p}",

@@ -11,7 +11,7 @@ sandboxed notebook: the declaration lists them (``passes``).
 
 import numpy as np
 
-from .. import bilinear, functions
+from .. import bilinear, functions, piecewise
 from .experiments import RUNGE2D_A, Experiment
 from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part
 from .result import CheckResult, call, case_rng, close, floats, gave_up, worst
@@ -136,7 +136,45 @@ def check_eval_pbilin(fn, seed=None):
                     )
                 )
             return result
+    return _several_cells(fn, result, xdata, ydata, xval, yval)
+
+
+def curved(x, y):
+    """A function that is not bilinear: each cell's interpolant of it is its own."""
+    return np.asarray(x, dtype=float) ** 2 + np.asarray(x, dtype=float) * np.asarray(y, dtype=float) ** 2
+
+
+def _several_cells(fn, result, xdata, ydata, xval, yval):
+    """The last step: a function that is not bilinear at points spread over every cell, against labkit's
+    interpolant (1, x, y and xy come out right from any one cell, extrapolated)."""
+    want = bilinear.eval_pbilin(curved, xdata, ydata, xval, yval)
+    ok, z = call(result, "f = x^2 + x y^2", fn, curved, xdata, ydata, xval, yval)
+    if not ok or result.step("each point in its own cell: f = x^2 + x y^2 on the grid", close(z, want), worst(z, want)):
+        return result
+    i, j = piecewise.bracket(xdata, xval[:1]), piecewise.bracket(ydata, yval[:1])
+    one = _one_cell(xdata, ydata, xval, yval, int(i[0]), int(j[0]))
+    result.hint = (
+        "every point is interpolated in the same cell (the first point's): each xval[k], yval[l] has its own "
+        "cell, which bracket(xdata, xval) and bracket(ydata, yval) give, one index per point."
+        if close(z, one)
+        else "1, x, y and xy come out right but a curved f does not: each point must use the four corners of its "
+        "own cell, found with bracket on xval and on yval."
+    )
     return result
+
+
+def _one_cell(xdata, ydata, xval, yval, i, j):
+    """The bilinear interpolant of :func:`curved` on cell (i, j), extended to every point."""
+    x0, x1, y0, y1 = xdata[i], xdata[i + 1], ydata[j], ydata[j + 1]
+    X, Y = np.meshgrid(xval, yval, indexing="ij")
+    f = curved
+    area = (x1 - x0) * (y1 - y0)
+    return (
+        f(x0, y0) * (x1 - X) * (y1 - Y)
+        + f(x1, y0) * (X - x0) * (y1 - Y)
+        + f(x1, y1) * (X - x0) * (Y - y0)
+        + f(x0, y1) * (x1 - X) * (Y - y0)
+    ) / area
 
 
 def _pbilin_corner_slip(fn):
@@ -271,7 +309,7 @@ EXERCISES = (
                 ("eval_pbilin",),
                 seeded=True,
                 refused=INTERPOLANTS,
-                passes=(functions.runge2d,) + tuple(function for _, function in BILINEAR_FUNCTIONS) + CORNERS,
+                passes=(functions.runge2d, curved) + tuple(function for _, function in BILINEAR_FUNCTIONS) + CORNERS,
             ),
         )
         + BILINEAR.parts(),

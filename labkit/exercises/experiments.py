@@ -419,6 +419,30 @@ def _slip_error(method, ndata, norm="max", **how):
     )
 
 
+def _cut_error(method, ndata, cut):
+    """The relative max error of a driver whose test points are the lab's with `cut` taken (one end left out)."""
+    exact, error = _measured(method, ndata)
+    return float(np.max(np.abs(error[cut])) / np.max(np.abs(exact[cut])))
+
+
+def _scaled_at_the_data(method, ndata, expected):
+    """The error a driver gives on the moved, scaled f when it divides by max|f| at the data points instead of
+    over the test points (`expected` is the lab's relative error there)."""
+    f = method.f(scaled=True)
+    data, test = np.linspace(0.0, 5.0, ndata), np.linspace(0.0, 5.0, method.ntest)
+    if method.key == "bilinear":
+        at = lambda x: np.asarray(f(*np.meshgrid(x, x, indexing="ij")), dtype=float)
+    else:
+        at = lambda x: np.asarray(f(x)[0], dtype=float)
+    return expected * np.max(np.abs(at(test))) / np.max(np.abs(at(data)))
+
+
+SCALED_AT_THE_DATA = (
+    "the error is divided by max|f| at the data points, not over the test points: the largest |f| can fall "
+    "between data points (for the Runge function on [0, 5] it is at a data point, which hides the slip)."
+)
+
+
 MEASURED = "the lab's error is the largest |f - p| over the test points (the infinity norm), relative to max|f|"
 
 
@@ -455,6 +479,14 @@ def _measurement_slips(method, ndata):
         for norm in ("signed+", "signed-")
     ]
     if method.key != "bilinear":
+        found += [
+            (
+                f"The error leaves out the {end} test point (x = {where}): the lab's {method.ntest} test points run "
+                "from 0 to 5, both ends included.",
+                lambda cut=cut: _cut_error(method, ndata, cut),
+            )
+            for end, where, cut in (("first", 0, slice(1, None)), ("last", 5, slice(None, -1)))
+        ]
         found.append(
             (
                 "The error looks measured against f's derivatives, the second of the two things f returns, "
@@ -620,6 +652,8 @@ def check_driver(method, fn, seed=None):
             "the error is absolute, not relative to max|f|: divide the largest error by max|f| over "
             "the test points (for the Runge function on [0, 5] that is 1, which hides the slip)."
             if tripled
+            else SCALED_AT_THE_DATA
+            if _agrees(err, _scaled_at_the_data(method, ndata, expected))
             else IGNORES_F
         )
     return result

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import functions, piecewise
 from .experiments import RUNGE_A, Experiment
-from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Part, Together
+from .model import INTERPOLANTS, OWN_FUNCTIONS, Exercise, Optional, Part, Together
 from .plotted import LAB_R0, check_limacon_plot, derivative_slips
 from .result import CheckResult, call, case_rng, close, floats, gave_up, several, shown, worst
 from .variants import Param
@@ -178,6 +178,10 @@ def _narrow_pherm(fn, result):
         )
         return result
     name, factor, other = bad[0]
+    mixed = _combination_slip(fn, interval) if all(o is None for _, _, o in bad) else ""
+    if mixed:
+        result.fail(label, f"wrong: {', '.join(n for n, _, _ in bad)}", mixed)
+        return result
     if factor == -1 and not unit_ok:
         # -1 on [0, 1] is a sign slip, or a power of (x_k - x_{k+1}) = -1 too many or too few: [0, 2] tells
         wider = _basis_failures(fn, [0.0, 2.0], result)
@@ -263,6 +267,43 @@ def _table3_slips(fn, name, eps=1e-5):
     what = ("its value at x_k", "its slope at x_k", "its value at x_{k+1}", "its slope at x_{k+1}")
     off = [w for w, got_, want in zip(what, found, TABLE3[name]) if abs(got_ - want) > 1e-4]
     return ", ".join(off[:-1]) + (" and " if len(off) > 1 else "") + off[-1] if off else ""
+
+
+DATA_NAMES = ("y_k", "y'_k", "y_{k+1}", "y'_{k+1}")
+
+
+def _combination_slip(fn, interval):
+    """The combination's slip in the student's words when each basis function is right but multiplied by other
+    data than equation (4) says (``y'_k * h4``), '' otherwise: each datum alone set, the interpolant is read as a
+    sum of the four basis functions, and every sum must be of whole basis functions."""
+    xdata = np.array(interval, dtype=float)
+    points = xdata[0] + (xdata[1] - xdata[0]) * np.linspace(0.05, 0.95, 9)
+    basis = np.asarray(piecewise.hermite_basis(xdata[0], xdata[1], points))  # (4, points)
+    rows = []
+    for m in range(4):
+        y, yp = np.zeros(2), np.zeros(2)
+        (y if m % 2 == 0 else yp)[m // 2] = 1.0
+        ok, got = call(CheckResult("eval_pherm"), "one datum", fn, xdata, y, yp, points)
+        try:
+            rows.append(floats(got) if ok else None)
+        except (TypeError, ValueError):
+            return ""
+    if any(r is None or r.shape != points.shape for r in rows):
+        return ""
+    weights = np.linalg.lstsq(basis.T, np.stack(rows).T, rcond=None)[0].T  # weights[m, n]: datum m times h_n
+    whole = np.rint(weights)
+    if not close(weights, whole, 1e-6) or np.array_equal(whole, np.eye(4)) or not set(whole.ravel()) <= {0.0, 1.0}:
+        return ""
+    wrong = [n for n in range(4) if not np.array_equal(whole[:, n], np.eye(4)[:, n])]
+    said = []
+    for n in wrong:
+        used = [DATA_NAMES[m] for m in range(4) if whole[m, n]]
+        said.append(f"h{n + 1} is multiplied by {' + '.join(used) or 'nothing'} where equation (4) has {DATA_NAMES[n]}")
+    return (
+        "each basis function is right, but the combination multiplies them by the wrong data: "
+        + "; ".join(said)
+        + ". p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4."
+    )
 
 
 def _basis_failures(fn, interval, result):
@@ -367,6 +408,32 @@ def _sign_slip(got, want):
     return ""
 
 
+def _term_slip(name, got, t, r0):
+    """Which of the product rule's two terms of `name` (dx/dt or dy/dt) is wrong, when the other is right and the
+    wrong one is a plain mix-up of sine and cosine or of a sign, in the student's words; '' otherwise."""
+    try:
+        got = floats(got)
+    except (TypeError, ValueError):
+        return ""
+    sin, cos, r = np.sin(t), np.cos(t), r0 + np.cos(t)
+    trig = cos if name == "dx/dt" else sin  # x = r cos t, y = r sin t
+    first, second = -sin * trig, r * (-sin if name == "dx/dt" else cos)  # dr/dt * trig, r * d(trig)/dt
+    if got.shape != t.shape:
+        return ""
+    wrong_second = [k * r * w for k in (1, -1) for w in (sin, cos)]
+    wrong_first = [k * sin * w for k in (1, -1) for w in (sin, cos)] + [
+        k * cos * w for k in (1, -1) for w in (sin, cos)
+    ]
+    which = "cos t" if name == "dx/dt" else "sin t"
+    if any(close(got - first, w) for w in wrong_second):
+        return f"the second term of your {name}, r times the derivative of {which}, is not that derivative: check it."
+    if any(close(got - second, w) for w in wrong_first):
+        return (
+            f"the first term of your {name}, dr/dt times {which}, is wrong: check dr/dt and the factor it multiplies."
+        )
+    return ""
+
+
 def check_limacon_derivatives(fn, seed=None):
     """Check ``limacon_derivatives(t, r0) -> (dxdt, dydt)`` of x = r cos t, y = r sin t, r = r0 + cos t."""
     result = CheckResult("limacon_derivatives")
@@ -417,7 +484,8 @@ def check_limacon_derivatives(fn, seed=None):
                 result.hint = (
                     f"{name} {slip}: differentiate with the product rule, and check the sign of each term."
                     if slip
-                    else f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "
+                    else _term_slip(name, got, t, r0)
+                    or f"differentiate {'x = r cos t' if name == 'dx/dt' else 'y = r sin t'} "
                     "with the product rule (r = r0 + cos t depends on t too); compare with a centred difference."
                 )
                 return result
@@ -504,6 +572,7 @@ EXERCISES = (
                 7,
                 check_limacon_plot,
                 ("ax4", Together(("tdata", "xdata", "ydata", "xpdata", "ypdata"), required=False)),
+                keywords=(("derivatives", Optional("limacon_derivatives")),),
                 uses=("limacon_derivatives",),
                 varied=("r0",),
             ),

@@ -468,19 +468,36 @@ MIRROR_SLIPS = (
         "round the patch abcd as the lab's table of its points lists them.",
         lambda c: patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
         "ABCD",
+        (SIZES9[1], SIZES9[0]),
     ),
     (
         "in your second patch each corner's ds is the mirror image of ABCD's ds (and dt of dt), so its mesh lines "
         "do not meet the first patch's along dc: in the mirror image, which way does s run, and which way t?",
         lambda c: patches.Corner(c.point[::-1], c.ds[::-1], c.dt[::-1], c.dsdt[::-1]),
         "ADCB",
+        (SIZES9[1], SIZES9[0]),
     ),
     (
         "the second patch's derivatives are not mirrored: its corner points are the mirror images of ABCD's, but "
         "their derivative vectors are ABCD's own; reflecting in y = x changes a vector as it changes a point.",
         lambda c: patches.Corner(c.point[::-1], c.dt, c.ds, c.dsdt),
         "ADCB",
+        (SIZES9[1], SIZES9[0]),
     ),
+    (
+        "the mirror reflects the derivative vectors but not the points: your second patch's corners are ABCD's own "
+        "points; reflecting in y = x swaps a point's x and y as it swaps a vector's.",
+        lambda c: patches.Corner(c.point, c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
+        "ADCB",
+        (SIZES9[1], SIZES9[0]),
+    ),
+)
+COUNTS_SWAPPED = (  # the right mirror, meshed with the first patch's counts: s and t swapped
+    "the second patch's point counts in s and t are swapped: its edge dc runs in s and lies on the first "
+    "patch's edge BC, which runs in t with 30 points, so abcd needs 30 points in s and 20 in t.",
+    lambda c: patches.Corner(c.point[::-1], c.dt[::-1], c.ds[::-1], c.dsdt[::-1]),
+    "ADCB",
+    (SIZES9[0], SIZES9[1]),
 )
 
 
@@ -495,9 +512,9 @@ def _mirror_slip(second, corners):
         return ""
     by_label = dict(zip("ABCD", corners))
     mine = nodes[np.lexsort(np.round(nodes[:, :2], 9).T[::-1])][:, :2]
-    for hint, mirrored, order in MIRROR_SLIPS:
+    for hint, mirrored, order, counts in MIRROR_SLIPS + (COUNTS_SWAPPED,):
         x, y = patches.patch(
-            *(mirrored(by_label[label]) for label in order), np.linspace(0, 1, SIZES9[1]), np.linspace(0, 1, SIZES9[0])
+            *(mirrored(by_label[label]) for label in order), np.linspace(0, 1, counts[0]), np.linspace(0, 1, counts[1])
         )
         theirs = np.stack((x.ravel(), y.ravel()), axis=1)
         if close(mine, theirs[np.lexsort(np.round(theirs, 9).T[::-1])], 1e-7):
@@ -537,15 +554,23 @@ def _corner_points(corners):
     return first, second
 
 
+def _missed(mesh, points):
+    nodes = np.asarray(mesh.points, dtype=float)[:, :2]
+    return [
+        f"{label} = ({point[0]:.3g}, {point[1]:.3g})"
+        for label, point in points.items()
+        if not nodes.size or np.min(np.hypot(*(nodes - point).T)) > ON_CORNER
+    ]
+
+
 def _corners_missed(meshes, corners):
     """The corner points (as 'B = (0.707, 0.707)') that no node of their mesh is on: ABCD's for the first
-    mesh, abcd's for the second."""
-    missed = []
-    for mesh, points in zip(meshes, _corner_points(corners)):
-        nodes = np.asarray(mesh.points, dtype=float)[:, :2]
-        for label, point in points.items():
-            if not nodes.size or np.min(np.hypot(*(nodes - point).T)) > ON_CORNER:
-                missed.append(f"{label} = ({point[0]:.3g}, {point[1]:.3g})")
+    mesh, abcd's for the second. A second mesh on ABCD's own points is a mirror that left the points where
+    they were: a slip of the mirror rule, charged in two_patches, so nothing is missed."""
+    first, second = _corner_points(corners)
+    missed = _missed(meshes[0], first)
+    if _missed(meshes[1], second) and _missed(meshes[1], first):
+        missed += _missed(meshes[1], second)
     return missed
 
 
@@ -591,13 +616,13 @@ def check_combined_mesh(region, corners, two_patches=None):
         return result.fail(
             "region is a QuadMesh",
             f"got {getattr(region, 'description', type(region).__name__)}",
-            "join the two patch meshes with +: region = first + second.",
+            "make region one QuadMesh of the two meshes two_patches returns.",
         )
     if max(len(region.points), len(region.quads)) > MAX_NODES:
         return result.fail(
             "region has the lab's size",
             f"{len(region.points):,} nodes and {len(region.quads):,} elements",
-            "mesh the two patches with 20 x 30 points each and join them with +.",
+            "mesh the two patches with 20 x 30 points each and make region of those two meshes.",
         )
     own = _own_meshes(two_patches, corners)
     why = attempted_meshes(own, corners) if own is not None else ""
@@ -623,8 +648,9 @@ def check_combined_mesh(region, corners, two_patches=None):
         f"got {len(region.points)} nodes and {len(region.quads)} elements",
     ):
         result.hint = (
-            "the shared edge's 30 nodes appear once in a conforming mesh: join the two meshes with "
-            "+, which merges them (20 x 30 + 30 x 20 - 30 nodes)."
+            f"a conforming mesh holds each node of the shared edge once, so region has {len(reference.points)} "
+            f"nodes where yours has {len(region.points)}: the edge's nodes are there "
+            f"{'twice' if len(region.points) > len(reference.points) else 'too few times'}."
         )
         return result
     order = np.lexsort(np.round(region.points, 9).T[::-1])
@@ -634,21 +660,21 @@ def check_combined_mesh(region, corners, two_patches=None):
         close(region.points[order], reference.points[expected], 1e-7),
         worst(region.points[order], reference.points[expected]),
     ):
-        result.hint = "make region from the two meshes two_patches returns: region = first + second."
+        result.hint = "make region from the two meshes two_patches returns, both whole."
         return result
     if not result.step(
         "conforming: no crack along the shared edge",
         _boundary_edges(region) == _boundary_edges(reference),
         f"{_boundary_edges(region)} boundary edges, {_boundary_edges(reference)} expected",
     ):
-        result.hint = "elements on both sides of the shared edge must use the same nodes: join the meshes with +."
+        result.hint = "elements on both sides of the shared edge must use the same nodes, not two copies of them."
         return result
     if not result.step(
         "no element folded by the join",
         _folded(region) <= _folded(reference),
         f"{_folded(region)} folded elements, {_folded(reference)} in the two meshes joined",
     ):
-        result.hint = "the join turned elements over: keep each mesh's node order when you join them with +."
+        result.hint = "the join turned elements over: keep each mesh's node order when you join them."
     return result
 
 
@@ -700,6 +726,15 @@ MIRROR_RULE = (  # 9: the mirror rule for abcd's corners
     "dt[::-1], c.ds[::-1]",
     "dt[::-1], corner.ds[::-1]",
     "point[::-1], dt[::-1], ds[::-1]",
+)
+
+JOIN_RULE = (  # 9(c): how two meshes become one conforming mesh
+    "+ merges",
+    "with +, which merges",
+    "merges nodes that coincide",
+    "merges coinciding nodes",
+    "merges the nodes that coincide",
+    "coinciding nodes are merged",
 )
 
 EXERCISES = (
@@ -758,6 +793,6 @@ EXERCISES = (
         ),
         notebook="03_meshes.ipynb",
         answers=("why the mirror image's corner data make the two patches match",),
-        withheld=MIRROR_RULE,
+        withheld=MIRROR_RULE + JOIN_RULE,
     ),
 )

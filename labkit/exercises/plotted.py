@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import functions, monotone, piecewise, splines
 from ..plotdata import NO_LINE, Line, line_of, lines_of  # noqa: F401 - Line and line_of for the checks' users
-from .result import CheckResult, Results, close, floats, judged_by_the_lab
+from .result import CheckResult, Results, call, close, floats, judged_by_the_lab, several
 
 MIN_POINTS = 100
 # bounds on the grader's work for one plot, whatever the notebook drew: the long lines examined,
@@ -117,12 +117,25 @@ def derivative_slips(t, r0=LAB_R0):
     }
 
 
-def attempted_data(own, r0=LAB_R0):
+def _own_slopes(derivatives, tdata, r0):
+    """The student's own ``limacon_derivatives(tdata, r0)`` (dx/dt, dy/dt) as floats, or None."""
+    if derivatives is None or not callable(derivatives):
+        return None
+    ok, got = call(CheckResult("limacon_derivatives"), "limacon_derivatives", derivatives, tdata, r0)
+    out = several(got, 2) if ok else None
+    try:
+        return None if out is None else [floats(v) for v in out]
+    except (TypeError, ValueError):
+        return None
+
+
+def attempted_data(own, r0=LAB_R0, derivatives=None):
     """Is the notebook's ``(tdata, xdata, ydata, xpdata, ypdata)`` an attempt at the lab's data?
 
     ``(data as floats, "")`` when it is: ``tdata``, ``xdata``, ``ydata`` are the lab's 21 points of the
     limaçon, and ``xpdata``, ``ypdata`` its derivatives there, each right or wrong by a slip the derivative
-    check names (so a wrong derivative is charged there, once). ``(None, why)`` when it is not, `why` in the
+    check names, or what the student's own `derivatives` (``limacon_derivatives``) give there, whatever its
+    slip (so a wrong derivative is charged there, once). ``(None, why)`` when it is not, `why` in the
     student's words; ``(None, "")`` when the notebook lacks them.
     """
     if own is None:
@@ -145,6 +158,9 @@ def attempted_data(own, r0=LAB_R0):
     slips = derivative_slips(tdata, r0)
     if r0 != LAB_R0:  # a function that ignores its r0 for the lab's (the derivative check names it)
         slips = {name: (*found, ("", derivative_slips(tdata)[name][0][1])) for name, found in slips.items()}
+    mine = _own_slopes(derivatives, tdata, r0)
+    if mine is not None:  # the student's own derivatives, whatever their slip: charged in their own part
+        slips = {name: (*found, ("", values)) for (name, found), values in zip(slips.items(), mine)}
     for name, got in (("dx/dt", data[3]), ("dy/dt", data[4])):
         if not any(close(got, values) for _, values in slips[name]):
             return None, (
@@ -154,7 +170,7 @@ def attempted_data(own, r0=LAB_R0):
     return data, ""
 
 
-def check_limacon_plot(plot, own=None, r0=LAB_R0):
+def check_limacon_plot(plot, own=None, r0=LAB_R0, derivatives=None):
     """Check Exercise 4's plot: the Hermite interpolant of the limaçon, drawn all the way round.
 
     The curve must be the piecewise cubic Hermite interpolant itself (to
@@ -162,9 +178,9 @@ def check_limacon_plot(plot, own=None, r0=LAB_R0):
     not straight segments: the interpolant of the notebook's own data `own`
     (``tdata, xdata, ydata, xpdata, ypdata``) when they are an attempt at the
     lab's (:func:`attempted_data`: the lab's 21 points, slopes right or wrong by
-    a named slip), so a wrong slope is marked where the slopes are checked and
-    not again here; otherwise the lab's (21 points, exact derivatives), and the
-    feedback says why.
+    a named slip, or what the student's own `derivatives` give there), so a
+    wrong slope is marked where the slopes are checked and not again here;
+    otherwise the lab's (21 points, exact derivatives), and the feedback says why.
     """
     result = CheckResult("ax4")
     lines = lines_of(plot)
@@ -180,7 +196,7 @@ def check_limacon_plot(plot, own=None, r0=LAB_R0):
         return result
     long = long[:MAX_CURVES]
     curves = [("the Hermite interpolant of the lab's data", _lab_hermite(r0))]
-    data, why = attempted_data(own, r0)
+    data, why = attempted_data(own, r0, derivatives)
     if why:
         whose = "the lab's" if r0 == LAB_R0 else f"your variant's (r0 = {r0:g})"
         judged_by_the_lab(result, why, f"{whose} Hermite limaçon (its 21 points with the exact slopes)")
@@ -372,7 +388,7 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
             "x and y are swapped: the data are drawn with the temperatures across and the times up. The first "
             "argument of ax14.plot is the horizontal coordinate: xdata, then ydata."
             if swapped
-            else "plot xdata, ydata themselves: ax14.plot(xdata, ydata, 'o')."
+            else "draw the data points themselves: the times across, the temperatures up."
         )
     elif data.step(
         "drawn as circles",
@@ -384,9 +400,9 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
             any(ln.marker == CIRCLE and not ln.joined for ln in at_data),
             "the circles are joined by lines",
         ):
-            data.hint = "circles only: marker 'o' with linestyle 'none' (the format string 'o')."
+            data.hint = "circles only: no line may join the data points."
     else:
-        data.hint = "use the marker 'o'."
+        data.hint = "draw each data point as a circle."
     results.append(data)
 
     curves = [ln for ln in lines if all(ln is not d for d in at_data)]
@@ -410,21 +426,21 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
                 f"x and y are swapped: {name} is drawn with its values across and xval up. The first argument "
                 "of ax14.plot is the horizontal coordinate: xval, then the values."
                 if swapped
-                else f"evaluate {name} of the data at many points xval and plot them: "
-                f"ax14.plot(xval, {'labkit.spline' if 'spline' in name else 'labkit.pchip'}(xdata, ydata, xval))."
+                else f"evaluate {name} of the data at many times from the first data point to the last, and draw "
+                "its values against those times."
             )
         else:
             most = max(matching, key=lambda ln: ln.x.size)
             if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS, f"only {most.x.size} points"):
-                check.hint = f"use at least {MIN_POINTS} points, e.g. xval = np.linspace(0, 4, 201)."
+                check.hint = f"evaluate it at {MIN_POINTS} points or more, so that the curve looks smooth."
             elif not check.step(
                 "over the whole data range [0, 4]",
                 most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
                 f"from {most.x.min():.3g} to {most.x.max():.3g}",
             ):
-                check.hint = "let xval run from the first data point to the last: np.linspace(0, 4, 201)."
+                check.hint = "let its times run from the first data point to the last."
             elif not check.step("drawn as a line", most.joined, "drawn as separate markers"):
-                check.hint = "draw the curve as a line (format string '-')."
+                check.hint = "draw the curve as a line, not as separate markers."
         results.append(check)
     return results
 

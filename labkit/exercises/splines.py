@@ -271,6 +271,11 @@ def check_ncspline(fn, seed=None, system=None):
                 "the first and last rows of A, and the first and last entries of D, are still the complete "
                 "spline's rows: change them so that those two equations say M1 = 0 and Mn = 0."
             )
+        elif got.shape == want.shape and np.allclose(got[[0, -1]], 0.0) and not np.allclose(want[[0, -1]], 0.0):
+            result.hint = (
+                "your end slopes are 0: the natural spline's ends have zero second derivative (M1 = Mn = 0), "
+                "not zero slope; its end slopes come from the solved M by (8) and (9), as the others do."
+            )
         else:
             result.hint = _natural_rows_slip(x, y, got) or (
                 "the second derivative is not 0 at the ends: the first and last equations of the system "
@@ -492,6 +497,9 @@ NATURAL_WHY = (
     "where the Runge function itself bends",
     "errs at the left end",
     "s'' = 0 at both ends, but",
+    "order lower",
+    "lower order",
+    "order is lower",
 )
 NOTAKNOT = Experiment("notaknot", 4, "test_spline_interpolate", "errors_notaknot", "rate_notaknot", weights=(3, 2, 2))
 

@@ -406,8 +406,10 @@ def plot_limacon(nintervals=20, r0=1.15, method="pherm", ax=None):
     return LimaconView(ax).update(nintervals, r0, method)
 
 
-def plot_convergence(tables, ax=None):
-    """Log-log plot of error against number of data for ConvergenceTables, with slopes -2 and -4."""
+def plot_convergence(tables, ax=None, slopes=()):
+    """Log-log plot of error against number of data for ConvergenceTables; with `slopes` (orders, e.g. (2, 4)),
+    a guide line of slope -p for each. The student release draws none: lines of the lab's orders beside the
+    tables would answer the question the tables ask."""
     ax = new_axes(ax, size=(6, 4.5))
     titles = {title.lower(): method for method, title in METHOD_TITLES.items()}
     looks = list(METHOD_STYLES.values())
@@ -416,7 +418,7 @@ def plot_convergence(tables, ax=None):
         look = METHOD_STYLES.get(titles.get(name.lower()), looks[k % len(looks)])
         ax.loglog(table.ndata, table.errors, ms=4, label=name, **look)  # the name only: the order is the lab's question
     n = np.array([tables[0].ndata[2], tables[0].ndata[-1]], dtype=float)
-    for order, style in ((2, "k--"), (4, "k:")):
+    for order, style in zip(slopes, ("k--", "k:", "k-.")):
         anchor = min(t.errors[2] for t in tables)
         ax.loglog(n, anchor * (n / n[0]) ** -order, style, lw=1, label=f"slope -{order}")
     ax.legend(fontsize="small")

@@ -56,15 +56,31 @@ def _also(name, *replace, part=None):
 
 
 # upstream part -> slips planted in it (the catalog's, in a notebook whose dependents really call it)
+# issue 47: a wrong term of dy/dt cost the plot too (judged on labkit's limaçon), and a mirror that reflects the
+# derivative vectors but not the points cost region too (judged on the lab's patches); their siblings with them
 SLIPS = {
-    "eval_pherm": (BY_NAME["wrong_denominator"], BY_NAME["values_and_slopes_swapped"]),
+    "eval_pherm": (
+        BY_NAME["wrong_denominator"],
+        BY_NAME["values_and_slopes_swapped"],
+        BY_NAME["h4_times_the_slope_at_xk"],
+    ),
     "runge": (BY_NAME["runge_derivative_sign"],),
-    "limacon_derivatives": (BY_NAME["limacon_dydt_sign"],),
+    "limacon_derivatives": (
+        BY_NAME["limacon_dydt_sign"],
+        BY_NAME["dydt_second_term_with_sin"],
+        BY_NAME["dxdt_first_term_with_sin"],
+    ),
     "coons": (_also("coons_without_twists", *OWN_COONS), _also("coons_dc_from_c_to_d", *OWN_COONS)),
-    "two_patches": (BY_NAME["mirror_without_swapping"], _also("mirror_keeps_the_derivative_vectors", *OWN_COONS)),
+    "two_patches": (
+        BY_NAME["mirror_without_swapping"],
+        _also("mirror_keeps_the_derivative_vectors", *OWN_COONS),
+        BY_NAME["mirror_leaves_the_points"],
+        _also("mirror_leaves_the_points", *OWN_COONS),
+        BY_NAME["second_patch_counts_swapped"],
+    ),
     "ccspline": (BY_NAME["complete_h_subscript"], _also("complete_h_subscript", *SLOPES_FROM_9)),
-    "ncspline": (BY_NAME["natural_rows_in_a_only"],),
-    "eval_pbilin": (BY_NAME["pbilin_corner_values_swapped"],),
+    "ncspline": (BY_NAME["natural_rows_in_a_only"], BY_NAME["natural_end_slopes_set_to_zero"]),
+    "eval_pbilin": (BY_NAME["pbilin_corner_values_swapped"], BY_NAME["pbilin_one_cell_for_every_point"]),
     "runge2d": (BY_NAME["runge2d_with_a_product"],),
 }
 CASES = [

@@ -242,7 +242,7 @@ def wrong_answers():
     yield "straight sides with the unit square's derivatives", 7, {"straight": chord}
     square = [labkit.Corner(p, [1, 0], [0, 1]) for p in ([0, 0], [1, 0], [1, 1], [0, 1])]
     yield "quarter circles with the chords' derivatives", 8, {"circle_sides": square}
-    for k, (_, mirror, order) in enumerate(patches.MIRROR_SLIPS):
+    for k, (_, mirror, order, _counts) in enumerate(patches.MIRROR_SLIPS):
         yield f"mirror slip {k + 1}", 9, {"two_patches": mirrored_with(mirror, order), **CORNERS9}
 
     def complete_rows(x, y):

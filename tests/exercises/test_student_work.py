@@ -370,10 +370,10 @@ def test_the_boiling_plot_passes_when_right():
 @pytest.mark.parametrize(
     "kwargs, failing, hint",
     [
-        ({"data": "o-"}, 0, "linestyle 'none'"),
-        ({"data": "s"}, 0, "marker 'o'"),
-        ({"spline_points": 20}, 1, "at least 100 points"),
-        ({"pchip_points": 5}, 2, "evaluate pchip of the data at many points"),
+        ({"data": "o-"}, 0, "no line may join the data points"),
+        ({"data": "s"}, 0, "as a circle"),
+        ({"spline_points": 20}, 1, "100 points or more"),
+        ({"pchip_points": 5}, 2, "evaluate pchip of the data at many times"),
         ({"spline_style": "."}, 1, "as a line"),
     ],
 )
@@ -456,9 +456,9 @@ def test_the_combined_mesh_is_judged_from_its_data():
         np.vstack((first.points, second.points)), np.vstack((first.quads, second.quads + len(first.points)))
     )
     result = check.combined_mesh(cracked, corners)
-    assert not result.passed and "appear once" in result.hint
+    assert not result.passed and "the shared edge once" in result.hint and "twice" in result.hint
     assert not check.combined_mesh(first, corners).passed
-    assert "region = first + second" in check.combined_mesh(protocol.NotNumbers("a list"), corners).hint
+    assert "one QuadMesh of the two meshes" in check.combined_mesh(protocol.NotNumbers("a list"), corners).hint
 
 
 def test_a_shuffled_but_equal_mesh_passes_and_the_protocol_carries_it():

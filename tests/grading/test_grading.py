@@ -195,7 +195,7 @@ PLANTED = [
         'ax14.plot(xdata, ydata, "o-", color="k"',
         14,
         "ax14: the data",
-        "linestyle 'none'",
+        "no line may join the data points",
     ),
     (
         "spline_20_points",

@@ -47,7 +47,8 @@ def test_limacon_rejects_other_methods():
 
 def test_convergence_plot_has_a_line_per_table_and_reference_slopes():
     tables = [labkit.convergence_table(m, ndata=(5, 11, 21, 41)) for m in ("plin", "pherm")]
-    ax = plots.plot_convergence(tables)
+    assert len(plots.plot_convergence(tables).get_lines()) == 2  # no guide lines unless asked for (issue 47)
+    ax = plots.plot_convergence(tables, slopes=(2, 4))
     _labelled(ax)
     lines = ax.get_lines()
     assert len(lines) == 4 and ax.get_xscale() == "log" and ax.get_yscale() == "log"

@@ -1,6 +1,9 @@
 """Similar code between submissions, flagged for a person to judge (it never changes a grade).
 
-For each graded function, the students' sources are compared pairwise; pairs
+For each graded function, the students' sources are compared pairwise (each
+source is the function's definition followed by the notebook's definitions it
+reaches, :func:`labkit.grading.submission.scan.reached_function_sources`, so a
+copy moved into a helper is compared too); pairs
 above a threshold are listed in the class report (:mod:`labkit.grading.reports.class_report`)
 side by side, with the lines they share marked.
 

@@ -13,8 +13,14 @@ How code is compared (winnowing, Schleimer, Wilkerson and Aiken 2003, as
 copydetect and MOSS do it, with hashes of labkit's own so that they are the
 same in every process):
 
-1. :func:`normalise` tokenises a source with pygments (never parses or
-   runs it) and writes every token as one or a few characters: a variable or
+0. :func:`labkit.grading.submission.fingerprint.canonical` first writes each
+   definition back from its syntax tree with what does nothing taken out
+   (dead stores, statements with no effect, ``getattr`` with a literal name,
+   staticmethods and namespace classes), and
+   :func:`~labkit.grading.submission.fingerprint.units` splits a part's code
+   into functions, a class's methods each alone, trivial wrappers left out.
+1. :func:`normalise` tokenises a source with pygments (never runs it) and
+   writes every token as one or a few characters: a variable or
    argument name is ``V``, a function's name ``F``, a class's ``O``, a string
    ``S``; comments, docstrings and white space go. Keywords, operators,
    numbers, builtins and the attribute after a dot (``np.searchsorted``'s
@@ -50,6 +56,9 @@ from pathlib import Path
 
 import numpy as np
 
+from . import fingerprint
+from .fingerprint import canonical
+
 NOISE = 25  # normalised characters hashed together: a shorter shared run is never evidence
 WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characters always shares a fingerprint
 # a part is held for a person when known units have THRESHOLD or more of its own fingerprints and it shares
@@ -58,7 +67,7 @@ WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characte
 THRESHOLD = 0.5
 MIN_SHARED = 70
 SHOWN = 12  # shared lines shown side by side
-VERSION = "labkit-known/3"  # the cache's format and normalisation: a change here recomputes every fingerprint
+VERSION = "labkit-known/4"  # the cache's format and normalisation: a change here recomputes every fingerprint
 
 PARENTHESES = {"(", ")"}
 BASE = np.uint64(1_000_003)
@@ -203,7 +212,7 @@ def _fingerprint_units(texts):
     """[(unit text, hashes)] → the unit index and hash arrays of their fingerprints."""
     hashes, units = [], []
     for index, text in enumerate(texts):
-        found = np.unique(fingerprints(normalise(text)[0])[0])
+        found = np.unique(fingerprints(normalise(canonical(text))[0])[0])
         hashes.append(found)
         units.append(np.full(found.size, index, dtype=np.int32))
     if not hashes:
@@ -352,7 +361,7 @@ class Given:
     """Every :data:`NOISE`-character hash of the release's code cells: what every student was given."""
 
     def __init__(self, cells):
-        found = [kgrams(normalise(cell)[0]) for cell in cells]
+        found = [kgrams(normalise(canonical(cell))[0]) for cell in cells]
         self.array = np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
 
 
@@ -386,7 +395,7 @@ def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
         The fingerprints the part must share at least (:data:`MIN_SHARED`).
     """
     judged, total, shared = [], 0, 0
-    for name, text in definitions:
+    for name, text in fingerprint.units(definitions):
         normalised, where, hashes, positions = _read(text, given)
         distinct = np.unique(hashes)
         if not distinct.size:

@@ -73,6 +73,7 @@ DYNAMIC_NAMES = {
     "breakpoint": "breakpoint",
     "get_ipython": "get_ipython() (the shell's own namespace)",
 }
+STRING_RUNNERS = {"exec", "eval", "compile"}
 DYNAMIC_ATTRIBUTES = {
     "__code__",
     "__closure__",
@@ -156,8 +157,8 @@ class _Reader:
 
     def __init__(self, sources, deadline):
         self.deadline = deadline
-        self.trees, self.texts = [], {}
-        for source in sources:
+        self.trees, self.texts, self.cells = [], {}, []
+        for cell, source in enumerate(sources):
             text = python_source(source)
             if text is None:
                 continue
@@ -166,12 +167,21 @@ class _Reader:
                 self.trees.append(ast.parse(text))
             except (SyntaxError, ValueError, RecursionError, MemoryError):
                 continue  # IPython could not run it either: it defines nothing
+            self.cells.append(cell)
             for node in _top_level(self.trees[-1].body):
                 self.texts[id(node)] = text
         self.aliases, self.definitions = {}, {}
-        for tree in self.trees:
+        self.when, self.strings = {}, []  # where each name was last bound; where a string is run as code
+        self.statements = []  # the top-level statements that are not definitions (plots are drawn there)
+        for cell, tree in zip(self.cells, self.trees):
             for node in tree.body:
+                before = {name: id(found) for name, found in self.definitions.items()}
                 self._record(node)
+                changed = [n for n, found in self.definitions.items() if before.get(n) != id(found)]
+                self.when.update({n: (cell, node.lineno) for n in changed})
+                self.strings += [(cell, node.lineno, what) for what in _runs_strings(node, self.definitions)]
+                if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                    self.statements.append(node)
 
     def _tick(self):
         if time.monotonic() > self.deadline:
@@ -198,12 +208,13 @@ class _Reader:
                 if isinstance(child, ast.stmt):
                     self._record(child)
 
-    def reached(self, name):
-        """(definition name, definition node, its local names) of everything the definition of `name` reaches."""
+    def reached(self, name, stop=frozenset()):
+        """(definition name, definition node, its local names) of everything the definition of `name` reaches
+        (not through the names in `stop`)."""
         seen, todo, found = set(), [name], []
         while todo:
             current = todo.pop()
-            if current in seen or current not in self.definitions:
+            if current in seen or current not in self.definitions or (current in stop and current != name):
                 continue
             seen.add(current)
             node = self.definitions[current]
@@ -222,9 +233,55 @@ class _Reader:
         return found
 
 
-def reached_sources(sources, names, deadline=None):
+def _runs_strings(node, definitions=None):
+    """How a top-level statement runs code handed to it as a string it builds (``exec(zlib.decompress(...))``):
+    ``exec``, ``eval`` or ``compile`` of anything but a literal string, itself or in a function of the
+    notebook (`definitions`) that it calls."""
+    if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+        return []
+    found = []
+    for inner in ast.walk(node):
+        by_name = isinstance(inner, ast.Call) and isinstance(inner.func, ast.Name) and definitions
+        called = definitions.get(inner.func.id) if by_name else None
+        if isinstance(called, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            found += [f"{what} (in {called.name})" for what in _runs_strings(ast.Module(called.body, []))]
+    literal = set()
+    for inner in ast.walk(node):
+        if isinstance(inner, ast.Call) and _named_call(inner, STRING_RUNNERS):
+            if inner.args and isinstance(inner.args[0], ast.Constant) and isinstance(inner.args[0].value, str):
+                literal.add(id(inner.func))
+    for inner in ast.walk(node):
+        if isinstance(inner, ast.Name) and inner.id in STRING_RUNNERS and id(inner) not in literal:
+            found.append(inner.id)
+    return found
+
+
+def _named_call(node, names):
+    return isinstance(node.func, ast.Name) and node.func.id in names
+
+
+def run_strings(sources, names, deadline=None):
+    """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec``/``eval``/``compile``
+    of a built string may have defined: the name is bound nowhere the reader can see after that statement.
+    Code that arrives in a string cannot be read, so it is never graded (as ``exec`` of labkit's file is not)."""
+    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    findings = []
+    for name in names:
+        bound = reader.when.get(name, (-1, 0)) if name in reader.definitions else (-1, 0)  # (cell, line)
+        late = [(c, line, what) for c, line, what in reader.strings if (c, line) >= bound]
+        for cell, line, what in late[:1]:
+            reason = (
+                f"code cell {cell + 1} (line {line}) runs a string built at run time as code ({what}), after "
+                f"the last definition of {name} the grader can read, so it may define {name}: code that "
+                "arrives in a string cannot be read, so it is not graded"
+            )
+            findings.append((name, line, reason))
+    return findings
+
+
+def reached_sources(sources, names, deadline=None, stop=frozenset()):
     """``[(name, source text)]`` of every definition in a notebook's code cells that the graded `names` reach
-    (the names themselves first), as :func:`scan` follows them; nothing is run.
+    (the names themselves first), as :func:`scan` follows them, not through the names in `stop`; nothing is run.
 
     Raises :class:`Unreadable` as :func:`scan` does.
 
@@ -242,7 +299,7 @@ def reached_sources(sources, names, deadline=None):
     reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
     found, seen = [], set()
     for name in names:
-        for owner, node, _ in reader.reached(name):
+        for owner, node, _ in reader.reached(name, frozenset(stop)):
             if id(node) in seen or id(node) not in reader.texts:
                 continue
             seen.add(id(node))
@@ -250,6 +307,29 @@ def reached_sources(sources, names, deadline=None):
             first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
             lines = text.split("\n")[first - 1 : node.end_lineno]
             found.append((owner, "\n".join(lines)))  # whole: a long comment must not push the code out
+    return found
+
+
+def drawn_with(sources, names, deadline=None):
+    """The names of the notebook's definitions that `names` reach, and that the top-level statements
+    mentioning `names` reach (``ax4.plot(t, my_eval(...))`` draws ``ax4`` with ``my_eval``); nothing is run.
+
+    Examples
+    --------
+    >>> cells = ["def h(x):\\n    return x", "fig, ax = 1, 2", "ax.plot(h(3))", "def g(x):\\n    return 0"]
+    >>> sorted(drawn_with(cells, ["ax"]) & {"ax", "g", "h"})
+    ['ax', 'h']
+    """
+    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    wanted, found = set(names), set()
+    starts = list(names)
+    for node in reader.statements:
+        loaded = {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        if loaded & wanted:
+            starts += sorted(loaded & set(reader.definitions))
+            found.update(loaded)  # a name bound where the reader cannot see (exec) counts too
+    for name in starts:
+        found.update(owner for owner, _, _ in reader.reached(name))
     return found
 
 
@@ -522,6 +602,31 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
             else:
                 for bound in _bound_names(node):
                     found.pop(bound, None)
+    return found
+
+
+def reached_function_sources(sources, names, graded=(), limit=MAX_SOURCE_CHARS):
+    """:func:`function_sources` of `names`, each followed by the definitions it reaches in the notebook (its
+    helpers, as :func:`reached_sources` follows them; other `graded` names are left to their own entries), so
+    that code moved into a helper is compared where the graded function uses it.
+
+    Examples
+    --------
+    >>> cells = ["def h(x):\\n    return x + 1", "def f(x):\\n    return h(x) * 2"]
+    >>> print(reached_function_sources(cells, ["f"])["f"])
+    def f(x):
+        return h(x) * 2
+    <BLANKLINE>
+    def h(x):
+        return x + 1
+    """
+    found = function_sources(sources, names, limit)
+    for name, text in found.items():
+        try:
+            helpers = [t for n, t in reached_sources(sources, [name], stop=set(graded))[1:] if n != name]
+        except Unreadable:
+            continue
+        found[name] = _clip("\n\n".join([text, *helpers]), limit)
     return found
 
 

@@ -37,7 +37,7 @@ from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from ..sandbox import backends, remote, timings
-from . import known, refusals, scan
+from . import holding, known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -302,8 +302,20 @@ def judge_known(check, part, code, registry, options):
         return check  # the refusal scan read the same cells in time: not reached here
     # a graded function another part judges (the driver's interpolant) is judged there, once
     reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
+    return _judge_reached(check, reached, registry, options)
+
+
+def _judge_reached(check, reached, registry, options):
+    """`check`, held when the definitions `reached` ([(name, source)]) are mostly known code."""
     found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
     return check if found is None else _held(check, found)
+
+
+def judge_plain(check, part, code, registry, options):
+    """A part without a refusal (a plot, a table of values), held when the code that draws it is mostly known
+    code (:func:`labkit.grading.submission.holding.judge_plain`)."""
+    judge = lambda check, reached: _judge_reached(check, reached, registry, options)
+    return holding.judge_plain(check, part, code, registry_graded(registry), judge)
 
 
 def registry_graded(registry):
@@ -367,7 +379,7 @@ def grade_notebook(
         return {}, [ProblemText.one(text, OTHER)]
     if sources is not None:
         wanted = [n for number in numbers for n in graded_functions(registry.exercises[number]) if n not in sources]
-        for function, text in scan.function_sources(code, wanted).items():
+        for function, text in scan.reached_function_sources(code, wanted, registry_graded(registry)).items():
             sources[function] = printable(text)[: scan.MAX_SOURCE_CHARS]
     if deadline - time.monotonic() <= 1:
         text = (
@@ -428,6 +440,8 @@ def grade_notebook(
             with timings.phase("recognition"):
                 _judge_code(verdict, exercise, code, profiles, registry, options)
             results[number] = _rescore(verdict, registry)
+        # copied code earns nothing through what it draws
+        holding.hold_dependents(results, registry, code, registry_graded(registry), _rescore)
         if notebook.stopped:
             text = f"{name}: {notebook.stopped} while its functions were being checked."
             problems.append(ProblemText.one(text, notebook.stopped_kind))
@@ -435,25 +449,26 @@ def grade_notebook(
 
 
 def _judge_code(verdict, exercise, code, profiles, registry, options):
-    """Each refused part of `verdict`: failed for a refused reference in its code, held when its code is known."""
+    """Each part of `verdict`: failed for a refused reference in its code or a name code run from a string may
+    define, held when its code is known (plain parts: when they reach known code)."""
     for index, part in enumerate(exercise.parts):
+        check = verdict["checks"][index]
         if part.refused is None:
+            verdict["checks"][index] = judge_plain(check, part, code, registry, options)
             continue
         try:
             findings = scan.scan(code, part.scanned, profiles[part.refused.name])
+            strung = scan.run_strings(code, part.scanned)
         except scan.Unreadable as exc:
-            verdict["checks"][index] = _failed_part(
-                verdict["checks"][index],
-                verdict["checks"][index]["name"],
-                "its source can be read",
-                str(exc),
-                "keep the notebook's code to what the lab asks for.",
-            )
+            why = "keep the notebook's code to what the lab asks for."
+            verdict["checks"][index] = _failed_part(check, check["name"], "its source can be read", str(exc), why)
             continue
         if findings:
-            verdict["checks"][index] = _own_code(verdict["checks"][index], findings)
+            verdict["checks"][index] = _own_code(check, findings)
+        elif strung:
+            verdict["checks"][index] = holding.run_from_a_string(check, strung)
         else:
-            verdict["checks"][index] = judge_known(verdict["checks"][index], part, code, registry, options)
+            verdict["checks"][index] = judge_known(check, part, code, registry, options)
 
 
 def _number(value):

@@ -16,7 +16,7 @@ from labkit.exercises.registry import LAB
 from labkit.grading.reports import similarity
 from labkit.grading.reports.similarity import DEFAULT_THRESHOLD, Pair, similar_pairs
 from labkit.grading.results.report import SubmissionGrade, read_results, write_csv
-from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources
+from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources, reached_function_sources
 from labkit.grading.submission.scoring import graded_functions, read_cells
 from labkit.student_notebooks import paths
 
@@ -373,3 +373,23 @@ def test_what_much_of_the_class_writes_alike_is_not_evidence_but_a_copy_among_th
     # in a small group the same runge is still shown: it is the class's common code that is set aside
     few = similar_pairs(grades[:4])
     assert {p.function for p in few} == {"runge", "eval_pherm"}
+
+
+def test_a_copy_moved_into_a_helper_is_compared_where_the_graded_function_uses_it():
+    # issue 47: the recorded source was the wrapper alone, so the copied lines in the helper were never compared
+    wrapper = HEAD + "    return _hermite(xdata, ydata, ypdata, xval)\n"
+    helper = "def _hermite(xdata, ydata, ypdata, xval):\n" + COPY_BODY
+    cells = ["import numpy as np\nimport labkit", helper, wrapper]
+    recorded = reached_function_sources(cells, ["eval_pherm"])["eval_pherm"]
+    assert "b1 = (t-right)" in recorded and recorded.startswith(HEAD.split("\n")[0])
+    assert function_sources(cells, ["eval_pherm"])["eval_pherm"] not in (recorded, "")  # the wrapper alone
+    pairs = similar_pairs(_grades({"ada": ORIGINAL, "bo": recorded, "cy": (HEAD + PHERM_SEARCH)}))
+    assert [(p.first, p.second) for p in pairs] == [("ada", "bo")]
+    honest = reached_function_sources([(HEAD + PHERM_SEARCH)], ["eval_pherm"])["eval_pherm"]
+    assert (
+        honest == function_sources([(HEAD + PHERM_SEARCH)], ["eval_pherm"])["eval_pherm"]
+    )  # nothing reached: as before
+    graded = reached_function_sources(
+        cells + ["def driver(n):\n    return eval_pherm(n, n, n, n)"], ["driver"], ["eval_pherm"]
+    )
+    assert "_hermite" not in graded["driver"]  # another graded function is compared in its own entry

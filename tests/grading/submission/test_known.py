@@ -17,17 +17,18 @@ import numpy as np
 import pytest
 from catalog import CORRECT, plant
 from conftest import sandbox_or_skip
-from copies import module_source
+from copies import REWRITES, exec_compressed, module_source
 
 from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading.options import GradeOptions
 from labkit.grading.results import report, rubric
-from labkit.grading.submission import known, scan
+from labkit.grading.submission import fingerprint, known, scan
 from labkit.grading.submission.scoring import (
     _rescore,
     exercises_in,
     judge_known,
+    judge_plain,
     known_sources,
     read_cells,
     registry_graded,
@@ -436,3 +437,126 @@ def test_the_class_report_lists_a_held_part_side_by_side(tmp_path):
     assert "ada" in section and "labkit.piecewise.eval_pherm" in section and "93%" in section
     assert "q1 = np.diff(q0)" in section and "h = np.diff(x)" in section and "bartholomew" not in section
     assert "<script>" not in section and "a &lt; b &amp; c" in section
+
+
+# -- one further rewrite of a copy (issue 47): compared by what the code does -----------------------------------
+
+
+@pytest.mark.parametrize("form", sorted(REWRITES))
+@pytest.mark.parametrize(("module", "also", "names"), COPIED, ids=[c[0] for c in COPIED])
+def test_a_copy_rewritten_once_more_is_still_recognised(module, also, names, form, given):
+    corpus = known_sources(LAB)
+    cells = [module_source(m) for m in also] + [module_source(module, drop=also)]
+    cells = [REWRITES[form](cell) for cell in cells]
+    for name in names:
+        reached = scan.reached_sources(cells, [name])
+        found = known.match(corpus, reached, given)
+        assert found is not None, (form, module, name, _best(corpus, reached, given))
+        assert found.source.startswith(module + ".") or any(found.source.startswith(m + ".") for m in also)
+        _note(f"copies rewritten ({form}): smallest share", found.share, largest=False)
+        _note(f"copies rewritten ({form}): fewest fingerprints shared", found.shared, largest=False)
+
+
+@pytest.mark.parametrize("form", sorted(REWRITES))
+def test_each_rewrite_comes_back_to_the_code_it_rewrote(form):
+    text = module_source("labkit.bilinear")
+    plain = sorted(t for _, t in fingerprint.units([("m", text)]) if t.startswith("def "))
+    rewritten = sorted(t for _, t in fingerprint.units([("m", REWRITES[form](text))]) if t.startswith("def "))
+    assert len(plain) >= 3 and plain == rewritten  # every function of the module, written as it was
+
+
+def test_what_the_normalisation_keeps_is_what_the_code_does():
+    one = "def f(x):\n    y = x * 2\n    return y + 1"
+    assert fingerprint.canonical(one) != fingerprint.canonical(one.replace("* 2", "* 3"))
+    assert fingerprint.canonical(one) != fingerprint.canonical(one.replace("y + 1", "x + 1"))  # y is read: kept
+    assert fingerprint.canonical("def f(:") == "def f(:"  # not Python: as it is
+
+
+def test_a_class_of_staticmethods_is_judged_method_by_method():
+    box = "class K:\n    @staticmethod\n    def a(x):\n        return x * 2 + 1\n    def b(self, y):\n        return y"
+    assert [name for name, _ in fingerprint.units([("K", box)])] == ["K.a", "K.b"]
+
+
+def test_a_copy_run_from_a_compressed_string_is_refused_with_why():
+    blob = exec_compressed(module_source("labkit.piecewise"))
+    found = scan.run_strings([blob], ["eval_pherm"])
+    assert found and "exec" in found[0][2] and "cannot be read" in found[0][2]
+    assert scan.run_strings([blob, module_source("labkit.piecewise")], ["eval_pherm"]) == []  # defined after
+    assert scan.run_strings(['x = eval("1 + 2")', "def eval_pherm(): pass"], ["eval_pherm"]) == []  # a literal
+    helper = ["def load(s):\n    exec(s, globals())", "load(open('copy.txt').read())"]
+    assert "in load" in scan.run_strings(helper, ["eval_pherm"])[0][2]
+
+
+def _passed(part):
+    return {"name": part.name, "passed": True, "hint": "", "weight": part.weight, "steps": []}
+
+
+def test_a_plot_drawn_with_a_copy_is_held():
+
+    copy = module_source("labkit.piecewise")
+    plot = "fig, ax4 = plt.subplots()\nt = np.linspace(0, 1, 5)\nax4.plot(t, eval_pherm(t, t, t, t))"
+    part = _part(4, "ax4")
+    held = judge_plain(_passed(part), part, [copy, plot], LAB, GradeOptions())
+    assert held["held"]["source"].startswith("labkit.piecewise.")
+    honest = "fig, ax4 = plt.subplots()\nt = np.linspace(0, 1, 5)\nax4.plot(t, labkit.eval_pherm(t, t, t, t))"
+    assert "held" not in judge_plain(_passed(part), part, [honest], LAB, GradeOptions())
+
+
+def test_a_part_built_on_a_held_definition_is_held_with_it():
+    from labkit.grading.submission import holding
+
+    cells = [module_source("labkit.piecewise"), "def test_pherm_interpolate(n, f):\n    return eval_pherm(n, f, f, n)"]
+    held_check = judge_known(_passed(_part(2, "eval_pherm")), _part(2, "eval_pherm"), cells, LAB, GradeOptions())
+    results = {
+        2: {"exercise": 2, "checks": [held_check]},
+        3: {"exercise": 3, "checks": [_passed(p) for p in LAB.exercises[3].parts]},
+    }
+    holding.hold_dependents(results, LAB, cells, registry_graded(LAB), _rescore)
+    three = {c["name"]: c for c in results[3]["checks"]}
+    assert "held" not in three["runge"] and three["test_pherm_interpolate"]["held"]["through"] == "eval_pherm"
+    assert results[3]["points"] == _part(3, "runge").weight
+
+
+def test_a_part_built_on_code_run_from_a_string_earns_nothing():
+    from labkit.grading.submission import holding
+
+    cells = [
+        exec_compressed(module_source("labkit.piecewise")),
+        "def test_pherm_interpolate(n):\n    return eval_pherm(n)",
+    ]
+    results = {3: {"exercise": 3, "checks": [_passed(p) for p in LAB.exercises[3].parts]}}
+    holding.hold_dependents(results, LAB, cells, registry_graded(LAB), _rescore)
+    driver = {c["name"]: c for c in results[3]["checks"]}["test_pherm_interpolate"]
+    assert not driver["passed"] and "cannot be read" in driver["steps"][-1]["detail"]
+
+
+def _with_cell(folder, notebook, source):
+    """The instructor notebook `notebook` with a code cell `source` added at its end, in `folder`."""
+    import nbformat
+
+    nb = nbformat.read(NOTEBOOKS / notebook, as_version=4)
+    nb.cells.append(nbformat.v4.new_code_cell(source))
+    folder.mkdir(parents=True)
+    nbformat.write(nb, folder / notebook)
+    return folder
+
+
+def test_rewritten_and_string_run_copies_are_held_or_refused_in_one_run_with_honest_classmates(tmp_path):
+    sandbox_or_skip()
+    copy = module_source("labkit.piecewise")
+    forms = {form: rewrite(copy) for form, rewrite in REWRITES.items()} | {"exec": exec_compressed(copy)}
+    subs = [_with_cell(tmp_path / form, "02_convergence.ipynb", cell) for form, cell in forms.items()]
+    subs += [INDEPENDENT / style for style in STYLES]
+    graded = {g.name: g for g in grading.grade(subs, tmp_path / "out", jobs=2, progress=False)}
+    for style in STYLES:
+        assert graded[style].total == rubric.default().maximum and not graded[style].held(), graded[style].feedback()
+    for form in forms:
+        grade = graded[form]
+        if form == "exec":  # run after every definition: it may have redefined any of them, so none is graded
+            assert grade.points[2] == grade.points[3] == 0 and not grade.held(), grade.feedback()
+            assert "runs a string built at run time as code (exec)" in grade.feedback()
+            assert "code run from a string is never graded" in grade.feedback()
+        else:
+            assert grade.points[2] == 0 and grade.points[3] == _part(3, "runge").weight, (form, grade.feedback())
+            held = {part for number, part, _, _ in grade.held() if number in (2, 3)}
+            assert held == {"eval_pherm", "test_pherm_interpolate", "errors_pherm", "rate_pherm"}, grade.feedback()

@@ -1,0 +1,110 @@
+"""Parts built on code that is not the student's: a plot or table drawn with known code is held, and a part
+whose code reaches a held definition is held with it (:func:`labkit.grading.submission.scoring.grade_notebook`).
+
+Known code earns nothing through what it draws: the parts a refusal guards are judged for copied code where
+they are graded (:func:`labkit.grading.submission.scoring.judge_known`); the others (plots, tables of values)
+are judged on what draws them (:func:`labkit.grading.submission.scan.drawn_with`), and every part whose
+code reaches a held definition, or a graded name that a string run as code may have defined
+(:func:`labkit.grading.submission.scan.run_strings`), waits or fails with it.
+"""
+
+from __future__ import annotations
+
+from ...exercises.result import REFUSED
+from ..results.report import HELD_STEP
+from . import scan
+
+
+def _read(part):
+    return [name for name in part.names() if name.isidentifier()]
+
+
+def judge_plain(check, part, code, graded, judge):
+    """A part without a refusal (a plot, a table of values), judged for known code on what draws it: `judge`
+    (check, [(name, source)]) is given the notebook's definitions that draw it, less the `graded` names (each
+    judged in its own part), and returns the check, held or as it was."""
+    if not check["passed"]:
+        return check
+    try:
+        names = scan.drawn_with(code, _read(part))
+        reached = scan.reached_sources(code, sorted(names))
+    except scan.Unreadable:
+        return check
+    return judge(check, [(n, t) for n, t in reached if n not in graded])
+
+
+def hold_dependents(results, registry, code, graded, rescore):
+    """Hold, in `results` ({exercise: verdict} of one notebook), every passed part whose code reaches a held
+    definition, and fail every one that reaches one of the `graded` names a string run as code may have
+    defined; `rescore` (verdict, registry) counts an exercise's points again."""
+    held, strung = _held_names(results, registry), _strung(code, graded)
+    if not held and not strung:
+        return results
+    for number, verdict in results.items():
+        parts = registry.exercises[number].parts
+        for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
+            if not check.get("passed") or check.get("held"):
+                continue
+            names = _reaches(part, code) - set(part.scanned)
+            on_held, on_string = sorted(names & held.keys()), sorted(names & strung.keys())
+            if on_held:
+                verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
+            elif on_string:
+                verdict["checks"][index] = _refused_with(check, on_string[0], strung[on_string[0]])
+        rescore(verdict, registry)
+    return results
+
+
+def _held_names(results, registry):
+    """{name: its held match} of the definitions held in `results`: the parts' graded names and the copies."""
+    held = {}
+    for number, verdict in results.items():
+        for part, check in zip(registry.exercises[number].parts, verdict["checks"]):
+            if check.get("held") and check.get("passed"):
+                for name in (*part.scanned, check["held"].get("definition", "")):
+                    held.setdefault(name, check["held"])
+    return held
+
+
+def _strung(code, graded):
+    """{graded name: why}: the graded names a string run as code may have defined."""
+    try:
+        return {name: why for name, _, why in scan.run_strings(code, sorted(graded))}
+    except scan.Unreadable:
+        return {}
+
+
+def _reaches(part, code):
+    try:
+        return set(part.uses) | scan.drawn_with(code, _read(part) + [n for n in part.scanned if n.isidentifier()])
+    except scan.Unreadable:
+        return set(part.uses)
+
+
+def _held_with(check, name, held):
+    step = {
+        "step": HELD_STEP,
+        "passed": False,
+        "detail": f"it is built on {name}, held for your instructor to look at: its code is mostly "
+        f"{held.get('source', '?')}'s",
+    }
+    hint = (
+        f"this part waits with {name}, which it is built on; write {name} in your own way to be paid without waiting."
+    )
+    return {**check, "held": {**held, "through": name}, "steps": list(check.get("steps", [])) + [step], "hint": hint}
+
+
+def run_from_a_string(check, findings):
+    """The part's check, failed: a graded name may have been defined by code run from a string
+    (:func:`labkit.grading.submission.scan.run_strings` `findings`), which the grader cannot read."""
+    name, _, why = findings[0]
+    return _refused_with(check, name, why, step="its code can be read")
+
+
+def _refused_with(check, name, why, step="is built on the student's own code"):
+    step = {"step": step, "passed": False, "detail": why, "kind": REFUSED}
+    hint = (
+        f"define {name} with def in a code cell, after any exec, eval or compile of a string, so that the grader "
+        "can read it; code run from a string is never graded."
+    )
+    return {**check, "passed": False, "steps": list(check.get("steps", [])) + [step], "hint": hint}
