@@ -568,7 +568,7 @@ def build_parser():
         help="ready to hand in? run your notebooks and list what is left to do",
         description="Run each lab notebook in DIR in a fresh kernel (every cell, even after one raised) and "
         "print, per notebook, the table its last cell shows: each graded part done and passing its "
-        "self-check, failing (with the hint) or not started; the cells that raised; the answers in words "
+        "self-check, failing (with the hint) or not done; the cells that raised; the answers in words "
         "left empty. Only the self-checks run, never the grader. Exit status: 0 when every notebook is ready, "
         "1 when something is left to do, 2 for bad input.",
     )

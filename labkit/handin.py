@@ -2,7 +2,7 @@
 
 The last cell of every lab notebook is ``labkit.ready_to_hand_in("02_convergence")``. Run after
 *Restart and run all*, it shows one table for the notebook: each graded part of its exercises done
-and passing its self-check, done but failing (with the check's hint), or not started; the cells
+and passing its self-check, done but failing (with the check's hint), or not done; the cells
 that raised; the answers in words left empty. It runs only the self-checks students call
 (:mod:`labkit.check`, on their fixed data); it never imports the grader (:mod:`labkit.grading`),
 whose hidden checks draw fresh data, so it says that the grade may differ.
@@ -30,9 +30,9 @@ from pathlib import Path
 
 from . import notebook as _notebook
 from .exercises.model import sections
-from .exercises.result import NOT_DONE, NOT_IMPLEMENTED
+from .exercises.result import NOT_DONE, NOT_IMPLEMENTED, part_kind
 
-DONE, FAILING, NOT_STARTED = "done, passes its self-check", "done but failing", "not started"
+DONE, FAILING, NOT_STARTED = "done, passes its self-check", "done but failing", NOT_DONE  # as part_kind names it
 ANSWER_STUB = "YOUR ANSWER HERE"  # what labkit release (and nbgrader) leave in an answer in words
 CALL = re.compile(r"""ready_to_hand_in\(\s*["']([\w.\-]+)["']""")
 WIDTH = 100
@@ -45,7 +45,7 @@ class PartStatus:
     exercise: int
     part: str
     status: str
-    detail: str = ""  # the check's hint when failing; what is missing when not started
+    detail: str = ""  # the check's hint when failing; what is missing when not done
 
 
 @dataclass
@@ -125,12 +125,12 @@ class HandIn:
         else:
             lines.append(
                 f"{count[DONE]} of {len(self.parts)} parts pass their self-checks, {count[FAILING]} fail, "
-                f"{count[NOT_STARTED]} not started."
+                f"{count[NOT_STARTED]} not done."
             )
         if self.raised and not self.every_cell_ran:
             lines.append(
                 "Run all stops at the first cell that raises, so the cells below it did not run: what they "
-                "define shows as not started. Fix that cell, then Restart and run all again."
+                "define shows as not done. Fix that cell, then Restart and run all again."
             )
         lines.append(
             "Only the self-checks ran, on fixed data; the grader uses fresh data too, so your grade may differ."
@@ -183,7 +183,7 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
     last saved. The grader is never run. The result prints as a table.
 
     >>> result = ready_to_hand_in("02_convergence", namespace={})
-    >>> [p.status for p in result.parts] == ["not started"] * 5
+    >>> [p.status for p in result.parts] == ["not done"] * 5
     True
     >>> result.ready
     False
@@ -251,7 +251,7 @@ def _status(number: int, part, check: Mapping, namespace: Mapping, stubbed: set,
         return PartStatus(number, part.name, DONE)
     steps = [s for s in check["steps"] if not s["passed"]]
     left = [s for s in steps if s.get("kind") == NOT_DONE]  # a stub called, or a name the check reads not defined
-    if left:
+    if part_kind(check) == NOT_DONE:
         stub = left[0]["detail"] == NOT_IMPLEMENTED  # which of the two, for the words only
         why = "it still raises NotImplementedError" if stub else f"{left[0]['step']}: {left[0]['detail']}"
         return PartStatus(number, part.name, NOT_STARTED, why)

@@ -38,7 +38,20 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
-from ...exercises.result import CRASH, NOT_DONE, OTHER, PASSED, RAISED, REFUSED, SLIP, TAMPERED, TIMEOUT, VARIANT
+from ...exercises.result import (
+    CRASH,
+    HELD,
+    NOT_DONE,
+    OTHER,
+    PASSED,
+    RAISED,
+    REFUSED,
+    SLIP,
+    TAMPERED,
+    TIMEOUT,
+    VARIANT,
+    part_kind,
+)
 from ..results import late as lateness
 from ..results.record import rubric_for
 from ..results.report import SubmissionGrade, one_line, printable, read_results
@@ -390,13 +403,13 @@ def check_outcome(check: dict) -> str:
     """
     if not isinstance(check, dict):
         raise ValueError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
-    if check.get("passed"):
+    kind = part_kind(check)  # the one place a part's kind is decided: the feedback and labkit handin agree
+    if kind in (PASSED, HELD):
         return PASSED
+    if kind in (NOT_DONE, VARIANT, SLIP):
+        return kind
     kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}  # each failed step's code, set where made
-    for kind in OUTCOMES:
-        if kind in kinds:
-            return kind
-    return SLIP
+    return next((kind for kind in OUTCOMES if kind in kinds), OTHER)
 
 
 def problem_kinds(problem: str) -> list[tuple[str, str]]:
@@ -563,7 +576,8 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
             continue
         for text in grade.problems:
             for kind, line in problem_kinds(text):
-                problems[(kind, grade.name)].append(line)
+                if kind != NOT_DONE:  # a stub's cell, or a cell as released: work not done, counted per part
+                    problems[(kind, grade.name)].append(line)
     by_kind: dict = {kind: [] for kind in KINDS}
     for (kind, student), texts in sorted(problems.items(), key=lambda item: (item[0][0], item[0][1])):
         by_kind[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))

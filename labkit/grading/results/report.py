@@ -5,7 +5,8 @@ Layout of an output folder::
     grades.csv               one row per submission: points per exercise, the branch that
                              counted, the extra credit, the total (under the rubric); with a
                              [late] table also the raw total, the time, the lateness and penalty
-    feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
+    feedback/<name>.txt      the total, the exercises' points, what failed in the student's words and its
+                             hint, the errors of cells the student changed; .html the same as one page
     results/<name>.json      the same grade as data: merged by ``labkit merge``
     seed.txt                 the seed of the run's random test data
     record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.results.record)
@@ -189,100 +190,10 @@ class SubmissionGrade:
         return self.score.total if lateness is None else lateness.total
 
     def feedback(self):
-        if not self.graded:
-            return printable(
-                f"Feedback for {one_line(self.name)}: not graded\n\n! could not be graded: "
-                f"{one_line(self.failure, 500)}\n"
-                "Your instructor has been told; nothing of this submission was scored.\n"
-            )
-        score, rubric, lateness = self.score, self.rubric, self.lateness
-        extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
-        if lateness is not None and lateness.penalty:
-            extra += f", {points_text(lateness.penalty)} off for late work"
-        lines = [
-            f"Feedback for {one_line(self.name)}: {points_text(self.total)} points "
-            f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})",
-            "",
-        ]
-        # a problem's first line is the grader's; what follows (a traceback) is indented, so no line can pose
-        # as one of the grader's own
-        lines += [line for problem in self.problems for line in _problem_lines(problem)]
-        if self.problems:
-            lines.append("")
-        lines += [rubric.describe(), ""]
-        for number in rubric.graded:
-            lines += self._exercise_lines(number)
-        lines += ["", self._summary()]
-        lines += self._answer_lines()
-        if self.seed is not None:
-            lines += ["", f"(random test data from seed {self.seed})"]
-        return printable("\n".join(lines) + "\n")
+        """The feedback text a student reads: the total first (labkit.grading.results.feedback)."""
+        from .feedback import build, text
 
-    def _exercise_lines(self, number):
-        points = self.rubric.points[number]
-        verdict = self.results.get(number)
-        if number in self.excused:
-            return [f"Exercise {number}: excused by your instructor (out of your total and full credit)"]
-        if verdict is None:
-            return [
-                f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
-                f"('## Exercise {number}') or it never ran."
-            ]
-        held = [c for c in verdict["checks"] if c.get("held") and c["passed"]]
-        earned = self.fractions.get(number, 0.0) >= 1.0 - 1e-9
-        status = "passed" if verdict["passed"] or earned else "FAILED"
-        if any(not self.released(number, c["name"]) for c in held):
-            status = (
-                "held for your instructor" if all(c["passed"] for c in verdict["checks"]) else status + ", part held"
-            )
-        worth = self.rubric.worth(number)
-        lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(worth)} - {status}"]
-        total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
-        for check in verdict["checks"]:
-            weight = check.get("weight") or 0
-            share = points * weight / total_weight
-            worth = f" ({points_text(share)} point{'' if share == 1 else 's'})" if weight else ""
-            released = bool(check.get("held")) and self.released(number, check["name"])
-            for step in check["steps"]:
-                mark = "ok  " if step["passed"] else "FAIL"
-                detail = f": {one_line(step['detail'], 1000)}" if step["detail"] else ""
-                if released and step["step"] == HELD_STEP:
-                    mark, detail = "ok  ", ": released by your instructor, who compared it with the code it resembles"
-                lines.append(
-                    f"    [{mark}] {one_line(check['name'], 100)}{worth}: {one_line(step['step'], 300)}{detail}"
-                )
-            if check["hint"] and not check["passed"]:
-                lines.append(f"    hint: {one_line(check['hint'], 1000)}")
-            if check.get("held") and check["passed"]:
-                lines += _held_lines(check, released)
-                mark = self.marks.get(f"exercise{number}/{check['name']}")
-                if mark and mark.get("comment"):
-                    lines.append(f"    your instructor: {one_line(mark['comment'], 1000)}")
-        return lines
-
-    def _answer_lines(self):
-        """The answers in words, for the instructor to read (no check scores them)."""
-        answers = self.rubric.registry.answers
-        if not answers:
-            return []
-        lines = ["", "Answers in words (marked by your instructor, not by labkit):"]
-        for grade_id, (number, what) in answers.items():
-            if number not in self.rubric.points:
-                continue
-            text = str(self.answers.get(grade_id, "")).strip()
-            if not text or text == "YOUR ANSWER HERE":
-                text = "(no answer)"
-            mark = self.marks.get(grade_id)
-            worth = self.rubric.answers.get(grade_id, 0.0)
-            if mark is not None:
-                marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
-            else:
-                marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
-            lines.append(f"  Exercise {number}, {what}: {marked}")
-            lines += [f"    | {one_line(line, 300)}" for line in text.splitlines()[:20]]
-            if mark is not None and mark.get("comment"):
-                lines.append(f"    your instructor: {one_line(mark['comment'], 1000)}")
-        return lines
+        return text(build(self))
 
     def _summary(self):
         score, rubric = self.score, self.rubric
@@ -587,11 +498,20 @@ def write_result(out_dir, grade):
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
-    _replace(out / "feedback" / f"{safe_name(grade.name)}.txt", grade.feedback())
+    _write_feedback(out / "feedback", grade)
     path = out / "results" / f"{safe_name(grade.name)}.json"
     text = json.dumps(grade.as_dict(), indent=1)
     _replace(path, text)
     return records.Written(path, hashlib.sha256(text.encode("utf-8")).hexdigest())
+
+
+def _write_feedback(folder, grade):
+    """feedback/<submission>.txt and .html (labkit.grading.results.feedback)."""
+    from . import feedback
+
+    model, stem = feedback.build(grade), feedback.file_stem(grade.name)
+    _replace(folder / f"{stem}.txt", feedback.text(model))
+    _replace(folder / f"{stem}.html", feedback.html(model))
 
 
 def _replace(path, text):

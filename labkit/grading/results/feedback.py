@@ -1,0 +1,306 @@
+"""A student's feedback, in the order a student reads it: the total first, then what to fix, errors last.
+
+:func:`build` turns a :class:`~labkit.grading.results.report.SubmissionGrade` into a :class:`Feedback`, the one
+model both forms are made from: :func:`text` (``feedback/<submission>.txt``) and :func:`html`
+(``feedback/<submission>.html``, one self-contained page from an autoescaped Jinja template,
+:mod:`labkit.grading.pages`). Every part's kind comes from
+:func:`labkit.exercises.result.part_kind`, as in the class report and ``labkit handin``:
+
+1. the total, the late penalty if any, and a table of the exercises: points, and done, partly or not done;
+2. exercise by exercise, each part that failed in the student's words, with its hint; a part not done says so
+   in one line, never as a slip or a traceback;
+3. what went wrong while the notebook ran: only the errors of cells the student changed; the cells that still
+   raise ``NotImplementedError`` counted in one line; the cells of the release left as they were (a branch
+   not chosen, a stub above them) not listed.
+
+Every text in the model is printable and bounded (:func:`~labkit.grading.results.report.one_line`); the HTML
+template escapes it.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from ...exercises.result import ERROR, HELD, NOT_DONE, PASSED, RAISED, VARIANT, part_kind
+from .text import points_text
+
+PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$")
+DONE, PARTLY = "done", "partly"  # an exercise's status in the score table (or NOT_DONE, "excused", "held")
+STUB_CELL = re.compile(r"raised NotImplementedError$")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One part of an exercise as the feedback shows it: its kind (:data:`labkit.exercises.result.PART_KINDS`),
+    the points it is worth, its failed steps ((step, detail) pairs), the hint, and extra lines (a held part's)."""
+
+    name: str
+    kind: str
+    worth: float
+    failed: tuple = ()
+    hint: str = ""
+    notes: tuple = ()
+
+
+@dataclass(frozen=True)
+class Exercise:
+    """One graded exercise: its points, what it is worth, its status, and its parts."""
+
+    number: int
+    points: float
+    worth: float
+    status: str
+    parts: tuple = ()
+    note: str = ""  # one line in place of the parts (not found, excused, another branch)
+
+    @property
+    def to_fix(self):
+        """The parts the student has to look at: every part that did not pass."""
+        return tuple(part for part in self.parts if part.kind != PASSED)
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """Everything a student's feedback says, in reading order."""
+
+    name: str
+    total: str  # "32.5 / 40 points", or "not graded"
+    headline: tuple  # lines after the total: extra credit, the late penalty
+    exercises: tuple = ()
+    summary: tuple = ()  # the branch that counts, extra credit, the late rule's lines
+    answers: tuple = ()  # (title, marked, lines, comment) of each answer in words
+    errors: tuple = ()  # one line per error of a cell the student changed, or another problem
+    stubs: int = 0  # cells that still raise NotImplementedError
+    seed: int | None = None
+    failure: str = ""
+    other_branch: tuple = field(default=())  # exercises of the branch that does not count
+
+
+def file_stem(name: str) -> str:
+    """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
+    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
+    :func:`~labkit.grading.results.report.safe_name`'s, with a hash of the whole name. A plain name never ends
+    as a hashed one does, so two submissions never share a file.
+
+    >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
+    ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
+    """
+    from .report import safe_name
+
+    return name if PLAIN_NAME.match(name) else safe_name(name)
+
+
+def build(grade) -> Feedback:
+    """The feedback of one graded (or ungradable) submission."""
+    from .report import one_line
+
+    name = one_line(grade.name, 120)
+    if not grade.graded:
+        return Feedback(name, "not graded", (), failure=one_line(grade.failure, 500))
+    score, rubric = grade.score, grade.rubric
+    other = _other_branch(rubric, score.branch)
+    exercises = tuple(_exercise(grade, number, number in other) for number in rubric.graded)
+    stubs, errors = _run_errors(grade)
+    return Feedback(
+        name,
+        f"{points_text(grade.total)} / {points_text(score.full_credit)} points",
+        _headline(grade),
+        exercises,
+        _summary(grade),
+        _answers(grade),
+        errors,
+        stubs,
+        grade.seed,
+        other_branch=tuple(sorted(other)),
+    )
+
+
+def _other_branch(rubric, branch):
+    """The exercises of the branches that do not count (none when no branch earned points yet)."""
+    if not branch or branch == "none":
+        return set()
+    return {n for b in rubric.branches if b.name != branch for n in b.exercises}
+
+
+def _headline(grade):
+    score, lateness = grade.score, grade.lateness
+    lines = []
+    if score.extra_total:
+        lines.append(f"including {points_text(score.extra_total)} extra credit")
+    if lateness is not None and lateness.penalty:
+        lines.append(
+            f"{points_text(lateness.penalty)} off for late work ({points_text(score.total)} before the penalty)"
+        )
+    return tuple(lines)
+
+
+def _exercise(grade, number, other_branch):
+    rubric, points = grade.rubric, grade.points.get(number, 0.0)
+    worth = rubric.worth(number)
+    if number in grade.excused:
+        return Exercise(number, 0.0, 0.0, "excused", note="excused by your instructor")
+    verdict = grade.results.get(number)
+    if verdict is None:
+        note = f"not done: no notebook has its section ('## Exercise {number}'), or it never ran"
+        return Exercise(number, 0.0, worth, NOT_DONE, note=note)
+    parts = tuple(_part(grade, number, check, verdict["checks"]) for check in verdict["checks"])
+    kinds = {part.kind for part in parts}
+    if worth and points >= worth - 1e-9:
+        status = DONE
+    elif points <= 0 and kinds <= {NOT_DONE}:
+        status = NOT_DONE
+    else:
+        status = PARTLY
+    if HELD in kinds:
+        status = HELD
+    note = "the other branch: it does not count (the better branch does)" if other_branch else ""
+    return Exercise(number, points, worth, status, parts, note)
+
+
+def _part(grade, number, check, checks):
+    from .report import HELD_STEP, _held_lines, one_line
+
+    released = bool(check.get("held")) and grade.released(number, check["name"])
+    kind = part_kind(check, released or not check.get("held"))
+    total = sum(c.get("weight", 0) for c in checks) or 1
+    worth = grade.rubric.points[number] * (check.get("weight") or 0) / total
+    failed = tuple(
+        (one_line(s["step"], 300), one_line(s["detail"], 1000))
+        for s in check.get("steps", [])
+        if not s["passed"] and not (released and s["step"] == HELD_STEP)
+    )
+    notes = ()
+    if check.get("held") and check.get("passed"):
+        notes = tuple(line.strip() for line in _held_lines(check, released))
+        mark = grade.marks.get(f"exercise{number}/{check['name']}")
+        if mark and mark.get("comment"):
+            notes += (f"your instructor: {one_line(mark['comment'], 1000)}",)
+    hint = one_line(check.get("hint") or "", 1000) if kind not in (PASSED, HELD) else ""
+    return Part(one_line(check["name"], 100), kind, worth, failed, hint, notes)
+
+
+def _summary(grade):
+    from .report import SubmissionGrade
+
+    return tuple(SubmissionGrade._summary(grade).split("\n")) + tuple(grade.rubric.describe().split("\n"))
+
+
+def _answers(grade):
+    from .report import one_line
+
+    found = []
+    for grade_id, (number, what) in grade.rubric.registry.answers.items():
+        if number not in grade.rubric.points:
+            continue
+        text = str(grade.answers.get(grade_id, "")).strip()
+        blank = not text or text == "YOUR ANSWER HERE"
+        mark, worth = grade.marks.get(grade_id), grade.rubric.answers.get(grade_id, 0.0)
+        if mark is not None:
+            marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
+        elif blank:
+            marked = "no answer" + (f", 0 / {points_text(worth)} points" if worth else "")
+        else:
+            marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
+        lines = ("(no answer)",) if blank else tuple(one_line(line, 300) for line in text.splitlines()[:20])
+        comment = one_line(mark["comment"], 1000) if mark and mark.get("comment") else ""
+        found.append((f"Exercise {number}, {what}", marked, lines, comment))
+    return tuple(found)
+
+
+def _run_errors(grade):
+    """(cells that still raise NotImplementedError, one line per error the student caused or other problem)."""
+    from .report import one_line, problem_kinds
+
+    stubs, errors = 0, []
+    for problem in grade.problems:
+        for kind, line in problem_kinds(problem):
+            if kind == NOT_DONE:
+                stubs += bool(STUB_CELL.search(line))
+            elif kind != VARIANT or line not in errors:
+                errors.append(one_line(line, 1000))
+    return stubs, tuple(errors)
+
+
+def text(feedback: Feedback) -> str:
+    """The feedback as plain text: the total on the first line."""
+    from .report import printable
+
+    if feedback.failure:
+        return printable(
+            f"{feedback.name}: not graded\n\nIt could not be graded: {feedback.failure}\n"
+            "Your instructor has been told; nothing of this submission was scored.\n"
+        )
+    lines = [f"{feedback.name}: {feedback.total}", *(f"  {line}" for line in feedback.headline), ""]
+    lines += _table_lines(feedback) + [""]
+    lines += [line for exercise in feedback.exercises for line in _exercise_lines(exercise)]
+    lines += _answer_lines(feedback) + _error_lines(feedback)
+    if feedback.seed is not None:
+        lines += ["", f"(random test data from seed {feedback.seed})"]
+    return printable("\n".join(lines) + "\n")
+
+
+def _table_lines(feedback):
+    lines = [f"{'exercise':>8}  {'points':>13}  status"]
+    for e in feedback.exercises:
+        status = f"{e.status} ({e.note.split(':')[0]})" if e.note and e.status != NOT_DONE else e.status
+        lines.append(f"{e.number:>8}  {points_text(e.points) + ' / ' + points_text(e.worth):>13}  {status}")
+    return lines + [""] + list(feedback.summary)
+
+
+def _exercise_lines(exercise):
+    if exercise.status in (DONE, "excused") or (exercise.note and not exercise.parts):
+        return []
+    if exercise.status == NOT_DONE:
+        return [f"Exercise {exercise.number}: not done.", ""]
+    lines = [f"Exercise {exercise.number} ({points_text(exercise.points)} / {points_text(exercise.worth)}):"]
+    for part in exercise.to_fix:
+        lines += _part_lines(part)
+    return lines + [""]
+
+
+def _part_lines(part):
+    worth = f" ({points_text(part.worth)} point{'' if part.worth == 1 else 's'})" if part.worth else ""
+    if part.kind == NOT_DONE:
+        return [f"  {part.name}{worth}: not done."]
+    lines = [f"  {part.name}{worth}: {_kind_words(part.kind)}"]
+    lines += [f"    {step}: {detail}" if detail else f"    {step}" for step, detail in part.failed]
+    lines += [f"    hint: {part.hint}"] if part.hint else []
+    return lines + [f"    {note}" for note in part.notes]
+
+
+def _kind_words(kind):
+    return {
+        ERROR: "an error",
+        VARIANT: "another variant's data",
+        HELD: "held for your instructor",
+        PASSED: "passed",
+    }.get(kind, kind)
+
+
+def _answer_lines(feedback):
+    if not feedback.answers:
+        return []
+    lines = ["Answers in words (marked by your instructor, not by labkit):"]
+    for title, marked, text_lines, comment in feedback.answers:
+        lines.append(f"  {title}: {marked}")
+        lines += [f"    | {line}" for line in text_lines]
+        lines += [f"    your instructor: {comment}"] if comment else []
+    return lines + [""]
+
+
+def _error_lines(feedback):
+    lines = []
+    if feedback.errors:
+        lines += ["What went wrong while your notebook ran:"] + [f"  ! {line}" for line in feedback.errors]
+    if feedback.stubs:
+        cells = "1 cell still raises" if feedback.stubs == 1 else f"{feedback.stubs} cells still raise"
+        lines.append(f"{cells} NotImplementedError (work not done yet).")
+    return lines
+
+
+def html(feedback: Feedback) -> str:
+    """The feedback as one self-contained HTML page (no request, everything escaped)."""
+    from ..pages import render
+
+    return render("feedback.html", feedback=feedback, points=points_text, kind_words=_kind_words, RAISED=RAISED)
