@@ -52,12 +52,13 @@ class Exercise:
     worth: float
     status: str
     parts: tuple = ()
-    note: str = ""  # one line in place of the parts (not found, excused, another branch)
+    note: str = ""  # one line in place of the parts (not found, excused)
+    other_branch: bool = False  # of the branch that does not count (the better one does)
 
     @property
     def to_fix(self):
-        """The parts the student has to look at: every part that did not pass."""
-        return tuple(part for part in self.parts if part.kind != PASSED)
+        """The parts the student has to look at: every part that did not pass, and a part a person looked at."""
+        return tuple(part for part in self.parts if part.kind != PASSED or part.notes)
 
 
 @dataclass(frozen=True)
@@ -142,8 +143,8 @@ def _exercise(grade, number, other_branch):
         return Exercise(number, 0.0, 0.0, "excused", note="excused by your instructor")
     verdict = grade.results.get(number)
     if verdict is None:
-        note = f"not done: no notebook has its section ('## Exercise {number}'), or it never ran"
-        return Exercise(number, 0.0, worth, NOT_DONE, note=note)
+        note = f"no notebook has its section ('## Exercise {number}'), or it never ran"
+        return Exercise(number, 0.0, worth, NOT_DONE, note=note, other_branch=other_branch)
     parts = tuple(_part(grade, number, check, verdict["checks"]) for check in verdict["checks"])
     kinds = {part.kind for part in parts}
     if worth and points >= worth - 1e-9:
@@ -154,8 +155,7 @@ def _exercise(grade, number, other_branch):
         status = PARTLY
     if HELD in kinds:
         status = HELD
-    note = "the other branch: it does not count (the better branch does)" if other_branch else ""
-    return Exercise(number, points, worth, status, parts, note)
+    return Exercise(number, points, worth, status, parts, other_branch=other_branch)
 
 
 def _part(grade, number, check, checks):
@@ -191,7 +191,7 @@ def _answers(grade):
 
     found = []
     for grade_id, (number, what) in grade.rubric.registry.answers.items():
-        if number not in grade.rubric.points:
+        if number not in grade.rubric.points or number not in grade.results:  # a notebook not handed in
             continue
         text = str(grade.answers.get(grade_id, "")).strip()
         blank = not text or text == "YOUR ANSWER HERE"
@@ -202,7 +202,7 @@ def _answers(grade):
             marked = "no answer" + (f", 0 / {points_text(worth)} points" if worth else "")
         else:
             marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
-        lines = ("(no answer)",) if blank else tuple(one_line(line, 300) for line in text.splitlines()[:20])
+        lines = () if blank else tuple(one_line(line, 300) for line in text.splitlines()[:20])
         comment = one_line(mark["comment"], 1000) if mark and mark.get("comment") else ""
         found.append((f"Exercise {number}, {what}", marked, lines, comment))
     return tuple(found)
@@ -243,17 +243,17 @@ def text(feedback: Feedback) -> str:
 def _table_lines(feedback):
     lines = [f"{'exercise':>8}  {'points':>13}  status"]
     for e in feedback.exercises:
-        status = f"{e.status} ({e.note.split(':')[0]})" if e.note and e.status != NOT_DONE else e.status
+        status = e.status + (" (the other branch: it does not count)" if e.other_branch else "")
         lines.append(f"{e.number:>8}  {points_text(e.points) + ' / ' + points_text(e.worth):>13}  {status}")
     return lines + [""] + list(feedback.summary)
 
 
 def _exercise_lines(exercise):
-    if exercise.status in (DONE, "excused") or (exercise.note and not exercise.parts):
+    if exercise.other_branch or not exercise.to_fix:
         return []
     if exercise.status == NOT_DONE:
         return [f"Exercise {exercise.number}: not done.", ""]
-    lines = [f"Exercise {exercise.number} ({points_text(exercise.points)} / {points_text(exercise.worth)}):"]
+    lines = [f"Exercise {exercise.number}: {points_text(exercise.points)} / {points_text(exercise.worth)}"]
     for part in exercise.to_fix:
         lines += _part_lines(part)
     return lines + [""]

@@ -545,6 +545,18 @@ def _seed_of(grades):
     return None if not seeds else seeds[0] if len(seeds) == 1 else seeds
 
 
+def _merged_delivery(deliveries):
+    """The merged runs' delivery records (labkit.grading.reports.delivery) as one, a later run's students
+    replacing an earlier one's; none when the runs came in different layouts."""
+    layouts = {d.get("layout") for d in deliveries if d}
+    if len(layouts) != 1:
+        return {}
+    students: dict = {}
+    for delivery in deliveries:
+        students.update(delivery.get("students", {}))
+    return {"layout": layouts.pop(), "students": students}
+
+
 @dataclass(frozen=True)
 class Replaced:
     """A submission's result that a later folder's result replaced in a merge.
@@ -699,6 +711,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         "digest": " ".join(sorted({k.get("digest") or "" for k in known} - {""})) or None,
         "solutions": " ".join(sorted({k.get("solutions") or "" for k in known} - {""})) or None,
     }
+    record.delivery = _merged_delivery([records.read(folder).delivery for folder in folders])
     if drawn != {None}:
         students: dict = {}
         for folder in folders:  # a later folder's data replace an earlier one's, as its results do

@@ -93,7 +93,7 @@ import stat
 import tempfile
 import zipfile
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..results.report import one_line, safe_name
@@ -178,6 +178,9 @@ class Student:
     layout: str
     lms_id: str | None = None
     marked_late: bool = False
+    # how the LMS names this student's files, for handing feedback back (labkit.grading.reports.delivery):
+    # Canvas's download prefix of one of the submission's files, "{name}[_LATE]_{user id}_{file id}"
+    lms_file: str | None = None
 
 
 @dataclass
@@ -650,6 +653,7 @@ def _canvas(root, builder, notes):
         if again:
             original, number = again["stem"] + (again["ext"] or ""), int(again["number"])
         group["files"].setdefault(original, []).append((number, Path(entry.path), match["file"], match["fid"]))
+        group["prefix"] = name[: len(name) - len(match["file"]) - 1]  # "{login}[_LATE]_{uid}_{fid}", Canvas's own
     students = []
     logins = [login for login, _ in groups]
     for (login, uid), group in groups.items():
@@ -672,7 +676,7 @@ def _canvas(root, builder, notes):
                 )
             pieces.append((Path(_safe_part(original)), path))
         student = builder.from_files(login, pieces, "canvas", uid, group["late"])
-        students.append(student)
+        students.append(replace(student, lms_file=group["prefix"]))
     return students
 
 

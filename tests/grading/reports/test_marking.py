@@ -11,6 +11,7 @@ from labkit.exercises.registry import LAB
 from labkit.grading.reports import marking
 from labkit.grading.reports.class_report import read as read_class
 from labkit.grading.results import report, rubric
+from labkit.grading.results.feedback import file_stem
 from labkit.grading.results.report import SubmissionGrade
 from labkit.grading.results.rubric import DEFAULT
 
@@ -135,9 +136,9 @@ def test_marks_reach_grades_csv_the_feedback_the_report_and_the_export(tmp_path)
     assert rows["ada"]["total"] == "44.5"  # 10 + 19.5 + 15
     assert rows["ada"]["to read: exercise 3, the order the table shows, against piecewise linear"] == "4.5"
     assert rows["'=bob"]["full credit"] == "93" and rows["'=bob"]["total"] == "15"  # 108 less exercise 4's 15
-    feedback = (out / "feedback" / f"{report.safe_name('ada')}.txt").read_text()
+    feedback = (out / "feedback" / f"{file_stem('ada')}.txt").read_text()
     assert "4.5 / 5 points" in feedback and "Right order; say why." in feedback and "Compared: her own." in feedback
-    assert "excused" in (out / "feedback" / f"{report.safe_name('=bob')}.txt").read_text()
+    assert "excused" in (out / "feedback" / f"{file_stem('=bob')}.txt").read_text()
     grades = read_class(out, None)  # what `labkit report` and `labkit export` read
     assert {g.name: g.total for g in grades} == {"ada": 44.5, "=bob": 15}
     assert main(["report", str(out), "--quiet"]) == 0
@@ -232,7 +233,7 @@ def test_student_text_in_a_comment_is_data_in_grades_csv_and_the_feedback(tmp_pa
     out = _run(tmp_path, _rubric(tmp_path))
     path = _marks(tmp_path, [["ada", "exercise3-answer-1", "1", "=HYPERLINK(x)\x1b[31m red"]])
     marking.import_marks(out, path)
-    feedback = (out / "feedback" / f"{report.safe_name('ada')}.txt").read_text()
+    feedback = (out / "feedback" / f"{file_stem('ada')}.txt").read_text()
     assert "\x1b" not in feedback
     text = marking.marks_csv(read_class(out, None))
     assert "'=HYPERLINK" in text and "\x1b" not in text
