@@ -16,7 +16,7 @@ import pytest
 from labkit import grading
 from labkit.check import EXERCISES
 from labkit.exercises.registry import LAB
-from labkit.grading.results.feedback import file_stem
+from labkit.grading.results.report import file_stem
 
 ANSWERS = LAB.answers
 from labkit.grading.results.rubric import default

@@ -34,7 +34,7 @@ from pathlib import Path
 
 from ..results import feedback as feedbacks
 from ..results import record as records
-from ..results.report import one_line, read_results
+from ..results.report import file_stem, one_line, read_results
 
 UPLOAD = "feedback-upload.zip"
 PAGE = "feedback.html"
@@ -93,7 +93,7 @@ def moodle_names(name, entry):
 def folder_names(name, entry):
     """A folder per student: ``{submission}/feedback.html`` (a name that is no plain folder name, hashed)."""
     plain = name not in (".", "..") and not re.search(r"[/\\\x00]", name) and not name.startswith(".")
-    return [f"{name if plain else feedbacks.file_stem(name)}/{PAGE}"]
+    return [f"{name if plain else file_stem(name)}/{PAGE}"]
 
 
 def nbgrader_names(name, entry):

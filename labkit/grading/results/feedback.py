@@ -22,10 +22,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from ...exercises.result import ERROR, HELD, NOT_DONE, PASSED, RAISED, VARIANT, part_kind
-from .text import points_text
+from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, RAISED, VARIANT, part_kind
+from .text import one_line, points_text, printable
 
-PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$")
 DONE, PARTLY = "done", "partly"  # an exercise's status in the score table (or NOT_DONE, "excused", "held")
 STUB_CELL = re.compile(r"raised NotImplementedError$")
 
@@ -78,24 +77,8 @@ class Feedback:
     other_branch: tuple = field(default=())  # exercises of the branch that does not count
 
 
-def file_stem(name: str) -> str:
-    """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
-    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
-    :func:`~labkit.grading.results.report.safe_name`'s, with a hash of the whole name. A plain name never ends
-    as a hashed one does, so two submissions never share a file.
-
-    >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
-    ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
-    """
-    from .report import safe_name
-
-    return name if PLAIN_NAME.match(name) else safe_name(name)
-
-
 def build(grade) -> Feedback:
     """The feedback of one graded (or ungradable) submission."""
-    from .report import one_line
-
     name = one_line(grade.name, 120)
     if not grade.graded:
         return Feedback(name, "not graded", (), failure=one_line(grade.failure, 500))
@@ -159,8 +142,6 @@ def _exercise(grade, number, other_branch):
 
 
 def _part(grade, number, check, checks):
-    from .report import HELD_STEP, _held_lines, one_line
-
     released = bool(check.get("held")) and grade.released(number, check["name"])
     kind = part_kind(check, released or not check.get("held"))
     total = sum(c.get("weight", 0) for c in checks) or 1
@@ -181,14 +162,10 @@ def _part(grade, number, check, checks):
 
 
 def _summary(grade):
-    from .report import SubmissionGrade
-
-    return tuple(SubmissionGrade._summary(grade).split("\n")) + tuple(grade.rubric.describe().split("\n"))
+    return tuple(grade._summary().split("\n")) + tuple(grade.rubric.describe().split("\n"))
 
 
 def _answers(grade):
-    from .report import one_line
-
     found = []
     for grade_id, (number, what) in grade.rubric.registry.answers.items():
         if number not in grade.rubric.points or number not in grade.results:  # a notebook not handed in
@@ -210,8 +187,6 @@ def _answers(grade):
 
 def _run_errors(grade):
     """(cells that still raise NotImplementedError, one line per error the student caused or other problem)."""
-    from .report import one_line, problem_kinds
-
     stubs, errors = 0, []
     for problem in grade.problems:
         for kind, line in problem_kinds(problem):
@@ -224,14 +199,17 @@ def _run_errors(grade):
 
 def text(feedback: Feedback) -> str:
     """The feedback as plain text: the total on the first line."""
-    from .report import printable
-
     if feedback.failure:
         return printable(
-            f"{feedback.name}: not graded\n\nIt could not be graded: {feedback.failure}\n"
+            f"Not graded: {feedback.name}\n\nIt could not be graded: {feedback.failure}\n"
             "Your instructor has been told; nothing of this submission was scored.\n"
         )
-    lines = [f"{feedback.name}: {feedback.total}", *(f"  {line}" for line in feedback.headline), ""]
+    lines = [
+        f"Total: {feedback.total}",
+        *(f"  {line}" for line in feedback.headline),
+        f"Feedback for {feedback.name}",
+        "",
+    ]
     lines += _table_lines(feedback) + [""]
     lines += [line for exercise in feedback.exercises for line in _exercise_lines(exercise)]
     lines += _answer_lines(feedback) + _error_lines(feedback)
@@ -304,3 +282,38 @@ def html(feedback: Feedback) -> str:
     from ..pages import render
 
     return render("feedback.html", feedback=feedback, points=points_text, kind_words=_kind_words, RAISED=RAISED)
+
+
+def problem_kinds(problem):
+    """The kinds of a submission's problem: its own (a :class:`ProblemText`), or "other" for a bare text."""
+    kinds = getattr(problem, "kinds", None)
+    return kinds if kinds else ((OTHER, str(problem).split("\n")[0]),)
+
+
+SIDE = 56  # characters of a line shown on each side of a held part's shared lines
+HELD_STEP = (
+    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
+)
+
+
+def _held_lines(check, released):
+    """A held part's lines in the feedback: what it matched, and the shared lines side by side."""
+    held = check["held"]
+    source = one_line(held.get("source", "?"), 120)
+    if released:
+        lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
+    else:
+        lines = [
+            f"    HELD: {float(held.get('share', 0)):.0%} of the code of {one_line(held.get('definition', '?'), 80)} "
+            f"and what it calls is, names aside, the same as {source}'s; its points wait for your instructor.",
+            f"    hint: {one_line(check['hint'], 1000)}",
+        ]
+    pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
+    if pairs and held.get("public", True):
+        width = min(SIDE, max(len(one_line(mine, SIDE)) for mine, _ in pairs))
+        lines.append(f"      {'yours':<{width}} | {source}")
+        lines += [f"      {one_line(mine, SIDE):<{width}} | {one_line(theirs, SIDE)}" for mine, theirs in pairs]
+    elif pairs:  # the solutions' lines are for the instructor's report only
+        lines.append("      your lines that are the same, names aside:")
+        lines += [f"      {one_line(mine, 2 * SIDE)}" for mine, _ in pairs]
+    return lines

@@ -30,12 +30,14 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ...exercises.result import KINDS, OTHER
+from ...exercises.result import KINDS
 from ..submission.scan import MAX_SOURCE_CHARS
+from . import feedback as feedbacks
 from . import record as records
 from . import rubric as rubrics
+from .feedback import HELD_STEP, problem_kinds  # noqa: F401 - HELD_STEP for the grader's scoring
 from .late import FROM_CSV, SubmissionTime, time_text
-from .text import points_text
+from .text import CONTROL, one_line, points_text, printable  # noqa: F401 - CONTROL for the reports
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
 OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again (SubmissionGrade.from_dict)
@@ -75,12 +77,6 @@ class ProblemText(str):
     def one(cls, text, kind):
         """A problem of one kind, described by its first line."""
         return cls(text, [(kind, str(text).split("\n")[0])])
-
-
-def problem_kinds(problem):
-    """The kinds of a submission's problem: its own (a :class:`ProblemText`), or "other" for a bare text."""
-    kinds = getattr(problem, "kinds", None)
-    return kinds if kinds else ((OTHER, str(problem).split("\n")[0]),)
 
 
 @dataclass
@@ -191,9 +187,7 @@ class SubmissionGrade:
 
     def feedback(self):
         """The feedback text a student reads: the total first (labkit.grading.results.feedback)."""
-        from .feedback import build, text
-
-        return text(build(self))
+        return feedbacks.text(feedbacks.build(self))
 
     def _summary(self):
         score, rubric = self.score, self.rubric
@@ -320,35 +314,6 @@ def _sources(value):
     return {printable(k)[:200]: printable(v)[:MAX_SOURCE_CHARS] for k, v in sources.items()}
 
 
-SIDE = 56  # characters of a line shown on each side of a held part's shared lines
-HELD_STEP = (
-    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
-)
-
-
-def _held_lines(check, released):
-    """A held part's lines in the feedback: what it matched, and the shared lines side by side."""
-    held = check["held"]
-    source = one_line(held.get("source", "?"), 120)
-    if released:
-        lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
-    else:
-        lines = [
-            f"    HELD: {float(held.get('share', 0)):.0%} of the code of {one_line(held.get('definition', '?'), 80)} "
-            f"and what it calls is, names aside, the same as {source}'s; its points wait for your instructor.",
-            f"    hint: {one_line(check['hint'], 1000)}",
-        ]
-    pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
-    if pairs and held.get("public", True):
-        width = min(SIDE, max(len(one_line(mine, SIDE)) for mine, _ in pairs))
-        lines.append(f"      {'yours':<{width}} | {source}")
-        lines += [f"      {one_line(mine, SIDE):<{width}} | {one_line(theirs, SIDE)}" for mine, theirs in pairs]
-    elif pairs:  # the solutions' lines are for the instructor's report only
-        lines.append("      your lines that are the same, names aside:")
-        lines += [f"      {one_line(mine, 2 * SIDE)}" for mine, _ in pairs]
-    return lines
-
-
 def _problems(texts, kinds):
     """A result file's problems, each with its kinds (ValueError when the two lists do not pair up)."""
     if not isinstance(texts, list) or not isinstance(kinds, list) or len(texts) != len(kinds):
@@ -364,22 +329,7 @@ def _problem_lines(problem):
     ]
 
 
-# control characters, and the invisible ones that break or reorder lines (line and paragraph separators, bidi marks)
-CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u061c\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff\ufff9-\ufffb]")
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
-
-
-def printable(text):
-    """`text` without control characters but newline and tab (no escape sequence reaches a terminal), and
-    with bytes that were not UTF-8 (a file name from an old zip) spelled out as escapes."""
-    text = str(text).encode("utf-8", "backslashreplace").decode("utf-8")
-    return CONTROL.sub("\ufffd", text)
-
-
-def one_line(text, limit=200):
-    """A submission's text as one printable line (a name in a table or a terminal)."""
-    line = printable(str(text)).replace("\n", " ").replace("\t", " ")
-    return line if len(line) <= limit else line[: limit - 1] + "\u2026"
 
 
 def safe_name(name):
@@ -387,6 +337,21 @@ def safe_name(name):
     so two students never share a file ("jane doe" and "jane_doe" differ)."""
     readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"
     return f"{readable}-{hashlib.sha256(str(name).encode('utf-8', 'surrogatepass')).hexdigest()[:10]}"
+
+
+PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$")
+
+
+def file_stem(name: str) -> str:
+    """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
+    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
+    :func:`~labkit.grading.results.report.safe_name`'s, with a hash of the whole name. A plain name never ends
+    as a hashed one does, so two submissions never share a file.
+
+    >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
+    ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
+    """
+    return name if PLAIN_NAME.match(name) else safe_name(name)
 
 
 def csv_cell(value):
@@ -507,11 +472,9 @@ def write_result(out_dir, grade):
 
 def _write_feedback(folder, grade):
     """feedback/<submission>.txt and .html (labkit.grading.results.feedback)."""
-    from . import feedback
-
-    model, stem = feedback.build(grade), feedback.file_stem(grade.name)
-    _replace(folder / f"{stem}.txt", feedback.text(model))
-    _replace(folder / f"{stem}.html", feedback.html(model))
+    model, stem = feedbacks.build(grade), file_stem(grade.name)
+    _replace(folder / f"{stem}.txt", feedbacks.text(model))
+    _replace(folder / f"{stem}.html", feedbacks.html(model))
 
 
 def _replace(path, text):

@@ -130,7 +130,7 @@ def test_canvas_feedback_is_named_for_re_upload_and_begins_with_the_total(graded
 def test_an_untouched_release_says_not_done_for_every_part_and_shows_no_traceback(graded):
     out, _ = graded["canvas"]
     text = (out / "feedback" / "turingalan.txt").read_text()
-    assert text.startswith("turingalan: 0 / ")
+    assert text.startswith("Total: 0 / 100 points\nFeedback for turingalan\n")
     assert "Traceback" not in text and 'File "' not in text and "line " not in text
     assert "slip" not in text and "hint:" not in text
     table = [line for line in text.splitlines() if re.match(r"\s+\d+\s+\d", line)]

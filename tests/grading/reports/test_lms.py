@@ -306,8 +306,12 @@ def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
     assert rows[0] == ["ID number", "labkit", "Feedback"]
     first, rest = rows[1][2].split("\n", 1)
     assert first == "104 points: 100 of 100 for full credit, and 4 of extra credit (labkit grade)"
-    assert rest.startswith("\nada: 104 / 100 points\n")  # then the student's whole feedback, many lines
-    assert rows[2][2].startswith("17.5 points: 17.5 of 100 for full credit (labkit grade)\n\nbob: 17.5 / 100")
+    assert rest.startswith(
+        "\nTotal: 104 / 100 points\n  including 4 extra credit\nFeedback for ada\n"
+    )  # then the student's whole feedback, many lines
+    assert rows[2][2].startswith(
+        "17.5 points: 17.5 of 100 for full credit (labkit grade)\n\nTotal: 17.5 / 100 points\nFeedback for bob"
+    )
     assert "Exercise 3, the order the table shows" in rows[2][2] and rows[2][2].count("\n") > 10
 
 

@@ -11,8 +11,7 @@ from labkit.exercises.registry import LAB
 from labkit.grading.reports import marking
 from labkit.grading.reports.class_report import read as read_class
 from labkit.grading.results import report, rubric
-from labkit.grading.results.feedback import file_stem
-from labkit.grading.results.report import SubmissionGrade
+from labkit.grading.results.report import SubmissionGrade, file_stem
 from labkit.grading.results.rubric import DEFAULT
 
 # the answers of both branches and of exercise 3 weighed: the branches stay worth the same (3 + 3)

@@ -121,7 +121,7 @@ def test_the_feedback_explains_the_rubric_and_where_the_points_came_from():
     }
     text = SubmissionGrade("ada", results, [], None, lab).feedback()
     full = _text(REQUIRED + BRANCH)
-    assert f"ada: {full} / {full} points" in text
+    assert f"Total: {full} / {full} points\nFeedback for ada\n" in text
     listed = lambda group: ", ".join(map(str, group))
     assert f"plus one branch: {FIRST_NAME} ({listed(FIRST)}) or {SECOND_NAME} ({listed(SECOND)})" in text
     assert f"Branch that counts: {SECOND_NAME}, {_text(BRANCH)} / {_text(BRANCH)}" in text
