@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, RAISED, VARIANT, part_kind
 from .text import one_line, points_text, printable
 
+NO_ANSWER = "YOUR ANSWER HERE"  # an answer in words as released
 DONE, PARTLY = "done", "partly"  # an exercise's status in the score table (or NOT_DONE, "excused", "held")
 STUB_CELL = re.compile(r"raised NotImplementedError$")
 
@@ -75,6 +76,11 @@ class Feedback:
     seed: int | None = None
     failure: str = ""
     other_branch: tuple = field(default=())  # exercises of the branch that does not count
+
+
+def blank(answer) -> bool:
+    """Whether an answer in words is none: empty, or left as released ("YOUR ANSWER HERE")."""
+    return str(answer or "").strip().upper() in ("", NO_ANSWER)
 
 
 def build(grade) -> Feedback:
@@ -171,15 +177,15 @@ def _answers(grade):
         if number not in grade.rubric.points or number not in grade.results:  # a notebook not handed in
             continue
         text = str(grade.answers.get(grade_id, "")).strip()
-        blank = not text or text == "YOUR ANSWER HERE"
+        empty = blank(text)
         mark, worth = grade.marks.get(grade_id), grade.rubric.answers.get(grade_id, 0.0)
         if mark is not None:
             marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
-        elif blank:
+        elif empty:
             marked = "no answer" + (f", 0 / {points_text(worth)} points" if worth else "")
         else:
             marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
-        lines = () if blank else tuple(one_line(line, 300) for line in text.splitlines()[:20])
+        lines = () if empty else tuple(one_line(line, 300) for line in text.splitlines()[:20])
         comment = one_line(mark["comment"], 1000) if mark and mark.get("comment") else ""
         found.append((f"Exercise {number}, {what}", marked, lines, comment))
     return tuple(found)
