@@ -22,7 +22,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, RAISED, VARIANT, part_kind
+from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, VARIANT, part_kind
 from .text import one_line, points_text, printable
 
 NO_ANSWER = "YOUR ANSWER HERE"  # an answer in words as released
@@ -287,7 +287,7 @@ def html(feedback: Feedback) -> str:
     """The feedback as one self-contained HTML page (no request, everything escaped)."""
     from ..pages import render
 
-    return render("feedback.html", feedback=feedback, points=points_text, kind_words=_kind_words, RAISED=RAISED)
+    return render("feedback.html", feedback=feedback, points=points_text, kind_words=_kind_words)
 
 
 def problem_kinds(problem):
