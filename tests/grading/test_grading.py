@@ -345,9 +345,9 @@ def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, n
 @pytest.mark.parametrize(
     "name, problem",
     [
-        ("raises", "raised an error"),
-        ("loops_forever", "raised an error"),
-        ("syntax_error", "raised an error"),
+        ("raises", "raised RuntimeError: student bug"),
+        ("loops_forever", "ran past its time limit"),
+        ("syntax_error", "raised SyntaxError"),
         ("prints_megabytes", None),
         ("deletes_files", None),
     ],

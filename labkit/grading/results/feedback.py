@@ -53,7 +53,7 @@ class Exercise:
     status: str
     parts: tuple = ()
     note: str = ""  # one line in place of the parts (not found, excused)
-    other_branch: bool = False  # of the branch that does not count (the better one does)
+    other_branch: bool = False  # of the branch that is not the better one (extra credit at most)
 
     @property
     def to_fix(self):
@@ -227,13 +227,13 @@ def text(feedback: Feedback) -> str:
 def _table_lines(feedback):
     lines = [f"{'exercise':>8}  {'points':>13}  status"]
     for e in feedback.exercises:
-        status = e.status + (" (the other branch: it does not count)" if e.other_branch else "")
+        status = e.status + (" (the other branch)" if e.other_branch else "")
         lines.append(f"{e.number:>8}  {points_text(e.points) + ' / ' + points_text(e.worth):>13}  {status}")
     return lines + [""] + list(feedback.summary)
 
 
 def _exercise_lines(exercise):
-    if exercise.other_branch or not exercise.to_fix:
+    if not exercise.to_fix:
         return []
     if exercise.status == NOT_DONE:
         return [f"Exercise {exercise.number}: not done.", ""]

@@ -126,7 +126,7 @@ def test_the_feedback_explains_the_rubric_and_where_the_points_came_from():
     assert f"plus one branch: {FIRST_NAME} ({listed(FIRST)}) or {SECOND_NAME} ({listed(SECOND)})" in text
     assert f"Branch that counts: {SECOND_NAME}, {_text(BRANCH)} / {_text(BRANCH)}" in text
     assert f"Extra credit, branch {FIRST_NAME}: 0" in text
-    row = f"\n{FIRST[0]:>8}  {'0 / ' + _text(P[FIRST[0]]):>13}  not done (the other branch: it does not count)\n"
+    row = f"\n{FIRST[0]:>8}  {'0 / ' + _text(P[FIRST[0]]):>13}  not done (the other branch)\n"
     assert row in text, text
 
 
