@@ -235,8 +235,6 @@ def _table_lines(feedback):
 def _exercise_lines(exercise):
     if not exercise.to_fix:
         return []
-    if exercise.status == NOT_DONE:
-        return [f"Exercise {exercise.number}: not done.", ""]
     lines = [f"Exercise {exercise.number}: {points_text(exercise.points)} / {points_text(exercise.worth)}"]
     for part in exercise.to_fix:
         lines += _part_lines(part)
@@ -245,8 +243,8 @@ def _exercise_lines(exercise):
 
 def _part_lines(part):
     worth = f" ({points_text(part.worth)} point{'' if part.worth == 1 else 's'})" if part.worth else ""
-    if part.kind == NOT_DONE:
-        return [f"  {part.name}{worth}: not done."]
+    if part.kind == NOT_DONE:  # one line: what is left to do
+        return [f"  {part.name}{worth}: not done" + (f": {part.hint}" if part.hint else ".")]
     lines = [f"  {part.name}{worth}: {_kind_words(part.kind)}"]
     lines += [f"    {step}: {detail}" if detail else f"    {step}" for step, detail in part.failed]
     lines += [f"    hint: {part.hint}"] if part.hint else []

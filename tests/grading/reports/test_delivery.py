@@ -142,7 +142,7 @@ def test_an_untouched_release_says_not_done_for_every_part_and_shows_no_tracebac
 def test_a_partly_done_student_reads_the_plot_as_not_done_and_no_stub_error(graded):
     out, _ = graded["canvas"]
     text = (out / "feedback" / "gaussfriedrich.txt").read_text()
-    assert "ax4" in text and re.search(r"ax4 \([\d.]+ points?\): not done\.", text), text
+    assert "ax4" in text and re.search(r"ax4 \([\d.]+ points?\): not done: draw the plot on `ax4`", text), text
     assert "10*(nintervals+1)" not in text  # the slip's hint of a plot that was drawn
     assert "Traceback" not in text
     assert text.index("ax4") < text.index("1 cell still raises NotImplementedError")  # errors last
