@@ -371,6 +371,10 @@ def _grade(args):
             roster=roster,
             variants=variants,
         )
+    if found.intake is not None:
+        from .grading.reports.delivery import remember
+
+        remember(args.out, found.intake)
     rubric = grades.earlier.rubric
     _summary(grades, args.out, start, "listed")
     _resumed(args.out)
@@ -406,6 +410,7 @@ class _Class:
     def __init__(self, paths, names=None, ungradable=None, notes=(), marked_late=()):
         self.paths, self.names, self.ungradable = paths, names, dict(ungradable or {})
         self.notes, self.marked_late = list(notes), set(marked_late)
+        self.intake = None
 
 
 def _class(args, workspace):
@@ -436,7 +441,7 @@ def _class(args, workspace):
             )
         found.students = [student for student in found.students if student.name in args.student]
     gradable = [student for student in found.students if student.path is not None]
-    return _Class(
+    chosen = _Class(
         [student.path for student in gradable],
         [student.name for student in gradable],
         {student.name: student.failure for student in found.students if student.path is None},
@@ -444,6 +449,8 @@ def _class(args, workspace):
         + found.notes,
         {student.name for student in found.students if student.marked_late},
     )  # (a listed submission's name is its folder's or notebook's, as before)
+    chosen.intake = found  # the layout and the LMS's names, for handing the feedback back (labkit feedback)
+    return chosen
 
 
 def _refused(found, what):
@@ -504,6 +511,16 @@ def _export(args):
         print(f"labkit export: {line}", file=sys.stderr)
     print(export.summary())
     return 1 if export.listed or grades.refused else 0
+
+
+def _feedback(args):
+    from .grading.reports import delivery
+
+    path, members, notes = delivery.write_upload(args.out, args.layout)
+    for line in notes:
+        print(f"labkit feedback: {line}", file=sys.stderr)
+    print(f"wrote {path}: {len(members)} file(s); {delivery.STEPS[delivery.layout_of(args.out, args.layout)]}")
+    return 1 if notes else 0
 
 
 def _report(args):
@@ -576,7 +593,7 @@ def build_parser():
         help="ready to hand in? run your notebooks and list what is left to do",
         description="Run each lab notebook in DIR in a fresh kernel (every cell, even after one raised) and "
         "print, per notebook, the table its last cell shows: each graded part done and passing its "
-        "self-check, failing (with the hint) or not started; the cells that raised; the answers in words "
+        "self-check, failing (with the hint) or not done; the cells that raised; the answers in words "
         "left empty. Only the self-checks run, never the grader. Exit status: 0 when every notebook is ready, "
         "1 when something is left to do, 2 for bad input.",
     )
@@ -889,6 +906,22 @@ def build_parser():
         help="leave it out: the rubric recorded by the run is used (one that grades otherwise is refused)",
     )
     exp.set_defaults(handler=_export)
+
+    fbk = commands.add_parser(
+        "feedback",
+        help="write OUT/feedback-upload.zip: each student's feedback page, named for the LMS's bulk upload",
+        description="Read the results/ of a `labkit grade` run in OUT and write OUT/feedback-upload.zip: each "
+        "student's feedback as one HTML page, named as the LMS the class came from needs it (the run recorded "
+        "its layout): Canvas's 'Re-upload submissions', Moodle's 'Upload multiple feedback files in a zip', "
+        "<submission>/feedback.html for a folder per student, and nbgrader's feedback/ folder.",
+    )
+    fbk.add_argument("out", type=Path, metavar="OUT", help="the --out folder of a `labkit grade` run")
+    fbk.add_argument(
+        "--layout",
+        choices=["canvas", "moodle", "folders", "nbgrader"],
+        help="name the files for this layout instead of the one the run recorded",
+    )
+    fbk.set_defaults(handler=_feedback)
 
     rep = commands.add_parser(
         "report",

@@ -2,7 +2,7 @@
 
 The last cell of every lab notebook is ``labkit.ready_to_hand_in("02_convergence")``. Run after
 *Restart and run all*, it shows one table for the notebook: each graded part of its exercises done
-and passing its self-check, done but failing (with the check's hint), or not started; the cells
+and passing its self-check, done but failing (with the check's hint), or not done; the cells
 that raised; the answers in words left empty. It runs only the self-checks students call
 (:mod:`labkit.check`, on their fixed data); it never imports the grader (:mod:`labkit.grading`),
 whose hidden checks draw fresh data, so it says that the grade may differ.
@@ -30,9 +30,9 @@ from pathlib import Path
 
 from . import notebook as _notebook
 from .exercises.model import sections
-from .exercises.result import NOT_DONE, NOT_IMPLEMENTED
+from .exercises.result import NOT_DONE, NOT_IMPLEMENTED, part_kind
 
-DONE, FAILING, NOT_STARTED = "done, passes its self-check", "done but failing", "not started"
+DONE, FAILING, NOT_STARTED = "done, passes its self-check", "done but failing", NOT_DONE  # as part_kind names it
 ANSWER_STUB = "YOUR ANSWER HERE"  # what labkit release (and nbgrader) leave in an answer in words
 CALL = re.compile(r"""ready_to_hand_in\(\s*["']([\w.\-]+)["']""")
 WIDTH = 100
@@ -45,7 +45,7 @@ class PartStatus:
     exercise: int
     part: str
     status: str
-    detail: str = ""  # the check's hint when failing; what is missing when not started
+    detail: str = ""  # the check's hint when failing; what is missing when not done
 
 
 @dataclass
@@ -126,7 +126,7 @@ class HandIn:
         else:
             lines.append(
                 f"{count[DONE]} of {len(self.parts)} parts pass their self-checks, {count[FAILING]} fail, "
-                f"{count[NOT_STARTED]} not started."
+                f"{count[NOT_STARTED]} not done."
             )
         if self.never_ran and not self.every_cell_ran:
             lines.append(_not_run_advice(self.never_ran))
@@ -181,7 +181,7 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
     last saved. The grader is never run. The result prints as a table.
 
     >>> result = ready_to_hand_in("02_convergence", namespace={})
-    >>> [p.status for p in result.parts] == ["not started"] * 5
+    >>> [p.status for p in result.parts] == ["not done"] * 5
     True
     >>> result.ready
     False
@@ -216,7 +216,7 @@ def _not_run_advice(numbers: list) -> str:
     shown = ", ".join(f"[{n}]" for n in numbers[:8]) + (", ..." if len(numbers) > 8 else "")
     return (
         f"{len(numbers)} cell(s) of the saved notebook did not run in this kernel ({shown}): what they define "
-        "shows as not started. Restart and run all; if it stops at a cell that raises, fix that cell and run all "
+        "shows as not done. Restart and run all; if it stops at a cell that raises, fix that cell and run all "
         "again."
     )
 
@@ -268,7 +268,7 @@ def _status(number: int, part, check: Mapping, namespace: Mapping, stubbed: set,
         return PartStatus(number, part.name, DONE)
     steps = [s for s in check["steps"] if not s["passed"]]
     left = [s for s in steps if s.get("kind") == NOT_DONE]  # a stub called, or a name the check reads not defined
-    if left:
+    if part_kind(check) == NOT_DONE:
         stub = left[0]["detail"] == NOT_IMPLEMENTED  # which of the two, for the words only
         why = "it still raises NotImplementedError" if stub else f"{left[0]['step']}: {left[0]['detail']}"
         return PartStatus(number, part.name, NOT_STARTED, why)

@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import functions, monotone, piecewise, splines
 from ..plotdata import NO_LINE, Line, line_of, lines_of  # noqa: F401 - Line and line_of for the checks' users
-from .result import CheckResult, Results, call, close, floats, judged_by_the_lab, several
+from .result import NOT_DONE, CheckResult, Results, call, close, floats, judged_by_the_lab, several
 
 MIN_POINTS = 100
 # bounds on the grader's work for one plot, whatever the notebook drew: the long lines examined,
@@ -29,6 +29,16 @@ SAMPLE = 20_000
 HERMITE_LIMACON = 2e-3  # near the curve: Hermite with 20 intervals is 2.3e-4 from the limaçon, linear 3.8e-2
 ON_CURVE = 1e-5  # on the Hermite interpolant itself (the polyline standing for it is within 1e-7)
 CIRCLE = "o"
+
+
+def _nothing_drawn(result, name):
+    """An Axes with no line at all: the plot is not done yet (its cell still raises, or draws nothing)."""
+    return result.fail(
+        f"something is drawn on {name}",
+        "nothing is drawn on it yet",
+        f"draw the plot on `{name}`: replace the `raise NotImplementedError()` of its cell with your code.",
+        NOT_DONE,
+    )
 
 
 def _no_plot(result, name, plot):
@@ -186,6 +196,8 @@ def check_limacon_plot(plot, own=None, r0=LAB_R0, derivatives=None):
     lines = lines_of(plot)
     if lines is None:
         return _no_plot(result, "ax4", plot)
+    if not lines:
+        return _nothing_drawn(result, "ax4")
     long = [line for line in lines if line.x.size >= MIN_POINTS and line.x.size == line.y.size]
     if not result.step(
         f"a curve of at least {MIN_POINTS} points",
@@ -365,6 +377,9 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
     if lines is None:
         failed = _no_plot(CheckResult("ax14"), "ax14", plot)
         return Results([failed, failed, failed])
+    if not lines:
+        names = ("ax14: the data", "ax14: the not-a-knot spline", "ax14: pchip")
+        return Results(_nothing_drawn(CheckResult(name), "ax14") for name in names)
     lines = [
         ln
         for ln in lines

@@ -33,6 +33,47 @@ VARIANT = "another variant"  # the notebook holds data other than its student's 
 KINDS = (NOT_DONE, RAISED, REFUSED, TIMEOUT, CRASH, TAMPERED, OTHER, VARIANT)  # of a failed step or a problem
 
 
+# A part's kind as everything that shows it names it (the feedback, the class report's slips and pass rates,
+# `labkit handin`, the grades): :func:`part_kind` is the one place that decides it
+ERROR, HELD, LATE = "error", "held", "late"  # the student's code failed to run; held for a person; handed in late
+PART_KINDS = (PASSED, NOT_DONE, SLIP, ERROR, HELD, VARIANT)  # of one part; LATE is the whole submission's
+ERRORS = (RAISED, REFUSED, TIMEOUT, CRASH, TAMPERED, OTHER)  # the failed steps' kinds a part shows as an error
+
+
+def part_kind(check, released=True):
+    """What became of one part, as the student and the instructor read it: one of :data:`PART_KINDS`.
+
+    `check` is a part's entry in a result (``passed``, ``steps``, each failed step that is not a slip with its
+    ``kind``; ``held`` when it matched code it may be copied from), or None for a part the results lack (its
+    section never ran). A part is "not done" when a failed step is a stub left as released or a name never
+    defined, whatever else failed; "another variant" when the notebook holds another student's data; an
+    "error" when the student's code raised, ran out of time or was refused; "held" when it passed but waits
+    for a person (`released` False); else a "slip", whose hint names it.
+
+    Examples
+    --------
+    >>> part_kind({"passed": False, "steps": [{"passed": False, "kind": "not done"}, {"passed": False}]})
+    'not done'
+    >>> part_kind({"passed": False, "steps": [{"passed": False, "detail": "off by 0.3"}]})
+    'slip'
+    >>> part_kind({"passed": True, "held": {"share": 0.97}, "steps": []}, released=False)
+    'held'
+    >>> part_kind(None)
+    'not done'
+    """
+    if not isinstance(check, dict) or not check:
+        return NOT_DONE
+    if check.get("passed"):
+        return HELD if check.get("held") and not released else PASSED
+    steps = check.get("steps") if isinstance(check.get("steps"), list) else []
+    kinds = {s.get("kind") for s in steps if isinstance(s, dict) and not s.get("passed")}
+    if NOT_DONE in kinds:
+        return NOT_DONE
+    if VARIANT in kinds:
+        return VARIANT
+    return ERROR if kinds & set(ERRORS) else SLIP
+
+
 @dataclass
 class CheckResult:
     """Outcome of one check: the steps run, whether all passed, and a hint if not."""

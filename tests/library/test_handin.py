@@ -138,7 +138,7 @@ def test_a_half_done_notebook_says_what_is_left(half):
     assert half.empty_answers == ["exercise 3: the order the table shows, against piecewise linear"]
     text = half.text()
     assert f"[{typo.number}] line {typo.line}: errors_pherm = [test_pherm_interpolate(n) for n in n_data]" in text
-    assert "2 of 5 parts pass their self-checks, 1 fail, 2 not started." in text
+    assert "2 of 5 parts pass their self-checks, 1 fail, 2 not done." in text
     assert not half.ready
 
 

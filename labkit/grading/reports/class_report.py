@@ -38,7 +38,20 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
-from ...exercises.result import CRASH, NOT_DONE, OTHER, PASSED, RAISED, REFUSED, SLIP, TAMPERED, TIMEOUT, VARIANT
+from ...exercises.result import (
+    CRASH,
+    HELD,
+    NOT_DONE,
+    OTHER,
+    PASSED,
+    RAISED,
+    REFUSED,
+    SLIP,
+    TAMPERED,
+    TIMEOUT,
+    VARIANT,
+    part_kind,
+)
 from ..results import late as lateness
 from ..results.record import rubric_for
 from ..results.report import SubmissionGrade, one_line, printable, read_results
@@ -46,6 +59,8 @@ from ..results.report import problem_kinds as kinds_of
 from ..results.rubric import Rubric
 from ..results.text import points_text
 from ..submission.known import THRESHOLD
+from .copies import Copies, pair_rows
+from .copies import find as find_copies
 from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
 
 REPORT = "report.html"
@@ -312,6 +327,7 @@ class ClassSummary:
     seeds: list = field(default_factory=list)
     late: LateSummary | None = None  # the late view, when the rubric has a [late] table
     held: list = field(default_factory=list)  # Held: parts held for a person (their code matched a known source)
+    copies: Copies | None = None  # whose data, solution markers, each student's graded functions (copies.py)
 
     @property
     def submissions(self):
@@ -390,13 +406,13 @@ def check_outcome(check: dict) -> str:
     """
     if not isinstance(check, dict):
         raise ValueError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
-    if check.get("passed"):
+    kind = part_kind(check)  # the one place a part's kind is decided: the feedback and labkit handin agree
+    if kind in (PASSED, HELD):
         return PASSED
+    if kind in (NOT_DONE, VARIANT, SLIP):
+        return kind
     kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}  # each failed step's code, set where made
-    for kind in OUTCOMES:
-        if kind in kinds:
-            return kind
-    return SLIP
+    return next((kind for kind in OUTCOMES if kind in kinds), OTHER)
 
 
 def problem_kinds(problem: str) -> list[tuple[str, str]]:
@@ -563,7 +579,8 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
             continue
         for text in grade.problems:
             for kind, line in problem_kinds(text):
-                problems[(kind, grade.name)].append(line)
+                if kind != NOT_DONE:  # a stub's cell, or a cell as released: work not done, counted per part
+                    problems[(kind, grade.name)].append(line)
     by_kind: dict = {kind: [] for kind in KINDS}
     for (kind, student), texts in sorted(problems.items(), key=lambda item: (item[0][0], item[0][1])):
         by_kind[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))
@@ -587,6 +604,7 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
         most_failed=struggles[:MOST_FAILED],
         seeds=sorted({g.seed for g in grades if isinstance(g.seed, int)}),
         late=_late_summary(rubric, graded),
+        copies=find_copies(grades),
         held=[
             Held(
                 g.name, number, str(part), str(what.get("definition", "")), str(what.get("source", "")),
@@ -1169,7 +1187,39 @@ def _held_section(summary):
     return "\n".join(out)
 
 
-def _similar_section(pairs, threshold, note):
+def _pair_details(pair):
+    """One graded function of a pair of students, its two versions side by side on demand."""
+    shared_first = {i for i in pair.shared_first if isinstance(i, int) and 0 <= i < len(pair.first_lines)}
+    shared_second = {i for i in pair.shared_second if isinstance(i, int) and 0 <= i < len(pair.second_lines)}
+    return (
+        f"<details><summary><code>{_e(pair.function, 100)}</code>, similarity {pair.score:.2f}: "
+        f"{len(shared_first)} of {len(pair.first_lines)} lines and {len(shared_second)} of "
+        f'{len(pair.second_lines)} shared</summary><div class="sides">'
+        + _code_side(pair.first, pair.first_lines, shared_first)
+        + _code_side(pair.second, pair.second_lines, shared_second)
+        + "</div></details>"
+    )
+
+
+def _copies_section(copies):
+    """Whose data a notebook holds and the submissions with the solutions' markers (instructor only)."""
+    out = ['<section aria-labelledby="copies"><h2 id="copies">Copies</h2>']
+    lines = copies.holder_lines() if copies is not None else []
+    marked = copies.marked if copies is not None else []
+    if not lines and not marked:
+        out.append("<p>No notebook holds a classmate's data or the solutions' markers.</p></section>")
+        return "".join(out)
+    items = [f"<li>{_e(line, 400)}</li>" for line in lines]
+    items += [
+        f"<li>{_e(name, MAX_NAME)} holds the instructor solutions' markers (<code>### BEGIN SOLUTION</code>) in "
+        f"{_e(', '.join(found), 300)}: the instructor notebooks were handed in</li>"
+        for name, found in marked
+    ]
+    out.append(f"<ul>{''.join(items)}</ul></section>")
+    return "".join(out)
+
+
+def _similar_section(pairs, threshold, note, copies=None):
     out = ['<section aria-labelledby="similar"><h2 id="similar">Similar code</h2>']
     out.append(
         "<p><strong>Similarity never changes a grade.</strong> These pairs are for a person to judge: shared "
@@ -1183,28 +1233,21 @@ def _similar_section(pairs, threshold, note):
     if not pairs:
         out.append(f"<p>No pair of submissions is similar at the threshold {threshold:.2f} or above.</p></section>")
         return "".join(out)
-    ordered = sorted(pairs, key=lambda p: (-p.score, p.function, p.first, p.second))
+    rows = pair_rows(pairs, copies.functions if copies is not None else {})
     out.append(
-        f"<p>{len(pairs)} pair{'' if len(pairs) == 1 else 's'} of versions of one graded function at a similarity "
-        f"of {threshold:.2f} or above, most similar first. Shared lines are highlighted and marked "
-        "<code>=</code> after their line number.</p>"
+        f"<p>{len(rows)} pair{'' if len(rows) == 1 else 's'} of students with graded functions alike at a similarity "
+        f"of {threshold:.2f} or above, most functions alike first; open a function to see both versions, shared "
+        "lines highlighted and marked <code>=</code> after their line number.</p>"
     )
-    for index, pair in enumerate(ordered[:MAX_PAIRS], 1):
-        shared_first = {i for i in pair.shared_first if isinstance(i, int) and 0 <= i < len(pair.first_lines)}
-        shared_second = {i for i in pair.shared_second if isinstance(i, int) and 0 <= i < len(pair.second_lines)}
+    for index, row in enumerate(rows[:MAX_PAIRS], 1):
         out.append(
             f'<article class="pair" aria-labelledby="pair-{index}"><h3 id="pair-{index}">'
-            f"<code>{_e(pair.function, 100)}</code>: {_e(pair.first, MAX_NAME)} and {_e(pair.second, MAX_NAME)}, "
-            f"similarity {pair.score:.2f}</h3>"
-            f"<p>{len(shared_first)} of {len(pair.first_lines)} lines of the first and {len(shared_second)} of "
-            f"{len(pair.second_lines)} of the second are shared.</p>"
-            '<div class="sides">'
-            + _code_side(pair.first, pair.first_lines, shared_first)
-            + _code_side(pair.second, pair.second_lines, shared_second)
-            + "</div></article>"
+            f"{_e(row.words, 2 * MAX_NAME + 80)}</h3>"
+            + "".join(_pair_details(pair) for pair in row.alike[:MAX_PAIRS])
+            + "</article>"
         )
-    if len(pairs) > MAX_PAIRS:
-        out.append(f"<p>and {len(pairs) - MAX_PAIRS} less similar pairs, not shown.</p>")
+    if len(rows) > MAX_PAIRS:
+        out.append(f"<p>and {len(rows) - MAX_PAIRS} pairs with fewer functions alike, not shown.</p>")
     out.append("</section>")
     return "".join(out)
 
@@ -1301,6 +1344,7 @@ def render(
         ("problems", "Problems"),
         ("most-failed", "The most failed parts"),
         ("held", "Held for a person"),
+        ("copies", "Copies"),
         ("similar", "Similar code"),
     ]
     nav = "".join(f'<li><a href="#{anchor}">{title}</a></li>' for anchor, title in sections)
@@ -1325,7 +1369,8 @@ def render(
                 _problems_section(summary),
                 _most_failed_section(summary),
                 _held_section(summary),
-                _similar_section(pairs, threshold, similarity_note),
+                _copies_section(summary.copies),
+                _similar_section(pairs, threshold, similarity_note, summary.copies),
             ]
         )
         + "\n</main>\n<footer><p>Written by <code>labkit report</code> from the grading run's "
@@ -1350,6 +1395,16 @@ def _check_pairs(pairs):
         if not isinstance(pair.score, (int, float)) or not 0.0 <= float(pair.score) <= 1.0:
             raise ValueError(f"a pair's score is a similarity from 0 to 1; got {pair.score!r} for {pair.function!r}.")
     return pairs
+
+
+def _variant_students(out):
+    """Each student's variant data, as the run in `out` recorded them ({} without variants or a record)."""
+    from ..results.record import read as read_record
+
+    try:
+        return read_record(out).variants.get("students", {})
+    except ValueError:
+        return {}
 
 
 def write(
@@ -1397,7 +1452,10 @@ def write(
     target = out / REPORT
     if target.is_symlink() or (target.exists() and not target.is_file()):
         raise ValueError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
-    page = render(summarise(grades), pairs, threshold=float(threshold), similarity_note=similarity_note)
+    grades = list(grades)
+    summary = summarise(grades)
+    summary.copies = find_copies(grades, _variant_students(out))
+    page = render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note)
     handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
         "w", encoding="utf-8", dir=out, prefix=".report-", suffix=".html.tmp", delete=False
     )

@@ -752,6 +752,8 @@ def to_canvas(
                 f"{gradebook} has two rows with {key} {one_line(value, 60)!r} (rows {rows_of[value]} and "
                 f"{number}); export the gradebook again, or match on another column with --key."
             )
+        if _test_student(row, value, entries, export):
+            continue
         if not value:  # a student without this id: no roster entry can name it
             export.lms_only.append((row[0].strip(), ""))
             continue
@@ -796,6 +798,17 @@ def to_canvas(
     return export
 
 
+CANVAS_TEST_STUDENT = "Student, Test"  # the row of the test student Canvas adds to every course ("Test Student")
+
+
+def _test_student(row, value, entries, export):
+    """Whether a gradebook row is Canvas's test student, which no roster holds: left alone, with a note."""
+    if row[0].strip() != CANVAS_TEST_STUDENT or value in set(entries.values()):
+        return False
+    export.notes.append(f"note: Canvas's test student ({CANVAS_TEST_STUDENT!r}) is in the gradebook; left as it is.")
+    return True
+
+
 def _feedback(grade):
     """The points in words, first the grade written beside them (after any late penalty), then how it was made.
 
@@ -819,6 +832,24 @@ def _feedback(grade):
         f"{points_text(lateness.penalty)} for late work ({units}, {points_text(lateness.percent)}% off{capped}) "
         "(labkit grade)"
     )
+
+
+MAX_FEEDBACK = 30_000  # characters of a Moodle feedback cell (the student's feedback text, bounded)
+
+
+def _feedback_cell(grade):
+    """Moodle's feedback cell: the points in words on the first line, then the student's whole feedback text
+    (labkit.grading.results.feedback), printable, bounded, and never read as a formula."""
+    from ..results.feedback import build, text
+
+    whole = f"{_feedback(grade)}\n\n{text(build(grade))}"
+    whole = whole if len(whole) <= MAX_FEEDBACK else whole[: MAX_FEEDBACK - 1] + "\u2026"
+    return csv_cell(_feedback(grade)) if not grade.graded else _formula_safe(whole)
+
+
+def _formula_safe(text):
+    """A multi-line cell that a spreadsheet shows as text (as :func:`csv_cell`, keeping its lines)."""
+    return csv_cell(text[:1]) + text[1:] if text else text
 
 
 def _is_email(value):
@@ -927,7 +958,7 @@ def to_moodle(
         if grade is None:
             export.no_submission.append((name, value))
         elif grade.graded:
-            rows.append([value, points_text(grade.total)] + ([csv_cell(_feedback(grade))] if feedback else []))
+            rows.append([value, points_text(grade.total)] + ([_feedback_cell(grade)] if feedback else []))
             export.exported[name] = (value, grade.total)
     if not export.exported:
         raise ValueError(

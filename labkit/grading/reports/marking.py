@@ -23,6 +23,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ..results import record as records
+from ..results.feedback import blank
 from ..results.names import name_cell, name_from_cell, shown_name
 from ..results.report import csv_cell, one_line, printable, read_results, write_csv, write_result
 from ..results.text import points_text
@@ -94,6 +95,8 @@ def read_marks(text, grades):
             continue
         kind, worth = known[item]
         value, why = _points(kind, worth, points)
+        if not why and kind == "answer" and value and blank(grade.answers.get(item)):
+            why = "the student wrote no answer (blank, or YOUR ANSWER HERE): it is marked 0, no answer"
         if why:
             problems.append(f"line {line}: {item} of {one_line(name, 80)}: {why}")
             continue
@@ -314,18 +317,20 @@ def tasks(grades, marker="instructor"):
     models = model_answers()
     found = []
     for grade_id, (number, what) in rubric.registry.answers.items():
-        if number not in rubric.points:
+        if number not in rubric.points or not rubric.answers.get(grade_id):  # only what is worth points
             continue
         question, model = models.get(grade_id, ("", ""))
-        entries = [
+        entries = [  # only answers the student wrote: a blank one is marked 0, no answer, and never queued
             {
                 "submission": g.name,
                 "shown": shown_name(g.name, 200),
                 "html": render_markdown(g.answers.get(grade_id) or ""),
             }
             for g in grades
-            if g.graded
+            if g.graded and not blank(g.answers.get(grade_id))
         ]
+        if not entries:
+            continue
         random.Random(f"{marker}\n{grade_id}").shuffle(entries)
         found.append({
             "item": grade_id, "kind": "answer", "max": rubric.answers.get(grade_id, 0.0),

@@ -78,6 +78,9 @@ class RunRecord:
     # the students' own data (labkit.exercises.variants): {"digest": the variants file's, "students": {name:
     # {exercise: {parameter: value}}}}, empty for a run without variants
     variants: dict = field(default_factory=dict)
+    # how the class came (labkit.grading.reports.delivery): {"layout": "canvas", "moodle", "folders", "nbgrader" or
+    # "listed", "students": {name: what names that student's files in the LMS}}; empty for a run before it
+    delivery: dict = field(default_factory=dict)
 
     def given_times(self, source):
         """{name: datetime} of the times the run was given from `source` (``"csv"``: ``--times``; ``"exchange"``)."""
@@ -98,6 +101,7 @@ class RunRecord:
             "flags": self.flags,
             "known": self.known,
             "variants": self.variants,
+            "delivery": self.delivery,
         }
 
     def rubric_object(self, folder):
@@ -199,13 +203,16 @@ def read(folder):
         variants = data.get("variants") or {}
         if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
             raise ValueError("its variants are not a table of students")
+        delivery = data.get("delivery") or {}
+        if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
+            raise ValueError("its delivery is not a table of students")
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
     return RunRecord(
         data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags,
-        known, variants,
+        known, variants, delivery,
     )  # fmt: skip
 
 

@@ -5,7 +5,8 @@ Layout of an output folder::
     grades.csv               one row per submission: points per exercise, the branch that
                              counted, the extra credit, the total (under the rubric); with a
                              [late] table also the raw total, the time, the lateness and penalty
-    feedback/<name>.txt      what passed, what failed, the hint, what went wrong while running
+    feedback/<name>.txt      the total, the exercises' points, what failed in the student's words and its
+                             hint, the errors of cells the student changed; .html the same as one page
     results/<name>.json      the same grade as data: merged by ``labkit merge``
     seed.txt                 the seed of the run's random test data
     record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.results.record)
@@ -29,11 +30,13 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ...exercises.result import KINDS, OTHER
+from ...exercises.result import KINDS
+from . import feedback as feedbacks
 from . import record as records
 from . import rubric as rubrics
+from .feedback import HELD_STEP, problem_kinds  # noqa: F401 - HELD_STEP for the grader's scoring
 from .late import FROM_CSV, SubmissionTime, time_text
-from .text import MAX_SOURCE_CHARS, points_text
+from .text import CONTROL, MAX_SOURCE_CHARS, one_line, points_text, printable
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
 OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again (SubmissionGrade.from_dict)
@@ -73,12 +76,6 @@ class ProblemText(str):
     def one(cls, text, kind):
         """A problem of one kind, described by its first line."""
         return cls(text, [(kind, str(text).split("\n")[0])])
-
-
-def problem_kinds(problem):
-    """The kinds of a submission's problem: its own (a :class:`ProblemText`), or "other" for a bare text."""
-    kinds = getattr(problem, "kinds", None)
-    return kinds if kinds else ((OTHER, str(problem).split("\n")[0]),)
 
 
 @dataclass
@@ -188,100 +185,8 @@ class SubmissionGrade:
         return self.score.total if lateness is None else lateness.total
 
     def feedback(self):
-        if not self.graded:
-            return printable(
-                f"Feedback for {one_line(self.name)}: not graded\n\n! could not be graded: "
-                f"{one_line(self.failure, 500)}\n"
-                "Your instructor has been told; nothing of this submission was scored.\n"
-            )
-        score, rubric, lateness = self.score, self.rubric, self.lateness
-        extra = f" + {points_text(score.extra_total)} extra credit" if score.extra_total else ""
-        if lateness is not None and lateness.penalty:
-            extra += f", {points_text(lateness.penalty)} off for late work"
-        lines = [
-            f"Feedback for {one_line(self.name)}: {points_text(self.total)} points "
-            f"({points_text(score.required + score.counted)} / {points_text(score.full_credit)}{extra})",
-            "",
-        ]
-        # a problem's first line is the grader's; what follows (a traceback) is indented, so no line can pose
-        # as one of the grader's own
-        lines += [line for problem in self.problems for line in _problem_lines(problem)]
-        if self.problems:
-            lines.append("")
-        lines += [rubric.describe(), ""]
-        for number in rubric.graded:
-            lines += self._exercise_lines(number)
-        lines += ["", self._summary()]
-        lines += self._answer_lines()
-        if self.seed is not None:
-            lines += ["", f"(random test data from seed {self.seed})"]
-        return printable("\n".join(lines) + "\n")
-
-    def _exercise_lines(self, number):
-        points = self.rubric.points[number]
-        verdict = self.results.get(number)
-        if number in self.excused:
-            return [f"Exercise {number}: excused by your instructor (out of your total and full credit)"]
-        if verdict is None:
-            return [
-                f"Exercise {number}: 0 / {points_text(points)} - not found: no notebook has its section "
-                f"('## Exercise {number}') or it never ran."
-            ]
-        held = [c for c in verdict["checks"] if c.get("held") and c["passed"]]
-        earned = self.fractions.get(number, 0.0) >= 1.0 - 1e-9
-        status = "passed" if verdict["passed"] or earned else "FAILED"
-        if any(not self.released(number, c["name"]) for c in held):
-            status = (
-                "held for your instructor" if all(c["passed"] for c in verdict["checks"]) else status + ", part held"
-            )
-        worth = self.rubric.worth(number)
-        lines = [f"Exercise {number}: {points_text(self.points[number])} / {points_text(worth)} - {status}"]
-        total_weight = sum(check.get("weight", 0) for check in verdict["checks"]) or 1
-        for check in verdict["checks"]:
-            weight = check.get("weight") or 0
-            share = points * weight / total_weight
-            worth = f" ({points_text(share)} point{'' if share == 1 else 's'})" if weight else ""
-            released = bool(check.get("held")) and self.released(number, check["name"])
-            for step in check["steps"]:
-                mark = "ok  " if step["passed"] else "FAIL"
-                detail = f": {one_line(step['detail'], 1000)}" if step["detail"] else ""
-                if released and step["step"] == HELD_STEP:
-                    mark, detail = "ok  ", ": released by your instructor, who compared it with the code it resembles"
-                lines.append(
-                    f"    [{mark}] {one_line(check['name'], 100)}{worth}: {one_line(step['step'], 300)}{detail}"
-                )
-            if check["hint"] and not check["passed"]:
-                lines.append(f"    hint: {one_line(check['hint'], 1000)}")
-            if check.get("held") and check["passed"]:
-                lines += _held_lines(check, released)
-                mark = self.marks.get(f"exercise{number}/{check['name']}")
-                if mark and mark.get("comment"):
-                    lines.append(f"    your instructor: {one_line(mark['comment'], 1000)}")
-        return lines
-
-    def _answer_lines(self):
-        """The answers in words, for the instructor to read (no check scores them)."""
-        answers = self.rubric.registry.answers
-        if not answers:
-            return []
-        lines = ["", "Answers in words (marked by your instructor, not by labkit):"]
-        for grade_id, (number, what) in answers.items():
-            if number not in self.rubric.points:
-                continue
-            text = str(self.answers.get(grade_id, "")).strip()
-            if not text or text == "YOUR ANSWER HERE":
-                text = "(no answer)"
-            mark = self.marks.get(grade_id)
-            worth = self.rubric.answers.get(grade_id, 0.0)
-            if mark is not None:
-                marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
-            else:
-                marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
-            lines.append(f"  Exercise {number}, {what}: {marked}")
-            lines += [f"    | {one_line(line, 300)}" for line in text.splitlines()[:20]]
-            if mark is not None and mark.get("comment"):
-                lines.append(f"    your instructor: {one_line(mark['comment'], 1000)}")
-        return lines
+        """The feedback text a student reads: the total first (labkit.grading.results.feedback)."""
+        return feedbacks.text(feedbacks.build(self))
 
     def _summary(self):
         score, rubric = self.score, self.rubric
@@ -408,35 +313,6 @@ def _sources(value):
     return {printable(k)[:200]: printable(v)[:MAX_SOURCE_CHARS] for k, v in sources.items()}
 
 
-SIDE = 56  # characters of a line shown on each side of a held part's shared lines
-HELD_STEP = (
-    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
-)
-
-
-def _held_lines(check, released):
-    """A held part's lines in the feedback: what it matched, and the shared lines side by side."""
-    held = check["held"]
-    source = one_line(held.get("source", "?"), 120)
-    if released:
-        lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
-    else:
-        lines = [
-            f"    HELD: {float(held.get('share', 0)):.0%} of the code of {one_line(held.get('definition', '?'), 80)} "
-            f"and what it calls is, names aside, the same as {source}'s; its points wait for your instructor.",
-            f"    hint: {one_line(check['hint'], 1000)}",
-        ]
-    pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
-    if pairs and held.get("public", True):
-        width = min(SIDE, max(len(one_line(mine, SIDE)) for mine, _ in pairs))
-        lines.append(f"      {'yours':<{width}} | {source}")
-        lines += [f"      {one_line(mine, SIDE):<{width}} | {one_line(theirs, SIDE)}" for mine, theirs in pairs]
-    elif pairs:  # the solutions' lines are for the instructor's report only
-        lines.append("      your lines that are the same, names aside:")
-        lines += [f"      {one_line(mine, 2 * SIDE)}" for mine, _ in pairs]
-    return lines
-
-
 def _problems(texts, kinds):
     """A result file's problems, each with its kinds (ValueError when the two lists do not pair up)."""
     if not isinstance(texts, list) or not isinstance(kinds, list) or len(texts) != len(kinds):
@@ -452,22 +328,7 @@ def _problem_lines(problem):
     ]
 
 
-# control characters, and the invisible ones that break or reorder lines (line and paragraph separators, bidi marks)
-CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f\u061c\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff\ufff9-\ufffb]")
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
-
-
-def printable(text):
-    """`text` without control characters but newline and tab (no escape sequence reaches a terminal), and
-    with bytes that were not UTF-8 (a file name from an old zip) spelled out as escapes."""
-    text = str(text).encode("utf-8", "backslashreplace").decode("utf-8")
-    return CONTROL.sub("\ufffd", text)
-
-
-def one_line(text, limit=200):
-    """A submission's text as one printable line (a name in a table or a terminal)."""
-    line = printable(str(text)).replace("\n", " ").replace("\t", " ")
-    return line if len(line) <= limit else line[: limit - 1] + "\u2026"
 
 
 def safe_name(name):
@@ -475,6 +336,21 @@ def safe_name(name):
     so two students never share a file ("jane doe" and "jane_doe" differ)."""
     readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"
     return f"{readable}-{hashlib.sha256(str(name).encode('utf-8', 'surrogatepass')).hexdigest()[:10]}"
+
+
+PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$")
+
+
+def file_stem(name: str) -> str:
+    """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
+    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
+    :func:`~labkit.grading.results.report.safe_name`'s, with a hash of the whole name. A plain name never ends
+    as a hashed one does, so two submissions never share a file.
+
+    >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
+    ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
+    """
+    return name if PLAIN_NAME.match(name) else safe_name(name)
 
 
 def csv_cell(value):
@@ -597,11 +473,18 @@ def write_result(out_dir, grade):
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
-    _replace(out / "feedback" / f"{safe_name(grade.name)}.txt", grade.feedback())
+    _write_feedback(out / "feedback", grade)
     path = out / "results" / f"{safe_name(grade.name)}.json"
     text = json.dumps(grade.as_dict(), indent=1)
     _replace(path, text)
     return records.Written(path, hashlib.sha256(text.encode("utf-8")).hexdigest())
+
+
+def _write_feedback(folder, grade):
+    """feedback/<submission>.txt and .html (labkit.grading.results.feedback)."""
+    model, stem = feedbacks.build(grade), file_stem(grade.name)
+    _replace(folder / f"{stem}.txt", feedbacks.text(model))
+    _replace(folder / f"{stem}.html", feedbacks.html(model))
 
 
 def _replace(path, text):
@@ -633,6 +516,18 @@ def _seed_of(grades):
     """The seed of a run's grades: one number, the list of them (a merge's), or None when none has one."""
     seeds = sorted({g.seed for g in grades if g.seed is not None})
     return None if not seeds else seeds[0] if len(seeds) == 1 else seeds
+
+
+def _merged_delivery(deliveries):
+    """The merged runs' delivery records (labkit.grading.reports.delivery) as one, a later run's students
+    replacing an earlier one's; none when the runs came in different layouts."""
+    layouts = {d.get("layout") for d in deliveries if d}
+    if len(layouts) != 1:
+        return {}
+    students: dict = {}
+    for delivery in deliveries:
+        students.update(delivery.get("students", {}))
+    return {"layout": layouts.pop(), "students": students}
 
 
 @dataclass(frozen=True)
@@ -789,6 +684,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         "digest": " ".join(sorted({k.get("digest") or "" for k in known} - {""})) or None,
         "solutions": " ".join(sorted({k.get("solutions") or "" for k in known} - {""})) or None,
     }
+    record.delivery = _merged_delivery([records.read(folder).delivery for folder in folders])
     if drawn != {None}:
         students: dict = {}
         for folder in folders:  # a later folder's data replace an earlier one's, as its results do

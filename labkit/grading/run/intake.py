@@ -101,7 +101,7 @@ import stat
 import tempfile
 import zipfile
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..results.report import one_line, safe_name
@@ -194,6 +194,9 @@ class Student:
     layout: str
     lms_id: str | None = None
     marked_late: bool = False
+    # how the LMS names this student's files, for handing feedback back (labkit.grading.reports.delivery):
+    # Canvas's download prefix of one of the submission's files, "{name}[_LATE]_{user id}_{file id}"
+    lms_file: str | None = None
 
 
 @dataclass
@@ -913,7 +916,7 @@ def _canvas_files(root, builder, notes):
 
 def _canvas(root, builder, notes):
     groups: dict = {}  # user id -> {"logins": {login}, "late": bool, "files": {original: [(number, path, given, fid)]}}
-    for reading, path in _canvas_files(root, builder, notes).values():
+    for name, (reading, path) in _canvas_files(root, builder, notes).items():
         group = groups.setdefault(reading.uid, {"logins": set(), "late": False, "files": {}})
         group["logins"].add(reading.login)
         group["late"] |= reading.late
@@ -922,6 +925,7 @@ def _canvas(root, builder, notes):
         if again:
             original, number = again["stem"] + (again["ext"] or ""), int(again["number"])
         group["files"].setdefault(original, []).append((number, path, reading.file, reading.fid))
+        group["prefix"] = name[: len(name) - len(reading.file) - 1]  # "{login}[_LATE]_{uid}_{fid}", Canvas's own
     logins = [min(group["logins"]) for group in groups.values()]
     students = []
     for (uid, group), login in zip(groups.items(), logins):
@@ -930,7 +934,8 @@ def _canvas(root, builder, notes):
             notes += [] if said in notes else [said]
             login = f"{login}_{uid}"
         pieces = _canvas_pieces(login, group["files"], notes)
-        students.append(builder.from_files(login, pieces, "canvas", uid, group["late"], key=("canvas", uid)))
+        student = builder.from_files(login, pieces, "canvas", uid, group["late"], key=("canvas", uid))
+        students.append(replace(student, lms_file=group["prefix"]))
     return students
 
 

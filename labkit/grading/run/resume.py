@@ -78,7 +78,7 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     out = Path(out)
     files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
     if fresh:
-        for path in [*files, *sorted((out / "feedback").glob("*.txt"))]:
+        for path in [*files, *sorted((out / "feedback").glob("*.txt")), *sorted((out / "feedback").glob("*.html"))]:
             path.unlink()
         for name in (records.RECORD, records.RUBRIC_COPY):
             (out / name).unlink(missing_ok=True)

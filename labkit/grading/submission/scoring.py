@@ -32,7 +32,7 @@ from pathlib import Path
 from ...exercises.model import sections
 from ...exercises.registry import LAB
 from ...exercises.registry import load as load_registry
-from ...exercises.result import CRASH, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
+from ...exercises.result import CRASH, NOT_DONE, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
@@ -230,6 +230,27 @@ def _student_frames(traceback):
     return kept
 
 
+def _released_cells():
+    """The code cells of the packaged student release, each with its whitespace collapsed: a cell of a
+    submission among them is one the student never changed."""
+    if not hasattr(_released_cells, "value"):
+        from ...student_notebooks import paths
+
+        _released_cells.value = {" ".join(c.split()) for p in paths() for c in read_cells(Path(str(p)))[0]}
+    return _released_cells.value
+
+
+def _untouched(error, code):
+    """Whether a cell that raised is work not done: it still raises NotImplementedError, or it is a cell of the
+    release the student never changed (its error comes from a stub above it, or from a branch not chosen)."""
+    if error.get("kind") == "NotImplementedError":
+        return True
+    cell = error.get("cell")
+    if not isinstance(cell, int) or not 0 <= cell < len(code):
+        return False
+    return " ".join(code[cell].split()) in _released_cells()
+
+
 def _run_problems(name, ran, code=()):
     problems, numbers = [], prompt_numbers(code)  # a cell named as Jupyter numbers it: [n] after Run All
     errors = ran.get("errors") if isinstance(ran.get("errors"), list) else []
@@ -243,6 +264,8 @@ def _run_problems(name, ran, code=()):
             # the worker marks a cell it stopped at its own time limit; an exception named Timeout is the student's
             if error.get("timeout") is True:
                 kinds.append((TIMEOUT, f"{name}: cell {cell} ran past its time limit"))
+            elif _untouched(error, code):  # a stub, or a cell as released: work not done, not an error of theirs
+                kinds.append((NOT_DONE, f"{name}: cell {cell} raised {one_line(error.get('kind'), 100)}"))
             else:
                 kinds.append((RAISED, f"{name}: {text}"))
             tail = _student_frames(str(error.get("traceback", ""))[-4000:])

@@ -472,10 +472,10 @@ def test_similar_code_is_shown_side_by_side_with_the_shared_lines_marked(grades)
     page = Page(html)
     similar = page.words("similar")
     assert "Similarity never changes a grade" in similar and "for a person to judge" in similar
-    assert similar.index("eval_pherm : ann and <script>alert(1)</script>, similarity 0.91") < similar.index(
-        "coons : ben and cleo, similarity 0.85"
+    assert similar.index("<script>alert(1)</script> – ann: 1 of 1 graded functions alike") < similar.index(
+        "ben – cleo: 1 of 1 graded functions alike"
     )
-    assert "2 of 4 lines of the first and 2 of 3 of the second are shared" in similar
+    assert "eval_pherm , similarity 0.91: 2 of 4 lines and 2 of 3 shared" in similar
     assert page.marked == [first[0], first[2], second[0], second[2], "a = 1", "a = 1"]
     assert "&lt; yours &amp; theirs</mark>" in html and "k = bracket" in similar and "return k" in similar
     assert sum(tag == "pre" for tag, _ in page.tags) == 4
@@ -484,12 +484,19 @@ def test_similar_code_is_shown_side_by_side_with_the_shared_lines_marked(grades)
 
 def test_similar_code_is_bounded(grades):
     lines = tuple(f"line {i} " + "y" * 500 for i in range(1000))
-    pair = Pair("eval_pherm", "ann", "ben", 1.0, lines, lines, frozenset(range(1000)), frozenset({5, 2000, -1}))
-    html = page_of(grades, [pair] * (class_report.MAX_PAIRS + 3))
+    shared = (frozenset(range(1000)), frozenset({5, 2000, -1}))
+    pairs = [
+        Pair("eval_pherm", f"s{k}", f"t{k}", 1.0, lines, lines, *shared) for k in range(class_report.MAX_PAIRS + 3)
+    ]
+    html = page_of(grades, pairs)
     assert html.count('<article class="pair"') == class_report.MAX_PAIRS
-    assert "and 3 less similar pairs" in html and f"and {1000 - class_report.MAX_LINES} more lines" in html
+    assert (
+        "and 3 pairs with fewer functions alike" in html and f"and {1000 - class_report.MAX_LINES} more lines" in html
+    )
     assert "y" * (class_report.MAX_LINE + 1) not in html
-    assert "1000 of 1000 lines of the first and 1 of 1000 of the second" in html
+    assert "1000 of 1000 lines and 1 of 1000 shared" in html
+    many = [Pair(f"f{k}", "ann", "ben", 1.0, ("a",), ("a",), frozenset({0}), frozenset({0})) for k in range(300)]
+    assert page_of(grades, many).count("<details><summary><code>") == class_report.MAX_PAIRS  # one pair, bounded
 
 
 # ------------------------------------------------------------------ late work
@@ -662,7 +669,7 @@ def test_the_cli_uses_the_similarity_search_when_labkit_has_one(grades, tmp_path
     monkeypatch.setattr(similarity, "similar_pairs", search, raising=False)
     assert main(["report", str(tmp_path), "--similarity-threshold", "0.6", "--quiet"]) == 0
     assert asked == [(sorted(g.name for g in grades), 0.6)]
-    assert "coons</code>: ann and ben, similarity 0.97" in (tmp_path / "report.html").read_text()
+    assert "coons</code>, similarity 0.97" in (tmp_path / "report.html").read_text()
     monkeypatch.undo()  # the real search: these grades kept no sources, so there is nothing to compare
     assert main(["report", str(tmp_path), "--quiet"]) == 0
     assert "Not computed" not in (tmp_path / "report.html").read_text()
@@ -812,3 +819,40 @@ def test_the_cli_help_names_the_options_and_their_defaults(capsys):
     text = " ".join(capsys.readouterr().out.split())
     assert exit.value.code == 0 and "usage: labkit report" in text
     assert f"(default {similarity.DEFAULT_THRESHOLD})" in text and "--rubric" in text and "--quiet" in text
+
+
+def test_three_identical_submissions_are_three_rows_one_per_pair_with_their_functions_on_demand(grades):
+    names, functions = ("ada", "fermat", "gauss"), ("eval_pherm", "runge")
+    code = ("def f(x):", "    return x")
+    pairs = [
+        Pair(function, a, b, 1.0, code, code, frozenset({0, 1}), frozenset({0, 1}))
+        for function in functions
+        for k, a in enumerate(names)
+        for b in names[k + 1 :]
+    ]
+    three = [
+        SubmissionGrade(name, {}, rubric=grades[0].rubric, sources={f: "\n".join(code) for f in (*functions, "pchip")})
+        for name in names
+    ]
+    page = Page(page_of([*grades, *three], pairs, threshold=0.8))
+    similar = page.words("similar")
+    assert "3 pairs of students" in similar
+    for a, b in (("ada", "fermat"), ("ada", "gauss"), ("fermat", "gauss")):
+        assert f"{a} – {b}: 2 of 3 graded functions alike" in similar
+    assert sum(tag == "details" for tag, _ in page.tags) >= 6  # each function, on demand
+
+
+def test_copies_name_whose_data_a_notebook_holds_and_flag_the_solutions_markers():
+    from labkit.exercises.registry import LAB
+    from labkit.grading.reports import copies
+
+    exercise = next(e for e in LAB if e.params)
+    param = exercise.params[0].name
+    number = exercise.number
+    students = {"ada": {str(number): {param: 1.25}}, "fermat": {str(number): {param: 1.75}}}
+    holder = SubmissionGrade("fermat", {number: {"fraction": 0.0, "passed": False, "checks": [],
+                                                "other_variant": {param: [1.25, 1.75]}}})  # fmt: skip
+    marked = SubmissionGrade("gauss", {}, sources={"runge": "def runge(x):\n    ### BEGIN SOLUTION\n    return x"})
+    found = copies.find([holder, marked], students)
+    assert found.holder_lines() == [f"fermat holds ada's data for exercise {number}"]
+    assert found.marked == [("gauss", ("runge",))]

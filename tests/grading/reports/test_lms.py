@@ -123,8 +123,9 @@ def test_canvas_lists_everyone_who_got_nothing(out, inputs, tmp_path):
     assert sorted(export.not_in_roster) == sorted(["dora", ESCAPE])
     assert export.no_submission == [("eve", "1005"), ("gus", "1007")]
     assert export.not_in_lms == []  # gus has no submission, which is said first
-    assert export.lms_only == [("Fourier, Frank", "1004"), ("Student, Test", "9999")]
-    assert export.listed == 7
+    assert export.lms_only == [("Fourier, Frank", "1004")]  # Canvas's test student is no one to list
+    assert export.listed == 6
+    assert "note: Canvas's test student ('Student, Test') is in the gradebook; left as it is." in export.summary()
     lines = export.problems()
     assert "not graded, no points exported: carl (its grading crashed twice)" in lines
     assert "in the Canvas gradebook, not in the roster: Fourier, Frank (id 1004)" in lines
@@ -146,7 +147,9 @@ def test_the_summary_has_every_student_once_and_neutralises_formula_names(out, i
     # a name that a spreadsheet would run as a formula is shown as text, and no control character is left
     assert "'" + HOSTILE in status and HOSTILE not in status
     assert all("\x1b" not in cell for row in rows for cell in row)
-    assert len(rows) == 1 + 6 + 2 + 2  # six submissions, two roster entries without one, two Canvas rows
+    assert (
+        len(rows) == 1 + 6 + 2 + 1
+    )  # six submissions, two roster entries without one, a Canvas row (not the test student)
 
 
 def test_an_existing_canvas_column_is_filled_and_a_cell_without_a_grade_is_left_as_exported(out, inputs, tmp_path):
@@ -239,8 +242,22 @@ def test_the_roster_can_match_canvas_on_sis_ids(out, tmp_path):
     assert "in the roster, not in the Canvas gradebook: dora (id dora@uni.example)" in export.problems()
     summary = {row[0]: row[1:] for row in _rows(export.summary_path)}
     assert summary["dora"] == ["dora@uni.example", "100", "not in the Canvas gradebook"]
-    # the test student has no login: listed without an id
-    assert ("Student, Test", "") in export.lms_only
+    # the test student has no login: left alone all the same
+    assert all(name != "Student, Test" for name, _ in export.lms_only)
+
+
+def test_canvas_test_student_is_left_alone_and_the_export_exits_0(tmp_path):
+    """Every Canvas gradebook has its test student, whom no roster holds: noted, never listed."""
+    results = tmp_path / "grades"
+    write_report(results, _grades()[:2])  # ada and bob
+    book = CANVAS.split('"Gauss, Carl"')[0] + '"Student, Test",9999,,,Section A,,,,\n'
+    gradebook = _write(tmp_path / "book.csv", book)
+    roster = _write(tmp_path / "roster.csv", "submission,id\nada,1001\nbob,1002\n")
+    run = _cli(results, "--canvas", gradebook, "--roster", roster, "--column", "Lab 8", "--out", tmp_path / "i.csv")
+    assert run.returncode == 0, run.stderr
+    assert "Canvas's test student ('Student, Test') is in the gradebook; left as it is." in run.stdout
+    rows = {row[0]: row[6] for row in _rows(tmp_path / "i.csv")[3:]}
+    assert rows == {"Lovelace, Ada": "104", "Babbage, Bob": "17.5", "Student, Test": ""}
 
 
 def test_a_semicolon_export_keeps_its_separator_and_decimal_commas(out, tmp_path):
@@ -287,8 +304,15 @@ def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
     lms.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", feedback=True)
     rows = _rows(tmp_path / "moodle.csv")
     assert rows[0] == ["ID number", "labkit", "Feedback"]
-    assert rows[1][2] == "104 points: 100 of 100 for full credit, and 4 of extra credit (labkit grade)"
-    assert rows[2][2] == "17.5 points: 17.5 of 100 for full credit (labkit grade)"
+    first, rest = rows[1][2].split("\n", 1)
+    assert first == "104 points: 100 of 100 for full credit, and 4 of extra credit (labkit grade)"
+    assert rest.startswith(
+        "\nTotal: 104 / 100 points\n  including 4 extra credit\nFeedback for ada\n"
+    )  # then the student's whole feedback, many lines
+    assert rows[2][2].startswith(
+        "17.5 points: 17.5 of 100 for full credit (labkit grade)\n\nTotal: 17.5 / 100 points\nFeedback for bob"
+    )
+    assert "Exercise 3, the order the table shows" in rows[2][2] and rows[2][2].count("\n") > 10
 
 
 def _late_grades():
@@ -320,6 +344,7 @@ def test_moodle_feedback_begins_with_the_grade_after_the_late_penalty_and_states
     assert {key: grade for key, (grade, _) in rows.items()} == {"S1": "83.2", "S2": "17.5", "S3": "50", "S4": "10"}
     for grade, feedback in rows.values():
         assert feedback.split(" ")[0] == grade  # the first number is the grade beside it
+    rows = {key: (grade, feedback.split("\n")[0]) for key, (grade, feedback) in rows.items()}  # its first line
     assert rows["S1"][1] == (
         "83.2 points: 104 (100 of 100 for full credit, and 4 of extra credit) less 20.8 for late work "
         "(2 started days, 20% off) (labkit grade)"
@@ -522,7 +547,7 @@ def test_labkit_export_canvas_writes_next_to_out_and_lists_on_stderr(out, tmp_pa
     assert run.returncode == 1, run.stderr  # written, with students listed
     target = tmp_path / "grades-canvas.csv"
     assert _rows(target)[3][6] == "104" and (tmp_path / "grades-canvas-summary.csv").exists()
-    assert f"wrote {target}" in run.stdout and "7 student(s) got nothing from this file" in run.stdout
+    assert f"wrote {target}" in run.stdout and "6 student(s) got nothing from this file" in run.stdout
     assert "labkit export: not graded, no points exported: carl (its grading crashed twice)" in run.stderr
     assert "labkit export: no roster entry, nothing exported: dora" in run.stderr
     assert "labkit export: in the roster, no submission: eve (id 1005)" in run.stderr

@@ -11,7 +11,7 @@ from labkit.exercises.registry import LAB
 from labkit.grading.reports import marking
 from labkit.grading.reports.class_report import read as read_class
 from labkit.grading.results import report, rubric
-from labkit.grading.results.report import SubmissionGrade
+from labkit.grading.results.report import SubmissionGrade, file_stem
 from labkit.grading.results.rubric import DEFAULT
 
 # the answers of both branches and of exercise 3 weighed: the branches stay worth the same (3 + 3)
@@ -135,9 +135,9 @@ def test_marks_reach_grades_csv_the_feedback_the_report_and_the_export(tmp_path)
     assert rows["ada"]["total"] == "44.5"  # 10 + 19.5 + 15
     assert rows["ada"]["to read: exercise 3, the order the table shows, against piecewise linear"] == "4.5"
     assert rows["'=bob"]["full credit"] == "93" and rows["'=bob"]["total"] == "15"  # 108 less exercise 4's 15
-    feedback = (out / "feedback" / f"{report.safe_name('ada')}.txt").read_text()
+    feedback = (out / "feedback" / f"{file_stem('ada')}.txt").read_text()
     assert "4.5 / 5 points" in feedback and "Right order; say why." in feedback and "Compared: her own." in feedback
-    assert "excused" in (out / "feedback" / f"{report.safe_name('=bob')}.txt").read_text()
+    assert "excused" in (out / "feedback" / f"{file_stem('=bob')}.txt").read_text()
     grades = read_class(out, None)  # what `labkit report` and `labkit export` read
     assert {g.name: g.total for g in grades} == {"ada": 44.5, "=bob": 15}
     assert main(["report", str(out), "--quiet"]) == 0
@@ -185,6 +185,7 @@ def test_importing_twice_changes_nothing_and_a_later_mark_replaces_the_earlier(t
         (["ada", "exercise2/eval_pherm", "3", ""], "release or keep"),
         (["ada", "exercise4", "0", ""], "excused or counted"),
         (["=bob", "exercise2/eval_pherm", "release", ""], "nothing to mark"),  # bob has nothing held
+        (["=bob", "exercise3-answer-1", "2", ""], "wrote no answer"),  # bob's answer is blank
     ],
 )
 def test_a_bad_mark_is_refused_and_nothing_changes(tmp_path, row, message, capsys):
@@ -232,7 +233,7 @@ def test_student_text_in_a_comment_is_data_in_grades_csv_and_the_feedback(tmp_pa
     out = _run(tmp_path, _rubric(tmp_path))
     path = _marks(tmp_path, [["ada", "exercise3-answer-1", "1", "=HYPERLINK(x)\x1b[31m red"]])
     marking.import_marks(out, path)
-    feedback = (out / "feedback" / f"{report.safe_name('ada')}.txt").read_text()
+    feedback = (out / "feedback" / f"{file_stem('ada')}.txt").read_text()
     assert "\x1b" not in feedback
     text = marking.marks_csv(read_class(out, None))
     assert "'=HYPERLINK" in text and "\x1b" not in text
@@ -270,7 +271,9 @@ def test_each_item_is_shuffled_per_marker_and_the_page_runs_only_its_own_script(
     import re
 
     grades = [
-        report.SubmissionGrade(f"s{k:02d}", {3: _passed(3)}, [], 7, _rubric(tmp_path), answers={}) for k in range(20)
+        report.SubmissionGrade(f"s{k:02d}", {3: _passed(3)}, [], 7, _rubric(tmp_path), answers=answer)
+        for k in range(20)
+        for answer in [{"exercise3-answer-1": f"order {k}"}]
     ]
     one, again, other = (marking.tasks(grades, m)[0] for m in ("ada", "ada", "bob"))
     names = [a["submission"] for a in one["answers"]]
@@ -287,6 +290,20 @@ def test_each_item_is_shuffled_per_marker_and_the_page_runs_only_its_own_script(
     assert [t["item"] for t in held] == ["exercise2/eval_pherm"] and "h = np.diff(x)" in held[0]["answers"][0]["html"]
 
 
+def test_only_answers_worth_points_and_written_by_the_student_are_queued(tmp_path):
+    marked = _rubric(tmp_path)
+    written = {"exercise3-answer-1": "order 4", "exercise7-answer-1": "YOUR ANSWER HERE", "exercise12-answer-1": "x"}
+    grades = [
+        report.SubmissionGrade("ada", {3: _passed(3)}, [], 7, marked, answers=written),
+        report.SubmissionGrade("bob", {3: _passed(3)}, [], 7, marked, answers={"exercise3-answer-1": "  "}),
+    ]
+    queued = {task["item"]: [a["submission"] for a in task["answers"]] for task in marking.tasks(grades, "me")}
+    # exercise 12's answer is worth nothing: not queued; the blank and untouched answers are not either
+    assert queued == {"exercise3-answer-1": ["ada"]}
+    feedback = grades[1].feedback()
+    assert "Exercise 3, the order the table shows, against piecewise linear: no answer, 0 / 5 points" in feedback
+
+
 def test_an_answer_can_carry_rubric_lines_that_the_page_shows_beside_the_model_answer(tmp_path):
     path = tmp_path / "rubric.toml"
     grade_id = next(iter(LAB.answers))
@@ -295,7 +312,7 @@ def test_an_answer_can_carry_rubric_lines_that_the_page_shows_beside_the_model_a
     )
     loaded = rubric.load(path)
     assert loaded.answers[grade_id] == 2 and loaded.answer_lines[grade_id] == ("names the order", "a < b")
-    grade = SubmissionGrade("ada", results={}, rubric=loaded)
+    grade = SubmissionGrade("ada", results={}, rubric=loaded, answers={grade_id: "an answer"})
     task = next(t for t in marking.tasks([grade]) if t["item"] == grade_id)
     assert "<li>names the order</li>" in task["model"] and "<li>a &lt; b</li>" in task["model"]
     path.write_text(DEFAULT.read_text() + f'\n[answers]\n{grade_id} = {{points = 2, lines = "x"}}\n')

@@ -365,7 +365,7 @@ def test_a_submission_without_a_time_is_listed_and_not_penalised():
 def test_the_feedback_shows_the_raw_total_the_lateness_the_penalty_and_the_final_total():
     grade = _grade("ada", _rubric(), DEADLINE + timedelta(hours=30), fraction=0.5)  # 10 points, 2 days: 20%
     text = grade.feedback()
-    assert text.startswith("Feedback for ada: 8 points (10 / 20, 2 off for late work)")
+    assert text.startswith("Total: 8 / 20 points\n  2 off for late work (10 before the penalty)\nFeedback for ada\n")
     assert "handed in 2026-12-03T05:59:00+01:00 (the --times file): late by 1 day 6 h: 2 started days, 20% off" in text
     assert "2 of 10 points" in text
     assert "Total: 8 (10 less 2 for late work; full credit is 20)" in text

@@ -15,7 +15,7 @@ from conftest import sandbox_or_skip
 
 from labkit.grading.results import late
 from labkit.grading.results import rubric as rubrics
-from labkit.grading.results.report import SubmissionGrade, safe_name, write_report
+from labkit.grading.results.report import SubmissionGrade, file_stem, safe_name, write_report
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 SEED = "4242"
@@ -97,7 +97,7 @@ def test_the_class_run_charges_the_slip_and_the_late_day_from_the_times_file_bef
     # bob: full marks, handed in 11 h 31 min after 23:59 +01:00, one started day: 10% of 8
     assert rows["bob"]["raw total"] == "8" and rows["bob"]["penalty"] == "0.8" and rows["bob"]["total"] == "7.2"
     assert rows["bob"]["submitted"] == "2026-12-02T11:30:00+01:00" and rows["bob"]["hours late"] == "11.52"
-    feedback = {name: (tmp / "class" / "feedback" / f"{safe_name(name)}.txt").read_text() for name in rows}
+    feedback = {name: (tmp / "class" / "feedback" / f"{file_stem(name)}.txt").read_text() for name in rows}
     assert f"handed in 2026-12-01T22:00:00+01:00 ({late.FROM_NBGRADER}): on time." in feedback["alice"]
     assert rows["alice"]["time source"] == late.FROM_NBGRADER and "student-supplied" in late.FROM_NBGRADER
     assert "handed in 2026-12-02T11:30:00+01:00 (the --times file): late by 11 h 31 min" in feedback["bob"]
@@ -111,7 +111,7 @@ def test_the_merge_has_the_new_result_for_the_regraded_student_and_the_old_for_t
     before, after = _rows(tmp / "class"), _rows(tmp / "final")
     assert after["alice"]["exercise 16"] == after["alice"]["total"] == "8" and after["alice"]["lateness"] == "on time"
     assert after["bob"] == before["bob"]
-    name = f"{safe_name('alice')}.txt"
+    name = f"{file_stem('alice')}.txt"
     assert (tmp / "final" / "feedback" / name).read_text() == (tmp / "regrade-alice" / "feedback" / name).read_text()
     # the merged summary names the result that was replaced, and merge.json keeps it
     earlier = tmp / "class" / "results" / f"{safe_name('alice')}.json"

@@ -1,0 +1,105 @@
+"""Copies named plainly, for the instructor's class report (never for a student): pairs of students whose graded
+functions look alike, one row per pair; whose data a notebook of another variant holds; and submissions that
+hold the instructor notebooks' solution markers.
+
+Nothing here changes a grade: it tells a person where to look.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass, field
+
+SOLUTION_MARKERS = ("### BEGIN SOLUTION", "### END SOLUTION", "### BEGIN HIDDEN TESTS")  # nbgrader's, in notebooks/
+
+
+@dataclass(frozen=True)
+class PairRow:
+    """Two students and the graded functions of theirs that look alike (each a similarity Pair)."""
+
+    first: str
+    second: str
+    alike: tuple  # Pair, most similar first
+    both: int  # graded functions both of them define
+
+    @property
+    def words(self):
+        alike = len(self.alike)
+        return f"{self.first} – {self.second}: {alike} of {max(self.both, alike)} graded functions alike"
+
+
+@dataclass
+class Copies:
+    """What the class report says about copies: each student's graded functions, whose data a notebook holds
+    ("fermat holds ada's data for exercises 4, 7, 14"), and the submissions with solution markers."""
+
+    functions: dict = field(default_factory=dict)  # submission -> frozenset of the graded functions it defines
+    holders: list = field(default_factory=list)  # (holder, whose, exercises), whose "" for no classmate
+    marked: list = field(default_factory=list)  # (submission, functions holding a solution marker)
+
+    def holder_lines(self):
+        """One line per notebook holding another's data, as the report shows it."""
+        lines = []
+        for holder, whose, numbers in self.holders:
+            owner = f"{whose}'s data" if whose else "another variant's data (no classmate's)"
+            lines.append(f"{holder} holds {owner} for exercise{'s' if len(numbers) > 1 else ''} {_numbers(numbers)}")
+        return lines
+
+
+def _numbers(numbers):
+    return ", ".join(map(str, numbers))
+
+
+def find(grades, students=None, registry=None) -> Copies:
+    """The copies of a class: `students` is the run's record of each student's variant data ({name: {exercise:
+    {parameter: value}}}), empty for a run without variants."""
+    graded = [g for g in grades if g.graded]
+    functions = {g.name: frozenset(g.sources) for g in graded}
+    marked = [(g.name, tuple(sorted(f for f, s in g.sources.items() if _marked(s)))) for g in graded]
+    holders = _holders(graded, students or {}, registry or (graded[0].rubric.registry if graded else None))
+    return Copies(functions, holders, [(name, found) for name, found in marked if found])
+
+
+def _marked(source):
+    return any(marker in str(source) for marker in SOLUTION_MARKERS)
+
+
+def _holders(grades, students, registry):
+    """(holder, whose data, exercises) for each notebook holding data of another variant."""
+    found = defaultdict(list)  # (holder, whose) -> exercises
+    for grade in grades:
+        for number, verdict in sorted(grade.results.items()):
+            other = (verdict or {}).get("other_variant") if isinstance(verdict, dict) else None
+            if other and registry is not None and number in registry.exercises:
+                whose = _whose(grade.name, registry.exercises[number], other, students)
+                found[(grade.name, ", ".join(whose))].append(number)
+    return [(holder, whose, tuple(numbers)) for (holder, whose), numbers in sorted(found.items())]
+
+
+def _whose(name, exercise, other, students):
+    """The classmates whose data for `exercise` are the values `other` found ({parameter: (found, own)})."""
+    params = {p.name: p for p in exercise.params}
+    return [
+        classmate
+        for classmate, data in sorted(students.items())
+        if classmate != name
+        and all(
+            param in params and params[param].holds(found, data.get(str(exercise.number), {}).get(param))
+            for param, (found, _) in other.items()
+        )
+    ]
+
+
+def pair_rows(pairs, functions) -> list[PairRow]:
+    """The similar pairs grouped by the two students, most functions alike first (`functions`: each
+    submission's graded functions, :attr:`Copies.functions`)."""
+    grouped = defaultdict(list)
+    for pair in pairs:
+        grouped[tuple(sorted((pair.first, pair.second)))].append(pair)
+    rows = [
+        PairRow(
+            a, b, tuple(sorted(found, key=lambda p: -p.score)), len(functions.get(a, set()) & functions.get(b, set()))
+        )
+        for (a, b), found in grouped.items()
+    ]
+    return sorted(rows, key=lambda r: (-len(r.alike), -max(p.score for p in r.alike), r.first, r.second))

@@ -1,0 +1,323 @@
+"""A student's feedback, in the order a student reads it: the total first, then what to fix, errors last.
+
+:func:`build` turns a :class:`~labkit.grading.results.report.SubmissionGrade` into a :class:`Feedback`, the one
+model both forms are made from: :func:`text` (``feedback/<submission>.txt``) and :func:`html`
+(``feedback/<submission>.html``, one self-contained page from an autoescaped Jinja template,
+:mod:`labkit.grading.pages`). Every part's kind comes from
+:func:`labkit.exercises.result.part_kind`, as in the class report and ``labkit handin``:
+
+1. the total, the late penalty if any, and a table of the exercises: points, and done, partly or not done;
+2. exercise by exercise, each part that failed in the student's words, with its hint; a part not done says so
+   in one line, never as a slip or a traceback;
+3. what went wrong while the notebook ran: only the errors of cells the student changed; the cells that still
+   raise ``NotImplementedError`` counted in one line; the cells of the release left as they were (a branch
+   not chosen, a stub above them) not listed.
+
+Every text in the model is printable and bounded (:func:`~labkit.grading.results.report.one_line`); the HTML
+template escapes it.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, VARIANT, part_kind
+from .text import one_line, points_text, printable
+
+NO_ANSWER = "YOUR ANSWER HERE"  # an answer in words as released
+DONE, PARTLY = "done", "partly"  # an exercise's status in the score table (or NOT_DONE, "excused", "held")
+STUB_CELL = re.compile(r"raised NotImplementedError$")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One part of an exercise as the feedback shows it: its kind (:data:`labkit.exercises.result.PART_KINDS`),
+    the points it is worth, its failed steps ((step, detail) pairs), the hint, and extra lines (a held part's)."""
+
+    name: str
+    kind: str
+    worth: float
+    failed: tuple = ()
+    hint: str = ""
+    notes: tuple = ()
+
+
+@dataclass(frozen=True)
+class Exercise:
+    """One graded exercise: its points, what it is worth, its status, and its parts."""
+
+    number: int
+    points: float
+    worth: float
+    status: str
+    parts: tuple = ()
+    note: str = ""  # one line in place of the parts (not found, excused)
+    other_branch: bool = False  # of the branch that is not the better one (extra credit at most)
+
+    @property
+    def to_fix(self):
+        """The parts the student has to look at: every part that did not pass, and a part a person looked at."""
+        return tuple(part for part in self.parts if part.kind != PASSED or part.notes)
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """Everything a student's feedback says, in reading order."""
+
+    name: str
+    total: str  # "32.5 / 40 points", or "not graded"
+    headline: tuple  # lines after the total: extra credit, the late penalty
+    exercises: tuple = ()
+    summary: tuple = ()  # the branch that counts, extra credit, the late rule's lines
+    answers: tuple = ()  # (title, marked, lines, comment) of each answer in words
+    errors: tuple = ()  # one line per error of a cell the student changed, or another problem
+    stubs: int = 0  # cells that still raise NotImplementedError
+    seed: int | None = None
+    failure: str = ""
+    other_branch: tuple = field(default=())  # exercises of the branch that does not count
+
+
+def blank(answer) -> bool:
+    """Whether an answer in words is none: empty, or left as released ("YOUR ANSWER HERE")."""
+    return str(answer or "").strip().upper() in ("", NO_ANSWER)
+
+
+def build(grade) -> Feedback:
+    """The feedback of one graded (or ungradable) submission."""
+    name = one_line(grade.name, 120)
+    if not grade.graded:
+        return Feedback(name, "not graded", (), failure=one_line(grade.failure, 500))
+    score, rubric = grade.score, grade.rubric
+    other = _other_branch(rubric, score.branch)
+    exercises = tuple(_exercise(grade, number, number in other) for number in rubric.graded)
+    stubs, errors = _run_errors(grade)
+    return Feedback(
+        name,
+        f"{points_text(grade.total)} / {points_text(score.full_credit)} points",
+        _headline(grade),
+        exercises,
+        _summary(grade),
+        _answers(grade),
+        errors,
+        stubs,
+        grade.seed,
+        other_branch=tuple(sorted(other)),
+    )
+
+
+def _other_branch(rubric, branch):
+    """The exercises of the branches that do not count (none when no branch earned points yet)."""
+    if not branch or branch == "none":
+        return set()
+    return {n for b in rubric.branches if b.name != branch for n in b.exercises}
+
+
+def _headline(grade):
+    score, lateness = grade.score, grade.lateness
+    lines = []
+    if score.extra_total:
+        lines.append(f"including {points_text(score.extra_total)} extra credit")
+    if lateness is not None and lateness.penalty:
+        lines.append(
+            f"{points_text(lateness.penalty)} off for late work ({points_text(score.total)} before the penalty)"
+        )
+    return tuple(lines)
+
+
+def _exercise(grade, number, other_branch):
+    rubric, points = grade.rubric, grade.points.get(number, 0.0)
+    worth = rubric.worth(number)
+    if number in grade.excused:
+        return Exercise(number, 0.0, 0.0, "excused", note="excused by your instructor")
+    verdict = grade.results.get(number)
+    if verdict is None:
+        note = f"no notebook has its section ('## Exercise {number}'), or it never ran"
+        return Exercise(number, 0.0, worth, NOT_DONE, note=note, other_branch=other_branch)
+    parts = tuple(_part(grade, number, check, verdict["checks"]) for check in verdict["checks"])
+    kinds = {part.kind for part in parts}
+    if worth and points >= worth - 1e-9:
+        status = DONE
+    elif points <= 0 and kinds <= {NOT_DONE}:
+        status = NOT_DONE
+    else:
+        status = PARTLY
+    if HELD in kinds:
+        status = HELD
+    return Exercise(number, points, worth, status, parts, other_branch=other_branch)
+
+
+def _part(grade, number, check, checks):
+    released = bool(check.get("held")) and grade.released(number, check["name"])
+    kind = part_kind(check, released or not check.get("held"))
+    total = sum(c.get("weight", 0) for c in checks) or 1
+    worth = grade.rubric.points[number] * (check.get("weight") or 0) / total
+    failed = tuple(
+        (one_line(s["step"], 300), one_line(s["detail"], 1000))
+        for s in check.get("steps", [])
+        if not s["passed"] and not (released and s["step"] == HELD_STEP)
+    )
+    notes = ()
+    if check.get("held") and check.get("passed"):
+        notes = tuple(line.strip() for line in _held_lines(check, released))
+        mark = grade.marks.get(f"exercise{number}/{check['name']}")
+        if mark and mark.get("comment"):
+            notes += (f"your instructor: {one_line(mark['comment'], 1000)}",)
+    hint = one_line(check.get("hint") or "", 1000) if kind not in (PASSED, HELD) else ""
+    return Part(one_line(check["name"], 100), kind, worth, failed, hint, notes)
+
+
+def _summary(grade):
+    return tuple(grade._summary().split("\n")) + tuple(grade.rubric.describe().split("\n"))
+
+
+def _answers(grade):
+    found = []
+    for grade_id, (number, what) in grade.rubric.registry.answers.items():
+        if number not in grade.rubric.points or number not in grade.results:  # a notebook not handed in
+            continue
+        text = str(grade.answers.get(grade_id, "")).strip()
+        empty = blank(text)
+        mark, worth = grade.marks.get(grade_id), grade.rubric.answers.get(grade_id, 0.0)
+        if mark is not None:
+            marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
+        elif empty:
+            marked = "no answer" + (f", 0 / {points_text(worth)} points" if worth else "")
+        else:
+            marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
+        lines = () if empty else tuple(one_line(line, 300) for line in text.splitlines()[:20])
+        comment = one_line(mark["comment"], 1000) if mark and mark.get("comment") else ""
+        found.append((f"Exercise {number}, {what}", marked, lines, comment))
+    return tuple(found)
+
+
+def _run_errors(grade):
+    """(cells that still raise NotImplementedError, one line per error the student caused or other problem)."""
+    stubs, errors = 0, []
+    for problem in grade.problems:
+        for kind, line in problem_kinds(problem):
+            if kind == NOT_DONE:
+                stubs += bool(STUB_CELL.search(line))
+            elif kind != VARIANT or line not in errors:
+                errors.append(one_line(line, 1000))
+    return stubs, tuple(errors)
+
+
+def text(feedback: Feedback) -> str:
+    """The feedback as plain text: the total on the first line."""
+    if feedback.failure:
+        return printable(
+            f"Not graded: {feedback.name}\n\nIt could not be graded: {feedback.failure}\n"
+            "Your instructor has been told; nothing of this submission was scored.\n"
+        )
+    lines = [
+        f"Total: {feedback.total}",
+        *(f"  {line}" for line in feedback.headline),
+        f"Feedback for {feedback.name}",
+        "",
+    ]
+    lines += _table_lines(feedback) + [""]
+    lines += [line for exercise in feedback.exercises for line in _exercise_lines(exercise)]
+    lines += _answer_lines(feedback) + _error_lines(feedback)
+    if feedback.seed is not None:
+        lines += ["", f"(random test data from seed {feedback.seed})"]
+    return printable("\n".join(lines) + "\n")
+
+
+def _table_lines(feedback):
+    lines = [f"{'exercise':>8}  {'points':>13}  status"]
+    for e in feedback.exercises:
+        status = e.status + (" (the other branch)" if e.other_branch else "")
+        lines.append(f"{e.number:>8}  {points_text(e.points) + ' / ' + points_text(e.worth):>13}  {status}")
+    return lines + [""] + list(feedback.summary)
+
+
+def _exercise_lines(exercise):
+    if not exercise.to_fix:
+        return []
+    lines = [f"Exercise {exercise.number}: {points_text(exercise.points)} / {points_text(exercise.worth)}"]
+    for part in exercise.to_fix:
+        lines += _part_lines(part)
+    return lines + [""]
+
+
+def _part_lines(part):
+    worth = f" ({points_text(part.worth)} point{'' if part.worth == 1 else 's'})" if part.worth else ""
+    if part.kind == NOT_DONE:  # one line: what is left to do
+        return [f"  {part.name}{worth}: not done" + (f": {part.hint}" if part.hint else ".")]
+    lines = [f"  {part.name}{worth}: {_kind_words(part.kind)}"]
+    lines += [f"    {step}: {detail}" if detail else f"    {step}" for step, detail in part.failed]
+    lines += [f"    hint: {part.hint}"] if part.hint else []
+    return lines + [f"    {note}" for note in part.notes]
+
+
+def _kind_words(kind):
+    return {
+        ERROR: "an error",
+        VARIANT: "another variant's data",
+        HELD: "held for your instructor",
+        PASSED: "passed",
+    }.get(kind, kind)
+
+
+def _answer_lines(feedback):
+    if not feedback.answers:
+        return []
+    lines = ["Answers in words (marked by your instructor, not by labkit):"]
+    for title, marked, text_lines, comment in feedback.answers:
+        lines.append(f"  {title}: {marked}")
+        lines += [f"    | {line}" for line in text_lines]
+        lines += [f"    your instructor: {comment}"] if comment else []
+    return lines + [""]
+
+
+def _error_lines(feedback):
+    lines = []
+    if feedback.errors:
+        lines += ["What went wrong while your notebook ran:"] + [f"  ! {line}" for line in feedback.errors]
+    if feedback.stubs:
+        cells = "1 cell still raises" if feedback.stubs == 1 else f"{feedback.stubs} cells still raise"
+        lines.append(f"{cells} NotImplementedError (work not done yet).")
+    return lines
+
+
+def html(feedback: Feedback) -> str:
+    """The feedback as one self-contained HTML page (no request, everything escaped)."""
+    from ..pages import render
+
+    return render("feedback.html", feedback=feedback, points=points_text, kind_words=_kind_words)
+
+
+def problem_kinds(problem):
+    """The kinds of a submission's problem: its own (a :class:`ProblemText`), or "other" for a bare text."""
+    kinds = getattr(problem, "kinds", None)
+    return kinds if kinds else ((OTHER, str(problem).split("\n")[0]),)
+
+
+SIDE = 56  # characters of a line shown on each side of a held part's shared lines
+HELD_STEP = (
+    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
+)
+
+
+def _held_lines(check, released):
+    """A held part's lines in the feedback: what it matched, and the shared lines side by side."""
+    held = check["held"]
+    source = one_line(held.get("source", "?"), 120)
+    if released:
+        lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
+    else:
+        lines = [
+            f"    HELD: {float(held.get('share', 0)):.0%} of the code of {one_line(held.get('definition', '?'), 80)} "
+            f"and what it calls is, names aside, the same as {source}'s; its points wait for your instructor.",
+            f"    hint: {one_line(check['hint'], 1000)}",
+        ]
+    pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
+    if pairs and held.get("public", True):
+        width = min(SIDE, max(len(one_line(mine, SIDE)) for mine, _ in pairs))
+        lines.append(f"      {'yours':<{width}} | {source}")
+        lines += [f"      {one_line(mine, SIDE):<{width}} | {one_line(theirs, SIDE)}" for mine, theirs in pairs]
+    elif pairs:  # the solutions' lines are for the instructor's report only
+        lines.append("      your lines that are the same, names aside:")
+        lines += [f"      {one_line(mine, 2 * SIDE)}" for mine, _ in pairs]
+    return lines
