@@ -541,6 +541,7 @@ def _with_cell(folder, notebook, source):
     return folder
 
 
+@pytest.mark.slow  # grades a class in the sandbox
 def test_rewritten_and_string_run_copies_are_held_or_refused_in_one_run_with_honest_classmates(tmp_path):
     sandbox_or_skip()
     copy = module_source("labkit.piecewise")
