@@ -159,4 +159,37 @@ def exec_compressed(cell):
     return f"import base64, zlib\nexec(zlib.decompress(base64.b64decode('{packed}')).decode())"
 
 
-REWRITES = {"dead-stores": dead_stores, "getattr": getattr_reads, "staticmethods": staticmethods}
+class _Loops(ast.NodeTransformer):
+    """``name = [e for v in it if c]`` written out as ``name = []`` and a loop that appends."""
+
+    def generic_visit(self, node):
+        super().generic_visit(node)
+        for field in ("body", "orelse"):
+            block = getattr(node, field, None)
+            if isinstance(block, list) and block and isinstance(block[0], ast.stmt):
+                setattr(node, field, [new for statement in block for new in self._written_out(statement)])
+        return node
+
+    @staticmethod
+    def _written_out(statement):
+        value = getattr(statement, "value", None)
+        if not (isinstance(statement, ast.Assign) and len(statement.targets) == 1 and isinstance(value, ast.ListComp)):
+            return [statement]
+        if not isinstance(statement.targets[0], ast.Name) or len(value.generators) != 1:
+            return [statement]
+        name, generator = statement.targets[0].id, value.generators[0]
+        if len(generator.ifs) > 1 or generator.is_async:
+            return [statement]
+        step = ast.parse(f"{name}.append(ELEMENT)").body[0]
+        step.value.args = [value.elt]
+        body = [ast.If(test=generator.ifs[0], body=[step], orelse=[])] if generator.ifs else [step]
+        loop = ast.For(target=generator.target, iter=generator.iter, body=body, orelse=[])
+        return [ast.parse(f"{name} = []").body[0], loop]
+
+
+def loops(cell):
+    """Every list built by a comprehension built by a loop that appends instead."""
+    return ast.unparse(ast.fix_missing_locations(_Loops().visit(ast.parse(cell))))
+
+
+REWRITES = {"dead-stores": dead_stores, "getattr": getattr_reads, "staticmethods": staticmethods, "loops": loops}

@@ -49,8 +49,7 @@ def canonical(text, namespaces=frozenset()):
     >>> print(canonical(text))
     def f(x):
         y = x.size
-        y = y + 1
-        return y
+        return y + 1
     >>> print(canonical("def g(v):\\n    return Tools.h(v) + sum(w for w in v)", {"Tools"}))
     def g(v):
         return h(v) + sum([w for w in v])
@@ -74,7 +73,7 @@ class _Canon(ast.NodeTransformer):
     def visit_FunctionDef(self, node):
         node.decorator_list = [d for d in node.decorator_list if not _named(d, UNWRAPPED)]
         self.generic_visit(node)
-        node.body = _pruned(node.body, _read_names(node)) or [ast.Pass()]
+        node.body = _pruned(_as_comprehensions(node.body), _read_names(node)) or [ast.Pass()]
         return node
 
     visit_AsyncFunctionDef = visit_FunctionDef
@@ -161,6 +160,75 @@ def _pruned(body, read):
                 setattr(statement, field, _pruned(block, read) or [ast.Pass()])
         kept.append(statement)
     return kept
+
+
+def _as_comprehensions(body):
+    """A block with its accumulating loops written as the comprehensions they equal, nested blocks too:
+    ``xs = []`` then ``for v in it: xs.append(e)`` (or ``if c: xs.append(e)``) is ``xs = [e for v in it (if c)]``,
+    and ``s = 0`` then ``for v in it: s = s + e`` is ``s = sum([e for v in it])``; a value named only to be
+    returned is returned (``y = e`` then ``return y`` is ``return e``)."""
+    kept: list = []
+    for statement in body:
+        for field in ("body", "orelse", "finalbody"):
+            block = getattr(statement, field, None)
+            if isinstance(block, list) and block and isinstance(block[0], ast.stmt):
+                setattr(statement, field, _as_comprehensions(block))
+        folded = _folded(kept[-1], statement) if kept else None
+        if folded is not None:
+            kept[-1] = ast.copy_location(folded, kept[-1])
+        else:
+            kept.append(statement)
+    return _returned(kept)
+
+
+def _returned(block):
+    """`block` with ``name = e`` then ``return name`` at its end written ``return e``."""
+    if len(block) >= 2 and isinstance(block[-1], ast.Return) and isinstance(block[-1].value, ast.Name):
+        last = block[-2]
+        if isinstance(last, ast.Assign) and len(last.targets) == 1 and _named(last.targets[0], {block[-1].value.id}):
+            return block[:-2] + [ast.copy_location(ast.Return(value=last.value), last)]
+    return block
+
+
+def _folded(start, loop):
+    """``name = <comprehension>`` for a start value and the loop that fills it, or None when they are not one."""
+    if not (isinstance(start, ast.Assign) and len(start.targets) == 1 and isinstance(start.targets[0], ast.Name)):
+        return None
+    if not isinstance(loop, ast.For) or loop.orelse or len(loop.body) != 1:
+        return None
+    name, step, conditions = start.targets[0].id, loop.body[0], []
+    if isinstance(step, ast.If) and not step.orelse and len(step.body) == 1:
+        conditions, step = [step.test], step.body[0]
+    element = _appended(step, name) if isinstance(start.value, ast.List) and not start.value.elts else None
+    total = _added(step, name) if _zero(start.value) and element is None else None
+    if element is None and total is None:
+        return None
+    generator = ast.comprehension(target=loop.target, iter=loop.iter, ifs=conditions, is_async=0)
+    made = ast.ListComp(elt=element if element is not None else total, generators=[generator])
+    value = made if element is not None else ast.Call(func=ast.Name(id="sum", ctx=ast.Load()), args=[made], keywords=[])
+    return ast.Assign(targets=[ast.Name(id=name, ctx=ast.Store())], value=value)
+
+
+def _appended(step, name):
+    """`e` of ``name.append(e)``, else None."""
+    call = step.value if isinstance(step, ast.Expr) else None
+    if isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute) and call.func.attr == "append":
+        if _named(call.func.value, {name}) and len(call.args) == 1 and not call.keywords:
+            return call.args[0]
+    return None
+
+
+def _added(step, name):
+    """`e` of ``name = name + e`` (``name += e`` is already written so), else None."""
+    if isinstance(step, ast.Assign) and len(step.targets) == 1 and _named(step.targets[0], {name}):
+        value = step.value
+        if isinstance(value, ast.BinOp) and isinstance(value.op, ast.Add) and _named(value.left, {name}):
+            return value.right
+    return None
+
+
+def _zero(node):
+    return isinstance(node, ast.Constant) and type(node.value) in (int, float) and node.value == 0
 
 
 # -- the units a part's code is compared in -------------------------------------------------------------------

@@ -465,6 +465,22 @@ def test_each_rewrite_comes_back_to_the_code_it_rewrote(form):
     assert len(plain) >= 3 and plain == rewritten  # every function of the module, written as it was
 
 
+def test_a_loop_that_fills_a_list_or_a_sum_reads_as_the_comprehension_it_equals():
+    looped = (
+        "def f(xs):\n    out = []\n    for x in xs:\n        if x > 0:\n            out.append(x * x)\n    return out"
+    )
+    assert fingerprint.canonical(looped) == fingerprint.canonical("def f(xs):\n    return [x * x for x in xs if x > 0]")
+    summed = "def g(v):\n    s = 0.0\n    for k in range(len(v)):\n        s += v[k] ** 2\n    return s"
+    assert fingerprint.canonical(summed) == fingerprint.canonical(
+        "def g(v):\n    return sum(v[k] ** 2 for k in range(len(v)))"
+    )
+    # what the loop computes still counts: another element, filter or start is other code
+    assert fingerprint.canonical(looped) != fingerprint.canonical(looped.replace("x * x", "x + x"))
+    assert fingerprint.canonical(looped) != fingerprint.canonical(looped.replace("x > 0", "x < 0"))
+    assert fingerprint.canonical(summed) != fingerprint.canonical(summed.replace("s = 0.0", "s = 1.0"))
+    assert "for k" in fingerprint.canonical(summed.replace("s += v[k] ** 2", "s += v[k] ** 2\n        print(s)"))
+
+
 def test_what_the_normalisation_keeps_is_what_the_code_does():
     one = "def f(x):\n    y = x * 2\n    return y + 1"
     assert fingerprint.canonical(one) != fingerprint.canonical(one.replace("* 2", "* 3"))
