@@ -10,11 +10,24 @@ from labkit.grading.results.rubric import default
 HOSTILE = "<script>alert(1)</script>"
 
 
-def _check(name, weight, failed=(), hint=""):
+def _check(name, weight, failed=(), hint="", figure=None):
     steps = [{"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}
              for step, detail, kind in failed]  # fmt: skip
     return {"name": name, "weight": weight, "passed": not failed, "hint": hint,
-            "steps": steps or [{"step": "the values at 41 points", "passed": True, "detail": ""}]}  # fmt: skip
+            "steps": steps or [{"step": "the values at 41 points", "passed": True, "detail": ""}],
+            **({"figure": figure} if figure else {})}  # fmt: skip
+
+
+def _limacon(points=211):
+    """The exact limaçon r = 1.15 + cos t, as a student plotting it instead of its interpolant draws it, with
+    the 21 data points as markers."""
+    import math
+
+    t = [2 * math.pi * k / (points - 1) for k in range(points)]
+    curve = {"x": [(1.15 + math.cos(a)) * math.cos(a) for a in t], "y": [(1.15 + math.cos(a)) * math.sin(a) for a in t],
+             "joined": True}  # fmt: skip
+    data = {"x": curve["x"][::10], "y": curve["y"][::10], "joined": False}
+    return [curve, data]
 
 
 def _verdict(checks):
@@ -44,7 +57,7 @@ def sample_grade(name="ada"):
             _check("ax4", 7, [("the curve is the Hermite interpolant of your data (within 1e-05)",
                                "a point is 2.31e-04 away from it", None)],
                    "that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
-                   "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm."),
+                   "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm.", _limacon()),
         ]),
     }  # fmt: skip
     problems = [

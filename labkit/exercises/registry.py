@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from ..plotdata import Line, figure_data
 from . import bilinear, hermite, monotone, patches, splines
-from .model import Exercise
+from .model import Exercise, read
 from .result import NOT_DONE, OTHER, VARIANT, CheckResult
 
 TOPICS = (hermite, patches, splines, monotone, bilinear)  # in the order of the exercises they declare
@@ -229,7 +230,8 @@ class Registry:
                     OTHER,
                 )
             _on_another_variant(result, part, other)
-            checks.append({**result.as_dict(), "name": part.name, "weight": part.weight})  # as the student names it
+            check = {**result.as_dict(), "name": part.name, "weight": part.weight}  # as the student names it
+            checks.append({**check, **_student_figure(part, namespace, check)})
         points = sum(check["weight"] for check in checks if check["passed"])
         return {
             **({"other_variant": other} if other else {}),
@@ -240,6 +242,21 @@ class Registry:
             "defined": defined,
             "checks": checks,
         }
+
+
+def _student_figure(part, namespace, check) -> dict:
+    """``{"figure": ...}``: the student's own plot that a failed part judged (as :func:`labkit.plotdata.figure_data`
+    keeps it), for the feedback page; empty for a part that passed or was not done, or that judges no plot."""
+    if check["passed"] or any(step.get("kind") == NOT_DONE for step in check["steps"]):
+        return {}
+    for spec in part.reads:
+        try:
+            value = read(namespace, spec)
+        except Exception:  # noqa: BLE001 - a value the check could not read has no figure to show
+            continue
+        if isinstance(value, list) and value and all(isinstance(line, Line) for line in value):
+            return {"figure": figure_data(value)}
+    return {}
 
 
 def _on_another_variant(result, part, other) -> None:

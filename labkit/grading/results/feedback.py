@@ -19,6 +19,7 @@ template escapes it.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 
@@ -41,6 +42,7 @@ class Part:
     failed: tuple = ()
     hint: str = ""
     notes: tuple = ()
+    figure: tuple = ()  # the student's own plot that the part judged: ((svg points, joined), ...), see _figure
 
 
 @dataclass(frozen=True)
@@ -164,7 +166,47 @@ def _part(grade, number, check, checks):
         if mark and mark.get("comment"):
             notes += (f"your instructor: {one_line(mark['comment'], 1000)}",)
     hint = one_line(check.get("hint") or "", 1000) if kind not in (PASSED, HELD) else ""
-    return Part(one_line(check["name"], 100), kind, worth, failed, hint, notes)
+    figure = _figure(check.get("figure")) if kind not in (PASSED, HELD, NOT_DONE) else ()
+    return Part(one_line(check["name"], 100), kind, worth, failed, hint, notes, figure)
+
+
+FIGURE_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")  # Okabe and Ito
+FIGURE_BOX = (320.0, 200.0, 10.0)  # the feedback page's picture of a plot: width, height and margin, in SVG units
+
+
+def _figure(lines) -> tuple:
+    """A plot the grader read (:func:`labkit.plotdata.figure_data`) as SVG points in :data:`FIGURE_BOX`, the data's
+    range filling it with y upwards: ``((points, joined), ...)``; nothing for what is not such data. At most 8
+    lines of 300 finite points are taken, whatever the result file holds."""
+    if not isinstance(lines, list):
+        return ()
+    kept = []
+    for line in lines[:8]:
+        x, y = (_numbers(line.get(key)) if isinstance(line, dict) else [] for key in ("x", "y"))
+        if x and len(x) == len(y):
+            kept.append((x, y, line.get("joined") is not False))
+    if not kept:
+        return ()
+    xs, ys = [v for x, _, _ in kept for v in x], [v for _, y, _ in kept for v in y]
+    width, height, margin = FIGURE_BOX
+    sx = (width - 2 * margin) / ((max(xs) - min(xs)) or 1.0)
+    sy = (height - 2 * margin) / ((max(ys) - min(ys)) or 1.0)
+    return tuple(
+        (
+            " ".join(
+                f"{margin + (a - min(xs)) * sx:.1f},{height - margin - (b - min(ys)) * sy:.1f}" for a, b in zip(x, y)
+            ),
+            joined,
+        )
+        for x, y, joined in kept
+    )
+
+
+def _numbers(values) -> list:
+    """The finite numbers of a list read back from a result file (at most 300), or [] when it holds anything else."""
+    if not isinstance(values, list) or not all(type(v) in (int, float) for v in values[:300]):
+        return []
+    return [float(v) for v in values[:300] if math.isfinite(v)] if all(math.isfinite(v) for v in values[:300]) else []
 
 
 def _summary(grade):
@@ -285,7 +327,8 @@ def html(feedback: Feedback) -> str:
     """The feedback as one self-contained HTML page (no request, everything escaped)."""
     from ..pages import render
 
-    return render("feedback.html", feedback=feedback, points=points_text, kind_words=_kind_words)
+    values = {"points": points_text, "kind_words": _kind_words, "box": FIGURE_BOX, "colours": FIGURE_COLOURS}
+    return render("feedback.html", feedback=feedback, **values)
 
 
 def problem_kinds(problem):
