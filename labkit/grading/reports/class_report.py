@@ -53,6 +53,7 @@ from ...exercises.result import (
     part_kind,
 )
 from ..results import late as lateness
+from ..results.names import shown_name
 from ..results.record import rubric_for
 from ..results.report import SubmissionGrade, one_line, printable, read_results
 from ..results.report import problem_kinds as kinds_of
@@ -772,6 +773,12 @@ def _e(value, limit=MAX_TEXT):
     return html.escape(one_line(value, limit), quote=True)
 
 
+def _name(value):
+    """A submission's name as HTML: shortened for reading with a hash of the whole name, so two names sharing a
+    beginning never look alike (:func:`labkit.grading.results.names.shown_name`), escaped."""
+    return html.escape(shown_name(value, MAX_NAME), quote=True)
+
+
 def _percent(rate):
     return "&ndash;" if rate is None else f"{rate:.0%}"
 
@@ -779,8 +786,8 @@ def _percent(rate):
 def _names(names, noun="students"):
     names = list(names)
     if len(names) <= 3:
-        return ", ".join(_e(name, MAX_NAME) for name in names)
-    shown = "".join(f"<li>{_e(name, MAX_NAME)}</li>" for name in names[:MAX_NAMES])
+        return ", ".join(_name(name) for name in names)
+    shown = "".join(f"<li>{_name(name)}</li>" for name in names[:MAX_NAMES])
     more = f"<li>and {len(names) - MAX_NAMES} more</li>" if len(names) > MAX_NAMES else ""
     one = noun[:-1] if noun.endswith("s") else noun
     return (
@@ -897,7 +904,7 @@ def _late_section(summary):
     if late:
         rows = [
             (
-                _e(e.student, MAX_NAME),
+                _name(e.student),
                 (TEXT, _when(e.deadline, rule) + (" (extension)" if e.extended else "")),
                 (TEXT, _when(e.submitted, rule)),
                 (TEXT, _e(e.source or "", 64)),
@@ -938,7 +945,7 @@ def _late_section(summary):
     if extended:
         rows = [
             (
-                _e(e.student, MAX_NAME),
+                _name(e.student),
                 (TEXT, _when(e.deadline, rule)),
                 (TEXT, _when(e.submitted, rule)),
                 (TEXT, _e(e.note)),
@@ -965,7 +972,7 @@ def _late_section(summary):
             "<p>Graded and not penalised. Give their times in <code>--times TIMES.csv</code> and merge again "
             "(<code>labkit merge</code>) to apply the rule.</p>"
         )
-        rows = [(_e(e.student, MAX_NAME), (TEXT, _e(e.note))) for e in unknown]
+        rows = [(_name(e.student), (TEXT, _e(e.note))) for e in unknown]
         out.append(_table("Submissions with no known time", ["student", "why"], rows))
     else:
         out.append("<p>Every graded submission has a time.</p>")
@@ -983,7 +990,7 @@ def _late_section(summary):
         )
         rows = [
             (
-                _e(e.student, MAX_NAME),
+                _name(e.student),
                 (TEXT, _e(e.source or "", 64)),
                 (TEXT, _when(e.submitted, rule)),
                 (TEXT, _e(e.note)),
@@ -1104,7 +1111,7 @@ def _problems_section(summary):
         for row in rows[:MAX_NAMES]:
             texts = "".join(f"<li>{_e(text)}</li>" for text in row.texts[:MAX_TEXTS])
             more = f"<li>and {len(row.texts) - MAX_TEXTS} more</li>" if len(row.texts) > MAX_TEXTS else ""
-            out.append(f'<tr><th scope="row">{_e(row.student, MAX_NAME)}</th><td><ul>{texts}{more}</ul></td></tr>')
+            out.append(f'<tr><th scope="row">{_name(row.student)}</th><td><ul>{texts}{more}</ul></td></tr>')
         out.append("</tbody></table>")
         if len(rows) > MAX_NAMES:
             out.append(f"<p>and {len(rows) - MAX_NAMES} more students.</p>")
@@ -1131,7 +1138,7 @@ def _most_failed_section(summary):
         extra = len(s.failed) - MAX_FAILED_SHOWN
         more = f", and {extra} more" if extra > 0 else ""
         out.append(
-            f'<tr><th scope="row">{_e(s.student, MAX_NAME)}</th><td class="num">{len(s.failed)}</td>'
+            f'<tr><th scope="row">{_name(s.student)}</th><td class="num">{len(s.failed)}</td>'
             f'<td class="num">{s.not_done}</td><td class="num">{points_text(s.total)}</td>'
             f"<td>{labels}{more}</td></tr>"
         )
@@ -1167,7 +1174,7 @@ def _held_section(summary):
         out.append("<p>No part of this class is held.</p></section>")
         return "\n".join(out)
     rows = [
-        [_e(s.student, MAX_NAME)]
+        [_name(s.student)]
         + [(TEXT, _e(cell, MAX_NAME)) for cell in (f"{s.exercise} {s.part}", s.definition, s.source)]
         + [(NUM, f"{s.share:.0%}"), (TEXT, "released" if s.released else "held")]
         for s in summary.held

@@ -26,6 +26,7 @@ from labkit.exercises.result import CheckResult, call
 from labkit.grading.reports import class_report, similarity
 from labkit.grading.reports.similarity import Pair
 from labkit.grading.results import late
+from labkit.grading.results.names import shown_name
 from labkit.grading.results.report import ProblemText, SubmissionGrade, merge, write_report
 from labkit.grading.results.rubric import default, load
 from labkit.grading.sandbox import remote
@@ -417,7 +418,15 @@ def test_long_and_control_character_names_are_bounded_and_printable(grades):
     grades[1].name = "x" * 10_000 + "\x1b[31m\u202e"
     html = page_of(grades)
     assert "x" * class_report.MAX_NAME not in html and "\x1b" not in html and "\u202e" not in html
-    assert "x" * (class_report.MAX_NAME - 1) + "\u2026" in html
+    shown = shown_name(grades[1].name, class_report.MAX_NAME)
+    assert len(shown) == class_report.MAX_NAME and shown.startswith("x" * 40) and shown in html
+
+
+def test_two_long_names_sharing_a_beginning_never_look_alike_in_the_report(grades):
+    grades[1].name, grades[2].name = "x" * 230 + "ada", "x" * 230 + "fermat"
+    html = page_of(grades)
+    one, two = (shown_name(g.name, class_report.MAX_NAME) for g in grades[1:3])
+    assert one != two and one in html and two in html
 
 
 def test_every_figure_says_in_numbers_what_it_shows(grades):
