@@ -12,7 +12,7 @@ from conftest import sandbox_or_skip
 from small_class import SLIP, cli, rows
 
 from labkit.grading.results import late
-from labkit.grading.results.report import SubmissionGrade, safe_name
+from labkit.grading.results.report import SubmissionGrade, file_stem, safe_name
 from labkit.grading.results.rubric import default
 
 SOLVED = Planted("as handed out", "06_bilinear.ipynb", ())
@@ -46,7 +46,7 @@ def test_a_class_folder_given_without_its_star_is_graded_as_the_class(submission
     assert "could not grade dave: holds no notebook (it holds notes.pdf)" in run.stderr
     assert sorted(p.name for p in (submissions / "carol").iterdir()) == ["work.zip"]  # never unpacked in place
     assert not list(out.glob(".labkit-unpacked-*"))
-    feedback = (out / "feedback" / f"{safe_name('dave')}.txt").read_text()
+    feedback = (out / "feedback" / f"{file_stem('dave')}.txt").read_text()
     assert "could not be graded" in feedback and "nothing of this submission was scored" in feedback
 
 
@@ -91,7 +91,7 @@ def test_times_inside_a_submission_count_only_when_asked_and_are_marked_student_
     run = cli("grade", late_one, "--rubric", rubric, "--out", tmp_path / "g2", "--quiet", "--times-from-submission")
     row = rows(tmp_path / "g2")["bob"]
     assert row["time source"] == late.FROM_NBGRADER and "student-supplied" in row["time source"]
-    feedback = (tmp_path / "g2" / "feedback" / f"{safe_name('bob')}.txt").read_text()
+    feedback = (tmp_path / "g2" / "feedback" / f"{file_stem('bob')}.txt").read_text()
     assert "student-supplied" in feedback
     again = cli("grade", late_one, "--out", tmp_path / "g2", "--quiet")  # resumed: the run's own choice holds
     assert again.returncode == 0, again.stderr

@@ -15,7 +15,7 @@ from helpers import processes_with
 from small_class import SEED, cli, files
 
 from labkit.grading.results import rubric as rubrics
-from labkit.grading.results.report import safe_name
+from labkit.grading.results.report import file_stem, safe_name
 from labkit.grading.run.resume import resumed
 from labkit.grading.submission.scoring import submission_name
 
@@ -53,8 +53,8 @@ def test_a_resumed_run_grades_only_the_missing_the_unreadable_and_the_not_graded
     assert (_run(out)["graded now"], _run(out)["already graded"], _run(out)["seed"]) == (4, 1, int(SEED))
     assert "changed since the run wrote it" in run.stderr and "missing (the result of 'bob')" in run.stderr
     assert (out / "grades.csv").read_bytes() == (reference / "grades.csv").read_bytes()
-    assert "not what the run wrote" not in (out / "feedback" / f"{safe_name('alice')}.txt").read_text()
-    regraded = {f"{safe_name(name)}.txt" for name in ("alice", "bob", "carol", "dave")}
+    assert "not what the run wrote" not in (out / "feedback" / f"{file_stem('alice')}.txt").read_text()
+    regraded = {f"{file_stem(name)}.txt" for name in ("alice", "bob", "carol", "dave")}
     assert {k: v for k, v in files(out, "feedback").items() if k in regraded} == {
         k: v for k, v in files(reference, "feedback").items() if k in regraded
     }

@@ -17,7 +17,7 @@ from conftest import sandbox_or_skip
 from labkit.exercises import variants
 from labkit.exercises.registry import LAB
 from labkit.grading.authoring.release import release_notebook, with_values
-from labkit.grading.results.report import safe_name
+from labkit.grading.results.report import file_stem
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 ROOT = Path(__file__).resolve().parents[3]
@@ -141,7 +141,7 @@ def test_each_solution_earns_full_marks_on_its_own_variant_whatever_its_metadata
         row = course["rows"][name]
         for number in (2, 3, 4, 5, 6, 7, 8, 9, 14, 15, 16):  # 2, 5, 6, 8 and 9 do not vary: each beside one that does
             assert float(row[f"exercise {number}"]) == LAB.exercises[number].points, (number, row)
-        feedback = (course["out"] / "feedback" / f"{safe_name(name)}.txt").read_text(encoding="utf-8")
+        feedback = (course["out"] / "feedback" / f"{file_stem(name)}.txt").read_text(encoding="utf-8")
         assert ANOTHER not in feedback
 
 
@@ -161,7 +161,7 @@ def test_a_copy_is_flagged_and_loses_only_its_data_dependent_part(course):
         same = {driver, "phi_table", "eval_pbilin"}
         kept = sum(p.weight for p in LAB.exercises[number].parts if p.name in same)
         assert float(row[f"exercise {number}"]) == kept, (number, row)
-    feedback = (course["out"] / "feedback" / f"{safe_name('dan')}.txt").read_text(encoding="utf-8")
+    feedback = (course["out"] / "feedback" / f"{file_stem('dan')}.txt").read_text(encoding="utf-8")
     assert "this notebook holds the data of another variant" in feedback
     ada, dan = course["values"]["ada"][4]["r0"], course["values"]["dan"][4]["r0"]
     assert f"r0 = {ada:g} where yours is {dan:g}" in feedback
