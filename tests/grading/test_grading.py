@@ -70,7 +70,10 @@ def test_release_is_deterministic_and_keeps_everything_but_solutions(released, t
         student = nbformat.reads(student_bytes.decode(), as_version=4)
         assert len(student.cells) == len(teacher.cells)
         for t_cell, s_cell in zip(teacher.cells, student.cells):
-            assert s_cell.cell_type == t_cell.cell_type and s_cell.metadata == t_cell.metadata
+            assert s_cell.cell_type == t_cell.cell_type
+            # a hidden test's cell is the grader's: the student's copy locks it (read-only, not deletable)
+            locked = {"editable": False, "deletable": False} if "### BEGIN HIDDEN TESTS" in t_cell.source else {}
+            assert s_cell.metadata == {**t_cell.metadata, **locked}
             if t_cell.cell_type == "markdown":
                 # an answer in words is the instructor's; the student gets an empty answer cell
                 expected = "YOUR ANSWER HERE" if "### BEGIN SOLUTION" in t_cell.source else t_cell.source
