@@ -43,7 +43,14 @@ def test_the_core_is_light_and_the_extras_hold_the_rest():
     assert core == {"numpy", "scipy", "matplotlib", "ipywidgets", "anywidget", "meshio", "ipykernel"}
     extras = PROJECT["optional-dependencies"]
     assert [d.split(">")[0] for d in extras["lab"]] == ["jupyterlab"]
-    assert {d.split(">")[0] for d in extras["grade"]} == {"nbformat", "nbclient", "rich", "copydetect", "latex2mathml", "jinja2"}
+    assert {d.split(">")[0] for d in extras["grade"]} == {
+        "nbformat",
+        "nbclient",
+        "rich",
+        "copydetect",
+        "latex2mathml",
+        "jinja2",
+    }
     assert "labkit[lab,grade]" in extras["test"] and any(d.startswith("nbgrader") for d in extras["test"])
     assert "'.[lab,grade,test]'" in (ROOT / "Makefile").read_text()
 
