@@ -18,7 +18,8 @@ def test_phases_add_up_and_the_run_gathers_them(tmp_path):
     except ValueError:
         pass
     taken = timings.taken()
-    assert taken["calls"]["count"] == 3 and 0.03 <= taken["calls"]["seconds"] < 1.0
+    # three sleeps of 0.01 s take 0.03 s at least; no upper limit, which a busy machine would break
+    assert taken["calls"]["count"] == 3 and taken["calls"]["seconds"] >= 0.03
     assert taken["cells"]["count"] == 1 and set(taken) == {"calls", "cells"}
     work, out = tmp_path / "work", tmp_path / "out"
     work.mkdir()
