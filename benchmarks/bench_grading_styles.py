@@ -62,8 +62,8 @@ def _grade(submission, out):
 
 
 def _total(results):
-    from labkit.grading.results import rubric
-    from labkit.grading.results.report import SubmissionGrade
+    from labkit.grading.store import rubric
+    from labkit.grading.store.report import SubmissionGrade
 
     grade = SubmissionGrade.from_dict(results, "bench", rubric.default())
     return grade.total, rubric.default().maximum

@@ -28,7 +28,7 @@ from class_results import pair_of, synthetic_class
 
 from labkit.cli import main as cli
 from labkit.grading.reports import class_report, similarity
-from labkit.grading.results.report import write_report
+from labkit.grading.store.report import write_report
 
 
 def timed(function, repeat):

@@ -21,7 +21,7 @@ import copydetect
 import numpy as np
 
 from labkit.grading.reports import similarity
-from labkit.grading.results.report import SubmissionGrade
+from labkit.grading.store.report import SubmissionGrade
 
 OPERATORS = ["+", "-", "*", "/", "**"]
 CALLS = ["np.sqrt", "np.abs", "np.sum", "np.max", "len", "np.cos", "np.exp", "float", "np.asarray", "np.diff"]

@@ -96,7 +96,7 @@ def _execute(args):
     from .execute import execute, notebook_paths
     from .grading.authoring.nbgrader import mark
     from .grading.authoring.release import tag_raising
-    from .grading.results.rubric import load
+    from .grading.store.rubric import load
 
     rubric = load(args.rubric)  # nbgrader's points are the rubric's in force
 
@@ -147,7 +147,7 @@ def _course(args):
         from .exercises.registry import LAB
 
         return LAB
-    from .grading.results.rubric import load
+    from .grading.store.rubric import load
 
     return load(args.rubric).registry
 
@@ -155,7 +155,7 @@ def _course(args):
 def _ties(variants, registry, roster):
     """Name, on stderr, the roster's students who drew the same data of an exercise."""
     from .exercises.variants import ties
-    from .grading.results.report import one_line
+    from .grading.store.report import one_line
 
     ids = {key: name for name, key in roster.items()}
     for number, tied in ties(variants, registry, roster.values()):
@@ -168,8 +168,8 @@ def _ties(variants, registry, roster):
 
 
 def _summary(grades, out, start, what):
-    from .grading.results.report import one_line
-    from .grading.results.text import points_text
+    from .grading.store.report import one_line
+    from .grading.store.text import points_text
 
     for g in grades:
         lateness = g.lateness
@@ -183,7 +183,7 @@ def _summary(grades, out, start, what):
 
 def _replaced(replaced):
     """Say which results a later folder's replaced in a merge."""
-    from .grading.results.report import one_line
+    from .grading.store.report import one_line
 
     if not replaced:
         return
@@ -196,8 +196,8 @@ def _replaced(replaced):
 def _times_notes(grades, rubric, times):
     """Tell the instructor about the submission times: times that cost nothing or match no submission, and
     each submission a deadline applies to whose time is unknown. The number of times that could not be read."""
-    from .grading.results.late import unknown_times
-    from .grading.results.report import one_line
+    from .grading.store.late import unknown_times
+    from .grading.store.report import one_line
 
     def names(found):
         shown = ", ".join(repr(one_line(name, 40)) for name in sorted(found)[:5])
@@ -292,8 +292,8 @@ def _engine(args):
 
 def _merge(args):
     from .grading import merge
-    from .grading.results.late import read_times
     from .grading.run.classrun import report_failures
+    from .grading.store.late import read_times
 
     start = time.perf_counter()
     given = [flag for flag, value in (("--shard", args.shard), ("--dask", args.dask), ("--fresh", args.fresh)) if value]
@@ -316,8 +316,8 @@ def _merge(args):
 
 def _grade(args):
     from .grading import grade
-    from .grading.results.late import read_exchange, read_times
     from .grading.run.classrun import report_failures
+    from .grading.store.late import read_exchange, read_times
 
     if args.merge is not None:
         raise ValueError(
@@ -432,7 +432,7 @@ def _class(args, workspace):
         names = {student.name for student in found.students}
         unknown = [name for name in args.student if name not in names]
         if unknown:
-            from .grading.results.report import one_line
+            from .grading.store.report import one_line
 
             shown = ", ".join(repr(one_line(name, 64)) for name in sorted(names)[:10])
             raise ValueError(
@@ -455,7 +455,7 @@ def _class(args, workspace):
 
 def _refused(found, what):
     """Name each result file that was not read (its run's record does not vouch for it)."""
-    from .grading.results.report import one_line
+    from .grading.store.report import one_line
 
     for path, why in found.refused:
         print(f"labkit: {what}: not read: {one_line(path, 200)}: {one_line(why, 300)}", file=sys.stderr)
@@ -463,7 +463,7 @@ def _refused(found, what):
 
 def _late_marks(grades, marked):
     """Name the submissions the LMS marked late whose time labkit does not know (so no penalty was applied)."""
-    from .grading.results.report import one_line
+    from .grading.store.report import one_line
 
     unknown = [g.name for g in grades if g.name in marked and g.graded and (g.time is None or g.time.when is None)]
     for name in unknown:
@@ -476,8 +476,8 @@ def _late_marks(grades, marked):
 
 def _export(args):
     from .grading.reports import lms
-    from .grading.results.record import rubric_for
-    from .grading.results.report import read_results
+    from .grading.store.record import rubric_for
+    from .grading.store.report import read_results
 
     if args.canvas is not None and args.feedback:
         raise ValueError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
@@ -548,7 +548,7 @@ def _report(args):
 
 def _mark(args):
     from .grading.reports import marking
-    from .grading.results.rubric import load
+    from .grading.store.rubric import load
 
     rubric = None if args.rubric is None else load(args.rubric)
     if args.import_ is None:
@@ -1015,7 +1015,7 @@ def build_parser():
 def _variants(args):
     from .exercises import variants
     from .grading.reports.lms import read_roster
-    from .grading.results.report import one_line
+    from .grading.store.report import one_line
 
     course = _course(args)
     if args.new is not None:
@@ -1069,8 +1069,8 @@ def _variants(args):
 
 
 def _rubric(args):
-    from .grading.results.rubric import DEFAULT, load
-    from .grading.results.text import points_text
+    from .grading.store.rubric import DEFAULT, load
+    from .grading.store.text import points_text
 
     if args.check:
         rubric = load(args.check)

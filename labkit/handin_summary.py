@@ -9,7 +9,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-RUBRIC = Path(__file__).with_name("grading") / "results" / "rubric.toml"
+RUBRIC = Path(__file__).with_name("grading") / "store" / "rubric.toml"
 
 
 def _plan(rubric: Path = RUBRIC) -> dict:

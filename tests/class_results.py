@@ -1,6 +1,6 @@
 """A made-up class's grading results, for the class report's browser test, its benchmark and the docs picture.
 
-:func:`synthetic_class` builds :class:`~labkit.grading.results.report.SubmissionGrade` objects for the lab's
+:func:`synthetic_class` builds :class:`~labkit.grading.store.report.SubmissionGrade` objects for the lab's
 exercises as `labkit grade` writes them: students of varying skill, a branch each, stubs left as
 released, slips named with the catalog's hints (``tests/catalog.py``), errors raised, time limits,
 refused references, cells that raised, a crash and a submission that could not be graded, all worded
@@ -14,8 +14,8 @@ from catalog import MISTAKES
 
 from labkit.exercises.result import NOT_DONE
 from labkit.exercises.result import RAISED as RAISED_KIND
-from labkit.grading.results.report import ProblemText, SubmissionGrade
-from labkit.grading.results.rubric import default
+from labkit.grading.store.report import ProblemText, SubmissionGrade
+from labkit.grading.store.rubric import default
 
 FIRST = ("Ada", "Ben", "Chloé", "Dmitri", "Eun-ji", "Farah", "Goran", "Hana", "Iker", "Jun", "Kofi", "Lena")
 LAST = ("Abara", "Berg", "Costa", "Diaz", "Eriksen", "Fujita", "García", "Haddad", "Ivanova", "Jensen")

@@ -4,8 +4,8 @@ name and texts hold markup, which the feedback page must show as text. Used by t
 test and by the picture in docs/instructors.md (tests/browser/feedback_picture.py)."""
 
 from labkit.exercises.result import NOT_DONE, RAISED
-from labkit.grading.results.report import ProblemText, SubmissionGrade
-from labkit.grading.results.rubric import default
+from labkit.grading.store.report import ProblemText, SubmissionGrade
+from labkit.grading.store.rubric import default
 
 HOSTILE = "<script>alert(1)</script>"
 

@@ -62,7 +62,7 @@ def test_the_toy_exercise_is_declared_once_and_everything_follows(course):
     import toy_lab
 
     from labkit.grading.authoring.nbgrader import mark
-    from labkit.grading.results import rubric as rubrics
+    from labkit.grading.store import rubric as rubrics
 
     registry = toy_lab.REGISTRY
     assert registry.points[17] == 5 and registry.exercises[17].notebook == "07_secants.ipynb"

@@ -64,7 +64,7 @@ def test_the_search_finds_a_pair_that_imports_each_other_even_inside_a_function(
     assert edges["pkg.other"] == {"pkg.sub.late"}
 
 
-SUBPACKAGES = ("authoring", "reports", "results", "sandbox", "submission")
+SUBPACKAGES = ("authoring", "reports", "sandbox", "store", "submission")
 
 
 def reaching_out(edges, inside, allowed_prefix="labkit.grading."):
@@ -87,13 +87,13 @@ def test_the_sandbox_imports_nothing_else_of_the_grader():
 def test_the_check_for_the_sandbox_finds_a_module_that_reaches_out(tmp_path):
     package = tmp_path / "labkit"
     (package / "grading" / "sandbox").mkdir(parents=True)
-    (package / "grading" / "results").mkdir()
-    for init in ("", "grading", "grading/sandbox", "grading/results"):
+    (package / "grading" / "store").mkdir()
+    for init in ("", "grading", "grading/sandbox", "grading/store"):
         (package / init / "__init__.py").write_text("")
-    (package / "grading" / "results" / "rubric.py").write_text("")
-    (package / "grading" / "sandbox" / "remote.py").write_text("def f():\n    from ..results import rubric\n")
+    (package / "grading" / "store" / "rubric.py").write_text("")
+    (package / "grading" / "sandbox" / "remote.py").write_text("def f():\n    from ..store import rubric\n")
     assert reaching_out(imports(package), "labkit.grading.sandbox") == {
-        "labkit.grading.sandbox.remote": {"labkit.grading.results.rubric"}
+        "labkit.grading.sandbox.remote": {"labkit.grading.store.rubric"}
     }
 
 
@@ -191,13 +191,13 @@ def test_the_cycle_search_finds_a_cycle_of_three_packages_through_single_modules
 
 
 # The grader's rooms in the order data flows through them, lowest first: a room imports only rooms below it.
-# (the class comes in and is planned and run: run; each submission is scored: submission; the store of a run: results;
+# (the class comes in and is planned and run: run; each submission is scored: submission; the store of a run: store;
 # what people read: reports and authoring, at the top.)
 FLOW = {
     "labkit.grading.progress": 0,
     "labkit.grading.pages": 0,
     "labkit.grading.sandbox": 1,
-    "labkit.grading.results": 2,
+    "labkit.grading.store": 2,
     "labkit.grading.options": 2,
     "labkit.grading.submission": 3,
     "labkit.grading.run": 4,

@@ -146,7 +146,7 @@ def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
     code = (
         "import sys, labkit.grading.sandbox.worker\n"
         "print(sorted({m for m in sys.modules} & {'nbformat', 'nbclient', 'labkit.grading.run.classrun', "
-        "'labkit.grading.submission.scoring', 'labkit.grading.results.report', 'concurrent.futures.process'}))"
+        "'labkit.grading.submission.scoring', 'labkit.grading.store.report', 'concurrent.futures.process'}))"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr
@@ -155,7 +155,7 @@ def test_the_sandboxed_worker_imports_none_of_the_graders_tools():
     assert (
         callable(grading.release)
         and callable(grading.grade)
-        and grading.results.report.safe_name("a b").startswith("a_b-")
+        and grading.store.report.safe_name("a b").startswith("a_b-")
     )
 
 

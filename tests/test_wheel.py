@@ -68,7 +68,7 @@ def test_the_wheel_ships_the_student_notebooks_and_no_solved_one(fresh):
         if name.endswith(".ipynb"):
             text = zipfile.ZipFile(fresh["wheel"]).read(name).decode()
             assert "### BEGIN SOLUTION" not in text and "### BEGIN HIDDEN TESTS" not in text
-    assert "labkit/grading/results/rubric.toml" in names and "labkit/plots/editor.js" in names
+    assert "labkit/grading/store/rubric.toml" in names and "labkit/plots/editor.js" in names
     assert "labkit/py.typed" in names  # PEP 561: type checkers read labkit's annotations
     # the feedback page's template and stylesheet (labkit.grading.pages), which labkit grade renders for each student
     assert {"labkit/grading/templates/feedback.html", "labkit/grading/templates/feedback.css"} <= set(names)

@@ -150,7 +150,7 @@ class Part:
     for all. ``reads`` are the notebook's names passed to it, in order: a name,
     an :class:`Optional` name, or names :class:`Together`. The weights of an
     exercise's parts are its points; a rubric that gives the exercise other
-    points scales them (:mod:`labkit.grading.results.rubric`).
+    points scales them (:mod:`labkit.grading.store.rubric`).
 
     ``passes`` are labkit's functions the check hands to the student's code
     (the only functions that may cross into the sandbox); ``refused`` is

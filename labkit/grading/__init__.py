@@ -9,7 +9,7 @@ One subpackage per process and job (CONTRIBUTING.md draws the process tree):
   the refusals, copied code, scoring;
 * :mod:`~labkit.grading.sandbox` - isolation: backends, cgroup, seccomp, the protocol, the grader's handle,
   the fork server and, inside the sandbox, the zygote, the worker and its watch;
-* :mod:`~labkit.grading.results` - what a run writes and reads back: results, the record, the rubric, lateness;
+* :mod:`~labkit.grading.store` - what a run writes and reads back: results, the record, the rubric, lateness;
 * :mod:`~labkit.grading.reports` - what a person reads afterwards: the class report, similarity, marking, LMS;
 * :mod:`~labkit.grading.options` - the limits of a run, built once at its edge and passed to every process.
 
@@ -24,10 +24,10 @@ from .authoring.release import release, release_notebook, strip_solutions  # lig
 # ``python -m labkit.grading.sandbox.worker``, does not pay for nbformat and the grader's modules.
 _EXPORTS = {
     "grade": "run.classrun",
-    "SubmissionGrade": "results.report",
-    "merge": "results.report",
-    "Rubric": "results.rubric",
-    "load_rubric": "results.rubric",
+    "SubmissionGrade": "store.report",
+    "merge": "store.report",
+    "Rubric": "store.rubric",
+    "load_rubric": "store.rubric",
     "exercises_in": "submission.scoring",
     "grade_notebook": "submission.scoring",
     "grade_submission": "submission.scoring",
@@ -35,7 +35,7 @@ _EXPORTS = {
     "GradeOptions": "options",
     "get_backend": "sandbox.backends",
 }
-_MODULES = {"authoring", "options", "reports", "results", "run", "sandbox", "submission"}
+_MODULES = {"authoring", "options", "reports", "run", "store", "sandbox", "submission"}
 
 __all__ = sorted(_EXPORTS) + ["release", "release_notebook", "strip_solutions"]
 

@@ -27,7 +27,7 @@ class GradeOptions:
     total_timeout: int = 600  # seconds for one submission in all, every notebook of it together
     seed: int | None = None  # the random test data's seed (a fresh one per run when None)
     backend: str = backends.DEFAULT  # the sandbox backend's name (labkit.grading.sandbox.backends; `--sandbox NAME`)
-    rubric: str | None = None  # the rubric's TOML file (None: the lab's own, labkit/grading/results/rubric.toml)
+    rubric: str | None = None  # the rubric's TOML file (None: the lab's own, labkit/grading/store/rubric.toml)
     limits: Limits = field(default_factory=Limits)  # the sandbox's resource limits
     grader_memory: int = 3 * 1024**3  # bytes of address space for the grader's own work on one submission
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit

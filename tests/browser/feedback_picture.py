@@ -15,7 +15,7 @@ from feedback_sample import sample_grade
 from jupyterlab_session import CHROMIUM_FLAGS
 from playwright.sync_api import sync_playwright
 
-from labkit.grading.results import feedback
+from labkit.grading.store import feedback
 
 ROOT = Path(__file__).resolve().parents[2]
 PICTURE = ROOT / "docs" / "images" / "feedback-page.png"

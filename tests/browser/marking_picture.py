@@ -14,7 +14,7 @@ from jupyterlab_session import CHROMIUM_FLAGS
 from playwright.sync_api import sync_playwright
 
 from labkit.grading.reports import marking
-from labkit.grading.results import report, rubric
+from labkit.grading.store import report, rubric
 
 ROOT = Path(__file__).resolve().parents[2]
 PICTURE = ROOT / "docs" / "images" / "marking.png"

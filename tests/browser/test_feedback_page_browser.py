@@ -13,7 +13,7 @@ import pytest
 from feedback_sample import HOSTILE, sample_grade
 from jupyterlab_session import CHROMIUM, CHROMIUM_FLAGS, skip_without_chromium
 
-from labkit.grading.results import feedback
+from labkit.grading.store import feedback
 
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 axe_playwright = pytest.importorskip("axe_playwright_python.sync_playwright", reason="axe-playwright-python is missing")

@@ -16,7 +16,7 @@ import pytest
 from jupyterlab_session import CHROMIUM, CHROMIUM_FLAGS, skip_without_chromium
 
 from labkit.grading.reports import marking
-from labkit.grading.results import report, rubric
+from labkit.grading.store import report, rubric
 
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 axe_playwright = pytest.importorskip("axe_playwright_python.sync_playwright", reason="axe-playwright-python is missing")

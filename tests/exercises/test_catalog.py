@@ -8,7 +8,7 @@ from catalog import CORRECT, GOLDEN, MISTAKES, SEED, SLIPS, grade_class, submiss
 from conftest import sandbox_or_skip
 
 from labkit.check import EXERCISES
-from labkit.grading.results.rubric import default
+from labkit.grading.store.rubric import default
 
 pytestmark = [
     pytest.mark.slow,

@@ -19,7 +19,7 @@ from conftest import sandbox_or_skip
 
 from labkit import grading
 from labkit.exercises.registry import LAB
-from labkit.grading.results.rubric import default
+from labkit.grading.store.rubric import default
 
 SEED = 20261201
 BY_NAME = {entry.name: entry for entry in MISTAKES}

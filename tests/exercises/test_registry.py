@@ -21,8 +21,8 @@ from labkit import convergence
 from labkit.exercises import model
 from labkit.exercises.registry import LAB, Registry, function_name, load
 from labkit.grading.authoring.nbgrader import CHECK_CALL
-from labkit.grading.results.rubric import default
 from labkit.grading.sandbox import protocol
+from labkit.grading.store.rubric import default
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = {path.name: path for path in sorted((ROOT / "notebooks").glob("*.ipynb"))}

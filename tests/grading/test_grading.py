@@ -16,12 +16,12 @@ import pytest
 from labkit import grading
 from labkit.check import EXERCISES
 from labkit.exercises.registry import LAB
-from labkit.grading.results.report import file_stem
+from labkit.grading.store.report import file_stem
 
 pytestmark = pytest.mark.slow  # grades the instructor notebooks and small classes
 
 ANSWERS = LAB.answers
-from labkit.grading.results.rubric import default
+from labkit.grading.store.rubric import default
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"
@@ -445,7 +445,7 @@ def test_every_submission_gets_a_result_file_and_the_seed_is_saved(graded):
     results, out, _, subs = graded
     seed = int((out / "seed.txt").read_text())
     for grade in results.values():
-        data = json.loads((out / "results" / f"{grading.results.report.safe_name(grade.name)}.json").read_text())
+        data = json.loads((out / "results" / f"{grading.store.report.safe_name(grade.name)}.json").read_text())
         assert data["total"] == grade.total and data["seed"] == seed
         assert {int(n): v for n, v in data["points"].items()} == grade.points
 
@@ -481,7 +481,7 @@ def test_merge_combines_batch_jobs_into_one_grades_csv(two_runs):
 def test_merge_keeps_a_later_folders_result_and_refuses_folders_without_results(two_runs, tmp_path):
     tmp, *_ = two_runs
     merged = grading.merge([tmp / "job1", tmp / "job3"], tmp_path / "m0")
-    result = f"{grading.results.report.safe_name('alice')}.json"
+    result = f"{grading.store.report.safe_name('alice')}.json"
     assert [g.name for g in merged] == ["alice"]
     assert [(r.name, r.earlier, r.later) for r in merged.replaced] == [
         ("alice", tmp / "job1" / "results" / result, tmp / "job3" / "results" / result)

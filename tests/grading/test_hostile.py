@@ -30,9 +30,9 @@ from helpers import processes_with as _processes_with
 
 import labkit.piecewise
 from labkit import grading
-from labkit.grading.results.report import file_stem, safe_name
-from labkit.grading.results.rubric import default
 from labkit.grading.sandbox.backends.base import remove_tree
+from labkit.grading.store.report import file_stem, safe_name
+from labkit.grading.store.rubric import default
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"

@@ -109,7 +109,7 @@ def _numbers(path):
 # numbers equal to a default that mean something else: each is looked at when it changes
 NOT_A_DEFAULT = {
     (
-        "grading/results/report.py",
+        "grading/store/report.py",
         'readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"',
     ): "characters of a file name",
     ("grading/run/processes.py", "log.seek(max(0, os.path.getsize(self.log) - 4096))"): "bytes of a log's tail",

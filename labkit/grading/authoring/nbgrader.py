@@ -24,7 +24,7 @@ meaning follow nbgrader's ``nbgrader/nbgraderformat/v3.json``.
 import re
 
 from ...exercises.model import sections
-from ..results import rubric as rubrics
+from ..store import rubric as rubrics
 from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
 
 SCHEMA_VERSION = 3

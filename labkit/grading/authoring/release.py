@@ -166,7 +166,7 @@ def _number(node):
 
 def folder_name(name):
     """A student's release folder: the roster's submission name when it is a plain file name, else a safe one."""
-    from ..results.report import safe_name
+    from ..store.report import safe_name
 
     name = str(name)
     return name if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,59}", name) else safe_name(name)

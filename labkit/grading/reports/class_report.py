@@ -21,7 +21,7 @@ with matplotlib's Agg canvas (no pyplot state), its style and its one small
 script are inline, and it names no other resource. Everything a submission
 could have influenced (its name, a hint that quotes its values, a problem's
 text, its code) is data: made printable and bounded in length
-(:func:`labkit.grading.results.report.one_line`), then HTML-escaped.
+(:func:`labkit.grading.store.report.one_line`), then HTML-escaped.
 """
 
 from __future__ import annotations
@@ -52,13 +52,13 @@ from ...exercises.result import (
     VARIANT,
     part_kind,
 )
-from ..results import late as lateness
-from ..results.names import shown_name
-from ..results.record import rubric_for
-from ..results.report import SubmissionGrade, one_line, printable, read_results
-from ..results.report import problem_kinds as kinds_of
-from ..results.rubric import Rubric
-from ..results.text import points_text
+from ..store import late as lateness
+from ..store.names import shown_name
+from ..store.record import rubric_for
+from ..store.report import SubmissionGrade, one_line, printable, read_results
+from ..store.report import problem_kinds as kinds_of
+from ..store.rubric import Rubric
+from ..store.text import points_text
 from ..submission.known import THRESHOLD
 from .copies import Copies, pair_rows
 from .copies import find as find_copies
@@ -186,12 +186,12 @@ def _student_supplied(time: lateness.SubmissionTime | None) -> bool:
 
     The ``timestamp.txt`` in a submission is written by the student's own process (nbgrader's submit step
     runs as the student), and a notebook's modification time is whatever the student's files say
-    (:data:`labkit.grading.results.late.STUDENT_SUPPLIED`); the LMS's ``--times`` and nbgrader's exchange, read by
+    (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`); the LMS's ``--times`` and nbgrader's exchange, read by
     labkit itself, are not. The one place that decides it, for the report's late view.
 
     Examples
     --------
-    >>> from labkit.grading.results.late import FROM_CSV, FROM_MTIME, SubmissionTime
+    >>> from labkit.grading.store.late import FROM_CSV, FROM_MTIME, SubmissionTime
     >>> _student_supplied(SubmissionTime(None, FROM_MTIME)), _student_supplied(SubmissionTime(None, FROM_CSV))
     (True, False)
     """
@@ -206,7 +206,7 @@ class LateEntry:
     deadline: datetime  # the student's deadline: the rubric's, or their extension
     extended: bool
     submitted: datetime | None  # None when the time is unknown
-    source: str | None  # where the time came from (labkit.grading.results.late's FROM_...)
+    source: str | None  # where the time came from (labkit.grading.store.late's FROM_...)
     late_by: timedelta | None  # None when the time is unknown; zero or less when on time
     units: int  # started days or hours counted (0: on time, within the grace, or unknown)
     percent: float  # the penalty in percent of raw_total
@@ -420,7 +420,7 @@ def problem_kinds(problem: str) -> list[tuple[str, str]]:
     """The kinds of a problem the grader recorded for a submission, each with the words to show.
 
     The kinds are the codes the grader set where it made the problem (a
-    :class:`labkit.grading.results.report.ProblemText`), never read from its words: a
+    :class:`labkit.grading.store.report.ProblemText`), never read from its words: a
     notebook whose cells raised has one (kind, description) per cell, a cell
     the worker stopped at its time limit a time limit, the others errors
     raised. A bare text, with no codes, is "other".
@@ -437,7 +437,7 @@ def problem_kinds(problem: str) -> list[tuple[str, str]]:
 
     Examples
     --------
-    >>> from labkit.grading.results.report import ProblemText
+    >>> from labkit.grading.store.report import ProblemText
     >>> problem_kinds(ProblemText.one("a.ipynb: stopped after the submission's time limit of 600 s.", "timeout"))
     [('timeout', "a.ipynb: stopped after the submission's time limit of 600 s.")]
     >>> problem_kinds("a.ipynb: it ran past the time limit")
@@ -512,7 +512,7 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
 
     Examples
     --------
-    >>> from labkit.grading.results.report import SubmissionGrade
+    >>> from labkit.grading.store.report import SubmissionGrade
     >>> summarise([SubmissionGrade("ann", {2: {"fraction": 1.0, "passed": True, "checks": [
     ...     {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}]}})]).totals
     {'ann': 10.0}
@@ -523,7 +523,7 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     for grade in grades:
         if not isinstance(grade, SubmissionGrade):
             raise ValueError(
-                f"a class report is made of SubmissionGrade objects (labkit.grading.results.report); got "
+                f"a class report is made of SubmissionGrade objects (labkit.grading.store.report); got "
                 f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
             )
     rubric = grades[0].rubric
@@ -775,7 +775,7 @@ def _e(value, limit=MAX_TEXT):
 
 def _name(value):
     """A submission's name as HTML: shortened for reading with a hash of the whole name, so two names sharing a
-    beginning never look alike (:func:`labkit.grading.results.names.shown_name`), escaped."""
+    beginning never look alike (:func:`labkit.grading.store.names.shown_name`), escaped."""
     return html.escape(shown_name(value, MAX_NAME), quote=True)
 
 
@@ -1406,7 +1406,7 @@ def _check_pairs(pairs):
 
 def _variant_students(out):
     """Each student's variant data, as the run in `out` recorded them ({} without variants or a record)."""
-    from ..results.record import read as read_record
+    from ..store.record import read as read_record
 
     try:
         return read_record(out).variants.get("students", {})

@@ -32,9 +32,9 @@ import re
 import zipfile
 from pathlib import Path
 
-from ..results import feedback as feedbacks
-from ..results import record as records
-from ..results.report import file_stem, one_line, read_results
+from ..store import feedback as feedbacks
+from ..store import record as records
+from ..store.report import file_stem, one_line, read_results
 
 UPLOAD = "feedback-upload.zip"
 PAGE = "feedback.html"

@@ -1,7 +1,7 @@
 """Grades into the LMS: the course's Canvas gradebook filled in, or a file for Moodle's grade import.
 
 ``labkit export OUT`` reads a grading run's results (``OUT/results/*.json``,
-:func:`labkit.grading.results.report.read_results`) and writes, for each student it
+:func:`labkit.grading.store.report.read_results`) and writes, for each student it
 can match, the **total under the rubric** (required exercises, the branch that
 counted and the extra credit: the ``total`` column of ``grades.csv``). A
 submission that could not be graded gets no number, never a zero.
@@ -119,8 +119,8 @@ and written to a summary CSV next to the output, one row per submission,
 roster entry and unmatched gradebook row, with the total of every graded
 submission, so that a grade can be entered by hand. Their cells are left as
 the LMS has them. Names from submissions reach the summary through
-:func:`~labkit.grading.results.report.csv_cell` and a terminal through
-:func:`~labkit.grading.results.report.one_line`.
+:func:`~labkit.grading.store.report.csv_cell` and a terminal through
+:func:`~labkit.grading.store.report.one_line`.
 
 Bad input (a roster without its columns or with a name or identifier twice,
 a gradebook that is not Canvas's CSV or not UTF-8, an assignment column that
@@ -141,8 +141,8 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..results.report import FORMULA_START, SubmissionGrade, csv_cell, one_line
-from ..results.text import points_text
+from ..store.report import FORMULA_START, SubmissionGrade, csv_cell, one_line
+from ..store.text import points_text
 
 DEFAULT_COLUMN = "labkit"
 CANVAS_KEYS = ("ID", "SIS User ID", "SIS Login ID")
@@ -213,7 +213,7 @@ class Export:
         Returns
         -------
         list of str
-            Lines for a terminal: names pass through :func:`~labkit.grading.results.report.one_line`.
+            Lines for a terminal: names pass through :func:`~labkit.grading.store.report.one_line`.
 
         Examples
         --------
@@ -646,7 +646,7 @@ def to_canvas(
     Parameters
     ----------
     grades : list of SubmissionGrade
-        The results of a grading run (:func:`~labkit.grading.results.report.read_results`), scored by their rubric.
+        The results of a grading run (:func:`~labkit.grading.store.report.read_results`), scored by their rubric.
     gradebook : path
         The course's gradebook as Canvas exports it (see the module's description of the layout).
     roster : path
@@ -814,7 +814,7 @@ def _feedback(grade):
 
     Examples
     --------
-    >>> from labkit.grading.results.report import SubmissionGrade
+    >>> from labkit.grading.store.report import SubmissionGrade
     >>> _feedback(SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}}))
     '10 points: 10 of 100 for full credit (labkit grade)'
     """
@@ -839,8 +839,8 @@ MAX_FEEDBACK = 30_000  # characters of a Moodle feedback cell (the student's fee
 
 def _feedback_cell(grade):
     """Moodle's feedback cell: the points in words on the first line, then the student's whole feedback text
-    (labkit.grading.results.feedback), printable, bounded, and never read as a formula."""
-    from ..results.feedback import build, text
+    (labkit.grading.store.feedback), printable, bounded, and never read as a formula."""
+    from ..store.feedback import build, text
 
     whole = f"{_feedback(grade)}\n\n{text(build(grade))}"
     whole = whole if len(whole) <= MAX_FEEDBACK else whole[: MAX_FEEDBACK - 1] + "\u2026"
@@ -897,7 +897,7 @@ def to_moodle(
     Parameters
     ----------
     grades : list of SubmissionGrade
-        The results of a grading run (:func:`~labkit.grading.results.report.read_results`), scored by their rubric.
+        The results of a grading run (:func:`~labkit.grading.store.report.read_results`), scored by their rubric.
     roster : path
         The roster (:func:`read_roster`): submission name -> the student's ID number or email address.
     out : path

@@ -22,11 +22,11 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
-from ..results import record as records
-from ..results.feedback import blank
-from ..results.names import name_cell, name_from_cell, shown_name
-from ..results.report import csv_cell, one_line, printable, read_results, write_csv, write_result
-from ..results.text import points_text
+from ..store import record as records
+from ..store.feedback import blank
+from ..store.names import name_cell, name_from_cell, shown_name
+from ..store.report import csv_cell, one_line, printable, read_results, write_csv, write_result
+from ..store.text import points_text
 
 HEADER = ["submission", "item", "points", "comment"]
 MAX_MARKS_BYTES = 16 * 1024 * 1024  # a marks.csv larger than this is not read

@@ -42,8 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results.report import one_line, printable
-from ..results.text import MAX_SOURCE_CHARS
+from ..store.report import one_line, printable
+from ..store.text import MAX_SOURCE_CHARS
 
 DEFAULT_THRESHOLD = 0.8  # similarity (0..1) from which a pair is shown
 NOISE = 25  # normalised characters hashed into one fingerprint (copydetect's noise threshold): shorter runs never count
@@ -108,7 +108,7 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
     Parameters
     ----------
     grades : iterable of SubmissionGrade
-        The class's grades (:class:`labkit.grading.results.report.SubmissionGrade`,
+        The class's grades (:class:`labkit.grading.store.report.SubmissionGrade`,
         or any objects with a ``name`` and a ``sources`` dict of function
         name to source text); names must differ.
     threshold : float, optional
@@ -139,7 +139,7 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
 
     Examples
     --------
-    >>> from labkit.grading.results.report import SubmissionGrade
+    >>> from labkit.grading.store.report import SubmissionGrade
     >>> mine = "def area(width, height):\\n    return 0.5 * (width + height) * abs(width - height) ** 2 / 3"
     >>> theirs = "def area(w, h):\\n    # renamed\\n    return 0.5*(w+h)*abs(w-h)**2/3"
     >>> own = "def area(a, b):\\n    s = min(a, b)\\n    return s * s + max(a, b) - 7"

@@ -13,7 +13,7 @@ reported as "could not be graded" with the reason, while every other
 submission is graded as usual.
 
 Each submission's time (for a rubric's ``[late]`` table) is read here, on the
-grader's side (:func:`labkit.grading.results.late.submission_time`), and saved with
+grader's side (:func:`labkit.grading.store.late.submission_time`), and saved with
 its result, so that ``labkit merge`` can apply a late rule later. Each
 submission's ``results/<name>.json`` and feedback are written as soon as it
 is graded, and entered in the run's record; the output folder always gets a
@@ -37,12 +37,12 @@ from pathlib import Path
 
 from ..options import GradeOptions
 from ..progress import Progress
-from ..results import record as records
-from ..results.late import submission_time
-from ..results.report import SubmissionGrade, labkit_version, one_line, write_report, write_result
-from ..results.rubric import load as load_rubric
 from ..sandbox import backends, timings
 from ..sandbox.backends.base import SandboxUnavailable
+from ..store import record as records
+from ..store.late import submission_time
+from ..store.report import SubmissionGrade, labkit_version, one_line, write_report, write_result
+from ..store.rubric import load as load_rubric
 from ..submission import refusals
 from ..submission.scoring import known_sources, submission_name
 from .engines import Batch, Engine, LocalEngine
@@ -92,7 +92,7 @@ def grade(
     (read by labkit from nbgrader's exchange), else, only with
     `times_from_submission`, from the ``timestamp.txt`` in its folder, else,
     only with `times_from_mtime`, from its notebooks' modification time
-    (:func:`labkit.grading.results.late.submission_time`); the last two are written
+    (:func:`labkit.grading.store.late.submission_time`); the last two are written
     by the student and marked "student-supplied" wherever they are shown.
 
     With `variants` (a :class:`labkit.exercises.variants.VariantsFile`) and
@@ -103,7 +103,7 @@ def grade(
     same file again.
 
     Each submission's result and feedback are written as soon as it is
-    graded, and entered in ``record.json`` (:mod:`labkit.grading.results.record`).
+    graded, and entered in ``record.json`` (:mod:`labkit.grading.store.record`).
     When `out_dir` already holds a run's record, only the submissions without
     a result there, or whose notebooks changed since, are graded, with that
     run's seed and rubric (:func:`~labkit.grading.run.resume.resumed`);
@@ -335,7 +335,7 @@ def _write_variants(out, grades, students, roster, registry):
     whose data its notebooks hold instead (``another variant`` when no one in the class has them)."""
     import csv
 
-    from ..results.report import csv_cell
+    from ..store.report import csv_cell
 
     varied = [e for e in registry if e.params]
     rows = []

@@ -43,9 +43,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..options import GradeOptions
-from ..results.report import one_line, safe_name
 from ..sandbox import backends
 from ..sandbox.backends.base import SandboxUnavailable
+from ..store.report import one_line, safe_name
 from ..submission import refusals
 from .engines import Batch, Engine, Outcome, grade_one
 from .processes import low_space, settled

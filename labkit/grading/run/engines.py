@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..options import GradeOptions
-from ..results.report import SubmissionGrade
-from ..results.rubric import Rubric
 from ..sandbox import backends
+from ..store.report import SubmissionGrade
+from ..store.rubric import Rubric
 from .processes import Job, low_space, settled
 from .warm import kept, warm
 

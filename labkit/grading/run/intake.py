@@ -17,7 +17,7 @@ The layouts recognised (:func:`find_class` tells them apart by their names):
 ``nbgrader``
     ``COURSE/submitted/<student>/<assignment>/*.ipynb`` (or ``submitted/``
     itself): the student's id is the name, and the path is the assignment's
-    folder, so nbgrader's ``timestamp.txt`` stays where :mod:`~labkit.grading.results.late`
+    folder, so nbgrader's ``timestamp.txt`` stays where :mod:`~labkit.grading.store.late`
     looks for it. With several assignments, ``assignment=`` picks one.
 ``canvas``
     Canvas's "Download Submissions": a flat folder of files named
@@ -87,7 +87,7 @@ writes "Participant" for the name; team submissions the group's name. Because
 the full name holds no ``_``, the first ``_<digits>_assignsubmission_`` ends it.
 
 The student's name is data: it is never used as a path; what is created for a
-student on disk is named with :func:`~labkit.grading.results.report.safe_name`.
+student on disk is named with :func:`~labkit.grading.store.report.safe_name`.
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..results.report import one_line, safe_name
+from ..store.report import one_line, safe_name
 from .lms_names import canvas_readings, resolve_canvas
 
 MAX_FILES = 5_000  # entries looked at in one folder walk (as scoring's walk of a submission)

@@ -30,7 +30,7 @@ import functools
 import re
 from dataclasses import dataclass
 
-from ..results.report import one_line
+from ..store.report import one_line
 
 _FIXED = re.compile(r"(?=(_LATE)?_([0-9]+)_([0-9]+)_(.))", re.DOTALL)
 _ANON = re.compile(r"^(LATE_)?(anon(?:ymous)?)(_LATE)?_([A-Za-z0-9]+)_([0-9]+)_(.+)$", re.DOTALL)

@@ -22,10 +22,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..results import record as records
-from ..results.late import read_small
-from ..results.report import FORMAT, SubmissionGrade, one_line, safe_name
 from ..sandbox import backends, cgroup, forkserver
+from ..store import record as records
+from ..store.late import read_small
+from ..store.report import FORMAT, SubmissionGrade, one_line, safe_name
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more

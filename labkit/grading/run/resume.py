@@ -1,6 +1,6 @@
 """What a run into an output folder takes over from the one before it there, and which part of a class it grades.
 
-:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.results.record`)
+:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.store.record`)
 and keeps the submissions graded there whose notebooks did not change since;
 :func:`carried_marks` keeps a person's marks that still apply to a
 submission graded again. :func:`shard` picks the I-th of N parts of a class,
@@ -10,16 +10,16 @@ for batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..results import record as records
-from ..results.report import SubmissionGrade, labkit_version, one_line
-from ..results.rubric import DEFAULT as DEFAULT_RUBRIC
-from ..results.rubric import Rubric
-from ..results.rubric import default as default_rubric
+from ..store import record as records
+from ..store.report import SubmissionGrade, labkit_version, one_line
+from ..store.rubric import DEFAULT as DEFAULT_RUBRIC
+from ..store.rubric import Rubric
+from ..store.rubric import default as default_rubric
 from ..submission.scoring import submission_notebooks
 
 
 def content(path):
-    """The digest of a submission's notebooks (:func:`labkit.grading.results.record.content_digest`)."""
+    """The digest of a submission's notebooks (:func:`labkit.grading.store.record.content_digest`)."""
     path = Path(path)
     return records.content_digest(notebooks(path), path if path.is_dir() else path.parent)
 
@@ -65,7 +65,7 @@ class Resumed:
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     """What the earlier run in `out` leaves to this one: a :class:`Resumed`.
 
-    An output folder with a run record (:mod:`labkit.grading.results.record`) is resumed: the submissions graded
+    An output folder with a run record (:mod:`labkit.grading.store.record`) is resumed: the submissions graded
     there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
     digest}: they changed since, and are graded again), and the run grades the others with the earlier
     run's seed, which `seed` may repeat but not change, and under the earlier run's rubric, which `rubric`

@@ -11,7 +11,7 @@ code reaches a held definition, or a graded name that a string run as code may h
 from __future__ import annotations
 
 from ...exercises.result import REFUSED
-from ..results.report import HELD_STEP
+from ..store.report import HELD_STEP
 from . import scan
 
 

@@ -29,7 +29,7 @@ import ast
 import re
 import time
 
-from ..results.text import MAX_SOURCE_CHARS
+from ..store.text import MAX_SOURCE_CHARS
 
 MAX_CODE_BYTES = 512 * 1024  # a lab notebook's code is a few tens of kilobytes
 TIME_BUDGET = 20.0  # seconds to read one notebook's code

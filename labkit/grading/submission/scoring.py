@@ -35,8 +35,8 @@ from ...exercises.registry import load as load_registry
 from ...exercises.result import CRASH, NOT_DONE, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
-from ..results.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from ..sandbox import backends, remote, timings
+from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from . import holding, known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
@@ -524,7 +524,7 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
     options = _options(options)
     rubric = None
     if options.rubric is not None:
-        from ..results.rubric import load
+        from ..store.rubric import load
 
         rubric = load(options.rubric)
     deadline = time.monotonic() + options.total_timeout

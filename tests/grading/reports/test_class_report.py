@@ -25,11 +25,11 @@ from labkit.exercises.registry import LAB, _missing
 from labkit.exercises.result import CheckResult, call
 from labkit.grading.reports import class_report, similarity
 from labkit.grading.reports.similarity import Pair
-from labkit.grading.results import late
-from labkit.grading.results.names import shown_name
-from labkit.grading.results.report import ProblemText, SubmissionGrade, merge, write_report
-from labkit.grading.results.rubric import default, load
 from labkit.grading.sandbox import remote
+from labkit.grading.store import late
+from labkit.grading.store.names import shown_name
+from labkit.grading.store.report import ProblemText, SubmissionGrade, merge, write_report
+from labkit.grading.store.rubric import default, load
 from labkit.grading.submission import scoring
 
 HOSTILE = "<script>alert(1)</script>"
@@ -800,7 +800,7 @@ def test_bad_input_to_the_module_says_what_to_fix(grades, tmp_path):
 
 
 def test_result_files_that_are_not_plain_files_or_too_large_are_never_read(grades, tmp_path, monkeypatch):
-    from labkit.grading.results import record
+    from labkit.grading.store import record
 
     write_report(tmp_path, grades)
     fifo = tmp_path / "results" / "zz.json"

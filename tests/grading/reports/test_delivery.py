@@ -13,7 +13,7 @@ from conftest import sandbox_or_skip
 from small_class import cli
 
 from labkit import grading
-from labkit.grading.results import record as records
+from labkit.grading.store import record as records
 
 NOTEBOOK = "01_limacon.ipynb"
 SEED = "20261205"

@@ -6,8 +6,8 @@ import zipfile
 import pytest
 
 from labkit.grading.reports import delivery
-from labkit.grading.results import record as records
-from labkit.grading.results.report import SubmissionGrade, write_report
+from labkit.grading.store import record as records
+from labkit.grading.store.report import SubmissionGrade, write_report
 
 
 def test_canvas_names_carry_the_downloads_user_and_file_ids():

@@ -9,9 +9,9 @@ import sys
 import pytest
 
 from labkit.grading.reports import lms
-from labkit.grading.results import late
-from labkit.grading.results.report import SubmissionGrade, read_results, write_report
-from labkit.grading.results.rubric import default
+from labkit.grading.store import late
+from labkit.grading.store.report import SubmissionGrade, read_results, write_report
+from labkit.grading.store.rubric import default
 
 LAB = default()
 SPLINES = (10, 11, 12, 13, 14, 15)

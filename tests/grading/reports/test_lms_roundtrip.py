@@ -25,7 +25,7 @@ from docs_markdown import DOCS
 from small_class import SLIP
 
 from labkit import grading
-from labkit.grading.results import late
+from labkit.grading.store import late
 
 DEADLINE = "2026-12-01T23:59:00+01:00"
 COURSE = f'''title = "Lab 8 with a deadline"

@@ -9,9 +9,9 @@ from test_marking import _passed, _rubric
 
 from labkit.cli import main
 from labkit.grading.reports import lms, marking
-from labkit.grading.results import report
-from labkit.grading.results.names import name_from_cell, shown_name
-from labkit.grading.results.report import read_results
+from labkit.grading.store import report
+from labkit.grading.store.names import name_from_cell, shown_name
+from labkit.grading.store.report import read_results
 
 COMMON = "ada lovelace, " + "x" * 185  # 199 characters
 FIRST, SECOND = COMMON + "1" + "a" * 30, COMMON + "2" + "b" * 30  # 230 each

@@ -10,9 +10,9 @@ from labkit.cli import main
 from labkit.exercises.registry import LAB
 from labkit.grading.reports import marking
 from labkit.grading.reports.class_report import read as read_class
-from labkit.grading.results import report, rubric
-from labkit.grading.results.report import SubmissionGrade, file_stem
-from labkit.grading.results.rubric import DEFAULT
+from labkit.grading.store import report, rubric
+from labkit.grading.store.report import SubmissionGrade, file_stem
+from labkit.grading.store.rubric import DEFAULT
 
 # the answers of both branches and of exercise 3 weighed: the branches stay worth the same (3 + 3)
 ANSWERS = """
@@ -143,7 +143,7 @@ def test_marks_reach_grades_csv_the_feedback_the_report_and_the_export(tmp_path)
     assert main(["report", str(out), "--quiet"]) == 0
     assert "44.5" in (out / "report.html").read_text(encoding="utf-8")
     from labkit.grading.reports import lms
-    from labkit.grading.results.report import read_results
+    from labkit.grading.store.report import read_results
 
     roster = tmp_path / "roster.csv"
     roster.write_text("submission,id\nada,S1\n=bob,S2\n", encoding="utf-8")

@@ -15,7 +15,7 @@ from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading.reports import similarity
 from labkit.grading.reports.similarity import DEFAULT_THRESHOLD, Pair, similar_pairs
-from labkit.grading.results.report import SubmissionGrade, read_results, write_csv
+from labkit.grading.store.report import SubmissionGrade, read_results, write_csv
 from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources, reached_function_sources
 from labkit.grading.submission.scoring import graded_functions, read_cells
 from labkit.student_notebooks import paths

@@ -11,9 +11,9 @@ from catalog import Planted, plant
 from conftest import sandbox_or_skip
 from small_class import SLIP, cli, rows
 
-from labkit.grading.results import late
-from labkit.grading.results.report import SubmissionGrade, file_stem, safe_name
-from labkit.grading.results.rubric import default
+from labkit.grading.store import late
+from labkit.grading.store.report import SubmissionGrade, file_stem, safe_name
+from labkit.grading.store.rubric import default
 
 SOLVED = Planted("as handed out", "06_bilinear.ipynb", ())
 

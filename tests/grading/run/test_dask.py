@@ -145,6 +145,6 @@ def test_dask_bad_input_is_refused_saying_what_to_do(monkeypatch, tmp_path):
 
 
 def test_the_core_never_imports_dask():
-    code = "import sys, labkit.cli, labkit.grading.run.classrun, labkit.grading.run.dask, labkit.grading.results.report; print(sorted({'dask', 'distributed'} & set(sys.modules)))"
+    code = "import sys, labkit.cli, labkit.grading.run.classrun, labkit.grading.run.dask, labkit.grading.store.report; print(sorted({'dask', 'distributed'} & set(sys.modules)))"
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and run.stdout.strip() == "[]", run.stdout + run.stderr

@@ -13,9 +13,9 @@ import pytest
 from catalog import MISTAKES, Planted, plant
 from conftest import sandbox_or_skip
 
-from labkit.grading.results import late
-from labkit.grading.results import rubric as rubrics
-from labkit.grading.results.report import SubmissionGrade, file_stem, safe_name, write_report
+from labkit.grading.store import late
+from labkit.grading.store import rubric as rubrics
+from labkit.grading.store.report import SubmissionGrade, file_stem, safe_name, write_report
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 SEED = "4242"

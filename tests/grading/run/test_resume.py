@@ -14,9 +14,9 @@ import pytest
 from helpers import processes_with
 from small_class import SEED, cli, files
 
-from labkit.grading.results import rubric as rubrics
-from labkit.grading.results.report import file_stem, safe_name
 from labkit.grading.run.resume import resumed
+from labkit.grading.store import rubric as rubrics
+from labkit.grading.store.report import file_stem, safe_name
 from labkit.grading.submission.scoring import submission_name
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")

@@ -17,7 +17,7 @@ from conftest import sandbox_or_skip
 from labkit.exercises import variants
 from labkit.exercises.registry import LAB
 from labkit.grading.authoring.release import release_notebook, with_values
-from labkit.grading.results.report import file_stem
+from labkit.grading.store.report import file_stem
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="the sandbox is Linux's")
 ROOT = Path(__file__).resolve().parents[3]

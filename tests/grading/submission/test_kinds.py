@@ -21,8 +21,8 @@ from labkit.exercises.registry import LAB
 from labkit.exercises.result import ABOUT_THE_NOTEBOOK, KINDS, CheckResult, call
 from labkit.grading.options import GradeOptions
 from labkit.grading.reports import class_report
-from labkit.grading.results.report import FORMAT, ProblemText, SubmissionGrade, merge
 from labkit.grading.sandbox import remote
+from labkit.grading.store.report import FORMAT, ProblemText, SubmissionGrade, merge
 from labkit.grading.submission import scoring
 
 UNCONFINED = GradeOptions(backend="none", cell_timeout=2)
@@ -221,7 +221,7 @@ def test_a_results_problems_keep_their_kinds_through_its_file_and_old_formats_ar
 def test_the_report_on_a_folder_of_the_old_format_says_to_grade_again(tmp_path, capsys):
     import hashlib
 
-    from labkit.grading.results.report import write_report
+    from labkit.grading.store.report import write_report
 
     write_report(tmp_path, [SubmissionGrade("ada", {}, [ProblemText.one("a.ipynb: it stopped.", "crash")], 1)])
     [path] = (tmp_path / "results").iterdir()

@@ -22,7 +22,7 @@ from copies import REWRITES, exec_compressed, module_source
 from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading.options import GradeOptions
-from labkit.grading.results import report, rubric
+from labkit.grading.store import report, rubric
 from labkit.grading.submission import fingerprint, known, scan
 from labkit.grading.submission.scoring import (
     _rescore,

@@ -1,7 +1,7 @@
 """A grading run's record: what was graded, under which rubric and seed, by which labkit, and each result's hash.
 
 Every output folder that labkit writes (``labkit grade --out OUT``, a merge,
-:func:`labkit.grading.results.report.write_report`) holds ``record.json``, written by
+:func:`labkit.grading.store.report.write_report`) holds ``record.json``, written by
 the grader alone and replaced whole each time it changes:
 
 * ``labkit``: the version that graded;
@@ -56,7 +56,7 @@ class RunRecord:
     seed : int or list of int or None
         The run's seed; a merge's seeds.
     rubric : dict
-        The rubric's data (:attr:`labkit.grading.results.rubric.Rubric.data`).
+        The rubric's data (:attr:`labkit.grading.store.rubric.Rubric.data`).
     rubric_text : str or None
         The rubric's TOML text, when it was read from a file.
     submissions : dict
@@ -116,7 +116,7 @@ def new(kind, labkit, seed, rubric):
     if rubric.data is None or not rubrics.from_dict(rubric.data, rubric.source).same_as(rubric):
         raise ValueError(
             "the rubric was made or changed in code, not read from TOML, so a run cannot record it as it grades: "
-            "read it with labkit.grading.results.rubric.load (or from_dict)."
+            "read it with labkit.grading.store.rubric.load (or from_dict)."
         )
     return RunRecord(kind, labkit, seed, rubric.data, rubric.text)
 
@@ -307,7 +307,7 @@ def rubric_for(folders, given, command):
     """The rubric `command` scores the output `folders` with: their recorded one, which all must share.
 
     `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded
-    one; one that grades otherwise (:meth:`~labkit.grading.results.rubric.Rubric.differences`) is refused with a
+    one; one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
     ValueError saying how to score under it, since `command` shows what the run graded."""
     records = [(Path(folder), read(folder)) for folder in folders]
     first_folder, first = records[0]

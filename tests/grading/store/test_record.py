@@ -1,12 +1,12 @@
-"""The run's record (labkit.grading.results.record): what it vouches for, and a record that is not one."""
+"""The run's record (labkit.grading.store.record): what it vouches for, and a record that is not one."""
 
 import json
 
 import pytest
 
-from labkit.grading.results import record
-from labkit.grading.results.report import SubmissionGrade, read_results, write_report
-from labkit.grading.results.rubric import DEFAULT, default
+from labkit.grading.store import record
+from labkit.grading.store.report import SubmissionGrade, read_results, write_report
+from labkit.grading.store.rubric import DEFAULT, default
 
 
 def _run(folder, names=("ada", "bob")):

@@ -1,6 +1,6 @@
 """A student's feedback, in the order a student reads it: the total first, then what to fix, errors last.
 
-:func:`build` turns a :class:`~labkit.grading.results.report.SubmissionGrade` into a :class:`Feedback`, the one
+:func:`build` turns a :class:`~labkit.grading.store.report.SubmissionGrade` into a :class:`Feedback`, the one
 model both forms are made from: :func:`text` (``feedback/<submission>.txt``) and :func:`html`
 (``feedback/<submission>.html``, one self-contained page from an autoescaped Jinja template,
 :mod:`labkit.grading.pages`). Every part's kind comes from
@@ -13,7 +13,7 @@ model both forms are made from: :func:`text` (``feedback/<submission>.txt``) and
    raise ``NotImplementedError`` counted in one line; the cells of the release left as they were (a branch
    not chosen, a stub above them) not listed.
 
-Every text in the model is printable and bounded (:func:`~labkit.grading.results.report.one_line`); the HTML
+Every text in the model is printable and bounded (:func:`~labkit.grading.store.report.one_line`); the HTML
 template escapes it.
 """
 

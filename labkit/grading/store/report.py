@@ -9,7 +9,7 @@ Layout of an output folder::
                              hint, the errors of cells the student changed; .html the same as one page
     results/<name>.json      the same grade as data: merged by ``labkit merge``
     seed.txt                 the seed of the run's random test data
-    record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.results.record)
+    record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.store.record)
     merge.json               (labkit merge only) the folders merged and the results a later one replaced
 
 Every file here is written by the grader from its own results; nothing in
@@ -90,7 +90,7 @@ class SubmissionGrade:
     failure: str | None = None  # why the submission could not be graded at all (then it has no points, not zero)
     answers: dict = field(default_factory=dict)  # grade id -> the student's answer in words, for the instructor
     time: SubmissionTime | None = (
-        None  # when it was handed in (labkit.grading.results.late), None when no source had a time
+        None  # when it was handed in (labkit.grading.store.late), None when no source had a time
     )
     # graded function -> the source of its definition (printable, at most MAX_SOURCE_CHARS), for the similarity
     # search (labkit.grading.reports.similarity); never part of the grade
@@ -167,7 +167,7 @@ class SubmissionGrade:
 
     @property
     def lateness(self):
-        """What the rubric's late rule makes of this submission (:class:`labkit.grading.results.late.Lateness`), or None
+        """What the rubric's late rule makes of this submission (:class:`labkit.grading.store.late.Lateness`), or None
         when the rubric has no ``[late]`` table or the submission could not be graded."""
         if self.rubric.late is None or not self.graded:
             return None
@@ -185,7 +185,7 @@ class SubmissionGrade:
         return self.score.total if lateness is None else lateness.total
 
     def feedback(self):
-        """The feedback text a student reads: the total first (labkit.grading.results.feedback)."""
+        """The feedback text a student reads: the total first (labkit.grading.store.feedback)."""
         return feedbacks.text(feedbacks.build(self))
 
     def _summary(self):
@@ -344,7 +344,7 @@ PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$"
 def file_stem(name: str) -> str:
     """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
     name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
-    :func:`~labkit.grading.results.report.safe_name`'s, with a hash of the whole name. A plain name never ends
+    :func:`~labkit.grading.store.report.safe_name`'s, with a hash of the whole name. A plain name never ends
     as a hashed one does, so two submissions never share a file.
 
     >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
@@ -362,7 +362,7 @@ def csv_cell(value):
 
 
 def name_cell(name):
-    """A submission's name as a CSV cell: whole (it is the key: labkit.grading.results.names), with an apostrophe
+    """A submission's name as a CSV cell: whole (it is the key: labkit.grading.store.names), with an apostrophe
     before a start a spreadsheet would run as a formula and control characters spelled ``\\xNN``.
 
     >>> name_cell("=1+1 eve"), name_cell("a" * 600) == "a" * 600
@@ -469,7 +469,7 @@ def write_csv(path, grades):
 def write_result(out_dir, grade):
     """results/<name>.json and feedback/<name>.txt of one submission, each replaced whole (a run killed while
     writing leaves the earlier file or none, never half of one); the result file and the SHA-256 of what was
-    written (:class:`labkit.grading.results.record.Written`), for the run's record."""
+    written (:class:`labkit.grading.store.record.Written`), for the run's record."""
     out = Path(out_dir)
     for folder in ("results", "feedback"):
         (out / folder).mkdir(parents=True, exist_ok=True)
@@ -481,7 +481,7 @@ def write_result(out_dir, grade):
 
 
 def _write_feedback(folder, grade):
-    """feedback/<submission>.txt and .html (labkit.grading.results.feedback)."""
+    """feedback/<submission>.txt and .html (labkit.grading.store.feedback)."""
     model, stem = feedbacks.build(grade), file_stem(grade.name)
     _replace(folder / f"{stem}.txt", feedbacks.text(model))
     _replace(folder / f"{stem}.html", feedbacks.html(model))
@@ -495,7 +495,7 @@ def _replace(path, text):
 
 def write_report(out_dir, grades, record=None):
     """grades.csv plus each submission's result and feedback files, each entered in the run's `record`
-    (:mod:`labkit.grading.results.record`; a new one of the grades' rubric and seeds when None), which is
+    (:mod:`labkit.grading.store.record`; a new one of the grades' rubric and seeds when None), which is
     written too."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -567,7 +567,7 @@ class Merged(list):
 
 def read_results(folders, rubric=None, replaced=None):
     """Every result of the given output folders that their run records vouch for, in name order, scored with
-    `rubric` (their recorded rubric when None; :mod:`labkit.grading.results.record`).
+    `rubric` (their recorded rubric when None; :mod:`labkit.grading.store.record`).
 
     A submission with a result in several folders counts from the last of them, in the order given (a
     regrade replaces the class's result); a later result without a submission time keeps the earlier one's.
@@ -643,7 +643,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
         Scores every result, and its ``[late]`` table applies to the submission times they carry; its
         exercises, groups and points must be the folders' own.
     times : dict, optional
-        {submission name: datetime} (:func:`labkit.grading.results.late.read_times`): these times replace the
+        {submission name: datetime} (:func:`labkit.grading.store.late.read_times`): these times replace the
         stored ones of the submissions they name.
     progress : bool
         Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).

@@ -7,8 +7,8 @@ import tomllib
 import pytest
 
 from labkit.check import EXERCISES
-from labkit.grading.results import rubric as rubrics
-from labkit.grading.results.report import SubmissionGrade
+from labkit.grading.store import rubric as rubrics
+from labkit.grading.store.report import SubmissionGrade
 
 # The groups come from the lab's rubric file and the points from the exercises' declarations (the registry), so a
 # new exercise in a group changes the expectations below with it; only the first test states the lab's own rule.

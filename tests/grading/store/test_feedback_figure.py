@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from labkit.exercises.registry import _student_figure
-from labkit.grading.results import feedback
-from labkit.grading.results.report import SubmissionGrade
-from labkit.grading.results.rubric import default
+from labkit.grading.store import feedback
+from labkit.grading.store.report import SubmissionGrade
+from labkit.grading.store.rubric import default
 from labkit.plotdata import Line, figure_data
 
 

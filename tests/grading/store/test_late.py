@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 
 from labkit.grading import merge
-from labkit.grading.results import late
-from labkit.grading.results import rubric as rubrics
-from labkit.grading.results.report import CSV_TAIL, SubmissionGrade, safe_name, write_report
+from labkit.grading.store import late
+from labkit.grading.store import rubric as rubrics
+from labkit.grading.store.report import CSV_TAIL, SubmissionGrade, safe_name, write_report
 
 CET = timezone(timedelta(hours=1))
 DEADLINE = datetime(2026, 12, 1, 23, 59, tzinfo=CET)

@@ -8,7 +8,7 @@ weights of its parts (:mod:`labkit.exercises`); a rubric may give an
 exercise other points in a ``[points]`` table, which scales its parts.
 ``exercises = "module:attribute"`` names another course's exercises (the
 lab's by default). An optional ``[late]`` table sets a deadline and what
-lateness costs (:mod:`labkit.grading.results.late`). An optional ``[held]`` table releases parts held for a person
+lateness costs (:mod:`labkit.grading.store.late`). An optional ``[held]`` table releases parts held for a person
 (their code matched a known source, :mod:`labkit.grading.submission.known`): ``release = {"ada" = [2, 10]}`` pays
 ada's held parts of exercises 2 and 10. An optional ``[answers]`` table gives the answers in words points a
 person marks (``labkit mark``): ``exercise12-answer-1 = 2`` (the answer's nbgrader grade id, as in grades.csv);
@@ -109,7 +109,7 @@ class Rubric:
     def digest(self):
         """A fingerprint of what the rubric grades and how: its title, exercises, groups and points.
 
-        Results graded under different rubrics are not merged (:func:`labkit.grading.results.report.read_results`).
+        Results graded under different rubrics are not merged (:func:`labkit.grading.store.report.read_results`).
         The ``[late]`` table is left out: ``labkit merge`` applies the late rule of the rubric it is given to the
         submission times the results carry.
         """
