@@ -16,6 +16,8 @@ ValueError that says so, instead of returning inf or NaN.
 
 import numpy as np
 
+from .errors import InputError
+
 LIMIT = 200  # binary exponents beyond +-LIMIT (about 1e+-60) are scaled
 
 
@@ -57,7 +59,7 @@ class Frame:
             if np.any(bad):
                 where = float(np.ldexp(np.asarray(points)[bad].flat[0], self.ex))
                 what = "value" if der == 0 else f"derivative of order {der}"
-                raise ValueError(
+                raise InputError(
                     f"the interpolant's {what} at xval = {where:g} is beyond the float range; "
                     "evaluate nearer to the data, or rescale xdata and ydata."
                 )
@@ -70,7 +72,7 @@ class Frame:
         if not np.all(np.isfinite(slopes)):
             gaps = np.diff(self._x)
             k = int(np.argmin(gaps))
-            raise ValueError(
+            raise InputError(
                 f"the {name} slopes are beyond the float range: the data change too fast for their spacing "
                 f"(the smallest interval is xdata[{k + 1}] - xdata[{k}] = {gaps[k]:g}). Rescale ydata, or "
                 "merge points that are this close."

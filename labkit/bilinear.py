@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._locate import locate
 from ._validate import as_float_array, as_knots, require_finite
+from .errors import InputError
 
 
 def eval_pbilin(
@@ -57,7 +58,7 @@ def eval_pbilin(
     yv = np.atleast_1d(as_float_array(yval, "yval"))
     for arr, name in ((xv, "xval"), (yv, "yval")):
         if arr.ndim != 1:
-            raise ValueError(f"{name} must be 1-D (the grid is xval x yval); got shape {arr.shape}.")
+            raise InputError(f"{name} must be 1-D (the grid is xval x yval); got shape {arr.shape}.")
     # Separable: linear in x along every grid line y = ydata[j], then linear in y.
     kx, wx = _cell_and_weight(x, xv)
     along_x = values[kx] * (1.0 - wx)[:, None] + values[kx + 1] * wx[:, None]
@@ -80,7 +81,7 @@ def _grid_values(f, x, y):
         values = as_float_array(f, "f")
         name = "f"
     if values.shape != (x.size, y.size):
-        raise ValueError(
+        raise InputError(
             f"{name} has shape {values.shape} but the grid is {x.size} x {y.size}; "
             "f must give one value per (xdata[i], ydata[j])."
         )

@@ -20,6 +20,7 @@ test_pherm_interpolate)``.
 
 import functools
 
+from .errors import InputError
 from .exercises import experiments as _experiments
 from .exercises.model import Exercise  # noqa: F401 - part of the facade (__all__)
 from .exercises.registry import FACADE as _FACADE
@@ -64,7 +65,7 @@ def _scale(experiment, data):
     name = experiment.scale.name
     unknown = sorted(set(data) - {name})
     if unknown:
-        raise ValueError(
+        raise InputError(
             f"the {experiment.key!r} experiment's check takes {name}= (the notebook's data cell), not "
             f"{', '.join(unknown)}=: pass {name}={name}."
         )

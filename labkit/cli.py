@@ -20,6 +20,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from .errors import InputError
+
 GRADE_EXTRA = ("nbformat", "nbclient", "rich")
 
 
@@ -30,7 +32,7 @@ def _notebooks(args):
     sources = paths()
     existing = [out / p.name for p in sources if (out / p.name).exists()]
     if existing and not args.force:
-        raise ValueError(
+        raise InputError(
             f"{existing[0]} already exists (your work?); choose another folder, or --force to "
             "overwrite the notebooks there."
         )
@@ -46,20 +48,20 @@ def _handin(args):
 
     folder = args.folder
     if not folder.exists():
-        raise ValueError(f"there is no {folder}; give the folder that holds your notebooks (or one notebook).")
+        raise InputError(f"there is no {folder}; give the folder that holds your notebooks (or one notebook).")
     if folder.is_file():
         files = [folder] if folder.suffix == ".ipynb" else []
     else:
         files = sorted(p for p in folder.glob("*.ipynb") if not p.name.startswith("."))
     if not files:
-        raise ValueError(f"{folder} holds no notebooks (*.ipynb); give the folder you work in.")
+        raise InputError(f"{folder} holds no notebooks (*.ipynb); give the folder you work in.")
     if args.timeout < 1:
-        raise ValueError(f"--timeout must be at least 1 second; got {args.timeout}.")
+        raise InputError(f"--timeout must be at least 1 second; got {args.timeout}.")
     lab = [(path, lab_notebook_of(path)) for path in files]
     skipped = [path.name for path, name in lab if name is None]
     lab = [(path, name) for path, name in lab if name is not None]
     if not lab:
-        raise ValueError(
+        raise InputError(
             f"none of the notebooks in {folder} is one of the lab's ({', '.join(skipped)}); give the folder "
             "that holds 01_limacon.ipynb ... 06_bilinear.ipynb."
         )
@@ -68,7 +70,7 @@ def _handin(args):
 
         from .handin import run_notebook
     except ModuleNotFoundError as exc:
-        raise ValueError(
+        raise InputError(
             f"labkit handin runs the notebooks with {exc.name}, which is not installed: pip install nbclient"
         ) from None
     results = []
@@ -110,7 +112,7 @@ def _execute(args):
         try:
             execute(path, timeout=args.timeout, before_save=marked)
         except CellExecutionError as exc:
-            raise ValueError(f"{path.name} failed; it was not saved.\n{str(exc)[:2000]}") from None
+            raise InputError(f"{path.name} failed; it was not saved.\n{str(exc)[:2000]}") from None
     return 0
 
 
@@ -119,7 +121,7 @@ def _roster_and_variants(args, purpose):
     if args.roster is None and args.variants is None:
         return None, None
     if args.roster is None or args.variants is None:
-        raise ValueError(f"give both --roster and --variants {purpose}, or neither.")
+        raise InputError(f"give both --roster and --variants {purpose}, or neither.")
     from .exercises import variants
     from .grading.reports.lms import read_roster
 
@@ -264,7 +266,7 @@ def grade_options(args):
 
     for name in ("jobs", "cell_timeout", "total_timeout", "memory", "grader_memory"):
         if getattr(args, name) < 1:
-            raise ValueError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
+            raise InputError(f"--{name.replace('_', '-')} must be at least 1; got {getattr(args, name)}.")
     return GradeOptions(
         cell_timeout=args.cell_timeout,
         total_timeout=args.total_timeout,
@@ -298,10 +300,10 @@ def _merge(args):
     start = time.perf_counter()
     given = [flag for flag, value in (("--shard", args.shard), ("--dask", args.dask), ("--fresh", args.fresh)) if value]
     if given:
-        raise ValueError(f"{', '.join(given)} grade(s) submissions, which `labkit merge` does not; merge without them.")
+        raise InputError(f"{', '.join(given)} grade(s) submissions, which `labkit merge` does not; merge without them.")
     for flag in ("times_from_mtime", "times_from_submission", "times_from_exchange"):
         if getattr(args, flag):
-            raise ValueError(
+            raise InputError(
                 f"--{flag.replace('_', '-')} reads the submissions' files or the exchange, which `labkit merge` does "
                 "not: give the times in --times TIMES.csv (the results keep the times they were graded with)."
             )
@@ -320,19 +322,19 @@ def _grade(args):
     from .grading.store.late import read_exchange, read_times
 
     if args.merge is not None:
-        raise ValueError(
+        raise InputError(
             "`labkit grade --merge` is now a command of its own: labkit merge DIR... --out DIR [--rubric R] "
             "[--times T]."
         )
     start = time.perf_counter()
     times = read_times(args.times) if args.times else None
     if not args.submissions:
-        raise ValueError(
+        raise InputError(
             "give the submissions: the class folder (or zip) the LMS gave you, or each submission (notebooks or "
             "folders); `labkit merge DIR...` combines runs."
         )
     if args.dask_workers is not None and args.dask != "local":
-        raise ValueError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
+        raise InputError("--dask-workers is the size of --dask local; a cluster's workers are started on its machines.")
     options = grade_options(args)
     engine = _engine(args)
     roster, variants = _roster_and_variants(args, "to grade each student against their own data")
@@ -343,11 +345,11 @@ def _grade(args):
     exchange = None
     if args.times_from_exchange is not None:
         if not args.assignment:
-            raise ValueError("--times-from-exchange needs --assignment NAME: the assignment's name in nbgrader.")
+            raise InputError("--times-from-exchange needs --assignment NAME: the assignment's name in nbgrader.")
         exchange = read_exchange(args.times_from_exchange, args.assignment)
     for given in args.submissions:
         if given.is_dir() and args.out.resolve().is_relative_to(given.resolve()):
-            raise ValueError(
+            raise InputError(
                 f"--out {args.out} is inside {given}, where it would read as part of a submission: give an --out "
                 "outside it."
             )
@@ -421,7 +423,7 @@ def _class(args, workspace):
     if len(paths) != 1 or not intake.is_class(paths[0]):
         for flag, value in (("--assignment", args.assignment), ("--student", args.student)):
             if value:
-                raise ValueError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
+                raise InputError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
         found = intake.find_students(paths, workspace)
     else:
         from .grading.reports.lms import read_roster
@@ -435,7 +437,7 @@ def _class(args, workspace):
             from .grading.store.report import one_line
 
             shown = ", ".join(repr(one_line(name, 64)) for name in sorted(names)[:10])
-            raise ValueError(
+            raise InputError(
                 f"--student {one_line(unknown[0], 60)!r} is not in {paths[0]}; its students are named {shown}"
                 f"{' ...' if len(names) > 10 else ''} (as in grades.csv)."
             )
@@ -480,9 +482,9 @@ def _export(args):
     from .grading.store.report import read_results
 
     if args.canvas is not None and args.feedback:
-        raise ValueError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
+        raise InputError("--feedback is for --moodle; a Canvas gradebook has no feedback column to import.")
     if args.canvas is None and args.new_column:
-        raise ValueError("--new-column is for --canvas; Moodle's import maps a column to a new grade item itself.")
+        raise InputError("--new-column is for --canvas; Moodle's import maps a column to a new grade item itself.")
     # the run's recorded rubric (late rule included): what is exported is grades.csv's total
     grades = read_results([args.results], rubric_for([args.results], args.rubric, "labkit export"))
     _refused(grades, "labkit export")
@@ -530,7 +532,7 @@ def _report(args):
     start = time.perf_counter()
     threshold = args.similarity_threshold
     if not 0.0 < threshold <= 1.0:
-        raise ValueError(f"--similarity-threshold is a similarity above 0 and at most 1; got {threshold}.")
+        raise InputError(f"--similarity-threshold is a similarity above 0 and at most 1; got {threshold}.")
     grades = class_report.read(args.out, args.rubric)  # the run's recorded rubric; a different one is refused
     _refused(grades, "labkit report")
     functions = {function for grade in grades for function in grade.sources}
@@ -1023,18 +1025,18 @@ def _variants(args):
         print(f"wrote {args.new}: keep it private; give it to `labkit release` and `labkit grade` as --variants")
         return 0
     if args.variants is None:
-        raise ValueError("give the course's variants file: --variants SECRET_FILE (make one with --new FILE).")
+        raise InputError("give the course's variants file: --variants SECRET_FILE (make one with --new FILE).")
     found = variants.read(args.variants)
     roster = read_roster(args.roster) if args.roster is not None else None
     if args.redraw is not None:
         if args.exercise is None or roster is None:
-            raise ValueError(
+            raise InputError(
                 "--redraw needs --exercise N (the exercise whose data the student gets afresh) and --roster (the "
                 "roster the id is in)."
             )
         args.redraw = args.redraw.strip()
         if args.redraw not in roster.values():
-            raise ValueError(
+            raise InputError(
                 f"{one_line(args.redraw, 60)} is no id of the roster {args.roster}: give an id as it has it."
             )
         number = variants.redraw(args.variants, args.redraw, args.exercise, course)
@@ -1043,7 +1045,7 @@ def _variants(args):
         return 0
     if args.show:
         if roster is None:
-            raise ValueError("--show needs --roster: the students whose data to print.")
+            raise InputError("--show needs --roster: the students whose data to print.")
         for name, key in roster.items():
             values = found.values(course, key)
             shown = "; ".join(

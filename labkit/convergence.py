@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, as_scalar
 from .bilinear import eval_pbilin
+from .errors import InputError
 from .functions import runge, runge2d
 from .monotone import pchip_slopes
 from .piecewise import _hermite_eval, eval_plin
@@ -117,12 +118,12 @@ def ratio_table(title: str, ndata: ArrayLike, errors: ArrayLike) -> str:
     sizes = _sizes(ndata)
     values = as_float_array(errors, "errors")
     if values.shape != sizes.shape:
-        raise ValueError(
+        raise InputError(
             f"errors has {values.size} entries but ndata has {sizes.size}; give one error per row "
             "(e.g. [test_pherm_interpolate(n) for n in ndata])."
         )
     if not np.all(np.isfinite(values)) or np.any(values <= 0):
-        raise ValueError(
+        raise InputError(
             "every error must be a positive finite number; a zero or NaN error means the driver "
             "measured at the wrong points or failed."
         )
@@ -169,7 +170,7 @@ def convergence_table(
     ndata = 11  Err( 11) =  1.252e-03  Err(  5)/Err( 11) =   28.446
     """
     if not isinstance(method, str) or method not in METHOD_TITLES:
-        raise ValueError(f"unknown method {method!r}; choose one of {', '.join(map(repr, METHOD_TITLES))}.")
+        raise InputError(f"unknown method {method!r}; choose one of {', '.join(map(repr, METHOD_TITLES))}.")
     sizes = _sizes(ndata)
     a, b = _check_interval(interval)
     xtest = np.linspace(a, b, _count(ntest, "ntest"))
@@ -184,9 +185,9 @@ def _sizes(ndata):
     """ndata: at least two whole numbers, each at least 2."""
     sizes = as_float_array(ndata, "ndata")
     if sizes.ndim != 1 or sizes.size < 2 or not np.all(np.isfinite(sizes)) or np.any(sizes != np.round(sizes)):
-        raise ValueError("ndata must be a sequence of at least two whole numbers of points.")
+        raise InputError("ndata must be a sequence of at least two whole numbers of points.")
     if np.any(sizes < 2):
-        raise ValueError("every entry of ndata must be at least 2 (one interval).")
+        raise InputError("every entry of ndata must be at least 2 (one interval).")
     return sizes.astype(int)
 
 
@@ -194,17 +195,17 @@ def _count(value, name):
     """A whole number of test points, at least 2."""
     number = as_scalar(value, name)
     if number != round(number) or number < 2:
-        raise ValueError(f"{name} must be a whole number of test points, at least 2; got {value!r}.")
+        raise InputError(f"{name} must be a whole number of test points, at least 2; got {value!r}.")
     return int(number)
 
 
 def _check_interval(interval, name="interval"):
     ends = as_float_array(interval, name)
     if ends.shape != (2,):
-        raise ValueError(f"{name} must be a pair (a, b) of numbers.")
+        raise InputError(f"{name} must be a pair (a, b) of numbers.")
     a, b = float(ends[0]), float(ends[1])
     if not (np.isfinite(a) and np.isfinite(b) and a < b):
-        raise ValueError(f"interval must satisfy a < b with finite ends; got ({a}, {b}).")
+        raise InputError(f"interval must satisfy a < b with finite ends; got ({a}, {b}).")
     return a, b
 
 
@@ -213,7 +214,7 @@ def _values_and_slopes(f, x, method):
     if isinstance(out, tuple):
         return np.asarray(out[0], dtype=float), np.asarray(out[1], dtype=float)
     if method in NEEDS_DERIVATIVE:
-        raise ValueError(
+        raise InputError(
             f"method {method!r} needs derivatives: f must return (values, derivatives) as labkit.runge does."
         )
     return np.asarray(out, dtype=float), None

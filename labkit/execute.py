@@ -13,6 +13,8 @@ ignores the tag, so an error there still stops it.
 import subprocess
 from pathlib import Path
 
+from .errors import InputError
+
 KERNEL = "python3"
 RAISES = "raises-exception"
 KERNELSPEC = {"display_name": "Python 3 (ipykernel)", "language": "python", "name": KERNEL}
@@ -22,7 +24,7 @@ def notebook_paths(directory):
     """The notebooks of a folder, in teaching order, skipping checkpoint copies."""
     paths = sorted(Path(directory).glob("*.ipynb"))
     if not paths:
-        raise ValueError(f"no notebooks (*.ipynb) in {directory}.")
+        raise InputError(f"no notebooks (*.ipynb) in {directory}.")
     return paths
 
 
@@ -33,11 +35,11 @@ def read_notebook(path):
     try:
         text = Path(path).read_text(encoding="utf-8")
     except UnicodeDecodeError:
-        raise ValueError(f"{Path(path).name} is not a text file, so not a notebook.") from None
+        raise InputError(f"{Path(path).name} is not a text file, so not a notebook.") from None
     try:
         return nbformat.reads(text, as_version=4)
     except Exception as exc:  # noqa: BLE001 - nbformat raises several kinds for broken files
-        raise ValueError(
+        raise InputError(
             f"{Path(path).name} is not a valid notebook ({type(exc).__name__}: {str(exc)[:200]})."
         ) from None
 

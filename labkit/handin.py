@@ -29,6 +29,7 @@ from numbers import Real
 from pathlib import Path
 
 from . import notebook as _notebook
+from .errors import InputError
 from .exercises.model import sections
 from .exercises.result import NOT_DONE, NOT_IMPLEMENTED, part_kind
 
@@ -165,7 +166,7 @@ def notebook_file(notebook: str) -> str:
     name = Path(name).name if name.endswith(".ipynb") else f"{Path(name).name}.ipynb"
     if name not in known:
         stems = ", ".join(f'"{Path(n).stem}"' for n in sorted(known))
-        raise ValueError(f"{notebook!r} is not one of the lab's notebooks; give one of {stems}.")
+        raise InputError(f"{notebook!r} is not one of the lab's notebooks; give one of {stems}.")
     return name
 
 
@@ -190,7 +191,7 @@ def ready_to_hand_in(notebook: str, namespace: Mapping | None = None, path: str 
     if namespace is None:
         namespace = sys._getframe(1).f_globals  # the notebook's variables: a cell runs in them
     if not isinstance(namespace, Mapping):
-        raise ValueError(
+        raise InputError(
             f"namespace must be a mapping of the notebook's names (globals()); got {type(namespace).__name__}."
         )
     if _notebook.headless():  # the grader's sandbox: nobody reads the table there, and the grade is its own
@@ -337,10 +338,10 @@ def _read_notebook(name: str, namespace: Mapping, path) -> tuple:
     if path is not None:
         file = Path(path)
         if not file.is_file():
-            raise ValueError(f"path {str(path)!r} is not a file; give the path of the saved notebook, or leave it out.")
+            raise InputError(f"path {str(path)!r} is not a file; give the path of the saved notebook, or leave it out.")
         cells = _cells(file)
         if cells is None:
-            raise ValueError(f"{file.name} is not a notebook (.ipynb) that can be read.")
+            raise InputError(f"{file.name} is not a notebook (.ipynb) that can be read.")
         return cells, f"in {file.name} as saved"
     colab = _colab_cells()
     if colab is not None:
@@ -460,7 +461,7 @@ def run_notebook(file: str | os.PathLike, timeout: int = 300) -> HandIn:
     file = Path(file)
     name = lab_notebook_of(file)
     if name is None:
-        raise ValueError(f"{file.name} is not one of the lab's notebooks.")
+        raise InputError(f"{file.name} is not one of the lab's notebooks.")
     nb = nbformat.read(file, as_version=4)
     numbers = _notebook.prompt_numbers(nb.cells)  # the student's numbering, the hand-in cell still in place
     ran = [(i, c) for i, c in enumerate(nb.cells) if not (c.cell_type == "code" and "ready_to_hand_in(" in c.source)]

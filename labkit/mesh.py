@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._alt import describe, num
 from ._validate import as_float_array, require_finite
+from .errors import InputError
 
 if TYPE_CHECKING:  # matplotlib is imported only when a mesh is drawn
     from matplotlib.axes import Axes
@@ -49,14 +50,14 @@ class QuadMesh:
         self.points = as_float_array(points, "points")
         numbers = as_float_array(quads, "quads")
         if not np.all(np.isfinite(numbers)) or np.any(numbers != np.round(numbers)):
-            raise ValueError("quads must hold whole node numbers (0, 1, 2, ...).")
+            raise InputError("quads must hold whole node numbers (0, 1, 2, ...).")
         self.quads = numbers.astype(np.intp)
         if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
-            raise ValueError(f"points must have shape (N, 2) or (N, 3); got {self.points.shape}.")
+            raise InputError(f"points must have shape (N, 2) or (N, 3); got {self.points.shape}.")
         if self.quads.ndim != 2 or self.quads.shape[1] != 4:
-            raise ValueError(f"quads must have shape (M, 4); got {self.quads.shape}.")
+            raise InputError(f"quads must have shape (M, 4); got {self.quads.shape}.")
         if self.quads.size and (self.quads.min() < 0 or self.quads.max() >= len(self.points)):
-            raise ValueError("quads refer to nodes that do not exist in points.")
+            raise InputError("quads refer to nodes that do not exist in points.")
 
     def __repr__(self) -> str:
         return f"QuadMesh({len(self.points)} nodes, {len(self.quads)} quads, {self.dim}-D)"
@@ -112,7 +113,7 @@ class QuadMesh:
         if not isinstance(other, QuadMesh):
             return NotImplemented
         if other.dim != self.dim:
-            raise ValueError(f"cannot join a {self.dim}-D mesh and a {other.dim}-D mesh.")
+            raise InputError(f"cannot join a {self.dim}-D mesh and a {other.dim}-D mesh.")
         points = np.vstack((self.points, other.points))
         quads = np.vstack((self.quads, other.quads + len(self.points)))
         shortest = min(_shortest_edge(self), _shortest_edge(other))
@@ -129,7 +130,7 @@ class QuadMesh:
 
         path = Path(path)
         if path.suffix.lower() not in WRITERS:
-            raise ValueError(f"cannot tell the mesh format from {path.name!r}; use one of " + ", ".join(WRITERS) + ".")
+            raise InputError(f"cannot tell the mesh format from {path.name!r}; use one of " + ", ".join(WRITERS) + ".")
         file_format, options = WRITERS[path.suffix.lower()]
         points = self.points if self.dim == 3 else np.column_stack((self.points, np.zeros(len(self.points))))
         cell_data: dict[str, list[NDArray[Any]]] = {"quality": [self.quality()]}
@@ -257,14 +258,14 @@ def quad_mesh(x: ArrayLike, y: ArrayLike, z: ArrayLike | None = None) -> QuadMes
     coords = [_grid(c, name) for c, name in ((x, "x"), (y, "y"), (z, "z")) if c is not None or name != "z"]
     shapes = {c.shape for c in coords}
     if len(shapes) != 1:
-        raise ValueError(
+        raise InputError(
             "coordinate arrays of different shapes: "
             + ", ".join(f"{n} {c.shape}" for n, c in zip("xyz", coords))
             + ". Pass the arrays of one patch evaluation."
         )
     ns, nt = coords[0].shape
     if ns < 2 or nt < 2:
-        raise ValueError(f"a mesh needs at least 2 x 2 nodes; got {ns} x {nt}.")
+        raise InputError(f"a mesh needs at least 2 x 2 nodes; got {ns} x {nt}.")
     index = np.arange(ns * nt).reshape(ns, nt)
     quads = np.stack((index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]), axis=-1).reshape(-1, 4)
     return QuadMesh(np.stack([c.ravel() for c in coords], axis=1), quads)
@@ -273,7 +274,7 @@ def quad_mesh(x: ArrayLike, y: ArrayLike, z: ArrayLike | None = None) -> QuadMes
 def _grid(values, name):
     arr = as_float_array(values, name)
     if arr.ndim != 2:
-        raise ValueError(f"{name} must be a 2-D array of shape (ns, nt); got shape {arr.shape}.")
+        raise InputError(f"{name} must be a 2-D array of shape (ns, nt); got shape {arr.shape}.")
     require_finite(arr, name)
     return arr
 
@@ -301,7 +302,7 @@ def _merge_coincident(points, quads, tolerance):
     count = int(np.sum(counts.astype(np.int64) * (counts - 1) // 2))
     limit = max(10_000, 10 * len(points))
     if count > limit:
-        raise ValueError(
+        raise InputError(
             f"{count:,} pairs of nodes coincide; meshes should meet only along their shared edges. "
             "Check that each mesh's nodes are distinct (no points piled on one spot)."
         )

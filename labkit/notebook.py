@@ -16,6 +16,8 @@ import sys
 import warnings
 from dataclasses import dataclass, replace
 
+from .errors import InputError
+
 
 class VersionWarning(UserWarning):
     """The kernel's labkit is another version than the one the notebook was written for."""
@@ -63,7 +65,7 @@ def ready(written_for: str) -> None:
     wanted = str(written_for).strip()
     parts = wanted.split(".")
     if len(parts) != 2 or not all(part.isdigit() for part in parts):
-        raise ValueError(
+        raise InputError(
             f'give the labkit version the notebook was written for as "major.minor", e.g. "0.1"; got {written_for!r}.'
         )
     have = _installed_version()
@@ -78,7 +80,7 @@ def ready(written_for: str) -> None:
     track_cells()
     missing = [name for name in NEEDED if importlib.util.find_spec(name) is None]
     if missing:
-        raise ValueError(
+        raise InputError(
             f"the kernel lacks {', '.join(missing)}, which the notebooks use: install labkit with "
             f"its dependencies in a cell,\n    {INSTALL}\nthen restart the kernel."
         )

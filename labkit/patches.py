@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, require_finite
+from .errors import InputError
 from .piecewise import hermite_basis
 
 
@@ -47,13 +48,13 @@ class Corner:
     def __init__(self, point: ArrayLike, ds: ArrayLike, dt: ArrayLike, dsdt: ArrayLike | None = None) -> None:
         where = _vector(point, "point")
         if where.size not in (2, 3):
-            raise ValueError(f"Corner point must have 2 (plane) or 3 (space) coordinates; got {where.size}.")
+            raise InputError(f"Corner point must have 2 (plane) or 3 (space) coordinates; got {where.size}.")
         twist = np.zeros(where.size) if dsdt is None else dsdt
         object.__setattr__(self, "point", where)
         for name, value in (("ds", ds), ("dt", dt), ("dsdt", twist)):
             vec = _vector(value, name)
             if vec.size != where.size:
-                raise ValueError(
+                raise InputError(
                     f"Corner {name} has {vec.size} components but point has {where.size}; "
                     "give every field of a corner the same dimension."
                 )
@@ -68,7 +69,7 @@ class Corner:
 def _vector(value, name):
     vec = as_float_array(value, f"Corner {name}")
     if vec.ndim != 1:
-        raise ValueError(f"Corner {name} must be a vector; got shape {vec.shape}.")
+        raise InputError(f"Corner {name} must be a vector; got shape {vec.shape}.")
     require_finite(vec, f"Corner {name}")
     return vec.copy()
 
@@ -76,10 +77,10 @@ def _vector(value, name):
 def _parameter(values, name):
     u = as_float_array(values, name)
     if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array of parameter values in [0, 1]; got shape {u.shape}.")
+        raise InputError(f"{name} must be a non-empty 1-D array of parameter values in [0, 1]; got shape {u.shape}.")
     require_finite(u, name)
     if u.min() < 0.0 or u.max() > 1.0:
-        raise ValueError(
+        raise InputError(
             f"{name} must lie in [0, 1] (the unit square is the patch's parameter domain); "
             f"got values from {u.min():g} to {u.max():g}."
         )
@@ -123,10 +124,10 @@ def patch(A: Corner, B: Corner, C: Corner, D: Corner, s: ArrayLike, t: ArrayLike
     corners = (A, B, C, D)
     for label, corner in zip("ABCD", corners):
         if not isinstance(corner, Corner):
-            raise ValueError(f"{label} must be a labkit.Corner; got {type(corner).__name__}.")
+            raise InputError(f"{label} must be a labkit.Corner; got {type(corner).__name__}.")
     dims = {c.dim for c in corners}
     if len(dims) != 1:
-        raise ValueError(
+        raise InputError(
             "corners of mixed dimension: "
             + ", ".join(f"{lab} is {c.dim}-D" for lab, c in zip("ABCD", corners))
             + ". Give all four corners 2 or all four 3 coordinates."

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._frame import Frame
 from ._validate import as_data, as_knots, as_order, as_points, as_scalar, scalar_or_array
+from .errors import InputError
 from .piecewise import _hermite_eval
 
 
@@ -28,7 +29,7 @@ def _solve_tridiagonal(sub, diag, sup, rhs):
 
     *_, solution, info = lapack.dgtsv(sub, diag, sup, rhs, 1, 1, 1, 1)
     if info != 0:  # cannot happen for the diagonally dominant systems built here
-        raise ValueError(f"the spline system is singular (LAPACK info={info}).")
+        raise InputError(f"the spline system is singular (LAPACK info={info}).")
     return solution
 
 

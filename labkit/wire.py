@@ -12,6 +12,8 @@ from importlib import import_module
 
 import numpy as np
 
+from .errors import InputError
+
 
 @dataclass(frozen=True)
 class WireType:
@@ -34,9 +36,9 @@ def _corner(point, ds, dt, dsdt):
 
     fields = [np.ravel(f) for f in (point, ds, dt, dsdt)]
     if fields[0].size not in (2, 3) or any(f.size != fields[0].size for f in fields):
-        raise ValueError("an invalid Corner (its fields must be vectors of 2 or 3 numbers, all the same size)")
+        raise InputError("an invalid Corner (its fields must be vectors of 2 or 3 numbers, all the same size)")
     if not all(np.all(np.isfinite(f)) for f in fields):
-        raise ValueError("an invalid Corner (NaN or infinite numbers)")
+        raise InputError("an invalid Corner (NaN or infinite numbers)")
     corner = object.__new__(Corner)
     for name, value in zip(("point", "ds", "dt", "dsdt"), fields):
         object.__setattr__(corner, name, value.copy())
@@ -47,11 +49,11 @@ def _mesh(points, quads):
     from .mesh import QuadMesh
 
     if not np.array_equal(quads, np.round(quads)):
-        raise ValueError("a QuadMesh whose quads are not node numbers")
+        raise InputError("a QuadMesh whose quads are not node numbers")
     try:
         return QuadMesh(points, quads.astype(np.intp))
     except (ValueError, TypeError) as exc:
-        raise ValueError(f"an invalid QuadMesh ({exc})") from None
+        raise InputError(f"an invalid QuadMesh ({exc})") from None
 
 
 TYPES = (

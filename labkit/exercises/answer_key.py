@@ -20,6 +20,8 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Iterable
 
+from ..errors import InputError
+
 ORDINALS = {1: "first", 2: "second", 3: "third", 4: "fourth", 5: "fifth", 6: "sixth"}
 # dropped before comparing: spacing, multiplication signs, grouping, LaTeX's backslashes, numpy's prefixes
 _WHOLE = re.compile(r"(\d)\.0+(?![\d])")
@@ -40,7 +42,7 @@ def orders(order: int, rate: str | None = None) -> tuple:
     """The ways a text states the order `order` (and, with the rate's name `rate`, the rate answer)."""
     p = int(order)
     if p < 1:
-        raise ValueError(f"an order is a whole number of at least 1; got {order!r}.")
+        raise InputError(f"an order is a whole number of at least 1; got {order!r}.")
     found = [
         f"order {p}",
         f"order-{p}",

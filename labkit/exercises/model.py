@@ -20,6 +20,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..errors import InputError
+
 CHECK_PREFIX = "check_"
 # a notebook's section of exercise N: a markdown heading of any level, "## Exercise N", with or without a title
 SECTION = re.compile(r"^#+[ \t]*Exercise[ \t]+(\d{1,3})(?!\d)", re.MULTILINE)
@@ -136,7 +138,7 @@ def facade_name(check: Callable) -> str:
     """The name a check has in :mod:`labkit.check`: its own name without ``check_``."""
     name = check.__name__
     if not name.startswith(CHECK_PREFIX):
-        raise ValueError(f"a part's check must be a function named {CHECK_PREFIX}<name>; got {name!r}.")
+        raise InputError(f"a part's check must be a function named {CHECK_PREFIX}<name>; got {name!r}.")
     return name[len(CHECK_PREFIX) :]
 
 
@@ -181,9 +183,9 @@ class Part:
     def __post_init__(self):
         facade_name(self.check)
         if int(self.weight) < 0:
-            raise ValueError(f"part {self.name!r} has a negative weight {self.weight}.")
+            raise InputError(f"part {self.name!r} has a negative weight {self.weight}.")
         if isinstance(self.uses, str) or not all(isinstance(name, str) for name in self.uses):
-            raise ValueError(f"part {self.name!r}: uses must be a tuple of the student's function names, as strings.")
+            raise InputError(f"part {self.name!r}: uses must be a tuple of the student's function names, as strings.")
 
     @property
     def scanned(self) -> tuple:
@@ -255,18 +257,18 @@ class Exercise:
     def __post_init__(self):
         seen = [part.name for part in self.parts]
         if len(set(seen)) != len(seen):
-            raise ValueError(f"exercise {self.number} has two parts with the same name.")
+            raise InputError(f"exercise {self.number} has two parts with the same name.")
         if not self.parts:
-            raise ValueError(f"exercise {self.number} has no parts: give it at least one checked part.")
+            raise InputError(f"exercise {self.number} has no parts: give it at least one checked part.")
         if self.points <= 0:
-            raise ValueError(f"exercise {self.number} is worth no points: give its parts positive weights.")
+            raise InputError(f"exercise {self.number} is worth no points: give its parts positive weights.")
         declared = [getattr(param, "name", None) for param in self.params]
         if len(set(declared)) != len(declared):
-            raise ValueError(f"exercise {self.number} declares a parameter twice: give each its own name.")
+            raise InputError(f"exercise {self.number} declares a parameter twice: give each its own name.")
         for part in self.parts:
             for name in part.varied:
                 if name not in declared:
-                    raise ValueError(
+                    raise InputError(
                         f"part {part.name!r} of exercise {self.number} varies {name!r}, which the exercise does not "
                         f"declare: add a Param named {name!r} to its params."
                     )

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from ..plotdata import Line, figure_data
 from . import bilinear, hermite, monotone, patches, splines
 from .model import Exercise, read
@@ -82,7 +83,7 @@ class Registry:
         numbers = [exercise.number for exercise in exercises]
         duplicated = sorted({n for n in numbers if numbers.count(n) > 1})
         if duplicated:
-            raise ValueError(f"exercise {duplicated[0]} is declared twice: give each exercise its own number.")
+            raise InputError(f"exercise {duplicated[0]} is declared twice: give each exercise its own number.")
         self.source = source
         self.exercises = {exercise.number: exercise for exercise in sorted(exercises, key=lambda e: e.number)}
         self.points = {n: e.points for n, e in self.exercises.items()}
@@ -96,7 +97,7 @@ class Registry:
         self.refusals = tuple(sorted({p.refused for p in parts if p.refused}, key=lambda refusal: refusal.name))
         names = [refusal.name for refusal in self.refusals]
         if len(set(names)) != len(names):
-            raise ValueError(
+            raise InputError(
                 f"two different refusals are named {sorted(n for n in names if names.count(n) > 1)[0]!r}: "
                 "give each Refusal a name of its own (the sandbox knows them by name)."
             )
@@ -117,12 +118,12 @@ class Registry:
                 continue
             name = part.self_check
             if name in FACADE:
-                raise ValueError(
+                raise InputError(
                     f"part {part.name!r}: labkit.check.{name} is taken by labkit itself; name the check "
                     f"check_<something else>."
                 )
             if self.self_checks.setdefault(name, part.check) is not part.check:
-                raise ValueError(f"two different checks would both be labkit.check.{name}: give one another name.")
+                raise InputError(f"two different checks would both be labkit.check.{name}: give one another name.")
 
     def __iter__(self):
         return iter(self.exercises.values())
@@ -141,13 +142,13 @@ class Registry:
         """The parts whose student's functions part `part` relies on (ValueError for an unknown part)."""
         known = {p.name for e in self for p in e.parts}
         if part not in known:
-            raise ValueError(f"no part is named {part!r}; choose one of {', '.join(map(repr, sorted(known)))}.")
+            raise InputError(f"no part is named {part!r}; choose one of {', '.join(map(repr, sorted(known)))}.")
         return [upstream for dependent, upstream in self.dependencies if dependent == part]
 
     def experiment(self, key: str):
         """The convergence experiment `key`; ValueError naming the choices otherwise."""
         if key not in self.experiments:
-            raise ValueError(f"unknown experiment {key!r}; choose one of {', '.join(map(repr, self.experiments))}.")
+            raise InputError(f"unknown experiment {key!r}; choose one of {', '.join(map(repr, self.experiments))}.")
         return self.experiments[key]
 
     def parts_checked(self, number: int, function: str, first: str | None = None) -> list:
@@ -298,7 +299,7 @@ def _dependencies(parts) -> list:
     for part in parts:
         for name in part.uses:
             if name not in graded:
-                raise ValueError(
+                raise InputError(
                     f"part {part.name!r} uses {name!r}, which no part grades: name a function some part "
                     "checks (its name or one of its functions), or declare the part that grades it."
                 )
@@ -317,18 +318,18 @@ def _check_shared_params(exercises: dict) -> None:
         for param in exercise.params:
             first = by_name.setdefault(param.name, (number, param))
             if first[1] != param:
-                raise ValueError(
+                raise InputError(
                     f"exercises {first[0]} and {number} both declare {param.name!r} but not alike: a name is one "
                     "datum, so declare one Param (with drawn_with) and use it in both."
                 )
             if first[0] != number and param.drawn_with is None:
-                raise ValueError(
+                raise InputError(
                     f"exercises {first[0]} and {number} both declare {param.name!r}, each drawing its own: give the "
                     "Param drawn_with=<the exercise that draws it>, or give the two data different names."
                 )
             drawing = exercises.get(param.drawn_with)
             if drawing is not None and not any(p == param for p in drawing.params):
-                raise ValueError(
+                raise InputError(
                     f"{param.name!r} is drawn with exercise {param.drawn_with}, which does not declare it: declare "
                     "it there too."
                 )
@@ -346,7 +347,7 @@ def _check_passable(function, part: str) -> None:
         except ImportError:
             ok = False
     if not ok:
-        raise ValueError(
+        raise InputError(
             f"part {part!r} passes {function!r} to student code: only module-level functions of labkit's "
             "own modules (outside labkit.grading) can be handed into the sandbox, by their name."
         )
@@ -373,12 +374,12 @@ def load(source: str | None = None) -> Registry:
     try:
         found: Any = getattr(importlib.import_module(module), attribute or "REGISTRY")
     except (ImportError, AttributeError) as exc:
-        raise ValueError(
+        raise InputError(
             f"cannot load the exercises {source!r} ({exc}); give module:attribute of a Registry, "
             "with the module importable."
         ) from None
     if not isinstance(found, Registry):
-        raise ValueError(f"{source!r} is a {type(found).__name__}, not a labkit Registry of exercises.")
+        raise InputError(f"{source!r} is a {type(found).__name__}, not a labkit Registry of exercises.")
     if found.source is None:
         found.source = source
     top = module.split(".")[0]

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import InputError
+
 TOLERANCE = 1e-9
 NOT_IMPLEMENTED = "not implemented yet"  # the failed step of a function that still raises NotImplementedError
 STUB = "replace the `raise NotImplementedError()` with your code."
@@ -96,7 +98,7 @@ class CheckResult:
         a slip the check names (a stub, an error raised, a time limit, ...) gives its `kind`, one of
         :data:`KINDS`."""
         if kind is not None and kind not in KINDS:
-            raise ValueError(f"a failed step's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
+            raise InputError(f"a failed step's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
         self.steps.append((description, bool(ok), "" if ok else detail))
         if kind is not None and not ok:
             self.kinds[len(self.steps) - 1] = kind

@@ -43,6 +43,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..errors import InputError
+
 SECRET_BYTES = 32
 MAX_DRAW = 10_000  # redraws of one exercise for one student: a handful in practice
 MAX_FILE_BYTES = 1024**2
@@ -62,7 +64,7 @@ class Param:
     >>> Param("r0", 1.3, 1.05, 2, lab=1.15)
     Traceback (most recent call last):
     ...
-    ValueError: parameter 'r0': its range [1.3, 1.05] is empty; give low < high.
+    labkit.errors.InputError: parameter 'r0': its range [1.3, 1.05] is empty; give low < high.
     """
 
     name: str
@@ -76,28 +78,28 @@ class Param:
 
     def __post_init__(self):
         if not str(self.name).isidentifier():
-            raise ValueError(f"a parameter's name is the notebook variable holding it; {self.name!r} is not a name.")
+            raise InputError(f"a parameter's name is the notebook variable holding it; {self.name!r} is not a name.")
         values = (self.low, self.high, self.lab)
         if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values):
-            raise ValueError(f"parameter {self.name!r}: low, high and lab must be finite numbers; got {values}.")
+            raise InputError(f"parameter {self.name!r}: low, high and lab must be finite numbers; got {values}.")
         if self.drawn_with is not None and (isinstance(self.drawn_with, bool) or not isinstance(self.drawn_with, int)):
-            raise ValueError(f"parameter {self.name!r}: drawn_with is an exercise number; got {self.drawn_with!r}.")
+            raise InputError(f"parameter {self.name!r}: drawn_with is an exercise number; got {self.drawn_with!r}.")
         if not self.low < self.high:
-            raise ValueError(f"parameter {self.name!r}: its range [{self.low}, {self.high}] is empty; give low < high.")
+            raise InputError(f"parameter {self.name!r}: its range [{self.low}, {self.high}] is empty; give low < high.")
         if isinstance(self.digits, bool) or not isinstance(self.digits, int) or not 0 <= self.digits <= 12:
-            raise ValueError(f"parameter {self.name!r}: digits is a whole number from 0 to 12; got {self.digits!r}.")
+            raise InputError(f"parameter {self.name!r}: digits is a whole number from 0 to 12; got {self.digits!r}.")
         if not self.low <= self.lab <= self.high:
-            raise ValueError(
+            raise InputError(
                 f"parameter {self.name!r}: the lab's value {self.lab} is outside [{self.low}, {self.high}]."
             )
         try:
             one = self.value(0.0) == self.value(1.0)
         except (OverflowError, ValueError):
-            raise ValueError(
+            raise InputError(
                 f"parameter {self.name!r}: [{self.low}, {self.high}] at {self.digits} digits holds too many values."
             ) from None
         if one:
-            raise ValueError(
+            raise InputError(
                 f"parameter {self.name!r}: [{self.low}, {self.high}] holds one value at {self.digits} digits; "
                 "widen the range or show more digits."
             )
@@ -221,40 +223,40 @@ def read(path) -> VariantsFile:
     try:
         raw = path.read_bytes()[: MAX_FILE_BYTES + 1]
     except OSError as exc:
-        raise ValueError(f"cannot read the variants file {path} ({exc.strerror or exc}); {fix}") from None
+        raise InputError(f"cannot read the variants file {path} ({exc.strerror or exc}); {fix}") from None
     if len(raw) > MAX_FILE_BYTES:
-        raise ValueError(f"the variants file {path} is larger than a variants file can be; {fix}")
+        raise InputError(f"the variants file {path} is larger than a variants file can be; {fix}")
     try:
         data = tomllib.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ValueError(f"the variants file {path} is not TOML ({exc}); {fix}") from None
+        raise InputError(f"the variants file {path} is not TOML ({exc}); {fix}") from None
     unknown = sorted(set(data) - {"secret", "redraw"})
     if unknown:
-        raise ValueError(f"the variants file {path} has unknown keys {unknown}; it holds `secret` and `[redraw]` only.")
+        raise InputError(f"the variants file {path} has unknown keys {unknown}; it holds `secret` and `[redraw]` only.")
     secret = data.get("secret")
     try:
         key = bytes.fromhex(secret) if isinstance(secret, str) else b""
     except ValueError:
         key = b""
     if len(key) < 16:
-        raise ValueError(f"the variants file {path} needs `secret`, at least 32 hexadecimal digits; {fix}")
+        raise InputError(f"the variants file {path} needs `secret`, at least 32 hexadecimal digits; {fix}")
     redraw = {}
     table = data.get("redraw", {})
     if not isinstance(table, dict):
-        raise ValueError(f'in {path}, [redraw] must be a table: "<roster id>" = {{<exercise> = <draw>}}.')
+        raise InputError(f'in {path}, [redraw] must be a table: "<roster id>" = {{<exercise> = <draw>}}.')
     for student, draws in table.items():
         if not isinstance(draws, dict):
-            raise ValueError(f"in {path}, the redraws of {student!r} must be a table such as {{4 = 1}}.")
+            raise InputError(f"in {path}, the redraws of {student!r} must be a table such as {{4 = 1}}.")
         found = {}
         for exercise, number in draws.items():
             text = str(exercise)
             if not (text.isascii() and text.isdecimal()) or isinstance(number, bool) or not isinstance(number, int):
-                raise ValueError(
+                raise InputError(
                     f"in {path}, {student!r} = {{{exercise} = {number!r}}}: give an exercise number and a whole draw "
                     "number, such as {4 = 1}."
                 )
             if not 0 <= number <= MAX_DRAW:
-                raise ValueError(f"in {path}, draw {number} of {student!r} is outside 0..{MAX_DRAW}.")
+                raise InputError(f"in {path}, draw {number} of {student!r} is outside 0..{MAX_DRAW}.")
             found[int(exercise)] = number
         redraw[str(student)] = found
     return VariantsFile(path, key, redraw)
@@ -271,7 +273,7 @@ def new(path) -> VariantsFile:
     try:
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
     except FileExistsError:
-        raise ValueError(
+        raise InputError(
             f"{path} already exists; a new secret would change every student's data. Choose another path."
         ) from None
     with os.fdopen(fd, "w", encoding="utf-8") as handle:
@@ -291,14 +293,14 @@ def redraw(path, student: str, exercise: int, registry) -> int:
             else ()
         )
         if shared:
-            raise ValueError(
+            raise InputError(
                 f"exercise {exercise}'s data are drawn with exercise {shared[0]}'s (they share them): "
                 f"redraw exercise {shared[0]}."
             )
-        raise ValueError(f"exercise {exercise} has no variants; the varied exercises are {sorted(drawn)}.")
+        raise InputError(f"exercise {exercise} has no variants; the varied exercises are {sorted(drawn)}.")
     student = str(student)
     if not student or not student.isprintable():
-        raise ValueError(f"{student!r} is not a roster id this file can hold; give the id as the roster has it.")
+        raise InputError(f"{student!r} is not a roster id this file can hold; give the id as the roster has it.")
     redraws = {key: dict(value) for key, value in current.redraw.items()}
     draws = redraws.setdefault(student, {})
     draws[exercise] = draws.get(exercise, 0) + 1
@@ -326,7 +328,7 @@ def write(path, secret: bytes, redraws: dict) -> VariantsFile:
     try:
         written = read(partial)
         if written.secret != secret or written.redraw != redraws:
-            raise ValueError(f"{path} could not be written as it should be; it was left as it was.")
+            raise InputError(f"{path} could not be written as it should be; it was left as it was.")
         os.chmod(partial, 0o600)
         os.replace(partial, path)
     finally:

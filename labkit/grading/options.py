@@ -12,6 +12,7 @@ a default of its own: they take the options object, or values from it.
 import os
 from dataclasses import asdict, dataclass, field, fields
 
+from ..errors import InputError
 from .sandbox import backends
 from .sandbox.backends.base import Limits
 
@@ -45,26 +46,26 @@ class GradeOptions:
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):
             if int(getattr(self, name)) < 1:
-                raise ValueError(f"{name.replace('_', '-')} must be at least 1 second; got {getattr(self, name)}.")
+                raise InputError(f"{name.replace('_', '-')} must be at least 1 second; got {getattr(self, name)}.")
         backends.backend_class(self.backend)  # ValueError naming the choices
         if self.rubric is not None:
             if not isinstance(self.rubric, (str, os.PathLike)):
-                raise ValueError(
+                raise InputError(
                     f"rubric must be the path of a TOML rubric (or None for the lab's own); got {self.rubric!r}."
                 )
             object.__setattr__(self, "rubric", os.fspath(self.rubric))
         if self.solutions is not None:
             if not isinstance(self.solutions, (str, os.PathLike)):
-                raise ValueError(
+                raise InputError(
                     f"solutions must be the folder of the instructor notebooks (or None); got {self.solutions!r}."
                 )
             object.__setattr__(self, "solutions", os.path.abspath(os.fspath(self.solutions)))
         if self.variants is not None and not (
             isinstance(self.variants, dict) and all(isinstance(v, dict) for v in self.variants.values())
         ):
-            raise ValueError("variants must map each submission name to its data, {exercise: {parameter: value}}.")
+            raise InputError("variants must map each submission name to its data, {exercise: {parameter: value}}.")
         if not isinstance(self.limits, Limits):
-            raise ValueError(f"limits must be a labkit.grading.sandbox.backends.base.Limits; got {self.limits!r}.")
+            raise InputError(f"limits must be a labkit.grading.sandbox.backends.base.Limits; got {self.limits!r}.")
 
     def as_dict(self):
         """The options as plain data (JSON): how they travel to each submission's grading process."""
@@ -78,7 +79,7 @@ class GradeOptions:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:
-            raise ValueError(
+            raise InputError(
                 f"unknown grading option(s) {', '.join(unknown)}; the options are {', '.join(sorted(known))}."
             )
         data["limits"] = Limits(**data.get("limits", {}))

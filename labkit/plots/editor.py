@@ -37,6 +37,7 @@ import functools
 
 import numpy as np
 
+from ..errors import InputError
 from ..patches import Corner
 from .explorers import (
     DPI,
@@ -90,7 +91,7 @@ def move_handle(corners, index, point, scale=ARROW):
     elif kind == 2:
         corners[which] = Corner(c.point, c.ds, (point - c.point) / scale, c.dsdt)
     else:
-        raise ValueError(f"handle index must be 0 to 11; got {index}.")
+        raise InputError(f"handle index must be 0 to 11; got {index}.")
     return corners
 
 
@@ -103,7 +104,7 @@ def handle_name(index):
     ('corner B', "A's d/ds arrow tip", "D's d/dt arrow tip")
     """
     if not isinstance(index, (int, np.integer)) or not 0 <= index < 12:
-        raise ValueError(f"handle index must be 0 to 11; got {index!r}.")
+        raise InputError(f"handle index must be 0 to 11; got {index!r}.")
     which, kind = NAMES[index % 4], index // 4
     return f"corner {which}" if kind == 0 else f"{which}'s {('d/ds', 'd/dt')[kind - 1]} arrow tip"
 
@@ -470,7 +471,7 @@ def patch_editor(corners=None, elements=10):
     if corners is None:
         corners = list(FIRST_PATCH)
     if len(corners) != 4 or not all(isinstance(c, Corner) for c in corners):
-        raise ValueError("patch_editor needs a list of four labkit.Corner objects A, B, C, D.")
+        raise InputError("patch_editor needs a list of four labkit.Corner objects A, B, C, D.")
     if any(c.point.size != 2 for c in corners):
-        raise ValueError("patch_editor edits plane patches: give corners with 2 coordinates.")
+        raise InputError("patch_editor edits plane patches: give corners with 2 coordinates.")
     return Editor(corners, elements)

@@ -19,6 +19,7 @@ import numpy as np
 from .._alt import describe, num, sci
 from ..bilinear import eval_pbilin
 from ..convergence import METHOD_TITLES, _interpolate
+from ..errors import InputError
 from ..functions import limacon, runge, runge2d
 from ..mesh import quad_mesh
 from ..monotone import pchip
@@ -137,7 +138,7 @@ class LimaconView(View):
 
     def update(self, nintervals=20, r0=1.15, method="pherm"):
         if method not in ("plin", "pherm"):
-            raise ValueError("method must be 'plin' (piecewise linear) or 'pherm' (Hermite).")
+            raise InputError("method must be 'plin' (piecewise linear) or 'pherm' (Hermite).")
         tdata = np.linspace(0, 2 * np.pi, nintervals + 1)
         xdata, ydata, xpdata, ypdata = limacon(tdata, r0)
         tval = np.linspace(0, 2 * np.pi, 10 * (nintervals + 1))
@@ -402,7 +403,7 @@ def plot_patch(corners, ns=11, nt=11, ax=None, color_by_quality=False, title=Non
 def plot_limacon(nintervals=20, r0=1.15, method="pherm", ax=None):
     """Interpolate the limaçon from nintervals+1 points with 'plin' or 'pherm' and draw it."""
     if method not in ("plin", "pherm"):
-        raise ValueError("method must be 'plin' (piecewise linear) or 'pherm' (Hermite).")
+        raise InputError("method must be 'plin' (piecewise linear) or 'pherm' (Hermite).")
     return LimaconView(ax).update(nintervals, r0, method)
 
 

@@ -32,6 +32,8 @@ import zlib
 
 import numpy as np
 
+from ..errors import InputError
+
 CAPS = {"butt": "butt", "round": "round", "projecting": "square"}
 AHEAD_KEPT = 2  # backgrounds rendered ahead of a move and kept for it (each a few MB of Agg pixels)
 
@@ -66,7 +68,7 @@ def encode_png(pixels):
     """
     pixels = np.asarray(pixels)
     if pixels.dtype != np.uint8 or pixels.ndim != 3 or pixels.shape[2] not in (3, 4) or 0 in pixels.shape[:2]:
-        raise ValueError(
+        raise InputError(
             f"encode_png takes a non-empty (height, width, 3 or 4) array of uint8; got {pixels.dtype} of shape "
             f"{pixels.shape}: pass a figure canvas's buffer_rgba() reshaped to (height, width, 4)."
         )

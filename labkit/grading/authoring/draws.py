@@ -43,6 +43,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+from ...errors import InputError
 from ...execute import read_notebook
 from ...exercises import variants as variant_data
 from ...exercises.registry import LAB
@@ -69,12 +70,12 @@ def load_catalog(path):
     path = Path(path)
     spec = importlib.util.spec_from_file_location(f"labkit_catalog_{abs(hash(str(path)))}", path)
     if spec is None or spec.loader is None or not path.is_file():
-        raise ValueError(f"{path} is not a Python file; give the catalog of correct variations and slips (.py).")
+        raise InputError(f"{path} is not a Python file; give the catalog of correct variations and slips (.py).")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     found = getattr(module, "CORRECT", None), getattr(module, "MISTAKES", None)
     if not all(isinstance(entries, (list, tuple)) for entries in found):
-        raise ValueError(f"{path} defines no lists CORRECT and MISTAKES; it is not a catalog of variations and slips.")
+        raise InputError(f"{path} defines no lists CORRECT and MISTAKES; it is not a catalog of variations and slips.")
     return tuple(found[0]), tuple(found[1])
 
 
@@ -88,7 +89,7 @@ def _planted(nb, replace, name):
     for old, new in replace:
         hits = [cell for cell in nb.cells if cell.cell_type == "code" and old in cell.source]
         if len(hits) != 1 or hits[0].source.count(old) != 1:
-            raise ValueError(f"catalog entry {name!r}: {old[:60]!r} is not in one code cell once; fix the entry.")
+            raise InputError(f"catalog entry {name!r}: {old[:60]!r} is not in one code cell once; fix the entry.")
         hits[0].source = hits[0].source.replace(old, new)
     return nb
 
@@ -174,11 +175,11 @@ def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, s
     folder, `catalog` a catalog file (or None). Returns the :class:`Trouble` found, an empty list when every
     draw is as it should be. `progress` (a function of one text) hears of each draw."""
     if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-        raise ValueError(f"--check needs a whole number of draws, at least 1; got {count!r}.")
+        raise InputError(f"--check needs a whole number of draws, at least 1; got {count!r}.")
     correct, mistakes = load_catalog(catalog) if catalog is not None else ((), ())
     varied = {e.number: e for e in registry if e.params}
     if not varied:
-        raise ValueError("no exercise declares parameters (Exercise.params): there is nothing to draw.")
+        raise InputError("no exercise declares parameters (Exercise.params): there is nothing to draw.")
     students = [f"draw-{i}" for i in range(count)] + [str(key) for key in (roster or {}).values()]
     by_notebook: dict = {}
     for exercise in varied.values():

@@ -23,6 +23,7 @@ meaning follow nbgrader's ``nbgrader/nbgraderformat/v3.json``.
 
 import re
 
+from ...errors import InputError
 from ...exercises.model import sections
 from ..store import rubric as rubrics
 from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
@@ -51,7 +52,7 @@ def test_points(source, where="a test cell", rubric=None):
     registry = rubric.registry
     found = EXERCISE_OF_TESTS.search(source)
     if not found or int(found.group(1)) not in registry.exercises:
-        raise ValueError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
+        raise InputError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
     number = int(found.group(1))
     exercise = registry.exercises[number]
     checked = {
@@ -61,7 +62,7 @@ def test_points(source, where="a test cell", rubric=None):
     }
     weights = sum(part.weight for part in exercise.parts if part.name in checked)
     if not weights:
-        raise ValueError(
+        raise InputError(
             f"{where} tests exercise {number} but checks none of its parts "
             f"({', '.join(p.name for p in exercise.parts)})."
         )

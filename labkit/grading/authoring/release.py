@@ -25,6 +25,7 @@ import json
 import re
 from pathlib import Path
 
+from ...errors import InputError
 from ...execute import RAISES, notebook_paths, raising_cells, read_notebook, set_tag
 from ...exercises import variants as variant_data
 from ...exercises.registry import LAB
@@ -42,7 +43,7 @@ def strip_solutions(source, where="cell", stub=STUB):
         marker = line.strip()
         if marker in (BEGIN_SOLUTION, BEGIN_HIDDEN):
             if region:
-                raise ValueError(f"{where}, line {number}: {marker!r} inside an open {region!r} region.")
+                raise InputError(f"{where}, line {number}: {marker!r} inside an open {region!r} region.")
             region = marker
             if marker == BEGIN_SOLUTION:
                 indent = line[: len(line) - len(line.lstrip())]
@@ -50,12 +51,12 @@ def strip_solutions(source, where="cell", stub=STUB):
         elif marker in (END_SOLUTION, END_HIDDEN):
             expected = BEGIN_SOLUTION if marker == END_SOLUTION else BEGIN_HIDDEN
             if region != expected:
-                raise ValueError(f"{where}, line {number}: {marker!r} without a matching {expected!r}.")
+                raise InputError(f"{where}, line {number}: {marker!r} without a matching {expected!r}.")
             region = None
         elif region is None:
             out.append(line)
     if region:
-        raise ValueError(f"{where}: the {region!r} region is never closed.")
+        raise InputError(f"{where}: the {region!r} region is never closed.")
     return "\n".join(out)
 
 
@@ -125,7 +126,7 @@ def with_values(nb, values, name="notebook", registry=LAB):
         try:
             tree = ast.parse(cell.source)
         except SyntaxError:
-            raise ValueError(f"{name}, cell {index}: a data cell must be plain Python assignments.") from None
+            raise InputError(f"{name}, cell {index}: a data cell must be plain Python assignments.") from None
         pieces = re.split(r"(\r\n|\r|\n)", cell.source)  # the line breaks ast counts, kept as they were
         lines, breaks = pieces[0::2], pieces[1::2]
         edits = []
@@ -139,9 +140,9 @@ def with_values(nb, values, name="notebook", registry=LAB):
                 target = node.targets[0].id
                 value = node.value
                 if value.lineno != value.end_lineno:
-                    raise ValueError(f"{name}, cell {index}: {target} must be assigned on one line.")
+                    raise InputError(f"{name}, cell {index}: {target} must be assigned on one line.")
                 if target in params and not _number(value):
-                    raise ValueError(f"{name}, cell {index}: {target} must be assigned a number, as `{target} = 1.15`.")
+                    raise InputError(f"{name}, cell {index}: {target} must be assigned a number, as `{target} = 1.15`.")
                 edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
                 done.add(target)
         for line, start, end, text in sorted(edits, reverse=True):
@@ -150,7 +151,7 @@ def with_values(nb, values, name="notebook", registry=LAB):
         cell.source = "".join(line + brk for line, brk in zip(lines, [*breaks, ""]))
     missing = sorted(set(wanted) - done)
     if missing:
-        raise ValueError(
+        raise InputError(
             f"{name} has no data cell assigning {', '.join(missing)}: add a code cell tagged "
             f"{variant_data.DATA_TAG!r} with `{missing[0]} = <the lab's value>`."
         )
@@ -182,17 +183,17 @@ def release(notebook_dir, out_dir, roster=None, variants=None, registry=LAB):
     import nbformat
 
     if (roster is None) != (variants is None):
-        raise ValueError("give both --roster and --variants for a release per student, or neither.")
+        raise InputError("give both --roster and --variants for a release per student, or neither.")
     paths = notebook_paths(notebook_dir)
     out = Path(out_dir)
     if out.resolve() == Path(notebook_dir).resolve():
-        raise ValueError("--out must differ from the notebook folder; the release would overwrite the solutions.")
+        raise InputError("--out must differ from the notebook folder; the release would overwrite the solutions.")
     students = (
         {None: None} if roster is None else {name: variants.values(registry, key) for name, key in roster.items()}
     )
     folders = [folder_name(name).casefold() for name in students if name is not None]
     if len(set(folders)) != len(folders):  # "Ada" and "ada" are one folder where case is not told apart
-        raise ValueError("two roster entries would share a release folder; give each submission its own name.")
+        raise InputError("two roster entries would share a release folder; give each submission its own name.")
     released = {path: release_notebook(read_notebook(path), path.name) for path in paths}
     written = []
     for name, values in students.items():

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path
 
+from ...errors import InputError
 from ...exercises.result import (
     CRASH,
     HELD,
@@ -362,13 +363,13 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
     >>> read("no/such/folder")
     Traceback (most recent call last):
     ...
-    ValueError: no/such/folder is not a folder: give the --out folder of a `labkit grade` run.
+    labkit.errors.InputError: no/such/folder is not a folder: give the --out folder of a `labkit grade` run.
     """
     folder = Path(folder)
     if not folder.is_dir():
-        raise ValueError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
+        raise InputError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
     if (folder / "results").is_dir() and len(os.listdir(folder / "results")) > MAX_SUBMISSIONS:
-        raise ValueError(
+        raise InputError(
             f"{folder / 'results'} holds more than {MAX_SUBMISSIONS:,} result files, more than a class report "
             "shows: split the class and report on each part."
         )
@@ -406,7 +407,7 @@ def check_outcome(check: dict) -> str:
     'slip'
     """
     if not isinstance(check, dict):
-        raise ValueError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
+        raise InputError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
     kind = part_kind(check)  # the one place a part's kind is decided: the feedback and labkit handin agree
     if kind in (PASSED, HELD):
         return PASSED
@@ -457,7 +458,7 @@ def _checks(grade, number):
         return None
     checks = verdict.get("checks") if isinstance(verdict, dict) else None
     if not isinstance(checks, list) or not all(isinstance(c, dict) for c in checks):
-        raise ValueError(
+        raise InputError(
             f"the result of {one_line(grade.name, MAX_NAME)!r} for exercise {number} has no list of checks: "
             "it was not written by `labkit grade`; grade the submission again."
         )
@@ -519,16 +520,16 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     """
     grades = list(grades)
     if not grades:
-        raise ValueError("there are no submissions to report on: grade some first (`labkit grade`).")
+        raise InputError("there are no submissions to report on: grade some first (`labkit grade`).")
     for grade in grades:
         if not isinstance(grade, SubmissionGrade):
-            raise ValueError(
+            raise InputError(
                 f"a class report is made of SubmissionGrade objects (labkit.grading.store.report); got "
                 f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
             )
     rubric = grades[0].rubric
     if any(grade.rubric != rubric for grade in grades):
-        raise ValueError("the grades are scored under different rubrics: read them all with one rubric.")
+        raise InputError("the grades are scored under different rubrics: read them all with one rubric.")
     graded = [g for g in grades if g.graded]
     exercises, parts = [], []
     slips = defaultdict(list)
@@ -1337,7 +1338,7 @@ def render(
     str
     """
     if not isinstance(summary, ClassSummary):
-        raise ValueError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
+        raise InputError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
     pairs = _check_pairs(pairs)
     if pairs is None and similarity_note is None:
         similarity_note = unavailable()
@@ -1389,18 +1390,18 @@ def _check_pairs(pairs):
     if pairs is None:
         return None
     if isinstance(pairs, (str, bytes, dict)):
-        raise ValueError(
+        raise InputError(
             f"pairs must be a list of labkit.grading.reports.similarity.Pair (or None); got {type(pairs).__name__}."
         )
     pairs = list(pairs)
     for pair in pairs:
         if not isinstance(pair, Pair):
-            raise ValueError(
+            raise InputError(
                 f"pairs must be labkit.grading.reports.similarity.Pair objects (similarity.similar_pairs gives them); "
                 f"got {type(pair).__name__}."
             )
         if not isinstance(pair.score, (int, float)) or not 0.0 <= float(pair.score) <= 1.0:
-            raise ValueError(f"a pair's score is a similarity from 0 to 1; got {pair.score!r} for {pair.function!r}.")
+            raise InputError(f"a pair's score is a similarity from 0 to 1; got {pair.score!r} for {pair.function!r}.")
     return pairs
 
 
@@ -1453,12 +1454,12 @@ def write(
     """
     out = Path(out_dir)
     if not out.is_dir():
-        raise ValueError(f"{out} is not a folder: give the --out folder of a `labkit grade` run.")
+        raise InputError(f"{out} is not a folder: give the --out folder of a `labkit grade` run.")
     if not isinstance(threshold, (int, float)) or not 0.0 < float(threshold) <= 1.0:
-        raise ValueError(f"the similarity threshold is a number above 0 and at most 1; got {threshold!r}.")
+        raise InputError(f"the similarity threshold is a number above 0 and at most 1; got {threshold!r}.")
     target = out / REPORT
     if target.is_symlink() or (target.exists() and not target.is_file()):
-        raise ValueError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
+        raise InputError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
     grades = list(grades)
     summary = summarise(grades)
     summary.copies = find_copies(grades, _variant_students(out))

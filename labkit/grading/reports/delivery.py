@@ -32,6 +32,7 @@ import re
 import zipfile
 from pathlib import Path
 
+from ...errors import InputError
 from ..store import feedback as feedbacks
 from ..store import record as records
 from ..store.report import file_stem, one_line, read_results
@@ -76,7 +77,7 @@ def canvas_names(name, entry):
     """Canvas: the download's prefix of one of the student's files, then ``_feedback.html``."""
     prefix = str(entry.get("file") or "")
     if not re.fullmatch(r"[^/\\\x00]+_\d+_\d+|anon\w*_[A-Za-z0-9]+_\d+", prefix):
-        raise ValueError(f"no Canvas file of {one_line(name, 80)} is recorded")
+        raise InputError(f"no Canvas file of {one_line(name, 80)} is recorded")
     return [f"{prefix}_{PAGE}"]
 
 
@@ -84,7 +85,7 @@ def moodle_names(name, entry):
     """Moodle: ``{full name}_{participant id}_assignfeedback_file_/feedback.html``."""
     pid = str(entry.get("lms id") or "")
     if not pid.isdigit():
-        raise ValueError(f"no Moodle participant id of {one_line(name, 80)} is recorded")
+        raise InputError(f"no Moodle participant id of {one_line(name, 80)} is recorded")
     full = name[: -len(pid) - 1] if name.endswith(f"_{pid}") else name
     full = re.sub(r"[_/\\\x00]+", " ", full).strip() or "Participant"
     return [f"{full}_{pid}_assignfeedback_file_/{PAGE}"]
@@ -123,7 +124,7 @@ def write_upload(out, layout=None) -> tuple[Path, list[str], list[str]]:
     delivery = records.read(out).delivery or {}
     layout = layout_of(out, layout)
     if layout not in NAMING:
-        raise ValueError(f"the layout is one of {', '.join(LAYOUTS)}, not {layout!r}.")
+        raise InputError(f"the layout is one of {', '.join(LAYOUTS)}, not {layout!r}.")
     students = delivery.get("students", {})
     grades = read_results([out])
     members, notes = [], [f"not read: {one_line(p, 200)}: {one_line(w, 300)}" for p, w in grades.refused]

@@ -141,6 +141,7 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...errors import InputError
 from ..store.report import FORMULA_START, SubmissionGrade, csv_cell, one_line
 from ..store.text import points_text
 
@@ -333,17 +334,17 @@ def _text(path, what, fix):
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise ValueError(f"cannot read {what} {path}: {exc.strerror or exc}.") from None
+        raise InputError(f"cannot read {what} {path}: {exc.strerror or exc}.") from None
     if data.startswith(XLSX_MAGIC):
-        raise ValueError(f"{path} is an Excel workbook, not CSV: {fix}")
+        raise InputError(f"{path} is an Excel workbook, not CSV: {fix}")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ValueError(
+        raise InputError(
             f"{path} is not UTF-8 text (byte {exc.start} is {data[exc.start : exc.start + 1]!r}): {fix}"
         ) from None
     if "\x00" in text:
-        raise ValueError(f"{path} is not a CSV text file (it holds NUL bytes): {fix}")
+        raise InputError(f"{path} is not a CSV text file (it holds NUL bytes): {fix}")
     return text, data.startswith(b"\xef\xbb\xbf"), "\r\n" if "\r\n" in text else "\n"
 
 
@@ -351,7 +352,7 @@ def _rows(text, path, delimiter, fix):
     try:
         return list(csv.reader(io.StringIO(text, newline=""), delimiter=delimiter, strict=True))
     except csv.Error as exc:
-        raise ValueError(f"{path} is not valid CSV ({exc}): {fix}") from None
+        raise InputError(f"{path} is not valid CSV ({exc}): {fix}") from None
 
 
 def _first_row(text, delimiter):
@@ -399,14 +400,14 @@ def read_roster(path: str | os.PathLike) -> dict[str, str]:
             break
     else:
         found = ", ".join(repr(one_line(c, 40)) for c in _first_row(text, ",")[:8]) or "nothing"
-        raise ValueError(
+        raise InputError(
             f"the roster {path} needs a header row with the columns 'submission' (the names in grades.csv) "
             f"and 'id' (the students' identifiers in the LMS); its first row has {found}. For example:\n"
             "    submission,id\n    ada_lovelace,1815"
         )
     for name in ("submission", "id"):
         if header.count(name) > 1:
-            raise ValueError(f"the roster {path} has two '{name}' columns; keep one.")
+            raise InputError(f"the roster {path} has two '{name}' columns; keep one.")
     rows = _rows(text, path, delimiter, ROSTER_FIX)
     at_name, at_id = header.index("submission"), header.index("id")
     roster: dict = {}
@@ -419,23 +420,23 @@ def read_roster(path: str | os.PathLike) -> dict[str, str]:
         key = row[at_id].strip() if at_id < len(row) else ""
         if not name or not key:
             missing = "submission" if not name else "id"
-            raise ValueError(
+            raise InputError(
                 f"the roster {path}, row {number}: the {missing} is empty; give every student both, or delete the row."
             )
         if name in roster:
-            raise ValueError(
+            raise InputError(
                 f"the roster {path} names the submission {one_line(name, 80)!r} twice (rows {lines_of[name]} and "
                 f"{number}); keep one row per submission."
             )
         if key in names_of:
-            raise ValueError(
+            raise InputError(
                 f"the roster {path} gives the id {one_line(key, 60)!r} to two submissions "
                 f"({one_line(names_of[key], 60)!r} and {one_line(name, 60)!r}, rows {lines_of[names_of[key]]} and "
                 f"{number}); each student has one id: correct one of the rows."
             )
         roster[name], lines_of[name], names_of[key] = key, number, name
     if not roster:
-        raise ValueError(f"the roster {path} has a header but no student: add one row per submission.")
+        raise InputError(f"the roster {path} has a header but no student: add one row per submission.")
     return roster
 
 
@@ -471,7 +472,7 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
             break
     else:
         found = ", ".join(repr(one_line(c, 40)) for c in _first_row(text, ",")[:6]) or "nothing"
-        raise ValueError(
+        raise InputError(
             f"{path} is not a Canvas gradebook export: its header must begin with the columns 'Student' and "
             f"'ID' (it begins with {found}); {CANVAS_FIX}"
         )
@@ -479,7 +480,7 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
     header = rows[0]
     section = next((i for i, cell in enumerate(header) if cell.strip() == "Section"), None)
     if section is None or any(cell.strip() not in CANVAS_STUDENT_COLUMNS for cell in header[:section]):
-        raise ValueError(
+        raise InputError(
             f"{path} has no 'Section' column after the student columns (Student, ID, SIS User ID, SIS Login ID), "
             f"which Canvas needs to import it; {CANVAS_FIX}"
         )
@@ -489,7 +490,7 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
             body.append(row)
             continue
         if len(row) > width and any(cell.strip() for cell in row[width:]):
-            raise ValueError(
+            raise InputError(
                 f"{path}, row {number} has {len(row)} cells but the header only {width}: a cell with an unquoted "
                 f"separator? {CANVAS_FIX}"
             )
@@ -499,12 +500,12 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
 
 def _check_column(column):
     if not isinstance(column, str) or not column.strip() or column != one_line(column, 200):
-        raise ValueError(
+        raise InputError(
             f"the column name {one_line(column, 80)!r} must be one line of text, at most 200 characters; "
             "give the assignment's name with --column."
         )
     if column.startswith(FORMULA_START):
-        raise ValueError(
+        raise InputError(
             f"the column name {column!r} starts like a spreadsheet formula ({column[0]!r}); give the assignment "
             "another name with --column."
         )
@@ -518,7 +519,7 @@ def _assignment_column(book, column, path):
     ]
     if len(found) > 1:
         names = ", ".join(repr(book.header[i]) for i in found)
-        raise ValueError(
+        raise InputError(
             f"{path} has {len(found)} assignment columns named {column!r} ({names}); give the one to fill with its "
             "number, e.g. --column " + repr(book.header[found[0]].strip()) + "."
         )
@@ -580,13 +581,13 @@ def _check_outputs(paths, inputs, force):
         path = Path(path)
         for source in inputs:
             if path.resolve() == Path(source).resolve():
-                raise ValueError(
+                raise InputError(
                     f"{path} is an input of this export; it is never overwritten: give --out another file name."
                 )
         if not path.parent.is_dir():
-            raise ValueError(f"the folder {path.parent} does not exist: create it, or give --out another path.")
+            raise InputError(f"the folder {path.parent} does not exist: create it, or give --out another path.")
         if path.exists() and not force:
-            raise ValueError(
+            raise InputError(
                 f"{path} already exists (an earlier export?); give --out another file name, or --force to replace it."
             )
 
@@ -595,10 +596,10 @@ def _by_name(grades):
     by_name = {}
     for grade in grades:
         if not isinstance(grade, SubmissionGrade):
-            raise ValueError(f"expected the grades of a grading run (read_results), got {type(grade).__name__}.")
+            raise InputError(f"expected the grades of a grading run (read_results), got {type(grade).__name__}.")
         by_name[grade.name] = grade
     if not by_name:
-        raise ValueError("there are no grades to export: give the --out folder of a `labkit grade` run.")
+        raise InputError("there are no grades to export: give the --out folder of a `labkit grade` run.")
     return by_name
 
 
@@ -680,7 +681,7 @@ def to_canvas(
         at all, or an output that exists or is an input. Nothing is written then.
     """
     if key not in CANVAS_KEYS:
-        raise ValueError(f"--key for Canvas is one of {', '.join(CANVAS_KEYS)} (a gradebook column); got {key!r}.")
+        raise InputError(f"--key for Canvas is one of {', '.join(CANVAS_KEYS)} (a gradebook column); got {key!r}.")
     _check_column(column)
     by_name = _by_name(grades)
     entries = read_roster(roster)
@@ -691,13 +692,13 @@ def to_canvas(
 
     header = [cell.strip() for cell in book.header]
     if key not in header[: book.section]:
-        raise ValueError(
+        raise InputError(
             f"{gradebook} has no {key!r} column (its student columns are {', '.join(header[: book.section + 1])}); "
             "export the gradebook with that column, or match the roster on another with --key."
         )
     at_key = header.index(key)
     if CANVAS_TOTALS.search(column) or column.strip() in CANVAS_STUDENT_COLUMNS:
-        raise ValueError(
+        raise InputError(
             f"Canvas reads a column named {column!r} as a student column or a total, never as an assignment; "
             "give the assignment another name with --column."
         )
@@ -705,14 +706,14 @@ def to_canvas(
     points_row = next((row for row in book.rows if row and book.kind(row) == "points"), None)
     full_credit = by_name[next(iter(by_name))].rubric.full_credit
     if target is None and not new_column:
-        raise ValueError(
+        raise InputError(
             f"{gradebook} has no assignment column named {column!r}; "
             f"{_assignments_text(book)}. Give one of them with --column (its title, with or "
             "without the number), or pass --new-column to add a column of that name on purpose (Canvas then "
             "creates a new assignment when the file is imported)."
         )
     if target is not None and new_column:
-        raise ValueError(
+        raise InputError(
             f"{gradebook} already has the assignment column {one_line(book.header[target], 80)!r}, which "
             f"--column {column!r} names (Canvas would fill that assignment, not make a new one): leave out "
             "--new-column to fill it, or give the new assignment another name with --column."
@@ -727,7 +728,7 @@ def to_canvas(
         export.column = book.header[target]
         possible = points_row[target].strip() if points_row else ""
         if "read only" in possible.lower():
-            raise ValueError(
+            raise InputError(
                 f"the column {book.header[target]!r} of {gradebook} is read-only in Canvas (a total); "
                 "give an assignment's column with --column."
             )
@@ -748,7 +749,7 @@ def to_canvas(
             continue
         value = row[at_key].strip()
         if value in students:
-            raise ValueError(
+            raise InputError(
                 f"{gradebook} has two rows with {key} {one_line(value, 60)!r} (rows {rows_of[value]} and "
                 f"{number}); export the gradebook again, or match on another column with --key."
             )
@@ -773,7 +774,7 @@ def to_canvas(
         else:
             matched[value] = name
     if not matched:
-        raise ValueError(
+        raise InputError(
             f"no submission of the results matched a row of {gradebook} through the roster {roster}: are the "
             f"roster's ids the gradebook's {key!r} values (--key), and its submissions the names in grades.csv?"
         )
@@ -869,13 +870,13 @@ def _check_id_numbers(entries, roster):
     if not emails:
         return
     if len(emails) == len(entries):
-        raise ValueError(
+        raise InputError(
             f"the roster {roster} holds email addresses (e.g. {_examples(entries, emails)}), not ID numbers, and "
             "--key idnumber (the default) would write them into Moodle's ID number column: give --key email, "
             "or give the students' ID numbers in the roster."
         )
     others = [name for name in entries if name not in emails]
-    raise ValueError(
+    raise InputError(
         f"the roster {roster} mixes email addresses ({len(emails)} of {len(entries)}: {_examples(entries, emails)}) "
         f"with other ids (e.g. {_examples(entries, others)}); with --key idnumber (the default) every id is an ID "
         "number: correct those rows, or give every student's email address with --key email."
@@ -926,18 +927,18 @@ def to_moodle(
         that starts like a formula, no student to write, or an output that exists or is an input.
     """
     if key not in MOODLE_KEYS:
-        raise ValueError(f"--key for Moodle is idnumber or email (the user field of the roster's ids); got {key!r}.")
+        raise InputError(f"--key for Moodle is idnumber or email (the user field of the roster's ids); got {key!r}.")
     _check_column(column)
     by_name = _by_name(grades)
     entries = read_roster(roster)
     for name, value in entries.items():
         if key == "email" and not _is_email(value):
-            raise ValueError(
+            raise InputError(
                 f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which is not an "
                 "email address: with --key email every id is one (or use --key idnumber)."
             )
         if value.startswith(FORMULA_START):
-            raise ValueError(
+            raise InputError(
                 f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which starts like "
                 "a spreadsheet formula; correct the roster."
             )
@@ -961,7 +962,7 @@ def to_moodle(
             rows.append([value, points_text(grade.total)] + ([_feedback_cell(grade)] if feedback else []))
             export.exported[name] = (value, grade.total)
     if not export.exported:
-        raise ValueError(
+        raise InputError(
             f"no graded submission of the results is on the roster {roster}: are its submissions the names in "
             "grades.csv?"
         )

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
+from ...errors import InputError
 from ..store import record as records
 from ..store.feedback import blank
 from ..store.names import name_cell, name_from_cell, shown_name
@@ -68,7 +69,7 @@ def read_marks(text, grades):
     header = next(reader, None)
     if header is None or [cell.strip().lower() for cell in header] != HEADER:
         shown = "nothing" if header is None else one_line(",".join(header), 120)
-        raise ValueError(f"marks.csv must start with the header {','.join(HEADER)}; it starts with {shown}.")
+        raise InputError(f"marks.csv must start with the header {','.join(HEADER)}; it starts with {shown}.")
     marks, problems = [], []
     for line, row in enumerate(reader, start=2):
         if not any(cell.strip() for cell in row):
@@ -103,7 +104,7 @@ def read_marks(text, grades):
         marks.append(Mark(name, item, value, printable(comment).strip()[:MAX_COMMENT]))
     if problems:
         shown = problems[:20] + ([f"... and {len(problems) - 20} more"] if len(problems) > 20 else [])
-        raise ValueError("marks.csv was not imported, nothing changed:\n  " + "\n  ".join(shown))
+        raise InputError("marks.csv was not imported, nothing changed:\n  " + "\n  ".join(shown))
     return marks
 
 
@@ -135,20 +136,20 @@ def import_marks(out, path, rubric=None, now=None):
     out, path = Path(out), Path(path)
     try:
         if path.stat().st_size > MAX_MARKS_BYTES:
-            raise ValueError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
+            raise InputError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
         text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"cannot read the marks {path}: {exc}") from None
+        raise InputError(f"cannot read the marks {path}: {exc}") from None
     record = records.read(out)
     recorded = record.rubric_object(out)
     if rubric is not None and recorded.digest != rubric.digest:
-        raise ValueError(
+        raise InputError(
             f"{out} was graded under the rubric {recorded.title!r} ({recorded.digest}), not {rubric.title!r} "
             f"({rubric.digest}): marks are imported under the run's own rubric; leave out --rubric."
         )
     grades = read_results([out], recorded)
     if grades.refused:
-        raise ValueError(
+        raise InputError(
             f"{out} has result files its record does not vouch for ({one_line(grades.refused[0][0], 200)}); "
             "grade the class again before marking."
         )
@@ -380,7 +381,7 @@ def write_page(out, marker="instructor", rubric=None):
     record = records.read(out)
     recorded = record.rubric_object(out)
     if rubric is not None and recorded.digest != rubric.digest:
-        raise ValueError(f"{out} was graded under another rubric ({recorded.digest}); leave out --rubric.")
+        raise InputError(f"{out} was graded under another rubric ({recorded.digest}); leave out --rubric.")
     grades = read_results([out], recorded)
     data = {"run": f"{recorded.digest}:{out.resolve()}", "title": recorded.title, "tasks": tasks(grades, marker)}
     script = SCRIPT.replace("__DATA__", _json_for_script(data))

@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import InputError
 from ..store.report import one_line, printable
 from ..store.text import MAX_SOURCE_CHARS
 
@@ -151,22 +152,22 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
     try:
         grades = list(grades)
     except TypeError:
-        raise ValueError(f"grades must be a list of SubmissionGrade; got {type(grades).__name__}.") from None
+        raise InputError(f"grades must be a list of SubmissionGrade; got {type(grades).__name__}.") from None
     by_function: dict = {}
     seen: set = set()
     for index, grade in enumerate(grades):
         name, sources = getattr(grade, "name", None), getattr(grade, "sources", None)
         if not isinstance(name, str) or not isinstance(sources, dict):
-            raise ValueError(
+            raise InputError(
                 f"grade {index} is a {type(grade).__name__}, not a SubmissionGrade with a name and sources: "
                 "give the grades that labkit.grading.grade or read_results returns."
             )
         if name in seen:
-            raise ValueError(f"two grades are both named {one_line(name, 80)!r}: keep one result per submission.")
+            raise InputError(f"two grades are both named {one_line(name, 80)!r}: keep one result per submission.")
         seen.add(name)
         for function, source in sources.items():
             if not isinstance(function, str) or not isinstance(source, str):
-                raise ValueError(
+                raise InputError(
                     f"the sources of {one_line(name, 80)!r} are not function names and source texts "
                     f"({type(function).__name__}: {type(source).__name__})."
                 )
@@ -184,9 +185,9 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
 
 def _threshold(threshold):
     if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.integer, np.floating)):
-        raise ValueError(f"threshold must be a number from 0 to 1 (a share of the code); got {threshold!r}.")
+        raise InputError(f"threshold must be a number from 0 to 1 (a share of the code); got {threshold!r}.")
     if not (math.isfinite(threshold) and 0 <= threshold <= 1):
-        raise ValueError(f"threshold must be a number from 0 to 1 (a share of the code); got {threshold!r}.")
+        raise InputError(f"threshold must be a number from 0 to 1 (a share of the code); got {threshold!r}.")
     return float(threshold)
 
 
@@ -258,7 +259,7 @@ def boilerplate(release=None) -> Boilerplate:
     except TypeError:
         texts = None
     if texts is None or not all(isinstance(text, str) for text in texts):
-        raise ValueError(
+        raise InputError(
             f"release must be a folder of notebooks, a notebook, or a list of code texts; got {release!r:.100}."
         )
     return _boilerplate_of(texts)
@@ -272,7 +273,7 @@ def _notebook_code(paths):
         try:
             code += read_cells(path)[0]
         except OSError as exc:
-            raise ValueError(f"the release notebook {path} cannot be read ({exc}).") from None
+            raise InputError(f"the release notebook {path} cannot be read ({exc}).") from None
     return code
 
 

@@ -35,6 +35,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from ...errors import InputError
 from ..options import GradeOptions
 from ..progress import Progress
 from ..sandbox import backends, timings
@@ -117,24 +118,24 @@ def grade(
     if options is None:
         options = GradeOptions()
     if not isinstance(options, GradeOptions):
-        raise ValueError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
+        raise InputError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
     if engine is None:
         engine = LocalEngine(jobs)
     elif not isinstance(engine, Engine):
-        raise ValueError(f"engine must be a labkit.grading.run.engines.Engine; got {engine!r}.")
+        raise InputError(f"engine must be a labkit.grading.run.engines.Engine; got {engine!r}.")
     submissions = [Path(s) for s in submissions]
     for path in submissions:
         if not os.path.lexists(path):
-            raise ValueError(f"{path} does not exist.")
+            raise InputError(f"{path} does not exist.")
         if not path.is_symlink() and path.is_file() and path.suffix != ".ipynb":
-            raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
+            raise InputError(f"{path} is not a notebook: give .ipynb files or folders of them.")
     names = [submission_name(p) for p in submissions] if names is None else [str(n) for n in names]
     if len(names) != len(submissions):
-        raise ValueError(f"{len(names)} names for {len(submissions)} submissions; give one name per submission.")
+        raise InputError(f"{len(names)} names for {len(submissions)} submissions; give one name per submission.")
     ungradable = dict(ungradable or {})
     every = names + list(ungradable)
     if len(set(every)) != len(every):
-        raise ValueError("two submissions have the same name; their feedback files would collide.")
+        raise InputError("two submissions have the same name; their feedback files would collide.")
     if shard is not None:
         shard = parse_shard(shard)
         chosen = set(shard_of(every, every, shard)[1])
@@ -146,7 +147,7 @@ def grade(
     try:
         backend.available()
     except SandboxUnavailable as exc:
-        raise ValueError(f"cannot grade in a sandbox: {exc}") from None
+        raise InputError(f"cannot grade in a sandbox: {exc}") from None
     warning = backend.warning()
     if warning:
         sys.stderr.write(warning)
@@ -166,7 +167,7 @@ def grade(
         if recorded_variants.get("digest") != digest:
             before = f"with the variants {recorded_variants['digest']}" if recorded_variants else "without variants"
             now = f"with {digest}" if digest else "without"
-            raise ValueError(
+            raise InputError(
                 f"{out} was graded {before}, and now {now}: grade with the same --variants (and --roster) as "
                 "before, into a new --out, or again with --fresh."
             )
@@ -175,13 +176,13 @@ def grade(
             name for name in earlier.done if name in recorded and students.get(name, {}) != recorded[name]
         )  # a roster entry changed or gone: the result kept would be of other data than the record says
         if moved:
-            raise ValueError(
+            raise InputError(
                 f"the roster gives {one_line(moved[0], 60)} other data than {out} was graded with (its id changed, "
                 "or it left the roster): grade with the roster of that run, into a new --out, or again with --fresh."
             )
     seed = secrets.randbits(63) if earlier.seed is None else int(earlier.seed)
     if options.exercises not in (None, rubric.registry.source):
-        raise ValueError(
+        raise InputError(
             f"the options grade the exercises {options.exercises!r} but the rubric grades {rubric.registry.source!r}: "
             'name the course\'s exercises in its rubric (exercises = "module:attribute") and leave the option out.'
         )
@@ -196,7 +197,7 @@ def grade(
     known = known_sources(rubric.registry, solutions)  # computed (or read from its cache) once, here
     recorded = earlier.record.known.get("digest") if earlier.record is not None else None
     if recorded and earlier.done and recorded != known.digest:
-        raise ValueError(
+        raise InputError(
             f"{out} was graded against other known sources ({recorded}; now {known.digest}): the solutions given "
             "to --solutions, labkit or scipy changed since, so its held parts would be judged otherwise. Grade "
             "into a new --out, or again with --fresh."
@@ -311,7 +312,7 @@ def _variants(registry, names, roster, variants, ungradable):
     """{name: {exercise (text): {parameter: value}}} of the submissions a roster names; the others go into
     `ungradable` with the reason. Empty without variants; ValueError for a roster without variants or the reverse."""
     if (roster is None) != (variants is None):
-        raise ValueError("give both --roster and --variants to grade each student against their own data, or neither.")
+        raise InputError("give both --roster and --variants to grade each student against their own data, or neither.")
     if variants is None:
         return {}
     found = {}

@@ -42,6 +42,7 @@ from collections.abc import Generator
 from dataclasses import replace
 from pathlib import Path
 
+from ...errors import InputError
 from ..options import GradeOptions
 from ..sandbox import backends
 from ..sandbox.backends.base import SandboxUnavailable
@@ -59,7 +60,7 @@ def _dask():
     try:
         import distributed
     except ImportError:
-        raise ValueError(
+        raise InputError(
             "--dask needs dask.distributed, which comes with the dask extra: pip install 'labkit[dask]' "
             "(on the client and on every worker)."
         ) from None
@@ -74,7 +75,7 @@ def connect(address, workers=2):
     distributed = _dask()
     if address == LOCAL:
         if int(workers) < 1:
-            raise ValueError(f"--dask-workers must be at least 1; got {workers}.")
+            raise InputError(f"--dask-workers must be at least 1; got {workers}.")
         cluster = distributed.LocalCluster(
             n_workers=int(workers),
             threads_per_worker=1,
@@ -90,11 +91,11 @@ def connect(address, workers=2):
 
         return client, close
     if not isinstance(address, str) or not address.strip():
-        raise ValueError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
+        raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
     try:
         client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError) as exc:
-        raise ValueError(
+        raise InputError(
             f"cannot reach the Dask scheduler at {one_line(address, 100)} ({one_line(exc, 200)}): start one "
             "(`dask scheduler`, and `dask worker ADDRESS --nthreads 1` on each machine), or give --dask local."
         ) from None
@@ -110,7 +111,7 @@ class DaskEngine(Engine):
 
     def __init__(self, address: str, workers: int = 2):
         if address != LOCAL and (not isinstance(address, str) or not address.strip()):
-            raise ValueError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
+            raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
         self.address, self.workers = address, workers
         self._record: dict = {"engine": self.name}
 

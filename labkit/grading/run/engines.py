@@ -18,6 +18,7 @@ from collections.abc import Generator
 from dataclasses import dataclass
 from pathlib import Path
 
+from ...errors import InputError
 from ..options import GradeOptions
 from ..sandbox import backends
 from ..store.report import SubmissionGrade
@@ -94,7 +95,7 @@ class LocalEngine(Engine):
 
     def __init__(self, jobs: int = 2):
         if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-            raise ValueError(f"jobs must be a whole number of grading processes, at least 1; got {jobs!r}.")
+            raise InputError(f"jobs must be a whole number of grading processes, at least 1; got {jobs!r}.")
         self.jobs = jobs
         self._record: dict = {"engine": self.name, "jobs": jobs}
 

@@ -104,6 +104,7 @@ import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ...errors import InputError
 from ..store.report import one_line, safe_name
 from .lms_names import canvas_readings, resolve_canvas
 
@@ -163,9 +164,9 @@ class UnpackLimits:
     def __post_init__(self):
         for name in ("max_total", "max_members", "max_member", "max_ratio"):
             if not getattr(self, name) > 0:
-                raise ValueError(f"UnpackLimits.{name} must be positive, not {getattr(self, name)!r}.")
+                raise InputError(f"UnpackLimits.{name} must be positive, not {getattr(self, name)!r}.")
         if self.max_depth < 0:
-            raise ValueError(f"UnpackLimits.max_depth must be 0 or more, not {self.max_depth!r}.")
+            raise InputError(f"UnpackLimits.max_depth must be 0 or more, not {self.max_depth!r}.")
 
 
 @dataclass(frozen=True)
@@ -262,7 +263,7 @@ def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackL
     >>> unpack(folder / "evil.zip", folder / "out2")
     Traceback (most recent call last):
     ...
-    ValueError: evil.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
+    labkit.errors.InputError: evil.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
     """
     return _unpack_top(zip_path, into, limits, True)
 
@@ -278,7 +279,7 @@ def _unpack_top(zip_path, into, limits, nested, depth=0, budget=None):
         if created_root is not None:
             into.mkdir(parents=True)
         elif not stat.S_ISDIR(os.lstat(into).st_mode):
-            raise ValueError(f"{into} is not a folder to unpack into.")
+            raise InputError(f"{into} is not a folder to unpack into.")
         budget = budget if budget is not None else _Budget(limits)
         _unpack(Path(zip_path), into, budget, depth, written, made, _text(Path(zip_path).name), nested)
     except BaseException:
@@ -309,12 +310,12 @@ def _member_parts(name, label, skip=0):
     shown = one_line(name, 120)
     text = name.replace("\\", "/")
     if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
-        raise ValueError(f"{label}: member {shown!r} has an absolute path; labkit never extracts it.")
+        raise InputError(f"{label}: member {shown!r} has an absolute path; labkit never extracts it.")
     parts = [p for p in text.split("/") if p not in ("", ".")]
     if ".." in parts:
-        raise ValueError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
+        raise InputError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
     if any(len(p.encode("utf-8", "surrogateescape")) > MAX_NAME for p in parts[skip:]):
-        raise ValueError(
+        raise InputError(
             f"{label}: member {shown!r} has a name longer than {MAX_NAME} bytes, more than a file system "
             "takes; rename it shorter."
         )
@@ -324,16 +325,16 @@ def _member_parts(name, label, skip=0):
 def _unpack(zip_path, into, budget, depth, written, made, label, nested=True):
     limits = budget.limits
     if depth > limits.max_depth:
-        raise ValueError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
+        raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     try:
         archive = zipfile.ZipFile(zip_path)
     except (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError) as exc:
-        raise ValueError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
+        raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
     with archive:
         infos = archive.infolist()
         budget.members += len(infos)
         if budget.members > limits.max_members:
-            raise ValueError(
+            raise InputError(
                 f"{label}: more than {limits.max_members} members; labkit extracts at most {limits.max_members} "
                 "for one student."
             )
@@ -349,7 +350,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label, nested=True):
                 inner.append((target, shown))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
-            raise ValueError(
+            raise InputError(
                 f"{label}: member {shown!r} is a zip nested more than {limits.max_depth} deep; "
                 "labkit never extracts deeper."
             )
@@ -372,12 +373,12 @@ def _checked(infos, budget, label, parts_of=None):
             continue
         shown, key = one_line(info.filename, 120), "/".join(parts)
         if key in seen:
-            raise ValueError(f"{label}: member {shown!r} appears twice; labkit extracts each name once.")
+            raise InputError(f"{label}: member {shown!r} appears twice; labkit extracts each name once.")
         seen.add(key)
         if not is_dir:
             declared += _declared(info, label, shown, budget.limits)
             if budget.total + declared > budget.limits.max_total:
-                raise ValueError(
+                raise InputError(
                     f"{label}: more than {_size(budget.limits.max_total)} uncompressed; "
                     f"labkit extracts at most {_size(budget.limits.max_total)} for one student."
                 )
@@ -391,17 +392,17 @@ def _member_kind(info, label):
     mode = info.external_attr >> 16
     kind = stat.S_IFMT(mode)
     if stat.S_ISLNK(mode):
-        raise ValueError(f"{label}: member {shown!r} is a symbolic link; labkit never extracts links.")
+        raise InputError(f"{label}: member {shown!r} is a symbolic link; labkit never extracts links.")
     if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
-        raise ValueError(f"{label}: member {shown!r} is a device or a pipe; labkit never extracts those.")
+        raise InputError(f"{label}: member {shown!r} is a device or a pipe; labkit never extracts those.")
     if info.flag_bits & 0x1:
-        raise ValueError(f"{label}: member {shown!r} is encrypted; labkit cannot read it.")
+        raise InputError(f"{label}: member {shown!r} is encrypted; labkit cannot read it.")
     return info.is_dir() or kind == stat.S_IFDIR
 
 
 def _declared(info, label, shown, limits):
     if info.file_size > limits.max_member:
-        raise ValueError(
+        raise InputError(
             f"{label}: member {shown!r} is larger than {_size(limits.max_member)} "
             f"({_size(info.file_size)}); labkit extracts at most {_size(limits.max_member)} a file."
         )
@@ -411,7 +412,7 @@ def _declared(info, label, shown, limits):
 
 def _check_ratio(label, shown, size, compressed, limits):
     if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
-        raise ValueError(
+        raise InputError(
             f"{label}: member {shown!r} is compressed more than {limits.max_ratio:g} times (a zip bomb?); "
             f"labkit never extracts it."
         )
@@ -426,9 +427,9 @@ def _make_dirs(into, parts, made, label, shown):
             made.append(folder)
         except FileExistsError:
             if not stat.S_ISDIR(os.lstat(folder).st_mode):
-                raise ValueError(f"{label}: member {shown!r} is inside a file of the zip; labkit refuses it.") from None
+                raise InputError(f"{label}: member {shown!r} is inside a file of the zip; labkit refuses it.") from None
         except OSError as exc:
-            raise ValueError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+            raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
 
 
 def _extract(archive, info, target, budget, label, shown, written):
@@ -436,7 +437,7 @@ def _extract(archive, info, target, budget, label, shown, written):
     try:
         descriptor = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o600)
     except OSError as exc:
-        raise ValueError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+        raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
     written.append(target)
     size = 0
     # Read as if the member were larger than any limit, so that the bytes it really holds are counted
@@ -448,21 +449,21 @@ def _extract(archive, info, target, budget, label, shown, written):
             while chunk := source.read(CHUNK):
                 size += len(chunk)
                 if size > limits.max_member:
-                    raise ValueError(
+                    raise InputError(
                         f"{label}: member {shown!r} grows past {_size(limits.max_member)} while extracting; "
                         f"labkit extracts at most {_size(limits.max_member)} a file."
                     )
                 if budget.total + size > limits.max_total:
-                    raise ValueError(
+                    raise InputError(
                         f"{label}: more than {_size(limits.max_total)} uncompressed while extracting; "
                         f"labkit extracts at most {_size(limits.max_total)} for one student."
                     )
                 _check_ratio(label, shown, size, info.compress_size, limits)
                 out.write(chunk)
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
-        raise ValueError(f"{label}: member {shown!r} cannot be read ({one_line(exc, 120)}).") from None
+        raise InputError(f"{label}: member {shown!r} cannot be read ({one_line(exc, 120)}).") from None
     if size != info.file_size:
-        raise ValueError(
+        raise InputError(
             f"{label}: member {shown!r} declares {info.file_size} bytes but holds {size}; labkit refuses the zip."
         )
     budget.total += size
@@ -498,7 +499,7 @@ def _class_zip(path, root, builder):
     try:
         archive = zipfile.ZipFile(path)
     except (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError) as exc:
-        raise ValueError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
+        raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
     with archive:
         members = [(i, _loose_parts(i.filename)) for i in archive.infolist()]
         members, prefix = _unwrap([(i, p) for i, p in members if p and p[0] not in ("__MACOSX", "..")])
@@ -604,7 +605,7 @@ def _student_plan(key, items, builder, label, skip):
 
     try:
         if budget.members > budget.limits.max_members:
-            raise ValueError(
+            raise InputError(
                 f"{label}: more than {budget.limits.max_members} members are this student's; labkit extracts at "
                 f"most {budget.limits.max_members} for one student."
             )
@@ -625,7 +626,7 @@ def _check_space(plans, root, label):
         return
     largest = sorted(sizes, key=lambda key: -sizes[key])[:SHOWN]
     shown = ", ".join(f"{_shown_key(key)} ({_size(sizes[key])})" for key in largest)
-    raise ValueError(
+    raise InputError(
         f"{label} unpacks to {_size(sum(sizes.values()))}, and only {_size(free)} is free in {root} (labkit keeps "
         f"{_size(SPARE)} spare); the largest students are {shown}. Free some space, or grade those students apart."
     )
@@ -697,7 +698,7 @@ def _walk(folder, notes=None):
         for entry in _entries(current):
             seen += 1
             if seen > MAX_FILES:
-                raise ValueError(f"{_text(str(folder))} holds more than {MAX_FILES} files; a submission is a few.")
+                raise InputError(f"{_text(str(folder))} holds more than {MAX_FILES} files; a submission is a few.")
             if entry.is_symlink():
                 if notes is not None:
                     notes.append(f"ignored {one_line(_text(entry.path))}: a link (links are never followed)")
@@ -806,14 +807,14 @@ class _Builder:
             destination.parent.mkdir(parents=True, exist_ok=True)
             size = os.lstat(path).st_size
             if size > self.limits.max_member:
-                raise ValueError(
+                raise InputError(
                     f"{one_line(_text(str(relative)))} is larger than {_size(self.limits.max_member)}; "
                     "labkit does not copy it."
                 )
             shutil.copyfile(path, destination, follow_symlinks=False)
             budget.total += 0 if budget.in_class else size  # the class zip's members were counted when unpacked
             if budget.total > self.limits.max_total:
-                raise ValueError(
+                raise InputError(
                     f"{one_line(_text(str(relative)))}: more than {_size(self.limits.max_total)} in all; "
                     f"labkit takes at most {_size(self.limits.max_total)} from one student."
                 )
@@ -859,19 +860,19 @@ def _nbgrader(submitted, assignment, builder, notes):
                 notes.append(f"ignored {one_line(name)}/{one_line(_text(inner.name))}: not an assignment's folder")
     assignments = sorted({a for per in found.values() for a in per})
     if not assignments:
-        raise ValueError(
+        raise InputError(
             f"{_text(str(submitted))} holds no assignment folders: nbgrader's layout is "
             "submitted/<student>/<assignment>/*.ipynb."
         )
     if assignment is None:
         if len(assignments) > 1:
-            raise ValueError(
+            raise InputError(
                 f"{_text(str(submitted))} holds several assignments ({_names(assignments)}); "
                 "pass --assignment NAME to grade one."
             )
         assignment = assignments[0]
     elif assignment not in assignments:
-        raise ValueError(
+        raise InputError(
             f"no student of {_text(str(submitted))} submitted {one_line(assignment, 60)!r}; "
             f"the assignments there are {', '.join(one_line(a, 60) for a in assignments)}."
         )
@@ -1039,12 +1040,12 @@ def _detect_tops(tops, where):
         return found[0]
     if not found:
         shown = ", ".join(one_line(name, 64) for name, _ in tops[:SHOWN]) or "nothing"
-        raise ValueError(f"{one_line(where)} holds no students ({shown}); expected {LAYOUTS}: see docs/instructors.md.")
+        raise InputError(f"{one_line(where)} holds no students ({shown}); expected {LAYOUTS}: see docs/instructors.md.")
     what = (
         f"{len(moodle)} named as Moodle names submissions, {len(canvas)} file(s) named as Canvas names them, "
         f"{len(other_dirs)} other folder(s) and {len(notebooks)} other notebook(s)"
     )
-    raise ValueError(
+    raise InputError(
         f"{one_line(where)} mixes layouts ({what}); expected one of {LAYOUTS}. "
         "Give a folder that holds one of them only."
     )
@@ -1114,7 +1115,7 @@ def is_class(path: str | os.PathLike) -> bool:
             except ValueError:
                 folders = True
     if loose and folders:
-        raise ValueError(
+        raise InputError(
             f"{one_line(_text(str(path)))} holds notebooks of its own and folders of notebooks, so it could be a "
             "class or one student's work: for a class, list its students (labkit grade --out OUT -- "
             f"{one_line(_text(str(path)), 60)}/*); for one student, give the notebooks one by one."
@@ -1177,11 +1178,11 @@ def find_class(
     try:
         info = os.lstat(path)
     except FileNotFoundError:
-        raise ValueError(f"{one_line(_text(str(path)))} does not exist.") from None
+        raise InputError(f"{one_line(_text(str(path)))} does not exist.") from None
     if stat.S_ISLNK(info.st_mode):
-        raise ValueError(f"{one_line(_text(str(path)))} is a symbolic link; give the folder or zip itself.")
+        raise InputError(f"{one_line(_text(str(path)))} is a symbolic link; give the folder or zip itself.")
     if stat.S_ISDIR(info.st_mode) and _inside(workspace, path):
-        raise ValueError(
+        raise InputError(
             f"the workspace {one_line(_text(str(workspace)))} is inside the class folder; "
             "labkit writes nothing there: give a workspace elsewhere."
         )
@@ -1205,7 +1206,7 @@ def _class_root(path, info, own, builder):
     if stat.S_ISDIR(info.st_mode):
         return path, _detect(path)
     if not stat.S_ISREG(info.st_mode) or path.suffix.lower() != ".zip":
-        raise ValueError(f"{one_line(_text(str(path)))} is neither a folder nor a zip; give the class as one.")
+        raise InputError(f"{one_line(_text(str(path)))} is neither a folder nor a zip; give the class as one.")
     root = own / "class"
     root.mkdir()
     layout = _class_zip(path, root, builder)
@@ -1226,7 +1227,7 @@ def _one_name_each(students):
     for student in students:
         if student.name in by_name:
             other = by_name[student.name]
-            raise ValueError(
+            raise InputError(
                 f"two students are both named {one_line(student.name, 80)!r} "
                 f"({_origin(other)} and {_origin(student)}); rename one so that each name is one student."
             )

@@ -22,6 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from ...errors import InputError
 from ..sandbox import backends, cgroup, forkserver
 from ..store import record as records
 from ..store.late import read_small
@@ -221,7 +222,7 @@ class Job:
             raw = read_small(self.result, records.MAX_RESULT)  # ValueError when larger than the grader accepts
             data = json.loads(raw.decode("utf-8"))
             if not isinstance(data, dict) or data.get("format") != FORMAT:
-                raise ValueError(f"format {data.get('format') if isinstance(data, dict) else data!r:.60}")
+                raise InputError(f"format {data.get('format') if isinstance(data, dict) else data!r:.60}")
         except (OSError, ValueError) as exc:
             return None, f"its result could not be read ({str(exc)[:200]})"
         return data, None

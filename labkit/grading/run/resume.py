@@ -10,6 +10,7 @@ for batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...errors import InputError
 from ..store import record as records
 from ..store.report import SubmissionGrade, labkit_version, one_line
 from ..store.rubric import DEFAULT as DEFAULT_RUBRIC
@@ -85,7 +86,7 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
         return Resumed({}, seed, rubric if rubric is not None else default_rubric())
     if not (out / records.RECORD).exists():
         if files:
-            raise ValueError(
+            raise InputError(
                 f"{out} holds results but no run record ({records.RECORD}; an older labkit wrote none): give "
                 "--fresh to grade every submission again there, or choose a new --out."
             )
@@ -93,11 +94,11 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     how = "give --fresh to grade every submission again, or choose a new --out"
     record = records.read(out)
     if record.kind != "grade":
-        raise ValueError(
+        raise InputError(
             f"{out} holds a merge ({records.RECORD} says so), which is not resumed: grade into a new --out, or {how}."
         )
     if record.labkit != labkit_version():
-        raise ValueError(
+        raise InputError(
             f"{out} was graded by labkit {one_line(record.labkit, 40)}, and this is labkit {labkit_version()}: "
             f"{how} with this version."
         )
@@ -105,20 +106,20 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     if rubric is None:
         rubric = recorded
     elif not recorded.same_as(rubric):
-        raise ValueError(
+        raise InputError(
             f"{out} was graded under the rubric recorded there ({recorded.title!r}), and {rubric.source} differs "
             f"from it in {' and '.join(recorded.differences(rubric))}: leave --rubric out to resume that run. "
             f"To grade under {rubric.source}, {how}; to apply only another [late] or [held] table to these results, "
             f"`labkit merge {out} --rubric {_file_of(rubric)} --out NEW`."
         )
     if seed is not None and record.seed is not None and int(seed) != int(record.seed):
-        raise ValueError(
+        raise InputError(
             f"{out} holds results of a run with seed {record.seed}, not --seed {seed}: leave --seed out to resume "
             f"it, {how}."
         )
     stray = sorted(set(record.submissions) - set(names))
     if stray:
-        raise ValueError(
+        raise InputError(
             f"{out} holds the result of {one_line(stray[0], 80)!r}, which is not among the submissions of this "
             "run: give the submissions (and --shard) of the run that wrote it to resume it, give --fresh to grade "
             "only these, or choose a new --out."
@@ -173,9 +174,9 @@ def parse_shard(spec):
         index, count = spec.split("/") if isinstance(spec, str) else spec
         index, count = int(index), int(count)
     except (TypeError, ValueError):
-        raise ValueError(f"{how}; got {one_line(spec, 40)!r}.") from None
+        raise InputError(f"{how}; got {one_line(spec, 40)!r}.") from None
     if not 1 <= index <= count:
-        raise ValueError(f"{how}; got {index}/{count}.")
+        raise InputError(f"{how}; got {index}/{count}.")
     return index, count
 
 

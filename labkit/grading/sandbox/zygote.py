@@ -45,6 +45,7 @@ import socket
 import struct
 import sys
 
+from ...errors import InputError
 from . import worker
 from .backends.base import Limits, apply_limits, environment_paths
 
@@ -238,7 +239,7 @@ def _parse(data, fds):
     request = json.loads(data.decode("utf-8"))
     count = int(request.get("cgroup", 0))
     if len(fds) != 4 + count or not 0 <= count <= MAX_FDS - 4:
-        raise ValueError("a request with the wrong descriptors")
+        raise InputError("a request with the wrong descriptors")
     named = dict(zip(("requests", "answers", "control", "status"), fds[:4]))
     named["cgroup"] = fds[4:]
     uid = int(request["uid"])
@@ -256,7 +257,7 @@ def serve_forks(server, shell, home):
         data, fds, flags = received
         try:
             if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
-                raise ValueError("a request larger than the server takes")
+                raise InputError("a request larger than the server takes")
             named, uid, limits = _parse(data, fds)
         except Exception:  # noqa: BLE001 - not a request of the grader's: dropped (its sender sees the pipes close)
             for fd in fds:

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime, timedelta, timezone, tzinfo
 from pathlib import Path
 
+from ...errors import InputError
 from .text import points_text
 
 UNITS = {"day": 86400, "hour": 3600}
@@ -93,23 +94,23 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
     >>> parse_deadline("2026-12-01T23:59")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: the deadline is '2026-12-01T23:59', which has no UTC offset: write it as ISO 8601 with a UTC offset...
+    labkit.errors.InputError: the deadline is '2026-12-01T23:59', which has no UTC offset: write it as ISO 8601 with a UTC offset...
     """
     if isinstance(value, datetime):
         if value.tzinfo is None or value.utcoffset() is None:
-            raise ValueError(f"{where} is {value.isoformat()}, which has no UTC offset: write it as {FORMAT}.")
+            raise InputError(f"{where} is {value.isoformat()}, which has no UTC offset: write it as {FORMAT}.")
         return value
     if not isinstance(value, str):
-        raise ValueError(f"{where} is {value!r}, not a time: write it as {FORMAT}.")
+        raise InputError(f"{where} is {value!r}, not a time: write it as {FORMAT}.")
     text = value.strip()
     if not _ISO.fullmatch(text):
         plain = re.fullmatch(r"\d{4}-\d{2}-\d{2}(?:[T ]\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?)?", text)
         why = "which has no UTC offset" if plain else "which is not in that format"
-        raise ValueError(f"{where} is {value[:SHOWN]!r}, {why}: write it as {FORMAT}.")
+        raise InputError(f"{where} is {value[:SHOWN]!r}, {why}: write it as {FORMAT}.")
     try:
         return datetime.fromisoformat(text.replace("Z", "+00:00"))
     except ValueError as exc:
-        raise ValueError(f"{where} is {value!r}, which is not a real time ({exc}): write it as {FORMAT}.") from None
+        raise InputError(f"{where} is {value!r}, which is not a real time ({exc}): write it as {FORMAT}.") from None
 
 
 def parse_timestamp(text: str) -> datetime:
@@ -148,19 +149,19 @@ def parse_timestamp(text: str) -> datetime:
     match = _NBGRADER.fullmatch(line)
     if not match:
         shown = line[:SHOWN] + ("..." if len(line) > SHOWN else "")
-        raise ValueError(f"{shown!r} is not a time as nbgrader writes it (e.g. 2026-12-01 23:59:59.123456 UTC)")
+        raise InputError(f"{shown!r} is not a time as nbgrader writes it (e.g. 2026-12-01 23:59:59.123456 UTC)")
     zone = match["zone"]
     if zone is None:
-        raise ValueError(f"{line!r} has no time zone, so the moment it means is unknown")
+        raise InputError(f"{line!r} has no time zone, so the moment it means is unknown")
     if zone in ("Z", "UTC", "GMT"):
         offset = UTC
     elif zone[0] in "+-":
         digits = zone[1:].replace(":", "")
         if int(digits[:2]) > 23 or int(digits[2:]) > 59:
-            raise ValueError(f"{line!r} has the offset {zone}, which no time zone has")
+            raise InputError(f"{line!r} has the offset {zone}, which no time zone has")
         offset = timezone((1 if zone[0] == "+" else -1) * timedelta(hours=int(digits[:2]), minutes=int(digits[2:])))
     else:
-        raise ValueError(
+        raise InputError(
             f"{line!r} names the time zone {zone!r}, which labkit cannot place (only UTC, GMT and numeric "
             "offsets are unambiguous)"
         )
@@ -171,7 +172,7 @@ def parse_timestamp(text: str) -> datetime:
     try:
         naive = datetime.fromisoformat(f"{match['date']}T{clock}")
     except ValueError as exc:
-        raise ValueError(f"{line!r} is not a real time ({exc})") from None
+        raise InputError(f"{line!r} is not a real time ({exc})") from None
     return naive.replace(tzinfo=offset)
 
 
@@ -239,13 +240,13 @@ class SubmissionTime:
         if data is None:
             return None
         if not isinstance(data, dict) or set(data) - {"time", "source", "problem"}:
-            raise ValueError("its submission time is not a time, source and problem")
+            raise InputError("its submission time is not a time, source and problem")
         when = data.get("time")
         if when is not None:
             when = parse_deadline(when, "its submission time")
         source, problem = data.get("source"), data.get("problem")
         if not all(v is None or isinstance(v, str) for v in (source, problem)):
-            raise ValueError("its submission time's source and problem must be text")
+            raise InputError("its submission time's source and problem must be text")
         return cls(when, source, problem)
 
 
@@ -400,10 +401,10 @@ def _minutes(value):
 def _amount(table, key, source, low=0.0, high=None, unit=""):
     value = table[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{source}: [late] {key} must be a number{unit}; got {value!r}.")
+        raise InputError(f"{source}: [late] {key} must be a number{unit}; got {value!r}.")
     if value < low or (high is not None and value > high):
         bound = f"between {_number(low)} and {_number(high)}" if high is not None else f"at least {_number(low)}"
-        raise ValueError(f"{source}: [late] {key} must be {bound}{unit}; got {value!r}.")
+        raise InputError(f"{source}: [late] {key} must be {bound}{unit}; got {value!r}.")
     return float(value)
 
 
@@ -429,20 +430,20 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
         Saying which key is wrong and what it must be.
     """
     if not isinstance(table, dict):
-        raise ValueError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
+        raise InputError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
     unknown = sorted(map(str, set(table) - KEYS))
     if unknown:
-        raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)} in [late]; it has {', '.join(sorted(KEYS))}.")
+        raise InputError(f"{source}: unknown key(s) {', '.join(unknown)} in [late]; it has {', '.join(sorted(KEYS))}.")
     missing = [key for key in ("deadline", "per", "percent", "cap") if key not in table]
     if missing:
-        raise ValueError(
+        raise InputError(
             f'{source}: [late] needs {", ".join(missing)} (e.g. deadline = "2026-12-01T23:59:00+01:00", '
             'per = "day", percent = 10, cap = 50).'
         )
     deadline = parse_deadline(table["deadline"], f"{source}: [late] deadline")
     per = table["per"]
     if per not in UNITS:
-        raise ValueError(
+        raise InputError(
             f'{source}: [late] per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.'
         )
     percent = _amount(table, "percent", source, 0, 100, " (percent of the points per started unit)")
@@ -450,13 +451,13 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
     grace = _amount(table, "grace", source, 0, unit=" of minutes") if "grace" in table else 0.0
     extensions = table.get("extensions", {})
     if not isinstance(extensions, dict):
-        raise ValueError(
+        raise InputError(
             f'{source}: [late.extensions] must be a table of `name = "new deadline"` or `name = hours` lines.'
         )
     granted = []
     for name, value in extensions.items():
         if not isinstance(name, str) or not name.strip():
-            raise ValueError(
+            raise InputError(
                 f"{source}: [late.extensions] has the name {name!r}; a name is a submission's name, as text."
             )
         where = f"{source}: [late.extensions] {name[:SHOWN]!r}"
@@ -464,12 +465,12 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
             new = parse_deadline(value, where)
         elif isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
             if value <= 0:
-                raise ValueError(f"{where} gives {value!r} hours; an extension adds more than 0 hours.")
+                raise InputError(f"{where} gives {value!r} hours; an extension adds more than 0 hours.")
             new = deadline + timedelta(hours=value)
         else:
-            raise ValueError(f"{where} is {value!r}: give a new deadline ({FORMAT}) or a number of hours.")
+            raise InputError(f"{where} is {value!r}: give a new deadline ({FORMAT}) or a number of hours.")
         if new <= deadline:
-            raise ValueError(
+            raise InputError(
                 f"{where} is {time_text(new, deadline.tzinfo)}, not after the deadline {time_text(deadline)}; "
                 "an extension gives more time."
             )
@@ -482,14 +483,14 @@ def read_small(path, limit):
     (FileNotFoundError when there is none)."""
     path = Path(path)
     if stat.S_ISLNK(os.lstat(path).st_mode):
-        raise ValueError(f"{path.name} is a symbolic link; links are never followed")
+        raise InputError(f"{path.name} is a symbolic link; links are never followed")
     fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
-            raise ValueError(f"{path.name} is not a file")
+            raise InputError(f"{path.name} is not a file")
         if info.st_size > limit:
-            raise ValueError(f"{path.name} is {info.st_size:,} bytes, more than the {limit:,} it can be")
+            raise InputError(f"{path.name} is {info.st_size:,} bytes, more than the {limit:,} it can be")
         chunks, size = [], 0
         while size < limit:
             chunk = os.read(fd, limit - size)
@@ -579,13 +580,13 @@ def read_times(path: str | os.PathLike) -> dict[str, datetime]:
         raw = read_small(path, MAX_TIMES)
         text = raw.decode("utf-8-sig")
     except FileNotFoundError:
-        raise ValueError(f"the times file {path} does not exist.") from None
+        raise InputError(f"the times file {path} does not exist.") from None
     except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError
-        raise ValueError(f"cannot read the times file {path}: {exc}.") from None
+        raise InputError(f"cannot read the times file {path}: {exc}.") from None
     rows = csv.reader(text.splitlines())
     header = [cell.strip().lower() for cell in next(rows, [])]
     if "submission" not in header or "time" not in header:
-        raise ValueError(
+        raise InputError(
             f"{path} needs a header row with the columns submission and time "
             "(e.g. `submission,time` then `alice,2026-12-01T23:10:00+01:00`)."
         )
@@ -595,16 +596,16 @@ def read_times(path: str | os.PathLike) -> dict[str, datetime]:
         if not any(cell.strip() for cell in row):
             continue
         if len(row) <= max(who, when):
-            raise ValueError(f"{path}, line {line}: it has {len(row)} cell(s), fewer than the header's columns.")
+            raise InputError(f"{path}, line {line}: it has {len(row)} cell(s), fewer than the header's columns.")
         name = row[who].strip()
         if not name:
-            raise ValueError(f"{path}, line {line}: the submission's name is empty.")
+            raise InputError(f"{path}, line {line}: the submission's name is empty.")
         if name in times:
-            raise ValueError(f"{path}, line {line}: {name[:SHOWN]!r} is listed twice; keep one time per submission.")
+            raise InputError(f"{path}, line {line}: {name[:SHOWN]!r} is listed twice; keep one time per submission.")
         try:
             times[name] = parse_timestamp(row[when])
         except ValueError as exc:
-            raise ValueError(f"{path}, line {line} ({name[:SHOWN]!r}): {exc}; write it as {FORMAT}.") from None
+            raise InputError(f"{path}, line {line} ({name[:SHOWN]!r}): {exc}; write it as {FORMAT}.") from None
     return times
 
 
@@ -704,7 +705,7 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
     course = Path(course)
     inbound = course if course.name == "inbound" else course / "inbound"
     if not inbound.is_dir():
-        raise ValueError(
+        raise InputError(
             f"{course} is not a course folder of nbgrader's exchange (it has no inbound/): give "
             "--times-from-exchange EXCHANGE/COURSE_ID, e.g. /srv/nbgrader/exchange/course101."
         )
@@ -712,14 +713,14 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
     with os.scandir(inbound) as entries:
         for count, entry in enumerate(entries):
             if count >= MAX_INBOUND:
-                raise ValueError(f"{inbound} holds more than {MAX_INBOUND:,} entries; it is not an exchange folder.")
+                raise InputError(f"{inbound} holds more than {MAX_INBOUND:,} entries; it is not an exchange folder.")
             if not entry.is_dir(follow_symlinks=False):
                 continue
             when = _inbound_time(entry.name, assignment)
             if when is None:
                 continue
             if isinstance(when, str):
-                raise ValueError(f"{inbound}: the folder {entry.name[:SHOWN]!r} has no readable time ({when}).")
+                raise InputError(f"{inbound}: the folder {entry.name[:SHOWN]!r} has no readable time ({when}).")
             student = entry.name.split(f"+{assignment}+")[0]
             if student not in found or when > found[student]:
                 found[student] = when

@@ -31,6 +31,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...errors import InputError
 from . import rubric as rubrics
 from .late import read_small
 
@@ -114,7 +115,7 @@ class RunRecord:
 def new(kind, labkit, seed, rubric):
     """A record of `kind` for a run under `rubric` (a Rubric that knows its data), with no submission yet."""
     if rubric.data is None or not rubrics.from_dict(rubric.data, rubric.source).same_as(rubric):
-        raise ValueError(
+        raise InputError(
             "the rubric was made or changed in code, not read from TOML, so a run cannot record it as it grades: "
             "read it with labkit.grading.store.rubric.load (or from_dict)."
         )
@@ -165,49 +166,49 @@ def read(folder):
     try:
         raw = read_small(path, MAX_RECORD)
     except FileNotFoundError:
-        raise ValueError(NO_RECORD.format(folder=folder, record=RECORD)) from None
+        raise InputError(NO_RECORD.format(folder=folder, record=RECORD)) from None
     try:
         data = json.loads(raw.decode("utf-8"))
         if not isinstance(data, dict) or data.get("format") != FORMAT:
-            raise ValueError(f"its format is not {FORMAT}")
+            raise InputError(f"its format is not {FORMAT}")
         if data.get("kind") not in KINDS:
-            raise ValueError(f"its kind is not one of {', '.join(KINDS)}")
+            raise InputError(f"its kind is not one of {', '.join(KINDS)}")
         submissions = data.get("submissions")
         if not isinstance(submissions, dict) or not isinstance(data.get("rubric"), dict):
-            raise ValueError("it has no submissions or no rubric")
+            raise InputError("it has no submissions or no rubric")
         for name, entry in submissions.items():
             if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("result", "sha256")):
-                raise ValueError(f"its entry for {str(name)[:80]!r} has no result file and hash")
+                raise InputError(f"its entry for {str(name)[:80]!r} has no result file and hash")
             if Path(entry["result"]).name != entry["result"] or not entry["result"].endswith(".json"):
-                raise ValueError(f"its entry for {str(name)[:80]!r} names a result outside results/")
+                raise InputError(f"its entry for {str(name)[:80]!r} names a result outside results/")
         text = data.get("rubric text")
         if text is not None and not isinstance(text, str):
-            raise ValueError("its rubric text is not text")
+            raise InputError("its rubric text is not text")
         times = data.get("times") or {}
         if not isinstance(times, dict) or not all(
             isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
             for given in times.values()
         ):
-            raise ValueError("its times are not times with a UTC offset")
+            raise InputError("its times are not times with a UTC offset")
         seed = data.get("seed")
         whole = isinstance(seed, int) and not isinstance(seed, bool)
         listed = isinstance(seed, list) and all(isinstance(s, int) and not isinstance(s, bool) for s in seed)
         if not (seed is None or (whole if data["kind"] == "grade" else listed)):
-            raise ValueError(f"its seed is not {'a number' if data['kind'] == 'grade' else 'a list of numbers'}")
+            raise InputError(f"its seed is not {'a number' if data['kind'] == 'grade' else 'a list of numbers'}")
         flags = data.get("flags") or {}
         if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
-            raise ValueError("its flags are not true or false")
+            raise InputError("its flags are not true or false")
         known = data.get("known") or {}
         if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
-            raise ValueError("its known sources are not named by text")
+            raise InputError("its known sources are not named by text")
         variants = data.get("variants") or {}
         if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
-            raise ValueError("its variants are not a table of students")
+            raise InputError("its variants are not a table of students")
         delivery = data.get("delivery") or {}
         if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
-            raise ValueError("its delivery is not a table of students")
+            raise InputError("its delivery is not a table of students")
     except (UnicodeDecodeError, ValueError) as exc:
-        raise ValueError(
+        raise InputError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
     return RunRecord(
@@ -256,7 +257,7 @@ def results(folder, record):
         try:
             data = json.loads(raw.decode("utf-8"))
         except (UnicodeDecodeError, ValueError) as exc:
-            raise ValueError(f"{path} is not JSON ({exc}).") from None
+            raise InputError(f"{path} is not JSON ({exc}).") from None
         if not isinstance(data, dict) or data.get("name") != name:
             refused.append((path, f"it is not the result of the submission the record names ({name[:80]!r})"))
             continue
@@ -315,7 +316,7 @@ def rubric_for(folders, given, command):
     for folder, record in records[1:]:
         other = record.rubric_object(folder)
         if not recorded.same_as(other):
-            raise ValueError(
+            raise InputError(
                 f"{folder} was graded under the rubric {other.title!r} and {first_folder} under {recorded.title!r} "
                 f"({' and '.join(recorded.differences(other))} differ): results of different rubrics are not read "
                 "together. Grade again under one rubric; when only the [late] or [held] tables differ, merge them "
@@ -327,7 +328,7 @@ def rubric_for(folders, given, command):
     differ = recorded.differences(chosen)
     if differ:
         file = given if not isinstance(given, rubrics.Rubric) else "FILE"
-        raise ValueError(
+        raise InputError(
             f"{first_folder} was graded under the rubric recorded in {first_folder / RECORD} "
             f"({recorded.title!r}), and {chosen.source} differs from it in {' and '.join(differ)}; {command} shows "
             f"grades.csv as graded, so leave --rubric out. To score the class under {chosen.source}: "

@@ -30,6 +30,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...errors import InputError
 from ...exercises.result import KINDS
 from . import feedback as feedbacks
 from . import record as records
@@ -56,7 +57,7 @@ class ProblemText(str):
     >>> ProblemText("a.ipynb: it stopped.", [("stopped", "?")])
     Traceback (most recent call last):
     ...
-    ValueError: a problem's kind is one of 'not done', 'raised', 'refused', 'timeout', 'crash', 'tampered', \
+    labkit.errors.InputError: a problem's kind is one of 'not done', 'raised', 'refused', 'timeout', 'crash', 'tampered', \
 'other', 'another variant', not 'stopped'.
     """
 
@@ -67,7 +68,7 @@ class ProblemText(str):
         pairs = []
         for kind, description in kinds:
             if kind not in KINDS:
-                raise ValueError(f"a problem's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
+                raise InputError(f"a problem's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
             pairs.append((str(kind), str(description)))
         self.kinds = tuple(pairs)
         return self
@@ -250,14 +251,14 @@ class SubmissionGrade:
         A result of an earlier format is refused, saying to grade again: ``labkit-grade/2`` kept its problems as
         words only, and guessing their kinds from the words is what format 3 ended."""
         if isinstance(data, dict) and data.get("format") in OLD_FORMATS:
-            raise ValueError(
+            raise InputError(
                 f"{source} is in the results format {data['format']}, which keeps a problem's words but not its "
                 f"kind (a time limit, a crash, an error raised, ...); this labkit reads {FORMAT} only. Grade "
                 "those submissions again with this version: `labkit grade` with --fresh, or into a new --out."
             )
         try:
             if data.get("format") != FORMAT:
-                raise ValueError(f"format is {data.get('format')!r}, not {FORMAT!r}")
+                raise InputError(f"format is {data.get('format')!r}, not {FORMAT!r}")
             results = {int(n): v for n, v in data["results"].items()}
             for verdict in results.values():
                 float(verdict["fraction"])
@@ -276,17 +277,17 @@ class SubmissionGrade:
             grade.time = SubmissionTime.from_dict(data.get("submitted"))
             grade.marks = _marks(data.get("marks") or {})
         except (AttributeError, KeyError, TypeError, ValueError) as exc:
-            raise ValueError(f"{source} is not a labkit grade result ({exc}).") from None
+            raise InputError(f"{source} is not a labkit grade result ({exc}).") from None
         if data.get("labkit") != labkit_version():
             written = f"labkit {one_line(data['labkit'], 40)}" if data.get("labkit") else "a labkit that did not say"
-            raise ValueError(
+            raise InputError(
                 f"{source} was written by {written}, and this is labkit {labkit_version()}: results of another "
                 "version are not mixed in (its checks may grade differently); grade those submissions again "
                 "with this version."
             )
         known = grade.rubric.registry.exercises
         if not set(grade.results) <= set(known):
-            raise ValueError(
+            raise InputError(
                 f"{source} grades exercises {sorted(grade.results)}, not {sorted(known)}: "
                 "it was written by another version of labkit."
             )
@@ -316,7 +317,7 @@ def _sources(value):
 def _problems(texts, kinds):
     """A result file's problems, each with its kinds (ValueError when the two lists do not pair up)."""
     if not isinstance(texts, list) or not isinstance(kinds, list) or len(texts) != len(kinds):
-        raise ValueError("its problems and their kinds do not pair up")
+        raise InputError("its problems and their kinds do not pair up")
     return [ProblemText(str(text), [(str(k), str(d)) for k, d in pairs]) for text, pairs in zip(texts, kinds)]
 
 
@@ -581,9 +582,9 @@ def read_results(folders, rubric=None, replaced=None):
     given = set()
     for folder in folders:
         if not folder.is_dir():
-            raise ValueError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
+            raise InputError(f"{folder} is not a folder: give the --out folder of a `labkit grade` run.")
         if folder.resolve() in given:
-            raise ValueError(f"{folder} is given twice; give each folder once.")
+            raise InputError(f"{folder} is given twice; give each folder once.")
         given.add(folder.resolve())
     if rubric is None:
         rubric = records.rubric_for(folders, None, "reading these folders")
@@ -591,14 +592,14 @@ def read_results(folders, rubric=None, replaced=None):
     for folder in folders:
         record = records.read(folder)
         if record.labkit != labkit_version():
-            raise ValueError(
+            raise InputError(
                 f"{folder} was graded by labkit {one_line(record.labkit, 40)}, and this is labkit "
                 f"{labkit_version()}: results of another version are not mixed in (its checks may grade "
                 "differently); grade those submissions again with this version."
             )
         recorded = record.rubric_object(folder)
         if recorded.digest != rubric.digest:
-            raise ValueError(
+            raise InputError(
                 f"{folder} was graded under the rubric {recorded.title!r} ({recorded.digest}), not "
                 f"{rubric.title!r} ({rubric.digest}): results of different rubrics (their exercises, groups or "
                 "points) are not merged. Grade again with the --rubric of the class's run; the [late] table may "
@@ -622,7 +623,7 @@ def read_results(folders, rubric=None, replaced=None):
             grades[grade.name], files[grade.name] = grade, path
     if not grades:
         what = "no result their records vouch for" if refused else "no results (only empty shards)"
-        raise ValueError(
+        raise InputError(
             f"{', '.join(map(str, folders))} hold {what}: give the --out folders of earlier `labkit grade` runs."
         )
     return Merged([grades[name] for name in sorted(grades)], replaced or (), refused, rubric)
@@ -658,12 +659,12 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False):
 
     out = Path(out_dir)
     if out.resolve() in {Path(folder).resolve() for folder in folders}:
-        raise ValueError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
+        raise InputError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
     if rubric is not None and not isinstance(rubric, rubrics.Rubric):
         rubric = rubrics.load(rubric)
     drawn = {records.read(folder).variants.get("digest") for folder in folders}
     if len(drawn) > 1:
-        raise ValueError(
+        raise InputError(
             "the folders were graded with different variants (or some without): each student's data would differ "
             "from one result to the next. Merge only runs graded with the same --variants file."
         )

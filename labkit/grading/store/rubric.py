@@ -25,6 +25,7 @@ import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ...errors import InputError
 from ...exercises.registry import LAB, Registry
 from ...exercises.registry import load as load_registry
 from . import late as lateness
@@ -204,10 +205,10 @@ def _exercise(value, where, source, registry):
     try:
         number = int(value)
     except (TypeError, ValueError):
-        raise ValueError(f"{source}: {where} has {value!r}, which is not an exercise number.") from None
+        raise InputError(f"{source}: {where} has {value!r}, which is not an exercise number.") from None
     if str(value).strip() != str(number) or number not in registry.exercises:
         known = ", ".join(map(str, sorted(registry.exercises)))
-        raise ValueError(
+        raise InputError(
             f"{source}: {where} names exercise {value!r}, which labkit does not grade "
             f"(graded exercises: {known}; exercise 1 is not graded)."
         )
@@ -216,10 +217,10 @@ def _exercise(value, where, source, registry):
 
 def _exercise_list(value, where, source, registry):
     if not isinstance(value, list):
-        raise ValueError(f"{source}: {where} must be a list of exercise numbers, e.g. [2, 3, 4].")
+        raise InputError(f"{source}: {where} must be a list of exercise numbers, e.g. [2, 3, 4].")
     numbers = [_exercise(v, where, source, registry) for v in value]
     if len(set(numbers)) != len(numbers):
-        raise ValueError(f"{source}: {where} lists an exercise twice.")
+        raise InputError(f"{source}: {where} lists an exercise twice.")
     return tuple(numbers)
 
 
@@ -228,17 +229,17 @@ def from_dict(data, source="the rubric"):
     known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late", "held", "answers"}
     unknown = sorted(set(data) - known)
     if unknown:
-        raise ValueError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
+        raise InputError(f"{source}: unknown key(s) {', '.join(unknown)}; a rubric has {', '.join(sorted(known))}.")
     named = data.get("exercises")
     if named is not None and not isinstance(named, str):
-        raise ValueError(f"{source}: exercises must be text, module:attribute of a Registry.")
+        raise InputError(f"{source}: exercises must be text, module:attribute of a Registry.")
     try:
         registry = load_registry(named)
     except ValueError as exc:
-        raise ValueError(f"{source}: {exc}") from None
+        raise InputError(f"{source}: {exc}") from None
     raw_points = data.get("points", {})
     if not isinstance(raw_points, dict):
-        raise ValueError(
+        raise InputError(
             f"{source}: [points] must be a table of `N = points` lines (or left out: each exercise "
             "is then worth its parts' weights)."
         )
@@ -246,9 +247,9 @@ def from_dict(data, source="the rubric"):
     for key, value in raw_points.items():
         number = _exercise(key, "[points]", source, registry)
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
-            raise ValueError(f"{source}: [points] gives exercise {number} {value!r}; points must be a number.")
+            raise InputError(f"{source}: [points] gives exercise {number} {value!r}; points must be a number.")
         if value < 0:
-            raise ValueError(
+            raise InputError(
                 f"{source}: [points] gives exercise {number} negative points ({value}); "
                 "use 0 to leave an exercise ungraded."
             )
@@ -262,7 +263,7 @@ def from_dict(data, source="the rubric"):
     for group, numbers in groups:
         for number in numbers:
             if number in seen:
-                raise ValueError(
+                raise InputError(
                     f"{source}: exercise {number} is in {seen[number]} and in {group}; "
                     "each exercise belongs to one group (branches may not overlap)."
                 )
@@ -270,7 +271,7 @@ def from_dict(data, source="the rubric"):
             points.setdefault(number, float(registry.points[number]))
     for number in points:
         if number not in seen:
-            raise ValueError(
+            raise InputError(
                 f"{source}: exercise {number} has points but is in no group: add it to required, "
                 "extra_credit or a branch, or remove its points."
             )
@@ -279,15 +280,15 @@ def from_dict(data, source="the rubric"):
     totals = {b.name: sum(worth[n] for n in b.exercises) for b in branches}
     if len(set(totals.values())) > 1:
         shown = ", ".join(f"{name} {points_text(total)}" for name, total in totals.items())
-        raise ValueError(
+        raise InputError(
             f"{source}: the branches must be worth the same points, since either one gives full "
             f"credit; they are worth {shown}."
         )
     title = data.get("title", "rubric")
     if not isinstance(title, str):
-        raise ValueError(f"{source}: title must be text.")
+        raise InputError(f"{source}: title must be text.")
     if not seen:
-        raise ValueError(f"{source}: grades nothing: list exercises in required, extra_credit or branches.")
+        raise InputError(f"{source}: grades nothing: list exercises in required, extra_credit or branches.")
     points = {number: points[number] for number in sorted(points)}
     late = lateness.from_dict(data["late"], source) if "late" in data else None
     released = _released(data.get("held"), source, registry, points)
@@ -303,7 +304,7 @@ def _answers(table, source, registry, points):
         return {}, {}
     example = "exercise12-answer-1 = 2"
     if not isinstance(table, dict):
-        raise ValueError(f"{source}: [answers] must be a table of `grade-id = points` lines, e.g. {example}.")
+        raise InputError(f"{source}: [answers] must be a table of `grade-id = points` lines, e.g. {example}.")
     found, lines = {}, {}
     for grade_id, value in table.items():
         if isinstance(value, dict):  # {points = 2, rubric = ["what earns a point", ...]}
@@ -315,7 +316,7 @@ def _answers(table, source, registry, points):
                 or not isinstance(given, list)
                 or not all(isinstance(line, str) for line in given)
             ):
-                raise ValueError(
+                raise InputError(
                     f"{source}: [answers] {grade_id} must be points, or a table of points and rubric lines: "
                     f'{grade_id} = {{points = 2, rubric = ["names the order", "says why"]}}.'
                 )
@@ -323,15 +324,15 @@ def _answers(table, source, registry, points):
             value = value["points"]
         if grade_id not in registry.answers:
             known = ", ".join(registry.answers) or "none"
-            raise ValueError(
+            raise InputError(
                 f"{source}: [answers] names {grade_id!r}, which is no answer in words of these exercises "
                 f"(their grade ids: {known})."
             )
         number = registry.answers[grade_id][0]
         if number not in points:
-            raise ValueError(f"{source}: [answers] gives {grade_id} points, but exercise {number} is in no group.")
+            raise InputError(f"{source}: [answers] gives {grade_id} points, but exercise {number} is in no group.")
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value < 0:
-            raise ValueError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a number, at least 0.")
+            raise InputError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a number, at least 0.")
         found[grade_id] = float(value)
     return {grade_id: found[grade_id] for grade_id in registry.answers if grade_id in found}, lines
 
@@ -342,20 +343,20 @@ def _released(table, source, registry, points):
         return {}
     example = 'release = {"ada" = [2, 10]}'
     if not isinstance(table, dict) or set(table) - {"release"}:
-        raise ValueError(
+        raise InputError(
             f"{source}: [held] has one key, release: a table of submission names and the exercises whose "
             f"held parts a person looked at and released, e.g. {example}."
         )
     release = table.get("release", {})
     if not isinstance(release, dict):
-        raise ValueError(f"{source}: [held] release must be a table of submission names, e.g. {example}.")
+        raise InputError(f"{source}: [held] release must be a table of submission names, e.g. {example}.")
     found = {}
     for name, numbers in release.items():
         where = f"[held] release for {name!r}"
         numbers = _exercise_list(numbers, where, source, registry)
         for number in numbers:
             if number not in points:
-                raise ValueError(f"{source}: {where} names exercise {number}, which this rubric does not grade.")
+                raise InputError(f"{source}: {where} names exercise {number}, which this rubric does not grade.")
         found[str(name)] = frozenset(numbers)
     return found
 
@@ -375,27 +376,27 @@ def _branches(table, source, registry):
     if table is None:
         return (), 0.0
     if not isinstance(table, dict):
-        raise ValueError(f"{source}: [branches] must be a table with extra_credit and [[branches.choice]] entries.")
+        raise InputError(f"{source}: [branches] must be a table with extra_credit and [[branches.choice]] entries.")
     unknown = sorted(set(table) - {"extra_credit", "choice"})
     if unknown:
-        raise ValueError(
+        raise InputError(
             f"{source}: unknown key(s) {', '.join(unknown)} in [branches]; it has extra_credit and choice."
         )
     extra = table.get("extra_credit", 0)
     if isinstance(extra, bool) or not isinstance(extra, (int, float)) or extra < 0:
-        raise ValueError(f"{source}: [branches] extra_credit must be a number of points, at least 0; got {extra!r}.")
+        raise InputError(f"{source}: [branches] extra_credit must be a number of points, at least 0; got {extra!r}.")
     choices = table.get("choice", [])
     if not isinstance(choices, list) or len(choices) < 2:
-        raise ValueError(f"{source}: [branches] needs at least two [[branches.choice]] entries (alternatives).")
+        raise InputError(f"{source}: [branches] needs at least two [[branches.choice]] entries (alternatives).")
     branches = []
     for index, choice in enumerate(choices, start=1):
         if not isinstance(choice, dict) or not isinstance(choice.get("name"), str) or "exercises" not in choice:
-            raise ValueError(f"{source}: branch {index} needs a name and a list of exercises.")
+            raise InputError(f"{source}: branch {index} needs a name and a list of exercises.")
         branches.append(
             Branch(choice["name"], _exercise_list(choice["exercises"], f"branch {choice['name']!r}", source, registry))
         )
     if len({b.name for b in branches}) != len(branches):
-        raise ValueError(f"{source}: two branches have the same name.")
+        raise InputError(f"{source}: two branches have the same name.")
     return tuple(branches), float(extra)
 
 
@@ -412,9 +413,9 @@ def load(path=None):
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"cannot read the rubric {path}: {exc}") from None
+        raise InputError(f"cannot read the rubric {path}: {exc}") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{source} is not valid TOML: {exc}") from None
+        raise InputError(f"{source} is not valid TOML: {exc}") from None
     return replace(from_dict(data, source), text=text)

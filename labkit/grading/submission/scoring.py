@@ -29,6 +29,7 @@ import sys
 import time
 from pathlib import Path
 
+from ...errors import InputError
 from ...exercises.model import sections
 from ...exercises.registry import LAB
 from ...exercises.registry import load as load_registry
@@ -57,9 +58,9 @@ def read_cells(path, answers=None, registry=LAB):
     path = Path(path)
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode):
-        raise ValueError(f"{path.name} is a symbolic link; links are never followed.")
+        raise InputError(f"{path.name} is a symbolic link; links are never followed.")
     if info.st_size > MAX_NOTEBOOK_BYTES:
-        raise ValueError(
+        raise InputError(
             f"{path.name} is {info.st_size / 1024**2:.1f} MB, more than the "
             f"{MAX_NOTEBOOK_BYTES // 1024**2} MB a lab notebook needs (clear its outputs and hand it in "
             "again); it was not graded."
@@ -68,22 +69,22 @@ def read_cells(path, answers=None, registry=LAB):
     with os.fdopen(fd, "rb") as handle:
         raw = handle.read(MAX_NOTEBOOK_BYTES + 1)
     if len(raw) > MAX_NOTEBOOK_BYTES:
-        raise ValueError(f"{path.name} is more than {MAX_NOTEBOOK_BYTES // 1024**2} MB; it was not graded.")
+        raise InputError(f"{path.name} is more than {MAX_NOTEBOOK_BYTES // 1024**2} MB; it was not graded.")
     try:
         nb = json.loads(raw.decode("utf-8"))
     except UnicodeDecodeError:
-        raise ValueError(f"{path.name} is not a text file, so not a notebook.") from None
+        raise InputError(f"{path.name} is not a text file, so not a notebook.") from None
     except (ValueError, RecursionError) as exc:
-        raise ValueError(f"{path.name} is not a valid notebook (not JSON: {str(exc)[:200]}).") from None
+        raise InputError(f"{path.name} is not a valid notebook (not JSON: {str(exc)[:200]}).") from None
     if not isinstance(nb, dict) or not isinstance(nb.get("cells"), list) or nb.get("nbformat") != 4:
-        raise ValueError(f"{path.name} is not a valid notebook (no list of cells in nbformat 4).")
+        raise InputError(f"{path.name} is not a valid notebook (no list of cells in nbformat 4).")
     code, markdown = [], []
     for cell in nb["cells"]:
         source = cell.get("source", "") if isinstance(cell, dict) else None
         if isinstance(source, list) and all(isinstance(line, str) for line in source):
             source = "".join(source)
         if not isinstance(source, str):
-            raise ValueError(f"{path.name} is not a valid notebook (a cell without text).")
+            raise InputError(f"{path.name} is not a valid notebook (a cell without text).")
         kind = cell.get("cell_type")
         if kind == "code":
             code.append(source)
@@ -114,18 +115,18 @@ def submission_notebooks(path):
     try:
         info = os.lstat(path)
     except FileNotFoundError:
-        raise ValueError(f"{path} does not exist.") from None
+        raise InputError(f"{path} does not exist.") from None
     if stat.S_ISLNK(info.st_mode):
-        raise ValueError(
+        raise InputError(
             f"{path} is a symbolic link; links are never followed (grade the folder it points to "
             "by its own name if it is really a submission)."
         )
     if stat.S_ISREG(info.st_mode):
         if path.suffix != ".ipynb":
-            raise ValueError(f"{path} is not a notebook: give .ipynb files or folders of them.")
+            raise InputError(f"{path} is not a notebook: give .ipynb files or folders of them.")
         return [path]
     if not stat.S_ISDIR(info.st_mode):
-        raise ValueError(f"{path} is neither a notebook nor a folder.")
+        raise InputError(f"{path} is neither a notebook nor a folder.")
     found, todo, seen = [], [(path, 0)], 0
     while todo:
         folder, depth = todo.pop()
@@ -136,7 +137,7 @@ def submission_notebooks(path):
         for entry in entries:
             seen += 1
             if seen > MAX_FILES:
-                raise ValueError(f"{path} holds more than {MAX_FILES} files; a submission is a few notebooks.")
+                raise InputError(f"{path} holds more than {MAX_FILES} files; a submission is a few notebooks.")
             if entry.is_symlink() or entry.name == ".ipynb_checkpoints":
                 continue
             if entry.is_dir(follow_symlinks=False) and depth < MAX_DEPTH:
@@ -144,7 +145,7 @@ def submission_notebooks(path):
             elif entry.is_file(follow_symlinks=False) and entry.name.endswith(".ipynb"):
                 found.append(Path(entry.path))
     if not found:
-        raise ValueError(f"{path} contains no notebooks (*.ipynb).")
+        raise InputError(f"{path} contains no notebooks (*.ipynb).")
     return sorted(found)[:MAX_NOTEBOOKS]
 
 
@@ -294,7 +295,7 @@ def solutions(folder):
     folder = Path(folder)
     notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
     if not notebooks:
-        raise ValueError(
+        raise InputError(
             f"{folder} holds no instructor notebooks (*.ipynb): give --solutions the folder of the course's "
             "instructor notebooks (the course repository's notebooks/)."
         )
@@ -504,7 +505,7 @@ def _options(options):
     if options is None:
         return GradeOptions()
     if not isinstance(options, GradeOptions):
-        raise ValueError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
+        raise InputError(f"options must be a GradeOptions (labkit.grading.options); got {options!r}.")
     return options
 
 

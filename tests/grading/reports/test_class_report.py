@@ -608,7 +608,7 @@ def test_the_late_view_says_who_was_late_by_how_much_and_what_it_cost(tmp_path):
     # and the page written by `labkit report` from a results folder says the same
     rubric = tmp_path / "course.toml"
     rubric.write_text(
-        (Path(class_report.__file__).parents[1] / "results" / "rubric.toml").read_text()
+        (Path(class_report.__file__).parents[1] / "store" / "rubric.toml").read_text()
         + '\n[late]\ndeadline = "2026-12-01T23:59:00+01:00"\nper = "day"\npercent = 10\ncap = 50\ngrace = 15\n'
         + "[late.extensions]\ncleo = 48\nzed = 24\n"
     )

@@ -28,6 +28,8 @@ import importlib.util
 import pkgutil
 import sys
 
+from ....errors import InputError
+
 DEFAULT = "bwrap"
 # one module each, backends/<name>.py, found in this package (the default first)
 BUILTIN = tuple(
@@ -45,19 +47,19 @@ def register(cls):
     from .base import Backend
 
     if not (isinstance(cls, type) and issubclass(cls, Backend)):
-        raise ValueError(
+        raise InputError(
             f"{cls!r} is not a subclass of labkit.grading.sandbox.backends.base.Backend; "
             "only backends can be registered."
         )
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not name.isidentifier() or name != name.lower():
-        raise ValueError(
+        raise InputError(
             f"{cls.__qualname__}.name is {name!r}; a backend needs a lower-case name that is a Python "
             "identifier, e.g. name = 'podman' (it is what `labkit grade --sandbox` takes)."
         )
     known = _registered.get(name)
     if known is not None and (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
-        raise ValueError(
+        raise InputError(
             f"a backend named {name!r} is already registered ({known.__module__}.{known.__qualname__}); "
             f"give {cls.__qualname__} another name."
         )
@@ -75,7 +77,7 @@ def backend_class(name):
     if isinstance(name, str) and name in BUILTIN and name not in _registered:
         importlib.import_module(f"{__name__}.{name}")  # the module registers its backend
     if not isinstance(name, str) or name not in _registered:
-        raise ValueError(
+        raise InputError(
             f"there is no sandbox backend called {name!r}; choose one of: {', '.join(names())} "
             f"(e.g. `labkit grade --sandbox {DEFAULT}`, the default)."
         )
@@ -103,13 +105,13 @@ def import_origin(module, path=None):
         return
     except ImportError:
         if not path:
-            raise ValueError(
+            raise InputError(
                 f"cannot import {module!r}, which defines the sandbox backend; make it importable "
                 "(on PYTHONPATH, or installed) in the grading processes."
             ) from None
     spec = importlib.util.spec_from_file_location(module, path)
     if spec is None or spec.loader is None:
-        raise ValueError(f"cannot import the sandbox backend's module {module!r} from {path}.")
+        raise InputError(f"cannot import the sandbox backend's module {module!r} from {path}.")
     loaded = importlib.util.module_from_spec(spec)
     sys.modules[module] = loaded
     try:
