@@ -57,8 +57,8 @@ class ProblemText(str):
     >>> ProblemText("a.ipynb: it stopped.", [("stopped", "?")])
     Traceback (most recent call last):
     ...
-    labkit.errors.InputError: a problem's kind is one of 'not done', 'raised', 'refused', 'timeout', 'crash', 'tampered', \
-'other', 'another variant', not 'stopped'.
+    labkit.errors.InputError: a problem's kind is one of 'not done', 'raised', 'refused', 'timeout', 'crash', \
+'tampered', 'other', 'another variant', not 'stopped'.
     """
 
     kinds: tuple
