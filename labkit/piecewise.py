@@ -200,6 +200,22 @@ def eval_pherm(
     return scalar_or_array(_hermite_eval(x, y, yp, xv, as_order(der, 3)), xval)
 
 
+def _power_form(x, y, yp, der):
+    """Each interval's cubic (or its `der`-th derivative) in powers of ``x - x_k``, highest power first.
+
+    Offsets from the left knot keep a straight line's higher coefficients at zero, so far outside
+    closely spaced data the cubic does not cancel large terms (as the basis form would).
+    """
+    h = np.diff(x)
+    delta = np.diff(y) / h
+    c2 = (3 * delta - 2 * yp[:-1] - yp[1:]) / h
+    c3 = (yp[:-1] + yp[1:] - 2 * delta) / h**2
+    powers = [c3, c2, yp[:-1], y[:-1]]
+    for _ in range(der):
+        powers = [c * (len(powers) - 1 - i) for i, c in enumerate(powers[:-1])]
+    return powers
+
+
 def _hermite_eval(x, y, yp, xv, der=0):
     """Evaluate validated Hermite data (or a derivative); shared by the splines and pchip.
 
@@ -209,17 +225,15 @@ def _hermite_eval(x, y, yp, xv, der=0):
     """
     frame = Frame(x, y)
     x, y, yp, xv = frame.knots, frame.values, frame.slopes(yp), frame.points(xv)
+    with np.errstate(all="ignore"):
+        coefficients = _power_form(x, y, yp, der)
 
     def cubic(k, p, out):
-        right = k + 1
-        h1, h2, h3, h4 = hermite_basis(np.take(x, k), np.take(x, right), p, der)
-        np.multiply(h1, np.take(y, k), out=out)
-        h2 *= np.take(yp, k)
-        h3 *= np.take(y, right)
-        h4 *= np.take(yp, right)
-        out += h2
-        out += h3
-        out += h4
+        d = p - np.take(x, k)
+        np.take(coefficients[0], k, out=out)
+        for c in coefficients[1:]:
+            out *= d
+            out += np.take(c, k)
 
     with np.errstate(all="ignore"):
         values = blockwise(x, xv, cubic)
