@@ -83,32 +83,8 @@ MAX_FAILED_SHOWN = 50  # failed parts listed per student
 NOT_GRADED = "not graded"  # a submission whose grading failed (its `failure`): no points, not zero
 # what a failed part's steps say became of it, the first kind found winning (no kind at all: a slip)
 OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER, NOT_DONE)
-# the kinds of problem, in the order the page lists them: (heading, what it means)
-KINDS = {
-    TIMEOUT: ("Time limits", "A cell, a call of a graded function or the whole submission ran past its time limit"),
-    CRASH: (
-        "Crashes",
-        "The notebook's process died (killed, exited, out of memory) or stopped answering the grader",
-    ),
-    RAISED: ("Errors raised", "A cell of the notebook, or a graded function the grader called, raised an exception"),
-    REFUSED: (
-        "Refused references",
-        "A graded function called, or its source reached for, a reference implementation the exercise switches off",
-    ),
-    TAMPERED: ("Answers voided", "The notebook interfered with the grader's watch, so none of its answers count"),
-    VARIANT: (
-        "Another variant's data",
-        "The notebook holds data other than its student's variant: copied, or worked on another's notebook",
-    ),
-    NOT_GRADED: (
-        "Could not be graded",
-        "The grading itself failed twice; these submissions have no points (not zero) and no other row here",
-    ),
-    OTHER: (
-        "Other problems",
-        "A flood of output, a notebook too large to grade, a sandbox that could not start, a fault of a check",
-    ),
-}
+# the kinds of problem, in the order the page lists them (its words for each are in the template)
+KINDS = (TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, VARIANT, NOT_GRADED, OTHER)
 
 
 @dataclass(frozen=True)
@@ -362,8 +338,7 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
             "shows: split the class and report on each part."
         )
     # the run's record gives the rubric (a different one is refused) and vouches for each result file
-    grades = read_results([folder], rubric_for([folder], rubric, "the class report"))
-    return grades
+    return read_results([folder], rubric_for([folder], rubric, "the class report"))
 
 
 def check_outcome(check: dict) -> str:
@@ -655,8 +630,8 @@ def _bins(totals, maximum):
     return edges
 
 
-def histogram_of_totals(summary: ClassSummary) -> tuple[str, str, list[tuple[float, float, int]]]:
-    """The histogram of the graded totals: (base64 PNG, alt text, [(low, high, count)]).
+def histogram_of_totals(summary: ClassSummary) -> tuple[str, list[tuple[float, float, int]]]:
+    """The histogram of the graded totals: (base64 PNG, [(low, high, count)]).
 
     Parameters
     ----------
@@ -665,50 +640,27 @@ def histogram_of_totals(summary: ClassSummary) -> tuple[str, str, list[tuple[flo
     Returns
     -------
     tuple
-        The picture, its alt text (the figures in words: how many, median, mean, range, full credit,
-        the largest bin) and the bins it shows.
+        The picture, with a dashed line at full credit, and the bins it shows (the page says them in words
+        and as a table).
     """
     import numpy as np
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
 
-    totals = list(summary.totals.values())
-    rubric = summary.rubric
-    edges = _bins(totals, rubric.maximum)
+    totals, full_credit = list(summary.totals.values()), summary.rubric.full_credit
+    edges = _bins(totals, summary.rubric.maximum)
     counts, _ = np.histogram(totals, bins=edges)
-    bins = [(float(lo), float(hi), int(n)) for lo, hi, n in zip(edges[:-1], edges[1:], counts)]
     figure = Figure(figsize=(6.4, 2.8), layout="constrained")
     axes = figure.subplots()
     axes.hist(totals, bins=edges, color="#2b5797", edgecolor="white")
-    axes.axvline(rubric.full_credit, color="black", linestyle="--", linewidth=1.2)
-    axes.annotate(
-        f"full credit {points_text(rubric.full_credit)}",
-        (rubric.full_credit, 1.0),
-        xycoords=("data", "axes fraction"),
-        xytext=(0, 3),
-        textcoords="offset points",
-        ha="center",
-        va="bottom",
-        fontsize=9,
-    )
+    axes.axvline(full_credit, color="black", linestyle="--", linewidth=1.2)
+    axes.annotate(f"full credit {points_text(full_credit)}", (full_credit, 1.0), xycoords=("data", "axes fraction"),
+                  xytext=(0, 3), textcoords="offset points", ha="center", va="bottom", fontsize=9)  # fmt: skip
     axes.set_xlabel("total points")
     axes.set_ylabel("submissions")
     axes.yaxis.set_major_locator(MaxNLocator(integer=True))
     axes.set_xlim(edges[0], edges[-1])
-    image = _png(figure)
-    if totals:
-        low, high, count = max(bins, key=lambda b: (b[2], -b[0]))
-        full = sum(t >= rubric.full_credit for t in totals)
-        alt = (
-            f"Histogram of {len(totals)} totals: median {points_text(statistics.median(totals))}, "
-            f"mean {statistics.fmean(totals):.1f}, lowest {points_text(min(totals))}, "
-            f"highest {points_text(max(totals))}; {full} of {len(totals)} reach full credit "
-            f"({points_text(rubric.full_credit)} points). The largest bin, {points_text(low)} to "
-            f"{points_text(high)} points, holds {count}."
-        )
-    else:
-        alt = "Histogram of totals: empty, no submission could be graded."
-    return image, alt, bins
+    return _png(figure), [(float(lo), float(hi), int(n)) for lo, hi, n in zip(edges[:-1], edges[1:], counts)]
 
 
 def _rate_text(rate, attempted):
@@ -736,8 +688,9 @@ def _bars(labels, rates, attempted):
     return _png(figure)
 
 
-def pass_rate_figures(summary: ClassSummary) -> list[tuple[str, str, str]]:
-    """Bar charts of the pass rates: [(base64 PNG, alt text, caption)], exercises then parts.
+def pass_rate_figures(summary: ClassSummary) -> list[str]:
+    """Bar charts of the pass rates as base64 PNGs: the exercises', then the parts' (the page gives every rate
+    in numbers in their alt text).
 
     Parameters
     ----------
@@ -745,35 +698,14 @@ def pass_rate_figures(summary: ClassSummary) -> list[tuple[str, str, str]]:
 
     Returns
     -------
-    list of tuple
-        Each figure with an alt text that gives every rate in numbers.
+    list of str
     """
     exercises, parts = summary.exercises, summary.parts
-    exercise_alt = (
-        "Bar chart of the pass rate of each exercise among the submissions that attempted it: "
-        + "; ".join(f"exercise {e.exercise} {_rate_text(e.rate, e.attempted)}" for e in exercises)
-        + "."
-    )
-    part_alt = (
-        "Bar chart of the pass rate of each part among the submissions that attempted it: "
-        + "; ".join(f"exercise {p.label} {_rate_text(p.rate, p.attempted)}" for p in parts)
-        + "."
-    )
     return [
-        (
-            _bars(
-                [f"exercise {e.exercise}" for e in exercises],
-                [e.rate for e in exercises],
-                [e.attempted for e in exercises],
-            ),
-            exercise_alt,
-            "Each exercise: passed (every part) of the submissions that attempted it.",
+        _bars(
+            [f"exercise {e.exercise}" for e in exercises], [e.rate for e in exercises], [e.attempted for e in exercises]
         ),
-        (
-            _bars([p.label for p in parts], [p.rate for p in parts], [p.attempted for p in parts]),
-            part_alt,
-            "Each part, labelled with its exercise: passed of the submissions that attempted it.",
-        ),
+        _bars([p.label for p in parts], [p.rate for p in parts], [p.attempted for p in parts]),
     ]
 
 
@@ -808,19 +740,16 @@ def _shared(indices, lines):
 
 
 def _totals(summary):
-    """The totals in figures: (what, value) rows."""
+    """The graded totals in figures, for the table and the histogram's alt text."""
     totals, rubric = list(summary.totals.values()), summary.rubric
+    image, bins = histogram_of_totals(summary)
     quartiles = statistics.quantiles(totals, n=4, method="inclusive") if len(totals) > 1 else totals * 3
-    return [
-        ("graded", len(totals)),
-        ("could not be graded", len(summary.not_graded)),
-        ("median", points_text(statistics.median(totals))),
-        ("mean", f"{statistics.fmean(totals):.1f}"),
-        ("lowest, highest", f"{points_text(min(totals))}, {points_text(max(totals))}"),
-        ("quartiles", ", ".join(points_text(q) for q in quartiles)),
-        (f"full credit ({points_text(rubric.full_credit)}) or more", sum(t >= rubric.full_credit for t in totals)),
-        ("the most possible, with extra credit", points_text(rubric.maximum)),
-    ]
+    return {
+        "image": image, "bins": bins, "count": len(totals), "median": statistics.median(totals),
+        "mean": statistics.fmean(totals), "lowest": min(totals), "highest": max(totals),
+        "quartiles": ", ".join(map(points_text, quartiles)),
+        "full": sum(t >= rubric.full_credit for t in totals), "largest": max(bins, key=lambda b: (b[2], -b[0])),
+    }  # fmt: skip
 
 
 def render(
@@ -859,11 +788,10 @@ def render(
         s=summary,
         rubric=summary.rubric,
         late=summary.late,
-        kinds=KINDS,
         limits=globals(),  # the MAX_... bounds above
-        histogram=histogram_of_totals(summary) if summary.totals else None,
-        totals=_totals(summary) if summary.totals else [],
-        rate_figures=pass_rate_figures(summary) if summary.totals else [],
+        totals=_totals(summary) if summary.totals else None,
+        rate_figures=pass_rate_figures(summary) if summary.totals else None,
+        rate_text=_rate_text,
         held_threshold=THRESHOLD,
         copy_lines=copies.holder_lines(),
         copies_marked=copies.marked,
