@@ -788,7 +788,7 @@ def render(
         s=summary,
         rubric=summary.rubric,
         late=summary.late,
-        limits=globals(),  # the MAX_... bounds above
+        limits={name: value for name, value in globals().items() if name.startswith("MAX_")},
         totals=_totals(summary) if summary.totals else None,
         rate_figures=pass_rate_figures(summary) if summary.totals else None,
         rate_text=_rate_text,
