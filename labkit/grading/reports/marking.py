@@ -267,7 +267,7 @@ def _spans(line):
 
 def _emphasis(text, kept, rules):
     if not rules:
-        return [kept[int(part)] if odd % 2 else (None, part) for odd, part in enumerate(KEPT.split(text)) if part]
+        return [kept[int(part)] if i % 2 else (None, part) for i, part in enumerate(KEPT.split(text)) if part]
     (kind, pattern), rest = rules[0], rules[1:]
     spans, at = [], 0
     for match in pattern.finditer(text):
