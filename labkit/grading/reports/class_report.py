@@ -483,7 +483,7 @@ class _Tally:
     def exercise(self, rubric, number, graded):
         """The class's rate of exercise `number` and of each of its parts."""
         names = _part_names(rubric, number, graded)
-        counts: dict = {name: defaultdict(int) for name in names}
+        counts = {name: defaultdict(int) for name in names}
         found = attempted = passed = 0
         for grade in graded:
             checks = _checks(grade, number)
@@ -519,7 +519,7 @@ class _Tally:
 
     def by_kind(self):
         """Each kind's problems, by student."""
-        found: dict = {kind: [] for kind in KINDS}
+        found = {kind: [] for kind in KINDS}
         for (kind, student), texts in sorted(self.problems.items()):
             found[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))
         return {kind: rows for kind, rows in found.items() if rows}
@@ -578,29 +578,29 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     ...     {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}]}})]).totals
     {'ann': 10.0}
     """
-    grades = _checked(grades)
-    rubric = grades[0].rubric
-    graded = [g for g in grades if g.graded]
+    submissions = _checked(grades)
+    rubric = submissions[0].rubric
+    graded = [g for g in submissions if g.graded]
     tally = _Tally({g.name: [] for g in graded})
     exercises, parts = [], []
     for number in rubric.graded:
         rate, part_rates = tally.exercise(rubric, number, graded)
         exercises.append(rate)
         parts += part_rates
-    tally.run_problems(grades)
+    tally.run_problems(submissions)
     totals = {g.name: g.total for g in graded}
     return ClassSummary(
         rubric=rubric,
         totals=totals,
-        not_graded={g.name: g.failure for g in grades if not g.graded},
+        not_graded={g.name: g.failure for g in submissions if not g.graded},
         exercises=exercises,
         parts=parts,
         slips=tally.slip_list(),
         problems=tally.by_kind(),
         most_failed=tally.most_failed(totals),
-        seeds=sorted({g.seed for g in grades if isinstance(g.seed, int)}),
+        seeds=sorted({g.seed for g in submissions if isinstance(g.seed, int)}),
         late=_late_summary(rubric, graded),
-        copies=find_copies(grades),
+        copies=find_copies(submissions),
         held=[held for g in graded for held in Held.of(g)],
     )
 
