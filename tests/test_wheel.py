@@ -70,8 +70,11 @@ def test_the_wheel_ships_the_student_notebooks_and_no_solved_one(fresh):
             assert "### BEGIN SOLUTION" not in text and "### BEGIN HIDDEN TESTS" not in text
     assert "labkit/grading/store/rubric.toml" in names and "labkit/plots/editor.js" in names
     assert "labkit/py.typed" in names  # PEP 561: type checkers read labkit's annotations
-    # the feedback page's template and stylesheet (labkit.grading.pages), which labkit grade renders for each student
-    assert {"labkit/grading/templates/feedback.html", "labkit/grading/templates/feedback.css"} <= set(names)
+    # the pages' templates, stylesheets and scripts (labkit.grading.pages): the feedback page labkit grade renders for
+    # each student, the class report (labkit report) and the marking page (labkit mark)
+    pages = ["feedback.html", "feedback.css", "class_report.html", "class_report.css", "class_report.js"]
+    pages += ["marking.html", "marking_parts.html", "marking.css", "marking.js"]
+    assert {f"labkit/grading/templates/{name}" for name in pages} <= set(names)
 
 
 def test_the_core_install_has_no_jupyterlab_and_import_labkit_pulls_none_in(fresh):

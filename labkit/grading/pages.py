@@ -1,6 +1,6 @@
 """HTML pages from the Jinja templates in ``templates/``, autoescaped: no text of a submission reaches a page
-unescaped. A template's stylesheet is inlined (``{{ style("feedback.css") }}``), so every page is one file that
-makes no request."""
+unescaped. A template's stylesheet and script are inlined (``{{ style("feedback.css") }}``, ``{{ script(...) }}``),
+so every page is one file that makes no request."""
 
 from __future__ import annotations
 
@@ -30,6 +30,11 @@ def style(name: str) -> Markup:
     return Markup(text.replace("</", "<\\/"))
 
 
+def script(name: str) -> Markup:
+    """A script of ``templates/`` as text to inline in a ``<script>`` element (labkit's own file, no input)."""
+    return style(name)
+
+
 def render(template: str, **values) -> str:
     """The page `template` of ``templates/`` filled with `values` (each escaped where it is shown)."""
-    return environment().get_template(template).render(style=style, **values)
+    return environment().get_template(template).render(style=style, script=script, **values)

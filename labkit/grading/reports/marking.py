@@ -16,13 +16,18 @@ later mark of the same item replaces the earlier one.
 """
 
 import csv
+import functools
 import io
 import json
+import re
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
+from markupsafe import Markup
+
 from ...errors import InputError
+from .. import pages
 from ..store import record as records
 from ..store.feedback import blank
 from ..store.names import name_cell, name_from_cell, shown_name
@@ -192,6 +197,15 @@ def marks_csv(grades):
 PAGE = "marking.html"
 SOLUTIONS = Path(__file__).resolve().parents[3] / "notebooks"  # the instructor notebooks, in a source tree
 MAX_SHOWN = 20000  # characters of a student's answer shown
+LIST_ITEM = re.compile(r"^\s*[-*] ")
+# code and maths are set apart first, in this order (no emphasis inside them), then the emphasis around them
+ATOMS = (
+    ("code", re.compile(r"`([^`]+)`")),
+    ("display", re.compile(r"\$\$(.+?)\$\$")),
+    ("math", re.compile(r"\$([^$]+)\$")),
+)
+EMPHASIS = (("strong", re.compile(r"\*\*([^*]+)\*\*")), ("em", re.compile(r"(?<![*\w])\*([^*]+)\*(?!\w)")))
+KEPT = re.compile(r"\x00(\d+)\x00")  # an atom's place in a line: printable() took every control character out
 
 
 def model_answers(folder=SOLUTIONS):
@@ -217,152 +231,123 @@ def model_answers(folder=SOLUTIONS):
     return found
 
 
-# the MathML a page may show: elements and attributes of presentation MathML, nothing that links or runs
-MATHML_TAGS = {
-    "math", "mrow", "mi", "mn", "mo", "ms", "mtext", "mspace", "msup", "msub", "msubsup", "mfrac", "msqrt",
-    "mroot", "mover", "munder", "munderover", "mtable", "mtr", "mtd", "mstyle", "mpadded", "mphantom",
-    "menclose", "semantics",
-}  # fmt: skip
-MATHML_ATTRIBUTES = {
-    "display", "stretchy", "mathvariant", "fence", "separator", "lspace", "rspace", "accent", "accentunder",
-    "columnalign", "rowspacing", "columnspacing", "displaystyle", "scriptlevel", "width", "height", "depth",
-    "linethickness", "notation", "minsize", "maxsize", "symmetric", "movablelimits", "largeop",
-}  # fmt: skip
+def _parts():
+    """The macros of ``templates/marking_parts.html``, which turn a student's text into HTML, escaped."""
+    return pages.environment().get_template("marking_parts.html").module
 
 
 def math_html(tex, display=False):
     """TeX a student wrote as MathML the browser typesets (offline, no script), every element and attribute
     from a fixed list and every text escaped; the TeX itself, escaped, when it cannot be converted."""
-    import html
     import xml.etree.ElementTree as ET
 
-    fallback = f'<span class="math{" display" if display else ""}">{html.escape(tex, quote=True)}</span>'
     try:
         from latex2mathml.converter import convert
 
         tree = ET.fromstring(convert(tex, display="block" if display else "inline"))
     except Exception:  # noqa: BLE001 - any TeX the converter cannot read is shown as it was written
-        return fallback
+        tree = None
+    return _parts().math(tree, tex, display)
 
-    def build(node):
-        tag = node.tag.rpartition("}")[2]
-        if tag not in MATHML_TAGS:
-            return html.escape("".join(node.itertext()))
-        attributes = "".join(
-            f' {name}="{html.escape(value, quote=True)}"'
-            for name, value in node.attrib.items()
-            if name in MATHML_ATTRIBUTES
-        )
-        inner = html.escape(node.text or "") + "".join(build(child) + html.escape(child.tail or "") for child in node)
-        return f"<{tag}{attributes}>{inner}</{tag}>"
 
-    return build(tree)
+def _spans(line):
+    """A line of Markdown as (kind, content) spans: plain text (kind None), code, maths (its MathML), or strong
+    and em holding spans of their own."""
+    kept = []
+
+    def keep(kind, match):
+        inner = match.group(1)
+        kept.append(("code", inner) if kind == "code" else ("math", math_html(inner, display=kind == "display")))
+        return f"\x00{len(kept) - 1}\x00"
+
+    for kind, pattern in ATOMS:
+        line = pattern.sub(functools.partial(keep, kind), line)
+    return _emphasis(line, kept, EMPHASIS)
+
+
+def _emphasis(text, kept, rules):
+    if not rules:
+        return [kept[int(part)] if i % 2 else (None, part) for i, part in enumerate(KEPT.split(text)) if part]
+    (kind, pattern), rest = rules[0], rules[1:]
+    spans, at = [], 0
+    for match in pattern.finditer(text):
+        spans += [*_emphasis(text[at : match.start()], kept, rest), (kind, _emphasis(match.group(1), kept, rest))]
+        at = match.end()
+    return spans + _emphasis(text[at:], kept, rest)
+
+
+def _blocks(text):
+    """Markdown a student wrote as ("list" or "paragraph", [spans of each item or line]) blocks."""
+    blocks = []
+    for block in re.split(r"\n\s*\n", printable(text)[:MAX_SHOWN].strip()):
+        lines = block.splitlines()
+        if lines and all(LIST_ITEM.match(line) for line in lines):
+            blocks.append(("list", [_spans(LIST_ITEM.sub("", line, count=1)) for line in lines]))
+        elif lines:
+            blocks.append(("paragraph", [_spans(line) for line in lines]))
+    return blocks
 
 
 def render_markdown(text):
-    """Markdown a student wrote as HTML that can run nothing: every character escaped first, then paragraphs,
-    lists, ``code``, **strong**, *emphasis*; maths ($...$, $$...$$) as MathML (:func:`math_html`)."""
-    import html
-    import re
-
-    escaped = html.escape(printable(text)[:MAX_SHOWN], quote=True)
-    out, items = [], []
-
-    def inline(line):
-        maths = []  # typeset apart, so the emphasis rules below never reach into the MathML
-
-        def keep(rendered):
-            maths.append(rendered)
-            return f"\x00{len(maths) - 1}\x00"  # printable() took every control character out of the text
-
-        line = re.sub(r"`([^`]+)`", r"<code>\1</code>", line)
-        line = re.sub(r"\$\$(.+?)\$\$", lambda m: keep(math_html(html.unescape(m.group(1)), display=True)), line)
-        line = re.sub(r"\$([^$]+)\$", lambda m: keep(math_html(html.unescape(m.group(1)))), line)
-        line = re.sub(r"\*\*([^*]+)\*\*", r"<strong>\1</strong>", line)
-        line = re.sub(r"(?<![*\w])\*([^*]+)\*(?!\w)", r"<em>\1</em>", line)
-        return re.sub(r"\x00(\d+)\x00", lambda m: maths[int(m.group(1))], line)
-
-    def flush():
-        if items:
-            out.append("<ul>" + "".join(f"<li>{inline(i)}</li>" for i in items) + "</ul>")
-            items.clear()
-
-    for block in re.split(r"\n\s*\n", escaped.strip()):
-        lines = block.splitlines()
-        if all(re.match(r"\s*[-*] ", line) for line in lines):
-            items.extend(re.sub(r"^\s*[-*] ", "", line) for line in lines)
-            flush()
-        elif lines:
-            out.append("<p>" + "<br>".join(inline(line) for line in lines) + "</p>")
-    return "".join(out) or "<p><em>(no answer)</em></p>"
+    """Markdown a student wrote as HTML that can run nothing: paragraphs, lists, ``code``, **strong**,
+    *emphasis*; maths ($...$, $$...$$) as MathML (:func:`math_html`); every text escaped."""
+    return str(_parts().markdown(_blocks(text)))
 
 
-def _rubric_lines(lines):
-    """The rubric's lines for an answer ([answers] rubric), as a list under the model answer."""
-    import html
+def _answer_task(rubric, grades, grade_id, models):
+    """The task of marking answer `grade_id`, or None when no student wrote it (a blank one is marked 0, no
+    answer, and never queued)."""
+    number, what = rubric.registry.answers[grade_id]
+    question, model = models.get(grade_id, ("", ""))
+    entries = [
+        {"submission": g.name, "shown": shown_name(g.name, 200), "html": render_markdown(g.answers.get(grade_id) or "")}
+        for g in grades
+        if g.graded and not blank(g.answers.get(grade_id))
+    ]
+    if not entries:
+        return None
+    return {
+        "item": grade_id, "kind": "answer", "max": rubric.answers.get(grade_id, 0.0),
+        "title": f"Exercise {number}: {what}", "question": render_markdown(question),
+        "model": str(_parts().model(_blocks(model), rubric.answer_lines.get(grade_id, ()))), "answers": entries,
+    }  # fmt: skip
 
-    if not lines:
-        return ""
-    return '<p>Rubric:</p><ul class="rubric">' + "".join(f"<li>{html.escape(line)}</li>" for line in lines) + "</ul>"
+
+def _held_tasks(grades):
+    """The tasks of the parts held for a person: release or keep, by item."""
+    held = {}
+    for g in grades:
+        for number, part, data, _ in g.held() if g.graded else ():
+            pairs = [(one_line(a, 200), one_line(b, 200)) for a, b in _pairs(data.get("lines", ()))]
+            side = _parts().held(float(data.get("share", 0)), one_line(data.get("source", "?"), 120), pairs)
+            entry = {"submission": g.name, "shown": shown_name(g.name, 200), "html": str(side)}
+            held.setdefault(f"exercise{number}/{part}", []).append(entry)
+    return [
+        {"item": item, "kind": "held", "max": 1, "title": f"Held: {item} (1 release, 0 keep)",
+         "question": str(_parts().held_question()), "model": "", "answers": entries}
+        for item, entries in sorted(held.items())
+    ]  # fmt: skip
+
+
+def _pairs(lines):
+    return [p for p in lines if isinstance(p, (list, tuple)) and len(p) == 2]
 
 
 def tasks(grades, marker="instructor"):
     """What the page marks, by item: [{"item", "title", "max", "kind", "answers": [...]}], each item's
     submissions in an order shuffled for `marker` (the same marker, the same order)."""
-    import html
     import random
 
     if not grades:
         return []
     rubric = grades[0].rubric
     models = model_answers()
-    found = []
-    for grade_id, (number, what) in rubric.registry.answers.items():
-        if number not in rubric.points or not rubric.answers.get(grade_id):  # only what is worth points
-            continue
-        question, model = models.get(grade_id, ("", ""))
-        entries = [  # only answers the student wrote: a blank one is marked 0, no answer, and never queued
-            {
-                "submission": g.name,
-                "shown": shown_name(g.name, 200),
-                "html": render_markdown(g.answers.get(grade_id) or ""),
-            }
-            for g in grades
-            if g.graded and not blank(g.answers.get(grade_id))
-        ]
-        if not entries:
-            continue
-        random.Random(f"{marker}\n{grade_id}").shuffle(entries)
-        found.append({
-            "item": grade_id, "kind": "answer", "max": rubric.answers.get(grade_id, 0.0),
-            "title": f"Exercise {number}: {what}", "question": render_markdown(question),
-            "model": render_markdown(model) + _rubric_lines(rubric.answer_lines.get(grade_id, ())),
-            "answers": entries,
-        })  # fmt: skip
-    held = {}
-    for g in grades:
-        for number, part, data, _ in g.held() if g.graded else ():
-            item = f"exercise{number}/{part}"
-            pairs = [p for p in data.get("lines", ()) if isinstance(p, (list, tuple)) and len(p) == 2]
-            rows = "".join(
-                f"<tr><td><code>{html.escape(one_line(a, 200))}</code></td>"
-                f"<td><code>{html.escape(one_line(b, 200))}</code></td></tr>"
-                for a, b in pairs
-            )
-            side = (
-                f'<table class="side"><caption>{float(data.get("share", 0)):.0%} the same as '
-                f'{html.escape(one_line(data.get("source", "?"), 120))}</caption><thead><tr><th scope="col">'
-                f'the student\'s code</th><th scope="col">the known source</th></tr></thead>'
-                f"<tbody>{rows}</tbody></table>"
-            )
-            held.setdefault(item, []).append({"submission": g.name, "shown": shown_name(g.name, 200), "html": side})
-    for item, entries in sorted(held.items()):
-        random.Random(f"{marker}\n{item}").shuffle(entries)
-        found.append({
-            "item": item, "kind": "held", "max": 1, "title": f"Held: {item} (1 release, 0 keep)",
-            "question": "<p>Its code matched a known source. Release its points (1) or keep them held (0).</p>",
-            "model": "", "answers": entries,
-        })  # fmt: skip
+    worth = [
+        i for i, (number, _) in rubric.registry.answers.items() if number in rubric.points and rubric.answers.get(i)
+    ]
+    found = [task for i in worth if (task := _answer_task(rubric, grades, i, models))] + _held_tasks(grades)
+    for task in found:
+        random.Random(f"{marker}\n{task['item']}").shuffle(task["answers"])
     return found
 
 
@@ -373,7 +358,8 @@ def _json_for_script(data):
 
 
 def write_page(out, marker="instructor", rubric=None):
-    """OUT/marking.html: every item to mark, by keyboard, offline; the path written."""
+    """OUT/marking.html: every item to mark, by keyboard, offline; the path written. Its one script is
+    ``templates/marking.js`` with the tasks as data, and the page's policy runs that script alone."""
     import base64
     import hashlib
 
@@ -384,102 +370,9 @@ def write_page(out, marker="instructor", rubric=None):
         raise InputError(f"{out} was graded under another rubric ({recorded.digest}); leave out --rubric.")
     grades = read_results([out], recorded)
     data = {"run": f"{recorded.digest}:{out.resolve()}", "title": recorded.title, "tasks": tasks(grades, marker)}
-    script = SCRIPT.replace("__DATA__", _json_for_script(data))
+    script = str(pages.script("marking.js")).replace("__DATA__", _json_for_script(data))
     digest = base64.b64encode(hashlib.sha256(script.encode("utf-8")).digest()).decode("ascii")
-    policy = f"default-src 'none'; script-src 'sha256-{digest}'; style-src 'unsafe-inline'; img-src data:"
-    import html
-
-    page = (
-        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-        f'<meta http-equiv="Content-Security-Policy" content="{policy}">\n'
-        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-        f"<title>Marking: {html.escape(one_line(recorded.title, 200))}</title>\n<style>{STYLE}</style>\n</head>\n"
-        '<body>\n<header><h1>Marking</h1><p id="progress" role="status" aria-live="polite"></p>\n'
-        '<p class="keys">Keys: digits give points, <kbd>j</kbd> or <kbd>&rarr;</kbd> next, <kbd>k</kbd> or '
-        "<kbd>&larr;</kbd> previous, <kbd>c</kbd> the comment box (<kbd>Esc</kbd> leaves it).</p>\n"
-        '<button type="button" id="download">Download marks.csv</button></header>\n'
-        '<main id="main"><h2 id="title"></h2><section aria-labelledby="q-h"><h3 id="q-h">Question</h3>'
-        '<div id="question"></div></section><section aria-labelledby="m-h"><h3 id="m-h">Model answer '
-        '<span id="worth"></span></h3><div id="model"></div></section>'
-        '<section aria-labelledby="a-h"><h3 id="a-h">Answer of <span id="who"></span></h3>'
-        '<div id="answer" class="answer"></div></section>'
-        '<p id="given" aria-live="polite"></p>'
-        '<label for="comment">Comment</label> <input id="comment" list="comments" size="60">'
-        '<datalist id="comments"></datalist></main>\n'
-        f"<script>{script}</script>\n</body>\n</html>\n"
-    )
+    page = pages.render(PAGE, title=one_line(recorded.title, 200), digest=digest, code=Markup(script))
     path = out / PAGE
     path.write_text(page, encoding="utf-8")
     return path
-
-
-STYLE = """
-body{font-family:system-ui,sans-serif;margin:0 auto;max-width:60rem;padding:1rem;color:#111;background:#fff}
-.answer{border:2px solid #245;padding:.5rem 1rem;background:#f4f7fb}
-.math{font-family:serif;font-style:italic;background:#eef}
-table.side{border-collapse:collapse;width:100%}table.side td,table.side th{border:1px solid #999;padding:2px 6px;
-vertical-align:top;text-align:left}kbd{border:1px solid #777;border-radius:3px;padding:0 3px}
-#given{font-weight:bold}button{font-size:1rem}
-"""
-
-SCRIPT = r"""
-(function(){
-"use strict";
-var DATA = __DATA__;
-var KEY = "labkit-marks:" + DATA.run;
-var order = [];
-DATA.tasks.forEach(function(t, i){ t.answers.forEach(function(a, j){ order.push([i, j]); }); });
-var state = {pos: 0, marks: {}};
-try { var saved = JSON.parse(localStorage.getItem(KEY) || "null"); if (saved) state = saved; } catch (e) {}
-function save(){ try { localStorage.setItem(KEY, JSON.stringify(state)); } catch (e) {} }
-function id(t, a){ return JSON.stringify([a.submission, t.item]); }
-function $(x){ return document.getElementById(x); }
-function current(){ var p = order[state.pos]; return p ? [DATA.tasks[p[0]], DATA.tasks[p[0]].answers[p[1]]] : null; }
-function text(points, kind){ if (kind === "held") return points === 1 ? "release" : "keep"; return String(points); }
-function show(){
-  var left = order.filter(function(p){ var t = DATA.tasks[p[0]]; return !state.marks[id(t, t.answers[p[1]])]; }).length;
-  $("progress").textContent = left + " of " + order.length + " left to mark";
-  var c = current(); if (!c) { $("title").textContent = "Nothing to mark"; return; }
-  var t = c[0], a = c[1], m = state.marks[id(t, a)];
-  $("title").textContent = t.title + " (" + (state.pos + 1) + " of " + order.length + ")";
-  $("question").innerHTML = t.question; $("model").innerHTML = t.model || "<p>(none)</p>";
-  $("worth").textContent = t.kind === "held" ? "" : "(worth " + t.max + ")";
-  $("who").textContent = a.shown; $("answer").innerHTML = a.html;
-  $("given").textContent = m ? "Marked: " + text(m.points, t.kind) : "Not marked yet";
-  $("comment").value = m ? m.comment : "";
-  var seen = {}, list = $("comments"); list.textContent = "";
-  Object.keys(state.marks).forEach(function(k){ var s = state.marks[k].comment;
-    if (s && !seen[s]) { seen[s] = 1; var o = document.createElement("option"); o.value = s; list.appendChild(o); } });
-}
-function give(points){
-  var c = current(); if (!c) return; var t = c[0], a = c[1];
-  if (points > t.max) return;
-  state.marks[id(t, a)] = {points: points, comment: $("comment").value, submission: a.submission,
-    item: t.item, kind: t.kind};
-  save(); show();
-}
-function move(by){ state.pos = Math.max(0, Math.min(order.length - 1, state.pos + by)); save(); show(); }
-$("comment").addEventListener("input", function(){
-  var c = current(); if (!c) return; var m = state.marks[id(c[0], c[1])]; if (m) { m.comment = this.value; save(); } });
-$("comment").addEventListener("keydown", function(e){
-  if (e.key === "Escape" || e.key === "Enter") { this.blur(); e.preventDefault(); } });
-document.addEventListener("keydown", function(e){
-  if (e.target === $("comment") || e.ctrlKey || e.metaKey || e.altKey) return;
-  if (/^[0-9]$/.test(e.key)) { give(Number(e.key)); e.preventDefault(); }
-  else if (e.key === "j" || e.key === "ArrowRight") { move(1); e.preventDefault(); }
-  else if (e.key === "k" || e.key === "ArrowLeft") { move(-1); e.preventDefault(); }
-  else if (e.key === "c") { $("comment").focus(); e.preventDefault(); }
-});
-function cell(s){ s = String(s); if (/^[=+\-@\t\r]/.test(s)) s = "'" + s;
-  return /[",\n\r]/.test(s) ? '"' + s.replace(/"/g, '""') + '"' : s; }
-$("download").addEventListener("click", function(){
-  var rows = ["submission,item,points,comment"];
-  Object.keys(state.marks).forEach(function(k){ var m = state.marks[k];
-    rows.push([cell(m.submission), cell(m.item), text(m.points, m.kind), cell(m.comment || "")].join(",")); });
-  var blob = new Blob([rows.join("\r\n") + "\r\n"], {type: "text/csv"});
-  var link = document.createElement("a"); link.href = URL.createObjectURL(blob); link.download = "marks.csv";
-  document.body.appendChild(link); link.click(); link.remove();
-});
-show();
-})();
-"""

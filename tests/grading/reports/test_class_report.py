@@ -409,7 +409,7 @@ def test_names_hints_and_problems_are_escaped(grades):
     html = page_of(grades)
     assert HOSTILE not in html and "<img src=x" not in html and "<b>h</b>" not in html
     assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html
-    assert "divide by &lt;b&gt;h&lt;/b&gt;&lt;img src=x onerror=&quot;alert(2)&quot;&gt; &amp; not by 2" in html
+    assert "divide by &lt;b&gt;h&lt;/b&gt;&lt;img src=x onerror=&#34;alert(2)&#34;&gt; &amp; not by 2" in html
     assert [tag for tag, _ in Page(html).tags].count("script") == 1  # the page's own, nothing of a student's
     assert HOSTILE in Page(html).words("most-failed")  # the name is shown, as text
 

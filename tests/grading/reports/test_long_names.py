@@ -54,7 +54,7 @@ def test_marks_csv_grades_csv_merge_and_export_keep_every_name(tmp_path):
     marked = _rubric(tmp_path)
     out = _run(tmp_path, marked)
     path = tmp_path / "marks.csv"
-    with open(path, "w", newline="", encoding="utf-8") as handle:  # as the page writes it (see marking.SCRIPT)
+    with open(path, "w", newline="", encoding="utf-8") as handle:  # as the page writes it (see templates/marking.js)
         writer = csv.writer(handle)
         writer.writerow(marking.HEADER)
         writer.writerows([[FIRST, "exercise3-answer-1", "5", ""], [SECOND, "exercise3-answer-1", "1", ""]])
