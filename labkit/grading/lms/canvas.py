@@ -1,36 +1,24 @@
 """Canvas: its "Download Submissions", its gradebook export filled in, its "Re-upload submissions".
 
-The download. Canvas names each file ``{name}[_LATE]_{user id}_{file id}_{display name}`` (``get_filename``,
-``add_upload_submission`` and ``sanitize_user_name`` in canvas-lms's ``lib/content_zipper.rb``; real names in
-mikewesthad/canvas-unzipper's README, ``smithbob_340934_208490284_BobsWork.zip``, and canvas-lms issue #2406):
-``{name}`` is the sortable name ("Lovelace, Ada") lower-cased with every character but letters, digits and ``_``
-dropped (``lovelaceada``); ``LATE`` when Canvas counts the submission late; ``{display name}`` is the file's name
-as uploaded, with only ``/ \\ : * ? " < > |`` and NUL made ``_``. Anonymous grading is assumed, without a source,
-to write ``anon_{anonymous id}`` (or ``anonymous_``) for name and user id. A group assignment names the files
-after the group, which reads the same way. Both ends of a name are the student's choice, so a file name can
-have several readings (:func:`canvas_readings`), less those Canvas cannot write (a name part with capitals, an
-id with a leading zero); :func:`resolve_canvas` takes the one its user's other files confirm, else the one whose
-user is on the roster, else files it to no one, and the notes say so: a display name never decides. The files
-are grouped per user id into a folder each, under their original names; the student is ``{name}`` (``{name}_
-{user id}`` for namesakes), the LMS id the user id. Canvas renames a file uploaded again under a name already
-used ``name-1.ext``, ``name-2.ext`` (students' reports: nus-cs2103 forum #361 and #459, IIC1253 issues #26 and
-#34): of one student's files under one original name the newest only is kept, under the original name.
+The download names each file ``{name}[_LATE]_{user id}_{file id}_{display name}`` (canvas-lms's
+``lib/content_zipper.rb``; real names in mikewesthad/canvas-unzipper's README and canvas-lms issue #2406):
+``{name}`` is the sortable name lower-cased with all but letters, digits and ``_`` dropped (``lovelaceada``), the
+display name as uploaded; anonymous grading is assumed to write ``anon_{anonymous id}``. Both ends are the
+student's choice, so a name can have several readings (:func:`canvas_readings`); :func:`resolve_canvas` takes the
+one the user's other files confirm, else the one whose user is on the roster, else none, and says so. The files
+are grouped per user id, under their original names; the student is ``{name}`` (``{name}_{user id}`` for
+namesakes). A file uploaded again is renamed ``name-1.ext`` (students' reports: nus-cs2103 forum #361, IIC1253
+issue #26): of one name the newest only is kept, under the original name.
 
 The gradebook (Canvas's Instructor Guide, "How do I import grades in the Gradebook?"; canvas-lms's
-``lib/gradebook_exporter.rb`` and ``lib/gradebook_importer.rb``). The header begins with the student columns
-``Student``, ``ID`` (Canvas's user number), maybe ``SIS User ID``, ``SIS Login ID``, ``Integration ID``, ``Root
-Account``, and ``Section``, which closes them; then one column per assignment, ``Title (number)``, then
-read-only totals the importer ignores. Before the students come at most a row of ``Muted`` (``Manual Posting``)
-cells and the ``Points Possible`` row. On import Canvas finds a student by ``ID``, ``SIS User ID`` or ``SIS Login
-ID``, an assignment by its number, else its title, and makes a **new assignment** of a header it does not know.
-So :func:`to_canvas` writes the export itself, every row and column as it was, with one assignment column filled
-in; a ``--column`` that names no assignment is refused (the message lists them), unless ``--new-column`` adds it
-on purpose, worth the rubric's full credit. The separator (a decimal comma with ``;``), byte-order mark and line
-endings are the export's.
+``lib/gradebook_importer.rb``): the student columns, closed by ``Section``; an assignment per column, ``Title
+(number)``; read-only totals; maybe a ``Muted`` row and the ``Points Possible`` row before the students. Canvas
+finds a student by ``ID``, ``SIS User ID`` or ``SIS Login ID``, and makes a **new assignment** of a header it does
+not know, so :func:`to_canvas` writes the export as it was with one assignment column filled in, and refuses a
+``--column`` that names none unless ``--new-column`` adds it on purpose.
 
-The feedback. "Re-upload submissions" reads a file's name as its download named it: the first two all-digit
-pieces between ``_`` are the user id and a file of that user's submission (``Assignment#infer_comment_context_
-from_filename``). So each page is ``{the download's prefix of one of the student's files}_feedback.html``.
+The feedback: "Re-upload submissions" reads the user and file ids as the download wrote them
+(``Assignment#infer_comment_context_from_filename``), so each page is ``{a file's download prefix}_feedback.html``.
 """
 
 from __future__ import annotations
@@ -73,7 +61,7 @@ _NOT_WORD = re.compile(r"\W")
 
 @dataclass(frozen=True)
 class Reading:
-    """One way to read a Canvas file name: the name part, late or not, the user id, the file id, the display name."""
+    """One reading of a Canvas file name: the name part, late or not, the user id, the file id, the display name."""
 
     login: str
     late: bool
@@ -389,43 +377,14 @@ def to_canvas(
     new_column: bool = False,
     force: bool = False,
 ) -> Export:
-    """Fill one assignment column of a Canvas gradebook export with the grades' totals.
+    """Fill one assignment column of the Canvas `gradebook` export with the grades' totals, into `out` (and its
+    summary), matching students through `roster` on the gradebook's `key` column.
 
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        The results of a grading run (:func:`~labkit.grading.store.report.read_results`), scored by their rubric.
-    gradebook : path
-        The course's gradebook as Canvas exports it (see the module's description of the layout).
-    roster : path
-        The roster (:func:`~.roster.read_roster`): submission name -> the student's value in the `key` column.
-    out : path
-        The file to write, for Canvas's Grades > Import; the summary CSV goes beside it.
-    column : str
-        The assignment: the existing column of that title (with or without Canvas's ``(number)``) is
-        filled. When the gradebook has none, the export is refused (a mistyped name would otherwise
-        become a new assignment in Canvas), unless `new_column` is given.
-    key : {"ID", "SIS User ID", "SIS Login ID"}
-        The gradebook column whose values the roster's ids are.
-    new_column : bool
-        Add `column` as a new column at the end, worth the rubric's full credit, which Canvas makes a new
-        assignment on import. Refused when the gradebook already has a column of that title: Canvas would
-        match the title to that assignment anyway, so leave out `new_column` to fill it.
-    force : bool
-        Replace `out` and its summary if they exist (an input file is never replaced).
-
-    Returns
-    -------
-    Export
-        What was written, and every student who got nothing from it.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see :func:`~.roster.read_roster` and :func:`read_canvas`), a `key` the export lacks, two
-        gradebook rows with one id, an ambiguous or read-only assignment column, a `column` the gradebook lacks
-        without `new_column` (the message lists its assignment columns) or has with it, no student matched
-        at all, or an output that exists or is an input. Nothing is written then.
+    `column` is the assignment's title, with or without Canvas's ``(number)``. A title the gradebook lacks is
+    refused (a typo would become a new assignment in Canvas), unless `new_column` adds it at the end, worth the
+    rubric's full credit; `new_column` with a title it has is refused too (Canvas would fill that assignment).
+    `force` replaces an existing `out`. ValueError (and nothing written) for bad input, a `key` the export lacks,
+    two rows with one id, an ambiguous or read-only column, no student matched, or an output that is an input.
     """
     if key not in KEYS:
         raise InputError(f"--key for Canvas is one of {', '.join(KEYS)} (a gradebook column); got {key!r}.")

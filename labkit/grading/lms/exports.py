@@ -1,19 +1,12 @@
-"""Grades into the LMS: what every LMS's export shares; the file for the LMS is its module's
-(:func:`.canvas.to_canvas`, :func:`.moodle.to_moodle`, or :func:`export` by the LMS's name).
+"""Grades into the LMS: what every LMS's export shares; its own file is its module's (:func:`.canvas.to_canvas`,
+:func:`.moodle.to_moodle`; :func:`export` by the LMS's name).
 
-``labkit export OUT`` reads a grading run's results (:func:`labkit.grading.store.report.read_results`) and
-writes, for each student it can match through the roster (:mod:`.roster`), the **total under the rubric** (the
-``total`` column of ``grades.csv``). A submission that could not be graded gets no number, never a zero.
-
-Nothing is dropped silently: a submission that could not be graded, a submission with no roster entry, a roster
-entry with no submission, and (for a gradebook the LMS exported) a roster entry whose identifier no row of it has
-and a row with no roster entry are all listed (:meth:`Export.problems`) and written to a summary CSV next to the
-output, one row per submission, roster entry and unmatched row, with the total of every graded submission, so
-that a grade can be entered by hand. Names from submissions reach the summary through
-:func:`~labkit.grading.store.report.csv_cell` and a terminal through
-:func:`~labkit.grading.store.report.one_line`. Bad input raises a ValueError that says what to fix, and then
-nothing is written. The output never replaces an input file, nor an existing file unless ``force`` is given; it
-is written to a temporary file and renamed into place.
+An export writes, for each student the roster (:mod:`.roster`) matches, the **total under the rubric**
+(``grades.csv``'s ``total``); a submission that could not be graded gets no number, never a zero. Nothing is
+dropped silently: every student who got nothing is listed (:meth:`Export.problems`) and in a summary CSV beside
+the output, with the total of every graded submission, to enter by hand. Bad input raises a ValueError saying
+what to fix, and nothing is written; the output never replaces an input, nor an existing file unless ``force``,
+and is renamed into place when complete.
 """
 
 from __future__ import annotations
@@ -35,31 +28,10 @@ SUMMARY_HEADER = ["submission", "id", "points", "status"]
 
 @dataclass
 class Export:
-    """What an export wrote, and what it could not match.
-
-    Attributes
-    ----------
-    path, summary_path : Path
-        The file for the LMS, and the summary CSV beside it.
-    lms : str
-        ``"Canvas"`` or ``"Moodle"``.
-    column : str
-        The header of the column that holds the points.
-    exported : dict
-        Submission name -> (identifier, points written).
-    not_graded : dict
-        Submission name -> why it could not be graded (it got no number).
-    not_in_roster : list
-        Submissions with no roster entry.
-    no_submission : list
-        (submission, identifier) of roster entries with no result.
-    not_in_lms : list
-        (submission, identifier) of roster entries whose identifier no gradebook row has (Canvas).
-    lms_only : list
-        (name, identifier) of gradebook rows with no roster entry (Canvas).
-    notes : list
-        Remarks that need no action (points possible that differ from full credit, totals above it).
-    """
+    """What an export wrote (`path`, for the LMS `lms`, the points in `column`; `summary_path`) and what it could
+    not match: `exported` {submission: (id, points)}; `not_graded` {submission: why}; `not_in_roster`
+    [submission]; `no_submission`, roster entries without a result, and `not_in_lms`, those no gradebook row has,
+    [(submission, id)]; `lms_only`, gradebook rows with no roster entry, [(name, id)]; `notes` needing no action."""
 
     path: Path
     summary_path: Path
@@ -118,7 +90,7 @@ class Export:
 
 
 def export(layout: str, grades: list[SubmissionGrade], roster, out, **options) -> Export:
-    """Write `grades` for the grade import of the LMS `layout` (:meth:`labkit.grading.lms.Lms.export`)."""
+    """Write `grades` for the grade import of the LMS named `layout` (its :meth:`~labkit.grading.lms.Lms.export`)."""
     return named(layout).export(grades, roster, out, **options)
 
 

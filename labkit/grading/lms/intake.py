@@ -1,20 +1,12 @@
 """The class as the LMS hands it over: one folder or one zip becomes a list of students.
 
-Nothing is graded here, and nothing is written anywhere but the grader's `workspace`: a zip (the class's, or a
-student's) is unpacked there by :func:`~.unzip.unpack`, and an LMS's loose files are grouped there into a folder
-per student. The class folder is only read, and no link is ever followed while reading it. Which LMS a download
-is comes from the names at its top (:func:`detect`): each LMS module claims the names it writes; its module's
-documentation says how it reads them.
-
-A zip given as the class (as Canvas and Moodle hand out their downloads) is a container: its members are sorted
-out by student from the LMS's part of their names before anything is written, and each student's are checked and
-unpacked on that student's own budget (:class:`~.unzip.UnpackLimits`, counted over all of the student's files and
-zips). A member that breaks a rule makes its student one who could not be graded; nothing a student uploads
-refuses the class. A zip whose top holds just one folder without notebooks of its own (a folder zipped whole) is
-read from that folder. With a roster, a student the LMS gives an id the roster has takes the roster's name for it.
-
-The student's name is data: it is never used as a path; what is created for a student on disk is named with
-:func:`~labkit.grading.store.report.safe_name`.
+Nothing is graded here, and nothing is written but in the grader's `workspace`; the class folder is only read,
+and no link is ever followed. Which LMS a download is comes from the names at its top (:func:`detect`). A zip
+given as the class is a container: its members are sorted out by student from the LMS's part of their names
+before anything is written, and each student's are checked and unpacked on that student's own budget
+(:class:`~.unzip.UnpackLimits`, over all their files and zips): a member that breaks a rule makes its student
+one who could not be graded, never refuses the class. A student's name is data, never a path
+(:func:`~labkit.grading.store.report.safe_name` names what is made for them).
 """
 
 from __future__ import annotations
@@ -29,22 +21,8 @@ from pathlib import Path
 
 from ...errors import InputError
 from ..store.report import one_line, safe_name
-from . import systems
-from .unzip import (
-    LIMITS,
-    Budget,
-    UnpackLimits,
-    as_text,
-    checked,
-    extract,
-    free,
-    make_dirs,
-    member_parts,
-    open_zip,
-    size_text,
-    undo,
-    unpack_into,
-)
+from . import systems, unzip
+from .unzip import LIMITS, Budget, UnpackLimits, as_text, free, size_text
 
 MAX_FILES = 5_000  # entries looked at in one folder walk (as scoring's walk of a submission)
 MAX_DEPTH = 8  # folder levels looked into
@@ -60,25 +38,10 @@ FIX = (
 
 @dataclass(frozen=True)
 class Student:
-    """One student of the class, as the LMS's layout gives them.
-
-    Attributes
-    ----------
-    name : str
-        The submission's name (what grades.csv, the feedback files and the roster use).
-    path : Path or None
-        A folder or one .ipynb to grade (possibly in the workspace); None when nothing can be graded.
-    failure : str or None
-        Why it cannot be graded; None when it can.
-    layout : str
-        The LMS it was found in (:attr:`~labkit.grading.lms.Lms.name`), or ``"listed"``.
-    lms_id : str or None
-        The LMS's own id when the layout carries one (Canvas's user id, Moodle's participant id).
-    marked_late : bool
-        The LMS marked it late in the download (Canvas's ``LATE``).
-    lms_file : str or None
-        How the LMS names the student's files, to hand feedback back (Canvas's ``{name}[_LATE]_{user}_{file}``).
-    """
+    """One student of the class: the submission's `name` (grades.csv's, the roster's), the folder or notebook
+    to grade (`path`, maybe in the workspace) or None and the `failure` why not, the `layout` (the LMS's name, or
+    ``listed``), the LMS's own id, whether the LMS marked it late, and how the LMS names the student's files
+    (`lms_file`, Canvas's ``{name}[_LATE]_{user}_{file}``, to hand feedback back)."""
 
     name: str
     path: Path | None
@@ -99,22 +62,17 @@ class Intake:
 
     @property
     def gradable(self) -> list[Student]:
-        """The students with something to grade."""
         return [s for s in self.students if s.path is not None]
 
 
 # ---------------------------------------------------------------------------------------------- reading folders
 
 
-def skipped(name):
-    return name.startswith(".") or name in IGNORED
-
-
 def entries(folder):
     """The entries of `folder` worth looking at, in name order; links never followed."""
     try:
         with os.scandir(folder) as found:
-            return sorted((e for e in found if not skipped(e.name)), key=lambda e: e.name)
+            return sorted((e for e in found if not (e.name.startswith(".") or e.name in IGNORED)), key=lambda e: e.name)
     except OSError:
         return []
 
@@ -252,7 +210,7 @@ class Builder:
         for relative, archive in zips:
             folder = free(target / relative.parent / safe_part(relative.stem))
             folder.parent.mkdir(parents=True, exist_ok=True)
-            unpack_into(archive, folder, limits, self.zip_depth, budget)
+            unzip.unpack_into(archive, folder, limits, self.zip_depth, budget)
             self.notes.append(f"{one_line(name, 80)}: unpacked {one_line(as_text(relative.as_posix()), 80)}")
 
 
@@ -339,7 +297,7 @@ def is_class(path: str | os.PathLike) -> bool:
         name = as_text(entry.name)
         if entry.is_file(follow_symlinks=False) and name.endswith(".ipynb"):
             loose = loose or not _named(name, "file")
-        elif entry.is_dir(follow_symlinks=False) and not skipped(entry.name):
+        elif entry.is_dir(follow_symlinks=False):
             try:
                 folders = folders or any(f.suffix == ".ipynb" for f in walk(Path(entry.path)))
             except ValueError:
@@ -363,7 +321,7 @@ def _class_zip(path, root, builder):
     before anything is written, and each student's are checked and extracted on that student's budget. A member
     that breaks a rule refuses its student only (``builder.refused``), never the class."""
     label = as_text(path.name)
-    with open_zip(path, label) as archive:
+    with unzip.open_zip(path, label) as archive:
         members = [
             (i, [p for p in i.filename.replace("\\", "/").split("/") if p not in ("", ".")]) for i in archive.infolist()
         ]
@@ -434,7 +392,7 @@ def _student_plan(key, items, builder, label, skip):
     parts_of = {id(info): parts for info, parts in items}
 
     def checked_parts(info):
-        member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
+        unzip.member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
         parts = parts_of[id(info)]
         return [disk.get(parts[0], parts[0]), *parts[1:]]
 
@@ -444,7 +402,7 @@ def _student_plan(key, items, builder, label, skip):
                 f"{label}: more than {budget.limits.max_members} members are this student's; labkit extracts at "
                 f"most {budget.limits.max_members} for one student."
             )
-        return checked([info for info, _ in items], budget, label, checked_parts)
+        return unzip.checked([info for info, _ in items], budget, label, checked_parts)
     except ValueError as exc:
         builder.refused[key] = f"{exc} {FIX}"
         return None
@@ -473,11 +431,11 @@ def _extract_student(archive, key, plan, root, builder, label):
     budget, written, made = builder.budget(key), [], []
     try:
         for info, parts, is_dir, shown in plan:
-            make_dirs(root, parts if is_dir else parts[:-1], made, label, shown)
+            unzip.make_dirs(root, parts if is_dir else parts[:-1], made, label, shown)
             if not is_dir:
-                extract(archive, info, root.joinpath(*parts), budget, label, shown, written)
+                unzip.extract(archive, info, root.joinpath(*parts), budget, label, shown, written)
     except ValueError as exc:
-        undo(None, written, made)
+        unzip.undo(None, written, made)
         builder.refused[key] = f"{exc} {FIX}"
 
 
@@ -507,38 +465,16 @@ def find_class(
     limits: UnpackLimits = LIMITS,
     roster: dict[str, str] | None = None,
 ) -> Intake:
-    """The students of the class in `path`, one folder or one zip as the LMS gave it.
+    """The students of the class in `path`, one folder or one zip as an LMS of :func:`~labkit.grading.lms.systems`
+    gives it, in name order; one that cannot be graded has ``path=None`` and the reason in ``failure``.
 
-    Parameters
-    ----------
-    path : path-like
-        The class: a folder, or a zip, as one of the LMSs of :func:`labkit.grading.lms.systems` gives it.
-    workspace : path-like
-        A folder the caller owns (and deletes): every zip is unpacked there and every folder made
-        there; nothing is written anywhere else. It must not be inside `path`.
-    assignment : str, optional
-        nbgrader's assignment to take when students have several.
-    limits : UnpackLimits
-        What one student's files and zips may hold, in all; the class's zip is only a container.
-    roster : dict, optional
-        {submission name: LMS id} (``--roster``): a student the LMS gives an id is named as the roster names
-        that id, whatever their display name; one whose id is not on it never takes a roster name.
+    `workspace` is a folder the caller owns (and deletes), not inside `path`: every zip is unpacked and every
+    folder made there, nothing anywhere else. `assignment` is nbgrader's to take when students have several;
+    `limits` what one student's files and zips may hold in all; `roster` ({submission: LMS id}, ``--roster``)
+    names a student the LMS gives an id the roster has as the roster names that id, whatever their display name.
+    ValueError when no layout fits or they are mixed, two students would share a name, an nbgrader assignment
+    must be picked, or the class's zip cannot be read or has no room. One student's upload never stops the others.
 
-    Returns
-    -------
-    Intake
-        The students in name order; one that cannot be graded has ``path=None`` and the reason in
-        ``failure``. One student's upload never stops the others.
-
-    Raises
-    ------
-    ValueError
-        When no layout fits, the layouts are mixed, two students would share a name, nbgrader's
-        students have several assignments and `assignment` is None, the class's zip cannot be read, or
-        there is no room to unpack it.
-
-    Examples
-    --------
     >>> import pathlib, tempfile
     >>> top = pathlib.Path(tempfile.mkdtemp())
     >>> for student in ("bob", "alice"):

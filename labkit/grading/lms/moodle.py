@@ -1,25 +1,17 @@
 """Moodle: its "Download all submissions", a file for its "Import grades from CSV", its feedback files zip.
 
-The download (``mod/assign``'s ``download_submissions`` and ``downloader``) prefixes each file with the
-student's full name, in which every ``_`` became a space, then ``_`` and the participant id
-(``get_uniqueid_for_user``: the id blind marking shows), through ``clean_filename``. With folders (the default
-since Moodle 3.1) each submission plugin gets a folder ``{Full Name}_{id}_assignsubmission_{plugin}_``; without,
-each file is ``{Full Name}_{id}_assignsubmission_{plugin}_{file name}``. Blind marking writes "Participant" for
-the name, team submissions the group's. As the full name holds no ``_``, the first ``_<digits>_assignsubmission_``
-ends it. The student is ``{Full Name}_{id}``, so two of one name stay apart; the LMS id is the participant id.
+The download (``mod/assign``'s ``download_submissions``) prefixes each file with the full name, every ``_`` made a
+space, and the participant id (the one blind marking shows): a folder ``{Full Name}_{id}_assignsubmission_
+{plugin}_`` per plugin, or without folders ``{Full Name}_{id}_assignsubmission_{plugin}_{file}``. The student is
+``{Full Name}_{id}``, so namesakes stay apart.
 
-The grade import (MoodleDocs, "Grade import"; ``grade/import/csv/classes/load_data.php``): the instructor maps
-the column that identifies users to "ID number" or "Email address", and every other column to a grade item or
-its feedback. A row whose user Moodle cannot find stops the whole import, so the ids are checked against the key
-(``idnumber``, the default, or ``email``): under ``email`` every id looks like an email address, under
-``idnumber`` none does; a roster of email addresses under ``idnumber`` is refused with the advice to give ``--key
-email``, and one that mixes both is refused naming a few rows of each. An empty cell would erase a grade entered
-by hand, so only students with a grade are written; grades above 100 need the site settings ``unlimitedgrades``
-and ``gradepointmax``. With ``--feedback`` a ``Feedback`` column carries the points in words, the grade first
-(after a late penalty, then the points before it and the penalty), then the student's whole feedback text.
+The grade import (MoodleDocs, "Grade import"; ``grade/import/csv/classes/load_data.php``) maps the id column to
+"ID number" or "Email address" (``--key``). A row whose user Moodle cannot find stops the whole import, so the
+ids must fit the key: emails under ``email``, none under ``idnumber``. An empty cell would erase a hand-entered
+grade, so only graded students are written. With ``--feedback`` a ``Feedback`` column holds the points in words
+(the grade first, a late penalty then explained) and the student's feedback text.
 
-The feedback ("Upload multiple feedback files in a zip", ``mod/assign/feedback/file/importziplib.php``): each
-name is ``{full name}_{participant id}_assignfeedback_file_/feedback.html``.
+The feedback (``mod/assign/feedback/file/importziplib.php``): ``{full name}_{id}_assignfeedback_file_/feedback.html``.
 """
 
 from __future__ import annotations
@@ -120,38 +112,11 @@ def to_moodle(
     feedback: bool = False,
     force: bool = False,
 ) -> Export:
-    """Write a CSV for Moodle's "Import grades from CSV": one row per graded student on the roster.
-
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        The results of a grading run (:func:`~labkit.grading.store.report.read_results`), scored by their rubric.
-    roster : path
-        The roster (:func:`~.roster.read_roster`): submission name -> the student's ID number or email address.
-    out : path
-        The file to write; the summary CSV goes beside it.
-    key : {"idnumber", "email"}
-        The Moodle user field the roster's ids are: the first column is headed ``ID number`` or
-        ``Email address``, to map on import to "ID number" or "Email address".
-    column : str
-        The header of the points column, to map on import to a grade item (or a new one).
-    feedback : bool
-        Add a ``Feedback`` column: the points in words (the grade first, then how it was made, a late
-        penalty included), to map to the item's feedback.
-    force : bool
-        Replace `out` and its summary if they exist (the roster is never replaced).
-
-    Returns
-    -------
-    Export
-        What was written, and every student who got nothing from it.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see :func:`~.roster.read_roster`), an id that is not an email address with ``key="email"``, a
-        roster with any email address with ``key="idnumber"`` (see the module's description), an id that starts
-        like a formula, no student to write, or an output that exists or is an input.
+    """Write `out`, a CSV for Moodle's "Import grades from CSV" (and its summary): a row per graded student on
+    `roster`, whose ids are the Moodle user field `key` (``idnumber`` or ``email``, the first column's header),
+    the totals in `column`, with `feedback` a ``Feedback`` column. `force` replaces an existing `out`. ValueError
+    (and nothing written) for bad input, ids that do not fit `key` or start like a formula, no student to write,
+    or an output that is an input.
     """
     if key not in KEYS:
         raise InputError(f"--key for Moodle is idnumber or email (the user field of the roster's ids); got {key!r}.")

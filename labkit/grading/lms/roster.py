@@ -1,12 +1,8 @@
 """The roster, and reading the CSV files an instructor gives (the roster, an LMS's gradebook).
 
-Submissions are named after their folders or notebooks; the LMS knows students by its own identifiers. The
-instructor's roster joins the two: a CSV file (UTF-8, a byte-order mark allowed, separated by commas, semicolons
-or tabs) whose header row has the columns ``submission`` (the name in ``grades.csv``) and ``id`` (the student's
-identifier in the LMS); other columns, a name for instance, are ignored. Which identifier ``id`` holds is the
-LMS's roster key (:attr:`~labkit.grading.lms.Lms.keys`, ``--key``). A submission and an identifier may each
-appear once. ``labkit grade`` (whose file is whose), ``labkit export``, ``labkit release`` and ``labkit variants``
-read it.
+The roster joins each submission's name (``grades.csv``'s) to the student's identifier in the LMS: a CSV file
+(UTF-8, a byte-order mark allowed; commas, semicolons or tabs) with the columns ``submission`` and ``id``, each
+value once. Which identifier ``id`` is is the LMS's roster key (:attr:`~labkit.grading.lms.Lms.keys`, ``--key``).
 """
 
 from __future__ import annotations
@@ -44,6 +40,7 @@ def read_text(path, what, fix):
 
 
 def csv_rows(text, path, delimiter, fix):
+    """The rows of CSV `text`; ValueError saying how to `fix` it when it is not valid CSV."""
     try:
         return list(csv.reader(io.StringIO(text, newline=""), delimiter=delimiter, strict=True))
     except csv.Error as exc:
@@ -51,6 +48,7 @@ def csv_rows(text, path, delimiter, fix):
 
 
 def first_row(text, delimiter):
+    """The first row of CSV `text` read with `delimiter`, or [] when it cannot be read so."""
     try:
         return next(csv.reader(io.StringIO(text, newline=""), delimiter=delimiter), [])
     except csv.Error:
@@ -58,27 +56,11 @@ def first_row(text, delimiter):
 
 
 def read_roster(path: str | os.PathLike) -> dict[str, str]:
-    """The roster: submission name -> the student's identifier in the LMS, in the file's order.
+    """The roster at `path`: {submission name: the student's identifier in the LMS}, in the file's order, both
+    without surrounding spaces. Its header names the columns ``submission`` and ``id`` (any case and order, other
+    columns ignored). ValueError when the file cannot be read, is not UTF-8 CSV, lacks a column, has a row with an
+    empty submission or id, names a submission or an id twice, or has no student.
 
-    Parameters
-    ----------
-    path : path
-        A CSV file whose header has the columns ``submission`` and ``id`` (any case, any order, other
-        columns ignored); comma, semicolon or tab separated; UTF-8, with or without a byte-order mark.
-
-    Returns
-    -------
-    dict
-        Submission name -> identifier, both without surrounding spaces.
-
-    Raises
-    ------
-    ValueError
-        The file cannot be read, is not UTF-8 CSV, lacks a column, has a row with an empty
-        submission or id, names a submission or an id twice, or has no student.
-
-    Examples
-    --------
     >>> import pathlib, tempfile
     >>> roster = pathlib.Path(tempfile.mkdtemp()) / "roster.csv"
     >>> _ = roster.write_text("name,submission,id\\nAda Lovelace,ada,1815\\n", encoding="utf-8")

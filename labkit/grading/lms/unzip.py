@@ -1,9 +1,5 @@
-"""The safe unzip: a zip a student (or the LMS) hands in, extracted only as far as it does no harm.
-
-:func:`unpack` refuses what a hostile zip does: a member that leaves the folder, a link, a device, an
-encrypted member, a bomb (too many members, bytes or too high a ratio, counted on the bytes really
-decompressed), zips nested too deep. The class intake (:mod:`.intake`) spends one :class:`Budget` per student.
-"""
+"""The safe unzip: what a hostile zip does (leave the folder, links, devices, bombs) refused, on a budget per
+student (:class:`Budget`, which the class intake keeps for each student)."""
 
 from __future__ import annotations
 
@@ -29,24 +25,11 @@ UNREADABLE = (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFEr
 
 @dataclass(frozen=True)
 class UnpackLimits:
-    """What :func:`unpack` extracts at most from one zip, the zips inside it included; in
-    :func:`~labkit.grading.lms.intake.find_class`, what one student's files and zips may hold in all.
+    """What :func:`unpack` extracts at most from one zip and the zips in it; in the class intake, what one
+    student's files and zips may hold in all: bytes (512 MiB), members, folders included (2000), the ratio of
+    uncompressed to compressed size of a member that grows past 1 MiB (100), bytes of one member (64 MiB), levels
+    of zips inside the zip (2: a zip in a zip in the zip).
 
-    Attributes
-    ----------
-    max_total : int
-        Bytes written in all (512 MiB).
-    max_members : int
-        Members, directories included (2000).
-    max_ratio : float
-        Uncompressed over compressed size of one member, for members that grow past 1 MiB (100).
-    max_member : int
-        Bytes of one member (64 MiB).
-    max_depth : int
-        Levels of zips inside the zip unpacked (2: a zip in a zip in the zip).
-
-    Examples
-    --------
     >>> UnpackLimits().max_members, UnpackLimits(max_depth=0).max_depth
     (2000, 0)
     """
@@ -68,33 +51,27 @@ class UnpackLimits:
 LIMITS = UnpackLimits()
 
 
+@dataclass
 class Budget:
-    """What one student (or one :func:`unpack` call) has spent, nested zips included."""
+    """What one student (or one :func:`unpack` call) has spent, nested zips included; ``in_class``: the student's
+    files came in the class zip (counted as they were unpacked)."""
 
-    def __init__(self, limits):
-        self.limits = limits
-        self.members = 0
-        self.total = 0
-        self.in_class = False  # the student's files came in the class zip (counted as they were unpacked)
+    limits: UnpackLimits
+    members: int = 0
+    total: int = 0
+    in_class: bool = False
 
 
 def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS) -> list[Path]:
     """Extract `zip_path` into the folder `into`, refusing whatever could harm, and return the files written.
 
-    A member is never extracted when its name is absolute, has a drive letter
-    or a ``..``, or when it is a link or a device; the members, the bytes of
-    each and of all, and each member's compression ratio are bounded by
-    `limits`, counted on the bytes actually decompressed (the sizes a zip
-    declares are checked first, and never trusted). A zip inside is unpacked
-    in its place (``work.zip`` into a folder ``work``), to ``limits.max_depth``
-    levels, on the same budget. ``__MACOSX/`` is skipped. Any refusal raises
-    ``ValueError`` naming the zip and the rule, after removing what this call
-    wrote; nothing is ever written outside `into`, and no existing file is
-    overwritten.
+    A member whose name is absolute, has a drive letter or a ``..``, a link, a device, and whatever breaks
+    `limits` (counted on the bytes really decompressed; the sizes a zip declares are checked first, never
+    trusted) refuse the zip: ValueError naming it and the rule, after removing what this call wrote. A zip inside
+    is unpacked in its place (``work.zip`` into a folder ``work``) on the same budget; ``__MACOSX/`` is skipped.
+    Nothing is written outside `into`, and no existing file is overwritten.
 
-    Examples
-    --------
-    >>> import io, pathlib, tempfile, zipfile
+    >>> import pathlib, tempfile, zipfile
     >>> folder = pathlib.Path(tempfile.mkdtemp())
     >>> with zipfile.ZipFile(folder / "work.zip", "w") as z:
     ...     z.writestr("lab/02_convergence.ipynb", "{}")
