@@ -9,6 +9,7 @@ An LMS is a module here that exposes ``LMS``, an instance of an :class:`Lms`: :m
 
 from __future__ import annotations
 
+import functools
 import importlib
 import pkgutil
 
@@ -88,10 +89,13 @@ def systems() -> list[Lms]:
     >>> [lms.name for lms in systems()]
     ['nbgrader', 'moodle', 'canvas', 'folders']
     """
-    found = [
-        getattr(importlib.import_module(f"{__name__}.{m.name}"), "LMS", None) for m in pkgutil.iter_modules(__path__)
-    ]
-    return sorted((lms for lms in found if isinstance(lms, Lms)), key=lambda lms: (lms.rank, lms.name))
+    return list(_discover(tuple(__path__)))
+
+
+@functools.lru_cache(maxsize=8)
+def _discover(path):
+    found = [getattr(importlib.import_module(f"{__name__}.{m.name}"), "LMS", None) for m in pkgutil.iter_modules(path)]
+    return tuple(sorted((lms for lms in found if isinstance(lms, Lms)), key=lambda lms: (lms.rank, lms.name)))
 
 
 def named(layout: str) -> Lms:
