@@ -493,7 +493,7 @@ def find_class(
         raise InputError(f"{one_line(as_text(str(path)))} does not exist.") from None
     if stat.S_ISLNK(info.st_mode):
         raise InputError(f"{one_line(as_text(str(path)))} is a symbolic link; give the folder or zip itself.")
-    if stat.S_ISDIR(info.st_mode) and _inside(workspace, path):
+    if stat.S_ISDIR(info.st_mode) and workspace.resolve().is_relative_to(path.resolve()):
         raise InputError(
             f"the workspace {one_line(as_text(str(workspace)))} is inside the class folder; "
             "labkit writes nothing there: give a workspace elsewhere."
@@ -511,14 +511,6 @@ def find_class(
     _one_name_each(students)
     students.sort(key=lambda s: (s.name.casefold(), s.name))
     return Intake(students, lms.name, notes)
-
-
-def _inside(path, folder):
-    try:
-        Path(path).resolve().relative_to(Path(folder).resolve())
-    except ValueError:
-        return False
-    return True
 
 
 def _class_root(path, info, own, builder):
