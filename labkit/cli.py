@@ -123,7 +123,7 @@ def _roster_and_variants(args, purpose):
     if args.roster is None or args.variants is None:
         raise InputError(f"give both --roster and --variants {purpose}, or neither.")
     from .exercises import variants
-    from .grading.reports.lms import read_roster
+    from .grading.lms.roster import read_roster
 
     return read_roster(args.roster), variants.read(args.variants)
 
@@ -374,7 +374,7 @@ def _grade(args):
             variants=variants,
         )
     if found.intake is not None:
-        from .grading.reports.delivery import remember
+        from .grading.lms.delivery import remember
 
         remember(args.out, found.intake)
     rubric = grades.earlier.rubric
@@ -416,8 +416,8 @@ class _Class:
 
 
 def _class(args, workspace):
-    """One class folder or zip as the LMS gives it (labkit.grading.run.intake), or the submissions one by one."""
-    from .grading.run import intake
+    """One class folder or zip as the LMS gives it (labkit.grading.lms.intake), or the submissions one by one."""
+    from .grading.lms import intake
 
     paths = args.submissions
     if len(paths) != 1 or not intake.is_class(paths[0]):
@@ -426,7 +426,7 @@ def _class(args, workspace):
                 raise InputError(f"{flag} picks from a class folder (or zip) as the LMS gives it; give that folder.")
         found = intake.find_students(paths, workspace)
     else:
-        from .grading.reports.lms import read_roster
+        from .grading.lms.roster import read_roster
 
         roster = read_roster(args.roster) if args.roster is not None else None  # its ids decide whose a file is
         found = intake.find_class(paths[0], workspace, assignment=args.assignment, roster=roster)
@@ -477,7 +477,7 @@ def _late_marks(grades, marked):
 
 
 def _export(args):
-    from .grading.reports import lms
+    from .grading.lms import canvas, exports, moodle
     from .grading.store.record import rubric_for
     from .grading.store.report import read_results
 
@@ -489,21 +489,21 @@ def _export(args):
     grades = read_results([args.results], rubric_for([args.results], args.rubric, "labkit export"))
     _refused(grades, "labkit export")
     if args.canvas is not None:
-        export = lms.to_canvas(
+        export = canvas.to_canvas(
             grades,
             args.canvas,
             args.roster,
-            args.out or lms.default_file(args.results, "canvas"),
+            args.out or exports.default_file(args.results, "canvas"),
             column=args.column,
             key=args.key or "ID",
             new_column=args.new_column,
             force=args.force,
         )
     else:
-        export = lms.to_moodle(
+        export = moodle.to_moodle(
             grades,
             args.roster,
-            args.out or lms.default_file(args.results, "moodle"),
+            args.out or exports.default_file(args.results, "moodle"),
             key=args.key or "idnumber",
             column=args.column,
             feedback=args.feedback,
@@ -516,12 +516,12 @@ def _export(args):
 
 
 def _feedback(args):
-    from .grading.reports import delivery
+    from .grading.lms import delivery
 
     path, members, notes = delivery.write_upload(args.out, args.layout)
     for line in notes:
         print(f"labkit feedback: {line}", file=sys.stderr)
-    print(f"wrote {path}: {len(members)} file(s); {delivery.STEPS[delivery.layout_of(args.out, args.layout)]}")
+    print(f"wrote {path}: {len(members)} file(s); {delivery.steps(delivery.layout_of(args.out, args.layout))}")
     return 1 if notes else 0
 
 
@@ -1016,7 +1016,7 @@ def build_parser():
 
 def _variants(args):
     from .exercises import variants
-    from .grading.reports.lms import read_roster
+    from .grading.lms.roster import read_roster
     from .grading.store.report import one_line
 
     course = _course(args)

@@ -64,7 +64,7 @@ def test_the_search_finds_a_pair_that_imports_each_other_even_inside_a_function(
     assert edges["pkg.other"] == {"pkg.sub.late"}
 
 
-SUBPACKAGES = ("authoring", "reports", "sandbox", "store", "submission")
+SUBPACKAGES = ("authoring", "lms", "reports", "sandbox", "store", "submission")
 
 
 def reaching_out(edges, inside, allowed_prefix="labkit.grading."):
@@ -200,6 +200,7 @@ FLOW = {
     "labkit.grading.store": 2,
     "labkit.grading.options": 2,
     "labkit.grading.submission": 3,
+    "labkit.grading.lms": 3,
     "labkit.grading.run": 4,
     "labkit.grading.authoring": 4,
     "labkit.grading.reports": 5,

@@ -176,7 +176,7 @@ def folder_name(name):
 def release(notebook_dir, out_dir, roster=None, variants=None, registry=LAB):
     """Write the student version of every notebook of `notebook_dir` into `out_dir`.
 
-    With `roster` ({submission name: roster id}, :func:`labkit.grading.reports.lms.read_roster`)
+    With `roster` ({submission name: roster id}, :func:`labkit.grading.lms.roster.read_roster`)
     and `variants` (a :class:`labkit.exercises.variants.VariantsFile`), each
     student gets a folder ``out_dir/<submission name>/`` whose notebooks hold
     that student's data. Returns the paths written."""

@@ -79,7 +79,7 @@ class RunRecord:
     # the students' own data (labkit.exercises.variants): {"digest": the variants file's, "students": {name:
     # {exercise: {parameter: value}}}}, empty for a run without variants
     variants: dict = field(default_factory=dict)
-    # how the class came (labkit.grading.reports.delivery): {"layout": "canvas", "moodle", "folders", "nbgrader" or
+    # how the class came (labkit.grading.lms.delivery): {"layout": "canvas", "moodle", "folders", "nbgrader" or
     # "listed", "students": {name: what names that student's files in the LMS}}; empty for a run before it
     delivery: dict = field(default_factory=dict)
 

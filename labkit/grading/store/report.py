@@ -520,7 +520,7 @@ def _seed_of(grades):
 
 
 def _merged_delivery(deliveries):
-    """The merged runs' delivery records (labkit.grading.reports.delivery) as one, a later run's students
+    """The merged runs' delivery records (labkit.grading.lms.delivery) as one, a later run's students
     replacing an earlier one's; none when the runs came in different layouts."""
     layouts = {d.get("layout") for d in deliveries if d}
     if len(layouts) != 1:

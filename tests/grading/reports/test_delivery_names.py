@@ -5,43 +5,44 @@ import zipfile
 
 import pytest
 
-from labkit.grading.reports import delivery
+from labkit.grading.lms import canvas, delivery, folders, moodle, nbgrader
 from labkit.grading.store import record as records
 from labkit.grading.store.report import SubmissionGrade, write_report
 
 
 def test_canvas_names_carry_the_downloads_user_and_file_ids():
-    assert delivery.canvas_names("lovelaceada", {"file": "lovelaceada_LATE_101_9001"}) == [
+    assert canvas.LMS.feedback_names("lovelaceada", {"file": "lovelaceada_LATE_101_9001"}) == [
         "lovelaceada_LATE_101_9001_feedback.html"
     ]
     for bad in ({}, {"file": "../x_1_2"}, {"file": "lovelaceada_101"}):
         with pytest.raises(ValueError, match="no Canvas file"):
-            delivery.canvas_names("lovelaceada", bad)
+            canvas.LMS.feedback_names("lovelaceada", bad)
 
 
 def test_moodle_names_are_the_participant_id_and_the_feedback_file_plugin():
-    assert delivery.moodle_names("Ada Lovelace_201", {"lms id": "201"}) == [
+    assert moodle.LMS.feedback_names("Ada Lovelace_201", {"lms id": "201"}) == [
         "Ada Lovelace_201_assignfeedback_file_/feedback.html"
     ]
     # a name that would add pieces at "_" or a folder keeps the participant id second
-    name = delivery.moodle_names("a_b/../c_7", {"lms id": "7"})[0]
+    name = moodle.LMS.feedback_names("a_b/../c_7", {"lms id": "7"})[0]
     assert name.split("/")[0].split("_", 4)[1:4] == ["7", "assignfeedback", "file"] and ".." not in name.split("/")
     with pytest.raises(ValueError, match="participant id"):
-        delivery.moodle_names("Ada", {"lms id": None})
+        moodle.LMS.feedback_names("Ada", {"lms id": None})
 
 
 def test_folder_and_nbgrader_names_stay_inside_the_zip():
-    assert delivery.folder_names("alice", {}) == ["alice/feedback.html"]
+    assert folders.LMS.feedback_names("alice", {}) == ["alice/feedback.html"]
     assert (
-        delivery.folder_names("..", {})[0].startswith("submission-") or ".." not in delivery.folder_names("..", {})[0]
+        folders.LMS.feedback_names("..", {})[0].startswith("submission-")
+        or ".." not in folders.LMS.feedback_names("..", {})[0]
     )
     entry = {"assignment": "lab8", "notebooks": ["01_limacon", "02_convergence"]}
-    assert delivery.nbgrader_names("alice", entry) == [
+    assert nbgrader.LMS.feedback_names("alice", entry) == [
         "alice/feedback.html",
         "feedback/alice/lab8/01_limacon.html",
         "feedback/alice/lab8/02_convergence.html",
     ]
-    assert delivery.nbgrader_names("alice", {**entry, "assignment": "../x"}) == ["alice/feedback.html"]
+    assert nbgrader.LMS.feedback_names("alice", {**entry, "assignment": "../x"}) == ["alice/feedback.html"]
 
 
 def test_an_nbgrader_run_writes_its_feedback_folder_with_the_timestamp_and_secret(tmp_path):

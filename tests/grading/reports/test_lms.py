@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from labkit.grading.reports import lms
+from labkit.grading.lms import canvas, exports, moodle
 from labkit.grading.store import late
 from labkit.grading.store.report import SubmissionGrade, read_results, write_report
 from labkit.grading.store.rubric import default
@@ -55,7 +55,7 @@ Eve Noether,eve,1005
 Gus Riemann,gus,1007
 '''
 
-# Canvas's layout (see labkit/grading/reports/lms.py): the student columns, closed by Section; assignments titled
+# Canvas's layout (see labkit/grading/lms/canvas.py): the student columns, closed by Section; assignments titled
 # "Title (number)"; read-only totals; a Muted row, the Points Possible row, then the students. Exported with a
 # byte-order mark. Frank has no roster entry; "Student, Test" is Canvas's test student.
 CANVAS = (
@@ -93,7 +93,9 @@ def _snapshot(folder):
 def test_a_new_canvas_column_holds_the_totals_and_everything_else_is_kept(out, inputs, tmp_path):
     gradebook, roster = inputs
     target = tmp_path / "import.csv"
-    export = lms.to_canvas(read_results([out]), gradebook, roster, target, column="Interpolation lab", new_column=True)
+    export = canvas.to_canvas(
+        read_results([out]), gradebook, roster, target, column="Interpolation lab", new_column=True
+    )
     before, after = _rows(gradebook), _rows(target)
     # every row and column as exported, one column added at the end
     assert [row[:-1] for row in after] == before
@@ -118,7 +120,7 @@ def test_a_new_canvas_column_holds_the_totals_and_everything_else_is_kept(out, i
 
 def test_canvas_lists_everyone_who_got_nothing(out, inputs, tmp_path):
     gradebook, roster = inputs
-    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", column="Lab 8")
+    export = canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", column="Lab 8")
     assert export.not_graded == {"carl": "its grading crashed twice"}
     assert sorted(export.not_in_roster) == sorted(["dora", ESCAPE])
     assert export.no_submission == [("eve", "1005"), ("gus", "1007")]
@@ -134,7 +136,7 @@ def test_canvas_lists_everyone_who_got_nothing(out, inputs, tmp_path):
 
 def test_the_summary_has_every_student_once_and_neutralises_formula_names(out, inputs, tmp_path):
     gradebook, roster = inputs
-    export = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", column="Lab 8")
+    export = canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", column="Lab 8")
     assert export.summary_path == tmp_path / "import-summary.csv"
     rows = _rows(export.summary_path)
     assert rows[0] == ["submission", "id", "points", "status"]
@@ -155,7 +157,7 @@ def test_the_summary_has_every_student_once_and_neutralises_formula_names(out, i
 def test_an_existing_canvas_column_is_filled_and_a_cell_without_a_grade_is_left_as_exported(out, inputs, tmp_path):
     gradebook, roster = inputs
     target = tmp_path / "import.csv"
-    export = lms.to_canvas(read_results([out]), gradebook, roster, target, column="Lab 8")
+    export = canvas.to_canvas(read_results([out]), gradebook, roster, target, column="Lab 8")
     before, after = _rows(gradebook), _rows(target)
     assert after[0] == before[0] and export.column == "Lab 8 (777)"
     at = before[0].index("Lab 8 (777)")
@@ -172,7 +174,7 @@ def test_an_existing_canvas_column_is_filled_and_a_cell_without_a_grade_is_left_
     }
     assert after[1][at] == "Muted" and after[2][at] == "100"
     # the full header, with Canvas's number, names the same column
-    again = lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "again.csv", column="Lab 8 (777)")
+    again = canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "again.csv", column="Lab 8 (777)")
     assert _rows(tmp_path / "again.csv") == after and again.column == "Lab 8 (777)"
 
 
@@ -181,7 +183,7 @@ def test_a_column_the_gradebook_lacks_is_refused_with_its_assignments_unless_new
     grades = read_results([out])
     message = _refused(
         tmp_path,
-        lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column="Lab 9"),
+        lambda: canvas.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column="Lab 9"),
         "has no assignment column named 'Lab 9'",
         "its assignment columns are 'Quiz 1 (501)', 'Lab 8 (777)'.",
         "--new-column",
@@ -189,9 +191,9 @@ def test_a_column_the_gradebook_lacks_is_refused_with_its_assignments_unless_new
     # the totals are not assignments, and the student columns are not listed
     assert "Current Score" not in message and "Final Score" not in message and "Section" not in message
     # the default column is no exception: a gradebook without a 'labkit' column is not given one silently
-    _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv"), "named 'labkit'")
+    _refused(tmp_path, lambda: canvas.to_canvas(grades, gradebook, roster, tmp_path / "x.csv"), "named 'labkit'")
     # asked for on purpose, the column is added
-    export = lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column="Lab 9", new_column=True)
+    export = canvas.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column="Lab 9", new_column=True)
     assert _rows(tmp_path / "x.csv")[0][-1] == "Lab 9" and export.column == "Lab 9"
 
 
@@ -201,28 +203,28 @@ def test_new_column_refuses_a_column_the_gradebook_has(out, inputs, tmp_path):
     for column in ("Lab 8", "Lab 8 (777)", " lab 8 ".upper().title()):
         _refused(
             tmp_path,
-            lambda c=column: lms.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column=c, new_column=True),
+            lambda c=column: canvas.to_canvas(grades, gradebook, roster, tmp_path / "x.csv", column=c, new_column=True),
             "already has the assignment column 'Lab 8 (777)'",
             "leave out --new-column to fill it",
         )
 
 
 def test_the_assignments_listed_in_the_refusal_are_bounded_and_printable(out, tmp_path):
-    names = [f"Quiz {i} \x1b[2J (50{i})" for i in range(lms.MAX_LISTED + 7)] + ["Current Score"]
+    names = [f"Quiz {i} \x1b[2J (50{i})" for i in range(canvas.MAX_LISTED + 7)] + ["Current Score"]
     header = "Student,ID,Section," + ",".join(names)
     points = "    Points Possible,,," + ",".join(["5"] * (len(names) - 1)) + ",(read only)"
     gradebook = _write(tmp_path / "gradebook.csv", f"{header}\n{points}\nAda,1001,A{',' * len(names)}\n")
     roster = _write(tmp_path / "roster.csv", "submission,id\nada,1001\n")
     message = _refused(
         tmp_path,
-        lambda: lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "x.csv", column="Exam"),
+        lambda: canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "x.csv", column="Exam"),
         "and 7 more",
     )
-    assert "\x1b" not in message and message.count("'Quiz") == lms.MAX_LISTED
+    assert "\x1b" not in message and message.count("'Quiz") == canvas.MAX_LISTED
     empty = _write(tmp_path / "empty.csv", "Student,ID,Section,Current Score\nAda,1001,A,\n")
     _refused(
         tmp_path,
-        lambda: lms.to_canvas(read_results([out]), empty, roster, tmp_path / "x.csv", column="Quiz"),
+        lambda: canvas.to_canvas(read_results([out]), empty, roster, tmp_path / "x.csv", column="Quiz"),
         "it has no assignment column yet",
     )
 
@@ -232,7 +234,7 @@ def test_the_roster_can_match_canvas_on_sis_ids(out, tmp_path):
     roster = _write(
         tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\ndora,dora@uni.example\n"
     )
-    export = lms.to_canvas(
+    export = canvas.to_canvas(
         read_results([out]), gradebook, roster, tmp_path / "import.csv", key="SIS Login ID", new_column=True
     )
     rows = {row[1]: row[-1] for row in _rows(tmp_path / "import.csv")[3:]}
@@ -269,7 +271,7 @@ def test_a_semicolon_export_keeps_its_separator_and_decimal_commas(out, tmp_path
     )
     gradebook = _write(tmp_path / "gradebook.csv", text)
     roster = _write(tmp_path / "roster.csv", "submission;id\nada;1001\nbob;1002\n")
-    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", new_column=True)
+    canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", new_column=True)
     written = (tmp_path / "import.csv").read_bytes().decode("utf-8")
     assert not written.startswith("\ufeff")  # no byte-order mark where the export had none
     assert written == (
@@ -289,7 +291,7 @@ def test_a_semicolon_export_keeps_its_separator_and_decimal_commas(out, tmp_path
 )
 def test_moodle_gets_one_row_per_graded_student_keyed_as_asked(out, tmp_path, key, roster, header):
     path = _write(tmp_path / "roster.csv", roster)
-    export = lms.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", key=key, column="Lab 8")
+    export = moodle.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", key=key, column="Lab 8")
     ids = dict(line.split(",") for line in roster.splitlines()[1:])
     # carl could not be graded: left out, so Moodle keeps what it has (an empty cell would mean "no grade")
     assert _rows(tmp_path / "moodle.csv") == [[header, "Lab 8"], [ids["ada"], "104"], [ids["bob"], "17.5"]]
@@ -301,7 +303,7 @@ def test_moodle_gets_one_row_per_graded_student_keyed_as_asked(out, tmp_path, ke
 
 def test_moodle_feedback_says_the_points_in_words(out, tmp_path):
     path = _write(tmp_path / "roster.csv", "submission,id\nada,S1001\nbob,S1002\n")
-    lms.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", feedback=True)
+    moodle.to_moodle(read_results([out]), path, tmp_path / "moodle.csv", feedback=True)
     rows = _rows(tmp_path / "moodle.csv")
     assert rows[0] == ["ID number", "labkit", "Feedback"]
     first, rest = rows[1][2].split("\n", 1)
@@ -339,7 +341,7 @@ def _late_grades():
 
 def test_moodle_feedback_begins_with_the_grade_after_the_late_penalty_and_states_the_penalty(tmp_path):
     roster = _write(tmp_path / "roster.csv", "submission,id\nada,S1\nbob,S2\ncy,S3\ndee,S4\n")
-    lms.to_moodle(_late_grades(), roster, tmp_path / "moodle.csv", feedback=True)
+    moodle.to_moodle(_late_grades(), roster, tmp_path / "moodle.csv", feedback=True)
     rows = {row[0]: row[1:] for row in _rows(tmp_path / "moodle.csv")[1:]}
     assert {key: grade for key, (grade, _) in rows.items()} == {"S1": "83.2", "S2": "17.5", "S3": "50", "S4": "10"}
     for grade, feedback in rows.values():
@@ -365,7 +367,7 @@ def test_another_rubric_than_the_runs_is_refused_and_none_needed(out, inputs, tm
     assert run.returncode == 2 and "differs from it in its exercises, groups or points" in run.stderr, run.stderr
     assert not (tmp_path / "x.csv").exists()
     # without --rubric, the run's own: the column holds grades.csv's totals
-    lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", new_column=True)
+    canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "import.csv", new_column=True)
     with open(out / "grades.csv", newline="", encoding="utf-8") as handle:
         totals = {row["submission"]: row["total"] for row in csv.DictReader(handle)}
     exported = {row[1]: row[-1] for row in _rows(tmp_path / "import.csv")[1:]}
@@ -399,8 +401,8 @@ def _refused(tmp_path, call, *messages):
 def test_a_bad_roster_is_refused(out, tmp_path, roster, messages):
     gradebook = _write(tmp_path / "gradebook.csv", CANVAS)
     path = _write(tmp_path / "roster.csv", roster)
-    _refused(tmp_path, lambda: lms.to_canvas(read_results([out]), gradebook, path, tmp_path / "x.csv"), *messages)
-    _refused(tmp_path, lambda: lms.to_moodle(read_results([out]), path, tmp_path / "x.csv"), *messages)
+    _refused(tmp_path, lambda: canvas.to_canvas(read_results([out]), gradebook, path, tmp_path / "x.csv"), *messages)
+    _refused(tmp_path, lambda: moodle.to_moodle(read_results([out]), path, tmp_path / "x.csv"), *messages)
 
 
 @pytest.mark.parametrize(
@@ -415,7 +417,7 @@ def test_a_bad_roster_is_refused(out, tmp_path, roster, messages):
 def test_a_file_that_is_not_a_canvas_export_is_refused(out, tmp_path, content, messages):
     gradebook = _write(tmp_path / "gradebook.csv", content)
     roster = _write(tmp_path / "roster.csv", ROSTER)
-    _refused(tmp_path, lambda: lms.to_canvas(read_results([out]), gradebook, roster, tmp_path / "x.csv"), *messages)
+    _refused(tmp_path, lambda: canvas.to_canvas(read_results([out]), gradebook, roster, tmp_path / "x.csv"), *messages)
 
 
 def test_a_canvas_export_that_is_not_utf8_or_is_a_workbook_is_refused(out, tmp_path):
@@ -423,7 +425,7 @@ def test_a_canvas_export_that_is_not_utf8_or_is_a_workbook_is_refused(out, tmp_p
     latin = _write(tmp_path / "latin.csv", CANVAS.replace("\ufeff", "").replace("Ada", "Adà"), "latin-1")
     _refused(
         tmp_path,
-        lambda: lms.to_canvas(read_results([out]), latin, roster, tmp_path / "x.csv"),
+        lambda: canvas.to_canvas(read_results([out]), latin, roster, tmp_path / "x.csv"),
         "is not UTF-8 text",
         "CSV UTF-8",
     )
@@ -431,7 +433,7 @@ def test_a_canvas_export_that_is_not_utf8_or_is_a_workbook_is_refused(out, tmp_p
     workbook.write_bytes(b"PK\x03\x04" + bytes(range(256)))
     _refused(
         tmp_path,
-        lambda: lms.to_canvas(read_results([out]), workbook, roster, tmp_path / "x.csv"),
+        lambda: canvas.to_canvas(read_results([out]), workbook, roster, tmp_path / "x.csv"),
         "is an Excel workbook, not CSV",
     )
 
@@ -441,7 +443,9 @@ def test_canvas_columns_and_ids_that_cannot_be_filled_are_refused(out, inputs, t
     grades = read_results([out])
 
     def refused(*messages, book=gradebook, **options):
-        return _refused(tmp_path, lambda: lms.to_canvas(grades, book, roster, tmp_path / "x.csv", **options), *messages)
+        return _refused(
+            tmp_path, lambda: canvas.to_canvas(grades, book, roster, tmp_path / "x.csv", **options), *messages
+        )
 
     refused("as a student column or a total", column="Current Score")
     refused("as a student column or a total", column="Section")
@@ -467,12 +471,12 @@ def test_an_output_is_never_an_input_nor_an_existing_file_unless_forced(out, inp
     gradebook, roster = inputs
     grades = read_results([out])
     for target in (gradebook, roster):
-        message = _refused(tmp_path, lambda t=target: lms.to_canvas(grades, gradebook, roster, t, force=True))
+        message = _refused(tmp_path, lambda t=target: canvas.to_canvas(grades, gradebook, roster, t, force=True))
         assert "is an input of this export; it is never overwritten" in message
     target = _write(tmp_path / "import.csv", "my earlier export")
-    _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, target), "already exists", "--force")
-    _refused(tmp_path, lambda: lms.to_canvas(grades, gradebook, roster, tmp_path / "no" / "x.csv"), "does not exist")
-    lms.to_canvas(grades, gradebook, roster, target, force=True, new_column=True)
+    _refused(tmp_path, lambda: canvas.to_canvas(grades, gradebook, roster, target), "already exists", "--force")
+    _refused(tmp_path, lambda: canvas.to_canvas(grades, gradebook, roster, tmp_path / "no" / "x.csv"), "does not exist")
+    canvas.to_canvas(grades, gradebook, roster, target, force=True, new_column=True)
     assert _rows(target)[0][-1] == "labkit" and gradebook.read_text(encoding="utf-8") == CANVAS
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "gradebook.csv",
@@ -486,13 +490,15 @@ def test_moodle_refuses_ids_that_are_not_what_the_key_says(out, tmp_path):
     grades = read_results([out])
     roster = _write(tmp_path / "roster.csv", "submission,id\nada,S1001\n")
     _refused(
-        tmp_path, lambda: lms.to_moodle(grades, roster, tmp_path / "m.csv", key="email"), "is not an email address"
+        tmp_path, lambda: moodle.to_moodle(grades, roster, tmp_path / "m.csv", key="email"), "is not an email address"
     )
     formula = _write(tmp_path / "roster.csv", "submission,id\nada,=1+1\n")
-    _refused(tmp_path, lambda: lms.to_moodle(grades, formula, tmp_path / "m.csv"), "starts like a spreadsheet formula")
+    _refused(
+        tmp_path, lambda: moodle.to_moodle(grades, formula, tmp_path / "m.csv"), "starts like a spreadsheet formula"
+    )
     nobody = _write(tmp_path / "roster.csv", "submission,id\ncarl,S1003\n")  # only a student who was not graded
-    _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv"), "no graded submission")
-    _refused(tmp_path, lambda: lms.to_moodle(grades, nobody, tmp_path / "m.csv", key="ID"), "idnumber or email")
+    _refused(tmp_path, lambda: moodle.to_moodle(grades, nobody, tmp_path / "m.csv"), "no graded submission")
+    _refused(tmp_path, lambda: moodle.to_moodle(grades, nobody, tmp_path / "m.csv", key="ID"), "idnumber or email")
 
 
 def test_moodle_refuses_email_addresses_under_the_id_number_key(out, tmp_path):
@@ -500,7 +506,7 @@ def test_moodle_refuses_email_addresses_under_the_id_number_key(out, tmp_path):
     emails = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
     message = _refused(
         tmp_path,
-        lambda: lms.to_moodle(grades, emails, tmp_path / "m.csv"),  # key="idnumber", the default
+        lambda: moodle.to_moodle(grades, emails, tmp_path / "m.csv"),  # key="idnumber", the default
         "holds email addresses (e.g. 'ada' ('ada@uni.example'), 'bob' ('bob@uni.example')), not ID numbers",
         "give --key email",
     )
@@ -511,17 +517,17 @@ def test_moodle_refuses_email_addresses_under_the_id_number_key(out, tmp_path):
     )
     message = _refused(
         tmp_path,
-        lambda: lms.to_moodle(grades, mixed, tmp_path / "m.csv", key="idnumber"),
+        lambda: moodle.to_moodle(grades, mixed, tmp_path / "m.csv", key="idnumber"),
         "mixes email addresses (2 of 4: 'bob' ('bob@uni.example'), 'mal\ufffd[2Jory' ('m\ufffd[2J@uni.example'))",
         "with other ids (e.g. 'ada' ('S1001'), 'carl' ('S1003'))",
         "correct those rows",
     )
     assert "\x1b" not in message
     # and under --key email, the ID numbers among the addresses are refused as before
-    _refused(tmp_path, lambda: lms.to_moodle(grades, mixed, tmp_path / "m.csv", key="email"), "not an email address")
+    _refused(tmp_path, lambda: moodle.to_moodle(grades, mixed, tmp_path / "m.csv", key="email"), "not an email address")
     # the same roster of addresses, under the key that says so, is exported
     emails = _write(tmp_path / "roster.csv", "submission,id\nada,ada@uni.example\nbob,bob@uni.example\n")
-    export = lms.to_moodle(grades, emails, tmp_path / "m.csv", key="email")
+    export = moodle.to_moodle(grades, emails, tmp_path / "m.csv", key="email")
     assert export.exported == {"ada": ("ada@uni.example", 104.0), "bob": ("bob@uni.example", 17.5)}
 
 
@@ -602,4 +608,4 @@ def test_the_default_column_is_the_modules():
     from labkit.cli import build_parser
 
     args = build_parser().parse_args(["export", "grades", "--moodle", "--roster", "r.csv"])
-    assert args.column == lms.DEFAULT_COLUMN
+    assert args.column == exports.DEFAULT_COLUMN

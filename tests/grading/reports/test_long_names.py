@@ -8,7 +8,8 @@ import re
 from test_marking import _passed, _rubric
 
 from labkit.cli import main
-from labkit.grading.reports import lms, marking
+from labkit.grading.lms import moodle
+from labkit.grading.reports import marking
 from labkit.grading.store import report
 from labkit.grading.store.names import name_from_cell, shown_name
 from labkit.grading.store.report import read_results
@@ -75,7 +76,7 @@ def test_marks_csv_grades_csv_merge_and_export_keep_every_name(tmp_path):
     roster = tmp_path / "roster.csv"
     with open(roster, "w", newline="", encoding="utf-8") as handle:
         csv.writer(handle).writerows([["submission", "id"], [FIRST, "S1"], [SECOND, "S2"], [ODD, "S3"]])
-    lms.to_moodle(read_results([merged]), roster, tmp_path / "moodle.csv", key="idnumber", column="Lab 8")
+    moodle.to_moodle(read_results([merged]), roster, tmp_path / "moodle.csv", key="idnumber", column="Lab 8")
     with open(tmp_path / "moodle.csv", newline="", encoding="utf-8") as handle:
         exported = {row[0]: float(row[1]) for row in list(csv.reader(handle))[1:]}
     assert exported == {"S1": totals[FIRST], "S2": totals[SECOND], "S3": totals[ODD]}

@@ -142,12 +142,12 @@ def test_marks_reach_grades_csv_the_feedback_the_report_and_the_export(tmp_path)
     assert {g.name: g.total for g in grades} == {"ada": 44.5, "=bob": 15}
     assert main(["report", str(out), "--quiet"]) == 0
     assert "44.5" in (out / "report.html").read_text(encoding="utf-8")
-    from labkit.grading.reports import lms
+    from labkit.grading.lms import moodle
     from labkit.grading.store.report import read_results
 
     roster = tmp_path / "roster.csv"
     roster.write_text("submission,id\nada,S1\n=bob,S2\n", encoding="utf-8")
-    lms.to_moodle(read_results([out]), roster, tmp_path / "moodle.csv", key="idnumber", column="Lab 8")
+    moodle.to_moodle(read_results([out]), roster, tmp_path / "moodle.csv", key="idnumber", column="Lab 8")
     with open(tmp_path / "moodle.csv", newline="", encoding="utf-8") as handle:
         exported = {row[0]: row[1] for row in list(csv.reader(handle))[1:]}
     assert exported == {"S1": "44.5", "S2": "15"}

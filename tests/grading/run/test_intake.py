@@ -1,4 +1,4 @@
-"""labkit.grading.run.intake: each LMS layout built in tmp_path, and zips that try to harm."""
+"""labkit.grading.lms.intake: each LMS layout built in tmp_path, and zips that try to harm."""
 
 import io
 import os
@@ -13,7 +13,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from labkit.grading.run.intake import Intake, Student, UnpackLimits, find_class, unpack
+from labkit.grading.lms.intake import Intake, Student, find_class
+from labkit.grading.lms.unzip import UnpackLimits, unpack
 
 MiB = 1 << 20
 
@@ -309,7 +310,7 @@ def test_canvas_namesakes_are_told_apart_by_their_user_id(tmp_path, workspace):
 
 
 def test_a_class_is_told_from_one_students_folder(tmp_path):
-    from labkit.grading.run.intake import is_class
+    from labkit.grading.lms.intake import is_class
 
     write_notebook(tmp_path / "class" / "alice" / "a.ipynb")
     write_notebook(tmp_path / "canvas" / "smithjohn_101_1_a.ipynb")
@@ -334,7 +335,7 @@ def test_numbered_files_without_their_plain_name_are_all_kept_as_named(tmp_path,
 
 
 def test_a_folder_with_notebooks_of_its_own_and_folders_of_notebooks_is_refused(tmp_path):
-    from labkit.grading.run.intake import is_class
+    from labkit.grading.lms.intake import is_class
 
     write_notebook(tmp_path / "mixed" / "alice" / "a.ipynb")
     write_notebook(tmp_path / "mixed" / "dave.ipynb")

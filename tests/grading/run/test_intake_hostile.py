@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from test_intake import notebook_text, zip_bytes
 
-from labkit.grading.run.intake import UnpackLimits, find_class
-from labkit.grading.run.lms_names import canvas_readings, resolve_canvas
+from labkit.grading.lms.canvas import canvas_readings, resolve_canvas
+from labkit.grading.lms.intake import UnpackLimits, find_class
 
 HONEST = {"alice": "1001", "bob": "1002"}
 LONG = "l" * 240 + ".ipynb"

@@ -1,0 +1,505 @@
+"""Canvas: its "Download Submissions", its gradebook export filled in, its "Re-upload submissions".
+
+The download names each file ``{name}[_LATE]_{user id}_{file id}_{display name}`` (canvas-lms's
+``lib/content_zipper.rb``; real names in mikewesthad/canvas-unzipper's README and canvas-lms issue #2406):
+``{name}`` is the sortable name lower-cased with all but letters, digits and ``_`` dropped (``lovelaceada``), the
+display name as uploaded; anonymous grading is assumed to write ``anon_{anonymous id}``. Both ends are the
+student's choice, so a name can have several readings (:func:`canvas_readings`); :func:`resolve_canvas` takes the
+one the user's other files confirm, else the one whose user is on the roster, else none, and says so. The files
+are grouped per user id, under their original names; the student is ``{name}`` (``{name}_{user id}`` for
+namesakes). A file uploaded again is renamed ``name-1.ext`` (students' reports: nus-cs2103 forum #361, IIC1253
+issue #26): of one name the newest only is kept, under the original name.
+
+The gradebook (Canvas's Instructor Guide, "How do I import grades in the Gradebook?"; canvas-lms's
+``lib/gradebook_importer.rb``): the student columns, closed by ``Section``; an assignment per column, ``Title
+(number)``; read-only totals; maybe a ``Muted`` row and the ``Points Possible`` row before the students. Canvas
+finds a student by ``ID``, ``SIS User ID`` or ``SIS Login ID``, and makes a **new assignment** of a header it does
+not know, so :func:`to_canvas` writes the export as it was with one assignment column filled in, and refuses a
+``--column`` that names none unless ``--new-column`` adds it on purpose.
+
+The feedback: "Re-upload submissions" reads the user and file ids as the download wrote them
+(``Assignment#infer_comment_context_from_filename``), so each page is ``{a file's download prefix}_feedback.html``.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from ...errors import InputError
+from ..store.report import SubmissionGrade, one_line
+from ..store.text import points_text
+from . import Lms
+from .exports import DEFAULT_COLUMN, Export, check_outputs, match, start, write, write_summary
+from .intake import entries, safe_part
+from .roster import csv_rows, first_row, read_roster, read_text
+
+KEYS = ("ID", "SIS User ID", "SIS Login ID")
+STUDENT_COLUMNS = ("Student", "ID", "SIS User ID", "SIS Login ID", "Integration ID", "Root Account", "Section")
+# headers the Canvas importer takes for totals, and ignores (a group's, and the "Unposted" ones, contain these)
+TOTALS = re.compile(
+    "Current Score|Current Points|Current Grade|Final Score|Final Points|Final Grade|"
+    "Override Score|Override Grade|Override Status"
+)
+TEST_STUDENT = "Student, Test"  # the row of the test student Canvas adds to every course ("Test Student")
+MAX_LISTED = 20  # assignment columns named in a message
+FIX = (
+    "give the file that Canvas's Grades > Export > Export Entire Gradebook downloads, as it is "
+    "(or saved from a spreadsheet as 'CSV UTF-8')."
+)
+REUPLOAD = re.compile(r"^(?P<stem>.+)-(?P<number>[1-9][0-9]?)(?P<ext>\.[^.]+)?$", re.DOTALL)
+_FIXED = re.compile(r"(?=(_LATE)?_([0-9]+)_([0-9]+)_(.))", re.DOTALL)
+_ANON = re.compile(r"^(LATE_)?(anon(?:ymous)?)(_LATE)?_([A-Za-z0-9]+)_([0-9]+)_(.+)$", re.DOTALL)
+_NOT_WORD = re.compile(r"\W")
+
+
+# ---------------------------------------------------------------------------------------------- whose file
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One reading of a Canvas file name: the name part, late or not, the user id, the file id, the display name."""
+
+    login: str
+    late: bool
+    uid: str
+    fid: str
+    file: str
+
+    @property
+    def prefix(self):
+        """What every file of this user starts with."""
+        return (self.login, self.late, self.uid)
+
+
+def canvas_readings(name: str) -> list[Reading]:
+    """Every reading of `name` as Canvas names a submission's file, shortest name part first.
+
+    >>> [(r.login, r.uid, r.file) for r in canvas_readings("ada_1001_9_lab.ipynb")]
+    [('ada', '1001', 'lab.ipynb')]
+    >>> [(r.login, r.uid) for r in canvas_readings("ada_1001_9_00_2002_77_x.ipynb")]
+    [('ada', '1001'), ('ada_1001_9_00', '2002')]
+    >>> [(r.login, r.uid, r.file) for r in canvas_readings("ada_LATE_1001_98765_02_convergence.ipynb")]
+    [('ada', '1001', '02_convergence.ipynb')]
+    >>> canvas_readings("Ada Lovelace.ipynb")
+    []
+    """
+    return list(_readings(name))
+
+
+@functools.lru_cache(maxsize=1 << 14)
+def _readings(name):
+    anon = _ANON.match(name)
+    if anon:
+        return (Reading(f"{anon[2]}_{anon[4]}", bool(anon[1] or anon[3]), anon[4], anon[5], anon[6]),)
+    stop = _NOT_WORD.search(name)
+    end = len(name) if stop is None else stop.start()  # the name part holds word characters only
+    found = []
+    for match_ in _FIXED.finditer(name):
+        at = match_.start()
+        if at > end:
+            break
+        login = name[:at]
+        if login != login.lower() or _padded(match_[2]) or _padded(match_[3]):
+            continue  # Canvas lower-cases the name, and writes its ids without leading zeros
+        found.append(Reading(login, bool(match_[1]), match_[2], match_[3], name[match_.end(3) + 1 :]))
+    return tuple(found)
+
+
+def _padded(number):
+    return len(number) > 1 and number.startswith("0")
+
+
+def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
+    """{file name: its Reading, or None when it is no one's} and notes for the instructor.
+
+    `names` are a download's file names; `roster_ids` the roster's ids (Canvas user ids), if any.
+
+    >>> names = ["ada_1001_5_a.ipynb", "ada_1001_7_hw_1_2_c.ipynb"]
+    >>> resolve_canvas(names)[0]["ada_1001_7_hw_1_2_c.ipynb"] is None  # user 1001, or user 1 named ada_1001_7_hw?
+    True
+    >>> chosen, notes = resolve_canvas(names, roster_ids=["1001"])
+    >>> chosen["ada_1001_7_hw_1_2_c.ipynb"].uid, len(notes)
+    ('1001', 1)
+    """
+    readings = {name: canvas_readings(name) for name in names}
+    settled: dict = {}  # user id -> the prefixes files without a second reading show it with
+    for found in readings.values():
+        if len(found) == 1:
+            settled.setdefault(found[0].uid, set()).add(found[0].prefix)
+    chosen: dict = {}
+    notes: list[str] = []
+    for name, found in readings.items():
+        chosen[name] = found[0] if len(found) == 1 else _choose(name, found, settled, set(roster_ids), notes)
+    return chosen, notes
+
+
+def _choose(name, found, settled, roster, notes):
+    if not found:
+        return None
+    shown = one_line(name, 120)
+    left = [r for r in found if r.uid not in settled or r.prefix in settled[r.uid]]
+    if len(left) > 1 and roster:
+        left = [r for r in left if r.uid in roster] or left
+    if len(left) == 1:
+        others = ", ".join(f"user {one_line(r.uid, 20)} ({one_line(r.login, 60)})" for r in found if r != left[0])
+        notes.append(
+            f"file {shown}: filed under user {one_line(left[0].uid, 20)} by its id; its name, which a student "
+            f"chooses, could also be read as {others}"
+        )
+        return left[0]
+    readings = ", ".join(f"user {one_line(r.uid, 20)} ({one_line(r.login, 60)})" for r in left or found)
+    notes.append(
+        f"file {shown}: filed to no one: its name, which a student chooses, reads as {readings}, and nothing "
+        "tells which (a --roster settles it when only one of those users is on it); ask the student to rename the "
+        "file, and grade it alone"
+    )
+    return None
+
+
+# ---------------------------------------------------------------------------------------------- the LMS
+
+
+class Canvas(Lms):
+    name = "canvas"
+    rank = 20
+    download = "Canvas's download"
+    counted = "file(s) named as Canvas names them"
+    keys = KEYS
+    steps = "upload it in Canvas: the assignment's SpeedGrader or Submissions page, 'Re-upload submissions'"
+
+    def claims(self, name, kind):
+        return kind == "file" and bool(canvas_readings(name))
+
+    def owners(self, tops, builder):
+        chosen, said = resolve_canvas([name for name, kind in tops if kind == "file"], builder.roster_ids)
+        builder.notes += said
+        builder.noted = True  # the files filed to no one are never unpacked: their notes are said here
+        owners = {name: None for name, _ in tops if canvas_readings(name)}
+        return owners | {name: ("canvas", r.uid) for name, r in chosen.items() if r is not None}
+
+    def shown(self, key):
+        return f"Canvas user {one_line(key[1], 40)}"
+
+    def students(self, root, builder, assignment):
+        groups: dict = {}  # user id -> {"logins", "late", "files": {original: [(number, path, given, fid)]}, "prefix"}
+        for name, (reading, path) in _files(root, builder).items():
+            group = groups.setdefault(reading.uid, {"logins": set(), "late": False, "files": {}})
+            group["logins"].add(reading.login)
+            group["late"] |= reading.late
+            original, number = reading.file, 0
+            if again := REUPLOAD.match(original):
+                original, number = again["stem"] + (again["ext"] or ""), int(again["number"])
+            group["files"].setdefault(original, []).append((number, path, reading.file, reading.fid))
+            group["prefix"] = name[: len(name) - len(reading.file) - 1]  # "{login}[_LATE]_{uid}_{fid}"
+        logins = [min(group["logins"]) for group in groups.values()]
+        students = []
+        for (uid, group), login in zip(groups.items(), logins):
+            if logins.count(login) > 1 or len(group["logins"]) > 1:  # namesakes: the user id parts them
+                said = f"{one_line(login, 80)} names several Canvas students: each is named {one_line(login, 60)}_ID"
+                builder.notes += [] if said in builder.notes else [said]
+                login = f"{login}_{uid}"
+            pieces = _pieces(login, group["files"], builder.notes)
+            student = builder.from_files(login, pieces, "canvas", uid, group["late"], key=("canvas", uid))
+            students.append(replace(student, lms_file=group["prefix"]))
+        return students
+
+    def feedback_names(self, name, entry):
+        """The download's prefix of one of the student's files, then ``_feedback.html``."""
+        prefix = str(entry.get("file") or "")
+        if not re.fullmatch(r"[^/\\\x00]+_\d+_\d+|anon\w*_[A-Za-z0-9]+_\d+", prefix):
+            raise InputError(f"no Canvas file of {one_line(name, 80)} is recorded")
+        return [f"{prefix}_feedback.html"]
+
+    def export(self, grades, roster, out, **options):
+        """:func:`to_canvas`, the gradebook given as ``gradebook=``."""
+        return to_canvas(grades, options.pop("gradebook"), roster, out, **options)
+
+
+def _files(root, builder):
+    """{file name as Canvas gave it: (its Reading, path)} of the download's files whose owner is settled."""
+    files = {}
+    for entry in entries(root):
+        name = builder.name(entry)
+        if entry.is_file(follow_symlinks=False) and not entry.is_symlink() and canvas_readings(name):
+            files[name] = Path(entry.path)
+        else:
+            builder.notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
+    chosen, said = resolve_canvas(files, builder.roster_ids)
+    builder.notes += [] if builder.noted else said
+    return {name: (reading, files[name]) for name, reading in chosen.items() if reading is not None}
+
+
+def _pieces(login, files, notes):
+    """[(name to give, path)] of one student's files: of a file uploaded again, the newest only."""
+    pieces = []
+    for original, versions in sorted(files.items()):
+        if not any(number == 0 for number, *_ in versions):
+            # no file of that very name: `part-1` and `part-2` may be two notebooks, not two uploads of one
+            pieces += [(Path(safe_part(given)), path) for _, path, given, _ in versions]
+            continue
+        versions.sort(key=lambda v: (int(v[3]), v[0]))  # file ids grow with each upload: the last is newest
+        number, path, given, _ = versions[-1]
+        if len(versions) > 1:
+            dropped = ", ".join(one_line(v[2], 80) for v in versions[:-1])
+            notes.append(
+                f"{one_line(login, 80)}: kept {one_line(given, 80)} (the newest upload) as "
+                f"{one_line(original, 80)}; older: {dropped}"
+            )
+        pieces.append((Path(safe_part(original)), path))
+    return pieces
+
+
+# ---------------------------------------------------------------------------------------------- the gradebook
+
+
+@dataclass
+class CanvasGradebook:
+    """A Canvas gradebook export, as read: its first row, every further row (each as long as the header, empty
+    lines empty), its separator and line ending, whether it had a byte-order mark, and the index of ``Section``."""
+
+    header: list
+    rows: list
+    delimiter: str
+    newline: str
+    bom: bool
+    section: int
+
+    def kind(self, row: list) -> str:
+        """``"points"`` for the Points Possible row, ``"muted"`` for a row that only marks hidden grades
+        (or an empty line), else ``"student"``."""
+        if row and "Points Possible" in row[0]:
+            return "points"
+        if all(re.fullmatch(r"\s*(Muted|Manual Posting.*)?\s*", cell, re.IGNORECASE) for cell in row):
+            return "muted"
+        return "student"
+
+    def points_row(self):
+        """The Points Possible row, or None."""
+        return next((row for row in self.rows if row and self.kind(row) == "points"), None)
+
+    def number(self, value):
+        """Points as Canvas writes them: a decimal comma where the cells are separated by semicolons."""
+        text = points_text(value)
+        return text.replace(".", ",") if self.delimiter == ";" else text
+
+
+def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
+    """A Canvas gradebook export (comma or semicolon separated, UTF-8, a byte-order mark allowed), checked to be
+    one: ValueError when it is not UTF-8 CSV, its header does not begin with ``Student``, ``ID`` or has no
+    ``Section`` closing the student columns, or a row has more cells than the header."""
+    text, bom, newline = read_text(path, "the Canvas gradebook", FIX)
+    for delimiter in (",", ";"):
+        if [cell.strip() for cell in first_row(text, delimiter)][:2] == ["Student", "ID"]:
+            break
+    else:
+        found = ", ".join(repr(one_line(c, 40)) for c in first_row(text, ",")[:6]) or "nothing"
+        raise InputError(
+            f"{path} is not a Canvas gradebook export: its header must begin with the columns 'Student' and "
+            f"'ID' (it begins with {found}); {FIX}"
+        )
+    rows = csv_rows(text, path, delimiter, FIX)
+    header = rows[0]
+    section = next((i for i, cell in enumerate(header) if cell.strip() == "Section"), None)
+    if section is None or any(cell.strip() not in STUDENT_COLUMNS for cell in header[:section]):
+        raise InputError(
+            f"{path} has no 'Section' column after the student columns (Student, ID, SIS User ID, SIS Login ID), "
+            f"which Canvas needs to import it; {FIX}"
+        )
+    width, body = len(header), []
+    for number, row in enumerate(rows[1:], start=2):
+        if row and len(row) > width and any(cell.strip() for cell in row[width:]):
+            raise InputError(
+                f"{path}, row {number} has {len(row)} cells but the header only {width}: a cell with an unquoted "
+                f"separator? {FIX}"
+            )
+        body.append(row[:width] + [""] * (width - len(row)) if row else row)
+    return CanvasGradebook(header, body, delimiter, newline, bom, section)
+
+
+def assignment_columns(book: CanvasGradebook) -> list[str]:
+    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only.
+
+    >>> book = CanvasGradebook(
+    ...     ["Student", "ID", "Section", "Quiz 1 (501)", "Current Score"],
+    ...     [["    Points Possible", "", "", "10", "(read only)"]], ",", "\\n", False, 2)
+    >>> assignment_columns(book)
+    ['Quiz 1 (501)']
+    """
+    points_row = book.points_row()
+    return [
+        cell.strip()
+        for i, cell in enumerate(book.header)
+        if i > book.section
+        and cell.strip()
+        and TOTALS.search(cell) is None
+        and not (points_row and "read only" in points_row[i].lower())
+    ]
+
+
+def _assignment_column(book, column, path):
+    """The index of the assignment column named `column` (with or without its Canvas number), or None."""
+    pattern = re.compile(re.escape(column.strip()) + r"(\s*\(\d+\))?")
+    found = [i for i, cell in enumerate(book.header) if i > book.section and pattern.fullmatch(cell.strip())]
+    if len(found) > 1:
+        names = ", ".join(repr(book.header[i]) for i in found)
+        raise InputError(
+            f"{path} has {len(found)} assignment columns named {column!r} ({names}); give the one to fill with its "
+            "number, e.g. --column " + repr(book.header[found[0]].strip()) + "."
+        )
+    return found[0] if found else None
+
+
+def _assignments_text(book):
+    """The gradebook's assignment columns in words, for a message: bounded, each name on one printable line."""
+    names = assignment_columns(book)
+    if not names:
+        return "it has no assignment column yet"
+    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
+    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
+    return f"its assignment columns are {shown}{more}"
+
+
+# ---------------------------------------------------------------------------------------------- the export
+
+
+def to_canvas(
+    grades: list[SubmissionGrade],
+    gradebook: str | os.PathLike,
+    roster: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    column: str = DEFAULT_COLUMN,
+    key: str = "ID",
+    new_column: bool = False,
+    force: bool = False,
+) -> Export:
+    """Fill one assignment column of the Canvas `gradebook` export with the grades' totals, into `out` (and its
+    summary), matching students through `roster` on the gradebook's `key` column.
+
+    `column` is the assignment's title, with or without Canvas's ``(number)``. A title the gradebook lacks is
+    refused (a typo would become a new assignment in Canvas), unless `new_column` adds it at the end, worth the
+    rubric's full credit; `new_column` with a title it has is refused too (Canvas would fill that assignment).
+    `force` replaces an existing `out`. ValueError (and nothing written) for bad input, a `key` the export lacks,
+    two rows with one id, an ambiguous or read-only column, no student matched, or an output that is an input.
+    """
+    if key not in KEYS:
+        raise InputError(f"--key for Canvas is one of {', '.join(KEYS)} (a gradebook column); got {key!r}.")
+    by_name, export = start(grades, out, "Canvas", column)
+    entries_ = read_roster(roster)
+    book = read_canvas(gradebook)
+    check_outputs(export, [gradebook, roster], force)
+    at_key = _key_column(book, key, gradebook)
+    full_credit = by_name[next(iter(by_name))].rubric.full_credit
+    target = _target(book, export, gradebook, full_credit, new_column)
+    students = _students_by_key(book, at_key, key, gradebook, entries_, export)
+    matched = match(export, by_name, entries_, students)
+    if not matched:
+        raise InputError(
+            f"no submission of the results matched a row of {gradebook} through the roster {roster}: are the "
+            f"roster's ids the gradebook's {key!r} values (--key), and its submissions the names in grades.csv?"
+        )
+    roster_ids = set(entries_.values())
+    for value, row in students.items():
+        name = matched.get(value)
+        if name is None:
+            if value not in roster_ids:  # a roster entry without a submission is listed as such
+                export.lms_only.append((row[0].strip(), value))
+        elif by_name[name].graded:
+            row[target] = book.number(by_name[name].total)
+            export.exported[name] = (value, by_name[name].total)
+    if any(total > full_credit for _, total in export.exported.values()):
+        export.notes.append(
+            f"note: some totals are above full credit ({points_text(full_credit)}) with extra credit; "
+            "Canvas takes them as they are."
+        )
+    write([book.header, *book.rows], out, delimiter=book.delimiter, newline=book.newline, bom=book.bom)
+    write_summary(export, entries_, by_name)
+    return export
+
+
+def _key_column(book, key, path):
+    """The index of the `key` column among the gradebook's student columns."""
+    header = [cell.strip() for cell in book.header]
+    if key not in header[: book.section]:
+        raise InputError(
+            f"{path} has no {key!r} column (its student columns are {', '.join(header[: book.section + 1])}); "
+            "export the gradebook with that column, or match the roster on another with --key."
+        )
+    return header.index(key)
+
+
+def _target(book, export, path, full_credit, new_column):
+    """The index of the assignment column to fill: the export's column, or a new one at the end."""
+    column = export.column
+    if TOTALS.search(column) or column.strip() in STUDENT_COLUMNS:
+        raise InputError(
+            f"Canvas reads a column named {column!r} as a student column or a total, never as an assignment; "
+            "give the assignment another name with --column."
+        )
+    target = _assignment_column(book, column, path)
+    if target is None and not new_column:
+        raise InputError(
+            f"{path} has no assignment column named {column!r}; {_assignments_text(book)}. Give one of them with "
+            "--column (its title, with or without the number), or pass --new-column to add a column of that name "
+            "on purpose (Canvas then creates a new assignment when the file is imported)."
+        )
+    if target is not None and new_column:
+        raise InputError(
+            f"{path} already has the assignment column {one_line(book.header[target], 80)!r}, which "
+            f"--column {column!r} names (Canvas would fill that assignment, not make a new one): leave out "
+            "--new-column to fill it, or give the new assignment another name with --column."
+        )
+    if target is None:
+        book.header.append(column)
+        for row in book.rows:
+            if row:
+                row.append(book.number(full_credit) if book.kind(row) == "points" else "")
+        return len(book.header) - 1
+    export.column = book.header[target]
+    points_row = book.points_row()
+    possible = points_row[target].strip() if points_row else ""
+    if "read only" in possible.lower():
+        raise InputError(
+            f"the column {book.header[target]!r} of {path} is read-only in Canvas (a total); "
+            "give an assignment's column with --column."
+        )
+    try:
+        differs = possible and float(possible.replace(",", ".")) != full_credit
+    except ValueError:
+        differs = False
+    if differs:
+        export.notes.append(
+            f"note: {book.header[target]!r} is worth {possible} points in Canvas, the rubric's full credit is "
+            f"{points_text(full_credit)}: the totals are written as they are."
+        )
+    return target
+
+
+def _students_by_key(book, at_key, key, path, roster, export):
+    """{the key's value: its row} of the gradebook's students; Canvas's test student and a row without the key
+    are listed in `export`."""
+    students: dict = {}
+    rows_of: dict = {}
+    for number, row in enumerate(book.rows, start=2):
+        if not row or book.kind(row) != "student":
+            continue
+        value = row[at_key].strip()
+        if value in students:
+            raise InputError(
+                f"{path} has two rows with {key} {one_line(value, 60)!r} (rows {rows_of[value]} and "
+                f"{number}); export the gradebook again, or match on another column with --key."
+            )
+        if row[0].strip() == TEST_STUDENT and value not in set(roster.values()):
+            export.notes.append(f"note: Canvas's test student ({TEST_STUDENT!r}) is in the gradebook; left as it is.")
+        elif not value:  # a student without this id: no roster entry can name it
+            export.lms_only.append((row[0].strip(), ""))
+        else:
+            students[value], rows_of[value] = row, number
+    return students
+
+
+LMS = Canvas()

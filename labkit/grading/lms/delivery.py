@@ -1,0 +1,64 @@
+"""Feedback back to the students through the LMS, with no server: ``labkit feedback OUT`` writes
+``OUT/feedback-upload.zip``, each student's ``feedback.html`` named as the LMS the class came from names it
+(:meth:`~labkit.grading.lms.Lms.feedback`). The run's record knows the layout the class came in and what
+names each student's files there (:func:`remember`, called by ``labkit grade``).
+"""
+
+from __future__ import annotations
+
+import zipfile
+from pathlib import Path
+
+from ..store import feedback as feedbacks
+from ..store import record as records
+from ..store.report import one_line, read_results
+from . import named
+
+UPLOAD = "feedback-upload.zip"
+
+
+def remember(out, intake) -> None:
+    """Enter in `out`'s run record the layout the class came in and each student's names in the LMS
+    (`intake`, an :class:`~labkit.grading.lms.intake.Intake`); a resumed run's earlier students are kept."""
+    record = records.read(out)
+    earlier = record.delivery.get("students", {}) if record.delivery.get("layout") == intake.layout else {}
+    lms = named(intake.layout)
+    students = {**earlier, **{s.name: lms.remember(s) for s in intake.students}}
+    record.delivery = {"layout": intake.layout, "students": students}
+    records.write(out, record)
+
+
+def write_upload(out, layout=None) -> tuple[Path, list[str], list[str]]:
+    """``OUT/feedback-upload.zip`` of a run: (its path, the members written, notes on students left out).
+
+    `layout` overrides the recorded one (``folders`` for a run that recorded none)."""
+    out = Path(out)
+    layout = layout_of(out, layout)
+    lms = named(layout)
+    students = records.read(out).delivery.get("students", {})
+    grades = read_results([out])
+    members, notes = [], [f"not read: {one_line(p, 200)}: {one_line(w, 300)}" for p, w in grades.refused]
+    path = out / UPLOAD
+    partial = path.with_name(f".{path.name}.partial")
+    with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
+        for grade in grades:
+            try:
+                files = lms.feedback(grade.name, students.get(grade.name, {}), feedbacks.html(feedbacks.build(grade)))
+            except ValueError as exc:
+                notes.append(f"{one_line(grade.name, 80)} left out: {exc} (was the class graded as {layout}?)")
+                continue
+            for member, text in files.items():
+                archive.writestr(member, text)
+            members += files
+    partial.replace(path)
+    return path, members, notes
+
+
+def steps(layout: str) -> str:
+    """How the instructor hands the feedback zip of `layout` to the LMS."""
+    return named(layout).steps
+
+
+def layout_of(out, layout=None):
+    """The layout `labkit feedback` names the files for: `layout`, else the run's recorded one, else folders."""
+    return layout or records.read(out).delivery.get("layout") or "folders"

@@ -1,0 +1,211 @@
+"""Grades into the LMS: what every LMS's export shares; its own file is its module's (:func:`.canvas.to_canvas`,
+:func:`.moodle.to_moodle`; :func:`export` by the LMS's name).
+
+An export writes, for each student the roster (:mod:`.roster`) matches, the **total under the rubric**
+(``grades.csv``'s ``total``); a submission that could not be graded gets no number, never a zero. Nothing is
+dropped silently: every student who got nothing is listed (:meth:`Export.problems`) and in a summary CSV beside
+the output, with the total of every graded submission, to enter by hand. Bad input raises a ValueError saying
+what to fix, and nothing is written; the output never replaces an input, nor an existing file unless ``force``,
+and is renamed into place when complete.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ...errors import InputError
+from ..store.report import FORMULA_START, SubmissionGrade, csv_cell, one_line
+from ..store.text import points_text
+from . import named
+
+DEFAULT_COLUMN = "labkit"
+SUMMARY_HEADER = ["submission", "id", "points", "status"]
+
+
+@dataclass
+class Export:
+    """What an export wrote (`path`, for the LMS `lms`, the points in `column`; `summary_path`) and what it could
+    not match: `exported` {submission: (id, points)}; `not_graded` {submission: why}; `not_in_roster`
+    [submission]; `no_submission`, roster entries without a result, and `not_in_lms`, those no gradebook row has,
+    [(submission, id)]; `lms_only`, gradebook rows with no roster entry, [(name, id)]; `notes` needing no action."""
+
+    path: Path
+    summary_path: Path
+    lms: str
+    column: str
+    exported: dict = field(default_factory=dict)
+    not_graded: dict = field(default_factory=dict)
+    not_in_roster: list = field(default_factory=list)
+    no_submission: list = field(default_factory=list)
+    not_in_lms: list = field(default_factory=list)
+    lms_only: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+
+    @property
+    def listed(self) -> int:
+        """How many students need the instructor's attention (each is in :meth:`problems`)."""
+        names = set(self.not_graded) | set(self.not_in_roster)
+        names |= {name for name, _ in self.no_submission + self.not_in_lms}
+        return len(names) + len(self.lms_only)
+
+    def problems(self) -> list[str]:
+        """One printable line per student who got no points from this export, and why.
+
+        >>> e = Export(Path("g.csv"), Path("g-summary.csv"), "Moodle", "labkit", not_in_roster=["ada\\x1b[2J"])
+        >>> e.problems()
+        ['no roster entry, nothing exported: ada\\ufffd[2J']
+        """
+        gradebook = f"the {self.lms} gradebook"
+        lines = [
+            f"not graded, no points exported: {one_line(name, 80)} ({one_line(reason, 200)})"
+            for name, reason in self.not_graded.items()
+        ]
+        lines += [f"no roster entry, nothing exported: {one_line(name, 80)}" for name in self.not_in_roster]
+        for what, pairs in (("no submission", self.no_submission), (f"not in {gradebook}", self.not_in_lms)):
+            lines += [f"in the roster, {what}: {one_line(n, 80)} (id {one_line(k, 60)})" for n, k in pairs]
+        lines += [
+            f"in {gradebook}, not in the roster: {one_line(name, 80)} (id {one_line(key, 60) or 'none'})"
+            for name, key in self.lms_only
+        ]
+        return lines
+
+    def summary(self) -> str:
+        """What was written, in a few lines for a terminal."""
+        lines = [
+            f"wrote {self.path}: the totals of {len(self.exported)} student(s) in the column "
+            f"{one_line(self.column, 80)!r}, for {self.lms}'s grade import",
+        ]
+        if self.listed:
+            lines.append(
+                f"{self.listed} student(s) got nothing from this file (listed above, and in {self.summary_path}): "
+                "enter their grades by hand or fix the roster and export again"
+            )
+        else:
+            lines.append(f"every submission and roster entry matched; the summary is in {self.summary_path}")
+        return "\n".join(lines + self.notes)
+
+
+def export(layout: str, grades: list[SubmissionGrade], roster, out, **options) -> Export:
+    """Write `grades` for the grade import of the LMS named `layout` (its :meth:`~labkit.grading.lms.Lms.export`)."""
+    return named(layout).export(grades, roster, out, **options)
+
+
+def default_file(results_dir: str | os.PathLike, lms: str) -> Path:
+    """Where ``labkit export`` writes when not told: ``<folder>-<lms>.csv`` beside the run's ``--out`` folder.
+
+    >>> default_file("/course/grades", "canvas").as_posix()
+    '/course/grades-canvas.csv'
+    """
+    folder = Path(results_dir).resolve()
+    return folder.with_name(f"{folder.name}-{lms}.csv")
+
+
+def summary_file(path: str | os.PathLike) -> Path:
+    """The summary CSV that goes with an export file.
+
+    >>> summary_file("/course/grades-canvas.csv").as_posix()
+    '/course/grades-canvas-summary.csv'
+    """
+    path = Path(path)
+    return path.with_name(f"{path.stem}-summary.csv")
+
+
+def start(grades, out, lms, column):
+    """({submission: grade}, the Export to fill) once `column` and `grades` are checked."""
+    if not isinstance(column, str) or not column.strip() or column != one_line(column, 200):
+        raise InputError(
+            f"the column name {one_line(column, 80)!r} must be one line of text, at most 200 characters; "
+            "give the assignment's name with --column."
+        )
+    if column.startswith(FORMULA_START):
+        raise InputError(
+            f"the column name {column!r} starts like a spreadsheet formula ({column[0]!r}); give the assignment "
+            "another name with --column."
+        )
+    by_name = {}
+    for grade in grades:
+        if not isinstance(grade, SubmissionGrade):
+            raise InputError(f"expected the grades of a grading run (read_results), got {type(grade).__name__}.")
+        by_name[grade.name] = grade
+    if not by_name:
+        raise InputError("there are no grades to export: give the --out folder of a `labkit grade` run.")
+    return by_name, Export(Path(out), summary_file(out), lms, column)
+
+
+def check_outputs(export, inputs, force):
+    """ValueError when the export's files would replace an input, or an existing file without `force`."""
+    for path in (export.path, export.summary_path):
+        for source in inputs:
+            if path.resolve() == Path(source).resolve():
+                raise InputError(
+                    f"{path} is an input of this export; it is never overwritten: give --out another file name."
+                )
+        if not path.parent.is_dir():
+            raise InputError(f"the folder {path.parent} does not exist: create it, or give --out another path.")
+        if path.exists() and not force:
+            raise InputError(
+                f"{path} already exists (an earlier export?); give --out another file name, or --force to replace it."
+            )
+
+
+def match(export, by_name, roster, rows=None):
+    """{id: submission} of the roster's entries with a submission (and, given the gradebook's `rows` by id, a row);
+    the others listed in `export`."""
+    for name, grade in by_name.items():
+        if name not in roster:
+            export.not_in_roster.append(name)
+        if not grade.graded:
+            export.not_graded[name] = grade.failure
+    matched = {}
+    for name, value in roster.items():
+        if name not in by_name:
+            export.no_submission.append((name, value))
+        elif rows is not None and value not in rows:
+            export.not_in_lms.append((name, value))
+        else:
+            matched[value] = name
+    return matched
+
+
+def write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
+    """Write `rows` as CSV: to a temporary file beside `path`, renamed into place when complete."""
+    path = Path(path)
+    handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
+        "w", encoding="utf-8", newline="", dir=path.parent, prefix=f".{path.name}.", suffix=".tmp", delete=False
+    )
+    try:
+        with handle:
+            if bom:
+                handle.write("\ufeff")
+            csv.writer(handle, delimiter=delimiter, lineterminator=newline).writerows(rows)
+        os.replace(handle.name, path)
+    except BaseException:
+        Path(handle.name).unlink(missing_ok=True)
+        raise
+
+
+def write_summary(export, roster, by_name):
+    """The summary beside the export: a row per submission, per roster entry without a submission, per
+    unmatched gradebook row."""
+    rows = [SUMMARY_HEADER]
+    missing_in_lms = {name for name, _ in export.not_in_lms}
+    for name, grade in by_name.items():
+        status = []
+        if not grade.graded:
+            status.append(f"not graded: {grade.failure}")
+        if name not in roster:
+            status.append("no roster entry")
+        elif name in missing_in_lms:
+            status.append(f"not in the {export.lms} gradebook")
+        points = points_text(grade.total) if grade.graded else ""
+        rows.append([csv_cell(name), csv_cell(roster.get(name, "")), points, csv_cell("; ".join(status) or "exported")])
+    for name, key in export.no_submission:
+        rows.append([csv_cell(name), csv_cell(key), "", "no submission (in the roster)"])
+    for name, key in export.lms_only:
+        status = f"in the {export.lms} gradebook ({one_line(name, 80)}), not in the roster"
+        rows.append(["", csv_cell(key), "", csv_cell(status)])
+    write(rows, export.summary_path)

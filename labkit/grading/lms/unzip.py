@@ -1,0 +1,311 @@
+"""The safe unzip: what a hostile zip does (leave the folder, links, devices, bombs) refused, on a budget per
+student (:class:`Budget`, which the class intake keeps for each student)."""
+
+from __future__ import annotations
+
+import copy
+import os
+import re
+import shutil
+import stat
+import zipfile
+import zlib
+from contextlib import suppress
+from dataclasses import dataclass
+from pathlib import Path
+
+from ...errors import InputError
+from ..store.report import one_line
+
+MAX_NAME = 255  # bytes of one file or folder name in a zip (what file systems take)
+RATIO_FLOOR = 1 << 20  # the compression ratio is checked for members that grow past this many bytes
+CHUNK = 1 << 16
+UNREADABLE = (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError)
+
+
+@dataclass(frozen=True)
+class UnpackLimits:
+    """What :func:`unpack` extracts at most from one zip and the zips in it; in the class intake, what one
+    student's files and zips may hold in all: bytes (512 MiB), members, folders included (2000), the ratio of
+    uncompressed to compressed size of a member that grows past 1 MiB (100), bytes of one member (64 MiB), levels
+    of zips inside the zip (2: a zip in a zip in the zip).
+
+    >>> UnpackLimits().max_members, UnpackLimits(max_depth=0).max_depth
+    (2000, 0)
+    """
+
+    max_total: int = 512 << 20
+    max_members: int = 2000
+    max_ratio: float = 100.0
+    max_member: int = 64 << 20
+    max_depth: int = 2
+
+    def __post_init__(self):
+        for name in ("max_total", "max_members", "max_member", "max_ratio"):
+            if not getattr(self, name) > 0:
+                raise InputError(f"UnpackLimits.{name} must be positive, not {getattr(self, name)!r}.")
+        if self.max_depth < 0:
+            raise InputError(f"UnpackLimits.max_depth must be 0 or more, not {self.max_depth!r}.")
+
+
+LIMITS = UnpackLimits()
+
+
+@dataclass
+class Budget:
+    """What one student (or one :func:`unpack` call) has spent, nested zips included; ``in_class``: the student's
+    files came in the class zip (counted as they were unpacked)."""
+
+    limits: UnpackLimits
+    members: int = 0
+    total: int = 0
+    in_class: bool = False
+
+
+def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS) -> list[Path]:
+    """Extract `zip_path` into the folder `into`, refusing whatever could harm, and return the files written.
+
+    A member whose name is absolute, has a drive letter or a ``..``, a link, a device, and whatever breaks
+    `limits` (counted on the bytes really decompressed; the sizes a zip declares are checked first, never
+    trusted) refuse the zip: ValueError naming it and the rule, after removing what this call wrote. A zip inside
+    is unpacked in its place (``work.zip`` into a folder ``work``) on the same budget; ``__MACOSX/`` is skipped.
+    Nothing is written outside `into`, and no existing file is overwritten.
+
+    >>> import pathlib, tempfile, zipfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> with zipfile.ZipFile(folder / "work.zip", "w") as z:
+    ...     z.writestr("lab/02_convergence.ipynb", "{}")
+    >>> [p.relative_to(folder).as_posix() for p in unpack(folder / "work.zip", folder / "out")]
+    ['out/lab/02_convergence.ipynb']
+    >>> with zipfile.ZipFile(folder / "evil.zip", "w") as z:
+    ...     z.writestr("../evil.ipynb", "{}")
+    >>> unpack(folder / "evil.zip", folder / "out2")
+    Traceback (most recent call last):
+    ...
+    labkit.errors.InputError: evil.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
+    """
+    return unpack_into(zip_path, into, limits)
+
+
+def unpack_into(zip_path, into, limits, depth=0, budget=None):
+    """:func:`unpack` at `depth` levels of zips in, on `budget` (a student's, shared by all their zips)."""
+    into = Path(into)
+    created_root = None if os.path.lexists(into) else into
+    while created_root is not None and not os.path.lexists(created_root.parent):
+        created_root = created_root.parent  # the first folder this call creates, removed again on failure
+    written: list[Path] = []
+    made: list[Path] = []
+    try:
+        if created_root is not None:
+            into.mkdir(parents=True)
+        elif not stat.S_ISDIR(os.lstat(into).st_mode):
+            raise InputError(f"{into} is not a folder to unpack into.")
+        budget = budget if budget is not None else Budget(limits)
+        _unpack(Path(zip_path), into, budget, depth, written, made, as_text(Path(zip_path).name))
+    except BaseException:
+        undo(created_root, written, made)
+        raise
+    return sorted(p for p in written if os.path.lexists(p))
+
+
+def undo(root, written, made):
+    """Remove what a refused unzip wrote: the folder `root` it created, else its files and folders."""
+    if root is not None:
+        shutil.rmtree(root, ignore_errors=True)
+        return
+    for remove, paths in ((os.unlink, written), (os.rmdir, made)):
+        for path in reversed(paths):
+            with suppress(OSError):
+                remove(path)
+
+
+def open_zip(path, label):
+    """The zip `path`, opened; ValueError naming `label` when it is none labkit can read."""
+    try:
+        return zipfile.ZipFile(path)
+    except UNREADABLE as exc:
+        raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
+
+
+def member_parts(name, label, skip=0):
+    """The parts of a member's name, or ValueError when it would leave the folder (or a part past the first
+    `skip` is longer than a file system takes)."""
+    shown = one_line(name, 120)
+    text = name.replace("\\", "/")
+    if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
+        raise InputError(f"{label}: member {shown!r} has an absolute path; labkit never extracts it.")
+    parts = [p for p in text.split("/") if p not in ("", ".")]
+    if ".." in parts:
+        raise InputError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
+    if any(len(p.encode("utf-8", "surrogateescape")) > MAX_NAME for p in parts[skip:]):
+        raise InputError(
+            f"{label}: member {shown!r} has a name longer than {MAX_NAME} bytes, more than a file system "
+            "takes; rename it shorter."
+        )
+    return parts
+
+
+def _unpack(zip_path, into, budget, depth, written, made, label):
+    limits = budget.limits
+    if depth > limits.max_depth:
+        raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
+    with open_zip(zip_path, label) as archive:
+        infos = archive.infolist()
+        budget.members += len(infos)
+        if budget.members > limits.max_members:
+            raise InputError(
+                f"{label}: more than {limits.max_members} members; labkit extracts at most {limits.max_members} "
+                "for one student."
+            )
+        plan = checked(infos, budget, label)
+        inner = []
+        for info, parts, is_dir, shown in plan:
+            target = into.joinpath(*parts)
+            make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
+            if is_dir:
+                continue
+            extract(archive, info, target, budget, label, shown, written)
+            if target.suffix.lower() == ".zip":
+                inner.append((target, shown))
+    for target, shown in inner:
+        if depth + 1 > limits.max_depth:
+            raise InputError(
+                f"{label}: member {shown!r} is a zip nested more than {limits.max_depth} deep; "
+                "labkit never extracts deeper."
+            )
+        folder = free(target.with_suffix(""))
+        folder.mkdir()
+        made.append(folder)
+        _unpack(target, folder, budget, depth + 1, written, made, f"{label}/{shown}")
+        os.unlink(target)
+        written.remove(target)
+
+
+def checked(infos, budget, label, parts_of=None):
+    """[(info, parts, is_dir, shown)] of the members `infos` to extract, after every check that their names and
+    declared sizes allow on `budget` (ValueError naming the first that fails)."""
+    plan, seen, declared = [], set(), 0
+    for info in infos:
+        parts = member_parts(info.filename, label) if parts_of is None else parts_of(info)
+        is_dir = _member_kind(info, label)
+        if not parts or parts[0] == "__MACOSX":
+            continue
+        shown, key = one_line(info.filename, 120), "/".join(parts)
+        if key in seen:
+            raise InputError(f"{label}: member {shown!r} appears twice; labkit extracts each name once.")
+        seen.add(key)
+        if not is_dir:
+            declared += _declared(info, label, shown, budget.limits)
+            if budget.total + declared > budget.limits.max_total:
+                raise InputError(
+                    f"{label}: more than {size_text(budget.limits.max_total)} uncompressed; "
+                    f"labkit extracts at most {size_text(budget.limits.max_total)} for one student."
+                )
+        plan.append((info, parts, is_dir, shown))
+    return plan
+
+
+def _member_kind(info, label):
+    """Whether the member is a folder; ValueError for a link, a device, a pipe or an encrypted member."""
+    shown = one_line(info.filename, 120)
+    mode = info.external_attr >> 16
+    kind = stat.S_IFMT(mode)
+    if stat.S_ISLNK(mode):
+        raise InputError(f"{label}: member {shown!r} is a symbolic link; labkit never extracts links.")
+    if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
+        raise InputError(f"{label}: member {shown!r} is a device or a pipe; labkit never extracts those.")
+    if info.flag_bits & 0x1:
+        raise InputError(f"{label}: member {shown!r} is encrypted; labkit cannot read it.")
+    return info.is_dir() or kind == stat.S_IFDIR
+
+
+def _declared(info, label, shown, limits):
+    if info.file_size > limits.max_member:
+        raise InputError(
+            f"{label}: member {shown!r} is larger than {size_text(limits.max_member)} "
+            f"({size_text(info.file_size)}); labkit extracts at most {size_text(limits.max_member)} a file."
+        )
+    _check_ratio(label, shown, info.file_size, info.compress_size, limits)
+    return info.file_size
+
+
+def _check_ratio(label, shown, size, compressed, limits):
+    if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
+        raise InputError(
+            f"{label}: member {shown!r} is compressed more than {limits.max_ratio:g} times (a zip bomb?); "
+            f"labkit never extracts it."
+        )
+
+
+def make_dirs(into, parts, made, label, shown):
+    folder = into
+    for part in parts:
+        folder = folder / part
+        try:
+            os.mkdir(folder)
+            made.append(folder)
+        except FileExistsError:
+            if not stat.S_ISDIR(os.lstat(folder).st_mode):
+                raise InputError(f"{label}: member {shown!r} is inside a file of the zip; labkit refuses it.") from None
+        except OSError as exc:
+            raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+
+
+def extract(archive, info, target, budget, label, shown, written):
+    limits = budget.limits
+    try:
+        descriptor = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o600)
+    except OSError as exc:
+        raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+    written.append(target)
+    size = 0
+    # Read as if the member were larger than any limit, so that the bytes it really holds are counted
+    # (zipfile would stop at the size it declares); the declared size is then checked against them.
+    probe = copy.copy(info)
+    probe.file_size = max(info.file_size, limits.max_member, limits.max_total) + 1
+    try:
+        with os.fdopen(descriptor, "wb") as out, archive.open(probe) as source:
+            while chunk := source.read(CHUNK):
+                size += len(chunk)
+                if size > limits.max_member:
+                    raise InputError(
+                        f"{label}: member {shown!r} grows past {size_text(limits.max_member)} while extracting; "
+                        f"labkit extracts at most {size_text(limits.max_member)} a file."
+                    )
+                if budget.total + size > limits.max_total:
+                    raise InputError(
+                        f"{label}: more than {size_text(limits.max_total)} uncompressed while extracting; "
+                        f"labkit extracts at most {size_text(limits.max_total)} for one student."
+                    )
+                _check_ratio(label, shown, size, info.compress_size, limits)
+                out.write(chunk)
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
+        raise InputError(f"{label}: member {shown!r} cannot be read ({one_line(exc, 120)}).") from None
+    if size != info.file_size:
+        raise InputError(
+            f"{label}: member {shown!r} declares {info.file_size} bytes but holds {size}; labkit refuses the zip."
+        )
+    budget.total += size
+
+
+def free(path):
+    """`path`, or the first of ``path~1``, ``path~2``… that does not exist."""
+    candidate, number = path, 0
+    while os.path.lexists(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.name}~{number}")
+    return candidate
+
+
+def size_text(n):
+    """Bytes for a person: ``512 bytes``, ``64 MiB``."""
+    for unit in ("bytes", "KiB", "MiB"):
+        if n < 1024:
+            return f"{n:g} {unit}" if unit == "bytes" else f"{n:.4g} {unit}"
+        n /= 1024
+    return f"{n:.4g} GiB"
+
+
+def as_text(name):
+    """A file name as text: bytes that are not UTF-8 spelled out as escapes (as scoring names submissions)."""
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
