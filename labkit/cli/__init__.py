@@ -15,6 +15,8 @@ Each command is a module of this package declaring its options (``add``) and doi
 the options several commands take are declared once in :mod:`labkit.cli.options`. A command's
 :class:`~labkit.errors.InputError` is the user's to fix: :func:`main` prints it and exits 2. Any other
 exception is a bug in labkit: :func:`main` says so in one line and exits 1 (``LABKIT_TRACEBACK=1`` shows it).
+A handler imports the grader's modules when it runs, so that ``labkit notebooks`` and ``labkit handin`` work
+without the ``[grade]`` extra.
 """
 
 import os
@@ -80,7 +82,7 @@ def main(argv=None):
     try:
         return args.handler(args)
     except Exception as exc:  # the user's errors are told apart from labkit's bugs below
-        if os.environ.get(TRACEBACK) and not _users(exc):
+        if os.environ.get(TRACEBACK, "0") != "0" and not _users(exc):
             raise
         return _failed(args.command, exc)
 
