@@ -82,7 +82,7 @@ def main(argv=None):
     try:
         return args.handler(args)
     except Exception as exc:  # the user's errors are told apart from labkit's bugs below
-        if os.environ.get(TRACEBACK, "0") != "0" and not _users(exc):
+        if os.environ.get(TRACEBACK, "") not in ("", "0") and not _users(exc):
             raise
         return _failed(args.command, exc)
 
