@@ -5,8 +5,8 @@ import argparse
 
 import pytest
 
-from labkit._cli_parser import Parser
 from labkit.cli import build_parser
+from labkit.cli.parser import Parser
 
 
 def subcommands():

@@ -237,7 +237,9 @@ def test_the_grading_modules_reach_a_sandbox_only_through_the_interface():
     """remote.py and the run's modules name no backend module, only the registry and the base interface."""
     run = sorted(path.relative_to(LABKIT / "grading").as_posix() for path in (LABKIT / "grading" / "run").glob("*.py"))
     assert "run/processes.py" in run and "run/engines.py" in run
-    for name in ("sandbox/remote.py", *run, "submission/scoring.py", "sandbox/worker.py", "options.py", "../cli.py"):
+    cli = sorted(f"../cli/{path.name}" for path in (LABKIT / "cli").glob("*.py"))
+    assert "../cli/grade.py" in cli
+    for name in ("sandbox/remote.py", *run, "submission/scoring.py", "sandbox/worker.py", "options.py", *cli):
         code, _ = _code_and_text(LABKIT / "grading" / name)
         assert not re.search(r"backends \. (bwrap|none)\b|backends import (bwrap|none)\b", code), name
 
