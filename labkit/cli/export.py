@@ -29,6 +29,11 @@ def add(commands):
         help="the course's gradebook as Canvas exports it (Grades > Export); it is read, never changed",
     )
     lms_choice.add_argument("--moodle", action="store_true", help="write a CSV for Moodle's 'Import grades from CSV'")
+    lms_choice.add_argument(
+        "--lms",
+        metavar="NAME",
+        help="write the grade import of another LMS: the name of its module added to labkit/grading/lms/",
+    )
     options.roster(
         parser,
         "CSV with the columns submission (the names in grades.csv) and id (the student's id in the LMS)",
@@ -84,7 +89,10 @@ def handle(args):
     # the run's recorded rubric (late rule included): what is exported is grades.csv's total
     grades = read_results([args.results], rubric_for([args.results], args.rubric, "labkit export"))
     refused(grades, "labkit export")
-    export = _to_canvas(args, grades) if args.canvas is not None else _to_moodle(args, grades)
+    if args.lms is not None:
+        export = _to_other(args, grades)
+    else:
+        export = _to_canvas(args, grades) if args.canvas is not None else _to_moodle(args, grades)
     for line in export.problems():
         print(f"labkit export: {line}", file=sys.stderr)
     print(export.summary())
@@ -118,3 +126,10 @@ def _to_moodle(args, grades):
         feedback=args.feedback,
         force=args.force,
     )
+
+
+def _to_other(args, grades):
+    from ..grading.lms import exports
+
+    out = args.out or exports.default_file(args.results, args.lms)
+    return exports.export(args.lms, grades, args.roster, out, force=args.force)

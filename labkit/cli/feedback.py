@@ -18,8 +18,9 @@ def add(commands):
     options.run_folder(parser)
     parser.add_argument(
         "--layout",
-        choices=["canvas", "moodle", "folders", "nbgrader"],
-        help="name the files for this layout instead of the one the run recorded",
+        metavar="LMS",
+        help="name the files for this LMS instead of the one the run recorded: canvas, moodle, folders, nbgrader, "
+        "or the name of an LMS module added to labkit/grading/lms/",
     )
     parser.set_defaults(handler=handle)
 

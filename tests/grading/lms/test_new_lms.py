@@ -11,6 +11,7 @@ import nbformat
 import pytest
 
 import labkit.grading.lms as lms
+from labkit import cli
 from labkit.grading.lms import delivery, exports
 from labkit.grading.lms.intake import find_class
 from labkit.grading.store.report import SubmissionGrade, read_results, write_report
@@ -138,6 +139,34 @@ def test_intake_recognises_its_download_and_feedback_and_export_find_it(toy, tmp
     with open(tmp_path / "toy.csv", encoding="utf-8", newline="") as handle:
         assert list(csv.reader(handle)) == [["username", "points"], ["ada", "10.0"], ["bob", "10.0"]]
     assert export.listed == 0 and export.exported == {"ada": ("ada", 10.0), "bob": ("bob", 10.0)}
+
+
+def test_the_command_line_takes_it_by_name(toy, tmp_path):
+    out = tmp_path / "grades"
+    write_report(out, [SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}})])
+    delivery.remember(out, find_class(_toy_class(tmp_path), tmp_path / "work"))
+    assert cli.main(["feedback", out, "--layout", "toy"]) == 0
+    with zipfile.ZipFile(out / "feedback-upload.zip") as archive:
+        assert archive.namelist() == ["ada_feedback.html"]
+    (tmp_path / "roster.csv").write_text("submission,id\nada,ada7\n", encoding="utf-8")
+    assert cli.main(["export", out, "--lms", "toy", "--roster", tmp_path / "roster.csv"]) == 0
+    with open(tmp_path / "grades-toy.csv", encoding="utf-8", newline="") as handle:
+        assert list(csv.reader(handle)) == [["username", "points"], ["ada7", "10.0"]]
+
+
+def test_an_lms_no_module_names_is_refused_with_the_names(tmp_path, capsys):
+    out = tmp_path / "grades"
+    write_report(out, [SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}})])
+    assert cli.main(["feedback", out, "--layout", "toy"]) == 2
+    assert "canvas" in capsys.readouterr().err and not (out / "feedback-upload.zip").exists()
+
+
+def _toy_class(tmp_path):
+    cls = tmp_path / "class"
+    cls.mkdir()
+    name = next(iter(FILES))
+    (cls / name).write_text(notebook_text("ada"), encoding="utf-8")
+    return cls
 
 
 def test_without_the_module_its_download_is_not_recognised(tmp_path):
