@@ -46,7 +46,7 @@ def hold_dependents(results, registry, code, graded, rescore):
             if not check.get("passed") or check.get("held"):
                 continue
             names = _reaches(part, code) - set(part.scanned)
-            on_held, on_string = sorted(names & held.keys()), sorted(names & strung.keys())
+            on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
             if on_held:
                 verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
             elif on_string:
