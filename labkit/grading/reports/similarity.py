@@ -1,16 +1,13 @@
-"""Similar code between classmates, flagged for a person to judge (it never changes a grade).
+"""Similar code between classmates, listed for a person to judge in the class report (never a grade).
 
-For each graded function, the students' versions (the definition and the notebook's definitions it reaches,
-:func:`labkit.grading.submission.scan.reached_function_sources`) are compared pairwise with the fingerprints
-of :mod:`labkit.grading.submission.fingerprint`, on the source as written so that the lines shared can be
-marked. The corpus of a version is its classmates' versions of the same function: what the student release
-gives everyone is set aside (:func:`boilerplate`), and so is code most of the class wrote alike (a
-fingerprint in more than :data:`COMMON_SHARE` of a function's versions and more than :data:`COMMON_MIN`
-of them): the obvious way to write a short function is no evidence. A pair's score is, for each side, the
-share of that side's fingerprinted code that the other side shares, the larger of the two; pairs from
-:data:`DEFAULT_THRESHOLD` are listed in the class report, side by side. Each source is at most
-:data:`~labkit.grading.store.text.MAX_SOURCE_CHARS` characters, tokenised and fingerprinted once; a
-function's pairs are scored together from an index of which versions have each fingerprint.
+Each graded function's versions (its definition and what it reaches,
+:func:`labkit.grading.submission.scan.reached_function_sources`) are compared pairwise by the engine of
+:mod:`labkit.grading.submission.fingerprint`, on the source as written, so that the lines shared can be
+marked. A version's corpus is its classmates' versions; the release's code (:func:`boilerplate`) and code
+much of the class wrote alike (a fingerprint in more than :data:`COMMON_SHARE` of the versions and more
+than :data:`COMMON_MIN` of them) are no evidence. A pair's score is the larger, of its two sides, of the
+share of one side's fingerprinted code that the other shares; each source is at most
+:data:`~labkit.grading.store.text.MAX_SOURCE_CHARS` characters, fingerprinted once.
 """
 
 from __future__ import annotations
@@ -68,9 +65,9 @@ class _Version:
 
 
 def unavailable() -> str | None:
-    """Why the similarity search cannot run here (its tokeniser, pygments, cannot be imported), or None.
+    """Why the search cannot run here (its tokeniser, pygments, cannot be imported), or None.
 
-    >>> unavailable() is None  # labkit's tests install every extra
+    >>> unavailable() is None
     True
     """
     try:
@@ -89,26 +86,19 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
     Parameters
     ----------
     grades : iterable of SubmissionGrade
-        The class's grades (or objects with a ``name`` and a ``sources`` dict of function name to source
-        text, as :class:`labkit.grading.store.report.SubmissionGrade` keeps them); names must differ.
+        The class's grades (or objects with a ``name`` and ``sources``, {function: source text}).
     threshold : float, optional
-        The score (0..1) from which a pair is listed; a pair that shares nothing is never listed.
+        The score (0..1) from which a pair is listed; a pair that shares nothing never is.
     release : path or sequence of str, optional
-        What every student was given (:func:`boilerplate`); None for the lab's packaged student release.
+        What every student was given (:func:`boilerplate`); None for the lab's packaged release.
     progress : labkit.grading.progress.Progress, optional
         Advanced by one after each graded function.
 
     Returns
     -------
     list of Pair or None
-        By score, highest first (then by function and names), ``first`` the name that sorts first; None
-        when the search cannot run here (:func:`unavailable` says why).
-
-    Raises
-    ------
-    ValueError
-        If `threshold` is not a number from 0 to 1, a grade has no name or sources, two grades share a
-        name, or `release` cannot be read.
+        By score (then function and names), ``first`` the name that sorts first; None when the search
+        cannot run here (:func:`unavailable`). ValueError for a bad threshold, grade or release.
 
     Examples
     --------
@@ -174,10 +164,8 @@ def _clean(text):
 
 
 def boilerplate(release=None) -> Boilerplate:
-    """The boilerplate of a student release: the stubs of the graded functions and the lab's given code.
-
-    `release` is a folder of notebooks (read as the grader reads submissions, never run) or one notebook, or
-    code texts; None for the lab's packaged student notebooks. ValueError when it is neither, or unreadable.
+    """The boilerplate of a student release (a folder of notebooks, one notebook, or code texts; None for the
+    packaged student notebooks): the stubs of the graded functions and the lab's given code.
 
     >>> stub = "def f(x):\\n    # YOUR CODE HERE\\n    raise NotImplementedError()"
     >>> sorted(boilerplate([stub]).lines)
@@ -243,12 +231,8 @@ def _without_common(versions):
 
 
 def shares(versions) -> np.ndarray:
-    """``S[i, j]``: the share of version i's fingerprinted code that version j shares, for all pairs at once.
-
-    A normalised character of i is shared with j when a fingerprint of i that j has too covers it. An index
-    of which versions have each fingerprint gives every j at once; versions sharing nothing with i cost
-    nothing more. The diagonal is zero.
-    """
+    """``S[i, j]``: the share of version i's fingerprinted code that fingerprints j has too cover, for all
+    pairs at once from an index of which versions have each fingerprint (zero on the diagonal)."""
     from scipy import sparse
 
     sizes = [v.hashes.size for v in versions]

@@ -1,22 +1,18 @@
 """The one fingerprinting engine: code read by what it does, winnowed, and compared run by run.
 
-Two searches use it, each with its own corpus and threshold: known code (labkit's, scipy's, the solutions')
-in a graded part, which holds the part for a person (:mod:`labkit.grading.submission.known`), and
-classmates' similar code, listed in the class report (:mod:`labkit.grading.reports.similarity`).
-Nothing is ever run:
+Known code in a graded part (:mod:`labkit.grading.submission.known`, which holds the part for a person) and
+classmates' similar code (:mod:`labkit.grading.reports.similarity`, for the class report) are both found
+with it, each with its own corpus and threshold. Nothing is ever run:
 
-1. :func:`canonical` (known code only) writes a definition back from its syntax tree with what does nothing
-   taken out: docstrings, statements with no effect and dead stores go, ``getattr(x, "name")`` is
-   ``x.name``, ``x += y`` is ``x = x + y``, accumulating loops and generators are list comprehensions,
-   ``staticmethod`` and the notebook's namespace classes go. :func:`units` splits a part's code into
-   functions, a class's methods each alone, trivial wrappers left out.
-2. :func:`normalise` tokenises with pygments and writes each token as one or a few characters: a name is
-   ``V`` (a function's ``F``, a class's ``O``), a string ``S``; comments, docstrings, white space and round
-   brackets go. Keywords, operators, numbers, builtins, exceptions and the attribute after a dot stay.
+1. :func:`canonical` (known code only) writes a definition back from its syntax tree without what does
+   nothing, and :func:`units` splits a part's code into functions and methods, trivial wrappers left out.
+2. :func:`normalise` tokenises with pygments: a name is ``V`` (a function's ``F``, a class's ``O``), a
+   string ``S``; comments, docstrings, white space and round brackets go; keywords, operators, numbers,
+   Python's own names and the attribute after a dot stay.
 3. :func:`fingerprints` hashes every run of :data:`NOISE` normalised characters and keeps the smallest of
-   each :data:`WINDOW` consecutive hashes (winnowing, Schleimer, Wilkerson and Aiken 2003), so a shared run
-   of ``NOISE + WINDOW - 1`` = 30 characters always shares a fingerprint. The hashes are the same in every
-   process, and what the student release gives everyone (:func:`release_grams`) is never evidence.
+   each :data:`WINDOW` (winnowing, Schleimer, Wilkerson and Aiken 2003): a shared run of 30 characters
+   always shares a fingerprint. What the student release gives everyone (:func:`release_grams`) is never
+   evidence.
 """
 
 from __future__ import annotations
@@ -45,9 +41,10 @@ def parse(text):
 
 
 def canonical(text, namespaces=frozenset()):
-    """`text` written back from its normalised syntax tree; `text` itself when it does not parse.
-
-    `namespaces` are names of the notebook's classes: ``Name.attr`` of one of them is read as ``attr``.
+    """`text` written back from its normalised syntax tree (`text` itself when it does not parse): docstrings,
+    statements with no effect and dead stores go, ``getattr(x, "name")`` is ``x.name``, ``x += y`` is
+    ``x = x + y``, accumulating loops and generators are list comprehensions, ``staticmethod`` goes, and
+    ``Name.attr`` of one of the `namespaces` (the notebook's classes) is ``attr``.
 
     Examples
     --------
@@ -83,15 +80,14 @@ class _Canon(ast.NodeTransformer):
 
     visit_AsyncFunctionDef = visit_FunctionDef
 
-    def visit_ClassDef(self, node):
-        self.generic_visit(node)
-        node.body = [s for s in node.body if not _no_effect(s)] or [ast.Pass()]
-        return node
-
-    def visit_Module(self, node):
+    def visit_ClassDef(self, node):  # and a module
         self.generic_visit(node)
         node.body = [s for s in node.body if not _no_effect(s)]
+        if isinstance(node, ast.ClassDef) and not node.body:
+            node.body = [ast.Pass()]
         return node
+
+    visit_Module = visit_ClassDef
 
     def visit_Call(self, node):
         self.generic_visit(node)
@@ -252,7 +248,9 @@ def units(definitions):
     """
     definitions = list(definitions)
     trees = [parse(text) for _, text in definitions]
-    namespaces = frozenset(n.name for tree in trees if tree is not None for n in tree.body if isinstance(n, ast.ClassDef))
+    namespaces = frozenset(
+        n.name for tree in trees if tree is not None for n in tree.body if isinstance(n, ast.ClassDef)
+    )
     return [unit for name, text in definitions for unit in _split(name, text, namespaces)]
 
 

@@ -1,18 +1,10 @@
-"""Code every student has on disk, recognised in a graded part however it is renamed or reordered.
+"""Code every student has on disk (labkit's, scipy's, the solutions' if they leak), recognised in a graded part.
 
-A student has labkit's own source (its private helpers too), scipy's, and, if they ever leak, the instructor
-notebooks' solutions. The source scan and the sandbox's watch refuse *calls* of that code; this module
-recognises *copies* of it, so that a part built on one is held for a person
-(:func:`labkit.grading.submission.scoring.grade_notebook`) instead of paid. Code is compared by the engine
-of :mod:`labkit.grading.submission.fingerprint`, its syntax tree normalised first; the corpus is every
-function and method of the known sources (:func:`corpus`), fingerprinted once per file and cached
-(:func:`cache_folder`) under the file's SHA-256, so a run pays only for what changed.
-
-A part's code is every definition its graded names reach. Each definition's own fingerprints (those the
-student release does not give everyone, each counted once) are set against the one known unit that has most
-of them; the part matches (:func:`match`) when those units have :data:`THRESHOLD` of all its own
-fingerprints and at least :data:`MIN_SHARED`: the lab's formulas make short code come out alike from
-everyone, so only a long shared stretch is evidence.
+The scan and the sandbox refuse *calls* of that code; this module recognises *copies* of it however they
+are renamed or reordered, so that a part built on one is held for a person instead of paid
+(:func:`labkit.grading.submission.scoring.judge_known`). The engine is
+:mod:`labkit.grading.submission.fingerprint`, syntax trees normalised first; the corpus is every function
+and method of the known sources, fingerprinted once per file and cached under its SHA-256 (:func:`corpus`).
 """
 
 from __future__ import annotations
@@ -53,13 +45,11 @@ class Unit:
 
 @dataclass(frozen=True)
 class Corpus:
-    """The fingerprints of the known sources: which unit and which source (file) each one comes from."""
+    """The fingerprints of the known sources, and the unit each one comes from."""
 
     units: tuple  # Unit
-    sources: tuple  # the names of the known sources: a module or a notebook
     hashes: np.ndarray  # sorted fingerprint hashes, one entry per (hash, unit)
     unit_of: np.ndarray  # the unit of each entry
-    source_of: np.ndarray  # its source (an index into `sources`)
     digest: str  # what the corpus was made of (its files' SHA-256), for the run's record
 
     def holders(self, hashes):
@@ -188,20 +178,16 @@ def corpus(refusals=(), solutions=()):
     `refusals` are :class:`labkit.exercises.model.Refusal` objects; `solutions` is a tuple of (notebook
     name, tuple of its code cells), the instructor notebooks as the grader reads them
     (:func:`labkit.grading.submission.scoring.solutions`)."""
-    entries = [(module, str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
-    entries += [(f"the solutions' {name}", name, _notebook_entry(name, cells)) for name, cells in solutions]
-    units, sources, hashes, unit_of, source_of = [], [], [], [], []
-    for source, path, (data, _) in entries:
+    entries = [(str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
+    entries += [(name, _notebook_entry(name, cells)) for name, cells in solutions]
+    units, hashes, unit_of = [], [np.zeros(0, dtype=np.uint64)], [np.zeros(0, dtype=np.int64)]
+    for path, (data, _) in entries:
         unit_of.append(np.asarray(data["unit_of"], dtype=np.int64) + len(units))
         units += [Unit(name, path, int(a), int(b), *rest) for name, a, b, *rest in data["units"]]
         hashes.append(np.asarray(data["hashes"], dtype=np.uint64))
-        source_of.append(np.full(len(data["hashes"]), len(sources), dtype=np.int64))
-        sources.append(source)
-    hashes = np.concatenate(hashes) if hashes else np.zeros(0, dtype=np.uint64)
-    order = np.argsort(hashes, kind="stable")
-    cat = (lambda parts: np.concatenate(parts)[order]) if hashes.size else (lambda parts: np.zeros(0, np.int64))
-    digest = hashlib.sha256("\n".join(sorted(key for _, _, (_, key) in entries)).encode()).hexdigest()[:16]
-    return Corpus(tuple(units), tuple(sources), hashes[order], cat(unit_of), cat(source_of), digest)
+    order = np.argsort(np.concatenate(hashes), kind="stable")
+    digest = hashlib.sha256("\n".join(sorted(key for _, (_, key) in entries)).encode()).hexdigest()[:16]
+    return Corpus(tuple(units), np.concatenate(hashes)[order], np.concatenate(unit_of)[order], digest)
 
 
 @dataclass(frozen=True)
@@ -220,32 +206,25 @@ class Match:
 
 
 class Given:
-    """Every fingerprint-sized hash of the release's code cells: what every student was given."""
+    """Every fingerprint-sized hash of the release's code cells: what every student was given (one per run:
+    :func:`match` caches by it)."""
 
     def __init__(self, cells):
         self.array = fingerprint.release_grams(cells)
 
 
-def release_grams(cells):
-    """:class:`Given` of a release's code cells (one per run: :func:`match` caches by it)."""
-    return Given(cells)
+release_grams = Given
 
 
 def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
-    """The :class:`Match` of a part's code, when known sources have :data:`THRESHOLD` or more of it; else None.
+    """The :class:`Match` of a part's code, when known sources have `threshold` or more of it; else None.
 
-    Parameters
-    ----------
-    known : Corpus
-        The known sources (:func:`corpus`).
-    definitions : iterable of (str, str)
-        (name, source text) of the notebook's definitions to judge: a graded function and what it reaches.
-    given : Given
-        :func:`release_grams` of what every student was given: code that only repeats it is nobody's.
-    threshold : float, optional
-        The share from which the part matches (0 gives the best sources whatever the share).
-    minimum : int, optional
-        The fingerprints the part must share at least.
+    The part's code is `definitions`, [(name, source)] of a graded function and what it reaches. Each unit
+    of it (:func:`~labkit.grading.submission.fingerprint.units`) is set against the one known unit of
+    `known` (:func:`corpus`) that has most of its own fingerprints (those the release, `given`, does not
+    give everyone, each counted once). It matches when those units have `threshold` of all its own
+    fingerprints (0: whatever the share) and at least `minimum`: the lab's formulas make short code come
+    out alike from everyone, so only a long shared stretch is evidence.
     """
     total, judged = 0, []
     for name, text in fingerprint.units(definitions):

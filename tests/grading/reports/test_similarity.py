@@ -19,8 +19,8 @@ from labkit.exercises.registry import LAB
 from labkit.grading.reports import similarity
 from labkit.grading.reports.similarity import DEFAULT_THRESHOLD, Pair, similar_pairs
 from labkit.grading.store.report import SubmissionGrade, read_results, write_csv
-from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources, reached_function_sources
 from labkit.grading.submission.fingerprint import NOISE, normalise
+from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources, reached_function_sources
 from labkit.grading.submission.scoring import exercises_in, graded_functions, read_cells, registry_graded
 from labkit.student_notebooks import paths
 
@@ -315,7 +315,10 @@ def test_independent_solutions_are_never_similar_to_the_solutions_or_each_other_
         ("two_patches", "plain_loops", "style_b"),
     }
     assert all(p.first_lines == p.second_lines for p in found)
-    assert max(p.score for p in similar_pairs(grades, threshold=0.0) if p.first_lines != p.second_lines) < DEFAULT_THRESHOLD
+    assert (
+        max(p.score for p in similar_pairs(grades, threshold=0.0) if p.first_lines != p.second_lines)
+        < DEFAULT_THRESHOLD
+    )
     # the solutions renamed, their docstrings gone, a statement added to each function and the cells reordered
     disguised = _notebook_sources(ROOT / "notebooks", lambda cells: renamed_cells(cells)[::-1])
     copier = SubmissionGrade("copier", sources={f: "# my own work\n" + text for f, text in disguised.items()})

@@ -79,7 +79,9 @@ def test_names_docstrings_comments_and_layout_do_not_change_the_normalised_text(
     two = "def surface(a,b):  return a*b"
     assert fingerprint.normalise(one)[0] == fingerprint.normalise(two)[0]
     assert fingerprint.normalise(one)[0] != fingerprint.normalise(two.replace("*", "+"))[0]  # what the code does counts
-    assert fingerprint.normalise("np.diff(x)")[0] != fingerprint.normalise("np.cumsum(x)")[0]  # so does the routine called
+    assert (
+        fingerprint.normalise("np.diff(x)")[0] != fingerprint.normalise("np.cumsum(x)")[0]
+    )  # so does the routine called
 
 
 def test_each_normalised_character_points_at_its_token_in_the_source():
