@@ -130,7 +130,7 @@ def _threshold(threshold):
 
 
 def _by_function(grades):
-    """{function: [(submission, its source, cleaned)]} of the grades, checked."""
+    """{function: [(submission, its cleaned source)]} of the grades, checked."""
     try:
         grades = list(grades)
     except TypeError:
@@ -268,9 +268,10 @@ def _function_pairs(function, versions, given, threshold):
 
 
 def _lines(version, other, given):
-    """0-based numbers of the lines of `version` that its fingerprints shared with `other` cover: lines of
-    code, less those the release gives (in `given`, stripped)."""
+    """0-based numbers of the lines of `version` that its fingerprints shared with `other` cover (comments
+    never are), less those the release gives (in `given`, stripped)."""
     positions = version.positions[np.isin(version.hashes, other.hashes)]
     lines = version.text.split("\n")
-    numbers = fingerprint.shared_lines(version.text, version.where, positions)
-    return frozenset(n for n in numbers if lines[n].strip() not in given and not lines[n].strip().startswith("#"))
+    return frozenset(
+        n for n in fingerprint.shared_lines(version.text, version.where, positions) if lines[n].strip() not in given
+    )

@@ -18,6 +18,7 @@ with it, each with its own corpus and threshold. Nothing is ever run:
 from __future__ import annotations
 
 import ast
+import functools
 import textwrap
 
 import numpy as np
@@ -290,33 +291,38 @@ def normalise(text):
     >>> normalise("y = np.searchsorted(x, 'a')")[0]
     'V=V.searchsortedV,S'
     """
-    from pygments import lexers, token
-
     out, where, previous = [], [], None
-    for start, kind, value in lexers.get_lexer_by_name("python").get_tokens_unprocessed(str(text)):
-        if kind in token.Text or kind in token.Comment or kind in token.String.Doc or value in PARENTHESES:
+    for start, kind, value in _lexer().get_tokens_unprocessed(str(text)):
+        piece = _written(kind)
+        if piece == "" or value in PARENTHESES or (piece == "S" and previous == "S"):  # adjacent strings are one
             continue
-        if kind in token.String:
-            piece = "S"
-            if previous == "S":
-                continue  # adjacent strings are one
-        elif kind in token.Name.Function:
-            piece = "F"
-        elif kind in token.Name.Class:
-            piece = "O"
-        elif kind in token.Name and not _builtin(kind, token) and previous != ".":
-            piece = "V"
-        else:
-            piece = value
+        piece = value if piece is None or (piece == "V" and previous == ".") else piece
         out.append(piece)
         where.extend(range(start, start + len(piece)) if piece == value else [start])
         previous = piece
     return "".join(out), np.asarray(where, dtype=np.int64)
 
 
-def _builtin(kind, token):
-    """Whether a name token is Python's own (a builtin, an exception, ``self``): what the code does."""
-    return kind in token.Name.Builtin or kind in token.Name.Exception
+@functools.cache
+def _lexer():
+    from pygments import lexers
+
+    return lexers.get_lexer_by_name("python")
+
+
+@functools.cache
+def _written(kind):
+    """How :func:`normalise` writes a token of this kind: "" left out, a letter, or None as itself (Python's own
+    names too: builtins, exceptions, ``self``)."""
+    from pygments import token
+
+    if kind in token.Text or kind in token.Comment or kind in token.String.Doc:
+        return ""
+    kinds = {"S": token.String, "F": token.Name.Function, "O": token.Name.Class}
+    found = next((letter for letter, of in kinds.items() if kind in of), None)
+    if found is None and kind in token.Name and not (kind in token.Name.Builtin or kind in token.Name.Exception):
+        return "V"
+    return found
 
 
 def kgrams(normalised):
