@@ -77,15 +77,6 @@ def _definitions(tree, prefix):
                 yield f"{prefix}{name}", first, inner.end_lineno
 
 
-def _fingerprint_units(texts):
-    """[(unit text, hashes)] → the unit index and hash arrays of their fingerprints."""
-    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(text))[0])[0]) for text in texts]
-    if not hashes:
-        return np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int32)
-    units = [np.full(found.size, index, dtype=np.int32) for index, found in enumerate(hashes)]
-    return np.concatenate(hashes), np.concatenate(units)
-
-
 @functools.cache
 def _tokeniser():
     from importlib.metadata import version
@@ -116,8 +107,10 @@ def _cached(name, raw, compute):
 
 
 def _entry(units, texts):
-    hashes, unit_of = _fingerprint_units(texts)
-    return {"units": units, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
+    """JSON data: the `units`, and the distinct fingerprints of each one's text (`texts`) with its index."""
+    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(text))[0])[0]).tolist() for text in texts]
+    unit_of = [index for index, found in enumerate(hashes) for _ in found]
+    return {"units": units, "hashes": [h for found in hashes for h in found], "unit_of": unit_of}
 
 
 def _module_entry(module, path):

@@ -175,7 +175,7 @@ def test_the_cache_is_used_and_a_broken_cache_entry_is_computed_again(tmp_path, 
         raise AssertionError("the cached fingerprints were computed again")
 
     with monkeypatch.context() as patched:
-        patched.setattr(known, "_fingerprint_units", never)
+        patched.setattr(known, "_entry", never)
         assert known._module_entry("labkit.bilinear", path)[0] == first  # read from the cache
     files[0].write_text("{not json")
     again, _ = known._module_entry("labkit.bilinear", path)
