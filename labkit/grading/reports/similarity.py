@@ -129,7 +129,7 @@ def _threshold(threshold):
     return float(threshold)
 
 
-def _by_function(grades):
+def _by_function(grades) -> dict:
     """{function: [(submission, its cleaned source)]} of the grades, checked."""
     try:
         grades = list(grades)
