@@ -47,7 +47,6 @@ def test_the_core_is_light_and_the_extras_hold_the_rest():
         "nbformat",
         "nbclient",
         "rich",
-        "copydetect",
         "latex2mathml",
         "jinja2",
     }

@@ -12,7 +12,7 @@ references, ...; each read from the kind code the grader set where it made
 the failed step or the problem, :data:`labkit.exercises.result.KINDS`, never
 from its words), the students with the most failed parts, and pairs of
 similar code side by side (:mod:`labkit.grading.reports.similarity`; similarity never
-changes a grade, it is for a person to judge). Without copydetect, which the
+changes a grade, it is for a person to judge). Without pygments, which the
 similarity search needs, the page is written all the same and its similar code
 section says "not computed", and why.
 

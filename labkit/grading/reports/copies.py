@@ -42,12 +42,9 @@ class Copies:
         lines = []
         for holder, whose, numbers in self.holders:
             owner = f"{whose}'s data" if whose else "another variant's data (no classmate's)"
-            lines.append(f"{holder} holds {owner} for exercise{'s' if len(numbers) > 1 else ''} {_numbers(numbers)}")
+            plural = "s" if len(numbers) > 1 else ""
+            lines.append(f"{holder} holds {owner} for exercise{plural} {', '.join(map(str, numbers))}")
         return lines
-
-
-def _numbers(numbers):
-    return ", ".join(map(str, numbers))
 
 
 def find(grades, students=None, registry=None) -> Copies:

@@ -1,33 +1,36 @@
-"""What a definition does, written one way: the syntax-tree normalisation applied before code is fingerprinted.
+"""The one fingerprinting engine: code read by what it does, winnowed, and compared run by run.
 
-Winnowing (:mod:`labkit.grading.submission.known`) compares runs of tokens,
-so anything a copier inserts at a finer grain than a run defeats it: a dead
-assignment after every statement, attributes read as ``getattr(obj,
-"name")``, functions moved into a class as staticmethods. :func:`canonical`
-parses a definition with :mod:`ast` (nothing is run) and writes it back
-with those differences taken out:
+Known code in a graded part (:mod:`labkit.grading.submission.known`, which holds the part for a person) and
+classmates' similar code (:mod:`labkit.grading.reports.similarity`, for the class report) are both found
+with it, each with its own corpus and threshold. Nothing is ever run:
 
-* docstrings, statements with no effect (a bare name or constant, ``pass``)
-  and dead stores (a name assigned in a function and never read there, or
-  assigned to itself) go;
-* ``getattr(x, "name")`` becomes ``x.name``; ``x += y`` becomes ``x = x + y``;
-* every comprehension and ``list(generator)`` becomes a list comprehension;
-* ``staticmethod``/``classmethod`` decorators go, and an attribute of a class
-  the notebook uses as a namespace (``Tools.bracket``, ``cls.bracket``) is
-  read as the plain name.
-
-:func:`units` splits what a graded part reaches into the units compared one
-by one: a class's methods each alone (so a container never dilutes a match),
-and trivial wrappers (one call handed on) left out.
+1. :func:`canonical` (known code only) writes a definition back from its syntax tree without what does
+   nothing, and :func:`units` splits a part's code into functions and methods, trivial wrappers left out.
+2. :func:`normalise` tokenises with pygments: a name is ``V`` (a function's ``F``, a class's ``O``), a
+   string ``S``; comments, docstrings, white space and round brackets go; keywords, operators, numbers,
+   Python's own names and the attribute after a dot stay.
+3. :func:`fingerprints` hashes every run of :data:`NOISE` normalised characters and keeps the smallest of
+   each :data:`WINDOW` (winnowing, Schleimer, Wilkerson and Aiken 2003): a shared run of 30 characters
+   always shares a fingerprint. What the student release gives everyone (:func:`release_grams`) is never
+   evidence.
 """
 
 from __future__ import annotations
 
 import ast
+import functools
 import textwrap
 
+import numpy as np
+
+NOISE = 25  # normalised characters hashed together: a shorter shared run is never evidence
+WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characters always shares a fingerprint
 UNWRAPPED = {"staticmethod", "classmethod"}
 SELF = {"self", "cls"}
+PARENTHESES = {"(", ")"}  # a formatter adds and drops them around tuples and long lines
+BASE = np.uint64(1_000_003)
+POWERS = BASE ** np.arange(NOISE - 1, -1, -1, dtype=np.uint64)  # wraps modulo 2**64, as the hashes do
+BLOCKS = ("body", "orelse", "finalbody")
 
 
 def parse(text):
@@ -39,9 +42,10 @@ def parse(text):
 
 
 def canonical(text, namespaces=frozenset()):
-    """`text` written back from its normalised syntax tree; `text` itself when it does not parse.
-
-    `namespaces` are names of the notebook's classes: ``Name.attr`` of one of them is read as ``attr``.
+    """`text` written back from its normalised syntax tree (`text` itself when it does not parse): docstrings,
+    statements with no effect and dead stores go, ``getattr(x, "name")`` is ``x.name``, ``x += y`` is
+    ``x = x + y``, accumulating loops and generators are list comprehensions, ``staticmethod`` goes, and
+    ``Name.attr`` of one of the `namespaces` (the notebook's classes) is ``attr``.
 
     Examples
     --------
@@ -58,8 +62,7 @@ def canonical(text, namespaces=frozenset()):
     if tree is None:
         return str(text)
     try:
-        tree = ast.fix_missing_locations(_Canon(frozenset(namespaces)).visit(tree))
-        return ast.unparse(tree)
+        return ast.unparse(ast.fix_missing_locations(_Canon(frozenset(namespaces)).visit(tree)))
     except (RecursionError, ValueError, TypeError, AttributeError):
         return str(text)
 
@@ -78,15 +81,14 @@ class _Canon(ast.NodeTransformer):
 
     visit_AsyncFunctionDef = visit_FunctionDef
 
-    def visit_ClassDef(self, node):
-        self.generic_visit(node)
-        node.body = [s for s in node.body if not _no_effect(s)] or [ast.Pass()]
-        return node
-
-    def visit_Module(self, node):
+    def visit_ClassDef(self, node):  # and a module
         self.generic_visit(node)
         node.body = [s for s in node.body if not _no_effect(s)]
+        if isinstance(node, ast.ClassDef) and not node.body:
+            node.body = [ast.Pass()]
         return node
+
+    visit_Module = visit_ClassDef
 
     def visit_Call(self, node):
         self.generic_visit(node)
@@ -148,17 +150,22 @@ def _dead(statement, read):
     return all(t.id not in read for t in targets)
 
 
+def _blocks(statement):
+    """(field, block) of each block of statements inside `statement` (a loop's body, an if's else...)."""
+    for field in BLOCKS:
+        block = getattr(statement, field, None)
+        if isinstance(block, list) and block and isinstance(block[0], ast.stmt):
+            yield field, block
+
+
 def _pruned(body, read):
     """A function body without its statements of no effect and its dead stores (nested blocks too)."""
     kept = []
     for statement in body:
-        if _no_effect(statement) or _dead(statement, read):
-            continue
-        for field in ("body", "orelse", "finalbody"):
-            block = getattr(statement, field, None)
-            if isinstance(block, list) and block and isinstance(block[0], ast.stmt):
+        if not (_no_effect(statement) or _dead(statement, read)):
+            for field, block in _blocks(statement):
                 setattr(statement, field, _pruned(block, read) or [ast.Pass()])
-        kept.append(statement)
+            kept.append(statement)
     return kept
 
 
@@ -169,10 +176,8 @@ def _as_comprehensions(body):
     returned is returned (``y = e`` then ``return y`` is ``return e``)."""
     kept: list = []
     for statement in body:
-        for field in ("body", "orelse", "finalbody"):
-            block = getattr(statement, field, None)
-            if isinstance(block, list) and block and isinstance(block[0], ast.stmt):
-                setattr(statement, field, _as_comprehensions(block))
+        for field, block in _blocks(statement):
+            setattr(statement, field, _as_comprehensions(block))
         folded = _folded(kept[-1], statement) if kept else None
         if folded is not None:
             kept[-1] = ast.copy_location(folded, kept[-1])
@@ -231,9 +236,6 @@ def _zero(node):
     return isinstance(node, ast.Constant) and type(node.value) in (int, float) and node.value == 0
 
 
-# -- the units a part's code is compared in -------------------------------------------------------------------
-
-
 def units(definitions):
     """``[(name, canonical text)]``: a part's definitions as :func:`canonical` writes them, a class's methods
     each on its own and trivial wrappers left out (they hand a call on, so the code is where they point).
@@ -246,16 +248,11 @@ def units(definitions):
     ['K.g']
     """
     definitions = list(definitions)
-    namespaces = set()
-    for _, text in definitions:
-        tree = parse(text)
-        if tree is not None:
-            namespaces.update(n.name for n in tree.body if isinstance(n, ast.ClassDef))
-    namespaces = frozenset(namespaces)
-    found = []
-    for name, text in definitions:
-        found.extend(_split(name, text, namespaces))
-    return found
+    trees = [parse(text) for _, text in definitions]
+    namespaces = frozenset(
+        n.name for tree in trees if tree is not None for n in tree.body if isinstance(n, ast.ClassDef)
+    )
+    return [unit for name, text in definitions for unit in _split(name, text, namespaces)]
 
 
 def _split(name, text, namespaces):
@@ -281,3 +278,115 @@ def _trivial(node):
         return False
     arithmetic = [n for n in ast.walk(last.value) if isinstance(n, ast.BinOp)]
     return not arithmetic and (len(node.body) == 1 or isinstance(node.body[0], ast.Assign))
+
+
+def normalise(text):
+    """``(normalised, where)``: `text`'s tokens as :func:`fingerprints` reads them, and the index in `text`
+    of each normalised character.
+
+    Examples
+    --------
+    >>> normalise("def area(w, h):\\n    '''Doc.'''\\n    return w * h  # cm2")[0]
+    'defFV,V:returnV*V'
+    >>> normalise("y = np.searchsorted(x, 'a')")[0]
+    'V=V.searchsortedV,S'
+    """
+    out, where, previous = [], [], None
+    for start, kind, value in _lexer().get_tokens_unprocessed(str(text)):
+        piece = _written(kind)
+        if piece == "" or value in PARENTHESES or (piece == "S" and previous == "S"):  # adjacent strings are one
+            continue
+        piece = value if piece is None or (piece == "V" and previous == ".") else piece
+        out.append(piece)
+        where.extend(range(start, start + len(piece)) if piece == value else [start])
+        previous = piece
+    return "".join(out), np.asarray(where, dtype=np.int64)
+
+
+@functools.cache
+def _lexer():
+    from pygments import lexers
+
+    return lexers.get_lexer_by_name("python")
+
+
+@functools.cache
+def _written(kind):
+    """How :func:`normalise` writes a token of this kind: "" left out, a letter, or None as itself (Python's own
+    names too: builtins, exceptions, ``self``)."""
+    from pygments import token
+
+    if kind in token.Text or kind in token.Comment or kind in token.String.Doc:
+        return ""
+    kinds = {"S": token.String, "F": token.Name.Function, "O": token.Name.Class}
+    found = next((letter for letter, of in kinds.items() if kind in of), None)
+    if found is None and kind in token.Name and not (kind in token.Name.Builtin or kind in token.Name.Exception):
+        return "V"
+    return found
+
+
+def kgrams(normalised):
+    """The hash of every run of :data:`NOISE` characters of a normalised text (the same in every process)."""
+    codes = np.frombuffer(str(normalised).encode("utf-32-le"), dtype=np.uint32).astype(np.uint64)
+    if codes.size < NOISE:
+        return np.zeros(0, dtype=np.uint64)
+    return np.lib.stride_tricks.sliding_window_view(codes, NOISE) @ POWERS
+
+
+def fingerprints(normalised):
+    """``(hashes, positions)``: the winnowed fingerprints of a normalised text, in order of position.
+
+    Examples
+    --------
+    >>> hashes, positions = fingerprints("V=V+1" * 20)
+    >>> bool(len(hashes)) and bool(np.all(np.diff(positions) > 0))
+    True
+    >>> fingerprints("V=1")[0].size  # shorter than NOISE: nothing to fingerprint
+    0
+    """
+    grams = kgrams(normalised)
+    if grams.size == 0:
+        return grams, np.zeros(0, dtype=np.int64)
+    width = min(WINDOW, grams.size)
+    windows = np.lib.stride_tricks.sliding_window_view(grams, width)
+    # robust winnowing: the rightmost smallest hash of each window
+    chosen = np.unique(np.arange(windows.shape[0]) + (width - 1 - np.argmin(windows[:, ::-1], axis=1)))
+    return grams[chosen], chosen
+
+
+def release_grams(cells, rewrite=canonical):
+    """Every :data:`NOISE`-character hash of a release's code cells, each written by `rewrite` first (sorted):
+    what every student was given, so never evidence; every run, not only those winnowing keeps, so that a
+    stub the student's code cuts off elsewhere leaves nothing behind."""
+    found = [kgrams(normalise(rewrite(cell))[0]) for cell in cells]
+    return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
+
+
+def own(text, given):
+    """``(where, hashes, positions)``: :func:`normalise`'s `where` of `text`, and its fingerprints that the
+    sorted hashes `given` (:func:`release_grams`) do not have."""
+    normalised, where = normalise(text)
+    hashes, positions = fingerprints(normalised)
+    mine = ~np.isin(hashes, given)
+    return where, hashes[mine], positions[mine]
+
+
+def coverage(positions, has):
+    """For each row of `has` (which of the fingerprints at sorted `positions` count), how many normalised
+    characters those fingerprints cover (each covers the :data:`NOISE` it hashes)."""
+    spots = np.asarray(positions, dtype=float)
+    at = np.where(has, spots, np.inf)
+    after = np.minimum.accumulate(at[:, ::-1], axis=1)[:, ::-1]  # the first counted position from each on
+    following = np.concatenate([after[:, 1:], np.full((len(has), 1), np.inf)], axis=1)
+    return np.where(has, np.minimum(NOISE, following - spots), 0.0).sum(axis=1)
+
+
+def shared_lines(text, where, positions):
+    """The numbers (0-based) of the lines of `text` with a normalised character that a fingerprint at one of
+    `positions` covers (`where`: :func:`normalise`'s of `text`)."""
+    marks = np.zeros(len(where) + NOISE + 1, dtype=np.int64)
+    np.add.at(marks, positions, 1)
+    np.add.at(marks, np.asarray(positions) + NOISE, -1)
+    covered = where[np.cumsum(marks)[: len(where)] > 0]
+    starts = np.cumsum([0] + [len(line) + 1 for line in text.split("\n")[:-1]])
+    return sorted(set((np.searchsorted(starts, covered, side="right") - 1).tolist()))

@@ -1,11 +1,8 @@
-"""Parts built on code that is not the student's: a plot or table drawn with known code is held, and a part
-whose code reaches a held definition is held with it (:func:`labkit.grading.submission.scoring.grade_notebook`).
+"""Parts built on code that is not the student's (:func:`labkit.grading.submission.scoring.grade_notebook`).
 
-Known code earns nothing through what it draws: the parts a refusal guards are judged for copied code where
-they are graded (:func:`labkit.grading.submission.scoring.judge_known`); the others (plots, tables of values)
-are judged on what draws them (:func:`labkit.grading.submission.scan.drawn_with`), and every part whose
-code reaches a held definition, or a graded name that a string run as code may have defined
-(:func:`labkit.grading.submission.scan.run_strings`), waits or fails with it.
+A part a refusal guards is judged for known code where it is graded; any other (a plot, a table) is judged on
+the definitions that draw it (:func:`judge_plain`); and every part whose code reaches a held definition, or
+a graded name that a string run as code may have defined, waits or fails with it (:func:`hold_dependents`).
 """
 
 from __future__ import annotations
@@ -46,7 +43,7 @@ def hold_dependents(results, registry, code, graded, rescore):
             if not check.get("passed") or check.get("held"):
                 continue
             names = _reaches(part, code) - set(part.scanned)
-            on_held, on_string = sorted(names & held.keys()), sorted(names & strung.keys())
+            on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
             if on_held:
                 verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
             elif on_string:

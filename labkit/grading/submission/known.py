@@ -1,51 +1,16 @@
-"""Code every student has on disk, recognised in a graded function however it is renamed or reordered.
+"""Code every student has on disk (labkit's, scipy's, the solutions' if they leak), recognised in a graded part.
 
-A student has labkit's own source (every helper of it, private ones
-included), scipy's, and, if they ever leak, the instructor notebooks'
-solutions. A graded function that is one of those with its names changed,
-its docstring gone, its statements moved about or split into helpers is not
-the student's work. The source scan (:mod:`labkit.grading.submission.scan`) and the
-sandbox's watch (:mod:`labkit.grading.sandbox.guard`) refuse *calls* of that code;
-this module recognises *copies* of it, so that a part built on one is held
-for a person (:func:`labkit.grading.submission.scoring.grade_notebook`) instead of paid.
-
-How code is compared (winnowing, Schleimer, Wilkerson and Aiken 2003, as
-copydetect and MOSS do it, with hashes of labkit's own so that they are the
-same in every process):
-
-0. :func:`labkit.grading.submission.fingerprint.canonical` first writes each
-   definition back from its syntax tree with what does nothing taken out
-   (dead stores, statements with no effect, ``getattr`` with a literal name,
-   staticmethods and namespace classes), and
-   :func:`~labkit.grading.submission.fingerprint.units` splits a part's code
-   into functions, a class's methods each alone, trivial wrappers left out.
-1. :func:`normalise` tokenises a source with pygments (never runs it) and
-   writes every token as one or a few characters: a variable or
-   argument name is ``V``, a function's name ``F``, a class's ``O``, a string
-   ``S``; comments, docstrings and white space go. Keywords, operators,
-   numbers, builtins and the attribute after a dot (``np.searchsorted``'s
-   ``searchsorted``) stay as they are: they are what the code does.
-2. :func:`fingerprints` hashes every run of :data:`NOISE` normalised
-   characters and keeps the smallest hash of each :data:`WINDOW` consecutive
-   ones, so that any shared run of ``NOISE + WINDOW - 1`` characters shares a
-   fingerprint, wherever it sits in either source.
-3. A graded part's code is every definition its graded names reach in the
-   notebook (:func:`labkit.grading.submission.scan.reached_sources`). Each definition's
-   own fingerprints (those the student release does not give everyone, each
-   counted once) are set against the one known unit (a function or method)
-   that has most of them. The part matches (:class:`Match`) when those units
-   have :data:`THRESHOLD` of all its own fingerprints and at least
-   :data:`MIN_SHARED` of them: the lab's formulas make short code come out
-   alike from everyone, so only a long shared stretch is evidence.
-
-The known sources are fingerprinted once per source file and kept in a
-cache folder (:func:`cache_folder`) under the file's SHA-256, so a grading
-run pays only for what changed since the last one.
+The scan and the sandbox refuse *calls* of that code; this module recognises *copies* of it however they
+are renamed or reordered, so that a part built on one is held for a person instead of paid
+(:func:`labkit.grading.submission.scoring.judge_known`). The engine is
+:mod:`labkit.grading.submission.fingerprint`, syntax trees normalised first; the corpus is every function
+and method of the known sources, fingerprinted once per file and cached under its SHA-256 (:func:`corpus`).
 """
 
 from __future__ import annotations
 
 import ast
+import dataclasses
 import functools
 import hashlib
 import json
@@ -57,102 +22,14 @@ from pathlib import Path
 import numpy as np
 
 from . import fingerprint
-from .fingerprint import canonical
+from .fingerprint import canonical, normalise
 
-NOISE = 25  # normalised characters hashed together: a shorter shared run is never evidence
-WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characters always shares a fingerprint
-# a part is held for a person when known units have THRESHOLD or more of its own fingerprints and it shares
-# MIN_SHARED or more with them: measured on copies, on independent solutions and on honest variants written
-# for the purpose (docs/grading-security.md). Honest work shares at most 46; the copies tried, 98 or more.
+# measured on copies, on independent solutions and on honest variants written for the purpose
+# (docs/grading-security.md): honest work shares at most 46 fingerprints; the copies tried, 98 or more
 THRESHOLD = 0.5
 MIN_SHARED = 70
 SHOWN = 12  # shared lines shown side by side
-VERSION = "labkit-known/4"  # the cache's format and normalisation: a change here recomputes every fingerprint
-
-PARENTHESES = {"(", ")"}
-BASE = np.uint64(1_000_003)
-POWERS = BASE ** np.arange(NOISE - 1, -1, -1, dtype=np.uint64)  # wraps modulo 2**64, as the hashes do
-
-
-def normalise(text):
-    """``(normalised, where)``: `text`'s tokens as :func:`fingerprints` reads them, and the index in `text`
-    of each normalised character.
-
-    Examples
-    --------
-    >>> normalise("def area(w, h):\\n    '''Doc.'''\\n    return w * h  # cm2")[0]
-    'defFV,V:returnV*V'
-    >>> normalise("y = np.searchsorted(x, 'a')")[0]
-    'V=V.searchsortedV,S'
-    """
-    from pygments import lexers, token
-
-    lexer = lexers.get_lexer_by_name("python")
-    out, where, previous = [], [], None
-    for start, kind, value in lexer.get_tokens_unprocessed(str(text)):
-        if kind in token.Text or kind in token.Comment or kind in token.String.Doc or value in PARENTHESES:
-            continue  # round brackets too: a formatter adds and drops them around tuples and long lines
-        if kind in token.String:
-            if previous != "S":
-                out.append("S")
-                where.append(start)
-            previous = "S"
-            continue
-        if kind in token.Name.Function:
-            piece = "F"
-        elif kind in token.Name.Class:
-            piece = "O"
-        elif kind in token.Name and kind not in token.Name.Builtin and previous != ".":
-            piece = "V"
-        else:
-            piece = value
-        out.append(piece)
-        where.extend(range(start, start + len(piece)) if piece == value else [start])
-        previous = piece
-    return "".join(out), np.asarray(where, dtype=np.int64)
-
-
-def fingerprints(normalised):
-    """``(hashes, positions)``: the winnowed fingerprints of a normalised text, in order of position.
-
-    Examples
-    --------
-    >>> hashes, positions = fingerprints("V=V+1" * 20)
-    >>> bool(len(hashes)) and bool(np.all(np.diff(positions) > 0))
-    True
-    >>> fingerprints("V=1")[0].size  # shorter than NOISE: nothing to fingerprint
-    0
-    """
-    grams = kgrams(normalised)
-    if grams.size == 0:
-        return grams, np.zeros(0, dtype=np.int64)
-    width = min(WINDOW, grams.size)
-    windows = np.lib.stride_tricks.sliding_window_view(grams, width)
-    # robust winnowing: the rightmost smallest hash of each window
-    chosen = np.arange(windows.shape[0]) + (width - 1 - np.argmin(windows[:, ::-1], axis=1))
-    chosen = np.unique(chosen)
-    return grams[chosen], chosen
-
-
-def kgrams(normalised):
-    """The hash of every run of :data:`NOISE` characters of a normalised text (the same in every process)."""
-    codes = np.frombuffer(str(normalised).encode("utf-32-le"), dtype=np.uint32).astype(np.uint64)
-    if codes.size < NOISE:
-        return np.zeros(0, dtype=np.uint64)
-    windows = np.lib.stride_tricks.sliding_window_view(codes, NOISE)
-    return windows @ POWERS
-
-
-def _covered(positions, length):
-    """How many characters of a text of `length` the fingerprints at `positions` cover, and the mask."""
-    marks = np.zeros(length + NOISE + 1, dtype=np.int64)
-    np.add.at(marks, positions, 1)
-    np.add.at(marks, positions + NOISE, -1)
-    mask = np.cumsum(marks)[:length] > 0
-    return int(mask.sum()), mask
-
-
-# -- the known sources -------------------------------------------------------------------------------------
+VERSION = "labkit-known/5"  # the cache's format and normalisation: a change here recomputes every fingerprint
 
 
 @dataclass(frozen=True)
@@ -168,23 +45,18 @@ class Unit:
 
 @dataclass(frozen=True)
 class Corpus:
-    """The fingerprints of the known sources: which unit and which source (file) each one comes from."""
+    """The fingerprints of the known sources, and the unit each one comes from."""
 
     units: tuple  # Unit
-    sources: tuple  # the names of the known sources: a module or a notebook
     hashes: np.ndarray  # sorted fingerprint hashes, one entry per (hash, unit)
     unit_of: np.ndarray  # the unit of each entry
-    source_of: np.ndarray  # its source (an index into `sources`)
     digest: str  # what the corpus was made of (its files' SHA-256), for the run's record
 
     def holders(self, hashes):
-        """For each hash, the entries of the corpus that have it: (index of the hash, entry) pairs."""
+        """The entries of the corpus that have one of the distinct `hashes`."""
         left = np.searchsorted(self.hashes, hashes, side="left")
-        right = np.searchsorted(self.hashes, hashes, side="right")
-        counts = right - left
-        which = np.repeat(np.arange(len(hashes)), counts)
-        entries = np.repeat(left - np.cumsum(np.r_[0, counts[:-1]]), counts) + np.arange(counts.sum())
-        return which, entries
+        counts = np.searchsorted(self.hashes, hashes, side="right") - left
+        return np.repeat(left - np.cumsum(np.r_[0, counts[:-1]]), counts) + np.arange(counts.sum())
 
 
 def cache_folder():
@@ -198,26 +70,11 @@ def cache_folder():
 def _definitions(tree, prefix):
     """(name, first line, last line) of each top-level function and each method of a top-level class."""
     for node in tree.body:
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-            first = min([node.lineno] + [d.lineno for d in node.decorator_list])
-            yield f"{prefix}{node.name}", first, node.end_lineno
-        elif isinstance(node, ast.ClassDef):
-            for inner in node.body:
-                if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                    first = min([inner.lineno] + [d.lineno for d in inner.decorator_list])
-                    yield f"{prefix}{node.name}.{inner.name}", first, inner.end_lineno
-
-
-def _fingerprint_units(texts):
-    """[(unit text, hashes)] → the unit index and hash arrays of their fingerprints."""
-    hashes, units = [], []
-    for index, text in enumerate(texts):
-        found = np.unique(fingerprints(normalise(canonical(text))[0])[0])
-        hashes.append(found)
-        units.append(np.full(found.size, index, dtype=np.int32))
-    if not hashes:
-        return np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int32)
-    return np.concatenate(hashes), np.concatenate(units)
+        for inner in node.body if isinstance(node, ast.ClassDef) else [node]:
+            if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                first = min([inner.lineno] + [d.lineno for d in inner.decorator_list])
+                name = inner.name if inner is node else f"{node.name}.{inner.name}"
+                yield f"{prefix}{name}", first, inner.end_lineno
 
 
 @functools.cache
@@ -249,6 +106,13 @@ def _cached(name, raw, compute):
     return data, key
 
 
+def _entry(units, texts):
+    """JSON data: the `units`, and the distinct fingerprints of each one's text (`texts`) with its index."""
+    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(text))[0])[0]).tolist() for text in texts]
+    unit_of = [index for index, found in enumerate(hashes) for _ in found]
+    return {"units": units, "hashes": [h for found in hashes for h in found], "unit_of": unit_of}
+
+
 def _module_entry(module, path):
     """The units and fingerprints of one Python source file, cached."""
     raw = Path(path).read_bytes()
@@ -257,23 +121,21 @@ def _module_entry(module, path):
         try:
             tree = ast.parse(raw)
         except (SyntaxError, ValueError):
-            return {"units": [], "hashes": [], "unit_of": []}
+            return _entry([], [])
         lines = raw.decode("utf-8", "replace").split("\n")
         found = [list(unit) for unit in _definitions(tree, f"{module}.")]
-        hashes, unit_of = _fingerprint_units(["\n".join(lines[a - 1 : b]) for _, a, b in found])
-        return {"units": found, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
+        return _entry(found, ["\n".join(lines[a - 1 : b]) for _, a, b in found])
 
     return _cached(module, raw, compute)
 
 
 def _notebook_entry(name, cells):
     """The units and fingerprints of one instructor notebook's code cells, cached."""
-    raw = json.dumps([name, list(cells)]).encode("utf-8")
 
     def compute():
         from .scan import python_source
 
-        units, texts = [], []
+        units = []
         for cell in cells:
             text = python_source(cell)  # as the grader reads a notebook: magics and shell lines left out
             try:
@@ -281,13 +143,10 @@ def _notebook_entry(name, cells):
             except (SyntaxError, ValueError):
                 continue  # IPython could not run it either: it defines nothing
             lines = text.split("\n")
-            for unit, first, last in _definitions(tree, f"{name}: "):
-                texts.append("\n".join(lines[first - 1 : last]))
-                units.append([unit, first, last, texts[-1]])
-        hashes, unit_of = _fingerprint_units(texts)
-        return {"units": units, "hashes": hashes.tolist(), "unit_of": unit_of.tolist()}
+            units += [[unit, a, b, "\n".join(lines[a - 1 : b])] for unit, a, b in _definitions(tree, f"{name}: ")]
+        return _entry(units, [unit[3] for unit in units])
 
-    return _cached(name, raw, compute)
+    return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), compute)
 
 
 def known_modules(refusals):
@@ -312,27 +171,16 @@ def corpus(refusals=(), solutions=()):
     `refusals` are :class:`labkit.exercises.model.Refusal` objects; `solutions` is a tuple of (notebook
     name, tuple of its code cells), the instructor notebooks as the grader reads them
     (:func:`labkit.grading.submission.scoring.solutions`)."""
-    entries = [(module, str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
-    entries += [(f"the solutions' {name}", name, _notebook_entry(name, cells)) for name, cells in solutions]
-    units, sources, hashes, unit_of, source_of, keys = [], [], [], [], [], []
-    for source, path, (data, key) in entries:
-        keys.append(key)
-        offset = len(units)
-        for unit in data["units"]:
-            name, first, last = unit[:3]
-            units.append(Unit(name, path, int(first), int(last), unit[3] if len(unit) > 3 else None))
+    entries = [(str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
+    entries += [(name, _notebook_entry(name, cells)) for name, cells in solutions]
+    units, hashes, unit_of = [], [np.zeros(0, dtype=np.uint64)], [np.zeros(0, dtype=np.int64)]
+    for path, (data, _) in entries:
+        unit_of.append(np.asarray(data["unit_of"], dtype=np.int64) + len(units))
+        units += [Unit(name, path, int(a), int(b), *rest) for name, a, b, *rest in data["units"]]
         hashes.append(np.asarray(data["hashes"], dtype=np.uint64))
-        unit_of.append(np.asarray(data["unit_of"], dtype=np.int64) + offset)
-        source_of.append(np.full(len(data["hashes"]), len(sources), dtype=np.int64))
-        sources.append(source)
-    hashes = np.concatenate(hashes) if hashes else np.zeros(0, dtype=np.uint64)
-    order = np.argsort(hashes, kind="stable")
-    cat = (lambda parts: np.concatenate(parts)[order]) if hashes.size else (lambda parts: np.zeros(0, np.int64))
-    digest = hashlib.sha256("\n".join(sorted(keys)).encode()).hexdigest()[:16]
-    return Corpus(tuple(units), tuple(sources), hashes[order], cat(unit_of), cat(source_of), digest)
-
-
-# -- a notebook's code against them ------------------------------------------------------------------------
+    order = np.argsort(np.concatenate(hashes), kind="stable")
+    digest = hashlib.sha256("\n".join(sorted(key for _, (_, key) in entries)).encode()).hexdigest()[:16]
+    return Corpus(tuple(units), np.concatenate(hashes)[order], np.concatenate(unit_of)[order], digest)
 
 
 @dataclass(frozen=True)
@@ -347,87 +195,52 @@ class Match:
     public: bool = True  # whether the source is on every student's disk (labkit, scipy), not the solutions
 
     def as_dict(self):
-        return {
-            "definition": self.definition,
-            "source": self.source,
-            "share": self.share,
-            "shared": self.shared,
-            "lines": self.lines,
-            "public": self.public,
-        }
+        return dataclasses.asdict(self)
 
 
 class Given:
-    """Every :data:`NOISE`-character hash of the release's code cells: what every student was given."""
+    """Every fingerprint-sized hash of the release's code cells: what every student was given (one per run:
+    :func:`match` caches by it)."""
 
     def __init__(self, cells):
-        found = [kgrams(normalise(canonical(cell))[0]) for cell in cells]
-        self.array = np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
+        self.array = fingerprint.release_grams(cells)
 
 
-def release_grams(cells):
-    """:class:`Given` of a release's code cells (one per run: :func:`match` caches by it)."""
-    return Given(cells)
+release_grams = Given
 
 
 def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
-    """The :class:`Match` of a part's code, when known sources have :data:`THRESHOLD` or more of it; else None.
+    """The :class:`Match` of a part's code, when known sources have `threshold` or more of it; else None.
 
-    The part's code is `definitions`, the graded function and every definition it reaches. What counts is
-    each definition's own code: its distinct fingerprints that the release does not give everyone (a run
-    repeated in the student's code counts once). Each definition is set against the one known unit (a
-    function or method of labkit, scipy or the solutions) that has most of its fingerprints; the part's
-    share is the part of all its own fingerprints that those units have. It matches when that share is
-    `threshold` or more and at least `minimum` fingerprints are shared: short code that the lab's formulas
-    dictate is written alike by everyone, so it is never evidence.
-
-    Parameters
-    ----------
-    known : Corpus
-        The known sources (:func:`corpus`).
-    definitions : iterable of (str, str)
-        (name, source text) of the notebook's definitions to judge: a graded function and what it reaches.
-    given : Given
-        :func:`release_grams` of what every student was given: code that only repeats it is nobody's.
-    threshold : float, optional
-        The share from which the part matches (:data:`THRESHOLD`; 0 gives the best sources whatever the share).
-    minimum : int, optional
-        The fingerprints the part must share at least (:data:`MIN_SHARED`).
+    The part's code is `definitions`, [(name, source)] of a graded function and what it reaches. Each unit
+    of it (:func:`~labkit.grading.submission.fingerprint.units`) is set against the one known unit of
+    `known` (:func:`corpus`) that has most of its own fingerprints (those the release, `given`, does not
+    give everyone, each counted once). It matches when those units have `threshold` of all its own
+    fingerprints (0: whatever the share) and at least `minimum`: the lab's formulas make short code come
+    out alike from everyone, so only a long shared stretch is evidence.
     """
-    judged, total, shared = [], 0, 0
+    total, judged = 0, []
     for name, text in fingerprint.units(definitions):
-        normalised, where, hashes, positions = _read(text, given)
+        where, hashes, positions = _read(text, given)
         distinct = np.unique(hashes)
-        if not distinct.size:
-            continue
         total += distinct.size
-        which, entries = known.holders(distinct)
-        if not entries.size:
-            continue
-        units, counts = np.unique(known.unit_of[entries], return_counts=True)
-        unit = int(units[np.argmax(counts)])
-        judged.append((int(counts.max()), name, text, where, hashes, positions, unit))
-        shared += int(counts.max())
-    if not judged or not total:
+        entries = known.holders(distinct) if distinct.size else distinct
+        if entries.size:
+            units, counts = np.unique(known.unit_of[entries], return_counts=True)
+            judged.append((int(counts.max()), name, text, where, hashes, positions, int(units[np.argmax(counts)])))
+    shared = sum(entry[0] for entry in judged)
+    if not judged or shared / total < threshold or shared < minimum:
         return None
-    share = shared / total
-    if share < threshold or shared < minimum:
-        return None
-    count, name, text, where, hashes, positions, unit = max(judged, key=lambda entry: entry[0])
-    theirs = known.hashes[known.unit_of == unit]
-    _, mask = _covered(positions[np.isin(hashes, theirs)], len(where))
+    _, name, text, where, hashes, positions, unit = max(judged, key=lambda entry: entry[0])
+    lines = fingerprint.shared_lines(text, where, positions[np.isin(hashes, known.hashes[known.unit_of == unit])])
     unit = known.units[unit]
-    return Match(name, unit.name, round(share, 3), shared, _side_by_side(text, where, mask, unit), unit.text is None)
+    return Match(name, unit.name, round(shared / total, 3), shared, _side_by_side(text, lines, unit), unit.text is None)
 
 
 @functools.lru_cache(maxsize=256)
 def _read(text, given):
-    """A definition's normalised text, and its fingerprints that the release does not give. (`given` is
-    hashed by identity: one per run.)"""
-    normalised, where = normalise(text)
-    hashes, positions = fingerprints(normalised)
-    mine = ~np.isin(hashes, given.array)
-    return normalised, where, hashes[mine], positions[mine]
+    """:func:`labkit.grading.submission.fingerprint.own` of a definition (`given` is hashed by identity)."""
+    return fingerprint.own(text, given.array)
 
 
 def _unit_text(unit):
@@ -437,24 +250,17 @@ def _unit_text(unit):
     return "\n".join(lines[unit.first - 1 : unit.last])
 
 
-def _shared_lines(text, where, mask):
-    """The lines of `text` (0-based numbers) with a normalised character that `mask` marks."""
-    starts = np.cumsum([0] + [len(line) + 1 for line in text.split("\n")[:-1]])
-    return sorted(set((np.searchsorted(starts, where[mask], side="right") - 1).tolist()))
-
-
-def _side_by_side(text, where, mask, unit):
-    """Up to :data:`SHOWN` pairs of shared lines: the student's, and the known unit's line most like it."""
+def _side_by_side(text, numbers, unit):
+    """Up to :data:`SHOWN` pairs of shared lines (`numbers` of `text`'s): the student's, and the known unit's
+    line most like it."""
     try:
-        theirs = _unit_text(unit)
+        theirs = _unit_text(unit).split("\n")
     except (OSError, IndexError, ValueError):
-        theirs = ""
-    mine_lines = text.split("\n")
-    their_lines = theirs.split("\n")
-    their_normal = [normalise(line)[0] for line in their_lines]
+        theirs = [""]
+    mine, their_normal = text.split("\n"), [normalise(line)[0] for line in theirs]
     pairs, after = [], 0
-    for number in _shared_lines(text, where, mask):
-        line = mine_lines[number].strip()
+    for number in numbers:
+        line = mine[number].strip()
         normal = normalise(line)[0]
         if not normal:
             continue
@@ -463,7 +269,7 @@ def _side_by_side(text, where, mask, unit):
         found = next((i for i in order if their_normal[i] == normal), None)
         if found is not None:
             after = found + 1
-        pairs.append((line[:120], "" if found is None else their_lines[found].strip()[:120]))
+        pairs.append((line[:120], "" if found is None else theirs[found].strip()[:120]))
         if len(pairs) == SHOWN:
             break
     return tuple(pairs)

@@ -684,7 +684,7 @@ def test_the_cli_uses_the_similarity_search_when_labkit_has_one(grades, tmp_path
     assert "Not computed" not in (tmp_path / "report.html").read_text()
 
 
-def test_the_report_is_written_without_copydetect_and_says_why_similar_code_was_not_computed(tmp_path, monkeypatch):
+def test_the_report_is_written_without_pygments_and_says_why_similar_code_was_not_computed(tmp_path, monkeypatch):
     from class_results import synthetic_class, synthetic_sources
 
     grades = synthetic_class(12, seed=3)
@@ -692,15 +692,15 @@ def test_the_report_is_written_without_copydetect_and_says_why_similar_code_was_
     for g in grades:
         g.sources = {function: by_student[g.name] for function, by_student in sources.items() if g.name in by_student}
     write_report(tmp_path, grades)
-    # copydetect not installed (labkit without its grade extra): every import of it fails
-    for name in [name for name in sys.modules if name == "copydetect" or name.startswith("copydetect.")]:
+    # the similarity search's tokeniser not installed: every import of it fails
+    for name in [name for name in sys.modules if name == "pygments" or name.startswith("pygments.")]:
         monkeypatch.setitem(sys.modules, name, None)
-    monkeypatch.setitem(sys.modules, "copydetect", None)
+    monkeypatch.setitem(sys.modules, "pygments", None)
     assert main(["report", str(tmp_path), "--quiet"]) == 0
-    assert similarity.similar_pairs(grades) is None and "copydetect" in similarity.unavailable()
+    assert similarity.similar_pairs(grades) is None and "pygments" in similarity.unavailable()
     page = Page((tmp_path / "report.html").read_text())
     similar = page.words("similar")
-    assert "Not computed (the similarity search needs copydetect, which cannot be imported here" in similar
+    assert "Not computed (the similarity search needs pygments, which cannot be imported here" in similar
     assert "pip install 'labkit[grade]'" in similar
     assert "12 submissions" in page.words(None)  # the rest of the page is there
     assert page.words("totals").startswith("Totals")

@@ -2,22 +2,26 @@
 release's stubs are never evidence, the shared lines are the copied ones, hostile sources are bounded, the
 grader keeps each graded function's source in its results, and no grade depends on any of it."""
 
+import io
+import itertools
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
 from catalog import PHERM_LOOPS, PHERM_SEARCH, Planted, plant
 from conftest import sandbox_or_skip
-from copydetect import compare_files
+from copies import renamed_cells
 
 from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading.reports import similarity
 from labkit.grading.reports.similarity import DEFAULT_THRESHOLD, Pair, similar_pairs
 from labkit.grading.store.report import SubmissionGrade, read_results, write_csv
+from labkit.grading.submission.fingerprint import NOISE, normalise
 from labkit.grading.submission.scan import MAX_CODE_BYTES, MAX_SOURCE_CHARS, function_sources, reached_function_sources
-from labkit.grading.submission.scoring import graded_functions, read_cells
+from labkit.grading.submission.scoring import exercises_in, graded_functions, read_cells, registry_graded
 from labkit.student_notebooks import paths
 
 DOC = '''    """Piecewise cubic Hermite interpolant of (xdata, ydata) with slopes ypdata, at xval.
@@ -162,8 +166,11 @@ def test_the_release_stub_shared_by_everyone_is_never_flagged():
     assert stubs["eval_pherm"].strip() == STUB
     grades = [SubmissionGrade(name, sources=dict(stubs)) for name in ("ada", "bo", "cy")]
     assert similar_pairs(grades, threshold=0.0) == []
-    # against no release, the very same stubs are what everyone shares
-    assert {p.function for p in similar_pairs(grades, release=[])} == set(stubs)
+    # against no release, the very same stubs are what everyone shares (but a stub shorter than one fingerprint,
+    # runge's one-line call, which is never evidence)
+    long_enough = {name for name, stub in stubs.items() if len(normalise(stub)[0]) >= NOISE}
+    assert long_enough >= {"eval_pherm", "coons", "ncspline", "eval_pbilin"}
+    assert {p.function for p in similar_pairs(grades, release=[])} == long_enough
 
 
 def test_a_student_who_left_the_stub_gets_no_pairs():
@@ -179,7 +186,7 @@ def test_a_stub_after_given_code_leaves_nothing_behind():
     # before the stub, does not pick: every run of the release is boilerplate, not only its fingerprints
     for n in range(12):
         cell = f"xs = np.linspace(0.0, {n + 2}.0, {10 * n + 1})\nplt.plot(xs, np.sin({n} * xs))\n\n\n{STUB}\n"
-        assert similarity._fingerprint(STUB, similarity.boilerplate([cell]).hashes) is None, cell
+        assert similarity._version("sam", STUB, similarity.boilerplate([cell]).hashes) is None, cell
         assert similar_pairs(_grades({"sam": STUB, "sue": STUB}), threshold=0.0, release=[cell]) == []
 
 
@@ -247,17 +254,77 @@ def test_pairs_come_most_similar_first_and_never_within_one_student():
     assert both == sorted(both, key=lambda p: (-p.score, p.function, p.first, p.second))
 
 
-def test_the_vectorised_scores_are_copydetects():
+def test_the_vectorised_scores_are_the_share_of_code_covered_by_shared_fingerprints():
     sources = [ORIGINAL, COPY, LOOP, PARTIAL, HEAD + PHERM_LOOPS, HEAD + PHERM_SEARCH, ORIGINAL.replace("xk", "q")]
     hashes = similarity.boilerplate().hashes
-    prints = [similarity._fingerprint(text, hashes) for text in sources]
-    scores = similarity.shares(prints)
-    for i, one in enumerate(prints):
-        for j, other in enumerate(prints):
+    versions = [similarity._version(str(k), text, hashes) for k, text in enumerate(sources)]
+    scores = similarity.shares(versions)
+    for i, one in enumerate(versions):
+        mine = {c for p in one.positions for c in range(p, p + NOISE)}
+        for j, other in enumerate(versions):
             if i != j:
-                _, (mine, _), _ = compare_files(one, other)
-                assert scores[i, j] == pytest.approx(float(mine), abs=1e-12), (i, j)
+                theirs = set(other.hashes.tolist())
+                shared = {c for p, h in zip(one.positions, one.hashes) if h in theirs for c in range(p, p + NOISE)}
+                assert scores[i, j] == pytest.approx(len(shared) / len(mine), abs=1e-12), (i, j)
     assert np.all(np.diag(scores) == 0) and scores.max() > 0.9
+
+
+def test_the_pairs_flagged_are_among_copydetects_and_include_its_near_copies():
+    # copydetect (labkit's test extra only) as an outside reference: it reads names, attributes and brackets
+    # more coarsely, so it scores honest loops higher; every pair flagged here it flags too
+    copydetect = pytest.importorskip("copydetect")
+    half = HEAD + "\n".join(BODY.split("\n")[:5]) + "\n    return h1 * ydata[k] - 7 * np.sum(xval ** 5) / len(xdata)\n"
+    sources = {"ada": ORIGINAL, "zoe": COPY, "lee": LOOP, "dee": PARTIAL, "cat": HEAD + PHERM_LOOPS}
+    sources |= {"sea": HEAD + PHERM_SEARCH, "ren": ORIGINAL.replace("xk", "q"), "bo": half}
+    ours = {(p.first, p.second) for p in similar_pairs(_grades(sources), release=[])}
+    prints = {
+        n: copydetect.CodeFingerprint("a.py", NOISE, 6, fp=io.StringIO(t), language="python")
+        for n, t in sources.items()
+    }
+    theirs = {
+        pair: max(copydetect.compare_files(*map(prints.get, pair))[1])
+        for pair in itertools.combinations(sorted(sources), 2)
+    }
+    assert {pair for pair, score in theirs.items() if score >= 0.95} <= ours
+    assert ours <= {pair for pair, score in theirs.items() if score >= DEFAULT_THRESHOLD}
+    assert ours == {("ada", "ren"), ("ada", "zoe"), ("ren", "zoe")}
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _notebook_sources(folder, rewrite=list):
+    """{graded function: its source} of a folder of notebooks, as the grader keeps them."""
+    found = {}
+    for path in sorted(folder.glob("*.ipynb")):
+        cells, markdown = read_cells(path)
+        names = [n for number in exercises_in(markdown, LAB) for n in graded_functions(LAB.exercises[number])]
+        found.update(reached_function_sources(rewrite(cells), names, registry_graded(LAB)))
+    return found
+
+
+def test_independent_solutions_are_never_similar_to_the_solutions_or_each_other_but_a_disguised_copy_is():
+    independent = ROOT / "tests" / "data" / "independent"
+    folders = {p.name: p for p in sorted(independent.iterdir()) if p.is_dir()} | {"instructor": ROOT / "notebooks"}
+    grades = [SubmissionGrade(name, sources=_notebook_sources(folder)) for name, folder in folders.items()]
+    assert len(grades) == 6 and all(len(g.sources) >= 15 for g in grades)
+    # the one pair flagged is no false alarm: plain_loops and style_b hold the same exercise 5 word for word
+    found = similar_pairs(grades)
+    assert {(p.function, p.first, p.second) for p in found} == {
+        ("mirror", "plain_loops", "style_b"),
+        ("two_patches", "plain_loops", "style_b"),
+    }
+    assert all(p.first_lines == p.second_lines for p in found)
+    assert (
+        max(p.score for p in similar_pairs(grades, threshold=0.0) if p.first_lines != p.second_lines)
+        < DEFAULT_THRESHOLD
+    )
+    # the solutions renamed, their docstrings gone, a statement added to each function and the cells reordered
+    disguised = _notebook_sources(ROOT / "notebooks", lambda cells: renamed_cells(cells)[::-1])
+    copier = SubmissionGrade("copier", sources={f: "# my own work\n" + text for f, text in disguised.items()})
+    flagged = similar_pairs([*grades, copier])
+    assert {(p.first, p.second) for p in flagged if "copier" in (p.first, p.second)} == {("copier", "instructor")}
+    assert {p.function for p in flagged if p.first == "copier"} == set(disguised)
 
 
 def test_similarity_never_changes_a_grade(tmp_path):

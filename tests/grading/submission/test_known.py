@@ -77,25 +77,27 @@ def _note(key, value, largest=True):
 def test_names_docstrings_comments_and_layout_do_not_change_the_normalised_text():
     one = 'def area(width, height):\n    """The area."""\n    # width times height\n    return width * height\n'
     two = "def surface(a,b):  return a*b"
-    assert known.normalise(one)[0] == known.normalise(two)[0]
-    assert known.normalise(one)[0] != known.normalise(two.replace("*", "+"))[0]  # what the code does counts
-    assert known.normalise("np.diff(x)")[0] != known.normalise("np.cumsum(x)")[0]  # so does the routine called
+    assert fingerprint.normalise(one)[0] == fingerprint.normalise(two)[0]
+    assert fingerprint.normalise(one)[0] != fingerprint.normalise(two.replace("*", "+"))[0]  # what the code does counts
+    assert (
+        fingerprint.normalise("np.diff(x)")[0] != fingerprint.normalise("np.cumsum(x)")[0]
+    )  # so does the routine called
 
 
 def test_each_normalised_character_points_at_its_token_in_the_source():
     text = "value = np.searchsorted(knots, 'left')  # done"
-    normalised, where = known.normalise(text)
+    normalised, where = fingerprint.normalise(text)
     for char, at in zip(normalised, where):
         assert char in "VFOS" or text[at] == char
 
 
 def test_fingerprints_are_the_same_in_every_process():
     text = module_source("labkit.bilinear")
-    here = known.fingerprints(known.normalise(text)[0])[0].tolist()
+    here = fingerprint.fingerprints(fingerprint.normalise(text)[0])[0].tolist()
     code = (
         "import sys, json; sys.path.insert(0, 'tests'); from copies import module_source; "
-        "from labkit.grading.submission import known; "
-        "print(json.dumps(known.fingerprints(known.normalise(module_source('labkit.bilinear'))[0])[0].tolist()))"
+        "from labkit.grading.submission import fingerprint; "
+        "print(json.dumps(fingerprint.fingerprints(fingerprint.normalise(module_source('labkit.bilinear'))[0])[0].tolist()))"
     )
     there = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
     assert json.loads(there.stdout) == here and len(here) > 50
@@ -107,7 +109,7 @@ def test_every_shared_run_of_thirty_normalised_characters_shares_a_fingerprint(r
         shared = "".join(rng.choice(alphabet, 30))
         one = "".join(rng.choice(alphabet, int(rng.integers(0, 80)))) + shared
         two = shared + "".join(rng.choice(alphabet, int(rng.integers(0, 80))))
-        first, second = known.fingerprints(one)[0], known.fingerprints(two)[0]
+        first, second = fingerprint.fingerprints(one)[0], fingerprint.fingerprints(two)[0]
         assert np.intersect1d(first, second).size, (one, two)
 
 
@@ -173,7 +175,7 @@ def test_the_cache_is_used_and_a_broken_cache_entry_is_computed_again(tmp_path, 
         raise AssertionError("the cached fingerprints were computed again")
 
     with monkeypatch.context() as patched:
-        patched.setattr(known, "_fingerprint_units", never)
+        patched.setattr(known, "_entry", never)
         assert known._module_entry("labkit.bilinear", path)[0] == first  # read from the cache
     files[0].write_text("{not json")
     again, _ = known._module_entry("labkit.bilinear", path)
