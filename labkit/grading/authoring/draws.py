@@ -47,7 +47,7 @@ from ...errors import InputError
 from ...execute import read_notebook
 from ...exercises import variants as variant_data
 from ...exercises.registry import LAB, Registry
-from .release import BEGIN_HIDDEN, END_HIDDEN, with_values
+from .release import BEGIN_HIDDEN, END_HIDDEN, copy_notebook, with_values
 
 
 @dataclass(frozen=True)
@@ -81,11 +81,7 @@ def load_catalog(path):
 
 def _planted(nb, replace, name):
     """Notebook `nb` with the (old, new) code replacements of a catalog entry (each old once in one code cell)."""
-    import json
-
-    import nbformat
-
-    nb = nbformat.from_dict(json.loads(json.dumps(nb)))
+    nb = copy_notebook(nb)
     for old, new in replace:
         hits = [cell for cell in nb.cells if cell.cell_type == "code" and old in cell.source]
         if len(hits) != 1 or hits[0].source.count(old) != 1:
