@@ -69,29 +69,11 @@ RUN = "run"  # the profile of the request that runs the cells: nothing is refuse
 BEGIN, CHOSEN, END = "labkit.begin", "labkit.chosen", "labkit.end"  # the worker's sentinels
 # audit events that void the notebook's answers: what reaches the watch's state or goes round it
 TAMPER_EVENTS = frozenset(
-    {
-        "sys.setprofile",
-        "sys.settrace",
-        "sys._current_frames",
-        "sys.addaudithook",
-        "gc.get_objects",
-        "gc.get_referrers",
-        "gc.get_referents",
-        "gc.freeze",
-        "os.fork",
-        "os.forkpty",
-        "os.posix_spawn",
-        "os.exec",
-        "os.spawn",
-        "os.system",
-        "subprocess.Popen",
-        "code.__new__",
-        "function.__new__",
-        "_thread.start_new_thread",
-        "cpython._PySys_ClearAuditHooks",
-        "cpython.run_interactivehook",
-        "sys.monitoring.register_callback",
-    }
+    {"sys.setprofile", "sys.settrace", "sys._current_frames", "sys.addaudithook", "sys.monitoring.register_callback"}
+    | {"gc.get_objects", "gc.get_referrers", "gc.get_referents", "gc.freeze"}
+    | {"os.fork", "os.forkpty", "os.posix_spawn", "os.exec", "os.spawn", "os.system", "subprocess.Popen"}
+    | {"code.__new__", "function.__new__", "_thread.start_new_thread"}
+    | {"cpython._PySys_ClearAuditHooks", "cpython.run_interactivehook"}
 )
 TAMPER_PREFIXES = ("ctypes.",)  # but ctypes.dlopen: scipy's own imports open libraries, which is no harm alone
 HARMLESS = frozenset({"ctypes.dlopen"})
@@ -328,35 +310,16 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     profiles, strictest = _kept_profiles(profiles)
     c_objects = _refused_objects([*profiles.values(), strictest])
     sizes, holders = _modules_as_found(c_objects)
-    state = {
-        "secret": secret,
-        "verdict_fd": verdict_fd,
-        "chain": chain,
-        "profiles": profiles,
-        "strictest": strictest,
-        "c_objects": c_objects,
-        "sizes": sizes,
-        "holders": holders,
-        "copies": _trusted_copies(passables),
-        "compiled_types": _compiled_types(),
-        "refused_call": _stand_in("").__code__,
-        "handed_code": _handed_over(lambda: None).__code__,
-        "cache": {},  # id(code) -> (code, key)
-        # mode: "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
-        "mode": "idle",
-        "rid": None,
-        "name": None,
-        "profile": None,
-        "passables": (),
-        "refused": None,
-        "tampered": None,
-        "live": frozenset(),
-        "stubbed": [],
-        "busy": False,
-        "gc": True,
-        # the code objects in the filter's table, alive until it is emptied: no other code takes their address
-        "held": [],
-    }
+    # what the watch was given, and what it took while the process was pristine
+    state = dict(secret=secret, verdict_fd=verdict_fd, chain=chain, profiles=profiles, strictest=strictest)
+    state.update(c_objects=c_objects, sizes=sizes, holders=holders, copies=_trusted_copies(passables))
+    state.update(compiled_types=_compiled_types(), refused_call=_stand_in("").__code__)
+    state.update(handed_code=_handed_over(lambda: None).__code__, cache={})  # cache: id(code) -> (code, key)
+    # the request: mode is "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
+    state.update(mode="idle", rid=None, name=None, profile=None, passables=(), refused=None, tampered=None)
+    state.update(live=frozenset(), stubbed=[], busy=False, gc=True)
+    # the code objects in the filter's table, alive until it is emptied: no other code takes their address
+    state["held"] = []
     hook_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.py_object, ctypes.c_int, ctypes.c_void_p)
     hook = hook_type(_profile_hook(state))
     set_profile = ctypes.pythonapi.PyEval_SetProfile

@@ -395,7 +395,7 @@ def grade_notebook(
     numbers = [n for n in exercises_in(markdown, registry) if n not in skip]
     if not numbers:
         return {}, []
-    size = sum(len(source.encode("utf-8", "surrogatepass")) for source in code)
+    size = scan.code_bytes(code)
     if size > scan.MAX_CODE_BYTES:
         text = (
             f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
