@@ -126,7 +126,6 @@ class Slip:
 class Problem:
     """What went wrong for one student, of one kind (its texts as the grader worded them)."""
 
-    kind: str
     student: str
     texts: tuple
 
@@ -147,24 +146,6 @@ class LateEntry(lateness.Lateness):
 
     student: str = ""
 
-    @property
-    def submitted(self):
-        return self.time.when if self.time is not None else None
-
-    @property
-    def source(self):
-        """Where the time came from (``late.FROM_...``), None when unknown."""
-        return self.time.source if self.time is not None else None
-
-    @property
-    def late(self):
-        return self.units > 0
-
-    @property
-    def student_supplied(self):
-        """Whether its time is the student's own word (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)."""
-        return self.source in lateness.STUDENT_SUPPLIED
-
 
 @dataclass(frozen=True)
 class LateSummary:
@@ -176,11 +157,11 @@ class LateSummary:
     @property
     def late(self):
         """The late submissions, latest first."""
-        return sorted((e for e in self.entries if e.late), key=lambda e: (-e.late_by, e.student))
+        return sorted((e for e in self.entries if e.units > 0), key=lambda e: (-e.late_by, e.student))
 
     @property
     def on_time(self):
-        return [e for e in self.entries if e.known and not e.late]
+        return [e for e in self.entries if e.known and e.units <= 0]
 
     @property
     def within_grace(self):
@@ -196,8 +177,8 @@ class LateSummary:
 
     @property
     def student_supplied(self):
-        """Submissions whose known time the student supplied (an unknown time is listed as unknown)."""
-        return [e for e in self.entries if e.known and e.student_supplied]
+        """Submissions whose known time the student supplied (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)."""
+        return [e for e in self.entries if e.known and e.time.source in lateness.STUDENT_SUPPLIED]
 
     @property
     def penalty(self):
@@ -266,31 +247,20 @@ class ClassSummary:
     held: list = field(default_factory=list)  # Held
     copies: Copies | None = None  # whose data, solution markers, each student's graded functions (copies.py)
 
-    @property
-    def submissions(self):
-        return len(self.totals) + len(self.not_graded)
-
 
 def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
-    """The grades of a grading run's output folder (``labkit grade ... --out OUT``, merged runs too).
+    """The grades, in name order, of a grading run's ``--out`` folder (``labkit grade`` or ``labkit merge``).
 
     Parameters
     ----------
     folder : str or Path
-        The ``--out`` folder of ``labkit grade`` (or of ``labkit merge``).
     rubric : Rubric, optional
-        The rubric the run was scored with (the lab's when None).
-
-    Returns
-    -------
-    list of SubmissionGrade
-        In name order.
+        The rubric the run was scored with (the recorded one when None; another one is refused).
 
     Raises
     ------
     ValueError
-        If the folder does not exist or holds too many or no results, a result is not labkit's, or the
-        results were scored under another rubric than `rubric`.
+        If the folder does not exist or holds too many or no results, or a result is not labkit's.
 
     Examples
     --------
@@ -312,19 +282,13 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
 
 
 def check_outcome(check: dict) -> str:
-    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"`` or a problem's kind.
+    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"``, ``"another
+    variant"`` or a problem's kind (:data:`OUTCOMES`; ``"other"``: a fault of the check itself).
 
     Parameters
     ----------
     check : dict
-        One entry of an exercise's ``checks`` in a result (a failed step that is not a slip has its ``kind``,
-        :data:`labkit.exercises.result.KINDS`).
-
-    Returns
-    -------
-    str
-        ``"passed"``, ``"slip"``, ``"not done"`` (a stub or a missing name), ``"another variant"``, or one
-        of the problem kinds of :data:`OUTCOMES` (``"other"``: a fault of the check itself).
+        One entry of an exercise's ``checks`` in a result.
 
     Examples
     --------
@@ -347,20 +311,9 @@ def check_outcome(check: dict) -> str:
 
 
 def problem_kinds(problem: str) -> list[tuple[str, str]]:
-    """The (kind, description) pairs of a problem the grader recorded for a submission.
-
-    The kinds are the codes the grader set where it made the problem (a
-    :class:`labkit.grading.store.report.ProblemText`); a bare text, with no codes, is "other".
-
-    Parameters
-    ----------
-    problem : str
-        One of a submission's ``problems``.
-
-    Returns
-    -------
-    list of (str, str)
-        Each description is one printable line, bounded.
+    """The (kind, description) pairs of one of a submission's ``problems``, each description one printable
+    line; the kinds are the codes the grader set (:class:`~labkit.grading.store.report.ProblemText`), "other"
+    for a bare text.
 
     Examples
     --------
@@ -467,7 +420,7 @@ class _Tally:
         """Each kind's problems, by student."""
         found = {kind: [] for kind in KINDS}
         for (kind, student), texts in sorted(self.problems.items()):
-            found[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))
+            found[kind].append(Problem(student, tuple(dict.fromkeys(texts))))
         return {kind: rows for kind, rows in found.items() if rows}
 
     def slip_list(self):
@@ -505,10 +458,6 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     grades : list of SubmissionGrade
         One per submission, all scored under one rubric (:func:`read` gives them).
 
-    Returns
-    -------
-    ClassSummary
-
     Raises
     ------
     ValueError
@@ -542,9 +491,6 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
         copies=find_copies(submissions),
         held=[held for g in graded for held in Held.of(g)],
     )
-
-
-# ---------------------------------------------------------------------------------------------- figures
 
 
 def _figure(width, height):
@@ -618,9 +564,6 @@ def _rate_figures(summary):
     ]
 
 
-# ---------------------------------------------------------------------------------------------- the page
-
-
 def _text(value, limit=MAX_TEXT):
     return one_line(value, limit)
 
@@ -662,23 +605,17 @@ def render(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> str:
-    """The class report as one HTML document (a string), figures inline (``templates/class_report.html``).
+    """The class report as one HTML document, figures inline (``templates/class_report.html``).
 
     Parameters
     ----------
     summary : ClassSummary
-        From :func:`summarise`.
     pairs : list of Pair, optional
         Similar code to show side by side; None when the search was not made.
     threshold : float
-        The similarity from which pairs were listed (said on the page).
+        The similarity from which pairs were listed.
     similarity_note : str, optional
-        Why the pairs were not computed, when `pairs` is None; by default, why the similarity search cannot
-        run here, if it cannot (:func:`labkit.grading.reports.similarity.unavailable`).
-
-    Returns
-    -------
-    str
+        Why `pairs` is None; by default, why the similarity search cannot run here, if it cannot.
     """
     if not isinstance(summary, ClassSummary):
         raise InputError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
@@ -748,26 +685,17 @@ def write(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> Path:
-    """Write ``report.html`` into a grading run's output folder (through a temporary file, renamed over an
-    earlier report); the folder's other files are neither read nor touched.
+    """Write ``report.html`` into a grading run's output folder, through a temporary file renamed over an
+    earlier report, and return its path; the folder's other files are neither read nor touched.
 
     Parameters
     ----------
     out_dir : str or Path
-        The run's ``--out`` folder (it must exist).
+        The run's ``--out`` folder.
     grades : list of SubmissionGrade
         The class (:func:`read` reads them from `out_dir`).
-    pairs : list of Pair, optional
-        Similar code, shown side by side; None says "not computed".
-    threshold : float
-        The similarity from which `pairs` were listed, in (0, 1].
-    similarity_note : str, optional
-        Why the pairs were not computed.
-
-    Returns
-    -------
-    Path
-        ``out_dir/report.html``.
+    pairs, threshold, similarity_note
+        As for :func:`render`; `threshold` is in (0, 1].
 
     Raises
     ------
