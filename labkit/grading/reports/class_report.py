@@ -1,16 +1,11 @@
 """The class report: one self-contained HTML page about a grading run (``labkit report OUT``).
 
-:func:`read` reads a run's ``results/`` back (a merged run's too), :func:`summarise` counts what the class
-did, and :func:`write` writes ``OUT/report.html``: the totals (after any late penalty), the late view of a
-rubric's ``[late]`` table, each exercise's and part's pass rate, the slips the checks named, the problems
-(read from the kind codes the grader set, :data:`labkit.exercises.result.KINDS`, never from their words),
-the most failed parts, the parts held for a person, copies, and similar code side by side
-(:mod:`labkit.grading.reports.similarity`: it never changes a grade; without pygments the section says
-"not computed", and why).
-
-The page needs nothing but itself: inline PNG figures drawn on matplotlib's Agg canvas (no pyplot), inline
-style and script (``templates/class_report.*``). Everything a submission could have influenced is made
-printable and bounded (:func:`labkit.grading.store.report.one_line`), then escaped by the template.
+:func:`read` reads a run's results back (a merged run's too), :func:`summarise` counts what the class did,
+:func:`write` writes ``OUT/report.html`` from ``templates/class_report.*``: totals (after any late penalty),
+lateness, pass rates, slips, problems (by the kind codes the grader set, never by their words), the most
+failed parts, held parts, copies and similar code (which never changes a grade; without pygments, "not
+computed" and why). Figures are inline PNGs drawn on matplotlib's Agg canvas; every text a submission could
+have influenced is made printable and bounded (:func:`~labkit.grading.store.report.one_line`), then escaped.
 """
 
 from __future__ import annotations
@@ -277,7 +272,6 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
             f"{folder / 'results'} holds more than {MAX_SUBMISSIONS:,} result files, more than a class report "
             "shows: split the class and report on each part."
         )
-    # the run's record gives the rubric (a different one is refused) and vouches for each result file
     return read_results([folder], rubric_for([folder], rubric, "the class report"))
 
 
