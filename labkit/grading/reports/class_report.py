@@ -562,17 +562,6 @@ def _text(value, limit=MAX_TEXT):
     return one_line(value, limit)
 
 
-def _code_rows(lines, shared):
-    """A side of a pair of code as (gutter, line, shared) rows, bounded, and how many lines are left out."""
-    width = len(str(min(len(lines), MAX_LINES)))
-    rows = [
-        (f"{n + 1:>{width}} {'=' if n in shared else ' '} ", printable(str(line)).replace("\t", "    ")
-         .replace("\n", " ")[:MAX_LINE], n in shared)
-        for n, line in enumerate(lines[:MAX_LINES])
-    ]  # fmt: skip
-    return rows, max(len(lines) - MAX_LINES, 0)
-
-
 def _shared(indices, lines):
     """The indices of a pair's shared lines that are lines of `lines`."""
     return {i for i in indices if isinstance(i, int) and 0 <= i < len(lines)}
@@ -637,7 +626,7 @@ def render(
         points=points_text,
         time_text=lateness.time_text,
         duration_text=lateness.duration_text,
-        code_rows=_code_rows,
+        printable=printable,
         shared=_shared,
     )
 
