@@ -318,7 +318,8 @@ def _held_tasks(grades):
     held = {}
     for g in grades:
         for number, part, data, _ in g.held() if g.graded else ():
-            pairs = [(one_line(a, 200), one_line(b, 200)) for a, b in _pairs(data.get("lines", ()))]
+            lines = [p for p in data.get("lines", ()) if isinstance(p, (list, tuple)) and len(p) == 2]
+            pairs = [(one_line(a, 200), one_line(b, 200)) for a, b in lines]
             side = _parts().held(float(data.get("share", 0)), one_line(data.get("source", "?"), 120), pairs)
             entry = {"submission": g.name, "shown": shown_name(g.name, 200), "html": str(side)}
             held.setdefault(f"exercise{number}/{part}", []).append(entry)
@@ -327,10 +328,6 @@ def _held_tasks(grades):
          "question": str(_parts().held_question()), "model": "", "answers": entries}
         for item, entries in sorted(held.items())
     ]  # fmt: skip
-
-
-def _pairs(lines):
-    return [p for p in lines if isinstance(p, (list, tuple)) and len(p) == 2]
 
 
 def tasks(grades, marker="instructor"):
