@@ -417,15 +417,7 @@ def _steps(check):
 
 def _checks(grade, number):
     verdict = grade.results.get(number)
-    if verdict is None:
-        return None
-    checks = verdict.get("checks") if isinstance(verdict, dict) else None
-    if not isinstance(checks, list) or not all(isinstance(c, dict) for c in checks):
-        raise InputError(
-            f"the result of {one_line(grade.name, MAX_NAME)!r} for exercise {number} has no list of checks: "
-            "it was not written by `labkit grade`; grade the submission again."
-        )
-    return checks
+    return None if verdict is None else [part.as_dict() for part in verdict.parts]
 
 
 def _part_names(rubric, number, grades):

@@ -67,7 +67,7 @@ class RunRecord:
 
     kind: str
     labkit: str
-    seed: object
+    seed: int | list[int] | None
     rubric: dict
     rubric_text: str | None = None
     submissions: dict = field(default_factory=dict)
@@ -126,12 +126,13 @@ def write(folder, record):
     """Write `record` into `folder` (``record.json``, replaced whole; ``rubric.toml`` beside it)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    _replace(folder / RECORD, json.dumps(record.as_dict(), indent=1))
+    replace_text(folder / RECORD, json.dumps(record.as_dict(), indent=1))
     if record.rubric_text is not None:
-        _replace(folder / RUBRIC_COPY, record.rubric_text)
+        replace_text(folder / RUBRIC_COPY, record.rubric_text)
 
 
-def _replace(path, text):
+def replace_text(path, text):
+    """Write `text` into `path`, replacing it whole: a process killed meanwhile leaves the earlier file or none."""
     partial = path.with_name(f".{path.name}.partial")
     partial.write_text(text, encoding="utf-8")
     os.replace(partial, path)

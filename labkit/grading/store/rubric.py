@@ -259,7 +259,7 @@ def from_dict(data, source="the rubric"):
     branches, branch_extra = _branches(data.get("branches"), source, registry)
     groups = [("required", required), ("extra_credit", extra_credit)]
     groups += [(f"branch {b.name!r}", b.exercises) for b in branches]
-    seen = {}
+    seen: dict[int, str] = {}
     for group, numbers in groups:
         for number in numbers:
             if number in seen:
