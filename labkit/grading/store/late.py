@@ -67,28 +67,9 @@ _NBGRADER = re.compile(
 
 
 def parse_deadline(value: str | datetime, where: str = "the deadline") -> datetime:
-    """A deadline as a timezone-aware datetime: ISO 8601 text with a UTC offset, or a TOML offset date-time.
+    """A deadline as a timezone-aware datetime, from ISO 8601 text with a UTC offset (``Z`` is ``+00:00``, the
+    seconds may be left out) or a TOML offset date-time; InputError naming `where` for anything else.
 
-    Parameters
-    ----------
-    value : str or datetime.datetime
-        ``"2026-12-01T23:59:00+01:00"`` (``Z`` stands for ``+00:00``; the seconds may be left out), or
-        an offset date-time as TOML reads an unquoted one.
-    where : str
-        What the value is, for the error message.
-
-    Returns
-    -------
-    datetime.datetime
-        The moment, with its offset.
-
-    Raises
-    ------
-    ValueError
-        If the value has no UTC offset or is not in that format.
-
-    Examples
-    --------
     >>> parse_deadline("2026-12-01T23:59:00+01:00").isoformat()
     '2026-12-01T23:59:00+01:00'
     >>> parse_deadline("2026-12-01T23:59")  # doctest: +ELLIPSIS
@@ -116,30 +97,11 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
 def parse_timestamp(text: str) -> datetime:
     """The time nbgrader wrote in a ``timestamp.txt``, as a timezone-aware datetime.
 
-    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` in its configured timezone
-    (``2026-12-01 23:59:59.123456 UTC``), older versions the same without the
-    fraction, and ``nbgrader zip_collect`` an ISO time with an offset. All of
-    these are read, as is a numeric offset after the time. A time without any
-    zone, or with a zone name other than UTC or GMT (``CET`` names several),
-    is refused: which moment it means cannot be known.
+    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` in its configured timezone, older versions without the
+    fraction, ``nbgrader zip_collect`` an ISO time with an offset; all are read, as is a numeric offset. A time
+    without a zone, or with a zone name other than UTC or GMT (``CET`` names several), is an InputError: which
+    moment it means cannot be known.
 
-    Parameters
-    ----------
-    text : str
-        The file's text.
-
-    Returns
-    -------
-    datetime.datetime
-        The moment, with its offset.
-
-    Raises
-    ------
-    ValueError
-        Saying what is wrong with the text (shown to the instructor with the submission's name).
-
-    Examples
-    --------
     >>> parse_timestamp("2026-12-01 23:59:59.123456 UTC\\n").isoformat()
     '2026-12-01T23:59:59.123456+00:00'
     >>> parse_timestamp("2026-12-02 00:30:00+0100").isoformat()
@@ -210,16 +172,9 @@ def duration_text(delta: timedelta) -> str:
 
 @dataclass(frozen=True)
 class SubmissionTime:
-    """When a submission was handed in, where that came from, or why it is not known.
-
-    Attributes
-    ----------
-    when : datetime.datetime or None
-        The moment (timezone-aware), None when unknown.
-    source : str or None
-        Where it came from: :data:`FROM_CSV`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`.
-    problem : str or None
-        Why the time could not be read (an unreadable ``timestamp.txt``), when it could not.
+    """When a submission was handed in (timezone-aware; None when unknown), where that came from
+    (:data:`FROM_CSV`, :data:`FROM_EXCHANGE`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`), and why it could not be
+    read, when it could not.
     """
 
     when: datetime | None = None
@@ -252,28 +207,10 @@ class SubmissionTime:
 
 @dataclass(frozen=True)
 class Lateness:
-    """What the late rule made of one submission.
-
-    Attributes
-    ----------
-    deadline : datetime.datetime
-        The student's deadline (the rubric's, or their extension).
-    extended : bool
-        Whether that deadline is an extension.
-    time : SubmissionTime or None
-        When the work was handed in (None, or without a moment, when unknown).
-    late_by : datetime.timedelta or None
-        How long after the deadline it came (zero or less: on time); None when the time is unknown.
-    units : int
-        Started days or hours counted for the penalty (0 when on time, within the grace, or unknown).
-    percent : float
-        The penalty in percent of the raw total (the cap applied).
-    raw_total : float
-        The points before the penalty.
-    penalty : float
-        The points taken off (rounded to 0.01).
-    note : str
-        One line saying what happened, for ``grades.csv``.
+    """What the late rule made of one submission: its deadline (the rubric's or an extension), when it came
+    (``late_by`` is None when unknown, zero or less when on time), the started ``units`` counted, the ``percent``
+    taken (the cap applied) of the ``raw_total``, the ``penalty`` in points (to 0.01), and a ``note`` for
+    ``grades.csv``.
     """
 
     deadline: datetime
@@ -299,22 +236,9 @@ class Lateness:
 
 @dataclass(frozen=True)
 class Late:
-    """The rubric's late rule (see the module's documentation for the table it is read from).
-
-    Attributes
-    ----------
-    deadline : datetime.datetime
-        When the work is due (timezone-aware).
-    per : str
-        ``"day"`` or ``"hour"``: the unit whose started ones are counted.
-    percent : float
-        Percent of the raw total lost per started unit.
-    cap : float
-        The largest penalty, in percent.
-    grace : float
-        Minutes after a deadline that still count as on time.
-    extensions : tuple
-        ``(name, deadline)`` pairs: a student's own deadline.
+    """The rubric's late rule (the module's documentation gives its table): the deadline, the unit whose started
+    ones count (``"day"`` or ``"hour"``), the percent lost per unit, the cap in percent, the grace in minutes, and
+    each extension as a ``(name, deadline)`` pair.
     """
 
     deadline: datetime
@@ -409,25 +333,8 @@ def _amount(table, key, source, low=0.0, high=None, unit=""):
 
 
 def from_dict(table: dict, source: str = "the rubric") -> Late:
-    """A validated :class:`Late` from the rubric's parsed ``[late]`` table.
-
-    Parameters
-    ----------
-    table : dict
-        The table: ``deadline``, ``per``, ``percent`` and ``cap`` (all required), ``grace`` and
-        ``extensions`` (optional).
-    source : str
-        The rubric's name, for error messages.
-
-    Returns
-    -------
-    Late
-        The rule.
-
-    Raises
-    ------
-    ValueError
-        Saying which key is wrong and what it must be.
+    """A validated :class:`Late` from the rubric's parsed ``[late]`` table (``deadline``, ``per``, ``percent`` and
+    ``cap``; ``grace`` and ``extensions`` optional); InputError saying which key is wrong and what it must be.
     """
     if not isinstance(table, dict):
         raise InputError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
@@ -504,17 +411,8 @@ def read_small(path, limit):
 
 
 def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
-    """The time in nbgrader's ``timestamp.txt`` at the top of a submission's folder.
-
-    Parameters
-    ----------
-    submission : path-like
-        A submission: a folder (a single notebook has no ``timestamp.txt``).
-
-    Returns
-    -------
-    SubmissionTime or None
-        None when there is no such file; a time whose ``problem`` says why when the file cannot be read.
+    """The time in nbgrader's ``timestamp.txt`` at the top of a submission's folder: None when there is no
+    such file (a single notebook has none), a time whose ``problem`` says why when it cannot be read.
     """
     path = Path(submission) / TIMESTAMP
     try:
@@ -533,17 +431,8 @@ def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
 
 
 def modification_time(notebooks: list) -> SubmissionTime | None:
-    """The newest modification time of a submission's notebooks (only on the instructor's explicit request).
-
-    Parameters
-    ----------
-    notebooks : list of path-like
-        The submission's notebook files.
-
-    Returns
-    -------
-    SubmissionTime or None
-        None when there are none.
+    """The newest modification time of a submission's notebooks (only on the instructor's explicit
+    request: the student sets it); None when there are none.
     """
     times = []
     for path in notebooks:
@@ -557,23 +446,10 @@ def modification_time(notebooks: list) -> SubmissionTime | None:
 
 
 def read_times(path: str | os.PathLike) -> dict[str, datetime]:
-    """The submission times in a CSV file with the columns ``submission`` and ``time`` (others are ignored).
-
-    Parameters
-    ----------
-    path : path-like
-        The file. A time is ISO 8601 with a UTC offset, or as nbgrader writes it
-        (``2026-12-01 23:59:59 UTC``).
-
-    Returns
-    -------
-    dict
-        {submission name: datetime}.
-
-    Raises
-    ------
-    ValueError
-        When the file cannot be read, lacks a column, names a submission twice or has a bad time (naming the line).
+    """{submission name: datetime} from a CSV file with the columns ``submission`` and ``time`` (others are
+    ignored); a time is ISO 8601 with a UTC offset, or as nbgrader writes it (``2026-12-01 23:59:59 UTC``).
+    InputError when the file cannot be read, lacks a column, names a submission twice or has a bad time (naming
+    the line).
     """
     path = Path(path)
     try:
@@ -619,30 +495,11 @@ def submission_time(
     from_submission: bool = False,
     exchange: dict | None = None,
 ) -> SubmissionTime | None:
-    """The time of one submission, by the precedence the module's documentation gives.
-
-    Parameters
-    ----------
-    submission : path-like or None
-        The submission (a folder or a notebook); None when it has nothing on disk.
-    name : str
-        Its name (what the ``--times`` file lists).
-    times : dict, optional
-        {name: datetime} from :func:`read_times`: the LMS's times, which the student cannot write.
-    notebooks : list of path-like, optional
-        Its notebooks, for `from_mtime`.
-    from_mtime : bool
-        Fall back on the notebooks' modification time (never unless the instructor asks; student-supplied).
-    from_submission : bool
-        Fall back on the ``timestamp.txt`` in the submission's folder (never unless the instructor asks: the
-        student's process writes it; student-supplied).
-    exchange : dict, optional
-        {name: datetime} that labkit read from nbgrader's exchange (:func:`read_exchange`).
-
-    Returns
-    -------
-    SubmissionTime or None
-        None when no source has a time.
+    """The time of one submission (None when no source has one), by the module's precedence: `times`
+    ({name: datetime}, the LMS's, which the student cannot write), then `exchange` (read by labkit from nbgrader's
+    exchange, :func:`read_exchange`), then, only with `from_submission`, the ``timestamp.txt`` in its folder, then,
+    only with `from_mtime`, its `notebooks`' modification time. The last two are written by the student's own
+    process, and marked student-supplied. `submission` is None when it has nothing on disk.
     """
     if times and name in times:
         return SubmissionTime(times[name], FROM_CSV)
@@ -677,30 +534,14 @@ MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
 
 
 def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datetime]:
-    """The submission times of `assignment` in nbgrader's exchange, read there: {student: datetime}.
+    """{student: the newest submission's time} of `assignment` in nbgrader's exchange, read there.
 
     nbgrader's ``submit`` copies a student's work into the course's ``inbound/`` folder, in a folder named
-    ``student+assignment+timestamp`` (newer versions add ``+random``); its ``collect`` step takes each
-    student's newest. The time read here is that newest one, from the folder's name in the exchange itself
-    (never from a ``timestamp.txt`` that travelled with the work).
-
-    Parameters
-    ----------
-    course : path-like
-        The course's folder in the exchange (``<exchange root>/<course id>``, which holds ``inbound/``), or
-        its ``inbound/`` folder itself.
-    assignment : str
-        The assignment's name, as nbgrader knows it.
-
-    Returns
-    -------
-    dict
-        {student id: the newest submission's time}.
-
-    Raises
-    ------
-    ValueError
-        When the folder holds no ``inbound/`` or a folder of that assignment has a time that cannot be read.
+    ``student+assignment+timestamp`` (newer versions add ``+random``), and ``collect`` takes each student's
+    newest; the time is read from that folder's name in the exchange itself, never from a ``timestamp.txt`` that
+    travelled with the work. `course` is the course's folder in the exchange (it holds ``inbound/``) or
+    ``inbound/`` itself. InputError when there is no ``inbound/`` or a folder of that assignment has a time
+    that cannot be read.
     """
     course = Path(course)
     inbound = course if course.name == "inbound" else course / "inbound"
@@ -728,17 +569,8 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
 
 
 def unknown_times(grades: list) -> list[tuple[str, str, bool]]:
-    """The graded submissions that a rubric's deadline applies to but whose time is unknown, with the reason.
-
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        A run's grades.
-
-    Returns
-    -------
-    list of tuple
-        (name, note, is an error) per such submission: an error is a time that could not be read.
+    """(name, note, whether it is an error) of each graded submission that a rubric's deadline applies to
+    but whose time is unknown; an error is a time that could not be read.
     """
     found = []
     for grade in grades:

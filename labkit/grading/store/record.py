@@ -28,7 +28,7 @@ switched off) is never read as a grade, and nothing a submission can write
 import hashlib
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ...errors import InputError
@@ -46,24 +46,9 @@ KINDS = ("grade", "merge")
 
 @dataclass
 class RunRecord:
-    """The record of one output folder (see the module's description).
-
-    Attributes
-    ----------
-    kind : str
-        ``"grade"`` or ``"merge"``.
-    labkit : str
-        The labkit version that wrote it.
-    seed : int or list of int or None
-        The run's seed; a merge's seeds.
-    rubric : dict
-        The rubric's data (:attr:`labkit.grading.store.rubric.Rubric.data`).
-    rubric_text : str or None
-        The rubric's TOML text, when it was read from a file.
-    submissions : dict
-        Submission name -> ``{"result": file name, "sha256": the file's hash, "content": the notebooks'
-        digest or None}``.
-    """
+    """The record of one output folder (the module's description gives its fields): the rubric's data and
+    TOML text, and each submission's ``{"result": file name, "sha256": its hash, "content": the notebooks'
+    digest or None}``."""
 
     kind: str
     labkit: str
@@ -89,21 +74,9 @@ class RunRecord:
 
         return {name: datetime.fromisoformat(when) for name, when in self.times.get(source, {}).items()}
 
-    def as_dict(self):
-        return {
-            "format": FORMAT,
-            "kind": self.kind,
-            "labkit": self.labkit,
-            "seed": self.seed,
-            "rubric": self.rubric,
-            "rubric text": self.rubric_text,
-            "submissions": self.submissions,
-            "times": self.times,
-            "flags": self.flags,
-            "known": self.known,
-            "variants": self.variants,
-            "delivery": self.delivery,
-        }
+    def as_dict(self) -> dict:
+        """The record as ``record.json``'s data: its fields, named with spaces."""
+        return {"format": FORMAT, **{name.replace("_", " "): value for name, value in asdict(self).items()}}
 
     def rubric_object(self, folder):
         """The recorded rubric, read again (its source named after `folder`)."""
