@@ -13,7 +13,7 @@ reported as "could not be graded" with the reason, while every other
 submission is graded as usual.
 
 Each submission's time (for a rubric's ``[late]`` table) is read here, on the
-grader's side (:func:`labkit.grading.store.late.submission_time`), and saved with
+grader's side (:func:`labkit.grading.run.times.submission_time`), and saved with
 its result, so that ``labkit merge`` can apply a late rule later. Each
 submission's ``results/<name>.json`` and feedback are written as soon as it
 is graded, and entered in the run's record; the output folder always gets a
@@ -42,13 +42,13 @@ from ..sandbox import backends, timings
 from ..sandbox.backends.base import SandboxUnavailable
 from ..store import record as records
 from ..store import report as run_folder
-from ..store.late import submission_time
 from ..store.report import SubmissionGrade, labkit_version, one_line, write_report
 from ..store.rubric import load as load_rubric
 from ..submission import refusals
 from ..submission.scoring import known_sources, submission_name
 from .engines import Batch, Engine, LocalEngine
 from .resume import carried_marks, content, notebooks, parse_shard, resumed, shard_of
+from .times import submission_time
 
 
 def grade(
@@ -94,7 +94,7 @@ def grade(
     (read by labkit from nbgrader's exchange), else, only with
     `times_from_submission`, from the ``timestamp.txt`` in its folder, else,
     only with `times_from_mtime`, from its notebooks' modification time
-    (:func:`labkit.grading.store.late.submission_time`); the last two are written
+    (:func:`labkit.grading.run.times.submission_time`); the last two are written
     by the student and marked "student-supplied" wherever they are shown.
 
     With `variants` (a :class:`labkit.exercises.variants.VariantsFile`) and

@@ -372,7 +372,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         Scores every result, and its ``[late]`` table applies to the submission times they carry; its
         exercises, groups and points must be the folders' own.
     times : dict, optional
-        {submission name: datetime} (:func:`labkit.grading.store.late.read_times`): these times replace the
+        {submission name: datetime} (:func:`labkit.grading.run.times.read_times`): these times replace the
         stored ones of the submissions they name.
     progress : bool
         Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).
