@@ -109,8 +109,8 @@ def duration_text(delta: timedelta) -> str:
 @dataclass(frozen=True)
 class SubmissionTime:
     """When a submission was handed in (timezone-aware; None when unknown), where that came from
-    (:data:`FROM_CSV`, :data:`FROM_EXCHANGE`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`), and why it could not be
-    read, when it could not.
+    (:data:`FROM_CSV`, :data:`FROM_EXCHANGE`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`), and why it could not
+    be read, when it could not.
     """
 
     when: datetime | None = None
@@ -144,9 +144,9 @@ class SubmissionTime:
 @dataclass(frozen=True)
 class Lateness:
     """What the late rule made of one submission: its deadline (the rubric's or an extension), when it came
-    (``late_by`` is None when unknown, zero or less when on time), the started ``units`` counted, the ``percent``
-    taken (the cap applied) of the ``raw_total``, the ``penalty`` in points (to 0.01), and a ``note`` for
-    ``grades.csv``.
+    (``late_by`` is None when unknown, zero or less when on time), the started ``units`` counted, the
+    ``percent`` taken (the cap applied) of the ``raw_total``, the ``penalty`` in points (to 0.01), and a
+    ``note`` for ``grades.csv``.
     """
 
     deadline: datetime
@@ -173,8 +173,8 @@ class Lateness:
 @dataclass(frozen=True)
 class Late:
     """The rubric's late rule (the module's documentation gives its table): the deadline, the unit whose started
-    ones count (``"day"`` or ``"hour"``), the percent lost per unit, the cap in percent, the grace in minutes, and
-    each extension as a ``(name, deadline)`` pair.
+    ones count (``"day"`` or ``"hour"``), the percent lost per unit, the cap in percent, the grace in minutes,
+    and each extension as a ``(name, deadline)`` pair.
     """
 
     deadline: datetime

@@ -1,8 +1,8 @@
 """A grading run's record: what was graded, under which rubric and seed, by which labkit, and each result's hash.
 
 Every output folder that labkit writes (``labkit grade --out OUT``, a merge,
-:func:`labkit.grading.store.report.write_report`) holds ``record.json``, written by
-the grader alone and replaced whole each time it changes:
+:func:`labkit.grading.store.report.write_report`) holds ``record.json``, written by the grader alone and replaced
+whole each time it changes:
 
 * ``labkit``: the version that graded;
 * ``kind``: ``"grade"`` (a grading run, resumable) or ``"merge"``;
@@ -15,14 +15,12 @@ the grader alone and replaced whole each time it changes:
 * ``submissions``: for each submission graded, its result file's name and
   SHA-256, and the digest of its notebooks' content (:func:`content_digest`).
 
-Every later command reads the folder through this record
-(:func:`read_results`): ``labkit report``, ``labkit export``, a resumed
-``labkit grade`` and ``labkit merge`` take the recorded rubric when none is given,
-refuse one that grades differently, and take a result file only when the
-record names it with that hash. So a result file that the run did not write
-(a submission's code writing into an output folder, where the sandbox is
-switched off) is never read as a grade, and nothing a submission can write
-(a name, a time, a file) changes what the run's record says it graded.
+Every later command reads the folder through this record (:func:`read_results`): ``labkit report``, ``labkit
+export``, a resumed ``labkit grade`` and ``labkit merge`` take the recorded rubric when none is given, refuse one
+that grades differently, and take a result file only when the record names it with that hash. So a result file that
+the run did not write (a submission's code writing into an output folder, where the sandbox is switched off) is
+never read as a grade, and nothing a submission can write (a name, a time, a file) changes what the run's record
+says it graded.
 """
 
 import hashlib
@@ -204,9 +202,9 @@ def _aware(text):
 def results(folder, record):
     """The result files of `folder` that its `record` vouches for, read: ({name: (path, data)}, refused).
 
-    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of
-    ``results/`` that is not read: one the record does not name (a run never graded that submission there),
-    one whose content is not what the run wrote (its hash differs), one that is not a plain file. A
+    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of ``results/``
+    that is not read: one the record does not name (a run never graded that submission there), one whose content
+    is not what the run wrote (its hash differs), one that is not a plain file. A
     submission the record names whose file is missing is refused too. ValueError when a vouched-for file is not JSON."""
     folder = Path(folder)
     by_file = {entry["result"]: name for name, entry in record.submissions.items()}
@@ -281,8 +279,8 @@ def content_digest(notebooks, base=None):
 def rubric_for(folders, given, command):
     """The rubric `command` scores the output `folders` with: their recorded one, which all must share.
 
-    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded
-    one; one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
+    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded one;
+    one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
     ValueError saying how to score under it, since `command` shows what the run graded."""
     records = [(Path(folder), read(folder)) for folder in folders]
     first_folder, first = records[0]

@@ -293,13 +293,13 @@ def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list |
     """Every result of the given output folders that their run records vouch for, in name order, scored with
     `rubric` (their recorded rubric when None; :mod:`labkit.grading.store.record`).
 
-    A submission with a result in several folders counts from the last of them, in the order given (a
-    regrade replaces the class's result); a later result without a submission time keeps the earlier one's.
-    Each replacement is appended to `replaced` (a list) when it is given. A result file that a folder's record
-    does not name with that hash (its run never graded that submission, or the file changed since) is never
-    read: it is listed in the returned :class:`Merged`'s ``refused``. ValueError when a folder has no record,
-    no folder has results, a folder is given twice, the results come from another labkit version, or the
-    folders' rubrics differ from each other or from `rubric` in their exercises, groups or points (the
+    A submission with a result in several folders counts from the last of them, in the order given (a regrade
+    replaces the class's result); a later result without a submission time keeps the earlier one's. Each
+    replacement is appended to `replaced` (a list) when it is given. A result file that a folder's record does
+    not name with that hash (its run never graded that submission, or the file changed since) is never read: it
+    is listed in the returned :class:`Merged`'s ``refused``. ValueError when a folder has no record, no folder
+    has results, a folder is given twice, the results come from another labkit version, or the folders' rubrics
+    differ from each other or from `rubric` in their exercises, groups or points (the
     ``[late]`` table may differ when `rubric` is given: it is the one applied)."""
     folders = _folders(folders)
     if rubric is None:
