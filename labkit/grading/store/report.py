@@ -169,9 +169,9 @@ def write_csv(path: str | Path, grades: list[SubmissionGrade]) -> None:
 
 
 def write_result(out_dir: str | Path, grade: SubmissionGrade) -> records.Written:
-    """results/<name>.json and feedback/<name>.txt and .html of one submission, each replaced whole (a run
-    killed while writing leaves the earlier file or none, never half of one); the result file and the SHA-256
-    of what was written (:class:`labkit.grading.store.record.Written`), for the run's record."""
+    """Write results/<name>.json and feedback/<name>.txt and .html of one submission, each replaced whole; the
+    result file and the SHA-256 of what was written (:class:`labkit.grading.store.record.Written`), for the record.
+    """
     out = Path(out_dir)
     prepare(out)
     model, stem = feedbacks.build(grade), file_stem(grade.name)
@@ -196,9 +196,9 @@ def enter(out_dir: str | Path, record: records.RunRecord, grade: SubmissionGrade
 
 
 def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: records.RunRecord | None = None):
-    """grades.csv plus each submission's result and feedback files, each entered in the run's `record`
-    (:mod:`labkit.grading.store.record`; a new one of the grades' rubric and seeds when None), which is
-    written too."""
+    """Write grades.csv plus each submission's result and feedback files, each entered in the run's `record` (a new
+    one of the grades' rubric and seeds when None), which is written too; the record.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if record is None:
@@ -290,17 +290,16 @@ def _vouched(folder: Path, rubric: rubrics.Rubric) -> records.RunRecord:
 
 
 def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list | None = None) -> Merged:
-    """Every result of the given output folders that their run records vouch for, in name order, scored with
-    `rubric` (their recorded rubric when None; :mod:`labkit.grading.store.record`).
+    """Every result of the output `folders` that their run records vouch for, in name order, scored with `rubric`
+    (their recorded rubric when None).
 
-    A submission with a result in several folders counts from the last of them, in the order given (a regrade
-    replaces the class's result); a later result without a submission time keeps the earlier one's. Each
-    replacement is appended to `replaced` (a list) when it is given. A result file that a folder's record does
-    not name with that hash (its run never graded that submission, or the file changed since) is never read: it
-    is listed in the returned :class:`Merged`'s ``refused``. ValueError when a folder has no record, no folder
-    has results, a folder is given twice, the results come from another labkit version, or the folders' rubrics
-    differ from each other or from `rubric` in their exercises, groups or points (the
-    ``[late]`` table may differ when `rubric` is given: it is the one applied)."""
+    A submission with results in several folders counts from the last of them (a regrade replaces the class's
+    result); a later result without a submission time keeps the earlier one's, and each replacement is appended to
+    `replaced` when given. A result file a record does not name with that hash is never read: it is listed in the
+    :class:`Merged`'s ``refused``. InputError when a folder has no record or is given twice, no folder has results,
+    the results come from another labkit, or the folders' rubrics differ from each other or from `rubric` in their
+    exercises, groups or points (the ``[late]`` table may differ when `rubric` is given: it is the one applied).
+    """
     folders = _folders(folders)
     if rubric is None:
         rubric = records.rubric_for(folders, None, "reading these folders")
@@ -358,30 +357,14 @@ def _merged_record(folders: list, grades: Merged) -> records.RunRecord:
 
 
 def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
-    """Combine the results of several grading runs (e.g. one per batch job, or a class's run and a regrade)
-    into one output folder, scored with `rubric` (the folders' recorded rubric when None).
+    """Combine the results of several grading runs' `folders` (one per batch job, say, or a class's run and a
+    regrade) into the new folder `out_dir`, scored with `rubric` (a Rubric or a TOML path; the folders' recorded one
+    when None), whose exercises, groups and points must be theirs and whose ``[late]`` table applies.
 
-    Parameters
-    ----------
-    folders : list of path-like
-        The ``--out`` folders of earlier runs. A submission in several of them counts from the last one
-        (:func:`read_results`); a result file a folder's record does not vouch for is never merged.
-    out_dir : path-like
-        The merged output folder (not one of `folders`).
-    rubric : Rubric or path-like, optional
-        Scores every result, and its ``[late]`` table applies to the submission times they carry; its
-        exercises, groups and points must be the folders' own.
-    times : dict, optional
-        {submission name: datetime} (:func:`labkit.grading.run.times.read_times`): these times replace the
-        stored ones of the submissions they name.
-    progress : bool
-        Show a progress bar with an ETA on a terminal (:mod:`labkit.grading.progress`).
-
-    Returns
-    -------
-    Merged
-        The grades in name order; its ``replaced`` lists the results a later folder replaced, which
-        ``merge.json`` in `out_dir` records as well, and its ``refused`` the result files not merged.
+    A submission in several folders counts from the last one (:func:`read_results`), and a result file a folder's
+    record does not vouch for is never merged. `times` ({name: datetime}, :func:`labkit.grading.run.times.read_times`)
+    replace the stored times of the submissions they name; `progress` shows a bar on a terminal. Returns the grades
+    in name order, with the results a later folder replaced (also in ``merge.json``) and the files not merged.
     """
     from ..progress import Progress
 
