@@ -204,8 +204,8 @@ def results(folder, record):
 
     `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of ``results/``
     that is not read: one the record does not name (a run never graded that submission there), one whose content
-    is not what the run wrote (its hash differs), one that is not a plain file. A
-    submission the record names whose file is missing is refused too. ValueError when a vouched-for file is not JSON."""
+    is not what the run wrote (its hash differs), one that is not a plain file; and a submission the record names
+    whose file is missing. ValueError when a vouched-for file is not JSON."""
     folder = Path(folder)
     by_file = {entry["result"]: name for name, entry in record.submissions.items()}
     found, refused = {}, []

@@ -146,8 +146,7 @@ class Rubric:
 
     def score(self, fractions, marked=None, excused=()):
         """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1), with the points
-        a person `marked` (exercise -> points of its answers in words) and the exercises `excused` (out of
-        the
+        a person `marked` (exercise -> points of its answers in words) and the exercises `excused` (out of the
         total and of full credit)."""
         marked = marked or {}
         points = {
