@@ -131,7 +131,7 @@ NO_RECORD = (
 )
 
 
-def read(folder):
+def read(folder) -> RunRecord:
     """The record of output folder `folder`; ValueError when it has none or it is not one."""
     folder = Path(folder)
     path = folder / RECORD
@@ -141,52 +141,55 @@ def read(folder):
         raise InputError(NO_RECORD.format(folder=folder, record=RECORD)) from None
     try:
         data = json.loads(raw.decode("utf-8"))
-        if not isinstance(data, dict) or data.get("format") != FORMAT:
-            raise InputError(f"its format is not {FORMAT}")
-        if data.get("kind") not in KINDS:
-            raise InputError(f"its kind is not one of {', '.join(KINDS)}")
-        submissions = data.get("submissions")
-        if not isinstance(submissions, dict) or not isinstance(data.get("rubric"), dict):
-            raise InputError("it has no submissions or no rubric")
-        for name, entry in submissions.items():
-            if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("result", "sha256")):
-                raise InputError(f"its entry for {str(name)[:80]!r} has no result file and hash")
-            if Path(entry["result"]).name != entry["result"] or not entry["result"].endswith(".json"):
-                raise InputError(f"its entry for {str(name)[:80]!r} names a result outside results/")
-        text = data.get("rubric text")
-        if text is not None and not isinstance(text, str):
-            raise InputError("its rubric text is not text")
-        times = data.get("times") or {}
-        if not isinstance(times, dict) or not all(
-            isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
-            for given in times.values()
-        ):
-            raise InputError("its times are not times with a UTC offset")
-        seed = data.get("seed")
-        whole = isinstance(seed, int) and not isinstance(seed, bool)
-        listed = isinstance(seed, list) and all(isinstance(s, int) and not isinstance(s, bool) for s in seed)
-        if not (seed is None or (whole if data["kind"] == "grade" else listed)):
-            raise InputError(f"its seed is not {'a number' if data['kind'] == 'grade' else 'a list of numbers'}")
-        flags = data.get("flags") or {}
-        if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
-            raise InputError("its flags are not true or false")
-        known = data.get("known") or {}
-        if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
-            raise InputError("its known sources are not named by text")
-        variants = data.get("variants") or {}
-        if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
-            raise InputError("its variants are not a table of students")
-        delivery = data.get("delivery") or {}
-        if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
-            raise InputError("its delivery is not a table of students")
+        _check(data)
     except (UnicodeDecodeError, ValueError) as exc:
         raise InputError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
+    tables = (data.get(key) or {} for key in ("times", "flags", "known", "variants", "delivery"))
     return RunRecord(
-        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags,
-        known, variants, delivery,
+        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], data.get("rubric text"),
+        data["submissions"], *tables,
     )  # fmt: skip
+
+
+def _check(data) -> None:
+    """InputError saying what is wrong with a record's data, when anything is."""
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"its format is not {FORMAT}")
+    if data.get("kind") not in KINDS:
+        raise InputError(f"its kind is not one of {', '.join(KINDS)}")
+    submissions = data.get("submissions")
+    if not isinstance(submissions, dict) or not isinstance(data.get("rubric"), dict):
+        raise InputError("it has no submissions or no rubric")
+    for name, entry in submissions.items():
+        if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("result", "sha256")):
+            raise InputError(f"its entry for {str(name)[:80]!r} has no result file and hash")
+        if Path(entry["result"]).name != entry["result"] or not entry["result"].endswith(".json"):
+            raise InputError(f"its entry for {str(name)[:80]!r} names a result outside results/")
+    text, seed, grade = data.get("rubric text"), data.get("seed"), data["kind"] == "grade"
+    if text is not None and not isinstance(text, str):
+        raise InputError("its rubric text is not text")
+    times, flags, known, variants, delivery = (
+        data.get(key) or {} for key in ("times", "flags", "known", "variants", "delivery")
+    )
+    if not isinstance(times, dict) or not all(
+        isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
+        for given in times.values()
+    ):
+        raise InputError("its times are not times with a UTC offset")
+    whole = isinstance(seed, int) and not isinstance(seed, bool)
+    listed = isinstance(seed, list) and all(isinstance(s, int) and not isinstance(s, bool) for s in seed)
+    if not (seed is None or (whole if grade else listed)):
+        raise InputError(f"its seed is not {'a number' if grade else 'a list of numbers'}")
+    if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
+        raise InputError("its flags are not true or false")
+    if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
+        raise InputError("its known sources are not named by text")
+    if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
+        raise InputError("its variants are not a table of students")
+    if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
+        raise InputError("its delivery is not a table of students")
 
 
 def _aware(text):
