@@ -245,7 +245,7 @@ def _exchange_times(args):
         return None
     if not args.assignment:
         raise InputError("--times-from-exchange needs --assignment NAME: the assignment's name in nbgrader.")
-    from ..grading.store.late import read_exchange
+    from ..grading.run.times import read_exchange
 
     return read_exchange(args.times_from_exchange, args.assignment)
 
@@ -264,7 +264,7 @@ def handle(args):
     """Grade the submissions into --out and print each total and what the instructor should know; 1 when a
     submission could not be graded or a time could not be read."""
     from ..grading import grade
-    from ..grading.store.late import read_times
+    from ..grading.run.times import read_times
 
     _refuse_misuse(args)
     start = time.perf_counter()

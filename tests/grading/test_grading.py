@@ -269,7 +269,7 @@ def test_instructor_notebooks_score_full_marks_and_all_extra_credit(graded):
     grade = results["instructor"]
     assert EVERYTHING == FULL + RUBRIC.branch_extra + sum(RUBRIC.points[n] for n in RUBRIC.extra_credit)
     assert grade.total == EVERYTHING, grade.feedback()
-    assert all(verdict["passed"] for verdict in grade.results.values()) and set(grade.results) == set(EXERCISES)
+    assert all(verdict.passed for verdict in grade.results.values()) and set(grade.results) == set(EXERCISES)
 
 
 def test_spline_branch_alone_is_full_credit_without_extra(graded):
@@ -294,7 +294,7 @@ def test_the_second_branch_is_ten_points_of_extra_credit(graded):
 def test_planted_mistake_loses_exactly_its_part_with_the_matching_hint(graded, name, exercise, part, hint):
     results, *_ = graded
     grade, instructor = results[name], results["instructor"]
-    failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
+    failed = [(n, c.name) for n, v in grade.results.items() for c in v.parts if not c.passed]
     assert failed == [(exercise, part)], grade.feedback()
     lost = (
         RUBRIC.points[exercise]
@@ -334,7 +334,7 @@ def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, n
     # denominator makes the student's own driver's errors stall at 1): it is what the driver measured. But a
     # rate is read from the student's own table, so the planted copy's unchanged answer no longer fits it
     also = {"natural_rows": [(12, "rate_natural")]}.get(name, [])
-    failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
+    failed = [(n, c.name) for n, v in grade.results.items() for c in v.parts if not c.passed]
     assert failed == [(exercise, part)] + also, grade.feedback()
     changed = {exercise} | {n for n, _ in also}
     assert {n: p for n, p in grade.points.items() if n not in changed} == {

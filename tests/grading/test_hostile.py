@@ -646,8 +646,8 @@ def test_no_hostile_submission_gets_a_point_it_did_not_earn(attacked):
 
 def test_only_the_first_notebook_that_defines_an_exercise_counts(attacked):
     grade = attacked["results"]["best_of_four"]
-    rate = next(c for c in grade.results[3]["checks"] if c["name"] == "rate_pherm")
-    assert not rate["passed"] and "got 1" in json.dumps(rate)
+    rate = next(c for c in grade.results[3].parts if c.name == "rate_pherm")
+    assert not rate.passed and "got 1" in json.dumps(rate.as_dict())
     assert grade.points[3] == 15 * (12 / 15)  # the driver and the table are right, the rate is not
 
 

@@ -328,15 +328,7 @@ def _steps(check):
 def _checks(grade, number):
     """{part name: check} of exercise `number` in `grade`; None when the submission does not have it."""
     verdict = grade.results.get(number)
-    if verdict is None:
-        return None
-    checks = verdict.get("checks") if isinstance(verdict, dict) else None
-    if not isinstance(checks, list) or not all(isinstance(c, dict) for c in checks):
-        raise InputError(
-            f"the result of {one_line(grade.name, MAX_NAME)!r} for exercise {number} has no list of checks: "
-            "it was not written by `labkit grade`; grade the submission again."
-        )
-    return {one_line(c.get("name", "?"), MAX_TEXT): c for c in checks}
+    return None if verdict is None else {one_line(part.name, MAX_TEXT): part.as_dict() for part in verdict.parts}
 
 
 def _weights(rubric, exercise):

@@ -66,7 +66,7 @@ def _holders(grades, students, registry):
     found = defaultdict(list)  # (holder, whose) -> exercises
     for grade in grades:
         for number, verdict in sorted(grade.results.items()):
-            other = (verdict or {}).get("other_variant") if isinstance(verdict, dict) else None
+            other = verdict.other_variant
             if other and registry is not None and number in registry.exercises:
                 whose = _whose(grade.name, registry.exercises[number], other, students)
                 found[(grade.name, ", ".join(whose))].append(number)

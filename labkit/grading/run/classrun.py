@@ -13,7 +13,7 @@ reported as "could not be graded" with the reason, while every other
 submission is graded as usual.
 
 Each submission's time (for a rubric's ``[late]`` table) is read here, on the
-grader's side (:func:`labkit.grading.store.late.submission_time`), and saved with
+grader's side (:func:`labkit.grading.run.times.submission_time`), and saved with
 its result, so that ``labkit merge`` can apply a late rule later. Each
 submission's ``results/<name>.json`` and feedback are written as soon as it
 is graded, and entered in the run's record; the output folder always gets a
@@ -41,13 +41,14 @@ from ..progress import Progress
 from ..sandbox import backends, timings
 from ..sandbox.backends.base import SandboxUnavailable
 from ..store import record as records
-from ..store.late import submission_time
-from ..store.report import SubmissionGrade, labkit_version, one_line, write_report, write_result
+from ..store import report as run_folder
+from ..store.report import SubmissionGrade, labkit_version, one_line, write_report
 from ..store.rubric import load as load_rubric
 from ..submission import refusals
 from ..submission.scoring import known_sources, submission_name
 from .engines import Batch, Engine, LocalEngine
 from .resume import carried_marks, content, notebooks, parse_shard, resumed, shard_of
+from .times import submission_time
 
 
 def grade(
@@ -93,7 +94,7 @@ def grade(
     (read by labkit from nbgrader's exchange), else, only with
     `times_from_submission`, from the ``timestamp.txt`` in its folder, else,
     only with `times_from_mtime`, from its notebooks' modification time
-    (:func:`labkit.grading.store.late.submission_time`); the last two are written
+    (:func:`labkit.grading.run.times.submission_time`); the last two are written
     by the student and marked "student-supplied" wherever they are shown.
 
     With `variants` (a :class:`labkit.exercises.variants.VariantsFile`) and
@@ -214,8 +215,7 @@ def grade(
         )
         for path, name in zip(submissions, names)
     ]
-    for folder in ("results", "feedback"):
-        (out / folder).mkdir(parents=True, exist_ok=True)  # an empty shard's folder is a run's too
+    run_folder.prepare(out)
     record = earlier.record or records.new("grade", labkit_version(), seed, rubric)
     record.times = {
         source: {name: when.isoformat() for name, when in sorted((given or {}).items())}
@@ -240,7 +240,7 @@ def grade(
         rubric=str((out / records.RUBRIC_COPY).resolve()) if rubric.text is not None else options.rubric,
         variants=students if variants is not None else None,
     )
-    (out / "seed.txt").write_text(f"{seed}\n", encoding="utf-8")
+    run_folder.write_seed(out, seed)
     when = dict(zip(names, handed_in))
     when.update({name: submission_time(None, name, times, exchange=exchange_times) for name in ungradable})
     todo = [(path, name) for path, name in zip(submissions, names) if name not in done]
@@ -254,7 +254,7 @@ def grade(
             grade.marks, lost = carried_marks(earlier.earlier[grade.name], grade)
             if lost:
                 dropped.append((grade.name, lost))
-        records.note(out, record, grade.name, write_result(out, grade), contents.get(grade.name))
+        run_folder.enter(out, record, grade, contents.get(grade.name))
 
     work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
     start, peaks, graded = time.monotonic(), [], {}
@@ -285,25 +285,22 @@ def grade(
             f"labkit grade: {one_line(name, 80)}'s notebooks changed; {lost} of the marks given to it no longer "
             "apply (an answer rewritten, a part no longer held): mark them again (labkit mark OUT).\n"
         )
-    (out / "run.json").write_text(
-        json.dumps(
-            {
-                "seed": seed,
-                "submissions": len(ordered),
-                "graded now": len(graded) - len(ungradable),
-                "already graded": len(done),
-                "graded again, changed": len(earlier.changed),
-                "handed in nothing to grade": len(ungradable),
-                "shard": None if shard is None else f"{shard[0]}/{shard[1]}",
-                "not graded": sum(not g.graded for g in ordered),
-                "seconds": round(time.monotonic() - start, 1),
-                **engine.record(),
-                "grader peak bytes": max((p for p in peaks if p), default=None),
-                "grader process peak bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
-            },
-            indent=1,
-        ),
-        encoding="utf-8",
+    run_folder.write_run(
+        out,
+        {
+            "seed": seed,
+            "submissions": len(ordered),
+            "graded now": len(graded) - len(ungradable),
+            "already graded": len(done),
+            "graded again, changed": len(earlier.changed),
+            "handed in nothing to grade": len(ungradable),
+            "shard": None if shard is None else f"{shard[0]}/{shard[1]}",
+            "not graded": sum(not g.graded for g in ordered),
+            "seconds": round(time.monotonic() - start, 1),
+            **engine.record(),
+            "grader peak bytes": max((p for p in peaks if p), default=None),
+            "grader process peak bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+        },
     )
     return Graded(ordered, earlier)
 
@@ -346,7 +343,7 @@ def _write_variants(out, grades, students, roster, registry):
             continue
         holds = []
         for exercise in varied:
-            other = (grade.results.get(exercise.number) or {}).get("other_variant") or {}
+            other = getattr(grade.results.get(exercise.number), "other_variant", {})
             if not other:
                 continue
             params = {p.name: p for p in exercise.params}

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ...errors import InputError
 from ..store import record as records
+from ..store.model import ItemKey
 from ..store.report import SubmissionGrade, labkit_version, one_line
 from ..store.rubric import DEFAULT as DEFAULT_RUBRIC
 from ..store.rubric import Rubric
@@ -144,12 +145,12 @@ def carried_marks(earlier, grade):
     `grade`: an answer's while its text is the same, a held part's while it is still held, an exercise's
     excuse always; and how many no longer apply."""
     kept, dropped = {}, 0
-    held = {f"exercise{number}/{part}" for number, part, _, _ in grade.held()}
+    held = {ItemKey.held(number, part) for number, part, _, _ in grade.held()}
     for item, mark in earlier.marks.items():
-        if item in grade.rubric.registry.answers:
-            same = str(earlier.answers.get(item, "")) == str(grade.answers.get(item, ""))
+        if item.kind == "answer":
+            same = str(earlier.answers.get(item.answer, "")) == str(grade.answers.get(item.answer, ""))
         else:
-            same = "/" not in item or item in held
+            same = item.kind == "exercise" or item in held
         if same:
             kept[item] = mark
         else:

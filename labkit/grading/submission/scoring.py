@@ -38,6 +38,7 @@ from ...exercises.result import CRASH, NOT_DONE, OTHER, RAISED, REFUSED, TAMPERE
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..sandbox import backends, remote, timings
+from ..store.model import ExerciseResult
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from . import holding, known, refusals, scan
 
@@ -569,7 +570,7 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
         grade.problems.append(ProblemText.one(str(exc), OTHER))
         return grade
     for notebook in notebooks:
-        claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
+        claimed = {n for n, verdict in grade.results.items() if verdict.defined}
         with timings.phase("notebooks"):
             results, problems = grade_notebook(
                 notebook,
@@ -585,8 +586,8 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)
             current = grade.results.get(number)
-            if current is None or (verdict["defined"] and not current.get("defined")):
-                grade.results[number] = verdict
+            if current is None or (verdict["defined"] and not current.defined):
+                grade.results[number] = ExerciseResult.from_dict(verdict, number, grade.name)
     return grade
 
 

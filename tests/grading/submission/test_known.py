@@ -11,6 +11,7 @@ import json
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,7 @@ from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading.options import GradeOptions
 from labkit.grading.store import report, rubric
+from labkit.grading.store.model import PartResult
 from labkit.grading.submission import fingerprint, known, scan
 from labkit.grading.submission.scoring import (
     _rescore,
@@ -418,8 +420,8 @@ def test_the_grader_holds_a_passed_part_whose_code_is_labkits_and_keeps_one_that
 
 def test_a_release_pays_only_the_held_part_of_a_partly_passed_exercise(tmp_path):
     grade = _held_grade()
-    checks = grade.results[2]["checks"]
-    checks.append({"name": "other", "passed": False, "hint": "h", "weight": 10, "steps": []})  # worth as much
+    other = PartResult("other", False, 10, "h")  # worth as much
+    grade.results[2] = replace(grade.results[2], parts=(*grade.results[2].parts, other))
     path = tmp_path / "rubric.toml"
     path.write_text(rubric.DEFAULT.read_text() + '\n[held]\nrelease = {"ada" = [2]}\n')
     grade.rubric = rubric.load(path)
@@ -432,7 +434,7 @@ def test_the_class_report_lists_a_held_part_side_by_side(tmp_path):
 
     honest = report.SubmissionGrade("bartholomew", results={}, rubric=rubric.default())
     copier = _held_grade()
-    copier.results[2]["checks"][0]["held"]["lines"].append(["x = a < b & c  # </pre><script>", "y"])
+    copier.results[2].parts[0].held["lines"].append(["x = a < b & c  # </pre><script>", "y"])
     page = class_report.render(class_report.summarise([copier, honest]), [])
     section = page[page.index('<h2 id="held">') :]
     section = section[: section.index("</section>")]
