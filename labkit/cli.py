@@ -277,6 +277,11 @@ def grade_options(args):
         limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE),
         fork_server=not args.no_fork_server,
         solutions=args.solutions,
+        jobs=args.jobs,
+        shard=args.shard,
+        fresh=args.fresh,
+        times_from_submission=args.times_from_submission,
+        times_from_mtime=args.times_from_mtime,
     )
 
 
@@ -317,7 +322,7 @@ def _merge(args):
 
 
 def _grade(args):
-    from .grading import grade
+    from .grading import Submissions, grade
     from .grading.run.classrun import report_failures
     from .grading.store.late import read_exchange, read_times
 
@@ -356,23 +361,8 @@ def _grade(args):
     args.out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=".labkit-unpacked-", dir=args.out) as workspace:
         found = _class(args, Path(workspace))
-        grades = grade(
-            found.paths,
-            args.out,
-            options,
-            engine=engine,
-            progress=not args.quiet,
-            times=times,
-            times_from_mtime=args.times_from_mtime,
-            shard=args.shard,
-            fresh=args.fresh,
-            names=found.names,
-            ungradable=found.ungradable,
-            times_from_submission=args.times_from_submission,
-            exchange_times=exchange,
-            roster=roster,
-            variants=variants,
-        )
+        given = Submissions(found.paths, found.names, found.ungradable, times, exchange, roster, variants)
+        grades = grade(given, args.out, options, engine=engine, progress=not args.quiet)
     if found.intake is not None:
         from .grading.reports.delivery import remember
 

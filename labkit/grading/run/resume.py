@@ -64,7 +64,7 @@ class Resumed:
 
 
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
-    """What the earlier run in `out` leaves to this one: a :class:`Resumed`.
+    """What the earlier run in `out` leaves to this one: a :class:`Resumed`. Reads, never writes.
 
     An output folder with a run record (:mod:`labkit.grading.store.record`) is resumed: the submissions graded
     there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
@@ -74,18 +74,12 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     graded is graded again (such failures are the grader's: a crash, a stopped run, a lost worker). A
     folder of another labkit version, a merge's folder, results without a record, a different rubric or
     seed, or a submission graded there that is not in `names` are refused with a ValueError saying what to
-    do, as nothing of them would fit this run's grades.csv. `fresh` deletes the earlier results, feedback
-    and record instead: every submission is graded, with `seed` (a fresh one when None)."""
+    do, as nothing of them would fit this run's grades.csv. With `fresh` nothing is kept: every submission
+    is graded, with `seed` (a fresh one when None), once :func:`clear` has deleted the earlier results."""
     out = Path(out)
     files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
-    if fresh:
-        for path in [*files, *sorted((out / "feedback").glob("*.txt")), *sorted((out / "feedback").glob("*.html"))]:
-            path.unlink()
-        for name in (records.RECORD, records.RUBRIC_COPY):
-            (out / name).unlink(missing_ok=True)
-        return Resumed({}, seed, rubric if rubric is not None else default_rubric())
-    if not (out / records.RECORD).exists():
-        if files:
+    if fresh or not (out / records.RECORD).exists():
+        if files and not fresh:
             raise InputError(
                 f"{out} holds results but no run record ({records.RECORD}; an older labkit wrote none): give "
                 "--fresh to grade every submission again there, or choose a new --out."
@@ -137,6 +131,16 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
         done[name] = grade
     seed = record.seed if record.seed is not None else seed
     return Resumed(done, seed, rubric, record, sorted(changed), refused, earlier=before)
+
+
+def clear(out):
+    """Delete the results, feedback and record of the run in `out` (``--fresh``)."""
+    out = Path(out)
+    for folder, pattern in (("results", "*.json"), ("feedback", "*.txt"), ("feedback", "*.html")):
+        for path in sorted((out / folder).glob(pattern)):
+            path.unlink()
+    for name in (records.RECORD, records.RUBRIC_COPY):
+        (out / name).unlink(missing_ok=True)
 
 
 def carried_marks(earlier, grade):
@@ -192,10 +196,3 @@ def shard(names, index, count):
     index, count = parse_shard((index, count))
     ordered = sorted(names)
     return ordered[(index - 1) * len(ordered) // count : index * len(ordered) // count]
-
-
-def shard_of(submissions, names, part):
-    """The submissions (and their names) of `part`, ``(I, N)``, in name order (:func:`shard`)."""
-    by_name = dict(zip(names, submissions))
-    chosen = shard(names, *part)
-    return [by_name[name] for name in chosen], chosen
