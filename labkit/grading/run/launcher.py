@@ -1,23 +1,16 @@
 """The launcher: one warm Python that forks each submission's grading process; its client and its server.
 
-A grading run grades every submission in a process of its own
-(:mod:`.processes`), so that a submission that makes its grading crash, run
-out of memory or hang costs only its own grade. Started as
-``python -m labkit.grading.submission.scoring SPEC``, each of those processes would
-import labkit's checks, numpy and scipy again. The client, :class:`Launcher`,
-starts ``python -m labkit.grading.run.launcher`` once per run instead: the
-server (:func:`main`) imports all that, then forks one child per submission,
-which puts itself in a session, cgroup and address-space limit of its own
-(what ``Popen``'s ``preexec_fn`` does otherwise) and runs
-:func:`labkit.grading.submission.scoring.main`. No student code runs here: student code
-runs only in the sandboxes the child starts.
+Started as ``python -m labkit.grading.submission.scoring SPEC``, each grading process (:mod:`.processes`)
+would import labkit's checks, numpy and scipy again. The client, :class:`Launcher`, starts
+``python -m labkit.grading.run.launcher`` once per run instead: the server (:func:`main`) imports all
+that, then forks one child per submission, which puts itself in a session, cgroup and address-space
+limit of its own (what ``Popen``'s ``preexec_fn`` does otherwise) and runs
+:func:`labkit.grading.submission.scoring.main`. No student code runs here: only in the child's sandboxes.
 
-The server reads one request per line on stdin
-(``{"spec", "log", "memory", "cgroups", "environment", "id"}``) and writes one
-line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id": i}``
-and ``{"ended": pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid
-can be used again once its process has ended), ``c`` as Popen's returncode.
-When its stdin closes (the run is over, or the grader died) it stops every
+The server reads one request per line on stdin (``{"spec", "log", "memory", "cgroups", "environment",
+"id"}``) and writes one line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id":
+i}`` and ``{"ended": pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid can be used again),
+``c`` as Popen's returncode. When its stdin closes (the run is over, or the grader died) it stops every
 child still running and ends.
 """
 
@@ -33,7 +26,7 @@ import threading
 import time
 
 from ..sandbox import protocol
-from .processes import die_with
+from .processes import die_with, one_thread
 
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
 LAUNCHER_READY = 120  # seconds for the launcher to import the grader
@@ -72,7 +65,6 @@ class Launcher:
 
     def __init__(self, options, server=None, wait=True):
         self.ended, self._lines, self._lock = {}, None, threading.RLock()
-        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         parent = os.getpid()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "labkit.grading.run.launcher", options.exercises or ""],
@@ -80,7 +72,7 @@ class Launcher:
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
-            env=environment,
+            env=one_thread(),
             pass_fds=(server.fd,) if server is not None else (),
             preexec_fn=lambda: die_with(parent),
         )
@@ -167,11 +159,7 @@ def _child(request):
     code = 1
     try:
         os.setsid()
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: die with the launcher
-        if os.getppid() != request["launcher"]:  # it died before the line above
-            os._exit(1)
+        die_with(request["launcher"])
         for procs in request.get("cgroups", ()):
             with open(procs, "w") as handle:
                 handle.write(str(os.getpid()))

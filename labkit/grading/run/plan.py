@@ -1,20 +1,17 @@
 """A class run's plan: what it grades, with what, and what it takes over, worked out before anything runs.
 
-:func:`plan` turns what was handed in (:class:`Submissions`), the output folder and the run's
-:class:`~labkit.grading.options.GradeOptions` into a frozen :class:`Plan`. It reads the submissions and
-the folder and writes nothing: the names and the shard, the earlier run it resumes (:mod:`.resume`),
-each student's data (variants), each submission's time, the known sources, and the options every
-grading process gets, settled. Every refusal (a bad name, another seed, rubric, roster or set of
-known sources than the run it resumes) comes from here, before a file is touched; the class run
-(:mod:`.classrun`) then runs the plan on an engine and writes the folder.
+:func:`plan` turns what was handed in (:class:`Submissions`), the output folder and the run's options into
+a frozen :class:`Plan`, reading the submissions and the folder and writing nothing: the names and the
+shard, the earlier run it resumes (:mod:`.resume`), each student's data (variants), each submission's
+time, the known sources, and the options every grading process gets, settled. Every refusal comes from
+here, before a file is touched; :mod:`.classrun` then runs the plan on an engine and writes the folder.
 
-What travels where: :class:`GradeOptions` holds the run's choices, plain data that a flag of
-``labkit grade`` sets and that hold for every submission (limits, seed, sandbox, rubric, and
-``jobs``, ``shard``, ``fresh``, the student-written times allowed). :class:`Submissions` holds what
-this run is asked to grade, data about this class that no flag spells: the paths, their names, the
-students with nothing to grade, the times from the LMS or the exchange, the roster and the variants
-file. The engine and the progress bar are how this process carries the run out: keywords of
-:func:`.classrun.grade`.
+What travels where: :class:`~labkit.grading.options.GradeOptions` holds the run's choices, plain data
+that a flag of ``labkit grade`` sets and that holds for every submission (limits, seed, sandbox, rubric,
+``jobs``, ``shard``, ``fresh``, the student-written times allowed). :class:`Submissions` holds what this
+run is asked to grade, data about one class that no flag spells: the paths and their names, the students
+with nothing to grade, the times from the LMS or the exchange, the roster and the variants file. The
+engine and the progress bar are how this process carries the run out: keywords of :func:`.classrun.grade`.
 """
 
 import os
@@ -43,24 +40,12 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Submissions:
-    """What one run is asked to grade.
-
-    Attributes
-    ----------
-    paths : sequence of path-like
-        Each submission: a notebook, or a folder of them.
-    names : sequence of str, optional
-        Each one's name (by default its folder's or notebook's).
-    ungradable : mapping
-        {name: why} of students who handed in nothing to grade: reported as "could not be graded", never
-        given a zero.
-    times, exchange_times : mapping, optional
-        {name: datetime}: the LMS's times (``--times``), and those labkit read from nbgrader's exchange.
-    roster : mapping, optional
-        {submission name: roster id}; with `variants` (a :class:`labkit.exercises.variants.VariantsFile`) each
-        submission is graded against its student's own data, derived from the roster id (never from the
-        notebook), and one the roster lacks could not be graded.
-    """
+    """What one run is asked to grade: each submission (a notebook, or a folder of them) and its name (by default
+    its folder's or notebook's); the students who handed in nothing to grade ({name: why}: reported as "could
+    not be graded", never given a zero); the LMS's times (``--times``) and those read from nbgrader's exchange
+    ({name: datetime}); a roster ({submission name: roster id}) with a variants file
+    (:class:`labkit.exercises.variants.VariantsFile`): each submission is graded against its student's own
+    data, derived from the roster id (never from the notebook), and one the roster lacks could not be graded."""
 
     paths: Sequence = ()
     names: Sequence | None = None
@@ -73,49 +58,20 @@ class Submissions:
 
 @dataclass(frozen=True)
 class Plan:
-    """A class run, worked out (:func:`plan`).
-
-    Attributes
-    ----------
-    out : Path
-        The output folder.
-    options : GradeOptions
-        What every grading process gets: the seed drawn, the rubric's exercises, the recorded rubric's copy,
-        each student's data, the earlier run's times flags and solutions.
-    rubric : Rubric
-        The rubric the results are scored with.
-    record : RunRecord
-        What ``record.json`` says as the run starts (the earlier run's, continued).
-    order : list
-        Every name, in the order of ``grades.csv`` (the order given, a shard's in name order; the ungradable last).
-    todo : list
-        (path, name) of the submissions to hand to the engine.
-    ungradable : dict
-        {name: why} of those that cannot be graded.
-    when : dict
-        {name: its submission time or None}.
-    contents : dict
-        {name: its notebooks' digest}, read before any student code runs.
-    earlier : Resumed
-        What the earlier run in `out` leaves to this one.
-    submissions : Submissions
-        The request, its times continued from the earlier run.
-    shard : tuple or None
-        ``(I, N)``.
-    """
+    """A class run, worked out (:func:`plan`)."""
 
     out: Path
-    options: GradeOptions
-    rubric: Rubric
-    record: records.RunRecord
-    order: list
-    todo: list
-    ungradable: dict
-    when: dict
-    contents: dict
-    earlier: Resumed
-    submissions: Submissions
-    shard: tuple | None = None
+    options: GradeOptions  # what every grading process gets: the seed drawn, the rubric's copy, each one's data
+    rubric: Rubric  # what the results are scored with
+    record: records.RunRecord  # what record.json says as the run starts (the earlier run's, continued)
+    order: list  # every name, as grades.csv lists them (a shard's in name order; the ungradable last)
+    todo: list  # (path, name) of the submissions the engine grades
+    ungradable: dict  # {name: why} of those that cannot be graded
+    when: dict  # {name: its submission time or None}
+    contents: dict  # {name: its notebooks' digest}, read before any student code runs
+    earlier: Resumed  # what the earlier run in `out` leaves to this one
+    submissions: Submissions  # as given, its times continued from the earlier run
+    shard: tuple | None = None  # (I, N)
 
 
 def plan(submissions, out_dir, options: GradeOptions) -> Plan:
