@@ -1,23 +1,14 @@
 """Grading a class: :func:`grade` plans the run (:mod:`.plan`), runs it on an engine, and writes the run folder.
 
-:func:`grade` takes the run's :class:`~labkit.grading.options.GradeOptions`, built
-once by its caller (the ``labkit grade`` command, or a script), and works the run
-out first, touching nothing (:func:`.plan.plan`: the sandbox checked, an earlier
-run resumed, the seed drawn, the students' data and times read). Then
-:func:`run` hands the submissions still to grade to an engine (:mod:`.engines`:
-a few grading processes at a time here, or on a Dask cluster), so a submission
-that makes its grading crash, run out of memory or hang costs only its own
-grade: its process is started once more, and if that fails too it is reported
-as "could not be graded" with the reason. :class:`RunFolder` does every write:
-each submission's ``results/<name>.json`` and feedback as soon as it is graded,
-entered in the run's record; then ``grades.csv`` with every submission once,
-and ``run.json`` (its seed, how many could not be graded, its time, the
-engine's record, the grader's peak memory for one submission). A progress bar
-with an ETA is drawn on a terminal (:mod:`..progress`).
+The plan touches nothing. :func:`run` hands the submissions still to grade to an engine (:mod:`.engines`:
+a few grading processes at a time here, or on a Dask cluster), each in a grading process of its own, so
+a submission that makes its grading crash, run out of memory or hang costs only its own grade (it is
+reported as "could not be graded", saying why). :class:`RunFolder` does every write: each submission's
+result and feedback as soon as it is graded, entered in the run's record, then ``grades.csv`` with every
+submission once and ``run.json``, how the run went (its seed, counts, time, engine, peak memory).
 """
 
 import contextlib
-import csv
 import json
 import resource
 import shutil
@@ -31,7 +22,8 @@ from ..options import GradeOptions
 from ..progress import Progress
 from ..sandbox import timings
 from ..store import record as records
-from ..store.report import SubmissionGrade, csv_cell, one_line, write_report, write_result
+from ..store.report import SubmissionGrade, one_line, write_report, write_result
+from ..store.variants import write_variants
 from ..submission import refusals
 from .engines import Batch, Engine, LocalEngine
 from .plan import Plan, plan
@@ -41,25 +33,19 @@ from .resume import carried_marks, clear
 def grade(submissions, out_dir, options: GradeOptions | None = None, *, engine: Engine | None = None, progress=True):
     """Grade submissions; write grades.csv, feedback/, results/, seed.txt and the run's record into `out_dir`.
 
-    `submissions` is a :class:`~labkit.grading.run.plan.Submissions` (the paths with their names, the students
-    who handed in nothing to grade, the times the LMS gave, a roster and variants file), or the paths alone.
-    `options` (a :class:`~labkit.grading.options.GradeOptions`, the defaults when None) bound the run: its
-    time and memory limits, its sandbox backend (``"none"``: student code runs unconfined, after a warning on
-    stderr), its seed (a fresh one is drawn and written to ``seed.txt`` when it is None), its rubric (a TOML
-    file; else the rubric recorded in `out_dir` by an earlier run, else the lab's), its shard (``"I/N"``: the
-    I-th of N parts of the class, :func:`~labkit.grading.run.resume.shard`), and which student-written times
-    count (:func:`labkit.grading.store.late.submission_time`).
+    `submissions` is a :class:`~labkit.grading.run.plan.Submissions`, or the paths alone. `options` (a
+    :class:`~labkit.grading.options.GradeOptions`, the defaults when None) bound the run: its limits, its
+    sandbox backend (``"none"``: student code runs unconfined, after a warning on stderr), its seed (drawn
+    and written to ``seed.txt`` when None), its rubric (a TOML file; else the one an earlier run recorded in
+    `out_dir`, else the lab's), its shard (``"I/N"``, :func:`~labkit.grading.run.resume.shard`), and the
+    student-written times that count (:func:`labkit.grading.store.late.submission_time`). `engine` grades:
+    by default a :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` processes here.
+    `progress` draws a bar with an ETA on a terminal.
 
-    `engine` (an :class:`~labkit.grading.run.engines.Engine`) grades the submissions: by default a
-    :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` grading processes at a time here; a
-    :class:`~labkit.grading.run.dask.DaskEngine` sends them to a Dask cluster. `progress` draws a bar with an
-    ETA on a terminal.
-
-    When `out_dir` already holds a run's record, only the submissions without a result there, or whose
-    notebooks changed since, are graded, with that run's seed and rubric
-    (:func:`~labkit.grading.run.resume.resumed`); ``options.fresh`` deletes those results first. Returns the
-    grades in the order given (a shard's in name order; the ungradable last), those of an earlier run
-    included; those with ``graded`` False could not be graded (their ``failure`` says why).
+    When `out_dir` holds a run's record, only the submissions without a result there, or whose notebooks
+    changed since, are graded, with that run's seed and rubric (:func:`~labkit.grading.run.resume.resumed`);
+    ``options.fresh`` deletes those results first. Returns the grades in the order given (a shard's in name
+    order; the ungradable last), an earlier run's included; those with ``graded`` False say why (``failure``).
     """
     if options is None:
         options = GradeOptions()
@@ -152,7 +138,7 @@ class RunFolder:
         request = self.plan.submissions
         if request.variants is not None:
             students = self.plan.record.variants["students"]
-            _write_variants(self.out, grades, students, request.roster, self.plan.rubric.registry)
+            write_variants(self.out, grades, students, request.roster, self.plan.rubric.registry)
         for name, lost in self.dropped:
             sys.stderr.write(
                 f"labkit grade: {one_line(name, 80)}'s notebooks changed; {lost} of the marks given to it no longer "
@@ -160,43 +146,6 @@ class RunFolder:
             )
         summary["grader process peak bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
         (self.out / "run.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
-
-
-VARIANTS_CSV = "variants.csv"
-
-
-def _write_variants(out, grades, students, roster, registry):
-    """``variants.csv``, for the instructor only: each submission's roster id and data, and the classmates
-    whose data its notebooks hold instead (``another variant`` when no one in the class has them)."""
-    varied = [e for e in registry if e.params]
-    rows = []
-    for grade in grades:
-        mine = students.get(grade.name)
-        if mine is None:
-            continue
-        holds = []
-        for exercise in varied:
-            other = (grade.results.get(exercise.number) or {}).get("other_variant") or {}
-            if not other:
-                continue
-            params = {p.name: p for p in exercise.params}
-            whose = [
-                name
-                for name, data in students.items()
-                if name != grade.name
-                and all(
-                    param in params and params[param].holds(found, data.get(str(exercise.number), {}).get(param))
-                    for param, (found, _) in other.items()
-                )
-            ]
-            holds.append(f"exercise {exercise.number}: " + (", ".join(whose) if whose else "another variant"))
-        shown = [", ".join(f"{p} = {v}" for p, v in mine.get(str(e.number), {}).items()) for e in varied]
-        rows.append([grade.name, roster.get(grade.name, ""), *shown, "; ".join(holds)])
-    with open(Path(out) / VARIANTS_CSV, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["submission", "id", *(f"exercise {e.number}" for e in varied), "holds the data of"])
-        for row in rows:
-            writer.writerow([csv_cell(cell) for cell in row])
 
 
 class Graded(list):

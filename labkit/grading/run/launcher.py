@@ -102,14 +102,17 @@ class Launcher:
     def pump(self, wait):
         """File every ended process the launcher reported (waiting up to `wait` s for one); whether any."""
         with self._lock:
-            message = self._next(time.monotonic() + wait)
-            found = False
+            found, message = False, self._next(time.monotonic() + wait)
             while message is not None:
-                if "ended" in message:
-                    self.ended[message.get("id")] = int(message["code"])
-                    found = True
+                found = self._filed(message) or found
                 message = self._next(time.monotonic())
             return found
+
+    def _filed(self, message):
+        """Whether `message` says a grading process ended (then filed)."""
+        if "ended" in message:
+            self.ended[message.get("id")] = int(message["code"])
+        return "ended" in message
 
     def launch(self, request):
         """Fork a grading process for `request`; a :class:`_Launched` (OSError when the launcher is gone)."""
@@ -124,9 +127,7 @@ class Launcher:
                 message = self._next(time.monotonic() + LAUNCH_TIMEOUT)
                 if message is None:
                     raise OSError("the launcher of grading processes stopped answering")
-                if "ended" in message:
-                    self.ended[message.get("id")] = int(message["code"])
-                elif "started" in message and message.get("id") == key:
+                if not self._filed(message) and "started" in message and message.get("id") == key:
                     return _Launched(self, int(message["started"]), key)
 
     def stop(self):
@@ -167,9 +168,8 @@ def _child(request):
         resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
         null = os.open(os.devnull, os.O_RDWR)
         log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        os.dup2(null, 0)
-        os.dup2(null, 1)
-        os.dup2(log, 2)
+        for fd, target in ((null, 0), (null, 1), (log, 2)):
+            os.dup2(fd, target)
         os.close(null)
         os.close(log)
         sys.stdin = open(os.devnull)  # noqa: SIM115 - for the rest of this process's life
@@ -197,6 +197,19 @@ def _say(message):
     os.write(1, (json.dumps(message) + "\n").encode())
 
 
+def _reaped(children):
+    """[(pid, its request's id, wait status)] of the `children` that ended, taken out of `children`."""
+    ended = []
+    for pid in list(children):
+        try:
+            done, status = os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            done, status = pid, 0
+        if done:
+            ended.append((pid, children.pop(pid), status))
+    return ended
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     _import_grader(argv[0] if argv and argv[0] else None)
@@ -205,13 +218,8 @@ def main(argv=None):
     try:
         while True:
             readable = select.select([0], [], [], 0.05)[0]
-            for pid in list(children):
-                try:
-                    done, status = os.waitpid(pid, os.WNOHANG)
-                except ChildProcessError:
-                    done, status = pid, 0
-                if done and pid in children:
-                    _say({"ended": pid, "id": children.pop(pid), "code": os.waitstatus_to_exitcode(status)})
+            for pid, key, status in _reaped(children):
+                _say({"ended": pid, "id": key, "code": os.waitstatus_to_exitcode(status)})
             if not readable:
                 continue
             chunk = os.read(0, 1 << 16)
@@ -237,12 +245,7 @@ def main(argv=None):
                 pass
         deadline = time.monotonic() + 5
         while children and time.monotonic() < deadline:
-            for pid in list(children):
-                try:
-                    if os.waitpid(pid, os.WNOHANG)[0]:
-                        children.pop(pid)
-                except ChildProcessError:
-                    children.pop(pid)
+            _reaped(children)
             time.sleep(0.02)
 
 

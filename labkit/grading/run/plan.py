@@ -110,21 +110,10 @@ def plan(submissions, out_dir, options: GradeOptions) -> Plan:
         rubric=str((out / records.RUBRIC_COPY).resolve()) if rubric.text is not None else options.rubric,
         variants=students if request.variants is not None else None,
     )
-    names = [name for _, name in kept]
-    return Plan(
-        out,
-        options,
-        rubric,
-        _record(earlier, options, request, known.digest),
-        [*names, *ungradable],
-        [(path, name) for path, name in kept if name not in earlier.done],
-        ungradable,
-        _times(request, options, kept, ungradable),
-        contents,
-        earlier,
-        request,
-        part,
-    )
+    order = [*[name for _, name in kept], *ungradable]
+    todo = [(path, name) for path, name in kept if name not in earlier.done]
+    record, when = _record(earlier, options, request, known.digest), _times(request, options, kept, ungradable)
+    return Plan(out, options, rubric, record, order, todo, ungradable, when, contents, earlier, request, part)
 
 
 def _named(request, part):
@@ -247,19 +236,10 @@ def _record(earlier, options, request, known):
 
 def _times(request, options, kept, ungradable):
     """{name: its submission time} (:func:`labkit.grading.store.late.submission_time`)."""
+    times, mtime, exchange = request.times, options.times_from_mtime, request.exchange_times
+    how = {"from_submission": options.times_from_submission, "exchange": exchange}
     when = {
-        name: submission_time(
-            path,
-            name,
-            request.times,
-            notebooks(path) if options.times_from_mtime else None,
-            options.times_from_mtime,
-            from_submission=options.times_from_submission,
-            exchange=request.exchange_times,
-        )
+        name: submission_time(path, name, times, notebooks(path) if mtime else None, mtime, **how)
         for path, name in kept
     }
-    when.update(
-        {name: submission_time(None, name, request.times, exchange=request.exchange_times) for name in ungradable}
-    )
-    return when
+    return when | {name: submission_time(None, name, times, exchange=exchange) for name in ungradable}

@@ -1,10 +1,9 @@
 """What a run into an output folder takes over from the one before it there, and which part of a class it grades.
 
-:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.store.record`)
-and keeps the submissions graded there whose notebooks did not change since;
-:func:`carried_marks` keeps a person's marks that still apply to a
-submission graded again. :func:`shard` picks the I-th of N parts of a class,
-for batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
+:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.store.record`) and keeps the
+submissions graded there whose notebooks did not change since; :func:`carried_marks` keeps a person's
+marks that still apply to one graded again. :func:`shard` picks the I-th of N parts of a class, for
+batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
 """
 
 from dataclasses import dataclass, field
@@ -35,30 +34,14 @@ def notebooks(path):
 
 @dataclass
 class Resumed:
-    """What an earlier run into the same output folder leaves to this one (:func:`resumed`).
+    """What an earlier run into the same output folder leaves to this one (:func:`resumed`)."""
 
-    Attributes
-    ----------
-    done : dict
-        {name: SubmissionGrade} kept: graded there, and its notebooks unchanged since.
-    seed : int or None
-        The seed to grade with (the earlier run's).
-    rubric : Rubric
-        The rubric to grade with (the earlier run's, when none was given).
-    record : RunRecord or None
-        The earlier run's record, which this run goes on writing.
-    changed : list
-        The submissions graded there whose notebooks changed since: graded again.
-    refused : list
-        (path, why) of result files in the folder that its record does not vouch for: never read.
-    """
-
-    done: dict
-    seed: object
-    rubric: Rubric
-    record: object = None
-    changed: list = field(default_factory=list)
-    refused: list = field(default_factory=list)
+    done: dict  # {name: SubmissionGrade} kept: graded there, and its notebooks unchanged since
+    seed: object  # the seed to grade with (the earlier run's), or None
+    rubric: Rubric  # the rubric to grade with (the earlier run's, when none was given)
+    record: object = None  # the earlier run's RunRecord, which this run goes on writing, or None
+    changed: list = field(default_factory=list)  # the names graded there whose notebooks changed since
+    refused: list = field(default_factory=list)  # (path, why) of result files its record does not vouch for
     # {name: its earlier grade} of the changed submissions: the marks a person gave them carry over where they apply
     earlier: dict = field(default_factory=dict)
 
