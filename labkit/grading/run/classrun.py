@@ -42,10 +42,9 @@ def grade(submissions, out_dir, options: GradeOptions | None = None, *, engine: 
     by default a :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` processes here.
     `progress` draws a bar with an ETA on a terminal.
 
-    When `out_dir` holds a run's record, only the submissions without a result there, or whose notebooks
-    changed since, are graded, with that run's seed and rubric (:func:`~labkit.grading.run.resume.resumed`);
-    ``options.fresh`` deletes those results first. Returns the grades in the order given (a shard's in name
-    order; the ungradable last), an earlier run's included; those with ``graded`` False say why (``failure``).
+    A run into a folder with a run's record resumes it (:func:`~labkit.grading.run.resume.resumed`). Returns the
+    grades in the order given (a shard's in name order; the ungradable last), an earlier run's included; those
+    with ``graded`` False say why (``failure``).
     """
     if options is None:
         options = GradeOptions()

@@ -1,17 +1,13 @@
 """A class run's plan: what it grades, with what, and what it takes over, worked out before anything runs.
 
-:func:`plan` turns what was handed in (:class:`Submissions`), the output folder and the run's options into
-a frozen :class:`Plan`, reading the submissions and the folder and writing nothing: the names and the
-shard, the earlier run it resumes (:mod:`.resume`), each student's data (variants), each submission's
-time, the known sources, and the options every grading process gets, settled. Every refusal comes from
-here, before a file is touched; :mod:`.classrun` then runs the plan on an engine and writes the folder.
-
-What travels where: :class:`~labkit.grading.options.GradeOptions` holds the run's choices, plain data
-that a flag of ``labkit grade`` sets and that holds for every submission (limits, seed, sandbox, rubric,
-``jobs``, ``shard``, ``fresh``, the student-written times allowed). :class:`Submissions` holds what this
-run is asked to grade, data about one class that no flag spells: the paths and their names, the students
-with nothing to grade, the times from the LMS or the exchange, the roster and the variants file. The
-engine and the progress bar are how this process carries the run out: keywords of :func:`.classrun.grade`.
+:func:`plan` turns a :class:`Submissions`, the output folder and the run's options into a frozen
+:class:`Plan`, reading and never writing: names and shard, the earlier run resumed (:mod:`.resume`), each
+student's data and time, the known sources, the options every grading process gets. Every refusal comes
+from here, before a file is touched. :class:`~labkit.grading.options.GradeOptions` holds the run's choices
+(plain data a flag sets, the same for every submission: limits, seed, rubric, ``jobs``, ``shard``,
+``fresh``, the student-written times allowed); :class:`Submissions` what this run grades (data about one
+class: paths, names, the ungradable, the times given, roster, variants). The engine and the progress bar,
+how this process carries the run out, are keywords of :func:`.classrun.grade`.
 """
 
 import os

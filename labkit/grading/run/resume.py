@@ -49,16 +49,11 @@ class Resumed:
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     """What the earlier run in `out` leaves to this one: a :class:`Resumed`. Reads, never writes.
 
-    An output folder with a run record (:mod:`labkit.grading.store.record`) is resumed: the submissions graded
-    there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
-    digest}: they changed since, and are graded again), and the run grades the others with the earlier
-    run's seed, which `seed` may repeat but not change, and under the earlier run's rubric, which `rubric`
-    (a Rubric, or None for the recorded one) may repeat but not change. A submission that could not be
-    graded is graded again (such failures are the grader's: a crash, a stopped run, a lost worker). A
-    folder of another labkit version, a merge's folder, results without a record, a different rubric or
-    seed, or a submission graded there that is not in `names` are refused with a ValueError saying what to
-    do, as nothing of them would fit this run's grades.csv. With `fresh` nothing is kept: every submission
-    is graded, with `seed` (a fresh one when None), once :func:`clear` has deleted the earlier results."""
+    The submissions graded there are kept unless their notebooks' digest differs from the recorded one
+    (`contents`, {name: digest}) or they could not be graded; the others are graded with the earlier run's
+    seed and rubric, which `seed` and `rubric` (None: the recorded one) may repeat but not change. Another
+    labkit version's folder, a merge's, results without a record, or a result of a name not in `names` are
+    refused with a ValueError saying what to do. With `fresh` nothing is kept (:func:`clear` deletes it)."""
     out = Path(out)
     files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
     if fresh or not (out / records.RECORD).exists():
