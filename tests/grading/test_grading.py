@@ -259,7 +259,7 @@ def graded(tmp_path_factory, released):
     subs["not_json"] = not_json
     out = tmp / "grades"
     results = grading.grade(
-        list(subs.values()), out, grading.GradeOptions(cell_timeout=10, total_timeout=120), jobs=2, progress=False
+        list(subs.values()), out, grading.GradeOptions(cell_timeout=10, total_timeout=120, jobs=2), progress=False
     )
     return {name: r for name, r in zip(subs, results)}, out, sentinel, subs
 
@@ -457,9 +457,9 @@ def two_runs(tmp_path_factory, released):
     solved, bare = tmp / "alice.ipynb", tmp / "bob.ipynb"
     shutil.copy(NOTEBOOKS / "06_bilinear.ipynb", solved)
     shutil.copy(released / "06_bilinear.ipynb", bare)
-    first = grading.grade([solved], tmp / "job1", grading.GradeOptions(seed=4242), jobs=1, progress=False)
-    second = grading.grade([bare], tmp / "job2", grading.GradeOptions(seed=4242), jobs=1, progress=False)
-    again = grading.grade([solved], tmp / "job3", grading.GradeOptions(seed=4242), jobs=1, progress=False)
+    first = grading.grade([solved], tmp / "job1", grading.GradeOptions(seed=4242, jobs=1), progress=False)
+    second = grading.grade([bare], tmp / "job2", grading.GradeOptions(seed=4242, jobs=1), progress=False)
+    again = grading.grade([solved], tmp / "job3", grading.GradeOptions(seed=4242, jobs=1), progress=False)
     return tmp, first + second, again
 
 
@@ -501,7 +501,7 @@ def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp
     rubric = tmp_path / "rubric.toml"
     rubric.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n')
     for path, job in ((solved, "job1"), (bare, "job2")):
-        grading.grade([path], tmp_path / job, grading.GradeOptions(seed=4242, rubric=rubric), jobs=1, progress=False)
+        grading.grade([path], tmp_path / job, grading.GradeOptions(seed=4242, rubric=rubric, jobs=1), progress=False)
     tmp = tmp_path
     other = tmp_path / "other.toml"
     other.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 10\n')

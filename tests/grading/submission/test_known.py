@@ -371,9 +371,9 @@ def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tm
     copier = tmp_path / "copier"  # the solutions, leaked whole
     copier.mkdir()
     shutil.copy(NOTEBOOKS / "03_meshes.ipynb", copier / "03_meshes.ipynb")
-    options = GradeOptions(solutions=str(NOTEBOOKS))
+    options = GradeOptions(solutions=str(NOTEBOOKS), jobs=2)
     out = tmp_path / "out"
-    graded = grading.grade([*subs, copier], out, jobs=2, progress=False, options=options)
+    graded = grading.grade([*subs, copier], out, options, progress=False)
     by_name = {g.name: g for g in graded}
     for style in (s for s in STYLES if s not in PLAIN):
         assert by_name[style].total == rubric.default().maximum, by_name[style].feedback()
@@ -388,7 +388,7 @@ def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tm
     assert record["known"]["solutions"] == str(NOTEBOOKS) and record["known"]["digest"]
     assert solution  # (read as the grader reads it)
     # a resumed run compares with the same sources, recorded: without --solutions they are used again
-    again = grading.grade([*subs, copier], out, jobs=2, progress=False)
+    again = grading.grade([*subs, copier], out, GradeOptions(jobs=2), progress=False)
     assert {(n, p) for n, p, _, _ in {g.name: g for g in again}["copier"].held()} == held
     assert json.loads((out / "record.json").read_text())["known"] == record["known"]
     # other solutions are other known sources: the run is not resumed under them
@@ -396,7 +396,7 @@ def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tm
     other.mkdir()
     shutil.copy(NOTEBOOKS / "02_convergence.ipynb", other / "02_convergence.ipynb")
     with pytest.raises(ValueError, match="other known sources"):
-        grading.grade([*subs, copier], out, jobs=2, progress=False, options=GradeOptions(solutions=str(other)))
+        grading.grade([*subs, copier], out, GradeOptions(solutions=str(other), jobs=2), progress=False)
 
 
 def _part(number, name):
@@ -568,7 +568,7 @@ def test_rewritten_and_string_run_copies_are_held_or_refused_in_one_run_with_hon
     forms = {form: rewrite(copy) for form, rewrite in REWRITES.items()} | {"exec": exec_compressed(copy)}
     subs = [_with_cell(tmp_path / form, "02_convergence.ipynb", cell) for form, cell in forms.items()]
     subs += [INDEPENDENT / style for style in STYLES]
-    graded = {g.name: g for g in grading.grade(subs, tmp_path / "out", jobs=2, progress=False)}
+    graded = {g.name: g for g in grading.grade(subs, tmp_path / "out", GradeOptions(jobs=2), progress=False)}
     for style in STYLES:
         assert graded[style].total == rubric.default().maximum and not graded[style].held(), graded[style].feedback()
     for form in forms:
