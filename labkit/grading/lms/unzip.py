@@ -65,11 +65,9 @@ class Budget:
 def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS) -> list[Path]:
     """Extract `zip_path` into the folder `into`, refusing whatever could harm, and return the files written.
 
-    A member whose name is absolute, has a drive letter or a ``..``, a link, a device, and whatever breaks
-    `limits` (counted on the bytes really decompressed; the sizes a zip declares are checked first, never
-    trusted) refuse the zip: ValueError naming it and the rule, after removing what this call wrote. A zip inside
-    is unpacked in its place (``work.zip`` into a folder ``work``) on the same budget; ``__MACOSX/`` is skipped.
-    Nothing is written outside `into`, and no existing file is overwritten.
+    A path out of `into`, a link, a device, or a broken limit (on the bytes really decompressed, never the sizes
+    declared) refuses the zip: ValueError, after removing what this call wrote. A zip inside is unpacked in its
+    place (``work.zip`` into a folder ``work``) on the same budget. No existing file is ever overwritten.
 
     >>> import pathlib, tempfile, zipfile
     >>> folder = pathlib.Path(tempfile.mkdtemp())
@@ -127,22 +125,38 @@ def open_zip(path, label):
         raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
 
 
+def refused(label, shown, why):
+    """The InputError for the member `shown` of the zip `label`."""
+    return InputError(f"{label}: member {shown!r} {why}")
+
+
 def member_parts(name, label, skip=0):
-    """The parts of a member's name, or ValueError when it would leave the folder (or a part past the first
-    `skip` is longer than a file system takes)."""
+    """The parts of a member's name; ValueError when it leaves the folder or a part past `skip` is too long."""
     shown = one_line(name, 120)
     text = name.replace("\\", "/")
     if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
-        raise InputError(f"{label}: member {shown!r} has an absolute path; labkit never extracts it.")
+        raise refused(label, shown, "has an absolute path; labkit never extracts it.")
     parts = [p for p in text.split("/") if p not in ("", ".")]
     if ".." in parts:
-        raise InputError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
+        raise refused(label, shown, "leaves the folder; labkit never extracts it.")
     if any(len(p.encode("utf-8", "surrogateescape")) > MAX_NAME for p in parts[skip:]):
-        raise InputError(
-            f"{label}: member {shown!r} has a name longer than {MAX_NAME} bytes, more than a file system "
-            "takes; rename it shorter."
+        raise refused(
+            label, shown, f"has a name longer than {MAX_NAME} bytes, more than a file system takes; rename it."
         )
     return parts
+
+
+def count_members(budget, count, label):
+    """Add `count` members to `budget`; ValueError when the student now has too many."""
+    budget.members += count
+    if budget.members > budget.limits.max_members:
+        most = budget.limits.max_members
+        raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
+
+
+def _over_total(label, limits, when=""):
+    most = size_text(limits.max_total)
+    return InputError(f"{label}: more than {most} uncompressed{when}; labkit extracts at most {most} for one student.")
 
 
 def _unpack(zip_path, into, budget, depth, written, made, label):
@@ -151,12 +165,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
         infos = archive.infolist()
-        budget.members += len(infos)
-        if budget.members > limits.max_members:
-            raise InputError(
-                f"{label}: more than {limits.max_members} members; labkit extracts at most {limits.max_members} "
-                "for one student."
-            )
+        count_members(budget, len(infos), label)
         plan = checked(infos, budget, label)
         inner = []
         for info, parts, is_dir, shown in plan:
@@ -169,9 +178,8 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
                 inner.append((target, shown))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
-            raise InputError(
-                f"{label}: member {shown!r} is a zip nested more than {limits.max_depth} deep; "
-                "labkit never extracts deeper."
+            raise refused(
+                label, shown, f"is a zip nested more than {limits.max_depth} deep; labkit never extracts deeper."
             )
         folder = free(target.with_suffix(""))
         folder.mkdir()
@@ -182,8 +190,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
 
 
 def checked(infos, budget, label, parts_of=None):
-    """[(info, parts, is_dir, shown)] of the members `infos` to extract, after every check that their names and
-    declared sizes allow on `budget` (ValueError naming the first that fails)."""
+    """[(info, parts, is_dir, shown)] of the members `infos`, once their names and declared sizes fit `budget`."""
     plan, seen, declared = [], set(), 0
     for info in infos:
         parts = member_parts(info.filename, label) if parts_of is None else parts_of(info)
@@ -192,15 +199,12 @@ def checked(infos, budget, label, parts_of=None):
             continue
         shown, key = one_line(info.filename, 120), "/".join(parts)
         if key in seen:
-            raise InputError(f"{label}: member {shown!r} appears twice; labkit extracts each name once.")
+            raise refused(label, shown, "appears twice; labkit extracts each name once.")
         seen.add(key)
         if not is_dir:
             declared += _declared(info, label, shown, budget.limits)
             if budget.total + declared > budget.limits.max_total:
-                raise InputError(
-                    f"{label}: more than {size_text(budget.limits.max_total)} uncompressed; "
-                    f"labkit extracts at most {size_text(budget.limits.max_total)} for one student."
-                )
+                raise _over_total(label, budget.limits)
         plan.append((info, parts, is_dir, shown))
     return plan
 
@@ -211,19 +215,19 @@ def _member_kind(info, label):
     mode = info.external_attr >> 16
     kind = stat.S_IFMT(mode)
     if stat.S_ISLNK(mode):
-        raise InputError(f"{label}: member {shown!r} is a symbolic link; labkit never extracts links.")
+        raise refused(label, shown, "is a symbolic link; labkit never extracts links.")
     if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
-        raise InputError(f"{label}: member {shown!r} is a device or a pipe; labkit never extracts those.")
+        raise refused(label, shown, "is a device or a pipe; labkit never extracts those.")
     if info.flag_bits & 0x1:
-        raise InputError(f"{label}: member {shown!r} is encrypted; labkit cannot read it.")
+        raise refused(label, shown, "is encrypted; labkit cannot read it.")
     return info.is_dir() or kind == stat.S_IFDIR
 
 
 def _declared(info, label, shown, limits):
     if info.file_size > limits.max_member:
-        raise InputError(
-            f"{label}: member {shown!r} is larger than {size_text(limits.max_member)} "
-            f"({size_text(info.file_size)}); labkit extracts at most {size_text(limits.max_member)} a file."
+        most = size_text(limits.max_member)
+        raise refused(
+            label, shown, f"is larger than {most} ({size_text(info.file_size)}); labkit extracts at most {most} a file."
         )
     _check_ratio(label, shown, info.file_size, info.compress_size, limits)
     return info.file_size
@@ -231,9 +235,8 @@ def _declared(info, label, shown, limits):
 
 def _check_ratio(label, shown, size, compressed, limits):
     if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
-        raise InputError(
-            f"{label}: member {shown!r} is compressed more than {limits.max_ratio:g} times (a zip bomb?); "
-            f"labkit never extracts it."
+        raise refused(
+            label, shown, f"is compressed more than {limits.max_ratio:g} times (a zip bomb?); labkit never extracts it."
         )
 
 
@@ -246,9 +249,9 @@ def make_dirs(into, parts, made, label, shown):
             made.append(folder)
         except FileExistsError:
             if not stat.S_ISDIR(os.lstat(folder).st_mode):
-                raise InputError(f"{label}: member {shown!r} is inside a file of the zip; labkit refuses it.") from None
+                raise refused(label, shown, "is inside a file of the zip; labkit refuses it.") from None
         except OSError as exc:
-            raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+            raise refused(label, shown, f"cannot be written ({one_line(exc, 120)}).") from None
 
 
 def extract(archive, info, target, budget, label, shown, written):
@@ -256,11 +259,10 @@ def extract(archive, info, target, budget, label, shown, written):
     try:
         descriptor = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o600)
     except OSError as exc:
-        raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+        raise refused(label, shown, f"cannot be written ({one_line(exc, 120)}).") from None
     written.append(target)
     size = 0
-    # Read as if the member were larger than any limit, so that the bytes it really holds are counted
-    # (zipfile would stop at the size it declares); the declared size is then checked against them.
+    # read past the size the member declares (zipfile stops there), so that the bytes it really holds are counted
     probe = copy.copy(info)
     probe.file_size = max(info.file_size, limits.max_member, limits.max_total) + 1
     try:
@@ -268,23 +270,18 @@ def extract(archive, info, target, budget, label, shown, written):
             while chunk := source.read(CHUNK):
                 size += len(chunk)
                 if size > limits.max_member:
-                    raise InputError(
-                        f"{label}: member {shown!r} grows past {size_text(limits.max_member)} while extracting; "
-                        f"labkit extracts at most {size_text(limits.max_member)} a file."
+                    most = size_text(limits.max_member)
+                    raise refused(
+                        label, shown, f"grows past {most} while extracting; labkit extracts at most {most} a file."
                     )
                 if budget.total + size > limits.max_total:
-                    raise InputError(
-                        f"{label}: more than {size_text(limits.max_total)} uncompressed while extracting; "
-                        f"labkit extracts at most {size_text(limits.max_total)} for one student."
-                    )
+                    raise _over_total(label, limits, " while extracting")
                 _check_ratio(label, shown, size, info.compress_size, limits)
                 out.write(chunk)
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
-        raise InputError(f"{label}: member {shown!r} cannot be read ({one_line(exc, 120)}).") from None
+        raise refused(label, shown, f"cannot be read ({one_line(exc, 120)}).") from None
     if size != info.file_size:
-        raise InputError(
-            f"{label}: member {shown!r} declares {info.file_size} bytes but holds {size}; labkit refuses the zip."
-        )
+        raise refused(label, shown, f"declares {info.file_size} bytes but holds {size}; labkit refuses the zip.")
     budget.total += size
 
 
