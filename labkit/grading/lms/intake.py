@@ -196,7 +196,7 @@ class Builder:
         for relative, archive in zips:
             folder = free(target / relative.parent / safe_part(relative.stem))
             folder.parent.mkdir(parents=True, exist_ok=True)
-            unzip.unpack_into(archive, folder, limits, self.zip_depth, budget)
+            unzip.unpack(archive, folder, limits, self.zip_depth, budget)
             self.notes.append(f"{one_line(name, 80)}: unpacked {one_line(as_text(relative.as_posix()), 80)}")
 
 

@@ -25,14 +25,8 @@ UNREADABLE = (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFEr
 
 @dataclass(frozen=True)
 class UnpackLimits:
-    """What :func:`unpack` extracts at most from one zip and the zips in it; in the class intake, what one
-    student's files and zips may hold in all: bytes (512 MiB), members, folders included (2000), the ratio of
-    uncompressed to compressed size of a member that grows past 1 MiB (100), bytes of one member (64 MiB), levels
-    of zips inside the zip (2: a zip in a zip in the zip).
-
-    >>> UnpackLimits().max_members, UnpackLimits(max_depth=0).max_depth
-    (2000, 0)
-    """
+    """What one student's files and zips may hold in all: bytes, members (folders included), the compression
+    ratio of a member past 1 MiB, bytes of one member, levels of zips inside the zip."""
 
     max_total: int = 512 << 20
     max_members: int = 2000
@@ -53,8 +47,7 @@ LIMITS = UnpackLimits()
 
 @dataclass
 class Budget:
-    """What one student (or one :func:`unpack` call) has spent, nested zips included; ``in_class``: the student's
-    files came in the class zip (counted as they were unpacked)."""
+    """What one student has spent, nested zips included (``in_class``: counted as the class zip was unpacked)."""
 
     limits: UnpackLimits
     members: int = 0
@@ -62,31 +55,21 @@ class Budget:
     in_class: bool = False
 
 
-def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS) -> list[Path]:
-    """Extract `zip_path` into the folder `into`, refusing whatever could harm, and return the files written.
-
-    A path out of `into`, a link, a device, or a broken limit (on the bytes really decompressed, never the sizes
-    declared) refuses the zip: ValueError, after removing what this call wrote. A zip inside is unpacked in its
-    place (``work.zip`` into a folder ``work``) on the same budget. No existing file is ever overwritten.
+def unpack(
+    zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS, depth=0, budget=None
+) -> list[Path]:
+    """Extract `zip_path` into `into` (its zips in their place, `depth` levels in, on `budget`), refusing whatever
+    could harm with a ValueError after removing what it wrote; the files written.
 
     >>> import pathlib, tempfile, zipfile
     >>> folder = pathlib.Path(tempfile.mkdtemp())
     >>> with zipfile.ZipFile(folder / "work.zip", "w") as z:
-    ...     z.writestr("lab/02_convergence.ipynb", "{}")
-    >>> [p.relative_to(folder).as_posix() for p in unpack(folder / "work.zip", folder / "out")]
-    ['out/lab/02_convergence.ipynb']
-    >>> with zipfile.ZipFile(folder / "evil.zip", "w") as z:
     ...     z.writestr("../evil.ipynb", "{}")
-    >>> unpack(folder / "evil.zip", folder / "out2")
+    >>> unpack(folder / "work.zip", folder / "out")
     Traceback (most recent call last):
     ...
-    labkit.errors.InputError: evil.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
+    labkit.errors.InputError: work.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
     """
-    return unpack_into(zip_path, into, limits)
-
-
-def unpack_into(zip_path, into, limits, depth=0, budget=None):
-    """:func:`unpack` at `depth` levels of zips in, on `budget` (a student's, shared by all their zips)."""
     into = Path(into)
     created_root = None if os.path.lexists(into) else into
     while created_root is not None and not os.path.lexists(created_root.parent):
@@ -164,11 +147,9 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
     if depth > limits.max_depth:
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
-        infos = archive.infolist()
-        count_members(budget, len(infos), label)
-        plan = checked(infos, budget, label)
+        count_members(budget, len(archive.infolist()), label)
         inner = []
-        for info, parts, is_dir, shown in plan:
+        for info, parts, is_dir, shown in checked(archive.infolist(), budget, label):
             target = into.joinpath(*parts)
             make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
             if is_dir:
@@ -178,9 +159,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
                 inner.append((target, shown))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
-            raise refused(
-                label, shown, f"is a zip nested more than {limits.max_depth} deep; labkit never extracts deeper."
-            )
+            raise refused(label, shown, f"is a zip nested more than {limits.max_depth} deep; labkit never goes deeper.")
         folder = free(target.with_suffix(""))
         folder.mkdir()
         made.append(folder)
@@ -202,7 +181,8 @@ def checked(infos, budget, label, parts_of=None):
             raise refused(label, shown, "appears twice; labkit extracts each name once.")
         seen.add(key)
         if not is_dir:
-            declared += _declared(info, label, shown, budget.limits)
+            _check_size(label, shown, info.file_size, info.compress_size, budget.limits)
+            declared += info.file_size
             if budget.total + declared > budget.limits.max_total:
                 raise _over_total(label, budget.limits)
         plan.append((info, parts, is_dir, shown))
@@ -223,21 +203,15 @@ def _member_kind(info, label):
     return info.is_dir() or kind == stat.S_IFDIR
 
 
-def _declared(info, label, shown, limits):
-    if info.file_size > limits.max_member:
+def _check_size(label, shown, size, compressed, limits, growing=False):
+    """ValueError when a member of `size` bytes (`compressed` in the zip) is too large or compressed too much."""
+    if size > limits.max_member:
         most = size_text(limits.max_member)
-        raise refused(
-            label, shown, f"is larger than {most} ({size_text(info.file_size)}); labkit extracts at most {most} a file."
-        )
-    _check_ratio(label, shown, info.file_size, info.compress_size, limits)
-    return info.file_size
-
-
-def _check_ratio(label, shown, size, compressed, limits):
+        grows = f"grows past {most} while extracting" if growing else f"is larger than {most} ({size_text(size)})"
+        raise refused(label, shown, f"{grows}; labkit extracts at most {most} a file.")
     if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
-        raise refused(
-            label, shown, f"is compressed more than {limits.max_ratio:g} times (a zip bomb?); labkit never extracts it."
-        )
+        ratio = f"{limits.max_ratio:g}"
+        raise refused(label, shown, f"is compressed more than {ratio} times (a zip bomb?); labkit never extracts it.")
 
 
 def make_dirs(into, parts, made, label, shown):
@@ -269,14 +243,9 @@ def extract(archive, info, target, budget, label, shown, written):
         with os.fdopen(descriptor, "wb") as out, archive.open(probe) as source:
             while chunk := source.read(CHUNK):
                 size += len(chunk)
-                if size > limits.max_member:
-                    most = size_text(limits.max_member)
-                    raise refused(
-                        label, shown, f"grows past {most} while extracting; labkit extracts at most {most} a file."
-                    )
+                _check_size(label, shown, size, info.compress_size, limits, growing=True)
                 if budget.total + size > limits.max_total:
                     raise _over_total(label, limits, " while extracting")
-                _check_ratio(label, shown, size, info.compress_size, limits)
                 out.write(chunk)
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
         raise refused(label, shown, f"cannot be read ({one_line(exc, 120)}).") from None
