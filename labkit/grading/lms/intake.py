@@ -129,6 +129,10 @@ class Builder:
         """An entry's name as the LMS gave it."""
         return self.aliases.get(entry.name) or as_text(entry.name)
 
+    def on_disk(self, name):
+        """The name a class zip's top-level `name` is written under."""
+        return next((alias for alias, given in self.aliases.items() if given == name), name)
+
     def refusal(self, student, key):
         """`student` as one who could not be graded when the class zip's members of theirs were refused, or None."""
         why = self.refused.get(key)
@@ -240,25 +244,14 @@ def detect_tops(tops, where):
     expected = ", ".join(lms.download for lms in found[:-1]) + f" or {found[-1].download} (a folder or its zip)"
     if not fits:
         shown = ", ".join(one_line(name, 64) for name, _ in tops[:SHOWN]) or "nothing"
-        raise InputError(
-            f"{one_line(where)} holds no students ({shown}); expected {expected}: see docs/instructors.md."
-        )
+        raise InputError(f"{one_line(where)} holds no students ({shown}); expected {expected} (docs/instructors.md).")
     what = ", ".join(lms.described(sorted(claimed[lms])) for lms in found if lms in claimed)
     raise InputError(f"{one_line(where)} mixes layouts ({what}); expected one of {expected}. Give one of them only.")
 
 
 def is_class(path: str | os.PathLike) -> bool:
-    """Whether `path` is a whole class (a zip, or a folder in one of the layouts) rather than one student's work.
-
-    A folder holding notebooks not named as an LMS names them is one student's, as is a notebook; a folder with
-    both such notebooks and folders of notebooks cannot be told apart: ValueError.
-
-    >>> import pathlib, tempfile
-    >>> root = pathlib.Path(tempfile.mkdtemp())
-    >>> (root / "alice").mkdir(); _ = (root / "alice" / "02_convergence.ipynb").write_text("{}")
-    >>> is_class(root), is_class(root / "alice"), is_class(root / "alice" / "02_convergence.ipynb")
-    (True, False, False)
-    """
+    """Whether `path` is a class (a zip, or a folder of an LMS's layout) rather than one student's notebooks;
+    ValueError for a folder of both notebooks (not named as an LMS names them) and folders of notebooks."""
     path = Path(path)
     try:
         info = os.lstat(path)
@@ -353,13 +346,12 @@ def _student_plan(key, items, builder, label, skip):
     """The checked members of one student, or None when one breaks a limit (``builder.refused[key]`` says why)."""
     budget = builder.budget(key)
     budget.in_class = True
-    disk = {name: alias for alias, name in builder.aliases.items()}
     parts_of = {id(info): parts for info, parts in items}
 
     def checked_parts(info):
         unzip.member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
         parts = parts_of[id(info)]
-        return [disk.get(parts[0], parts[0]), *parts[1:]]
+        return [builder.on_disk(parts[0]), *parts[1:]]
 
     try:
         unzip.count_members(budget, len(items), label)
@@ -388,12 +380,9 @@ def _check_space(lms, plans, root, label):
 
 def _extract_student(archive, key, plan, root, builder, label):
     """Write one student's checked members under `root` on their budget; on a refusal remove them again."""
-    budget, written, made = builder.budget(key), [], []
+    written, made = [], []
     try:
-        for info, parts, is_dir, shown in plan:
-            unzip.make_dirs(root, parts if is_dir else parts[:-1], made, label, shown)
-            if not is_dir:
-                unzip.extract(archive, info, root.joinpath(*parts), budget, label, shown, written)
+        unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
     except ValueError as exc:
         unzip.undo(None, written, made)
         builder.refused[key] = f"{exc} {FIX}"
@@ -403,13 +392,12 @@ def _placeholder(root, key, items, depth, builder):
     """For a refused student, empty stand-ins of what names them at the top, so that the layout finds them."""
     if key not in builder.refused:
         return
-    disk = {name: alias for alias, name in builder.aliases.items()}
     folders = {tuple(p[:depth]) for info, p in items if len(p) > depth or (len(p) == depth and info.is_dir())}
     files = {tuple(p) for _, p in items if len(p) == 1 and depth == 1} - folders
     for parts in sorted(folders)[:SHOWN]:
-        (root / disk.get(parts[0], parts[0])).joinpath(*parts[1:]).mkdir(parents=True, exist_ok=True)
+        (root / builder.on_disk(parts[0])).joinpath(*parts[1:]).mkdir(parents=True, exist_ok=True)
     for (name,) in sorted(files)[:SHOWN]:
-        target = root / disk.get(name, name)
+        target = root / builder.on_disk(name)
         if not os.path.lexists(target):
             target.touch()
 
@@ -423,22 +411,11 @@ def find_class(
     roster: dict[str, str] | None = None,
 ) -> Intake:
     """The students of the class in `path` (a folder or zip of one LMS), in name order; one that cannot be graded
-    has ``path=None`` and the reason in ``failure``. One student's upload never stops the others.
+    has ``path=None`` and the reason in ``failure``, and never stops the others.
 
     Everything is written in `workspace` (the caller's, not inside `path`). `assignment` is nbgrader's to take;
     `limits` what one student's files and zips may hold in all; `roster` ({submission: LMS id}) names a student
     whose LMS id it has. ValueError when the layout is unclear, two students share a name, or the zip has no room.
-
-    >>> import pathlib, tempfile
-    >>> top = pathlib.Path(tempfile.mkdtemp())
-    >>> for student in ("bob", "alice"):
-    ...     (top / "class" / student).mkdir(parents=True)
-    ...     _ = (top / "class" / student / "02_convergence.ipynb").write_text("{}")
-    >>> (top / "class" / "carol").mkdir()
-    >>> _ = (top / "class" / "carol" / "notes.pdf").write_bytes(b"%PDF")
-    >>> intake = find_class(top / "class", top / "work")
-    >>> intake.layout, [(s.name, s.failure) for s in intake.students]
-    ('folders', [('alice', None), ('bob', None), ('carol', 'holds no notebook (it holds notes.pdf)')])
     """
     path, workspace = Path(path), Path(workspace)
     try:

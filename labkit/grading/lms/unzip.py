@@ -148,15 +148,8 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
         count_members(budget, len(archive.infolist()), label)
-        inner = []
-        for info, parts, is_dir, shown in checked(archive.infolist(), budget, label):
-            target = into.joinpath(*parts)
-            make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
-            if is_dir:
-                continue
-            extract(archive, info, target, budget, label, shown, written)
-            if target.suffix.lower() == ".zip":
-                inner.append((target, shown))
+        plan = checked(archive.infolist(), budget, label)
+        inner = write_plan(archive, plan, into, budget, label, (written, made))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
             raise refused(label, shown, f"is a zip nested more than {limits.max_depth} deep; labkit never goes deeper.")
@@ -212,6 +205,19 @@ def _check_size(label, shown, size, compressed, limits, growing=False):
     if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
         ratio = f"{limits.max_ratio:g}"
         raise refused(label, shown, f"is compressed more than {ratio} times (a zip bomb?); labkit never extracts it.")
+
+
+def write_plan(archive, plan, into, budget, label, undo_lists):
+    """Write the checked members `plan` under `into` (recording them in `undo_lists`); [(a zip written, shown)]."""
+    written, made, inner = *undo_lists, []
+    for info, parts, is_dir, shown in plan:
+        make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
+        if not is_dir:
+            target = into.joinpath(*parts)
+            extract(archive, info, target, budget, label, shown, written)
+            if target.suffix.lower() == ".zip":
+                inner.append((target, shown))
+    return inner
 
 
 def make_dirs(into, parts, made, label, shown):
