@@ -49,12 +49,7 @@ class Export:
         return len(names) + len(self.lms_only)
 
     def problems(self) -> list[str]:
-        """One printable line per student who got no points from this export, and why.
-
-        >>> e = Export(Path("g.csv"), Path("g-summary.csv"), "Moodle", "labkit", not_in_roster=["ada\\x1b[2J"])
-        >>> e.problems()
-        ['no roster entry, nothing exported: ada\\ufffd[2J']
-        """
+        """One printable line per student who got no points from this export, and why."""
         gradebook = f"the {self.lms} gradebook"
         lines = [
             f"not graded, no points exported: {one_line(name, 80)} ({one_line(reason, 200)})"
@@ -71,18 +66,14 @@ class Export:
 
     def summary(self) -> str:
         """What was written, in a few lines for a terminal."""
-        column = one_line(self.column, 80)
-        lines = [
-            f"wrote {self.path}: the totals of {len(self.exported)} student(s) in the column {column!r}, for "
-            f"{self.lms}'s grade import"
-        ]
+        column, where = one_line(self.column, 80), self.summary_path
+        wrote = f"wrote {self.path}: the totals of {len(self.exported)} student(s) in the column {column!r}, for "
+        lines = [f"{wrote}{self.lms}'s grade import"]
         if self.listed:
-            lines.append(
-                f"{self.listed} student(s) got nothing from this file (listed above, and in {self.summary_path}): "
-                "enter their grades by hand or fix the roster and export again"
-            )
+            nothing = f"{self.listed} student(s) got nothing from this file (listed above, and in {where})"
+            lines.append(f"{nothing}: enter their grades by hand or fix the roster and export again")
         else:
-            lines.append(f"every submission and roster entry matched; the summary is in {self.summary_path}")
+            lines.append(f"every submission and roster entry matched; the summary is in {where}")
         return "\n".join(lines + self.notes)
 
 
@@ -92,21 +83,13 @@ def export(layout: str, grades: list[SubmissionGrade], roster, out, **options) -
 
 
 def default_file(results_dir: str | os.PathLike, lms: str) -> Path:
-    """Where ``labkit export`` writes when not told: ``<folder>-<lms>.csv`` beside the run's ``--out`` folder.
-
-    >>> default_file("/course/grades", "canvas").as_posix()
-    '/course/grades-canvas.csv'
-    """
+    """Where ``labkit export`` writes when not told: ``<folder>-<lms>.csv`` beside the run's ``--out`` folder."""
     folder = Path(results_dir).resolve()
     return folder.with_name(f"{folder.name}-{lms}.csv")
 
 
 def summary_file(path: str | os.PathLike) -> Path:
-    """The summary CSV that goes with an export file.
-
-    >>> summary_file("/course/grades-canvas.csv").as_posix()
-    '/course/grades-canvas-summary.csv'
-    """
+    """The summary CSV that goes with an export file: ``grades-canvas.csv``'s is ``grades-canvas-summary.csv``."""
     path = Path(path)
     return path.with_name(f"{path.stem}-summary.csv")
 
