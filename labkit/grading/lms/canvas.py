@@ -55,8 +55,7 @@ class Reading:
     file: str
 
     @property
-    def prefix(self):
-        """What every file of this user starts with."""
+    def prefix(self):  # what every file of this user starts with
         return (self.login, self.late, self.uid)
 
 
@@ -99,8 +98,8 @@ def _padded(number):
 
 
 def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
-    """{file name: its Reading, or None when it is no one's} and notes: of a name's readings, the one its user's
-    other files confirm, else the one whose user is among `roster_ids`, else none.
+    """{file name: the Reading its user's other files confirm, else the one whose user is among `roster_ids`,
+    else None} and notes.
 
     >>> names = ["ada_1001_5_a.ipynb", "ada_1001_7_hw_1_2_c.ipynb"]
     >>> resolve_canvas(names)[0]["ada_1001_7_hw_1_2_c.ipynb"] is None  # user 1001, or user 1 named ada_1001_7_hw?
@@ -283,14 +282,7 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
 
 
 def assignment_columns(book: CanvasGradebook) -> list[str]:
-    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only.
-
-    >>> book = CanvasGradebook(
-    ...     ["Student", "ID", "Section", "Quiz 1 (501)", "Current Score"],
-    ...     [["    Points Possible", "", "", "10", "(read only)"]], ",", "\\n", False, 2)
-    >>> assignment_columns(book)
-    ['Quiz 1 (501)']
-    """
+    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only."""
     points_row = book.points_row()
     return [
         cell.strip()
@@ -337,10 +329,8 @@ def to_canvas(
     force: bool = False,
 ) -> Export:
     """Fill the assignment `column` of the Canvas `gradebook` with the grades' totals into `out` (and its summary),
-    matching students through `roster` on the gradebook's `key` column; ValueError, and nothing written, for bad
-    input. A `column` the gradebook lacks is refused (a typo would be a new assignment) unless `new_column`, which
-    refuses one it has; `force` replaces an existing `out`.
-    """
+    matching students through `roster` on the `key` column; ValueError, and nothing written, for bad input. A
+    `column` it lacks is refused (a typo would be a new assignment in Canvas) unless `new_column`."""
     if key not in KEYS:
         raise InputError(f"--key for Canvas is one of {', '.join(KEYS)} (a gradebook column); got {key!r}.")
     by_name, export = start(grades, out, "Canvas", column)
@@ -348,7 +338,7 @@ def to_canvas(
     book = read_canvas(gradebook)
     check_outputs(export, [gradebook, roster], force)
     at_key = _key_column(book, key, gradebook)
-    full_credit = by_name[next(iter(by_name))].rubric.full_credit
+    full_credit = next(iter(by_name.values())).rubric.full_credit
     target = _target(book, export, gradebook, full_credit, new_column)
     students = _students_by_key(book, at_key, key, gradebook, entries_, export)
     matched = match(export, by_name, entries_, students)
@@ -387,9 +377,7 @@ def _target(book, export, path, full_credit, new_column):
     """The index of the assignment column to fill: the export's column, or a new one at the end."""
     column = export.column
     if TOTALS.search(column) or column.strip() in STUDENT_COLUMNS:
-        raise InputError(
-            f"Canvas reads a column named {column!r} as a student column or a total: give another --column."
-        )
+        raise InputError(f"Canvas reads {column!r} as a student column or a total: give another --column.")
     target = _assignment_column(book, column, path)
     if target is None and not new_column:
         raise InputError(
@@ -431,8 +419,8 @@ def _students_by_key(book, at_key, key, path, roster, export):
             continue
         value = row[at_key].strip()
         if value in students:
-            rows = f"rows {rows_of[value]} and {number}"
-            raise InputError(f"{path} has two rows with {key} {one_line(value, 60)!r} ({rows}); give another --key.")
+            lines = f"rows {rows_of[value]} and {number}"
+            raise InputError(f"{path} has two rows with {key} {one_line(value, 60)!r} ({lines}); give another --key.")
         if row[0].strip() == TEST_STUDENT and value not in set(roster.values()):
             export.notes.append(f"note: Canvas's test student ({TEST_STUDENT!r}) is in the gradebook; left as it is.")
         elif not value:  # a student without this id: no roster entry can name it

@@ -450,15 +450,12 @@ def _class_root(path, info, own, builder):
     root = own / "class"
     root.mkdir()
     lms = _class_zip(path, root, builder)
-    builder.notes.append(
-        f"unpacked {one_line(as_text(path.name))} into the workspace, each student's files on their own"
-    )
+    builder.notes.append(f"unpacked {one_line(as_text(path.name))} into the workspace, each student's files apart")
     return root, lms
 
 
 def _by_roster(students, roster, notes):
-    """The students named by the roster by their LMS id (never a display name); one whose id it lacks keeps a
-    name no roster entry has."""
+    """The students named by the roster from their LMS id (never a display name), or a name no roster entry has."""
     names = {key: name for name, key in roster.items()}
     with_ids = [s for s in students if s.lms_id is not None]
     if not any(s.lms_id in names for s in with_ids):
@@ -470,10 +467,8 @@ def _by_roster(students, roster, notes):
         name = names.get(student.lms_id) if student.lms_id is not None else student.name
         if name is None:
             name = student.name if student.name not in roster else f"{student.name}_{student.lms_id}"
-            notes.append(
-                f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)}) is not on the roster: "
-                f"graded as {one_line(name, 80)}"
-            )
+            who = f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)})"
+            notes.append(f"{who} is not on the roster: graded as {one_line(name, 80)}")
         renamed.append(dataclasses.replace(student, name=name))
     return renamed
 

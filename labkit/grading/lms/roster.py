@@ -89,11 +89,13 @@ def read_roster(path: str | os.PathLike) -> dict[str, str]:
             missing = "submission" if not name else "id"
             raise InputError(f"the roster {path}, row {number}: the {missing} is empty; give both, or delete the row.")
         if name in roster:
-            rows = f"rows {lines_of[name]} and {number}"
-            raise InputError(f"the roster {path} names the submission {one_line(name, 80)!r} twice ({rows}); keep one.")
+            lines = f"rows {lines_of[name]} and {number}"
+            raise InputError(
+                f"the roster {path} names the submission {one_line(name, 80)!r} twice ({lines}); keep one."
+            )
         if key in names_of:
-            rows = f"rows {lines_of[names_of[key]]} and {number}"
-            both = f"{one_line(names_of[key], 60)!r} and {one_line(name, 60)!r}, {rows}"
+            lines = f"rows {lines_of[names_of[key]]} and {number}"
+            both = f"{one_line(names_of[key], 60)!r} and {one_line(name, 60)!r}, {lines}"
             raise InputError(
                 f"the roster {path} gives the id {one_line(key, 60)!r} to two submissions ({both}); correct one."
             )

@@ -209,7 +209,7 @@ def _check_size(label, shown, size, compressed, limits, growing=False):
 
 def write_plan(archive, plan, into, budget, label, undo_lists):
     """Write the checked members `plan` under `into` (recording them in `undo_lists`); [(a zip written, shown)]."""
-    written, made, inner = *undo_lists, []
+    (written, made), inner = undo_lists, []
     for info, parts, is_dir, shown in plan:
         make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
         if not is_dir:
