@@ -1,7 +1,8 @@
 """The LMSs a class comes from and goes back to: one module per LMS, whose ``LMS`` is an :class:`Lms`.
 
-:func:`systems` finds them all, so adding an LMS is adding its module. :mod:`.intake` reads a class (with the safe
-unzip :mod:`.unzip`), :mod:`.exports` writes grades, :mod:`.delivery` the feedback zip, :mod:`.roster` the roster.
+:func:`systems` finds them all, so adding an LMS is adding its module. Run in the instructor's process:
+:mod:`.intake` reads a class (with the safe unzip :mod:`.unzip`), :mod:`.exports` writes grades, :mod:`.delivery`
+the feedback zip, :mod:`.roster` the roster.
 """
 
 from __future__ import annotations
