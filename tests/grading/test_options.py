@@ -113,6 +113,7 @@ NOT_A_DEFAULT = {
         'readable = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")[:60] or "submission"',
     ): "characters of a file name",
     ("grading/run/processes.py", "log.seek(max(0, os.path.getsize(self.log) - 4096))"): "bytes of a log's tail",
+    ("grading/lms/nbgrader.py", 'there = ", ".join(one_line(a, 60) for a in assignments)'): "characters of a name",
 }
 
 
