@@ -1,20 +1,11 @@
 """A cgroup per sandbox: a memory limit that counts every page, a CPU limit, and a list of every process.
 
-An address-space limit (``RLIMIT_AS``) counts what a process maps, not the
-pages of an anonymous file or a tmpfs it writes to, nor what its children
-hold together. A memory cgroup counts them all, and its ``cgroup.procs``
-names every process of the sandbox, so the grader can stop all of them. A
-CPU limit of one core per sandbox keeps one submission that spins from
-slowing a classmate graded beside it (with ``--jobs`` no more than the cores).
-
-:class:`MemoryCgroup` makes one under the grading process's own cgroup
-(cgroup v2, or v1's memory hierarchy and, where there is one, its cpu
-hierarchy), moves the sandbox into it from inside the new process before it
-starts the sandbox (:class:`labkit.grading.sandbox.backends.base.Box`), and removes
-it afterwards.
-Where no cgroup can be made (not root, no delegation, no cgroup file
-system) :func:`create` returns None and the sandbox relies on its other
-limits; the instructors' documentation says what that leaves open.
+``RLIMIT_AS`` counts what one process maps, not an anonymous file's or a tmpfs's pages, nor children together; a
+memory cgroup counts them all, and its ``cgroup.procs`` lists every process so the grader can stop them all. One
+core per sandbox keeps a spinning submission from slowing a classmate. :class:`MemoryCgroup` is made under the
+grading process's cgroup (v2, or v1's memory and cpu hierarchies), joined by the new process before it starts the
+sandbox, and removed afterwards. Where none can be made :func:`create` returns None and the sandbox relies on its
+other limits (the instructors' documentation says what that leaves open).
 """
 
 import os

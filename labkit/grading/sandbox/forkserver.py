@@ -1,27 +1,13 @@
 """The grader's side of the fork server: imports paid once per run, not once per notebook.
 
-Starting a worker the plain way (:meth:`labkit.grading.sandbox.backends.base.Backend.box`)
-costs a new sandbox and a new Python that imports numpy, scipy, matplotlib,
-IPython and labkit, for every notebook of every submission: most of a
-submission's grading time. A :class:`ForkServer` starts one process in a
-sandbox of the backend (:mod:`labkit.grading.sandbox.zygote`) that imports all of
-that once; each notebook then gets a worker forked from it and isolated
-from every other notebook before any student code runs (namespaces of its
-own, empty private folders, its own uid, cgroup and rlimits; the zygote's
-description says how).
-
-A grading run (:func:`labkit.grading.run.classrun.grade`) starts one server and
-hands its socket to every submission's grading process: the descriptor's
-number is in the environment variable :data:`ENV`. In that process
-:func:`box` makes a :class:`ForkedBox`, a :class:`~.backends.base.Box`
-whose worker comes from the server; where there is no server, or it cannot
-give a worker, the notebook gets a sandbox of its own the plain way, so a
-broken server costs time, never a grade.
-
-A backend offers a server through :meth:`~.backends.base.Backend.zygote_box`;
-the default backend does when the grader runs as root (the zygote needs the
-capabilities to make namespaces and change uid). ``--no-fork-server``
-(``GradeOptions.fork_server``) keeps the plain way.
+A plain worker (:meth:`.backends.base.Backend.box`) costs a new sandbox and a Python that imports numpy, scipy,
+matplotlib, IPython and labkit: most of a submission's grading time. A :class:`ForkServer` runs one zygote
+(:mod:`labkit.grading.sandbox.zygote`) that imports all of that once and forks each notebook a worker isolated
+from every other notebook before any student code runs. A grading run starts one and passes its socket to each
+grading process (descriptor in :data:`ENV`), where :func:`box` makes a :class:`ForkedBox`. Without a server, or
+when it cannot give a worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
+Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (bwrap, as root only);
+``--no-fork-server`` keeps the plain way.
 """
 
 import array

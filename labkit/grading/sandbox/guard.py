@@ -1,43 +1,26 @@
 """The watch over a notebook's process while it is graded (the sandbox's side).
 
-The notebook's process is the student's: anything its cells leave behind (a
-patched module, a saved code object, code that rewrites labkit's own grading
-code) is in it. So the watch is installed before the first cell runs, by
-the pristine process that forks the notebook's (:mod:`labkit.grading.sandbox.worker`),
-and nothing of it is reachable from Python afterwards:
+Anything a notebook's cells leave behind (a patched module, a saved code object, rewritten grading code) lives
+in its process, so the pristine supervisor (:mod:`labkit.grading.sandbox.worker`) installs the watch before the
+first cell, and nothing of it is reachable from Python afterwards:
 
-* an **audit hook** (``sys.addaudithook``: it cannot be removed or listed)
-  holds the watch's state and the key it signs with. It reports *tampering*
-  to the supervisor the moment it happens, on a pipe the supervisor reads:
-  switching the profile hook off, walking the garbage collector's lists,
-  ctypes, new processes, new code objects, a function's ``__code__``
-  replaced. Once reported, nothing the notebook does afterwards counts, even
-  if it then reads the process's memory. The audit hook also receives the
-  worker's sentinels (``sys.audit("labkit.begin")``, ``"labkit.chosen"``,
-  ``"labkit.end"``), recognised by the pristine code objects of the serving
-  functions that raise them;
-* while a graded request runs (between ``begin`` and ``end``) a **profile
-  hook**, installed through the C API with no Python object the notebook
-  could fetch (``sys.getprofile()`` stays None), notes every call of a
-  refused reference: any Python function whose code is one of the refused
-  modules' functions, recognised by a digest of its code that the grader
-  computed from the library's files (so a subclass, a saved code object,
-  ``construct_fast``, a private helper or a pasted copy of the code are
-  caught alike). Compiled routines of the refused modules are replaced in
-  their modules for the length of the request;
-* at the end of each answer the audit hook writes an **attestation**: the
-  request, its profile and the functions handed to student code, whether it
-  stayed clean (or the first refused reference), and a digest of the answer,
-  signed with a key that never existed in the notebook's memory outside the
-  watch. The supervisor forwards an answer only with a valid attestation.
+* an **audit hook** (it cannot be removed or listed) holds the watch's state and signing key. It reports
+  *tampering* at once on a pipe the supervisor reads (switching the profile hook off, the garbage collector's
+  lists, ctypes, new processes, new code objects, a replaced ``__code__``); from then on nothing the notebook
+  does counts, even if it reads the process's memory. It also takes the worker's sentinels (``labkit.begin``,
+  ``labkit.chosen``, ``labkit.end``), accepted only from the pristine code of the serving functions;
+* during a graded request a **profile hook**, set through the C API (``sys.getprofile()`` stays None: nothing
+  to fetch), notes every call of a refused function, recognised by a digest of its code computed from the
+  library's files (a subclass, a saved code object, a private helper or a pasted copy are caught alike); the
+  refused modules' compiled routines are replaced for the length of the request;
+* after each answer the audit hook writes a signed **attestation** (request, profile, functions handed over,
+  clean or the first refusal, digest of the answer) with a key that never existed in the notebook's memory
+  outside the watch. The supervisor forwards only attested answers.
 
-Neither hook ever touches an object of the student's (no attribute, no
-comparison, no hash): they read code objects, frames and exact built-in
-types only, and the garbage collector is off while they work, so no student
-code ever runs while the watch's own frames are on the stack. The sandbox
-makes threads and new signal handlers impossible (:mod:`labkit.grading.sandbox.seccomp`),
-so nothing interrupts them either. A refused call is allowed to run and its
-answer is voided afterwards: neither hook raises.
+Neither hook touches a student's object (no attribute, comparison or hash): they read code objects, frames and
+exact built-in types, with the garbage collector off, so no student code runs while the watch's frames are on
+the stack; seccomp (:mod:`labkit.grading.sandbox.seccomp`) forbids threads and signal handlers that could
+interrupt them. Neither hook raises: a refused call runs and its answer is voided.
 """
 
 import _hashlib

@@ -1,34 +1,16 @@
-"""What crosses between the grader and a sandboxed notebook: plain numbers in tagged JSON.
+"""What crosses between the grader and a sandboxed notebook: plain numbers in tagged JSON, one object per line.
 
-Both directions use one format, one JSON object per line:
+Tags: ``["f", x]``, ``["i", n]``, ``["none"]``, ``["s", text]``; ``["a", shape, base64 of <f8]`` (integers and
+booleans as floats; complex and object arrays are not numbers); ``["t", [...]]`` and ``["l", [...]]``; a course
+type of :data:`labkit.wire.TYPES` as its tag and its array fields (e.g. ``["mesh", points, quads]``, validated
+by the table's ``rebuild``); a plot as the data of its lines, ``["lines", [[x, y, marker, linestyle], ...]]``,
+so plots are judged from data on the grader's side. Towards the notebook only, a labkit function the exercises
+declare passable, by name (``["fn", "labkit.piecewise:eval_pherm"]``, optionally with at most
+:data:`MAX_KEYWORDS` finite float keywords bound): the notebook gets the watch's trusted copy. From the notebook
+only, ``["obj", description]`` for anything else.
 
-* a float ``["f", x]``, an integer ``["i", n]``, ``["none"]``, text ``["s", text]``;
-* an array ``["a", shape, base64 of little-endian float64]`` (integers and
-  booleans are sent as floats; complex and object arrays are not numbers);
-* a tuple ``["t", [...]]`` or a list ``["l", [...]]``;
-* a course type of :data:`labkit.wire.TYPES` as its tag and its fields, each an array:
-  a :class:`labkit.Corner` ``["corner", point, ds, dt, dsdt]`` and a
-  :class:`labkit.QuadMesh` ``["mesh", points, quads]``, rebuilt (and
-  validated) by the table's ``rebuild``;
-* a plot (a matplotlib Axes or Figure) ``["lines", [[x, y, marker, linestyle], ...]]``:
-  the data of its Line2D objects (:func:`labkit.plotdata.lines_of`),
-  rebuilt as :class:`labkit.plotdata.Line` records, so plots are judged
-  from their data on the grader's side;
-* towards the notebook only, a function of labkit's that the checks hand to
-  student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``. Only the
-  functions the exercises declare (``Registry.passable``) are named; the
-  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.sandbox.guard`).
-  Such a function with float keywords bound (a ``functools.partial``, as a
-  student's variant of the Runge function is) is
-  ``["fn", "labkit.functions:runge", {"a": 1.25}]``, at most
-  :data:`MAX_KEYWORDS` finite floats, rebuilt as a partial of the trusted copy;
-* from the notebook only, ``["obj", description]`` for anything else.
-
-The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
-and shapes are checked, every number becomes a float64 array or a Python
-float, and anything else becomes a :class:`NotNumbers` that fails every
-comparison with a message saying what it was. Nothing is unpickled or
-evaluated. The notebook side encodes with :func:`encode`.
+:func:`decode` trusts nothing: sizes, depth and shapes are checked, every number becomes a float64 array or a
+float, anything else a :class:`NotNumbers` that fails every comparison. Nothing is unpickled or evaluated.
 """
 
 import base64

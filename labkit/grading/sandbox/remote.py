@@ -1,22 +1,12 @@
 """The grader's handle on one sandboxed notebook: start it, run it, call into it, stop it.
 
-:class:`NotebookHandle` starts the worker (:mod:`labkit.grading.sandbox.worker`) inside the
-sandbox of the backend its settings name (a :class:`~labkit.grading.options.GradeOptions`, or
-anything with the same fields: :class:`Settings`)
-(:mod:`labkit.grading.sandbox.backends`), tells it what the watch refuses, sends it
-requests and reads its answers with a deadline and a size limit, and stops
-every process of the sandbox when it is done, stuck or misbehaving.
-:class:`Namespace` is the mapping the checks read (``ns["eval_pherm"]``): a
-function comes back as a :class:`Function` proxy that forwards each call
-into the sandbox, and data come back decoded as plain numbers
-(:func:`labkit.grading.sandbox.protocol.decode`). So the checks of
-:mod:`labkit.exercises` run unchanged on this side, never in the student's
-process.
-
-A time limit is an exception of its own type, raised where it is detected:
-:class:`NotebookTimeout` when the submission's total time is used up,
-:class:`CellTimeout` when a cell, a request or one call of a student's
-function ran past its own limit. Callers tell them apart by type.
+:class:`NotebookHandle` starts the worker (:mod:`labkit.grading.sandbox.worker`) in the sandbox of the backend its
+:class:`Settings` name, reads its answers with a deadline and a size limit, and stops every process of the sandbox
+when it is done, stuck or misbehaving. :class:`Namespace` is the mapping the checks read: a function comes back
+as a :class:`Function` proxy that forwards each call into the sandbox, data as plain numbers, so the checks of
+:mod:`labkit.exercises` run unchanged here, never in the student's process. Time limits are types of their own:
+:class:`NotebookTimeout` (the submission's total time is used up) and :class:`CellTimeout` (one cell, request or
+call ran past its own limit).
 """
 
 import secrets

@@ -1,28 +1,14 @@
-"""The system calls a sandboxed notebook may not make: small seccomp filters, written out here.
+"""The system calls a sandboxed notebook may not make: small classic-BPF seccomp filters, written out here.
 
-The sandbox's filter (:func:`pipe_with_program`, for a backend that installs it from a descriptor) refuses:
-
-* ``memfd_create`` and ``memfd_secret``: anonymous files hold memory that
-  an address-space limit does not count;
-* ``add_key``, ``request_key`` and ``keyctl``: the kernel's keyrings outlive
-  the sandbox and are shared by every process of one uid, so one
-  submission could leave a key for the next one to read;
-* ``ptrace``, ``process_vm_readv`` and ``process_vm_writev``: no process of
-  the sandbox reads or writes another's memory;
-* new **threads** (``clone`` with ``CLONE_THREAD``; ``clone3``, whose flags
-  a filter cannot read, answers "not implemented", so the C library falls
-  back to ``clone``): the grading watch follows one thread, and a second one
-  would run unwatched.
-
-The notebook's process installs the same refusals again, with
-``rt_sigaction`` added, once it has set up its own signal handling
-(:func:`install_for_notebook`): so the notebook cannot install a signal
-handler that would interrupt the watch and see its frames, and the refusals
-hold whatever the sandbox backend, ``--sandbox none`` included.
-
-System calls of another architecture (32-bit calls on a 64-bit machine)
-are refused too: they would reach the same functions under other numbers.
-The filters are classic BPF, a few dozen instructions each.
+The sandbox's filter (:func:`pipe_with_program`) refuses ``memfd_create`` and ``memfd_secret`` (memory an
+address-space limit does not count); ``add_key``, ``request_key`` and ``keyctl`` (keyrings outlive the sandbox
+and are shared per uid: one submission could leave a key for the next); ``ptrace`` and ``process_vm_readv``/
+``writev`` (no reading or writing another process's memory); new threads (``clone`` with ``CLONE_THREAD``;
+``clone3``, whose flags a filter cannot read, gets "not implemented" so libc falls back to ``clone``): the watch
+follows one thread and a second would run unwatched. The notebook's process installs the same again plus
+``rt_sigaction`` (:func:`install_for_notebook`), so no signal handler can interrupt the watch and see its frames,
+whatever the backend (``--sandbox none`` included). Calls of another architecture are refused too: they reach
+the same functions under other numbers.
 """
 
 import errno

@@ -1,36 +1,17 @@
 """The sandboxed side of grading: a pristine supervisor and the notebook's process it watches.
 
-Started by the grader as ``python -I -m labkit.grading.sandbox.worker [UID]`` inside the
-sandbox its backend made (:mod:`labkit.grading.sandbox.backends`); a backend that
-starts it as root gives the otherwise unused UID it is to become, so that
-the sandbox's process limit holds. Two processes:
+Run as ``python -I -m labkit.grading.sandbox.worker [UID]`` in a backend's sandbox; started as root it becomes
+UID, an otherwise unused uid, so the sandbox's process limit holds. The **supervisor** holds the grader's pipes,
+imports what notebooks need once and never runs a line of student code. It forks the **notebook's process**,
+which installs the watch (:mod:`labkit.grading.sandbox.guard`) before anything else, closes the grader's pipes,
+runs the cells and answers, through the supervisor, one JSON line per request (:mod:`.protocol`): ``setup``
+(what the watch refuses and the functions the checks may hand over; always first), ``run`` (the cells, each
+interrupted after ``cell_timeout``), ``names``, ``get`` and ``call`` (with a ``profile`` refused).
 
-* the **supervisor** holds the grader's pipes and never runs a line of the
-  student's code. It imports what notebooks need once, then forks
-* the **notebook's process**, which installs the watch
-  (:mod:`labkit.grading.sandbox.guard`) before anything else, closes the grader's
-  pipes, runs the cells and answers the grader's requests through the
-  supervisor.
-
-Requests, one JSON line each (:mod:`labkit.grading.sandbox.protocol`):
-
-* ``{"op": "setup", "profiles": {...}, "passables": [...]}``: what the watch
-  refuses (:func:`labkit.grading.submission.refusals.wire`) and the functions the
-  checks may hand to student code; the first request;
-* ``{"op": "run", "cells": [...], "cell_timeout": s}``: run the code cells
-  in an IPython shell, in order, each interrupted after ``s`` seconds;
-* ``{"op": "names", "names": [...]}``: which are functions, data or missing;
-* ``{"op": "get", "name": n, "timeout": s}``: a variable as plain numbers;
-* ``{"op": "call", "name": n, "args": [...], "profile": p, "passables": [...],
-  "timeout": s}``: call a function with the profile `p` refused.
-
-The supervisor forwards an answer only with the watch's valid attestation
-for that very request (its profile, the functions handed over, and a digest
-of the answer); it answers a refused call, tampering, a time limit or a dead
-notebook process itself. If the notebook's process dies (``os._exit``, a
-crash, a time limit), the next request starts a new one that runs the cells
-again, so one bad call costs only its own part. Everything said here is
-still only evidence: the grader checks it and computes every score itself.
+The supervisor forwards an answer only with the watch's valid attestation for that very request (its profile,
+the functions handed over, a digest of the answer); a refused call, tampering, a time limit or a dead notebook it
+answers itself. A dead notebook's process is replaced at the next request, which runs the cells again, so one
+bad call costs only its own part. All of it is evidence only: the grader checks it and computes every score.
 """
 
 import hashlib

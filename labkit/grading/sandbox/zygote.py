@@ -1,39 +1,19 @@
 """The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
 
-Started by the grader (:mod:`labkit.grading.sandbox.forkserver`) as
-``python -I -m labkit.grading.sandbox.zygote FD`` inside a sandbox its backend made
-(:meth:`labkit.grading.sandbox.backends.base.Backend.zygote_box`), with the
-capabilities to make namespaces and to change uid. It imports what notebooks
-need (:func:`labkit.grading.sandbox.worker.preload`), says ``ready`` on stdout and then
-waits on the socket `FD` for requests, one datagram each: a small JSON text
-(the notebook's uid and limits) and, passed along with it, the descriptors
-of the new worker (its requests and answers pipes, a control pipe, a status
-pipe and, where the grader made one, the files that put a process in the
-notebook's cgroup). It never reads a line of a notebook, and no student code
-ever runs in it.
+Run by :mod:`labkit.grading.sandbox.forkserver` as ``python -I -m labkit.grading.sandbox.zygote FD`` in a sandbox
+with the capabilities to make namespaces and change uid. It preloads (:func:`~.worker.preload`), says ``ready``
+and then takes requests on socket FD, one datagram each: JSON (the notebook's uid and limits) with the new
+worker's descriptors (requests, answers, control and status pipes, and the files that join the notebook's
+cgroup). It never reads a notebook and no student code runs in it.
 
-For each request it forks; the child (the notebook's **keeper**) makes what
-separates this notebook from every other one graded through the same
-server, before any student code exists:
-
-* new mount, network, IPC, UTS and PID namespaces;
-* fresh, empty tmpfs on ``/tmp``, the home folder and ``/dev/shm``, so no
-  file written by one notebook is ever seen by another;
-* a new ``/proc`` (read-only) that shows only this notebook's processes.
-
-The keeper then forks the **worker**, the first process of the new PID
-namespace: it joins the notebook's cgroup, takes the notebook's rlimits,
-closes every descriptor but its own pipes (the server's socket among them),
-becomes the notebook's own uid (which drops every capability), sets
-no-new-privileges and runs the worker's supervisor
-(:class:`labkit.grading.sandbox.worker.Supervisor`) with the imports it inherited.
-When the worker ends, the kernel ends every process of its namespace.
-
-The keeper stays outside, as root, running only this module's code: it
-writes ``S`` on the status pipe once the worker runs (or ``E`` and why it
-could not), waits for the worker to end or for the control pipe to close
-(the grader stopped the notebook, or died), kills the worker if it still
-runs, and writes its wait status.
+Per request it forks a **keeper**, which isolates the notebook before any student code exists: new mount,
+network, IPC, UTS and PID namespaces; empty tmpfs on ``/tmp``, the home folder and ``/dev/shm`` (no file of one
+notebook is seen by another); a read-only ``/proc`` of its own. The keeper forks the **worker**, the first
+process of the PID namespace (when it ends the kernel ends the whole namespace): it joins the cgroup, takes the
+rlimits, closes every descriptor but its pipes (the server's socket too), becomes the notebook's own uid (no
+capability left), sets no-new-privileges and runs the supervisor. The keeper stays outside as root running only
+this module: ``S`` on the status pipe once the worker runs (``E`` and why not), then it waits for the worker's
+end or the control pipe's closing (the grader is done or died), kills the worker and writes its wait status.
 """
 
 import ctypes

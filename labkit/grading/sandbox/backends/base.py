@@ -1,24 +1,11 @@
 """What every sandbox backend provides, and what backends share.
 
-The grader's handle on a notebook (:class:`labkit.grading.sandbox.remote.NotebookHandle`)
-and a grading run (:func:`labkit.grading.run.classrun.grade`) use a backend only
-through :class:`Backend`:
-
-* :meth:`Backend.available` raises :class:`SandboxUnavailable`, saying what
-  to do, when the backend cannot run sandboxes on this machine; a grading
-  run asks once, before anything is graded;
-* :meth:`Backend.warning` is printed on stderr once per run, when there is
-  something the instructor must know (student code running unconfined);
-* :meth:`Backend.box` makes one notebook's :class:`Box` from the worker's
-  command (``python -I -m labkit.grading.sandbox.worker``) and the notebook's
-  :class:`Limits`: the command that starts the worker inside the sandbox,
-  and whatever has to be set up for it and undone after it.
-
-:class:`Box` runs the command as a local process in a session of its own,
-in a memory cgroup of its own where one can be made
-(:mod:`labkit.grading.sandbox.cgroup`), under the rlimits of :class:`Limits`
-(:func:`apply_limits`); a backend whose sandbox lives elsewhere (a
-container engine) overrides :meth:`Box.start` and :meth:`Box.stop`.
+Grading uses a backend only through :class:`Backend`: :meth:`~Backend.available` raises
+:class:`SandboxUnavailable` (saying what to do) once before a run, :meth:`~Backend.warning` is printed once per
+run, and :meth:`~Backend.box` makes one notebook's :class:`Box` from the worker's command and its
+:class:`Limits`. A :class:`Box` runs the command in a session of its own, in a memory cgroup of its own where one
+can be made (:mod:`labkit.grading.sandbox.cgroup`) and under the rlimits (:func:`apply_limits`); a backend whose
+sandbox lives elsewhere overrides :meth:`Box.start` and :meth:`Box.stop`.
 """
 
 import abc

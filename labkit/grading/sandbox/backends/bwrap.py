@@ -1,31 +1,13 @@
 """The default backend: a bubblewrap sandbox on this machine.
 
-:func:`command` builds the ``bwrap`` command line for one notebook:
-
-* a new, empty root: the system (``/usr``, ``/etc``) and the Python
-  environment (its prefixes and labkit's own package folder) mounted
-  read-only, nothing else of the machine (no other home folders, no course
-  folder, no instructor notebooks, no output folder, no other submission);
-* ``HOME`` (the working directory) and ``/tmp``: small private tmpfs of
-  their own, the only writable places; they live in the sandbox's mount
-  namespace and vanish with it, so nothing the notebook writes is left on
-  the machine and there is nothing to clean up;
-* ``/proc`` of its own, read-only (no process writes its own memory
-  through ``/proc/self/mem``); a minimal ``/dev``;
-* a seccomp filter (:mod:`labkit.grading.sandbox.seccomp`, handed to ``bwrap
-  --seccomp`` through a pipe): no anonymous memory files, no kernel
-  keyrings, no reading or writing another process's memory;
-* no network (``--unshare-net``: only a loopback of its own), its own PID,
-  IPC and UTS namespaces, a new session (no terminal to inject into), and
-  ``--die-with-parent``, so every process of the notebook dies with the grader;
-* all capabilities dropped but the two the worker needs to give up root
-  (it then runs as an otherwise unused uid, :func:`sandbox_uid`, given on
-  its command line, so the process limit holds).
-
-:class:`Bubblewrap` is the backend: its :class:`~.base.Box` adds a memory
-cgroup around the whole sandbox where it can (:mod:`labkit.grading.sandbox.cgroup`)
-and sets the rlimits in the child before ``bwrap`` starts
-(:func:`~.base.apply_limits`); they are inherited by everything inside.
+:func:`command` builds one notebook's ``bwrap`` command line: a new empty root with only ``/usr``, ``/etc`` and
+the Python environment read-only (no other home, course, instructor or submission folder); ``HOME`` and
+``/tmp`` as small private tmpfs, the only writable places, gone with the sandbox; a read-only ``/proc`` of its
+own (no writing one's memory through ``/proc/self/mem``) and a minimal ``/dev``; the seccomp filter
+(:mod:`labkit.grading.sandbox.seccomp`, on a pipe); no network, its own PID, IPC and UTS namespaces, a new
+session (no terminal to inject into) and ``--die-with-parent``; every capability dropped but the two the worker
+needs to become an otherwise unused uid (:func:`sandbox_uid`, so the process limit holds). The rlimits are set
+before ``bwrap`` starts and a memory cgroup surrounds it where one can be made.
 """
 
 import itertools
