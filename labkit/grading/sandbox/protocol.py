@@ -42,10 +42,6 @@ class ProtocolError(ValueError):
     """A message that is not in the format (sizes, tags, shapes)."""
 
 
-class LineTooLong(ProtocolError):
-    """A line longer than its reader's limit."""
-
-
 class NotNumbers:
     """Stands for a value from the notebook that is not numbers; every check step on it fails."""
 
@@ -314,28 +310,6 @@ def ended(signal_number, status):
     return f"the notebook's process exited with status {status} (os._exit or a crash)"
 
 
-def answer_to(lines, rid, until=None, strict=True, wait=None):
-    """Read `lines` up to the answer whose id is `rid`: (the answer, its line).
-
-    TimeoutError after `until` (monotonic), EOFError at the end, ProtocolError for a line out of protocol; when not
-    `strict` a line that is not JSON is passed over (the notebook's process can write to its own answers' pipe).
-    `wait(until)`, if given, returns once a line may be read (the supervisor reads the watch's pipe meanwhile)."""
-    while True:
-        if wait is not None:
-            wait(until)
-        line = lines.readline(until)
-        if line is None:
-            raise EOFError
-        try:
-            answer = loads(line)
-        except ProtocolError:
-            if strict:
-                raise
-            continue
-        if answer.get("id") == rid:
-            return answer, line
-
-
 class Lines:
     """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError): the one line reader of
     the grader, the supervisor, the notebook's process and the launcher."""
@@ -355,7 +329,7 @@ class Lines:
                 return None
             self.buffer += chunk
             if len(self.buffer) > self.limit:
-                raise LineTooLong(f"a line longer than {self.limit} bytes")
+                raise ProtocolError(f"a line longer than {self.limit} bytes")
         line, _, self.buffer = self.buffer.partition(b"\n")
         return line
 

@@ -189,26 +189,17 @@ class NotebookHandle:
         except (BrokenPipeError, OSError):
             self._stop(self._ended())
         until = min(self.deadline, time.monotonic() + timeout)
-        try:
-            answer, _ = protocol.answer_to(self._lines, rid, until)
-        except TimeoutError:
-            if until >= self.deadline:
-                self._stop("stopped after the total time limit: the notebook did not answer in time", NotebookTimeout)
-            self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
-        except protocol.LineTooLong:
-            self._stop("the notebook's process sent an answer larger than the protocol allows")
-        except protocol.ProtocolError as exc:
-            self._stop(f"the notebook's process answered out of protocol ({exc})")
-        except EOFError:
+        while True:
+            line = self._read_line(until)
             try:
-                self.process.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                pass
-            self._stop(self._ended())
-        error = answer.get("error") if isinstance(answer.get("error"), dict) else {}
-        if error.get("kind") == "Tampered" and error.get("grader"):  # the supervisor's word, not a name
-            self.tampered = str(error.get("message", "tampering"))[:500]
-        return answer
+                answer = protocol.loads(line)
+            except protocol.ProtocolError as exc:
+                self._stop(f"the notebook's process answered out of protocol ({exc})")
+            if answer.get("id") == rid:
+                error = answer.get("error") if isinstance(answer.get("error"), dict) else {}
+                if error.get("kind") == "Tampered" and error.get("grader"):  # the supervisor's word, not a name
+                    self.tampered = str(error.get("message", "tampering"))[:500]
+                return answer
 
     def answered(self, call, timeout):
         """The answer to a call request: the notebook's earlier answer to the very same call (function, arguments,
@@ -230,6 +221,23 @@ class NotebookHandle:
         if code is None:
             return "the notebook's process stopped answering"
         return protocol.ended(-code if code < 0 else None, code)
+
+    def _read_line(self, until):
+        try:
+            line = self._lines.readline(until)
+        except TimeoutError:
+            if until >= self.deadline:
+                self._stop("stopped after the total time limit: the notebook did not answer in time", NotebookTimeout)
+            self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
+        except protocol.ProtocolError:
+            self._stop("the notebook's process sent an answer larger than the protocol allows")
+        if line is None:
+            try:
+                self.process.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                pass
+            self._stop(self._ended())
+        return line
 
 
 class Function:

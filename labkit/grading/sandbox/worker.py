@@ -49,10 +49,6 @@ class _Interrupted(KeyboardInterrupt):
     pass
 
 
-class _TamperReported(Exception):
-    pass
-
-
 def _alarm(signum, frame):
     """A cell's time is up: interrupt it, unless the watch is running (it never raises), then a moment later."""
     if frame is not None and frame.f_code.co_filename == _GUARD_FILE:
@@ -351,40 +347,41 @@ class Supervisor:
             self.stop()
             return _grader_error("WorkerError", self.ended)
         until = None if timeout is None else time.monotonic() + float(timeout) + 1.0
-        try:
-            answer, line = protocol.answer_to(
-                self.child["answers"], request.get("id"), until, strict=False, wait=self._wait
-            )
-        except _TamperReported:
-            self.stop("the grader's watch reported tampering")
-            return _grader_error("Tampered", self._tamper_text())
-        except TimeoutError:
-            self.stop("stopped after the time limit: the notebook did not answer in time")
-            answer = _grader_error("Timeout", "interrupted: it ran longer than the time limit")
-            answer["error"]["timeout"] = True  # the grader raises its CellTimeout for this mark, not the words
-            return answer
-        except protocol.ProtocolError as exc:
-            self.stop(f"the notebook's process answered out of protocol ({exc})")
-            return _grader_error("WorkerError", self.ended)
-        except EOFError:
-            self.stop()
-            return _grader_error("WorkerError", self.ended)
-        return self._verified(answer, line + b"\n", rid, profile, passables)
-
-    def _wait(self, until):
-        """Until an answer's line can be read, read the watch's pipe, so nothing the notebook writes to it stalls it."""
         answers, verdicts = self.child["answers"], self.child["verdicts"]
-        while b"\n" not in answers.buffer:
-            remaining = None if until is None else until - time.monotonic()
-            if remaining is not None and remaining <= 0:
-                raise TimeoutError()
-            ready = select.select([answers.fd, verdicts.fd], [], [], remaining)[0]
-            if verdicts.fd in ready:
-                verdicts.pump()
-                if self._read_verdicts():
-                    raise _TamperReported
-            if answers.fd in ready:
-                return
+        while True:
+            try:
+                # the watch's pipe is read while waiting, so nothing the notebook writes to it can stall it
+                while b"\n" not in answers.buffer:
+                    remaining = None if until is None else until - time.monotonic()
+                    if remaining is not None and remaining <= 0:
+                        raise TimeoutError()
+                    ready = select.select([answers.fd, verdicts.fd], [], [], remaining)[0]
+                    if verdicts.fd in ready:
+                        verdicts.pump()
+                        if self._read_verdicts():
+                            self.stop("the grader's watch reported tampering")
+                            return _grader_error("Tampered", self._tamper_text())
+                    if answers.fd in ready:
+                        break
+                line = answers.readline(until)
+            except TimeoutError:
+                self.stop("stopped after the time limit: the notebook did not answer in time")
+                answer = _grader_error("Timeout", "interrupted: it ran longer than the time limit")
+                answer["error"]["timeout"] = True  # the grader raises its CellTimeout for this mark, not the words
+                return answer
+            except protocol.ProtocolError as exc:
+                self.stop(f"the notebook's process answered out of protocol ({exc})")
+                return _grader_error("WorkerError", self.ended)
+            if line is None:
+                self.stop()
+                return _grader_error("WorkerError", self.ended)
+            try:
+                answer = protocol.loads(line)
+            except protocol.ProtocolError:
+                continue  # not an answer: something the notebook wrote itself
+            if isinstance(answer, dict) and answer.get("id") == request.get("id"):
+                break
+        return self._verified(answer, line + b"\n", rid, profile, passables)
 
     def _tamper_text(self):
         return (
