@@ -6,7 +6,7 @@ matplotlib, IPython and labkit: most of a submission's grading time. A :class:`F
 from every other notebook before any student code runs. A grading run starts one and passes its socket to each
 grading process (descriptor in :data:`ENV`), where :func:`box` makes a :class:`ForkedBox`. Without a server, or
 when it cannot give a worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
-Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (bwrap, as root only);
+Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (the default one as root);
 ``--no-fork-server`` keeps the plain way.
 """
 
