@@ -31,8 +31,7 @@ import os
 import sys
 import types
 
-# what the watch calls, taken when this module is imported (in the pristine supervisor): the watch's own
-# code resolves its names in a private copy of this module's namespace (:func:`install`), so a notebook
+# taken at import, in the pristine supervisor, and looked up in a private namespace (:func:`install`): a notebook
 # that rebinds ``guard.hashlib``, ``builtins.any`` or ``hashlib.sha1`` changes nothing the watch uses
 _sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
 _write, _getframe, _modules = os.write, sys._getframe, sys.modules
@@ -66,8 +65,7 @@ EXPOSED = frozenset({"_stand_in", "_plain", "_handed_over", "_barrier"})
 
 
 def _constant(value):
-    """What a constant the bytecode loads contributes to :func:`code_key`: numbers and None by value, any other
-    constant by its kind only (exact built-in types only; nothing of the student's is touched)."""
+    """A loaded constant in :func:`code_key`: numbers and None by value, others by kind (exact types only)."""
     kind = type(value)
     if kind is _NoneType or kind is bool:
         return repr(value)
@@ -87,14 +85,9 @@ def _constant(value):
 def code_key(code):
     """A digest of a function's code that survives renaming the function but not rewriting it.
 
-    The bytecode with each constant it loads replaced by that constant's value
-    (numbers and None; strings by their kind only), the names and local names
-    it uses and its number of arguments. So where a constant sits in
-    ``co_consts`` does not count: a function whose docstring was deleted (None
-    in its place, and the constants after it one place earlier) has the same
-    key, and so has one compiled with its docstring stripped (``optimize=2``,
-    which leaves a NOP: NOPs are left out). Short functions (which an honest student might write identically)
-    are also keyed by their name, file and line.
+    Bytecode (NOPs left out) with each loaded constant by value (strings by kind only), names, local names and
+    argument count: so a deleted or stripped (``optimize=2``) docstring keeps the key. Short functions, which an
+    honest student might write identically, are keyed by their name, file and line too.
     """
     raw, consts = code.co_code, code.co_consts
     structure, loaded, count, extended = bytearray(), [], len(consts), 0
@@ -135,9 +128,7 @@ def attestation_text(rid, profile, passables, status, digest):
 
 
 def _stand_in(name):
-    """A function that stands in for a refused compiled function or class while a graded request runs.
-
-    The watch recognises a call of one by its code, and reads the name from its frame (a plain string only)."""
+    """A stand-in for a refused compiled function or class; the watch knows its code and reads `name` from its frame."""
 
     def refused(*args, **kwargs):
         raise RuntimeError(
@@ -160,8 +151,7 @@ def _plain(value):
 
 
 def _handed_over(copy):
-    """The function student code gets for a trusted copy: its arguments become plain numbers before the
-    copy runs, and a function among them runs behind a barrier (untrusted) when the copy calls it."""
+    """A trusted copy for student code: arguments become plain numbers, functions run behind an untrusted barrier."""
 
     def handed_over(*args, **kwargs):
         args = tuple(_barrier(a) if callable(a) else _plain(a) for a in args)
@@ -191,11 +181,9 @@ def _compiled_types():
     return frozenset(found)
 
 
-# a filter in front of the profile hook, in machine code: only 'call' events (what == 0) of code objects not in its
-# table reach the Python hook; every other event (a return, a call of a compiled function) and every call of a code
-# object the hook found clean in this request returns 0 at once. So the watch costs a Python-heavy notebook one hook
-# call per code object it runs, not one per call and return of everything it calls. x86-64 (System V), CPython 3.11
-# (the code object read as frame->f_frame->f_code; checked before use):
+# machine code in front of the profile hook: only 'call' events (what == 0) of code objects not in its table (found
+# clean in this request) reach the Python hook, so a notebook pays one hook call per code object, not per call.
+# x86-64 System V, CPython 3.11 (frame->f_frame->f_code; checked before use):
 #   endbr64; test edx, edx; jne done; mov rax, [rsi+24]; mov rax, [rax+32]; mov r8, rax; shr r8, 4;
 #   and r8d, SLOTS-1; movabs r9, TABLE; cmp [r9+r8*8], rax; je done; movabs rax, HOOK; jmp rax; done: xor eax, eax; ret
 _CALL_FILTER = {
@@ -220,10 +208,8 @@ def _frames_as_the_filter_reads_them():
 
 
 def _call_filter(hook_address):
-    """(the address of :data:`_CALL_FILTER` in front of the hook at `hook_address`, its table, what keeps both
-    alive), or (`hook_address`, None, None) where there is none (another machine or Python, no executable
-    memory): every event then reaches the hook, which passes over all but 'call' itself. Called while the
-    process is pristine."""
+    """(the filter's address in front of the hook at `hook_address`, its table, what keeps both alive), or
+    (`hook_address`, None, None) where it cannot run: the hook then sees every event. Called while pristine."""
     import ctypes
     import mmap
     import platform
@@ -250,29 +236,18 @@ def _call_filter(hook_address):
 def install(secret, verdict_fd, profiles, passables, chain):
     """Install the watch in this (still pristine) process; afterwards nothing of it is reachable from Python.
 
-    The watch's code runs in a private copy of this module's namespace, with a
-    private copy of the builtins: every function of this module is rebound to
-    it, so no name the watch looks up can be changed by a notebook. The few
-    functions student code can hold (:data:`EXPOSED`) are rebound to another
-    copy, so their ``__globals__`` lead nowhere.
-
-    `profiles` maps a profile name to ``(names, modules, c_names)``: the refused
-    Python code as {digest: readable name} (:func:`code_key`), the refused
-    module prefixes (their compiled functions are replaced during a request)
-    and single refused compiled functions ``(module, name)``. `passables` maps
-    the names the grader may hand to student code to pristine functions: the
-    watch makes each a copy with a code object of its own, trusted during the
-    request it is handed to, when it is called through the function handed
-    over (which turns its arguments into plain numbers first). Only the
-    copy's own code is trusted, not what it calls. `chain` is the pristine
-    code of the serving functions, innermost first, that must raise the
-    sentinels.
+    Its code runs in a private copy of this module's namespace and builtins, so no name it looks up can be
+    rebound by a notebook; the functions student code can hold (:data:`EXPOSED`) get another copy, so their
+    ``__globals__`` lead nowhere. `profiles`: name -> ``(names, modules, c_names)``, the refused Python code as
+    {:func:`code_key`: readable name}, refused module prefixes and refused compiled ``(module, name)``.
+    `passables`: name -> pristine function; each gets a copy with its own code object, trusted (not what it calls)
+    only during its request and only through the function handed over, which makes its arguments plain numbers.
+    `chain`: the pristine code of the serving functions, innermost first, that must raise the sentinels.
     """
     private = dict(globals())
     private["__builtins__"] = dict(vars(builtins))
-    # what student code can reach (the stand-ins put in refused modules, the functions handed over and the
-    # barriers around the student's callables) gets a namespace of its own: through their ``__globals__``
-    # a notebook reaches only that, never the names the hooks look up
+    # stand-ins, functions handed over and barriers get a namespace of their own: their ``__globals__`` never
+    # lead to the names the hooks look up
     exposed = {"__name__": __name__, "__builtins__": dict(vars(builtins))}
     for name, value in list(private.items()):
         if type(value) is _FunctionType and value.__globals__ is globals():
@@ -284,10 +259,7 @@ def install(secret, verdict_fd, profiles, passables, chain):
 
 
 def _install(secret, verdict_fd, profiles, passables, chain):
-    """The watch itself; called by :func:`install` with this module's namespace privately copied.
-
-    Its state is one dictionary that only the hooks' closures hold; the steps below are this module's functions,
-    which :func:`install` rebound to the private namespace, so they too look up nothing a notebook can rebind."""
+    """The watch itself, run in the private namespace; its state is one dict only the hooks' closures hold."""
     import ctypes
 
     profiles, strictest = _kept_profiles(profiles)
@@ -413,9 +385,8 @@ def _stub(state, profile):
 
 
 def _holds_target(state, module_name, namespace, target_ids):
-    """Whether a module holds a refused compiled function: where the process held one when the watch was installed,
-    and any module loaded or grown since (ids compared in C: no object of the notebook's is asked anything; a live
-    target's id is its own)."""
+    """Whether a module holds a refused compiled function (as at install, or loaded or grown since: ids compared in
+    C, so no object of the notebook's is asked anything)."""
     held = module_name in state["holders"]
     if target_ids and not held and state["sizes"].get(module_name) != len(namespace):
         held = not target_ids.isdisjoint(map(id, namespace.values()))
@@ -546,8 +517,7 @@ def _choose(state, args):
         live=frozenset(live),
         mode=RUN if name == RUN else "graded",
     )
-    # the cells run unwatched but for tampering, and at full speed; a graded request's walk over the modules runs
-    # unprofiled (no student code runs); a request where nothing is refused is watched for tampering only
+    # cells: watched for tampering only, at full speed; the walk over the modules runs unprofiled (no student code)
     state["set_profile"](None, None)
     if name == RUN:
         if state["gc"]:

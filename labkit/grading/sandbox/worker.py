@@ -62,9 +62,8 @@ def _error(kind, message, refused=None):
 
 
 def _grader_error(kind, message):
-    """An error of the supervisor's own (the notebook died, was tampered with or ran out of time), marked as the
-    grader's: :func:`labkit.grading.sandbox.remote._value` trusts the mark, never the kind's name, which a student's
-    exception may share."""
+    """The supervisor's own error, marked as the grader's: the grader trusts the mark, never a kind's name, which a
+    student's exception may share."""
     answer = _error(kind, message)
     answer["error"]["grader"] = True
     return answer
@@ -82,8 +81,7 @@ def _describe(exc):
 
 
 def _tail(exc, lines=40):
-    """The last lines of an exception's traceback, as the student's cell would show them (the grader picks
-    the student's own frames from them, :func:`labkit.grading.submission.scoring._student_frames`)."""
+    """The last lines of an exception's traceback, as the student's cell would show them."""
     import traceback
 
     try:
@@ -174,10 +172,8 @@ class NotebookProcess:
 
 
 def _serve_one(notebook, reader, answers):
-    """Answer one request, between the sentinels the watch recognises (see :mod:`labkit.grading.sandbox.guard`).
-
-    The request is read only after the watch has started watching, so nothing
-    the notebook left behind sees a request's data unwatched."""
+    """Answer one request between the watch's sentinels; read only once the watch watches, so nothing the notebook
+    left behind sees a request's data unwatched."""
     handoff = {}
     sys.audit(guard.BEGIN)
     line = reader.readline()
@@ -202,8 +198,7 @@ def _serve(notebook, reader, answers):
 
 
 def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles, passable_names):
-    """The notebook's process: its timer, no signal handlers of the notebook's own, the watch, then the
-    requests until the pipe closes."""
+    """The notebook's process: its timer, seccomp, the watch, then requests until the pipe closes."""
     os.setpgrp()  # the supervisor stops it and everything it starts at once
     output = _Counter()
     sys.stdout = sys.stderr = output
@@ -466,16 +461,14 @@ def not_dumpable():
 
 
 def preload(everything=False):
-    """What every notebook imports, once, in the supervisor: each notebook's process starts with it; with
-    `everything`, what the lab's notebooks import as well."""
+    """Import what every notebook needs (with `everything`, the lab's imports too) once; the shell to fork with."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot
     import numpy  # noqa: F401
 
-    # `import labkit` no longer loads scipy, but the watch learns the exact types of compiled routines
-    # (Cython's, f2py's) from the modules loaded when it is installed: scipy's must be among them
+    # the watch learns the exact types of compiled routines (Cython's, f2py's) from the modules loaded at install
     import scipy.linalg
     import scipy.spatial  # noqa: F401
     from IPython.core.interactiveshell import InteractiveShell
@@ -484,8 +477,7 @@ def preload(everything=False):
     import labkit
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
 
-    # what the lab's notebooks import too: paid once per fork server (labkit.grading.sandbox.zygote); a worker of its
-    # own would pay for them in the notebook's own time, whether its notebook imports them or not
+    # only in a fork server: a plain worker would pay for them in the notebook's time, imported or not
     for name in NOTEBOOK_IMPORTS if everything else ():
         try:
             importlib.import_module(name)
@@ -501,8 +493,8 @@ def preload(everything=False):
 
 
 def supervise(requests, answers, shell):
-    """Answer the grader on the descriptors `requests` and `answers` until it says bye; the student's code
-    gets /dev/null for 0, 1 and 2 and the working folder on its path, as in a kernel."""
+    """Answer the grader on `requests` and `answers` until bye; student code gets /dev/null for 0-2 and the working
+    folder on its path, as in a kernel."""
     given = (requests, answers)
     requests, answers = os.dup(requests), os.dup(answers)
     for fd in given:  # the student's code must not find a second copy of the grader's pipes
@@ -514,7 +506,7 @@ def supervise(requests, answers, shell):
     if null > 2:
         os.close(null)
     sys.path.insert(0, os.getcwd())
-    # the course module a rubric names, for the notebook's self-checks: shown by the sandbox, or without one where it is
+    # the course modules a rubric names, for the notebook's self-checks
     for folder in [protocol.COURSE_FOLDER, *os.environ.pop(protocol.COURSE_PATH, "").split(os.pathsep)]:
         if folder and os.path.isdir(folder):
             sys.path.append(folder)
