@@ -71,10 +71,7 @@ def _array_tag(value):
 
 
 def encode(value, passable=frozenset(), depth=0):
-    """Tagged plain form of a value; a function whose ``module:qualname`` is in `passable` is sent by name.
-
-    Used on both sides: the notebook's answers (which may be hostile, so they are re-checked) and the
-    arguments the grader's checks pass."""
+    """Tagged plain form of a value (both sides); a function whose ``module:qualname`` is in `passable` by name."""
     if depth > MAX_DEPTH:
         return ["obj", "a value nested too deeply"]
     if value is None:
@@ -134,8 +131,7 @@ def _lines_tag(plot):
 
 
 def _bound(keywords):
-    """The float keywords of a partial as a plain dict, or None if they are not at most MAX_KEYWORDS finite
-    floats under identifiers."""
+    """A partial's keywords as a dict, or None unless they are at most MAX_KEYWORDS finite floats."""
     if not isinstance(keywords, dict) or not 0 < len(keywords) <= MAX_KEYWORDS:
         return None
     bound = {}
@@ -188,11 +184,8 @@ def passable(name):
 
 
 def loads(line):
-    """Parse one message line; anything but a JSON object of bounded size and structure is a ProtocolError.
-
-    The bounds are checked on the bytes, before parsing: a line of nested
-    empty lists would otherwise cost the parser some thirty times its size.
-    """
+    """Parse one line; anything but a bounded JSON object is a ProtocolError. The bounds are checked before parsing:
+    a line of nested empty lists would otherwise cost the parser some thirty times its size."""
     if len(line) > MAX_LINE:
         raise ProtocolError(f"a message of {len(line)} bytes is larger than {MAX_LINE}")
     if isinstance(line, str):
@@ -252,9 +245,7 @@ def _course_type(row, parts):
 
 
 def decode(tag, depth=0, functions=None):
-    """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
-    Corners, QuadMeshes, or a NotNumbers. On the notebook's side `functions` maps the
-    names of ``["fn", name]`` to the functions handed over for this request."""
+    """The value of a tagged form; on the notebook's side `functions` maps ``["fn", name]`` to those handed over."""
     if depth > MAX_DEPTH + 1:
         raise ProtocolError("nested too deeply")
     if not isinstance(tag, list) or not tag or not isinstance(tag[0], str):
@@ -311,8 +302,7 @@ def ended(signal_number, status):
 
 
 class Lines:
-    """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError): the one line reader of
-    the grader, the supervisor, the notebook's process and the launcher."""
+    """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError)."""
 
     def __init__(self, fd, limit=MAX_LINE):
         self.fd, self.limit, self.buffer = fd, limit, b""

@@ -49,8 +49,7 @@ class NotebookTimeout(WorkerTimeout):
 
 
 class StudentError(Exception):
-    """An exception the student's code raised in the sandbox (its type name in ``kind``), or one of its calls
-    that the grader ended (the subclasses below, each with its ``grader_kind``): either way it costs that call."""
+    """An exception of the student's code (type name in ``kind``), or a call the grader ended (the subclasses)."""
 
     grader_kind: str | None = None  # an exception the student's code raised: whatever its name, no kind of the grader's
 
@@ -62,18 +61,14 @@ class StudentError(Exception):
 
 
 class CallEnded(StudentError):
-    """A call of the student's function that its process never answered: the process ended (``os._exit``, a
-    signal, a resource limit) or could answer no more. The supervisor says so in an answer it marks as its own
-    (:func:`labkit.grading.sandbox.worker._grader_error`), never through an exception's name; the call costs only
-    itself, as the supervisor starts the notebook again for the next request (up to its restarts)."""
+    """A call its process never answered (it ended or could answer no more), said in the supervisor's marked
+    answer, never an exception's name; it costs only itself (the notebook restarts for the next request)."""
 
     grader_kind = CRASH  # the kind of a failed step (labkit.exercises.result.grader_kind)
 
 
 class Tampered(StudentError):
-    """A call whose answer the grader's watch cannot vouch for (the notebook switched it off, went round it or
-    wrote to its pipe): the supervisor's own marked answer, and the notebook's answers are void
-    (:attr:`NotebookHandle.tampered`)."""
+    """A call the watch cannot vouch for (switched off, gone round, its pipe written to): every answer is void."""
 
     grader_kind = TAMPERED
 
@@ -93,18 +88,14 @@ class Settings(Protocol):
     def total_timeout(self) -> float: ...  # seconds
 
 
-# benchmarks/bench_grading_styles.py only, set in its own process: calls ask for no refusal, so the watch has nothing
-# to watch (no profile hook, no switched-off functions). No option, variable or file of a grading run reaches it.
+# benchmarks/bench_grading_styles.py only, in its own process: no refusal asked. No option, variable or file sets it.
 _UNWATCHED = False
 MEMO_BYTES = 64 * 1024**2  # the calls whose answers a notebook's handle keeps, in bytes of the calls
 
 
 class NotebookHandle:
-    """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest.
-
-    `profiles` are what the watch refuses (:func:`labkit.grading.submission.refusals.wire`; none when
-    None), `passables` the functions the checks may hand to student code, by name.
-    """
+    """One worker in the sandbox `options` name, until `deadline` (monotonic); `profiles` are what the watch refuses
+    (:func:`labkit.grading.submission.refusals.wire`), `passables` what the checks may hand to student code."""
 
     def __init__(self, options: Settings, deadline=None, profiles=None, passables=()):
         self.options = options
@@ -139,8 +130,7 @@ class NotebookHandle:
         )
 
     def _forked(self):
-        """A worker from this process's fork server (:mod:`labkit.grading.sandbox.forkserver`), or None: there is no
-        server for this backend, or it could not give one (the notebook then gets a sandbox the plain way)."""
+        """A worker from this process's fork server, or None (then the notebook gets a sandbox the plain way)."""
         box = forkserver.box(self.backend, self.options.limits)
         if box is None:
             return None
@@ -202,9 +192,8 @@ class NotebookHandle:
                 return answer
 
     def answered(self, call, timeout):
-        """The answer to a call request: the notebook's earlier answer to the very same call (function, arguments,
-        refusal, functions handed over), else a new one. The checks of several parts call the student's function
-        on the same sizes; it is computed once per notebook. An answer the grader gave up on is never kept."""
+        """The answer to a call: the earlier answer to the very same call (parts call on the same sizes), else a
+        new one. An answer the grader gave up on is never kept."""
         key = protocol.dumps(call)
         if key not in self._answers:
             with timings.phase("calls"):
@@ -285,11 +274,8 @@ def _value(answer):
 
 
 class Namespace:
-    """The student's variables, read through the sandbox: the mapping the checks take.
-
-    :meth:`refusing` sets what is switched off for the functions read after it
-    (each part of an exercise says its own, :meth:`labkit.exercises.registry.Registry.check`).
-    """
+    """The student's variables, read through the sandbox: the mapping the checks take; :meth:`refusing` sets what
+    is switched off for the functions read after it."""
 
     def __init__(self, notebook, timeout=None):
         self.notebook = notebook
