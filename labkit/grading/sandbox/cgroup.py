@@ -8,6 +8,7 @@ sandbox, and removed afterwards. Where none can be made :func:`create` returns N
 other limits (the instructors' documentation says what that leaves open).
 """
 
+import contextlib
 import os
 import signal
 import time
@@ -106,10 +107,8 @@ class MemoryCgroup:
             if not pids:
                 break
             for pid in pids:
-                try:
+                with contextlib.suppress(ProcessLookupError, PermissionError):
                     os.kill(pid, signal.SIGKILL)
-                except (ProcessLookupError, PermissionError):
-                    pass
             time.sleep(0.005)  # a killed process leaves its cgroup within milliseconds
         for folder in (self.path, self.cpu_path):
             for _ in range(50):
@@ -145,10 +144,8 @@ def _cpu_v1(name, cores):
         period = int((path / "cpu.cfs_period_us").read_text())
         (path / "cpu.cfs_quota_us").write_text(str(int(period * cores)))
     except (OSError, ValueError):
-        try:
+        with contextlib.suppress(OSError):
             path.rmdir()
-        except OSError:
-            pass
         return None
     return path
 
@@ -166,22 +163,16 @@ def create(limit, label="labkit", cores=1):
         try:
             if version == "v1":
                 (path / "memory.limit_in_bytes").write_text(str(int(limit)))
-                try:
+                with contextlib.suppress(OSError):
                     (path / "memory.memsw.limit_in_bytes").write_text(str(int(limit)))  # no swapping past it
-                except OSError:
-                    pass
             else:
                 (path / "memory.max").write_text(str(int(limit)))
                 for setting, value in (("memory.swap.max", "0"), ("cpu.max", f"{int(100_000 * cores)} 100000")):
-                    try:
+                    with contextlib.suppress(OSError):
                         (path / setting).write_text(value)
-                    except OSError:
-                        pass
         except OSError:
-            try:
+            with contextlib.suppress(OSError):
                 path.rmdir()
-            except OSError:
-                pass
             continue
         cpu = _cpu_v1(name, cores) if version == "v1" and cores else None
         return MemoryCgroup(version, path, limit, cpu)

@@ -11,6 +11,7 @@ Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (the 
 """
 
 import array
+import contextlib
 import json
 import os
 import select
@@ -114,10 +115,8 @@ class ForkServer:
             self.box.stop()
             self.box.close()
             for pipe in (self.box.process.stdin, self.box.process.stdout) if self.box.process else ():
-                try:
+                with contextlib.suppress(OSError):
                     pipe.close()
-                except OSError:
-                    pass
 
     def __enter__(self):
         return self.start()
@@ -270,10 +269,8 @@ class ForkedBox(Box):
         if self.process is None:
             return
         self.process.kill()
-        try:
+        with contextlib.suppress(subprocess.TimeoutExpired):
             self.process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            pass
 
     def close(self):
         if self.closed:

@@ -9,6 +9,7 @@ as a :class:`Function` proxy that forwards each call into the sandbox, data as p
 call ran past its own limit).
 """
 
+import contextlib
 import secrets
 import subprocess
 import sys
@@ -158,10 +159,8 @@ class NotebookHandle:
             self.stopped_kind = CRASH
         self.box.close()
         for pipe in (self.process.stdin, self.process.stdout):
-            try:
+            with contextlib.suppress(OSError):
                 pipe.close()
-            except OSError:
-                pass
 
     def _stop(self, why, error=WorkerError):
         self.stopped, self.stopped_kind = why, error.grader_kind
@@ -221,10 +220,8 @@ class NotebookHandle:
         except protocol.ProtocolError:
             self._stop("the notebook's process sent an answer larger than the protocol allows")
         if line is None:
-            try:
+            with contextlib.suppress(subprocess.TimeoutExpired):
                 self.process.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                pass
             self._stop(self._ended())
         return line
 

@@ -14,6 +14,7 @@ answers itself. A dead notebook's process is replaced at the next request, which
 bad call costs only its own part. All of it is evidence only: the grader checks it and computes every score.
 """
 
+import contextlib
 import hashlib
 import hmac
 import importlib
@@ -287,10 +288,8 @@ class Supervisor:
     def stop(self, why=None):
         if self.child is None:
             return
-        try:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(self.child["pid"], signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
         _, status = os.waitpid(self.child["pid"], 0)
         for fd in (self.child["requests"], self.child["answers"].fd, self.child["verdicts"].fd):
             os.close(fd)
@@ -479,10 +478,8 @@ def preload(everything=False):
 
     # only in a fork server: a plain worker would pay for them in the notebook's time, imported or not
     for name in NOTEBOOK_IMPORTS if everything else ():
-        try:
+        with contextlib.suppress(ImportError):  # a course without the lab's extras still grades
             importlib.import_module(name)
-        except ImportError:  # a course without the lab's extras still grades
-            pass
 
     config = Config()
     config.HistoryManager.enabled = False

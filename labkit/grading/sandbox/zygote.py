@@ -16,6 +16,7 @@ this module: ``S`` on the status pipe once the worker runs (``E`` and why not), 
 end or the control pipe's closing (the grader is done or died), kills the worker and writes its wait status.
 """
 
+import contextlib
 import ctypes
 import json
 import os
@@ -87,6 +88,15 @@ def isolate(limits, home, keep=()):
     os.chdir(home)
 
 
+def _say_failed(fd, exc):
+    """Write ``E`` and why the worker could not start on the status pipe `fd`; False where it cannot be written."""
+    try:
+        os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+    except OSError:
+        return False
+    return True
+
+
 def _capabilities():
     """The worker's permitted, effective and ambient capability sets (from /proc/self/status), as numbers."""
     with open("/proc/self/status") as status:
@@ -140,7 +150,7 @@ def _keeper(fds, uid, limits, home, shell):
         isolate(limits, home, KEEP)
         pid = os.fork()
     except OSError as exc:
-        os.write(status, f"E{exc}"[:500].encode("utf-8", "replace"))
+        _say_failed(status, exc)
         os._exit(1)
     if pid == 0:
         code, running = 0, False
@@ -151,11 +161,8 @@ def _keeper(fds, uid, limits, home, shell):
         except BaseException as exc:  # noqa: BLE001 - the worker's end, whatever it is, is its status
             code = 1
             for fd in () if running else (FIRST_FD + 2, status):  # why it could not start, if it can still say
-                try:
-                    os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+                if _say_failed(fd, exc):
                     break
-                except OSError:
-                    continue
         os._exit(code)
     for name in ("requests", "answers"):
         os.close(fds[name])
@@ -175,15 +182,11 @@ def _keeper(fds, uid, limits, home, shell):
                 wait_status = found
                 break
         if control in ready:  # closed (or written to): the grader is done with this notebook
-            try:
+            with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
             _, wait_status = os.waitpid(pid, 0)
-    try:
+    with contextlib.suppress(OSError):  # the grader is gone
         os.write(status, f"W{wait_status}".encode())
-    except OSError:  # the grader is gone
-        pass
     os._exit(0)
 
 
@@ -233,10 +236,7 @@ def serve_forks(server, shell, home):
         try:
             pid = os.fork()
         except OSError as exc:
-            try:
-                os.write(named["status"], f"E{exc}"[:500].encode("utf-8", "replace"))
-            except OSError:
-                pass
+            _say_failed(named["status"], exc)
             pid = None
         if pid == 0:
             try:

@@ -9,6 +9,7 @@ sandbox lives elsewhere overrides :meth:`Box.start` and :meth:`Box.stop`.
 """
 
 import abc
+import contextlib
 import os
 import resource
 import signal
@@ -92,10 +93,8 @@ def processes_of_this_user():
     count = 0
     for entry in os.scandir("/proc"):
         if entry.name.isdigit():
-            try:
+            with contextlib.suppress(OSError):
                 count += entry.stat().st_uid == uid
-            except OSError:
-                pass
     return count
 
 
@@ -153,10 +152,8 @@ class Box:
 
     def _close_passed(self):
         for fd in self.pass_fds:
-            try:
+            with contextlib.suppress(OSError):
                 os.close(fd)
-            except OSError:
-                pass
         self.pass_fds = ()
 
     def stop(self):
