@@ -18,7 +18,7 @@ ROOT = Path("/sys/fs/cgroup")
 
 
 def _own(path_in_hierarchy):
-    """The grading process's cgroup in one hierarchy (from /proc/self/cgroup), or None."""
+    """The grading process's cgroup in the v1 hierarchy of a controller, or in v2 ("v2"); None if none."""
     try:
         lines = Path("/proc/self/cgroup").read_text().splitlines()
     except OSError:
@@ -27,7 +27,7 @@ def _own(path_in_hierarchy):
         number, controllers, path = line.split(":", 2)
         if path_in_hierarchy == "v2" and number == "0" and controllers == "":
             return path
-        if path_in_hierarchy == "memory" and "memory" in controllers.split(","):
+        if path_in_hierarchy != "v2" and path_in_hierarchy in controllers.split(","):
             return path
     return None
 
@@ -125,14 +125,7 @@ class MemoryCgroup:
 
 def _cpu_v1(name, cores):
     """A v1 cpu cgroup limited to `cores` cores beside our own, or None."""
-    own = None
-    try:
-        for line in Path("/proc/self/cgroup").read_text().splitlines():
-            _, controllers, path = line.split(":", 2)
-            if "cpu" in controllers.split(","):
-                own = path
-    except OSError:
-        return None
+    own = _own("cpu")
     root = ROOT / "cpu"
     if own is None or not (root / "cpu.cfs_quota_us").exists():
         return None
@@ -151,8 +144,7 @@ def _cpu_v1(name, cores):
 
 
 def create(limit, label="labkit", cores=1):
-    """A new cgroup of `limit` bytes (and `cores` cores, where the CPU can be limited) for one sandbox,
-    or None where none can be made here."""
+    """A new cgroup of `limit` bytes (and `cores` cores where possible) for one sandbox, or None where none can be."""
     for version, parent in _candidates():
         name = f"{label}-{os.getpid()}-{time.monotonic_ns()}"
         path = parent / name

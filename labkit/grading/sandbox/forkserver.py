@@ -39,11 +39,8 @@ def _wait_readable(fd, until):
 
 
 class ForkServer:
-    """One zygote in a sandbox of `backend`, bounded by `limits`; use it as a context manager.
-
-    While it runs, :func:`box` in this process (and in every process started
-    with :meth:`environment` and :attr:`fd` passed on) forks workers from it.
-    """
+    """One zygote in a sandbox of `backend` bounded by `limits` (a context manager); while it runs, :func:`box` here
+    and in processes given :meth:`environment` and :attr:`fd` forks workers from it."""
 
     def __init__(self, backend, limits):
         self.backend, self.limits = backend, limits
@@ -60,13 +57,11 @@ class ForkServer:
 
     @property
     def needs_cgroup(self):
-        """Whether each notebook needs a cgroup of its own: the server has one, which a notebook's memory
-        must never fill (a notebook that cannot get one gets a sandbox the plain way)."""
+        """Whether each notebook needs a cgroup of its own: a notebook's memory must never fill the server's."""
         return self.box is not None and self.box.cgroup is not None
 
     def start(self, wait=True):
-        """Start the server; with `wait`, wait until it is ready (:meth:`wait_ready`), else call that later
-        (what else must start can start meanwhile)."""
+        """Start the server; with `wait`, :meth:`wait_ready` too (else call it later)."""
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         zygote_fd = theirs.detach()
         try:
@@ -88,8 +83,7 @@ class ForkServer:
         return self.wait_ready() if wait else self
 
     def wait_ready(self):
-        """Wait until the server has imported what notebooks need, then let this process ask it; ForkServerError
-        (and the server stopped) when it does not get ready."""
+        """Wait until the server is ready and let this process ask it; else stop it and raise ForkServerError."""
         process = self.box.process
         line = b""
         until = time.monotonic() + READY_TIMEOUT

@@ -43,8 +43,7 @@ def write_beside(result):
 
 
 def collect(work, out):
-    """Gather the figures the grading processes left in `work` into `out`/timings.json ({submission file stem:
-    figures}); nothing is written when there are none."""
+    """Gather the grading processes' figures in `work` into `out`/timings.json, by submission (if there are any)."""
     found = {}
     for path in sorted(Path(work).glob("*" + SUFFIX)):
         try:

@@ -413,12 +413,8 @@ class Supervisor:
             )
         parts = mine[0]
         *fields, signature = parts if len(parts) == 6 else ([""] * 6)
-        if (fields[0], fields[1], fields[2], fields[4]) != (
-            expected[0],
-            expected[1],
-            expected[2],
-            expected[4],
-        ) or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
+        matches = [fields[i] for i in (0, 1, 2, 4)] == [expected[i] for i in (0, 1, 2, 4)]  # all but the status
+        if not matches or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
             return _grader_error(
                 "Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers"
             )

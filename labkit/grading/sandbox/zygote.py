@@ -60,8 +60,7 @@ def _mount(source, target, kind, flags, data=None):
 
 
 def isolate(limits, home, keep=()):
-    """In the keeper: new namespaces and empty private folders (see the module's description); the folders of
-    `keep` (the Python environment and labkit, read-only) that lie inside one are mounted back into it."""
+    """In the keeper: new namespaces and empty private folders; folders of `keep` inside one are mounted back."""
     _checked(_libc.unshare(CLONE_NEWNS | CLONE_NEWNET | CLONE_NEWIPC | CLONE_NEWUTS | CLONE_NEWPID), "unshare")
     _mount("none", "/", None, MS_REC | MS_PRIVATE)  # nothing mounted here reaches the server's view
     folders = [("/tmp", limits.tmp_size), (home, limits.home_size)]
@@ -105,15 +104,13 @@ def _capabilities():
 
 
 def _become_worker(fds, uid, limits):
-    """In the worker, as the first process of the new PID namespace: everything up to the student's uid, then
-    ``S`` on the status pipe (only then does the grader count on this worker)."""
+    """In the worker (pid 1 of its namespace): everything up to the student's uid, then ``S`` on the status pipe."""
     if uid <= 0:
         raise OSError(f"refusing to run a notebook as uid {uid}: a forked worker needs a uid of its own")
     _mount("proc", "/proc", "proc", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC)
     for fd in fds["cgroup"]:
         os.write(fd, b"0")  # 0: the writing process
-    # the worker's pipes at 3 and 4, its status pipe at 5, then nothing else: the server's socket, the
-    # keeper's control pipe, the cgroup files and any other descriptor close
+    # the worker's pipes at 3 and 4, its status pipe at 5; every other descriptor (the server's socket too) closes
     wanted = [fds["requests"], fds["answers"], fds["status"]]
     moved = [os.dup(fd) for fd in wanted]
     for index, fd in enumerate(moved):

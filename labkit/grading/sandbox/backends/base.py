@@ -73,10 +73,8 @@ COURSE_FOLDER = protocol.COURSE_FOLDER
 
 
 def course_mounts():
-    """(the course module's file or package folder, where the sandbox shows it) for every course module whose
-    exercises this process grades (:data:`labkit.exercises.registry.COURSES`) and that the Python environment
-    does not hold already. Only the module itself is shown, never the folder around it (where the course
-    keeps its submissions and grades)."""
+    """(course module's file or package, where the sandbox shows it) for each course module graded here and not in
+    the environment: only the module, never the folder around it (with the course's submissions and grades)."""
     from ....exercises.registry import COURSES
 
     environment = environment_paths()
@@ -109,14 +107,9 @@ def remove_tree(path):
 
 
 class Box:
-    """One notebook's sandbox, from the start of its worker to the cleanup after it.
-
-    `argv` starts the worker inside the sandbox, with `cwd` and `env` (the
-    grader's when None) and the descriptors `pass_fds`, which are closed on
-    this side once the worker has them. `processes_base` processes are
-    already counted against the sandbox's process limit (those of its uid
-    outside it). `cleanup` is called once, after the worker is stopped.
-    """
+    """One notebook's sandbox, from its worker's start to the cleanup: `argv` runs with `cwd`, `env` (the grader's
+    when None) and `pass_fds` (closed here once passed); `processes_base` processes of its uid already count
+    against the process limit; `cleanup` runs once after the worker is stopped."""
 
     def __init__(self, argv, limits, *, cwd=None, env=None, pass_fds=(), processes_base=0, cleanup=None):
         self.argv, self.limits, self.cwd, self.env = list(argv), limits, cwd, env
@@ -206,12 +199,8 @@ class Backend(abc.ABC):
         """The :class:`Box` that runs the worker's command `argv` in a new sandbox bounded by `limits`."""
 
     def zygote_box(self, argv, limits, pass_fds):
-        """The :class:`Box` of a fork server (:mod:`labkit.grading.sandbox.forkserver`), or None: this backend
-        offers none, and every notebook gets a sandbox of its own from :meth:`box`.
-
-        The server runs `argv` with the descriptors `pass_fds`, and must be
-        able to make namespaces, mount and change uid for the workers it
-        forks (:mod:`labkit.grading.sandbox.zygote`)."""
+        """The :class:`Box` of a fork server running `argv` with `pass_fds`, able to make namespaces, mount and change
+        uid (:mod:`labkit.grading.sandbox.zygote`); None: no server, each notebook gets :meth:`box`."""
         return None
 
     def notebook_uid(self):

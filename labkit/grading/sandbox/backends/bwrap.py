@@ -51,12 +51,8 @@ _FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def sandbox_uid():
-    """An unused uid for this grading process's sandboxes (0 when not root: bwrap maps the caller's).
-
-    Sandboxes graded at the same time come from different processes, so they
-    get different uids (one per process id) and one notebook's processes
-    never count against another's limit.
-    """
+    """An unused uid for this process's sandboxes (0 when not root: bwrap maps the caller's); one per process id, so
+    no notebook's processes count against another's limit."""
     return 100_000 + os.getpid() if os.geteuid() == 0 else 0
 
 
@@ -153,9 +149,7 @@ class Bubblewrap(Backend):
         return _box([*argv, str(uid)], limits, processes_base=0 if uid else processes_of_this_user())
 
     def zygote_box(self, argv, limits, pass_fds):
-        """As root: a fork server in a sandbox like every notebook's (see :mod:`labkit.grading.sandbox.zygote`).
-
-        Not as another user: its workers could not each get a uid of their own."""
+        """As root only (else its workers could not each get a uid of their own): a fork server sandboxed alike."""
         return _box(list(argv), limits, pass_fds, zygote=True) if os.geteuid() == 0 else None
 
     def notebook_uid(self):
