@@ -38,12 +38,8 @@ _write, _getframe, _modules = os.write, sys._getframe, sys.modules
 _gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
 _HASCONST, _EXTENDED_ARG, _NOP = frozenset(opcode.hasconst), opcode.EXTENDED_ARG, opcode.opmap["NOP"]
 _NoneType = type(None)
-_ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
-    types.ModuleType,
-    types.CodeType,
-    types.FunctionType,
-    types.BuiltinFunctionType,
-)
+_ModuleType, _CodeType = types.ModuleType, types.CodeType
+_FunctionType, _BuiltinFunctionType = types.FunctionType, types.BuiltinFunctionType
 
 _HEAP_TYPE = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
 SMALL_CODE = 64  # bytes of bytecode below which a function is only recognised with its name and place

@@ -121,14 +121,7 @@ class NotebookHandle:
                 self.box.close()
                 raise
         self._lines = protocol.Lines(self.process.stdout.fileno())  # each answer at most protocol.MAX_LINE
-        self.request(
-            {
-                "op": "setup",
-                "profiles": profiles if profiles is not None else {},
-                "passables": sorted(self.passables),
-            },
-            SETUP_TIMEOUT,
-        )
+        self.request({"op": "setup", "profiles": profiles or {}, "passables": sorted(self.passables)}, SETUP_TIMEOUT)
 
     def _forked(self):
         """A worker from this process's fork server, or None (then the notebook gets a sandbox the plain way)."""

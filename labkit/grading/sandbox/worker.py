@@ -198,7 +198,7 @@ def _serve(notebook, reader, answers):
         pass
 
 
-def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles, passable_names):
+def _notebook_main(shell, pipes, setup):
     """The notebook's process: its timer, seccomp, the watch, then requests until the pipe closes."""
     os.setpgrp()  # the supervisor stops it and everything it starts at once
     output = _Counter()
@@ -206,16 +206,12 @@ def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles,
     sys.stdin = io.StringIO("")
     signal.signal(signal.SIGALRM, _alarm)
     seccomp.install_for_notebook()
-    passables = {name: protocol.passable(name) for name in passable_names}
-    guard.install(
-        os.read(key_fd, 32),
-        verdict_fd,
-        guard.unwire(profiles),
-        passables,
-        chain=(_serve_one.__code__, _serve.__code__, _notebook_main.__code__),
-    )
-    os.close(key_fd)
-    _serve(NotebookProcess(shell, output), protocol.Lines(requests_fd), answers_fd)
+    passables = {name: protocol.passable(name) for name in setup["passables"]}
+    key = pipes["key"][0]
+    chain = (_serve_one.__code__, _serve.__code__, _notebook_main.__code__)
+    guard.install(os.read(key, 32), pipes["verdict"][1], guard.unwire(setup["profiles"]), passables, chain=chain)
+    os.close(key)
+    _serve(NotebookProcess(shell, output), protocol.Lines(pipes["requests"][0]), pipes["answers"][1])
 
 
 # -- the supervisor -------------------------------------------------------------
@@ -262,15 +258,7 @@ class Supervisor:
                 os.close(self.answers)
                 for name, (read, write) in pipes.items():
                     os.close(write if name in ("key", "requests") else read)
-                _notebook_main(
-                    self.shell,
-                    pipes["key"][0],
-                    pipes["verdict"][1],
-                    pipes["requests"][0],
-                    pipes["answers"][1],
-                    self.setup["profiles"],
-                    self.setup["passables"],
-                )
+                _notebook_main(self.shell, pipes, self.setup)
             finally:
                 os._exit(0)
         for name, (read, write) in pipes.items():
