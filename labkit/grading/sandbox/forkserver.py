@@ -66,14 +66,12 @@ class ForkServer:
         zygote_fd = theirs.detach()
         try:
             self.box = self.backend.zygote_box([*ZYGOTE, str(zygote_fd)], self.limits, (zygote_fd,))
+            if self.box is None:
+                raise ForkServerError(f"the {self.backend.name} sandbox offers no fork server")
         except BaseException:
             os.close(zygote_fd)
             ours.close()
             raise
-        if self.box is None:
-            os.close(zygote_fd)
-            ours.close()
-            raise ForkServerError(f"the {self.backend.name} sandbox offers no fork server")
         self.socket = ours
         try:
             self.box.start()
@@ -108,9 +106,6 @@ class ForkServer:
         if self.box is not None:
             self.box.stop()
             self.box.close()
-            for pipe in (self.box.process.stdin, self.box.process.stdout) if self.box.process else ():
-                with contextlib.suppress(OSError):
-                    pipe.close()
 
     def __enter__(self):
         return self.start()

@@ -151,9 +151,6 @@ class NotebookHandle:
             self.stopped = "the notebook ran out of memory"
             self.stopped_kind = CRASH
         self.box.close()
-        for pipe in (self.process.stdin, self.process.stdout):
-            with contextlib.suppress(OSError):
-                pipe.close()
 
     def _stop(self, why, error=WorkerError):
         self.stopped, self.stopped_kind = why, error.grader_kind

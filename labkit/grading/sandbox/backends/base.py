@@ -169,11 +169,14 @@ class Box:
         return self.cgroup.peak() if self.cgroup is not None else None
 
     def close(self):
-        """After :meth:`stop`: undo what was set up for this notebook (nothing of it is left on the machine)."""
+        """After :meth:`stop`: close the worker's pipes and undo what was set up for it (nothing is left behind)."""
         if self.closed:
             return
         self.closed = True
         self._close_passed()
+        for pipe in (self.process.stdin, self.process.stdout) if self.process is not None else ():
+            with contextlib.suppress(OSError):
+                pipe.close()
         if self.cgroup is not None:
             self.cgroup.remove()
         if self._cleanup is not None:
