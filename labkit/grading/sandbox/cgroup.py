@@ -1,22 +1,14 @@
 """A cgroup per sandbox: a memory limit that counts every page, a CPU limit, and a list of every process.
 
-An address-space limit (``RLIMIT_AS``) counts what a process maps, not the
-pages of an anonymous file or a tmpfs it writes to, nor what its children
-hold together. A memory cgroup counts them all, and its ``cgroup.procs``
-names every process of the sandbox, so the grader can stop all of them. A
-CPU limit of one core per sandbox keeps one submission that spins from
-slowing a classmate graded beside it (with ``--jobs`` no more than the cores).
-
-:class:`MemoryCgroup` makes one under the grading process's own cgroup
-(cgroup v2, or v1's memory hierarchy and, where there is one, its cpu
-hierarchy), moves the sandbox into it from inside the new process before it
-starts the sandbox (:class:`labkit.grading.sandbox.backends.base.Box`), and removes
-it afterwards.
-Where no cgroup can be made (not root, no delegation, no cgroup file
-system) :func:`create` returns None and the sandbox relies on its other
-limits; the instructors' documentation says what that leaves open.
+``RLIMIT_AS`` counts what one process maps, not an anonymous file's or a tmpfs's pages, nor children together; a
+memory cgroup counts them all, and its ``cgroup.procs`` lists every process so the grader can stop them all. One
+core per sandbox keeps a spinning submission from slowing a classmate. :class:`MemoryCgroup` is made under the
+grading process's cgroup (v2, or v1's memory and cpu hierarchies), joined by the new process before it starts the
+sandbox, and removed afterwards. Where none can be made :func:`create` returns None and the sandbox relies on its
+other limits (the instructors' documentation says what that leaves open).
 """
 
+import contextlib
 import os
 import signal
 import time
@@ -26,7 +18,7 @@ ROOT = Path("/sys/fs/cgroup")
 
 
 def _own(path_in_hierarchy):
-    """The grading process's cgroup in one hierarchy (from /proc/self/cgroup), or None."""
+    """The grading process's cgroup in the v1 hierarchy of a controller, or in v2 ("v2"); None if none."""
     try:
         lines = Path("/proc/self/cgroup").read_text().splitlines()
     except OSError:
@@ -35,7 +27,7 @@ def _own(path_in_hierarchy):
         number, controllers, path = line.split(":", 2)
         if path_in_hierarchy == "v2" and number == "0" and controllers == "":
             return path
-        if path_in_hierarchy == "memory" and "memory" in controllers.split(","):
+        if path_in_hierarchy != "v2" and path_in_hierarchy in controllers.split(","):
             return path
     return None
 
@@ -115,10 +107,8 @@ class MemoryCgroup:
             if not pids:
                 break
             for pid in pids:
-                try:
+                with contextlib.suppress(ProcessLookupError, PermissionError):
                     os.kill(pid, signal.SIGKILL)
-                except (ProcessLookupError, PermissionError):
-                    pass
             time.sleep(0.005)  # a killed process leaves its cgroup within milliseconds
         for folder in (self.path, self.cpu_path):
             for _ in range(50):
@@ -135,14 +125,7 @@ class MemoryCgroup:
 
 def _cpu_v1(name, cores):
     """A v1 cpu cgroup limited to `cores` cores beside our own, or None."""
-    own = None
-    try:
-        for line in Path("/proc/self/cgroup").read_text().splitlines():
-            _, controllers, path = line.split(":", 2)
-            if "cpu" in controllers.split(","):
-                own = path
-    except OSError:
-        return None
+    own = _own("cpu")
     root = ROOT / "cpu"
     if own is None or not (root / "cpu.cfs_quota_us").exists():
         return None
@@ -154,17 +137,14 @@ def _cpu_v1(name, cores):
         period = int((path / "cpu.cfs_period_us").read_text())
         (path / "cpu.cfs_quota_us").write_text(str(int(period * cores)))
     except (OSError, ValueError):
-        try:
+        with contextlib.suppress(OSError):
             path.rmdir()
-        except OSError:
-            pass
         return None
     return path
 
 
 def create(limit, label="labkit", cores=1):
-    """A new cgroup of `limit` bytes (and `cores` cores, where the CPU can be limited) for one sandbox,
-    or None where none can be made here."""
+    """A new cgroup of `limit` bytes (and `cores` cores where possible) for one sandbox, or None where none can be."""
     for version, parent in _candidates():
         name = f"{label}-{os.getpid()}-{time.monotonic_ns()}"
         path = parent / name
@@ -175,22 +155,16 @@ def create(limit, label="labkit", cores=1):
         try:
             if version == "v1":
                 (path / "memory.limit_in_bytes").write_text(str(int(limit)))
-                try:
+                with contextlib.suppress(OSError):
                     (path / "memory.memsw.limit_in_bytes").write_text(str(int(limit)))  # no swapping past it
-                except OSError:
-                    pass
             else:
                 (path / "memory.max").write_text(str(int(limit)))
                 for setting, value in (("memory.swap.max", "0"), ("cpu.max", f"{int(100_000 * cores)} 100000")):
-                    try:
+                    with contextlib.suppress(OSError):
                         (path / setting).write_text(value)
-                    except OSError:
-                        pass
         except OSError:
-            try:
+            with contextlib.suppress(OSError):
                 path.rmdir()
-            except OSError:
-                pass
             continue
         cpu = _cpu_v1(name, cores) if version == "v1" and cores else None
         return MemoryCgroup(version, path, limit, cpu)

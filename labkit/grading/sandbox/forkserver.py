@@ -1,30 +1,17 @@
 """The grader's side of the fork server: imports paid once per run, not once per notebook.
 
-Starting a worker the plain way (:meth:`labkit.grading.sandbox.backends.base.Backend.box`)
-costs a new sandbox and a new Python that imports numpy, scipy, matplotlib,
-IPython and labkit, for every notebook of every submission: most of a
-submission's grading time. A :class:`ForkServer` starts one process in a
-sandbox of the backend (:mod:`labkit.grading.sandbox.zygote`) that imports all of
-that once; each notebook then gets a worker forked from it and isolated
-from every other notebook before any student code runs (namespaces of its
-own, empty private folders, its own uid, cgroup and rlimits; the zygote's
-description says how).
-
-A grading run (:func:`labkit.grading.run.classrun.grade`) starts one server and
-hands its socket to every submission's grading process: the descriptor's
-number is in the environment variable :data:`ENV`. In that process
-:func:`box` makes a :class:`ForkedBox`, a :class:`~.backends.base.Box`
-whose worker comes from the server; where there is no server, or it cannot
-give a worker, the notebook gets a sandbox of its own the plain way, so a
-broken server costs time, never a grade.
-
-A backend offers a server through :meth:`~.backends.base.Backend.zygote_box`;
-the default backend does when the grader runs as root (the zygote needs the
-capabilities to make namespaces and change uid). ``--no-fork-server``
-(``GradeOptions.fork_server``) keeps the plain way.
+A plain worker (:meth:`.backends.base.Backend.box`) costs a new sandbox and a Python that imports numpy, scipy,
+matplotlib, IPython and labkit: most of a submission's grading time. A :class:`ForkServer` runs one zygote
+(:mod:`labkit.grading.sandbox.zygote`) that imports all of that once and forks each notebook a worker isolated
+from every other notebook before any student code runs. A grading run starts one and passes its socket to each
+grading process (descriptor in :data:`ENV`), where :func:`box` makes a :class:`ForkedBox`. Without a server, or
+when it cannot give a worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
+Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (the default one as root);
+``--no-fork-server`` keeps the plain way.
 """
 
 import array
+import contextlib
 import json
 import os
 import select
@@ -52,11 +39,8 @@ def _wait_readable(fd, until):
 
 
 class ForkServer:
-    """One zygote in a sandbox of `backend`, bounded by `limits`; use it as a context manager.
-
-    While it runs, :func:`box` in this process (and in every process started
-    with :meth:`environment` and :attr:`fd` passed on) forks workers from it.
-    """
+    """One zygote in a sandbox of `backend` bounded by `limits` (a context manager); while it runs, :func:`box` here
+    and in processes given :meth:`environment` and :attr:`fd` forks workers from it."""
 
     def __init__(self, backend, limits):
         self.backend, self.limits = backend, limits
@@ -73,25 +57,21 @@ class ForkServer:
 
     @property
     def needs_cgroup(self):
-        """Whether each notebook needs a cgroup of its own: the server has one, which a notebook's memory
-        must never fill (a notebook that cannot get one gets a sandbox the plain way)."""
+        """Whether each notebook needs a cgroup of its own: a notebook's memory must never fill the server's."""
         return self.box is not None and self.box.cgroup is not None
 
     def start(self, wait=True):
-        """Start the server; with `wait`, wait until it is ready (:meth:`wait_ready`), else call that later
-        (what else must start can start meanwhile)."""
+        """Start the server; with `wait`, :meth:`wait_ready` too (else call it later)."""
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         zygote_fd = theirs.detach()
         try:
             self.box = self.backend.zygote_box([*ZYGOTE, str(zygote_fd)], self.limits, (zygote_fd,))
+            if self.box is None:
+                raise ForkServerError(f"the {self.backend.name} sandbox offers no fork server")
         except BaseException:
             os.close(zygote_fd)
             ours.close()
             raise
-        if self.box is None:
-            os.close(zygote_fd)
-            ours.close()
-            raise ForkServerError(f"the {self.backend.name} sandbox offers no fork server")
         self.socket = ours
         try:
             self.box.start()
@@ -101,8 +81,7 @@ class ForkServer:
         return self.wait_ready() if wait else self
 
     def wait_ready(self):
-        """Wait until the server has imported what notebooks need, then let this process ask it; ForkServerError
-        (and the server stopped) when it does not get ready."""
+        """Wait until the server is ready and let this process ask it; else stop it and raise ForkServerError."""
         process = self.box.process
         line = b""
         until = time.monotonic() + READY_TIMEOUT
@@ -127,11 +106,6 @@ class ForkServer:
         if self.box is not None:
             self.box.stop()
             self.box.close()
-            for pipe in (self.box.process.stdin, self.box.process.stdout) if self.box.process else ():
-                try:
-                    pipe.close()
-                except OSError:
-                    pass
 
     def __enter__(self):
         return self.start()
@@ -284,10 +258,8 @@ class ForkedBox(Box):
         if self.process is None:
             return
         self.process.kill()
-        try:
+        with contextlib.suppress(subprocess.TimeoutExpired):
             self.process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            pass
 
     def close(self):
         if self.closed:

@@ -1,43 +1,26 @@
 """The watch over a notebook's process while it is graded (the sandbox's side).
 
-The notebook's process is the student's: anything its cells leave behind (a
-patched module, a saved code object, code that rewrites labkit's own grading
-code) is in it. So the watch is installed before the first cell runs, by
-the pristine process that forks the notebook's (:mod:`labkit.grading.sandbox.worker`),
-and nothing of it is reachable from Python afterwards:
+Anything a notebook's cells leave behind (a patched module, a saved code object, rewritten grading code) lives
+in its process, so the pristine supervisor (:mod:`labkit.grading.sandbox.worker`) installs the watch before the
+first cell, and nothing of it is reachable from Python afterwards:
 
-* an **audit hook** (``sys.addaudithook``: it cannot be removed or listed)
-  holds the watch's state and the key it signs with. It reports *tampering*
-  to the supervisor the moment it happens, on a pipe the supervisor reads:
-  switching the profile hook off, walking the garbage collector's lists,
-  ctypes, new processes, new code objects, a function's ``__code__``
-  replaced. Once reported, nothing the notebook does afterwards counts, even
-  if it then reads the process's memory. The audit hook also receives the
-  worker's sentinels (``sys.audit("labkit.begin")``, ``"labkit.chosen"``,
-  ``"labkit.end"``), recognised by the pristine code objects of the serving
-  functions that raise them;
-* while a graded request runs (between ``begin`` and ``end``) a **profile
-  hook**, installed through the C API with no Python object the notebook
-  could fetch (``sys.getprofile()`` stays None), notes every call of a
-  refused reference: any Python function whose code is one of the refused
-  modules' functions, recognised by a digest of its code that the grader
-  computed from the library's files (so a subclass, a saved code object,
-  ``construct_fast``, a private helper or a pasted copy of the code are
-  caught alike). Compiled routines of the refused modules are replaced in
-  their modules for the length of the request;
-* at the end of each answer the audit hook writes an **attestation**: the
-  request, its profile and the functions handed to student code, whether it
-  stayed clean (or the first refused reference), and a digest of the answer,
-  signed with a key that never existed in the notebook's memory outside the
-  watch. The supervisor forwards an answer only with a valid attestation.
+* an **audit hook** (it cannot be removed or listed) holds the watch's state and signing key. It reports
+  *tampering* at once on a pipe the supervisor reads (switching the profile hook off, the garbage collector's
+  lists, ctypes, new processes, new code objects, a replaced ``__code__``); from then on nothing the notebook
+  does counts, even if it reads the process's memory. It also takes the worker's sentinels (``labkit.begin``,
+  ``labkit.chosen``, ``labkit.end``), accepted only from the pristine code of the serving functions;
+* during a graded request a **profile hook**, set through the C API (``sys.getprofile()`` stays None: nothing
+  to fetch), notes every call of a refused function, recognised by a digest of its code computed from the
+  library's files (a subclass, a saved code object, a private helper or a pasted copy are caught alike); the
+  refused modules' compiled routines are replaced for the length of the request;
+* after each answer the audit hook writes a signed **attestation** (request, profile, functions handed over,
+  clean or the first refusal, digest of the answer) with a key that never existed in the notebook's memory
+  outside the watch. The supervisor forwards only attested answers.
 
-Neither hook ever touches an object of the student's (no attribute, no
-comparison, no hash): they read code objects, frames and exact built-in
-types only, and the garbage collector is off while they work, so no student
-code ever runs while the watch's own frames are on the stack. The sandbox
-makes threads and new signal handlers impossible (:mod:`labkit.grading.sandbox.seccomp`),
-so nothing interrupts them either. A refused call is allowed to run and its
-answer is voided afterwards: neither hook raises.
+Neither hook touches a student's object (no attribute, comparison or hash): they read code objects, frames and
+exact built-in types, with the garbage collector off, so no student code runs while the watch's frames are on
+the stack; seccomp (:mod:`labkit.grading.sandbox.seccomp`) forbids threads and signal handlers that could
+interrupt them. Neither hook raises: a refused call runs and its answer is voided.
 """
 
 import _hashlib
@@ -48,20 +31,15 @@ import os
 import sys
 import types
 
-# what the watch calls, taken when this module is imported (in the pristine supervisor): the watch's own
-# code resolves its names in a private copy of this module's namespace (:func:`install`), so a notebook
+# taken at import, in the pristine supervisor, and looked up in a private namespace (:func:`install`): a notebook
 # that rebinds ``guard.hashlib``, ``builtins.any`` or ``hashlib.sha1`` changes nothing the watch uses
 _sha1, _sha256, _hmac_digest = _hashlib.openssl_sha1, _hashlib.openssl_sha256, _hashlib.hmac_digest
 _write, _getframe, _modules = os.write, sys._getframe, sys.modules
 _gc_disable, _gc_enable, _gc_isenabled = gc.disable, gc.enable, gc.isenabled
 _HASCONST, _EXTENDED_ARG, _NOP = frozenset(opcode.hasconst), opcode.EXTENDED_ARG, opcode.opmap["NOP"]
 _NoneType = type(None)
-_ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
-    types.ModuleType,
-    types.CodeType,
-    types.FunctionType,
-    types.BuiltinFunctionType,
-)
+_ModuleType, _CodeType = types.ModuleType, types.CodeType
+_FunctionType, _BuiltinFunctionType = types.FunctionType, types.BuiltinFunctionType
 
 _HEAP_TYPE = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
 SMALL_CODE = 64  # bytes of bytecode below which a function is only recognised with its name and place
@@ -83,8 +61,7 @@ EXPOSED = frozenset({"_stand_in", "_plain", "_handed_over", "_barrier"})
 
 
 def _constant(value):
-    """What a constant the bytecode loads contributes to :func:`code_key`: numbers and None by value, any other
-    constant by its kind only (exact built-in types only; nothing of the student's is touched)."""
+    """A loaded constant in :func:`code_key`: numbers and None by value, others by kind (exact types only)."""
     kind = type(value)
     if kind is _NoneType or kind is bool:
         return repr(value)
@@ -104,14 +81,9 @@ def _constant(value):
 def code_key(code):
     """A digest of a function's code that survives renaming the function but not rewriting it.
 
-    The bytecode with each constant it loads replaced by that constant's value
-    (numbers and None; strings by their kind only), the names and local names
-    it uses and its number of arguments. So where a constant sits in
-    ``co_consts`` does not count: a function whose docstring was deleted (None
-    in its place, and the constants after it one place earlier) has the same
-    key, and so has one compiled with its docstring stripped (``optimize=2``,
-    which leaves a NOP: NOPs are left out). Short functions (which an honest student might write identically)
-    are also keyed by their name, file and line.
+    Bytecode (NOPs left out) with each loaded constant by value (strings by kind only), names, local names and
+    argument count: so a deleted or stripped (``optimize=2``) docstring keeps the key. Short functions, which an
+    honest student might write identically, are keyed by their name, file and line too.
     """
     raw, consts = code.co_code, code.co_consts
     structure, loaded, count, extended = bytearray(), [], len(consts), 0
@@ -152,9 +124,7 @@ def attestation_text(rid, profile, passables, status, digest):
 
 
 def _stand_in(name):
-    """A function that stands in for a refused compiled function or class while a graded request runs.
-
-    The watch recognises a call of one by its code, and reads the name from its frame (a plain string only)."""
+    """A stand-in for a refused compiled function or class; the watch knows its code and reads `name` from its frame."""
 
     def refused(*args, **kwargs):
         raise RuntimeError(
@@ -177,8 +147,7 @@ def _plain(value):
 
 
 def _handed_over(copy):
-    """The function student code gets for a trusted copy: its arguments become plain numbers before the
-    copy runs, and a function among them runs behind a barrier (untrusted) when the copy calls it."""
+    """A trusted copy for student code: arguments become plain numbers, functions run behind an untrusted barrier."""
 
     def handed_over(*args, **kwargs):
         args = tuple(_barrier(a) if callable(a) else _plain(a) for a in args)
@@ -208,11 +177,9 @@ def _compiled_types():
     return frozenset(found)
 
 
-# a filter in front of the profile hook, in machine code: only 'call' events (what == 0) of code objects not in its
-# table reach the Python hook; every other event (a return, a call of a compiled function) and every call of a code
-# object the hook found clean in this request returns 0 at once. So the watch costs a Python-heavy notebook one hook
-# call per code object it runs, not one per call and return of everything it calls. x86-64 (System V), CPython 3.11
-# (the code object read as frame->f_frame->f_code; checked before use):
+# machine code in front of the profile hook: only 'call' events (what == 0) of code objects not in its table (found
+# clean in this request) reach the Python hook, so a notebook pays one hook call per code object, not per call.
+# x86-64 System V, CPython 3.11 (frame->f_frame->f_code; checked before use):
 #   endbr64; test edx, edx; jne done; mov rax, [rsi+24]; mov rax, [rax+32]; mov r8, rax; shr r8, 4;
 #   and r8d, SLOTS-1; movabs r9, TABLE; cmp [r9+r8*8], rax; je done; movabs rax, HOOK; jmp rax; done: xor eax, eax; ret
 _CALL_FILTER = {
@@ -237,10 +204,8 @@ def _frames_as_the_filter_reads_them():
 
 
 def _call_filter(hook_address):
-    """(the address of :data:`_CALL_FILTER` in front of the hook at `hook_address`, its table, what keeps both
-    alive), or (`hook_address`, None, None) where there is none (another machine or Python, no executable
-    memory): every event then reaches the hook, which passes over all but 'call' itself. Called while the
-    process is pristine."""
+    """(the filter's address in front of the hook at `hook_address`, its table, what keeps both alive), or
+    (`hook_address`, None, None) where it cannot run: the hook then sees every event. Called while pristine."""
     import ctypes
     import mmap
     import platform
@@ -267,29 +232,18 @@ def _call_filter(hook_address):
 def install(secret, verdict_fd, profiles, passables, chain):
     """Install the watch in this (still pristine) process; afterwards nothing of it is reachable from Python.
 
-    The watch's code runs in a private copy of this module's namespace, with a
-    private copy of the builtins: every function of this module is rebound to
-    it, so no name the watch looks up can be changed by a notebook. The few
-    functions student code can hold (:data:`EXPOSED`) are rebound to another
-    copy, so their ``__globals__`` lead nowhere.
-
-    `profiles` maps a profile name to ``(names, modules, c_names)``: the refused
-    Python code as {digest: readable name} (:func:`code_key`), the refused
-    module prefixes (their compiled functions are replaced during a request)
-    and single refused compiled functions ``(module, name)``. `passables` maps
-    the names the grader may hand to student code to pristine functions: the
-    watch makes each a copy with a code object of its own, trusted during the
-    request it is handed to, when it is called through the function handed
-    over (which turns its arguments into plain numbers first). Only the
-    copy's own code is trusted, not what it calls. `chain` is the pristine
-    code of the serving functions, innermost first, that must raise the
-    sentinels.
+    Its code runs in a private copy of this module's namespace and builtins, so no name it looks up can be
+    rebound by a notebook; the functions student code can hold (:data:`EXPOSED`) get another copy, so their
+    ``__globals__`` lead nowhere. `profiles`: name -> ``(names, modules, c_names)``, the refused Python code as
+    {:func:`code_key`: readable name}, refused module prefixes and refused compiled ``(module, name)``.
+    `passables`: name -> pristine function; each gets a copy with its own code object, trusted (not what it calls)
+    only during its request and only through the function handed over, which makes its arguments plain numbers.
+    `chain`: the pristine code of the serving functions, innermost first, that must raise the sentinels.
     """
     private = dict(globals())
     private["__builtins__"] = dict(vars(builtins))
-    # what student code can reach (the stand-ins put in refused modules, the functions handed over and the
-    # barriers around the student's callables) gets a namespace of its own: through their ``__globals__``
-    # a notebook reaches only that, never the names the hooks look up
+    # stand-ins, functions handed over and barriers get a namespace of their own: their ``__globals__`` never
+    # lead to the names the hooks look up
     exposed = {"__name__": __name__, "__builtins__": dict(vars(builtins))}
     for name, value in list(private.items()):
         if type(value) is _FunctionType and value.__globals__ is globals():
@@ -301,10 +255,7 @@ def install(secret, verdict_fd, profiles, passables, chain):
 
 
 def _install(secret, verdict_fd, profiles, passables, chain):
-    """The watch itself; called by :func:`install` with this module's namespace privately copied.
-
-    Its state is one dictionary that only the hooks' closures hold; the steps below are this module's functions,
-    which :func:`install` rebound to the private namespace, so they too look up nothing a notebook can rebind."""
+    """The watch itself, run in the private namespace; its state is one dict only the hooks' closures hold."""
     import ctypes
 
     profiles, strictest = _kept_profiles(profiles)
@@ -430,9 +381,8 @@ def _stub(state, profile):
 
 
 def _holds_target(state, module_name, namespace, target_ids):
-    """Whether a module holds a refused compiled function: where the process held one when the watch was installed,
-    and any module loaded or grown since (ids compared in C: no object of the notebook's is asked anything; a live
-    target's id is its own)."""
+    """Whether a module holds a refused compiled function (as at install, or loaded or grown since: ids compared in
+    C, so no object of the notebook's is asked anything)."""
     held = module_name in state["holders"]
     if target_ids and not held and state["sizes"].get(module_name) != len(namespace):
         held = not target_ids.isdisjoint(map(id, namespace.values()))
@@ -563,8 +513,7 @@ def _choose(state, args):
         live=frozenset(live),
         mode=RUN if name == RUN else "graded",
     )
-    # the cells run unwatched but for tampering, and at full speed; a graded request's walk over the modules runs
-    # unprofiled (no student code runs); a request where nothing is refused is watched for tampering only
+    # cells: watched for tampering only, at full speed; the walk over the modules runs unprofiled (no student code)
     state["set_profile"](None, None)
     if name == RUN:
         if state["gc"]:

@@ -1,34 +1,16 @@
-"""What crosses between the grader and a sandboxed notebook: plain numbers in tagged JSON.
+"""What crosses between the grader and a sandboxed notebook: plain numbers in tagged JSON, one object per line.
 
-Both directions use one format, one JSON object per line:
+Tags: ``["f", x]``, ``["i", n]``, ``["none"]``, ``["s", text]``; ``["a", shape, base64 of <f8]`` (integers and
+booleans as floats; complex and object arrays are not numbers); ``["t", [...]]`` and ``["l", [...]]``; a course
+type of :data:`labkit.wire.TYPES` as its tag and its array fields (e.g. ``["mesh", points, quads]``, validated
+by the table's ``rebuild``); a plot as the data of its lines, ``["lines", [[x, y, marker, linestyle], ...]]``,
+so plots are judged from data on the grader's side. Towards the notebook only, a labkit function the exercises
+declare passable, by name (``["fn", "labkit.piecewise:eval_pherm"]``, optionally with at most
+:data:`MAX_KEYWORDS` finite float keywords bound): the notebook gets the watch's trusted copy. From the notebook
+only, ``["obj", description]`` for anything else.
 
-* a float ``["f", x]``, an integer ``["i", n]``, ``["none"]``, text ``["s", text]``;
-* an array ``["a", shape, base64 of little-endian float64]`` (integers and
-  booleans are sent as floats; complex and object arrays are not numbers);
-* a tuple ``["t", [...]]`` or a list ``["l", [...]]``;
-* a course type of :data:`labkit.wire.TYPES` as its tag and its fields, each an array:
-  a :class:`labkit.Corner` ``["corner", point, ds, dt, dsdt]`` and a
-  :class:`labkit.QuadMesh` ``["mesh", points, quads]``, rebuilt (and
-  validated) by the table's ``rebuild``;
-* a plot (a matplotlib Axes or Figure) ``["lines", [[x, y, marker, linestyle], ...]]``:
-  the data of its Line2D objects (:func:`labkit.plotdata.lines_of`),
-  rebuilt as :class:`labkit.plotdata.Line` records, so plots are judged
-  from their data on the grader's side;
-* towards the notebook only, a function of labkit's that the checks hand to
-  student code, by name: ``["fn", "labkit.piecewise:eval_pherm"]``. Only the
-  functions the exercises declare (``Registry.passable``) are named; the
-  notebook's side gets the watch's trusted copy (:mod:`labkit.grading.sandbox.guard`).
-  Such a function with float keywords bound (a ``functools.partial``, as a
-  student's variant of the Runge function is) is
-  ``["fn", "labkit.functions:runge", {"a": 1.25}]``, at most
-  :data:`MAX_KEYWORDS` finite floats, rebuilt as a partial of the trusted copy;
-* from the notebook only, ``["obj", description]`` for anything else.
-
-The grader decodes with :func:`decode`, which trusts nothing: sizes, depth
-and shapes are checked, every number becomes a float64 array or a Python
-float, and anything else becomes a :class:`NotNumbers` that fails every
-comparison with a message saying what it was. Nothing is unpickled or
-evaluated. The notebook side encodes with :func:`encode`.
+:func:`decode` trusts nothing: sizes, depth and shapes are checked, every number becomes a float64 array or a
+float, anything else a :class:`NotNumbers` that fails every comparison. Nothing is unpickled or evaluated.
 """
 
 import base64
@@ -89,10 +71,7 @@ def _array_tag(value):
 
 
 def encode(value, passable=frozenset(), depth=0):
-    """Tagged plain form of a value; a function whose ``module:qualname`` is in `passable` is sent by name.
-
-    Used on both sides: the notebook's answers (which may be hostile, so they are re-checked) and the
-    arguments the grader's checks pass."""
+    """Tagged plain form of a value (both sides); a function whose ``module:qualname`` is in `passable` by name."""
     if depth > MAX_DEPTH:
         return ["obj", "a value nested too deeply"]
     if value is None:
@@ -152,8 +131,7 @@ def _lines_tag(plot):
 
 
 def _bound(keywords):
-    """The float keywords of a partial as a plain dict, or None if they are not at most MAX_KEYWORDS finite
-    floats under identifiers."""
+    """A partial's keywords as a dict, or None unless they are at most MAX_KEYWORDS finite floats."""
     if not isinstance(keywords, dict) or not 0 < len(keywords) <= MAX_KEYWORDS:
         return None
     bound = {}
@@ -206,11 +184,8 @@ def passable(name):
 
 
 def loads(line):
-    """Parse one message line; anything but a JSON object of bounded size and structure is a ProtocolError.
-
-    The bounds are checked on the bytes, before parsing: a line of nested
-    empty lists would otherwise cost the parser some thirty times its size.
-    """
+    """Parse one line; anything but a bounded JSON object is a ProtocolError. The bounds are checked before parsing:
+    a line of nested empty lists would otherwise cost the parser some thirty times its size."""
     if len(line) > MAX_LINE:
         raise ProtocolError(f"a message of {len(line)} bytes is larger than {MAX_LINE}")
     if isinstance(line, str):
@@ -270,9 +245,7 @@ def _course_type(row, parts):
 
 
 def decode(tag, depth=0, functions=None):
-    """The grader's value for a tagged form: float arrays, floats, ints, tuples, lists,
-    Corners, QuadMeshes, or a NotNumbers. On the notebook's side `functions` maps the
-    names of ``["fn", name]`` to the functions handed over for this request."""
+    """The value of a tagged form; on the notebook's side `functions` maps ``["fn", name]`` to those handed over."""
     if depth > MAX_DEPTH + 1:
         raise ProtocolError("nested too deeply")
     if not isinstance(tag, list) or not tag or not isinstance(tag[0], str):
@@ -329,8 +302,7 @@ def ended(signal_number, status):
 
 
 class Lines:
-    """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError): the one line reader of
-    the grader, the supervisor, the notebook's process and the launcher."""
+    """Lines from a pipe, each at most `limit` bytes (a longer one is a ProtocolError)."""
 
     def __init__(self, fd, limit=MAX_LINE):
         self.fd, self.limit, self.buffer = fd, limit, b""

@@ -1,24 +1,15 @@
 """The grader's handle on one sandboxed notebook: start it, run it, call into it, stop it.
 
-:class:`NotebookHandle` starts the worker (:mod:`labkit.grading.sandbox.worker`) inside the
-sandbox of the backend its settings name (a :class:`~labkit.grading.options.GradeOptions`, or
-anything with the same fields: :class:`Settings`)
-(:mod:`labkit.grading.sandbox.backends`), tells it what the watch refuses, sends it
-requests and reads its answers with a deadline and a size limit, and stops
-every process of the sandbox when it is done, stuck or misbehaving.
-:class:`Namespace` is the mapping the checks read (``ns["eval_pherm"]``): a
-function comes back as a :class:`Function` proxy that forwards each call
-into the sandbox, and data come back decoded as plain numbers
-(:func:`labkit.grading.sandbox.protocol.decode`). So the checks of
-:mod:`labkit.exercises` run unchanged on this side, never in the student's
-process.
-
-A time limit is an exception of its own type, raised where it is detected:
-:class:`NotebookTimeout` when the submission's total time is used up,
-:class:`CellTimeout` when a cell, a request or one call of a student's
-function ran past its own limit. Callers tell them apart by type.
+:class:`NotebookHandle` starts the worker (:mod:`labkit.grading.sandbox.worker`) in the sandbox of the backend its
+:class:`Settings` name, reads its answers with a deadline and a size limit, and stops every process of the sandbox
+when it is done, stuck or misbehaving. :class:`Namespace` is the mapping the checks read: a function comes back
+as a :class:`Function` proxy that forwards each call into the sandbox, data as plain numbers, so the checks of
+:mod:`labkit.exercises` run unchanged here, never in the student's process. Time limits are types of their own:
+:class:`NotebookTimeout` (the submission's total time is used up) and :class:`CellTimeout` (one cell, request or
+call ran past its own limit).
 """
 
+import contextlib
 import secrets
 import subprocess
 import sys
@@ -59,8 +50,7 @@ class NotebookTimeout(WorkerTimeout):
 
 
 class StudentError(Exception):
-    """An exception the student's code raised in the sandbox (its type name in ``kind``), or one of its calls
-    that the grader ended (the subclasses below, each with its ``grader_kind``): either way it costs that call."""
+    """An exception of the student's code (type name in ``kind``), or a call the grader ended (the subclasses)."""
 
     grader_kind: str | None = None  # an exception the student's code raised: whatever its name, no kind of the grader's
 
@@ -72,18 +62,14 @@ class StudentError(Exception):
 
 
 class CallEnded(StudentError):
-    """A call of the student's function that its process never answered: the process ended (``os._exit``, a
-    signal, a resource limit) or could answer no more. The supervisor says so in an answer it marks as its own
-    (:func:`labkit.grading.sandbox.worker._grader_error`), never through an exception's name; the call costs only
-    itself, as the supervisor starts the notebook again for the next request (up to its restarts)."""
+    """A call its process never answered (it ended or could answer no more), said in the supervisor's marked
+    answer, never an exception's name; it costs only itself (the notebook restarts for the next request)."""
 
     grader_kind = CRASH  # the kind of a failed step (labkit.exercises.result.grader_kind)
 
 
 class Tampered(StudentError):
-    """A call whose answer the grader's watch cannot vouch for (the notebook switched it off, went round it or
-    wrote to its pipe): the supervisor's own marked answer, and the notebook's answers are void
-    (:attr:`NotebookHandle.tampered`)."""
+    """A call the watch cannot vouch for (switched off, gone round, its pipe written to): every answer is void."""
 
     grader_kind = TAMPERED
 
@@ -103,18 +89,14 @@ class Settings(Protocol):
     def total_timeout(self) -> float: ...  # seconds
 
 
-# benchmarks/bench_grading_styles.py only, set in its own process: calls ask for no refusal, so the watch has nothing
-# to watch (no profile hook, no switched-off functions). No option, variable or file of a grading run reaches it.
+# benchmarks/bench_grading_styles.py only, in its own process: no refusal asked. No option, variable or file sets it.
 _UNWATCHED = False
 MEMO_BYTES = 64 * 1024**2  # the calls whose answers a notebook's handle keeps, in bytes of the calls
 
 
 class NotebookHandle:
-    """One worker in the sandbox of the backend `options` name, until `deadline` (monotonic) at the latest.
-
-    `profiles` are what the watch refuses (:func:`labkit.grading.submission.refusals.wire`; none when
-    None), `passables` the functions the checks may hand to student code, by name.
-    """
+    """One worker in the sandbox `options` name, until `deadline` (monotonic); `profiles` are what the watch refuses
+    (:func:`labkit.grading.submission.refusals.wire`), `passables` what the checks may hand to student code."""
 
     def __init__(self, options: Settings, deadline=None, profiles=None, passables=()):
         self.options = options
@@ -139,18 +121,10 @@ class NotebookHandle:
                 self.box.close()
                 raise
         self._lines = protocol.Lines(self.process.stdout.fileno())  # each answer at most protocol.MAX_LINE
-        self.request(
-            {
-                "op": "setup",
-                "profiles": profiles if profiles is not None else {},
-                "passables": sorted(self.passables),
-            },
-            SETUP_TIMEOUT,
-        )
+        self.request({"op": "setup", "profiles": profiles or {}, "passables": sorted(self.passables)}, SETUP_TIMEOUT)
 
     def _forked(self):
-        """A worker from this process's fork server (:mod:`labkit.grading.sandbox.forkserver`), or None: there is no
-        server for this backend, or it could not give one (the notebook then gets a sandbox the plain way)."""
+        """A worker from this process's fork server, or None (then the notebook gets a sandbox the plain way)."""
         box = forkserver.box(self.backend, self.options.limits)
         if box is None:
             return None
@@ -177,11 +151,6 @@ class NotebookHandle:
             self.stopped = "the notebook ran out of memory"
             self.stopped_kind = CRASH
         self.box.close()
-        for pipe in (self.process.stdin, self.process.stdout):
-            try:
-                pipe.close()
-            except OSError:
-                pass
 
     def _stop(self, why, error=WorkerError):
         self.stopped, self.stopped_kind = why, error.grader_kind
@@ -212,9 +181,8 @@ class NotebookHandle:
                 return answer
 
     def answered(self, call, timeout):
-        """The answer to a call request: the notebook's earlier answer to the very same call (function, arguments,
-        refusal, functions handed over), else a new one. The checks of several parts call the student's function
-        on the same sizes; it is computed once per notebook. An answer the grader gave up on is never kept."""
+        """The answer to a call: the earlier answer to the very same call (parts call on the same sizes), else a
+        new one. An answer the grader gave up on is never kept."""
         key = protocol.dumps(call)
         if key not in self._answers:
             with timings.phase("calls"):
@@ -242,10 +210,8 @@ class NotebookHandle:
         except protocol.ProtocolError:
             self._stop("the notebook's process sent an answer larger than the protocol allows")
         if line is None:
-            try:
+            with contextlib.suppress(subprocess.TimeoutExpired):
                 self.process.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                pass
             self._stop(self._ended())
         return line
 
@@ -295,11 +261,8 @@ def _value(answer):
 
 
 class Namespace:
-    """The student's variables, read through the sandbox: the mapping the checks take.
-
-    :meth:`refusing` sets what is switched off for the functions read after it
-    (each part of an exercise says its own, :meth:`labkit.exercises.registry.Registry.check`).
-    """
+    """The student's variables, read through the sandbox: the mapping the checks take; :meth:`refusing` sets what
+    is switched off for the functions read after it."""
 
     def __init__(self, notebook, timeout=None):
         self.notebook = notebook

@@ -1,28 +1,14 @@
-"""The system calls a sandboxed notebook may not make: small seccomp filters, written out here.
+"""The system calls a sandboxed notebook may not make: small classic-BPF seccomp filters, written out here.
 
-The sandbox's filter (:func:`pipe_with_program`, for a backend that installs it from a descriptor) refuses:
-
-* ``memfd_create`` and ``memfd_secret``: anonymous files hold memory that
-  an address-space limit does not count;
-* ``add_key``, ``request_key`` and ``keyctl``: the kernel's keyrings outlive
-  the sandbox and are shared by every process of one uid, so one
-  submission could leave a key for the next one to read;
-* ``ptrace``, ``process_vm_readv`` and ``process_vm_writev``: no process of
-  the sandbox reads or writes another's memory;
-* new **threads** (``clone`` with ``CLONE_THREAD``; ``clone3``, whose flags
-  a filter cannot read, answers "not implemented", so the C library falls
-  back to ``clone``): the grading watch follows one thread, and a second one
-  would run unwatched.
-
-The notebook's process installs the same refusals again, with
-``rt_sigaction`` added, once it has set up its own signal handling
-(:func:`install_for_notebook`): so the notebook cannot install a signal
-handler that would interrupt the watch and see its frames, and the refusals
-hold whatever the sandbox backend, ``--sandbox none`` included.
-
-System calls of another architecture (32-bit calls on a 64-bit machine)
-are refused too: they would reach the same functions under other numbers.
-The filters are classic BPF, a few dozen instructions each.
+The sandbox's filter (:func:`pipe_with_program`) refuses ``memfd_create`` and ``memfd_secret`` (memory an
+address-space limit does not count); ``add_key``, ``request_key`` and ``keyctl`` (keyrings outlive the sandbox
+and are shared per uid: one submission could leave a key for the next); ``ptrace`` and ``process_vm_readv``/
+``writev`` (no reading or writing another process's memory); new threads (``clone`` with ``CLONE_THREAD``;
+``clone3``, whose flags a filter cannot read, gets "not implemented" so libc falls back to ``clone``): the watch
+follows one thread and a second would run unwatched. The notebook's process installs the same again plus
+``rt_sigaction`` (:func:`install_for_notebook`), so no signal handler can interrupt the watch and see its frames,
+whatever the backend (``--sandbox none`` included). Calls of another architecture are refused too: they reach
+the same functions under other numbers.
 """
 
 import errno
@@ -30,45 +16,24 @@ import os
 import platform
 import struct
 
-# numbers of the refused calls on the architectures the grader runs on
-SYSCALLS = {
-    "x86_64": {
-        "memfd_create": 319,
-        "memfd_secret": 447,
-        "add_key": 248,
-        "request_key": 249,
-        "keyctl": 250,
-        "ptrace": 101,
-        "process_vm_readv": 310,
-        "process_vm_writev": 311,
-        "clone": 56,
-        "clone3": 435,
-        "rt_sigaction": 13,
-    },
-    "aarch64": {
-        "memfd_create": 279,
-        "memfd_secret": 447,
-        "add_key": 217,
-        "request_key": 218,
-        "keyctl": 219,
-        "ptrace": 117,
-        "process_vm_readv": 270,
-        "process_vm_writev": 271,
-        "clone": 220,
-        "clone3": 435,
-        "rt_sigaction": 134,
-    },
-}
-SANDBOX = (
-    "memfd_create",
-    "memfd_secret",
-    "add_key",
-    "request_key",
-    "keyctl",
-    "ptrace",
-    "process_vm_readv",
-    "process_vm_writev",
-)
+# the refused calls' numbers on the architectures the grader runs on
+_TABLE = """
+name               x86_64  aarch64
+memfd_create       319     279
+memfd_secret       447     447
+add_key            248     217
+request_key        249     218
+keyctl             250     219
+ptrace             101     117
+process_vm_readv   310     270
+process_vm_writev  311     271
+clone              56      220
+clone3             435     435
+rt_sigaction       13      134
+"""
+_ROWS = [line.split() for line in _TABLE.strip().splitlines()]
+SYSCALLS = {machine: {row[0]: int(row[column]) for row in _ROWS[1:]} for column, machine in enumerate(_ROWS[0][1:], 1)}
+SANDBOX = tuple(row[0] for row in _ROWS[1:9])  # all but clone, clone3 and rt_sigaction
 AUDIT_ARCH = {"x86_64": 0xC000003E, "aarch64": 0xC00000B7}
 X32_BIT = 0x40000000  # x86_64's x32 calls: the same functions under numbers with this bit
 CLONE_THREAD = 0x00010000
@@ -83,10 +48,8 @@ def _instruction(code, jt, jf, k):
 
 
 def program(machine=None, deny=SANDBOX, threads=True):
-    """A filter as bytes (struct sock_filter[]), or None on an architecture it does not know.
-
-    `deny` are refused with EPERM; with `threads`, ``clone`` with ``CLONE_THREAD`` is refused with
-    EPERM and ``clone3`` with ENOSYS."""
+    """A filter as bytes (struct sock_filter[]), or None on an unknown architecture: `deny` get EPERM; with
+    `threads`, ``clone`` with ``CLONE_THREAD`` gets EPERM and ``clone3`` ENOSYS."""
     machine = machine or platform.machine()
     if machine not in SYSCALLS:
         return None
@@ -124,12 +87,8 @@ def pipe_with_program():
 
 
 def install_for_notebook():
-    """In the calling process, from now on: the sandbox's refusals and ``rt_sigaction`` too (True), or False
-    where this cannot be done.
-
-    Called by the notebook's process after it has set up its own timer's
-    handler and before any student code runs, so the refusals hold whatever
-    the sandbox backend."""
+    """From now on, the sandbox's refusals and ``rt_sigaction`` here (True), or False where that cannot be done.
+    The notebook's process calls it after its timer's handler is set and before any student code runs."""
     code = program(deny=SANDBOX + ("rt_sigaction",), threads=True)
     if code is None:
         return False

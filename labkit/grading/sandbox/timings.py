@@ -1,12 +1,8 @@
-"""Where a submission's grading time goes: seconds per phase, measured in the grading process (beside the
-sandbox's client, :mod:`labkit.grading.sandbox.remote`, which times the requests).
+"""Where a submission's grading time goes: seconds per phase, measured in the grading process.
 
-The grading process adds up the seconds of each phase (:func:`phase`):
-starting sandboxes, running the notebooks' cells, the checks' calls of
-student code, reading the student's variables, recognising known code, and
-the whole notebook. The class run keeps each submission's figures in its
-folder (``timings.json``) for the instructor and ``benchmarks/``; they are
-never part of a student's feedback.
+:func:`phase` adds up the seconds of starting sandboxes, running cells, the checks' calls and reads of student
+code, recognising known code and the whole notebook. The class run keeps them per submission
+(``timings.json``) for the instructor and ``benchmarks/``; they never reach a student's feedback.
 """
 
 import contextlib
@@ -47,8 +43,7 @@ def write_beside(result):
 
 
 def collect(work, out):
-    """Gather the figures the grading processes left in `work` into `out`/timings.json ({submission file stem:
-    figures}); nothing is written when there are none."""
+    """Gather the grading processes' figures in `work` into `out`/timings.json, by submission (if there are any)."""
     found = {}
     for path in sorted(Path(work).glob("*" + SUFFIX)):
         try:

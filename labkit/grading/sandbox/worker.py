@@ -1,38 +1,20 @@
 """The sandboxed side of grading: a pristine supervisor and the notebook's process it watches.
 
-Started by the grader as ``python -I -m labkit.grading.sandbox.worker [UID]`` inside the
-sandbox its backend made (:mod:`labkit.grading.sandbox.backends`); a backend that
-starts it as root gives the otherwise unused UID it is to become, so that
-the sandbox's process limit holds. Two processes:
+Run as ``python -I -m labkit.grading.sandbox.worker [UID]`` in a backend's sandbox; started as root it becomes
+UID, an otherwise unused uid, so the sandbox's process limit holds. The **supervisor** holds the grader's pipes,
+imports what notebooks need once and never runs a line of student code. It forks the **notebook's process**,
+which installs the watch (:mod:`labkit.grading.sandbox.guard`) before anything else, closes the grader's pipes,
+runs the cells and answers, through the supervisor, one JSON line per request (:mod:`.protocol`): ``setup``
+(what the watch refuses and the functions the checks may hand over; always first), ``run`` (the cells, each
+interrupted after ``cell_timeout``), ``names``, ``get`` and ``call`` (with a ``profile`` refused).
 
-* the **supervisor** holds the grader's pipes and never runs a line of the
-  student's code. It imports what notebooks need once, then forks
-* the **notebook's process**, which installs the watch
-  (:mod:`labkit.grading.sandbox.guard`) before anything else, closes the grader's
-  pipes, runs the cells and answers the grader's requests through the
-  supervisor.
-
-Requests, one JSON line each (:mod:`labkit.grading.sandbox.protocol`):
-
-* ``{"op": "setup", "profiles": {...}, "passables": [...]}``: what the watch
-  refuses (:func:`labkit.grading.submission.refusals.wire`) and the functions the
-  checks may hand to student code; the first request;
-* ``{"op": "run", "cells": [...], "cell_timeout": s}``: run the code cells
-  in an IPython shell, in order, each interrupted after ``s`` seconds;
-* ``{"op": "names", "names": [...]}``: which are functions, data or missing;
-* ``{"op": "get", "name": n, "timeout": s}``: a variable as plain numbers;
-* ``{"op": "call", "name": n, "args": [...], "profile": p, "passables": [...],
-  "timeout": s}``: call a function with the profile `p` refused.
-
-The supervisor forwards an answer only with the watch's valid attestation
-for that very request (its profile, the functions handed over, and a digest
-of the answer); it answers a refused call, tampering, a time limit or a dead
-notebook process itself. If the notebook's process dies (``os._exit``, a
-crash, a time limit), the next request starts a new one that runs the cells
-again, so one bad call costs only its own part. Everything said here is
-still only evidence: the grader checks it and computes every score itself.
+The supervisor forwards an answer only with the watch's valid attestation for that very request (its profile,
+the functions handed over, a digest of the answer); a refused call, tampering, a time limit or a dead notebook it
+answers itself. A dead notebook's process is replaced at the next request, which runs the cells again, so one
+bad call costs only its own part. All of it is evidence only: the grader checks it and computes every score.
 """
 
+import contextlib
 import hashlib
 import hmac
 import importlib
@@ -81,9 +63,8 @@ def _error(kind, message, refused=None):
 
 
 def _grader_error(kind, message):
-    """An error of the supervisor's own (the notebook died, was tampered with or ran out of time), marked as the
-    grader's: :func:`labkit.grading.sandbox.remote._value` trusts the mark, never the kind's name, which a student's
-    exception may share."""
+    """The supervisor's own error, marked as the grader's: the grader trusts the mark, never a kind's name, which a
+    student's exception may share."""
     answer = _error(kind, message)
     answer["error"]["grader"] = True
     return answer
@@ -101,8 +82,7 @@ def _describe(exc):
 
 
 def _tail(exc, lines=40):
-    """The last lines of an exception's traceback, as the student's cell would show them (the grader picks
-    the student's own frames from them, :func:`labkit.grading.submission.scoring._student_frames`)."""
+    """The last lines of an exception's traceback, as the student's cell would show them."""
     import traceback
 
     try:
@@ -193,10 +173,8 @@ class NotebookProcess:
 
 
 def _serve_one(notebook, reader, answers):
-    """Answer one request, between the sentinels the watch recognises (see :mod:`labkit.grading.sandbox.guard`).
-
-    The request is read only after the watch has started watching, so nothing
-    the notebook left behind sees a request's data unwatched."""
+    """Answer one request between the watch's sentinels; read only once the watch watches, so nothing the notebook
+    left behind sees a request's data unwatched."""
     handoff = {}
     sys.audit(guard.BEGIN)
     line = reader.readline()
@@ -220,25 +198,20 @@ def _serve(notebook, reader, answers):
         pass
 
 
-def _notebook_main(shell, key_fd, verdict_fd, requests_fd, answers_fd, profiles, passable_names):
-    """The notebook's process: its timer, no signal handlers of the notebook's own, the watch, then the
-    requests until the pipe closes."""
+def _notebook_main(shell, pipes, setup):
+    """The notebook's process: its timer, seccomp, the watch, then requests until the pipe closes."""
     os.setpgrp()  # the supervisor stops it and everything it starts at once
     output = _Counter()
     sys.stdout = sys.stderr = output
     sys.stdin = io.StringIO("")
     signal.signal(signal.SIGALRM, _alarm)
     seccomp.install_for_notebook()
-    passables = {name: protocol.passable(name) for name in passable_names}
-    guard.install(
-        os.read(key_fd, 32),
-        verdict_fd,
-        guard.unwire(profiles),
-        passables,
-        chain=(_serve_one.__code__, _serve.__code__, _notebook_main.__code__),
-    )
-    os.close(key_fd)
-    _serve(NotebookProcess(shell, output), protocol.Lines(requests_fd), answers_fd)
+    passables = {name: protocol.passable(name) for name in setup["passables"]}
+    key = pipes["key"][0]
+    chain = (_serve_one.__code__, _serve.__code__, _notebook_main.__code__)
+    guard.install(os.read(key, 32), pipes["verdict"][1], guard.unwire(setup["profiles"]), passables, chain=chain)
+    os.close(key)
+    _serve(NotebookProcess(shell, output), protocol.Lines(pipes["requests"][0]), pipes["answers"][1])
 
 
 # -- the supervisor -------------------------------------------------------------
@@ -285,15 +258,7 @@ class Supervisor:
                 os.close(self.answers)
                 for name, (read, write) in pipes.items():
                     os.close(write if name in ("key", "requests") else read)
-                _notebook_main(
-                    self.shell,
-                    pipes["key"][0],
-                    pipes["verdict"][1],
-                    pipes["requests"][0],
-                    pipes["answers"][1],
-                    self.setup["profiles"],
-                    self.setup["passables"],
-                )
+                _notebook_main(self.shell, pipes, self.setup)
             finally:
                 os._exit(0)
         for name, (read, write) in pipes.items():
@@ -311,10 +276,8 @@ class Supervisor:
     def stop(self, why=None):
         if self.child is None:
             return
-        try:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(self.child["pid"], signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
         _, status = os.waitpid(self.child["pid"], 0)
         for fd in (self.child["requests"], self.child["answers"].fd, self.child["verdicts"].fd):
             os.close(fd)
@@ -438,12 +401,8 @@ class Supervisor:
             )
         parts = mine[0]
         *fields, signature = parts if len(parts) == 6 else ([""] * 6)
-        if (fields[0], fields[1], fields[2], fields[4]) != (
-            expected[0],
-            expected[1],
-            expected[2],
-            expected[4],
-        ) or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
+        matches = [fields[i] for i in (0, 1, 2, 4)] == [expected[i] for i in (0, 1, 2, 4)]  # all but the status
+        if not matches or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
             return _grader_error(
                 "Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers"
             )
@@ -485,16 +444,14 @@ def not_dumpable():
 
 
 def preload(everything=False):
-    """What every notebook imports, once, in the supervisor: each notebook's process starts with it; with
-    `everything`, what the lab's notebooks import as well."""
+    """Import what every notebook needs (with `everything`, the lab's imports too) once; the shell to fork with."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot
     import numpy  # noqa: F401
 
-    # `import labkit` no longer loads scipy, but the watch learns the exact types of compiled routines
-    # (Cython's, f2py's) from the modules loaded when it is installed: scipy's must be among them
+    # the watch learns the exact types of compiled routines (Cython's, f2py's) from the modules loaded at install
     import scipy.linalg
     import scipy.spatial  # noqa: F401
     from IPython.core.interactiveshell import InteractiveShell
@@ -503,13 +460,10 @@ def preload(everything=False):
     import labkit
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
 
-    # what the lab's notebooks import too: paid once per fork server (labkit.grading.sandbox.zygote); a worker of its
-    # own would pay for them in the notebook's own time, whether its notebook imports them or not
+    # only in a fork server: a plain worker would pay for them in the notebook's time, imported or not
     for name in NOTEBOOK_IMPORTS if everything else ():
-        try:
+        with contextlib.suppress(ImportError):  # a course without the lab's extras still grades
             importlib.import_module(name)
-        except ImportError:  # a course without the lab's extras still grades
-            pass
 
     config = Config()
     config.HistoryManager.enabled = False
@@ -520,8 +474,8 @@ def preload(everything=False):
 
 
 def supervise(requests, answers, shell):
-    """Answer the grader on the descriptors `requests` and `answers` until it says bye; the student's code
-    gets /dev/null for 0, 1 and 2 and the working folder on its path, as in a kernel."""
+    """Answer the grader on `requests` and `answers` until bye; student code gets /dev/null for 0-2 and the working
+    folder on its path, as in a kernel."""
     given = (requests, answers)
     requests, answers = os.dup(requests), os.dup(answers)
     for fd in given:  # the student's code must not find a second copy of the grader's pipes
@@ -533,7 +487,7 @@ def supervise(requests, answers, shell):
     if null > 2:
         os.close(null)
     sys.path.insert(0, os.getcwd())
-    # the course module a rubric names, for the notebook's self-checks: shown by the sandbox, or without one where it is
+    # the course modules a rubric names, for the notebook's self-checks
     for folder in [protocol.COURSE_FOLDER, *os.environ.pop(protocol.COURSE_PATH, "").split(os.pathsep)]:
         if folder and os.path.isdir(folder):
             sys.path.append(folder)

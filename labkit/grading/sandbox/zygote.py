@@ -1,41 +1,22 @@
 """The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
 
-Started by the grader (:mod:`labkit.grading.sandbox.forkserver`) as
-``python -I -m labkit.grading.sandbox.zygote FD`` inside a sandbox its backend made
-(:meth:`labkit.grading.sandbox.backends.base.Backend.zygote_box`), with the
-capabilities to make namespaces and to change uid. It imports what notebooks
-need (:func:`labkit.grading.sandbox.worker.preload`), says ``ready`` on stdout and then
-waits on the socket `FD` for requests, one datagram each: a small JSON text
-(the notebook's uid and limits) and, passed along with it, the descriptors
-of the new worker (its requests and answers pipes, a control pipe, a status
-pipe and, where the grader made one, the files that put a process in the
-notebook's cgroup). It never reads a line of a notebook, and no student code
-ever runs in it.
+Run by :mod:`labkit.grading.sandbox.forkserver` as ``python -I -m labkit.grading.sandbox.zygote FD`` in a sandbox
+with the capabilities to make namespaces and change uid. It preloads (:func:`~.worker.preload`), says ``ready``
+and then takes requests on socket FD, one datagram each: JSON (the notebook's uid and limits) with the new
+worker's descriptors (requests, answers, control and status pipes, and the files that join the notebook's
+cgroup). It never reads a notebook and no student code runs in it.
 
-For each request it forks; the child (the notebook's **keeper**) makes what
-separates this notebook from every other one graded through the same
-server, before any student code exists:
-
-* new mount, network, IPC, UTS and PID namespaces;
-* fresh, empty tmpfs on ``/tmp``, the home folder and ``/dev/shm``, so no
-  file written by one notebook is ever seen by another;
-* a new ``/proc`` (read-only) that shows only this notebook's processes.
-
-The keeper then forks the **worker**, the first process of the new PID
-namespace: it joins the notebook's cgroup, takes the notebook's rlimits,
-closes every descriptor but its own pipes (the server's socket among them),
-becomes the notebook's own uid (which drops every capability), sets
-no-new-privileges and runs the worker's supervisor
-(:class:`labkit.grading.sandbox.worker.Supervisor`) with the imports it inherited.
-When the worker ends, the kernel ends every process of its namespace.
-
-The keeper stays outside, as root, running only this module's code: it
-writes ``S`` on the status pipe once the worker runs (or ``E`` and why it
-could not), waits for the worker to end or for the control pipe to close
-(the grader stopped the notebook, or died), kills the worker if it still
-runs, and writes its wait status.
+Per request it forks a **keeper**, which isolates the notebook before any student code exists: new mount,
+network, IPC, UTS and PID namespaces; empty tmpfs on ``/tmp``, the home folder and ``/dev/shm`` (no file of one
+notebook is seen by another); a read-only ``/proc`` of its own. The keeper forks the **worker**, the first
+process of the PID namespace (when it ends the kernel ends the whole namespace): it joins the cgroup, takes the
+rlimits, closes every descriptor but its pipes (the server's socket too), becomes the notebook's own uid (no
+capability left), sets no-new-privileges and runs the supervisor. The keeper stays outside as root running only
+this module: ``S`` on the status pipe once the worker runs (``E`` and why not), then it waits for the worker's
+end or the control pipe's closing (the grader is done or died), kills the worker and writes its wait status.
 """
 
+import contextlib
 import ctypes
 import json
 import os
@@ -79,8 +60,7 @@ def _mount(source, target, kind, flags, data=None):
 
 
 def isolate(limits, home, keep=()):
-    """In the keeper: new namespaces and empty private folders (see the module's description); the folders of
-    `keep` (the Python environment and labkit, read-only) that lie inside one are mounted back into it."""
+    """In the keeper: new namespaces and empty private folders; folders of `keep` inside one are mounted back."""
     _checked(_libc.unshare(CLONE_NEWNS | CLONE_NEWNET | CLONE_NEWIPC | CLONE_NEWUTS | CLONE_NEWPID), "unshare")
     _mount("none", "/", None, MS_REC | MS_PRIVATE)  # nothing mounted here reaches the server's view
     folders = [("/tmp", limits.tmp_size), (home, limits.home_size)]
@@ -107,6 +87,15 @@ def isolate(limits, home, keep=()):
     os.chdir(home)
 
 
+def _say_failed(fd, exc):
+    """Write ``E`` and why the worker could not start on the status pipe `fd`; False where it cannot be written."""
+    try:
+        os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+    except OSError:
+        return False
+    return True
+
+
 def _capabilities():
     """The worker's permitted, effective and ambient capability sets (from /proc/self/status), as numbers."""
     with open("/proc/self/status") as status:
@@ -115,15 +104,13 @@ def _capabilities():
 
 
 def _become_worker(fds, uid, limits):
-    """In the worker, as the first process of the new PID namespace: everything up to the student's uid, then
-    ``S`` on the status pipe (only then does the grader count on this worker)."""
+    """In the worker (pid 1 of its namespace): everything up to the student's uid, then ``S`` on the status pipe."""
     if uid <= 0:
         raise OSError(f"refusing to run a notebook as uid {uid}: a forked worker needs a uid of its own")
     _mount("proc", "/proc", "proc", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC)
     for fd in fds["cgroup"]:
         os.write(fd, b"0")  # 0: the writing process
-    # the worker's pipes at 3 and 4, its status pipe at 5, then nothing else: the server's socket, the
-    # keeper's control pipe, the cgroup files and any other descriptor close
+    # the worker's pipes at 3 and 4, its status pipe at 5; every other descriptor (the server's socket too) closes
     wanted = [fds["requests"], fds["answers"], fds["status"]]
     moved = [os.dup(fd) for fd in wanted]
     for index, fd in enumerate(moved):
@@ -160,7 +147,7 @@ def _keeper(fds, uid, limits, home, shell):
         isolate(limits, home, KEEP)
         pid = os.fork()
     except OSError as exc:
-        os.write(status, f"E{exc}"[:500].encode("utf-8", "replace"))
+        _say_failed(status, exc)
         os._exit(1)
     if pid == 0:
         code, running = 0, False
@@ -171,11 +158,8 @@ def _keeper(fds, uid, limits, home, shell):
         except BaseException as exc:  # noqa: BLE001 - the worker's end, whatever it is, is its status
             code = 1
             for fd in () if running else (FIRST_FD + 2, status):  # why it could not start, if it can still say
-                try:
-                    os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+                if _say_failed(fd, exc):
                     break
-                except OSError:
-                    continue
         os._exit(code)
     for name in ("requests", "answers"):
         os.close(fds[name])
@@ -195,15 +179,11 @@ def _keeper(fds, uid, limits, home, shell):
                 wait_status = found
                 break
         if control in ready:  # closed (or written to): the grader is done with this notebook
-            try:
+            with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
             _, wait_status = os.waitpid(pid, 0)
-    try:
+    with contextlib.suppress(OSError):  # the grader is gone
         os.write(status, f"W{wait_status}".encode())
-    except OSError:  # the grader is gone
-        pass
     os._exit(0)
 
 
@@ -253,10 +233,7 @@ def serve_forks(server, shell, home):
         try:
             pid = os.fork()
         except OSError as exc:
-            try:
-                os.write(named["status"], f"E{exc}"[:500].encode("utf-8", "replace"))
-            except OSError:
-                pass
+            _say_failed(named["status"], exc)
             pid = None
         if pid == 0:
             try:

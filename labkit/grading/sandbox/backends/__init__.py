@@ -1,26 +1,12 @@
 """Sandbox backends: where a student's notebook runs while it is graded.
 
-The rest of grading knows a backend only through :class:`~.base.Backend`
-(:mod:`labkit.grading.sandbox.backends.base`): whether it can run here, what to warn
-about once per run, and a :class:`~.base.Box` per notebook, which starts the
-grading worker inside the sandbox and cleans up after it. Everything a
-backend knows about its own tool lives in its own module, named after it:
-
-* :mod:`~labkit.grading.sandbox.backends.bwrap` - the default: bubblewrap namespaces,
-  a seccomp filter, rlimits and a memory cgroup, on this machine;
-* :mod:`~labkit.grading.sandbox.backends.none` - no sandbox of labkit's own, for
-  when something outside already isolates each submission (a Kubernetes pod
-  or a batch job's container of its own); it warns that student code runs
-  unconfined.
-
-A Docker or podman backend must be one new module: ``backends/<name>.py``
-with a :class:`~.base.Backend` subclass whose ``name`` is ``<name>``,
-decorated with :func:`register`. :data:`BUILTIN` is read from the package's
-modules, so nothing else in labkit changes: ``labkit grade --sandbox <name>`` and
-:class:`labkit.grading.options.GradeOptions` take their choices from here.
-A backend registered from a module outside labkit (a test's, a site's own)
-works too: each grading process imports the module that registered it
-(:func:`origin`, :func:`import_origin`).
+Grading knows a backend only through :class:`~.base.Backend`: whether it can run here, a warning once per run,
+and a :class:`~.base.Box` per notebook that starts the worker in the sandbox and cleans up after it. Built in:
+``bwrap`` (the default: namespaces, seccomp, rlimits and a memory cgroup) and ``none`` (no sandbox of labkit's
+own, for submissions already isolated outside, e.g. a pod each; it warns). A new backend (Docker, podman) is one
+module ``backends/<name>.py`` with a :func:`register`-ed subclass named ``<name>``: :data:`BUILTIN` is read from
+the package, so ``labkit grade --sandbox`` and GradeOptions take it. A backend registered outside labkit works
+too: each grading process imports its module (:func:`origin`, :func:`import_origin`).
 """
 
 import importlib

@@ -1,27 +1,15 @@
 """What every sandbox backend provides, and what backends share.
 
-The grader's handle on a notebook (:class:`labkit.grading.sandbox.remote.NotebookHandle`)
-and a grading run (:func:`labkit.grading.run.classrun.grade`) use a backend only
-through :class:`Backend`:
-
-* :meth:`Backend.available` raises :class:`SandboxUnavailable`, saying what
-  to do, when the backend cannot run sandboxes on this machine; a grading
-  run asks once, before anything is graded;
-* :meth:`Backend.warning` is printed on stderr once per run, when there is
-  something the instructor must know (student code running unconfined);
-* :meth:`Backend.box` makes one notebook's :class:`Box` from the worker's
-  command (``python -I -m labkit.grading.sandbox.worker``) and the notebook's
-  :class:`Limits`: the command that starts the worker inside the sandbox,
-  and whatever has to be set up for it and undone after it.
-
-:class:`Box` runs the command as a local process in a session of its own,
-in a memory cgroup of its own where one can be made
-(:mod:`labkit.grading.sandbox.cgroup`), under the rlimits of :class:`Limits`
-(:func:`apply_limits`); a backend whose sandbox lives elsewhere (a
-container engine) overrides :meth:`Box.start` and :meth:`Box.stop`.
+Grading uses a backend only through :class:`Backend`: :meth:`~Backend.available` raises
+:class:`SandboxUnavailable` (saying what to do) once before a run, :meth:`~Backend.warning` is printed once per
+run, and :meth:`~Backend.box` makes one notebook's :class:`Box` from the worker's command and its
+:class:`Limits`. A :class:`Box` runs the command in a session of its own, in a memory cgroup of its own where one
+can be made (:mod:`labkit.grading.sandbox.cgroup`) and under the rlimits (:func:`apply_limits`); a backend whose
+sandbox lives elsewhere overrides :meth:`Box.start` and :meth:`Box.stop`.
 """
 
 import abc
+import contextlib
 import os
 import resource
 import signal
@@ -85,10 +73,8 @@ COURSE_FOLDER = protocol.COURSE_FOLDER
 
 
 def course_mounts():
-    """(the course module's file or package folder, where the sandbox shows it) for every course module whose
-    exercises this process grades (:data:`labkit.exercises.registry.COURSES`) and that the Python environment
-    does not hold already. Only the module itself is shown, never the folder around it (where the course
-    keeps its submissions and grades)."""
+    """(course module's file or package, where the sandbox shows it) for each course module graded here and not in
+    the environment: only the module, never the folder around it (with the course's submissions and grades)."""
     from ....exercises.registry import COURSES
 
     environment = environment_paths()
@@ -105,10 +91,8 @@ def processes_of_this_user():
     count = 0
     for entry in os.scandir("/proc"):
         if entry.name.isdigit():
-            try:
+            with contextlib.suppress(OSError):
                 count += entry.stat().st_uid == uid
-            except OSError:
-                pass
     return count
 
 
@@ -123,14 +107,9 @@ def remove_tree(path):
 
 
 class Box:
-    """One notebook's sandbox, from the start of its worker to the cleanup after it.
-
-    `argv` starts the worker inside the sandbox, with `cwd` and `env` (the
-    grader's when None) and the descriptors `pass_fds`, which are closed on
-    this side once the worker has them. `processes_base` processes are
-    already counted against the sandbox's process limit (those of its uid
-    outside it). `cleanup` is called once, after the worker is stopped.
-    """
+    """One notebook's sandbox, from its worker's start to the cleanup: `argv` runs with `cwd`, `env` (the grader's
+    when None) and `pass_fds` (closed here once passed); `processes_base` processes of its uid already count
+    against the process limit; `cleanup` runs once after the worker is stopped."""
 
     def __init__(self, argv, limits, *, cwd=None, env=None, pass_fds=(), processes_base=0, cleanup=None):
         self.argv, self.limits, self.cwd, self.env = list(argv), limits, cwd, env
@@ -166,10 +145,8 @@ class Box:
 
     def _close_passed(self):
         for fd in self.pass_fds:
-            try:
+            with contextlib.suppress(OSError):
                 os.close(fd)
-            except OSError:
-                pass
         self.pass_fds = ()
 
     def stop(self):
@@ -192,11 +169,14 @@ class Box:
         return self.cgroup.peak() if self.cgroup is not None else None
 
     def close(self):
-        """After :meth:`stop`: undo what was set up for this notebook (nothing of it is left on the machine)."""
+        """After :meth:`stop`: close the worker's pipes and undo what was set up for it (nothing is left behind)."""
         if self.closed:
             return
         self.closed = True
         self._close_passed()
+        for pipe in (self.process.stdin, self.process.stdout) if self.process is not None else ():
+            with contextlib.suppress(OSError):
+                pipe.close()
         if self.cgroup is not None:
             self.cgroup.remove()
         if self._cleanup is not None:
@@ -222,12 +202,8 @@ class Backend(abc.ABC):
         """The :class:`Box` that runs the worker's command `argv` in a new sandbox bounded by `limits`."""
 
     def zygote_box(self, argv, limits, pass_fds):
-        """The :class:`Box` of a fork server (:mod:`labkit.grading.sandbox.forkserver`), or None: this backend
-        offers none, and every notebook gets a sandbox of its own from :meth:`box`.
-
-        The server runs `argv` with the descriptors `pass_fds`, and must be
-        able to make namespaces, mount and change uid for the workers it
-        forks (:mod:`labkit.grading.sandbox.zygote`)."""
+        """The :class:`Box` of a fork server running `argv` with `pass_fds`, able to make namespaces, mount and change
+        uid (:mod:`labkit.grading.sandbox.zygote`); None: no server, each notebook gets :meth:`box`."""
         return None
 
     def notebook_uid(self):

@@ -1,31 +1,13 @@
 """The default backend: a bubblewrap sandbox on this machine.
 
-:func:`command` builds the ``bwrap`` command line for one notebook:
-
-* a new, empty root: the system (``/usr``, ``/etc``) and the Python
-  environment (its prefixes and labkit's own package folder) mounted
-  read-only, nothing else of the machine (no other home folders, no course
-  folder, no instructor notebooks, no output folder, no other submission);
-* ``HOME`` (the working directory) and ``/tmp``: small private tmpfs of
-  their own, the only writable places; they live in the sandbox's mount
-  namespace and vanish with it, so nothing the notebook writes is left on
-  the machine and there is nothing to clean up;
-* ``/proc`` of its own, read-only (no process writes its own memory
-  through ``/proc/self/mem``); a minimal ``/dev``;
-* a seccomp filter (:mod:`labkit.grading.sandbox.seccomp`, handed to ``bwrap
-  --seccomp`` through a pipe): no anonymous memory files, no kernel
-  keyrings, no reading or writing another process's memory;
-* no network (``--unshare-net``: only a loopback of its own), its own PID,
-  IPC and UTS namespaces, a new session (no terminal to inject into), and
-  ``--die-with-parent``, so every process of the notebook dies with the grader;
-* all capabilities dropped but the two the worker needs to give up root
-  (it then runs as an otherwise unused uid, :func:`sandbox_uid`, given on
-  its command line, so the process limit holds).
-
-:class:`Bubblewrap` is the backend: its :class:`~.base.Box` adds a memory
-cgroup around the whole sandbox where it can (:mod:`labkit.grading.sandbox.cgroup`)
-and sets the rlimits in the child before ``bwrap`` starts
-(:func:`~.base.apply_limits`); they are inherited by everything inside.
+:func:`command` builds one notebook's ``bwrap`` command line: a new empty root with only ``/usr``, ``/etc`` and
+the Python environment read-only (no other home, course, instructor or submission folder); ``HOME`` and
+``/tmp`` as small private tmpfs, the only writable places, gone with the sandbox; a read-only ``/proc`` of its
+own (no writing one's memory through ``/proc/self/mem``) and a minimal ``/dev``; the seccomp filter
+(:mod:`labkit.grading.sandbox.seccomp`, on a pipe); no network, its own PID, IPC and UTS namespaces, a new
+session (no terminal to inject into) and ``--die-with-parent``; every capability dropped but the two the worker
+needs to become an otherwise unused uid (:func:`sandbox_uid`, so the process limit holds). The rlimits are set
+before ``bwrap`` starts and a memory cgroup surrounds it where one can be made.
 """
 
 import itertools
@@ -69,12 +51,8 @@ _FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def sandbox_uid():
-    """An unused uid for this grading process's sandboxes (0 when not root: bwrap maps the caller's).
-
-    Sandboxes graded at the same time come from different processes, so they
-    get different uids (one per process id) and one notebook's processes
-    never count against another's limit.
-    """
+    """An unused uid for this process's sandboxes (0 when not root: bwrap maps the caller's); one per process id, so
+    no notebook's processes count against another's limit."""
     return 100_000 + os.getpid() if os.geteuid() == 0 else 0
 
 
@@ -171,9 +149,7 @@ class Bubblewrap(Backend):
         return _box([*argv, str(uid)], limits, processes_base=0 if uid else processes_of_this_user())
 
     def zygote_box(self, argv, limits, pass_fds):
-        """As root: a fork server in a sandbox like every notebook's (see :mod:`labkit.grading.sandbox.zygote`).
-
-        Not as another user: its workers could not each get a uid of their own."""
+        """As root only (else its workers could not each get a uid of their own): a fork server sandboxed alike."""
         return _box(list(argv), limits, pass_fds, zygote=True) if os.geteuid() == 0 else None
 
     def notebook_uid(self):

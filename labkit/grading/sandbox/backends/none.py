@@ -1,16 +1,9 @@
 """No sandbox of labkit's own: for when each submission is already isolated outside labkit.
 
-Meant for grading where the outer system already isolates each submission:
-one ``labkit grade`` per submission, each in a container of its own that is
-thrown away afterwards (a Kubernetes pod, a batch job's container), the runs
-combined with ``labkit merge``. That container is the sandbox. The
-worker then runs as a plain process in
-a session of its own, with a private temporary folder as its home and
-working directory (removed afterwards, whatever the notebook left in it),
-the same rlimits and, where one can be made, the same memory cgroup as in
-a sandbox. The refusals of the notebook's own process (its seccomp filter
-and the grader's watch) hold too. Everything else is open: student code
-runs with the grader's permissions, so every run starts with
+For one ``labkit grade`` per submission in a throw-away container (a Kubernetes pod, a batch job), combined with
+``labkit merge``: the container is the sandbox. The worker runs as a plain process in a session of its own with
+a private temporary home (removed afterwards), the same rlimits and memory cgroup where one can be made; the
+notebook's seccomp filter and the grader's watch hold too. Everything else is open, so every run starts with
 :data:`WARNING` on stderr.
 """
 
