@@ -102,7 +102,7 @@ def _on(engine, planned, progress, arrived):
                 arrived(outcome.grade)
                 bar.advance()
     finally:
-        timings.collect(work, planned.out)  # where each submission's grading time went (never in its feedback)
+        store.write_timings(planned.out, timings.collect(work))  # where each submission's time went (not feedback)
         shutil.rmtree(work, ignore_errors=True)
     return graded, peaks
 

@@ -2,7 +2,7 @@
 
 :func:`phase` adds up the seconds of starting sandboxes, running cells, the checks' calls and reads of student
 code, recognising known code and the whole notebook. The class run keeps them per submission
-(``timings.json``) for the instructor and ``benchmarks/``; they never reach a student's feedback.
+(the store's ``timings.json``) for the instructor and ``benchmarks/``; they never reach a student's feedback.
 """
 
 import contextlib
@@ -42,13 +42,12 @@ def write_beside(result):
     Path(result).with_suffix(SUFFIX).write_text(json.dumps(taken()), encoding="utf-8")
 
 
-def collect(work, out):
-    """Gather the grading processes' figures in `work` into `out`/timings.json, by submission (if there are any)."""
+def collect(work):
+    """The grading processes' figures in `work`, by submission: {result file's stem: :func:`taken`}."""
     found = {}
     for path in sorted(Path(work).glob("*" + SUFFIX)):
         try:
             found[path.name[: -len(SUFFIX)]] = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
-    if found:
-        (Path(out) / "timings.json").write_text(json.dumps(found, indent=1), encoding="utf-8")
+    return found

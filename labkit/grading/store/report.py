@@ -218,6 +218,12 @@ def write_seed(out_dir: str | Path, seeds: int | list[int] | None) -> None:
     (Path(out_dir) / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")
 
 
+def write_timings(out_dir: str | Path, found: dict) -> None:
+    """timings.json: where each submission's grading time went, by phase (only when something was measured)."""
+    if found:
+        (Path(out_dir) / "timings.json").write_text(json.dumps(found, indent=1), encoding="utf-8")
+
+
 def write_run(out_dir: str | Path, summary: dict) -> None:
     """run.json: how the run went (its seed, counts, time and the engine's record)."""
     (Path(out_dir) / "run.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
