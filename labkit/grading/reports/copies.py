@@ -1,8 +1,6 @@
-"""Copies named plainly, for the instructor's class report (never for a student): pairs of students whose graded
-functions look alike, one row per pair; whose data a notebook of another variant holds; and submissions that
-hold the instructor notebooks' solution markers.
-
-Nothing here changes a grade: it tells a person where to look.
+"""Copies named plainly, for the instructor's class report (never a grade, never a student): pairs of students
+whose graded functions look alike, whose data a notebook of another variant holds, and submissions that hold
+the instructor notebooks' solution markers.
 """
 
 from __future__ import annotations
@@ -30,12 +28,12 @@ class PairRow:
 
 @dataclass
 class Copies:
-    """What the class report says about copies: each student's graded functions, whose data a notebook holds
-    ("fermat holds ada's data for exercises 4, 7, 14"), and the submissions with solution markers."""
+    """What the class report says about copies: {submission: frozenset of its graded functions}, (holder, whose
+    data or "" for no classmate, exercises), and (submission, functions holding a solution marker)."""
 
-    functions: dict = field(default_factory=dict)  # submission -> frozenset of the graded functions it defines
-    holders: list = field(default_factory=list)  # (holder, whose, exercises), whose "" for no classmate
-    marked: list = field(default_factory=list)  # (submission, functions holding a solution marker)
+    functions: dict = field(default_factory=dict)
+    holders: list = field(default_factory=list)
+    marked: list = field(default_factory=list)
 
     def holder_lines(self):
         """One line per notebook holding another's data, as the report shows it."""
@@ -93,10 +91,8 @@ def pair_rows(pairs, functions) -> list[PairRow]:
     grouped = defaultdict(list)
     for pair in pairs:
         grouped[tuple(sorted((pair.first, pair.second)))].append(pair)
+    both = {pair: len(functions.get(pair[0], set()) & functions.get(pair[1], set())) for pair in grouped}
     rows = [
-        PairRow(
-            a, b, tuple(sorted(found, key=lambda p: -p.score)), len(functions.get(a, set()) & functions.get(b, set()))
-        )
-        for (a, b), found in grouped.items()
+        PairRow(a, b, tuple(sorted(found, key=lambda p: -p.score)), both[a, b]) for (a, b), found in grouped.items()
     ]
     return sorted(rows, key=lambda r: (-len(r.alike), -max(p.score for p in r.alike), r.first, r.second))

@@ -171,43 +171,27 @@ def _as_comprehensions(body):
 def _folded(start, loop):
     """``xs = [e for v in it if c]`` for ``xs = []`` and ``for v in it: (if c:) xs.append(e)``, ``s = sum([e for v
     in it])`` for ``s = 0`` and ``for v in it: s = s + e``; else None."""
-    if not (isinstance(start, ast.Assign) and len(start.targets) == 1 and isinstance(start.targets[0], ast.Name)):
-        return None
-    if not isinstance(loop, ast.For) or loop.orelse or len(loop.body) != 1:
-        return None
-    name, step, conditions = start.targets[0].id, loop.body[0], []
+    match start, loop:
+        case ast.Assign(targets=[ast.Name(id=name)], value=first), ast.For(body=[step], orelse=[]):
+            conditions = []
+        case _:
+            return None
     if isinstance(step, ast.If) and not step.orelse and len(step.body) == 1:
         conditions, step = [step.test], step.body[0]
-    element = _appended(step, name) if isinstance(start.value, ast.List) and not start.value.elts else None
-    total = _added(step, name) if _zero(start.value) and element is None else None
-    if element is None and total is None:
-        return None
     generator = ast.comprehension(target=loop.target, iter=loop.iter, ifs=conditions, is_async=0)
-    made = ast.ListComp(elt=element if element is not None else total, generators=[generator])
-    value = made if element is not None else ast.Call(func=ast.Name(id="sum", ctx=ast.Load()), args=[made], keywords=[])
+    match first, step:
+        case ast.List(elts=[]), ast.Expr(
+            value=ast.Call(func=ast.Attribute(value=ast.Name(id=owner), attr="append"), args=[element], keywords=[])
+        ) if owner == name:
+            value = ast.ListComp(elt=element, generators=[generator])
+        case ast.Constant(value=zero), ast.Assign(
+            targets=[ast.Name(id=owner)], value=ast.BinOp(left=ast.Name(id=left), op=ast.Add(), right=element)
+        ) if type(zero) in (int, float) and zero == 0 and owner == left == name:
+            made = ast.ListComp(elt=element, generators=[generator])
+            value = ast.Call(func=ast.Name(id="sum", ctx=ast.Load()), args=[made], keywords=[])
+        case _:
+            return None
     return ast.Assign(targets=[ast.Name(id=name, ctx=ast.Store())], value=value)
-
-
-def _appended(step, name):
-    """`e` of ``name.append(e)``, else None."""
-    call = step.value if isinstance(step, ast.Expr) else None
-    if isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute) and call.func.attr == "append":
-        if _named(call.func.value, {name}) and len(call.args) == 1 and not call.keywords:
-            return call.args[0]
-    return None
-
-
-def _added(step, name):
-    """`e` of ``name = name + e`` (``name += e`` is already written so), else None."""
-    if isinstance(step, ast.Assign) and len(step.targets) == 1 and _named(step.targets[0], {name}):
-        value = step.value
-        if isinstance(value, ast.BinOp) and isinstance(value.op, ast.Add) and _named(value.left, {name}):
-            return value.right
-    return None
-
-
-def _zero(node):
-    return isinstance(node, ast.Constant) and type(node.value) in (int, float) and node.value == 0
 
 
 def units(definitions):
@@ -222,10 +206,8 @@ def units(definitions):
     ['K.g']
     """
     definitions = list(definitions)
-    trees = [parse(text) for _, text in definitions]
-    namespaces = frozenset(
-        n.name for tree in trees if tree is not None for n in tree.body if isinstance(n, ast.ClassDef)
-    )
+    trees = [tree for _, text in definitions if (tree := parse(text)) is not None]
+    namespaces = frozenset(n.name for tree in trees for n in tree.body if isinstance(n, ast.ClassDef))
     return [unit for name, text in definitions for unit in _split(name, text, namespaces)]
 
 
