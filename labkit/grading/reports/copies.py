@@ -1,7 +1,5 @@
-"""Copies named plainly, for the instructor's class report (never a grade, never a student): pairs of students
-whose graded functions look alike, whose data a notebook of another variant holds, and submissions that hold
-the instructor notebooks' solution markers.
-"""
+"""Copies named plainly for the instructor's class report, never changing a grade: students whose graded
+functions look alike, whose data a notebook of another variant holds, and solution markers handed in."""
 
 from __future__ import annotations
 
@@ -49,26 +47,24 @@ def find(grades, students=None, registry=None) -> Copies:
     """The copies of a class: `students` is the run's record of each student's variant data ({name: {exercise:
     {parameter: value}}}), empty for a run without variants."""
     graded = [g for g in grades if g.graded]
-    functions = {g.name: frozenset(g.sources) for g in graded}
+    registry = registry or (graded[0].rubric.registry if graded else None)
+    found = defaultdict(list)  # (holder, whose data) -> exercises
+    for grade in graded:
+        for number, verdict in sorted(grade.results.items()):
+            other = verdict.get("other_variant") if isinstance(verdict, dict) else None
+            if other and registry is not None and number in registry.exercises:
+                whose = _whose(grade.name, registry.exercises[number], other, students or {})
+                found[(grade.name, ", ".join(whose))].append(number)
     marked = [(g.name, tuple(sorted(f for f, s in g.sources.items() if _marked(s)))) for g in graded]
-    holders = _holders(graded, students or {}, registry or (graded[0].rubric.registry if graded else None))
-    return Copies(functions, holders, [(name, found) for name, found in marked if found])
+    return Copies(
+        {g.name: frozenset(g.sources) for g in graded},
+        [(holder, whose, tuple(numbers)) for (holder, whose), numbers in sorted(found.items())],
+        [(name, functions) for name, functions in marked if functions],
+    )
 
 
 def _marked(source):
     return any(marker in str(source) for marker in SOLUTION_MARKERS)
-
-
-def _holders(grades, students, registry):
-    """(holder, whose data, exercises) for each notebook holding data of another variant."""
-    found = defaultdict(list)  # (holder, whose) -> exercises
-    for grade in grades:
-        for number, verdict in sorted(grade.results.items()):
-            other = (verdict or {}).get("other_variant") if isinstance(verdict, dict) else None
-            if other and registry is not None and number in registry.exercises:
-                whose = _whose(grade.name, registry.exercises[number], other, students)
-                found[(grade.name, ", ".join(whose))].append(number)
-    return [(holder, whose, tuple(numbers)) for (holder, whose), numbers in sorted(found.items())]
 
 
 def _whose(name, exercise, other, students):
@@ -86,8 +82,7 @@ def _whose(name, exercise, other, students):
 
 
 def pair_rows(pairs, functions) -> list[PairRow]:
-    """The similar pairs grouped by the two students, most functions alike first (`functions`: each
-    submission's graded functions, :attr:`Copies.functions`)."""
+    """The similar pairs grouped by the two students, most alike first (`functions`: :attr:`Copies.functions`)."""
     grouped = defaultdict(list)
     for pair in pairs:
         grouped[tuple(sorted((pair.first, pair.second)))].append(pair)

@@ -28,8 +28,8 @@ COMMON_MIN = 5  # of them is the class's common code, set aside like the release
 
 @dataclass(frozen=True)
 class Pair:
-    """Two submissions' versions of one graded `function` that look alike: `score` (0..1) is how much of the
-    code is shared, the lines are the two sources' and ``shared_*`` the 0-based numbers of those shared."""
+    """Two submissions' alike versions of a `function`: `score` (0..1) is how much is shared, ``shared_*``
+    the 0-based numbers of the shared lines."""
 
     function: str
     first: str
@@ -43,8 +43,7 @@ class Pair:
 
 @dataclass(frozen=True)
 class Boilerplate:
-    """What a release gives every student: the sorted hashes of every fingerprint-sized run of its code, and
-    its lines, stripped (a stub's ``def`` line is never marked as shared)."""
+    """What a release gives everyone: hashes of its code, and its stripped lines (a stub's never shared)."""
 
     hashes: np.ndarray
     lines: frozenset
@@ -136,8 +135,7 @@ def _by_function(grades) -> dict:
 
 
 def _clean(text):
-    """A source as the pairs show it: one kind of line end, printable, at most MAX_SOURCE_CHARS characters
-    (fingerprinted once)."""
+    """A source as the pairs show it: one kind of line end, printable, at most MAX_SOURCE_CHARS characters."""
     text = str(text)[: 2 * MAX_SOURCE_CHARS].replace("\r\n", "\n").replace("\r", "\n")
     return printable(text)[:MAX_SOURCE_CHARS]
 
@@ -155,7 +153,7 @@ def boilerplate(release=None) -> Boilerplate:
     if isinstance(release, (str, os.PathLike)):
         from ..submission.scoring import submission_notebooks
 
-        return _boilerplate_of(_notebook_code(submission_notebooks(release)))
+        release = _notebook_code(submission_notebooks(release))
     try:
         texts = list(release)
     except TypeError:
@@ -164,14 +162,16 @@ def boilerplate(release=None) -> Boilerplate:
         raise InputError(
             f"release must be a folder of notebooks, a notebook, or a list of code texts; got {release!r:.100}."
         )
-    return _boilerplate_of(texts)
+    texts = [_clean(text) for text in texts]
+    lines = frozenset(line.strip() for text in texts for line in text.split("\n") if line.strip())
+    return Boilerplate(fingerprint.release_grams(texts, rewrite=str), lines)
 
 
 @functools.cache
 def _packaged():
     from ...student_notebooks import paths
 
-    return _boilerplate_of(_notebook_code([Path(str(p)) for p in paths()]))
+    return boilerplate(_notebook_code([Path(str(p)) for p in paths()]))
 
 
 def _notebook_code(paths):
@@ -186,12 +186,6 @@ def _notebook_code(paths):
     return code
 
 
-def _boilerplate_of(texts):
-    texts = [_clean(text) for text in texts]
-    lines = frozenset(line.strip() for text in texts for line in text.split("\n") if line.strip())
-    return Boilerplate(fingerprint.release_grams(texts, rewrite=str), lines)
-
-
 def _version(name, text, given):
     """The :class:`_Version` of a source without the hashes `given`; None when nothing is left."""
     version = _Version(name, text, *fingerprint.own(text, given))
@@ -199,8 +193,7 @@ def _version(name, text, given):
 
 
 def shares(versions) -> np.ndarray:
-    """``S[i, j]``: the share of version i's fingerprinted code that fingerprints j has too cover (zero on
-    the diagonal), from an index of which versions have each fingerprint."""
+    """``S[i, j]``: the share of version i's fingerprinted code that fingerprints j has too cover (0 if i == j)."""
     from scipy import sparse
 
     sizes = [v.hashes.size for v in versions]
@@ -219,8 +212,7 @@ def shares(versions) -> np.ndarray:
 
 
 def _function_pairs(function, versions, given, threshold):
-    """The pairs of one function's versions [(submission, source)] at `threshold` or more, without the
-    class's common code (and the versions it leaves empty)."""
+    """The pairs of one function's versions [(submission, source)] at `threshold` or more, common code aside."""
     kept = [v for v in (_version(name, text, given.hashes) for name, text in versions) if v is not None]
     distinct = np.concatenate([np.unique(v.hashes) for v in kept]) if kept else np.zeros(0, np.uint64)
     hashes, counts = np.unique(distinct, return_counts=True)

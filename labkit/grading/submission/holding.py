@@ -29,9 +29,8 @@ def judge_plain(check, part, code, graded, judge):
 
 
 def hold_dependents(results, registry, code, graded, rescore):
-    """Hold, in `results` ({exercise: verdict} of one notebook), every passed part whose code reaches a held
-    definition, and fail every one that reaches one of the `graded` names a string run as code may have
-    defined; `rescore` (verdict, registry) counts an exercise's points again."""
+    """Hold, in `results` ({exercise: verdict}), every passed part whose code reaches a held definition, and
+    fail those reaching a `graded` name a string run as code may have defined; `rescore` (verdict, registry)."""
     held = {}  # name: its held match, for the held parts' graded names and the copies
     for number, verdict in results.items():
         for part, check in zip(registry.exercises[number].parts, verdict["checks"]):
@@ -49,7 +48,13 @@ def hold_dependents(results, registry, code, graded, rescore):
         for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
             if not check.get("passed") or check.get("held"):
                 continue
-            names = _reaches(part, code) - set(part.scanned)
+            try:
+                names = set(part.uses) | scan.drawn_with(
+                    code, _read(part) + [n for n in part.scanned if n.isidentifier()]
+                )
+            except scan.Unreadable:
+                names = set(part.uses)
+            names -= set(part.scanned)
             on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
             if on_held:
                 verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
@@ -57,13 +62,6 @@ def hold_dependents(results, registry, code, graded, rescore):
                 verdict["checks"][index] = _refused_with(check, on_string[0], strung[on_string[0]])
         rescore(verdict, registry)
     return results
-
-
-def _reaches(part, code):
-    try:
-        return set(part.uses) | scan.drawn_with(code, _read(part) + [n for n in part.scanned if n.isidentifier()])
-    except scan.Unreadable:
-        return set(part.uses)
 
 
 def _held_with(check, name, held):
@@ -78,8 +76,7 @@ def _held_with(check, name, held):
 
 
 def run_from_a_string(check, findings):
-    """The part's check, failed: a graded name may have been defined by code run from a string
-    (:func:`labkit.grading.submission.scan.run_strings` `findings`), which the grader cannot read."""
+    """The part's check, failed: a graded name may have been defined by code run from a string (`findings`)."""
     name, _, why = findings[0]
     return _refused_with(check, name, why, step="its code can be read")
 

@@ -33,8 +33,7 @@ VERSION = "labkit-known/5"  # the cache's format and normalisation: a change her
 
 @dataclass(frozen=True)
 class Unit:
-    """One function or method of a known source, lines 1-based and inclusive; `text` is a notebook's
-    definition itself (a module's is read from its file when shown)."""
+    """A known function or method, lines 1-based; `text` a notebook's (a module's is read when shown)."""
 
     name: str  # as the feedback names it: labkit.piecewise.eval_pherm, scipy.interpolate._cubic.pchip...
     path: str
@@ -60,8 +59,7 @@ class Corpus:
 
 
 def _definitions(text, prefix, source=None):
-    """[name, first line, last line, its text] of each top-level function and method of a top-level class of
-    `text` (parsed from `source`, a file's bytes, when given)."""
+    """[name, first line, last line, text] of each function and class method of `text` (or bytes `source`)."""
     try:
         tree = ast.parse(text if source is None else source)
     except (SyntaxError, ValueError):
@@ -85,8 +83,7 @@ def _tokeniser():
 
 
 def _cached(name, raw, compute):
-    """``(compute(), key)``: JSON data kept between runs (in ``$LABKIT_CACHE`` or the user's cache) under `key`,
-    the SHA-256 of `raw`, its `name`, :data:`VERSION` and pygments' version."""
+    """``(compute(), key)``: JSON data cached under `key`, the SHA-256 of `raw`, `name` and the versions."""
     key = hashlib.sha256(f"{_tokeniser()}\0{name}\0".encode() + raw).hexdigest()
     cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     folder = Path(os.environ.get("LABKIT_CACHE") or os.path.join(cache, "labkit")) / "known"
@@ -138,8 +135,7 @@ def _notebook_entry(name, cells):
 
 
 def known_modules(refusals):
-    """(module, file) of every Python source a student has that the lab's answers are in: labkit's library
-    (its grader left out: it holds no answer) and the Python modules the refusals switch off."""
+    """(module, file) of labkit's library (but its grader: no answer there) and the modules `refusals` refuse."""
     from .refusals import _module_files
 
     prefixes = ["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]
@@ -153,9 +149,8 @@ def known_modules(refusals):
 
 @functools.lru_cache(maxsize=4)
 def corpus(refusals=(), solutions=()):
-    """The :class:`Corpus` of labkit's library, the refused modules' Python sources (`refusals`: Refusal
-    objects) and the instructor notebooks' code cells (`solutions`: tuple of (notebook name, tuple of its code
-    cells), :func:`labkit.grading.submission.scoring.solutions`)."""
+    """The :class:`Corpus` of :func:`known_modules` and the instructor notebooks, `solutions`: ((name, cells),)
+    as :func:`labkit.grading.submission.scoring.solutions` gives them."""
     entries = [(str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
     entries += [(name, _notebook_entry(name, cells)) for name, cells in solutions]
     units, hashes, unit_of = [], [np.zeros(0, dtype=np.uint64)], [np.zeros(0, dtype=np.int64)]
@@ -170,10 +165,8 @@ def corpus(refusals=(), solutions=()):
 
 @dataclass(frozen=True)
 class Match:
-    """A definition of the notebook (the graded function or a helper it reaches) that is mostly known code:
-    `share` (0..1) of the part's own fingerprints, `shared` of them, are `source`'s (the known unit it
-    shares most with); `lines` pairs (student's line, known line), at most :data:`SHOWN`; `public` when
-    the source is on every student's disk (labkit, scipy), not the solutions."""
+    """A `definition` of the notebook that is mostly known code: `shared` fingerprints, `share` (0..1) of its
+    own, are known, most from `source`; `lines` are (student's, known) lines; `public`: not the solutions."""
 
     definition: str
     source: str
@@ -187,8 +180,7 @@ class Match:
 
 
 class Given:
-    """Every fingerprint-sized hash of the release's code cells, what every student was given (one per run:
-    :func:`match` caches by its identity)."""
+    """The release's code cells' hashes (:func:`.fingerprint.release_grams`), cached by identity, one per run."""
 
     def __init__(self, cells):
         self.array = fingerprint.release_grams(cells)
@@ -198,13 +190,11 @@ release_grams = Given
 
 
 def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
-    """The :class:`Match` of a part's code, when known sources have `threshold` or more of it; else None.
+    """The :class:`Match` of `definitions` ([(name, source)] of a graded function and what it reaches), or None.
 
-    The part's code is `definitions`, [(name, source)] of a graded function and what it reaches. Each unit
-    of it (:func:`.fingerprint.units`) is set against the one unit of `known` (:func:`corpus`) that has most
-    of its own fingerprints (those the release, `given`, does not give everyone, each counted once). It
-    matches when those units have `threshold` of all its own fingerprints and at least `minimum`: the lab's
-    formulas make short code come out alike from everyone, so only a long shared stretch is evidence.
+    Each unit (:func:`.fingerprint.units`) is set against the unit of `known` that has most of its own
+    fingerprints (not `given`). It matches when those have `threshold` of its own fingerprints and at least
+    `minimum`: the lab's formulas make short code alike in everyone, so only a long shared stretch is evidence.
     """
     total, judged = 0, []
     for name, text in fingerprint.units(definitions):
@@ -230,8 +220,8 @@ def _read(text, given):
 
 
 def _side_by_side(text, numbers, unit):
-    """Up to :data:`SHOWN` pairs of shared lines (`numbers` of `text`'s): the student's, and the known unit's
-    line of the same shape, the first after the last one paired (copies keep their order)."""
+    """Up to :data:`SHOWN` pairs of shared lines: the student's (`numbers` of `text`'s), and the first known
+    line of the same shape after the last one paired (copies keep their order)."""
     try:
         if unit.text is None:
             theirs = (
