@@ -55,16 +55,14 @@ def find(grades, students=None, registry=None) -> Copies:
             if other and registry is not None and number in registry.exercises:
                 whose = _whose(grade.name, registry.exercises[number], other, students or {})
                 found[(grade.name, ", ".join(whose))].append(number)
-    marked = [(g.name, tuple(sorted(f for f, s in g.sources.items() if _marked(s)))) for g in graded]
+    marked = [
+        (g.name, sorted(f for f, s in g.sources.items() if any(m in str(s) for m in SOLUTION_MARKERS))) for g in graded
+    ]
     return Copies(
         {g.name: frozenset(g.sources) for g in graded},
         [(holder, whose, tuple(numbers)) for (holder, whose), numbers in sorted(found.items())],
-        [(name, functions) for name, functions in marked if functions],
+        [(name, tuple(functions)) for name, functions in marked if functions],
     )
-
-
-def _marked(source):
-    return any(marker in str(source) for marker in SOLUTION_MARKERS)
 
 
 def _whose(name, exercise, other, students):

@@ -1,10 +1,6 @@
-"""Similar code between classmates, listed for a person to judge in the class report (never a grade).
-
-Each graded function's versions (its definition and what it reaches) are compared pairwise with
-:mod:`labkit.grading.submission.fingerprint`, on the source as written so that the shared lines can be marked.
-The release's code (:func:`boilerplate`) and code much of the class wrote alike (:data:`COMMON_SHARE`) are no
-evidence. A pair's score is the larger share, of its two sides, of one side's fingerprinted code the other has.
-"""
+"""Similar code between classmates, listed for a person to judge in the class report (never a grade): each
+graded function's versions are fingerprinted as written (so that shared lines can be marked) and compared
+pairwise; the release's code (:func:`boilerplate`) and code much of the class wrote alike are no evidence."""
 
 from __future__ import annotations
 
@@ -82,8 +78,6 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
     that sorts first; a pair that shares nothing never is listed. `release` is what every student was given
     (:func:`boilerplate`); `progress` is advanced after each function. None when :func:`unavailable`.
 
-    Examples
-    --------
     >>> from labkit.grading.store.report import SubmissionGrade
     >>> mine = "def area(width, height):\\n    return 0.5 * (width + height) * abs(width - height) ** 2 / 3"
     >>> theirs = "def area(w, h):\\n    # renamed\\n    return 0.5*(w+h)*abs(w-h)**2/3"

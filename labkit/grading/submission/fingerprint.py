@@ -32,8 +32,6 @@ def canonical(text, namespaces=frozenset()):
     ``x = x + y``, accumulating loops and generators are list comprehensions, ``staticmethod`` goes, and
     ``Name.attr`` of one of the `namespaces` (the notebook's classes) is ``attr``.
 
-    Examples
-    --------
     >>> text = "def f(x):\\n    '''Doc.'''\\n    _ = None\\n    y = getattr(x, 'size')\\n    y += 1\\n    return y"
     >>> print(canonical(text))
     def f(x):
@@ -198,8 +196,6 @@ def units(definitions):
     """``[(name, canonical text)]`` of a part's definitions, a class's methods each on its own, trivial wrappers
     left out (the code is where they point).
 
-    Examples
-    --------
     >>> box = "class K:\\n    @staticmethod\\n    def g(x):\\n        return x * x + 1"
     >>> found = units([("f", "def f(x):\\n    return K.g(x)"), ("K", box)])
     >>> [name for name, _ in found]
@@ -208,21 +204,19 @@ def units(definitions):
     definitions = list(definitions)
     trees = [tree for _, text in definitions if (tree := parse(text)) is not None]
     namespaces = frozenset(n.name for tree in trees for n in tree.body if isinstance(n, ast.ClassDef))
-    return [unit for name, text in definitions for unit in _split(name, text, namespaces)]
-
-
-def _split(name, text, namespaces):
-    tree = parse(canonical(text, namespaces))
-    if tree is None:
-        return [(name, str(text))]
-    pieces = []
-    for node in tree.body:
-        if isinstance(node, ast.ClassDef):
-            methods = [m for m in node.body if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef))]
-            pieces += [(f"{node.name}.{m.name}", m) for m in methods if not _trivial(m)]
-        elif not _trivial(node):
-            pieces.append((name, node))
-    return [(label, ast.unparse(node)) for label, node in pieces]
+    found = []
+    for name, text in definitions:
+        tree = parse(canonical(text, namespaces))
+        if tree is None:
+            found.append((name, str(text)))
+            continue
+        for node in tree.body:
+            if isinstance(node, ast.ClassDef):
+                methods = [m for m in node.body if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef))]
+                found += [(f"{node.name}.{m.name}", ast.unparse(m)) for m in methods if not _trivial(m)]
+            elif not _trivial(node):
+                found.append((name, ast.unparse(node)))
+    return found
 
 
 def _trivial(node):
@@ -240,8 +234,6 @@ def normalise(text):
     """``(normalised, where)``: `text`'s tokens with a name ``V`` (a function's ``F``, a class's ``O``), a string
     ``S``, no comments, docstrings, white space or round brackets; and the index in `text` of each character.
 
-    Examples
-    --------
     >>> normalise("def area(w, h):\\n    '''Doc.'''\\n    return w * h  # cm2")[0]
     'defFV,V:returnV*V'
     >>> normalise("y = np.searchsorted(x, 'a')")[0]
@@ -293,8 +285,6 @@ def fingerprints(normalised):
     """``(hashes, positions)``: the winnowed fingerprints of a normalised text, in order of position (a shared
     run of ``NOISE + WINDOW - 1`` characters always shares one).
 
-    Examples
-    --------
     >>> hashes, positions = fingerprints("V=V+1" * 20)
     >>> bool(len(hashes)) and bool(np.all(np.diff(positions) > 0))
     True

@@ -1,9 +1,6 @@
-"""Parts built on code that is not the student's (:func:`labkit.grading.submission.scoring.grade_notebook`).
-
-A part a refusal guards is judged for known code where it is graded, any other (a plot, a table) on the
-definitions that draw it (:func:`judge_plain`); a part whose code reaches a held definition, or a graded name
-that a string run as code may have defined, waits or fails with it (:func:`hold_dependents`).
-"""
+"""Parts built on code that is not the student's (:func:`labkit.grading.submission.scoring.grade_notebook`):
+parts without a refusal judged for known code on what draws them, and parts reaching held or string-run
+definitions holding or failing with them."""
 
 from __future__ import annotations
 
@@ -12,17 +9,14 @@ from ..store.report import HELD_STEP
 from . import scan
 
 
-def _read(part):
-    return [name for name in part.names() if name.isidentifier()]
-
-
 def judge_plain(check, part, code, graded, judge):
     """A passed part without a refusal, judged for known code: `judge` (check, [(name, source)]) is given the
     definitions that draw it, less the `graded` names (each judged in its own part), and returns the check."""
     if not check["passed"]:
         return check
+    readable = [n for n in part.names() if n.isidentifier()]
     try:
-        reached = scan.reached_sources(code, sorted(scan.drawn_with(code, _read(part))))
+        reached = scan.reached_sources(code, sorted(scan.drawn_with(code, readable)))
     except scan.Unreadable:
         return check
     return judge(check, [(n, t) for n, t in reached if n not in graded])
@@ -48,10 +42,9 @@ def hold_dependents(results, registry, code, graded, rescore):
         for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
             if not check.get("passed") or check.get("held"):
                 continue
+            readable = [n for n in (*part.names(), *part.scanned) if n.isidentifier()]
             try:
-                names = set(part.uses) | scan.drawn_with(
-                    code, _read(part) + [n for n in part.scanned if n.isidentifier()]
-                )
+                names = set(part.uses) | scan.drawn_with(code, readable)
             except scan.Unreadable:
                 names = set(part.uses)
             names -= set(part.scanned)

@@ -1,10 +1,8 @@
 """Code every student has on disk (labkit's, scipy's, the solutions' if they leak), recognised in a graded part.
 
-The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*
-of it, so that a part built on one is held for a person instead of paid
-(:func:`labkit.grading.submission.scoring.judge_known`). The corpus is every function and method of the known
-sources, fingerprinted (:mod:`.fingerprint`, syntax trees normalised first) once per file and cached.
-"""
+The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*,
+so that a part built on one is held for a person instead of paid (:func:`.scoring.judge_known`). The corpus,
+every known function and method fingerprinted (syntax trees normalised first), is cached per file."""
 
 from __future__ import annotations
 
@@ -75,16 +73,11 @@ def _definitions(text, prefix, source=None):
     return found
 
 
-@functools.cache
-def _tokeniser():
-    from importlib.metadata import version
-
-    return f"{VERSION} pygments {version('pygments')}"
-
-
 def _cached(name, raw, compute):
     """``(compute(), key)``: JSON data cached under `key`, the SHA-256 of `raw`, `name` and the versions."""
-    key = hashlib.sha256(f"{_tokeniser()}\0{name}\0".encode() + raw).hexdigest()
+    import pygments
+
+    key = hashlib.sha256(f"{VERSION} pygments {pygments.__version__}\0{name}\0".encode() + raw).hexdigest()
     cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     folder = Path(os.environ.get("LABKIT_CACHE") or os.path.join(cache, "labkit")) / "known"
     path = folder / f"{key}.json"
@@ -134,24 +127,18 @@ def _notebook_entry(name, cells):
     return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), compute)
 
 
-def known_modules(refusals):
-    """(module, file) of labkit's library (but its grader: no answer there) and the modules `refusals` refuse."""
-    from .refusals import _module_files
-
-    prefixes = ["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]
-    found = {}
-    for prefix in dict.fromkeys(prefixes):
-        for module, path in _module_files(prefix):
-            if not module.startswith("labkit.grading"):
-                found.setdefault(str(path), module)
-    return sorted((module, path) for path, module in found.items())
-
-
 @functools.lru_cache(maxsize=4)
 def corpus(refusals=(), solutions=()):
-    """The :class:`Corpus` of :func:`known_modules` and the instructor notebooks, `solutions`: ((name, cells),)
-    as :func:`labkit.grading.submission.scoring.solutions` gives them."""
-    entries = [(str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
+    """The :class:`Corpus` of labkit's library (but its grader: no answer there), the modules `refusals` refuse,
+    and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.solutions` gives them."""
+    from .refusals import _module_files
+
+    modules = {}  # file: module
+    for prefix in dict.fromkeys(["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]):
+        for module, path in _module_files(prefix):
+            if not module.startswith("labkit.grading"):
+                modules.setdefault(str(path), module)
+    entries = [(path, _module_entry(module, path)) for module, path in sorted((m, p) for p, m in modules.items())]
     entries += [(name, _notebook_entry(name, cells)) for name, cells in solutions]
     units, hashes, unit_of = [], [np.zeros(0, dtype=np.uint64)], [np.zeros(0, dtype=np.int64)]
     for path, (data, _) in entries:
