@@ -26,8 +26,7 @@ class PairRow:
 
 @dataclass
 class Copies:
-    """What the class report says about copies: {submission: frozenset of its graded functions}, (holder, whose
-    data or "" for no classmate, exercises), and (submission, functions holding a solution marker)."""
+    """{submission: its graded functions}, (holder, whose data or "", exercises), (submission, marked functions)."""
 
     functions: dict = field(default_factory=dict)
     holders: list = field(default_factory=list)
@@ -44,8 +43,7 @@ class Copies:
 
 
 def find(grades, students=None, registry=None) -> Copies:
-    """The copies of a class: `students` is the run's record of each student's variant data ({name: {exercise:
-    {parameter: value}}}), empty for a run without variants."""
+    """The copies of a class; `students`: the run's variant data ({name: {exercise: {parameter: value}}}) or None."""
     graded = [g for g in grades if g.graded]
     registry = registry or (graded[0].rubric.registry if graded else None)
     found = defaultdict(list)  # (holder, whose data) -> exercises

@@ -7,6 +7,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,8 +25,7 @@ COMMON_MIN = 5  # of them is the class's common code, set aside like the release
 
 @dataclass(frozen=True)
 class Pair:
-    """Two submissions' alike versions of a `function`: `score` (0..1) is how much is shared, ``shared_*``
-    the 0-based numbers of the shared lines."""
+    """Two submissions' alike versions of a `function`: `score` (0..1) shared, ``shared_*`` lines (0-based)."""
 
     function: str
     first: str
@@ -37,23 +37,10 @@ class Pair:
     shared_second: frozenset
 
 
-@dataclass(frozen=True)
-class Boilerplate:
-    """What a release gives everyone: hashes of its code, and its stripped lines (a stub's never shared)."""
-
-    hashes: np.ndarray
-    lines: frozenset
-
-
-@dataclass(frozen=True)
-class _Version:
-    """One student's version of a function, with its own fingerprints, by position."""
-
-    name: str
-    text: str
-    where: np.ndarray
-    hashes: np.ndarray
-    positions: np.ndarray
+# what a release gives everyone: the hashes of its code, and its stripped lines (a stub's are never shared)
+Boilerplate = namedtuple("Boilerplate", "hashes lines")
+# one student's version of a function, with its own fingerprints (fingerprint.own)
+_Version = namedtuple("_Version", "name text where hashes positions")
 
 
 def unavailable() -> str | None:
@@ -73,10 +60,9 @@ def unavailable() -> str | None:
 
 
 def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, progress=None) -> list[Pair] | None:
-    """The pairs of `grades` (SubmissionGrade, or objects with a ``name`` and ``sources``) whose versions of a
-    graded function score `threshold` (0..1) or more, by score then function and names, ``first`` the name
-    that sorts first; a pair that shares nothing never is listed. `release` is what every student was given
-    (:func:`boilerplate`); `progress` is advanced after each function. None when :func:`unavailable`.
+    """The pairs of `grades` (with a ``name`` and ``sources``) whose versions of a graded function score
+    `threshold` (0..1) or more (never 0), by score, function and names, ``first`` sorting first. `release` is
+    what everyone was given (:func:`boilerplate`); `progress` advances per function. None if :func:`unavailable`.
 
     >>> from labkit.grading.store.report import SubmissionGrade
     >>> mine = "def area(width, height):\\n    return 0.5 * (width + height) * abs(width - height) ** 2 / 3"
@@ -213,7 +199,7 @@ def _function_pairs(function, versions, given, threshold):
     common = hashes[counts > max(COMMON_MIN, COMMON_SHARE * len(kept))]
     if common.size:
         masks = [(v, ~np.isin(v.hashes, common)) for v in kept]
-        kept = [_Version(v.name, v.text, v.where, v.hashes[k], v.positions[k]) for v, k in masks if k.any()]
+        kept = [v._replace(hashes=v.hashes[k], positions=v.positions[k]) for v, k in masks if k.any()]
     if len(kept) < 2:
         return []
     scores = shares(kept)

@@ -2,8 +2,7 @@
 (:mod:`labkit.grading.reports.similarity`), each with its own corpus and threshold. Nothing is ever run:
 :func:`canonical` (known code only) writes code back without what does nothing, :func:`normalise` keeps what
 the tokens do, not their names, and :func:`fingerprints` winnows runs of :data:`NOISE` characters (Schleimer,
-Wilkerson and Aiken 2003). What the student release gives everyone (:func:`release_grams`) is never evidence.
-"""
+Wilkerson and Aiken 2003). What the student release gives everyone (:func:`release_grams`) is never evidence."""
 
 from __future__ import annotations
 
@@ -27,10 +26,9 @@ def parse(text):
 
 
 def canonical(text, namespaces=frozenset()):
-    """`text` written back from its normalised syntax tree (`text` itself when it does not parse): docstrings,
-    statements with no effect and dead stores go, ``getattr(x, "name")`` is ``x.name``, ``x += y`` is
-    ``x = x + y``, accumulating loops and generators are list comprehensions, ``staticmethod`` goes, and
-    ``Name.attr`` of one of the `namespaces` (the notebook's classes) is ``attr``.
+    """`text` written back from its normalised syntax tree (itself if it does not parse): no docstrings, dead
+    stores or ``staticmethod``; ``getattr(x, "name")`` is ``x.name``, ``x += y`` ``x = x + y``, accumulating
+    loops and generators list comprehensions, and ``Name.attr`` of one of the `namespaces` ``attr``.
 
     >>> text = "def f(x):\\n    '''Doc.'''\\n    _ = None\\n    y = getattr(x, 'size')\\n    y += 1\\n    return y"
     >>> print(canonical(text))
@@ -123,9 +121,8 @@ def _dead(statement, read):
     targets = statement.targets if isinstance(statement, ast.Assign) else [statement.target]
     if not all(isinstance(t, ast.Name) for t in targets):
         return False
-    if isinstance(statement.value, ast.Name) and all(t.id == statement.value.id for t in targets):
-        return True
-    return all(t.id not in read for t in targets)
+    itself = isinstance(statement.value, ast.Name) and all(t.id == statement.value.id for t in targets)
+    return itself or all(t.id not in read for t in targets)
 
 
 def _blocks(statement):
@@ -148,8 +145,7 @@ def _pruned(body, read):
 
 
 def _as_comprehensions(body):
-    """`body` with accumulating loops as comprehensions (:func:`_folded`), nested blocks too, and
-    ``y = e`` then ``return y`` at its end as ``return e``."""
+    """`body` with loops folded (:func:`_folded`), nested blocks too, and ``y = e; return y`` as ``return e``."""
     kept: list = []
     for statement in body:
         for field, block in _blocks(statement):
@@ -301,8 +297,7 @@ def fingerprints(normalised):
 
 
 def release_grams(cells, rewrite=canonical):
-    """Every :data:`NOISE`-character hash (sorted, not only those winnowing keeps, so that a stub cut off
-    elsewhere leaves nothing) of a release's code cells, each written by `rewrite` first."""
+    """Every :data:`NOISE`-character hash of the release `cells`, written by `rewrite` (all: a cut stub leaves none)."""
     found = [kgrams(normalise(rewrite(cell))[0]) for cell in cells]
     return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
 

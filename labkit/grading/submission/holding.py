@@ -10,8 +10,7 @@ from . import scan
 
 
 def judge_plain(check, part, code, graded, judge):
-    """A passed part without a refusal, judged for known code: `judge` (check, [(name, source)]) is given the
-    definitions that draw it, less the `graded` names (each judged in its own part), and returns the check."""
+    """A passed part without a refusal, `judge`d (check, [(name, source)]) on what draws it but `graded` names."""
     if not check["passed"]:
         return check
     readable = [n for n in part.names() if n.isidentifier()]

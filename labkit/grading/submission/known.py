@@ -13,6 +13,7 @@ import hashlib
 import json
 import os
 import tempfile
+from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,15 +30,9 @@ SHOWN = 12  # shared lines shown side by side
 VERSION = "labkit-known/5"  # the cache's format and normalisation: a change here recomputes every fingerprint
 
 
-@dataclass(frozen=True)
-class Unit:
-    """A known function or method, lines 1-based; `text` a notebook's (a module's is read when shown)."""
-
-    name: str  # as the feedback names it: labkit.piecewise.eval_pherm, scipy.interpolate._cubic.pchip...
-    path: str
-    first: int
-    last: int
-    text: str | None = None
+# a known function or method: its name as the feedback names it (labkit.piecewise.eval_pherm), its file, its
+# lines (1-based), and a notebook's text (a module's is read from its file when shown)
+Unit = namedtuple("Unit", "name path first last text", defaults=[None])
 
 
 @dataclass(frozen=True)
@@ -178,11 +173,9 @@ release_grams = Given
 
 def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
     """The :class:`Match` of `definitions` ([(name, source)] of a graded function and what it reaches), or None.
-
     Each unit (:func:`.fingerprint.units`) is set against the unit of `known` that has most of its own
     fingerprints (not `given`). It matches when those have `threshold` of its own fingerprints and at least
-    `minimum`: the lab's formulas make short code alike in everyone, so only a long shared stretch is evidence.
-    """
+    `minimum`: the lab's formulas make short code alike in everyone, so only a long shared stretch is evidence."""
     total, judged = 0, []
     for name, text in fingerprint.units(definitions):
         where, hashes, positions = _read(text, given)
@@ -207,8 +200,7 @@ def _read(text, given):
 
 
 def _side_by_side(text, numbers, unit):
-    """Up to :data:`SHOWN` pairs of shared lines: the student's (`numbers` of `text`'s), and the first known
-    line of the same shape after the last one paired (copies keep their order)."""
+    """Up to :data:`SHOWN` pairs (student's line `numbers` of `text`, the next known line of the same shape)."""
     try:
         if unit.text is None:
             theirs = (
