@@ -31,7 +31,7 @@ def main(out):
     out.mkdir(parents=True)
     folders = plant_class(out)
     start = time.perf_counter()
-    grading.grade(list(folders.values()), out / "out", grading.GradeOptions(seed=SEED), jobs=2, progress=False)
+    grading.grade(list(folders.values()), out / "out", grading.GradeOptions(seed=SEED, jobs=2), progress=False)
     print(f"{len(folders)} submissions graded in {time.perf_counter() - start:.0f} s: {out / 'out' / 'grades.csv'}")
 
 

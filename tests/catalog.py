@@ -1449,7 +1449,7 @@ def grade_class(folder):
 
     folders = plant_class(Path(folder))
     out = Path(folder) / "out"
-    results = grading.grade(list(folders.values()), out, grading.GradeOptions(seed=SEED), jobs=2, progress=False)
+    results = grading.grade(list(folders.values()), out, grading.GradeOptions(seed=SEED, jobs=2), progress=False)
     return dict(zip(folders, results)), out
 
 

@@ -14,6 +14,7 @@ from catalog import MISTAKES
 
 from labkit.exercises.result import NOT_DONE
 from labkit.exercises.result import RAISED as RAISED_KIND
+from labkit.grading.store.model import ExerciseResult
 from labkit.grading.store.report import ProblemText, SubmissionGrade
 from labkit.grading.store.rubric import default
 
@@ -156,7 +157,7 @@ def synthetic_class(count, seed=0, rubric=None, extra_names=()):
                 else _stub(part.name, part.weight)
                 for part in exercise.parts
             ]
-            grade.results[number] = _verdict(number, checks, exercise.points)
+            grade.results[number] = ExerciseResult.from_dict(_verdict(number, checks, exercise.points), number)
         if rng.random() < 0.12:
             kind, message, line = RAISED[rng.integers(len(RAISED))]
             cell = rng.integers(5, 40)

@@ -246,3 +246,51 @@ def test_the_flow_check_finds_an_import_upwards(tmp_path):
     assert imports_up_the_flow(root, flow) == []
     (root / "grading" / "low" / "l.py").write_text("def f():\n    from ..high import h\n")
     assert imports_up_the_flow(root, flow) == [("labkit.grading.low", "labkit.grading.high")]
+
+
+MAX_LINES, MAX_PARAMETERS = 80, 8
+
+
+def oversized(root, skip=frozenset()):
+    """[(file:line name, lines, parameters)] of every function under `root` (nested ones too) over
+    :data:`MAX_LINES` lines (its decorators included) or over :data:`MAX_PARAMETERS` parameters (self and cls
+    not counted); files whose path relative to `root`'s parent is in `skip` are left out."""
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        relative = path.relative_to(root.parent).as_posix()
+        if relative in skip or "student_notebooks" in path.parts:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                continue
+            first = node.decorator_list[0].lineno if node.decorator_list else node.lineno
+            lines = node.end_lineno - first + 1
+            a = node.args
+            named = [arg.arg for arg in (*a.posonlyargs, *a.args, *a.kwonlyargs)]
+            if named[:1] in (["self"], ["cls"]):
+                named = named[1:]
+            parameters = len(named) + bool(a.vararg) + bool(a.kwarg)
+            if lines > MAX_LINES or parameters > MAX_PARAMETERS:
+                found.append((f"{relative}:{node.lineno} {node.name}", lines, parameters))
+    return found
+
+
+def test_no_function_of_labkit_is_too_long_or_takes_too_many_parameters():
+    assert oversized(ROOT) == []
+
+
+def test_the_size_check_finds_a_long_function_a_wide_one_and_a_long_nested_one(tmp_path):
+    package = tmp_path / "pkg"
+    package.mkdir()
+    body = "".join(f"    x{i} = {i}\n" for i in range(MAX_LINES - 2))
+    (package / "fits.py").write_text(
+        f"@staticmethod\ndef at_the_limit():\n{body}\n"
+        "class C:\n    def method(self, a, b, c, d, e, f, g, h):\n        pass\n"
+    )
+    (package / "over.py").write_text(
+        f"@staticmethod\n@staticmethod\ndef long():\n{body}\n"
+        "def wide(a, b, c, d, e, f, g, h, *rest):\n    pass\n"
+        "def outer():\n    def inner():\n" + "".join(f"        x{i} = {i}\n" for i in range(MAX_LINES - 1))
+    )
+    found = {where.split(" ")[1]: (lines, parameters) for where, lines, parameters in oversized(package)}
+    assert found == {"long": (MAX_LINES + 1, 0), "wide": (2, 9), "outer": (MAX_LINES + 1, 0)}

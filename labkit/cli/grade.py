@@ -215,6 +215,11 @@ def grade_options(args):
         limits=Limits(memory=args.memory * MIB, cpu_seconds=args.total_timeout + CPU_GRACE),
         fork_server=not args.no_fork_server,
         solutions=args.solutions,
+        jobs=args.jobs,
+        shard=args.shard,
+        fresh=args.fresh,
+        times_from_submission=args.times_from_submission,
+        times_from_mtime=args.times_from_mtime,
     )
 
 
@@ -245,7 +250,7 @@ def _exchange_times(args):
         return None
     if not args.assignment:
         raise InputError("--times-from-exchange needs --assignment NAME: the assignment's name in nbgrader.")
-    from ..grading.store.late import read_exchange
+    from ..grading.run.times import read_exchange
 
     return read_exchange(args.times_from_exchange, args.assignment)
 
@@ -263,8 +268,8 @@ def _check_out(args):
 def handle(args):
     """Grade the submissions into --out and print each total and what the instructor should know; 1 when a
     submission could not be graded or a time could not be read."""
-    from ..grading import grade
-    from ..grading.store.late import read_times
+    from ..grading import Submissions, grade
+    from ..grading.run.times import read_times
 
     _refuse_misuse(args)
     start = time.perf_counter()
@@ -288,23 +293,8 @@ def handle(args):
     args.out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=".labkit-unpacked-", dir=args.out) as workspace:
         found = chosen(args, Path(workspace))
-        grades = grade(
-            found.paths,
-            args.out,
-            options,
-            engine=engine,
-            progress=not args.quiet,
-            times=times,
-            times_from_mtime=args.times_from_mtime,
-            shard=args.shard,
-            fresh=args.fresh,
-            names=found.names,
-            ungradable=found.ungradable,
-            times_from_submission=args.times_from_submission,
-            exchange_times=exchange,
-            roster=roster,
-            variants=variants,
-        )
+        given = Submissions(found.paths, found.names, found.ungradable, times, exchange, roster, variants)
+        grades = grade(given, args.out, options, engine=engine, progress=not args.quiet)
     if found.intake is not None:
         from ..grading.lms.delivery import remember
 

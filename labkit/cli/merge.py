@@ -55,7 +55,7 @@ def handle(args):
     from ..grading import merge
     from ..grading.reports.notes import time_notes
     from ..grading.run.classrun import report_failures
-    from ..grading.store.late import read_times
+    from ..grading.run.times import read_times
 
     start = time.perf_counter()
     _refuse_grading_options(args)

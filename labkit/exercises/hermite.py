@@ -191,35 +191,50 @@ def _narrow_pherm(fn, result):
         if factor2 is not None and not np.isclose(factor2, -1.0):
             factor, interval, unit_ok = factor2, [0.0, 2.0], True
             label = "each Hermite basis function alone on [0, 2]"
-    if other is not None and other not in {n for n, _, _ in bad}:
-        hint = (
+    if other is not None:
+        hint = _swapped_basis_hint(name, other, {n for n, _, _ in bad})
+    else:
+        hint = _basis_formula_hint(fn, name, factor, interval, unit_ok)
+    result.fail(label, f"wrong: {', '.join(n for n, _, _ in bad)}", hint)
+    return result
+
+
+def _swapped_basis_hint(name, other, wrong):
+    """The hint when the data of basis function `name` alone give `other` (`wrong`: every basis function found
+    wrong)."""
+    if other not in wrong:
+        return (
             f"with only the data of {name} set, your interpolant gives {other}, and {other}'s own data give "
             f"{other}: your {name} is {other}'s formula. Compare {name} with the lab's definition, factor by "
             "factor (which of x_k, x_{k+1} each factor has)."
         )
-    elif other is not None and {name, other} in ({"h1", "h2"}, {"h3", "h4"}):
-        hint = (
+    if {name, other} in ({"h1", "h2"}, {"h3", "h4"}):
+        return (
             f"with only the data of {name} set, your interpolant gives {other}: the values and the slopes are "
             "swapped in the combination. The value y_k goes with h1 and the slope y'_k with h2 "
             "(y_{k+1} with h3, y'_{k+1} with h4), equation (4)."
         )
-    elif other is not None and {name, other} in ({"h1", "h3"}, {"h2", "h4"}):
-        hint = (
+    if {name, other} in ({"h1", "h3"}, {"h2", "h4"}):
+        return (
             f"with only the data of {name} set, your interpolant gives {other}: the two ends of the interval "
             "are swapped in the combination. The data at x_k (y_k, y'_k) go with h1 and h2, the data at "
             "x_{k+1} with h3 and h4, equation (4)."
         )
-    elif other is not None:
-        hint = (
-            f"with only the data of {name} set, your interpolant gives {other}: the combination pairs the data "
-            "with the wrong basis functions. p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4)."
-        )
-    elif factor == -1:
-        hint = (
+    return (
+        f"with only the data of {name} set, your interpolant gives {other}: the combination pairs the data "
+        "with the wrong basis functions. p = y_k h1 + y'_k h2 + y_{k+1} h3 + y'_{k+1} h4 (equation 4)."
+    )
+
+
+def _basis_formula_hint(fn, name, factor, interval, unit_ok):
+    """The hint for a basis function `name` whose own formula is wrong: its sign, its denominator (off by
+    `factor` on `interval`), or a value or slope of the lab's table (3)."""
+    if factor == -1:
+        return (
             f"{name} has the wrong sign: compare its factors with the lab's definition, a minus sign at a time "
             "(x - x_{k+1} and x_k - x_{k+1} are not the same)."
         )
-    elif factor is not None or unit_ok:
+    if factor is not None or unit_ok:
         times = f" times {factor:g}" if factor is not None else ""
         hint = (
             f"{name} is the right polynomial{times} on [{interval[0]:g}, {interval[1]:g}]: its denominator is wrong "
@@ -228,17 +243,15 @@ def _narrow_pherm(fn, result):
         )
         if factor is None:
             hint = hint.replace(" is the right polynomial on", " is right on [0, 1] but not on")
-    else:
-        off = _table3_slips(fn, name)
-        hint = (
-            f"{name} is wrong: {off} {'is' if ' and ' not in off else 'are'} not what the lab's table (3) says. "
-            "Compare your formula with the lab's definition of the four Hermite polynomials, factor by factor."
-            if off
-            else f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
-            "polynomials, factor by factor."
-        )
-    result.fail(label, f"wrong: {', '.join(n for n, _, _ in bad)}", hint)
-    return result
+        return hint
+    off = _table3_slips(fn, name)
+    return (
+        f"{name} is wrong: {off} {'is' if ' and ' not in off else 'are'} not what the lab's table (3) says. "
+        "Compare your formula with the lab's definition of the four Hermite polynomials, factor by factor."
+        if off
+        else f"{name} is wrong: compare your formula with the lab's definition of the four Hermite "
+        "polynomials, factor by factor."
+    )
 
 
 TABLE3 = {  # the lab's table (3): each basis function's value and slope at x_k and x_{k+1}

@@ -215,6 +215,37 @@ def check_limacon_plot(plot, own=None, r0=LAB_R0, derivatives=None):
     own_curve = _own_hermite(data)
     if own_curve is not None:
         curves.insert(0, ("the Hermite interpolant of your tdata, xdata, ydata, xpdata, ypdata", own_curve))
+    best = _closest_curve(long, curves)
+    if best is None:
+        return result.fail(
+            "the curve is the Hermite interpolant",
+            "every long line has NaN or infinite points",
+            "plot xherm, yherm from eval_pherm.",
+        )
+    far, cover, name = best
+    on_exact = _all_on(long, _limacon_curve(r0))
+    ok = result.step(
+        f"the curve is {name} (within {ON_CURVE:g})",
+        far <= ON_CURVE,
+        f"a point is {far:.2e} away from it"
+        if np.isfinite(far)
+        else f"points are more than {10 * HERMITE_LIMACON:g} away from it",
+    )
+    if not ok:
+        result.hint = _plot_slip(long, data, r0) or _limacon_miss(on_exact, far <= HERMITE_LIMACON, bool(why))
+        return result
+    if not result.step(
+        "the curve goes all the way round",
+        cover <= 0.1,
+        f"part of the curve is {min(cover, 1.0):.2f} or more away from every plotted point",
+    ):
+        result.hint = "interpolate over the whole turn: tval from 0 to 2*pi."
+    return result
+
+
+def _closest_curve(long, curves):
+    """(how far, how much of it is left undrawn, its name) of the named curve that the finite lines of `long`
+    follow most closely, or None when no line is finite."""
     best = None
     for line in long:
         points = np.stack((line.x, line.y))[:, :: -(-line.x.size // SAMPLE)]
@@ -226,54 +257,36 @@ def check_limacon_plot(plot, own=None, r0=LAB_R0, derivatives=None):
             cover = float(_nearest(curve[:, ::50], np.unique(points, axis=1), 1.0).max())
             if best is None or (far, cover) < best[:2]:
                 best = (far, cover, name)
-    if best is None:
-        return result.fail(
-            "the curve is the Hermite interpolant",
-            "every long line has NaN or infinite points",
-            "plot xherm, yherm from eval_pherm.",
-        )
-    far, cover, name = best
-    exact = _limacon_curve(r0)
-    on_exact = all(
-        float(_distances(np.stack((ln.x, ln.y))[:, :: -(-ln.x.size // SAMPLE)], exact, 10 * HERMITE_LIMACON).max())
+    return best
+
+
+def _all_on(long, curve):
+    """Whether every finite line of `long` lies on `curve` (within :data:`ON_CURVE`)."""
+    return all(
+        float(_distances(np.stack((ln.x, ln.y))[:, :: -(-ln.x.size // SAMPLE)], curve, 10 * HERMITE_LIMACON).max())
         <= ON_CURVE
         for ln in long
         if np.all(np.isfinite(ln.x)) and np.all(np.isfinite(ln.y))
     )
-    ok = result.step(
-        f"the curve is {name} (within {ON_CURVE:g})",
-        far <= ON_CURVE,
-        f"a point is {far:.2e} away from it"
-        if np.isfinite(far)
-        else f"points are more than {10 * HERMITE_LIMACON:g} away from it",
+
+
+def _limacon_miss(on_exact, near, labs):
+    """The hint for a curve that is not the Hermite interpolant and shows no named slip: the exact limaçon,
+    `near` the interpolant (of the lab's data when `labs`), or corners and wiggles."""
+    if on_exact:
+        return (
+            "that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
+            "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm."
+        )
+    if near:
+        return (
+            f"close to the curve but not the interpolant of {'the lab' if labs else 'your'} data: plot "
+            "eval_pherm of tdata, xdata, xpdata and of tdata, ydata, ypdata at tval."
+        )
+    return (
+        "corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
+        "bends the curve away; use eval_pherm with the derivatives of Exercise 4."
     )
-    if not ok:
-        slip = _plot_slip(long, data, r0)
-        if slip:
-            result.hint = slip
-        elif on_exact:
-            result.hint = (
-                "that is the exact limaçon, not its Hermite interpolant: evaluate eval_pherm with tdata, "
-                "xdata, xpdata (and ydata, ypdata) at tval and plot xherm, yherm."
-            )
-        elif far <= HERMITE_LIMACON:
-            result.hint = (
-                f"close to the curve but not the interpolant of {'the lab' if why else 'your'} data: plot "
-                "eval_pherm of tdata, xdata, xpdata and of tdata, ydata, ypdata at tval."
-            )
-        else:
-            result.hint = (
-                "corners or wiggles: straight segments (eval_plin) are about 4e-2 off, and a wrong slope "
-                "bends the curve away; use eval_pherm with the derivatives of Exercise 4."
-            )
-        return result
-    if not result.step(
-        "the curve goes all the way round",
-        cover <= 0.1,
-        f"part of the curve is {min(cover, 1.0):.2f} or more away from every plotted point",
-    ):
-        result.hint = "interpolate over the whole turn: tval from 0 to 2*pi."
-    return result
 
 
 def _plot_slip(long, data, r0=LAB_R0):
@@ -386,6 +399,16 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
         if ln.x.size == ln.y.size and ln.x.size and np.all(np.isfinite(ln.x)) and np.all(np.isfinite(ln.y))
     ]
 
+    data, at_data = _boiling_data_check(lines, xdata, ydata)
+    results.append(data)
+    curves = [ln for ln in lines if all(ln is not d for d in at_data)]
+    for name, interpolant in (("the not-a-knot spline", splines.spline), ("pchip", monotone.pchip)):
+        results.append(_boiling_curve_check(curves, name, interpolant, xdata, ydata))
+    return results
+
+
+def _boiling_data_check(lines, xdata, ydata):
+    """Exercise 14's data drawn as circles without lines: (the check, the lines at the data points)."""
     data = CheckResult("ax14: the data")
     at_data = [
         ln
@@ -418,46 +441,43 @@ def check_boiling_plot(plot, rise=LAB_RISE, boil=LAB_BOIL):
             data.hint = "circles only: no line may join the data points."
     else:
         data.hint = "draw each data point as a circle."
-    results.append(data)
+    return data, at_data
 
-    curves = [ln for ln in lines if all(ln is not d for d in at_data)]
-    for name, interpolant in (("the not-a-knot spline", splines.spline), ("pchip", monotone.pchip)):
-        check = CheckResult(f"ax14: {name}")
-        matching = [
-            ln
+
+def _boiling_curve_check(curves, name, interpolant, xdata, ydata):
+    """One of Exercise 14's curves (`interpolant` of the data, called `name`) among the lines `curves`."""
+    check = CheckResult(f"ax14: {name}")
+    matching = [
+        ln
+        for ln in curves
+        if _matches(ln, interpolant(xdata, ydata, ln.x)) and not _matches(ln, _other(interpolant)(xdata, ydata, ln.x))
+    ]
+    if not check.step(f"a curve that is {name}", bool(matching), f"none of the {len(curves)} other line(s) follows it"):
+        swapped = any(  # a line whose x are the interpolant's values at its y
+            np.allclose(ln.x, interpolant(xdata, ydata, ln.y), rtol=0, atol=1e-6)
+            and not np.allclose(ln.x, _other(interpolant)(xdata, ydata, ln.y), rtol=0, atol=1e-6)
             for ln in curves
-            if _matches(ln, interpolant(xdata, ydata, ln.x))
-            and not _matches(ln, _other(interpolant)(xdata, ydata, ln.x))
-        ]
-        if not check.step(
-            f"a curve that is {name}", bool(matching), f"none of the {len(curves)} other line(s) follows it"
-        ):
-            swapped = any(  # a line whose x are the interpolant's values at its y
-                np.allclose(ln.x, interpolant(xdata, ydata, ln.y), rtol=0, atol=1e-6)
-                and not np.allclose(ln.x, _other(interpolant)(xdata, ydata, ln.y), rtol=0, atol=1e-6)
-                for ln in curves
-            )
-            check.hint = (
-                f"x and y are swapped: {name} is drawn with its values across and xval up. The first argument "
-                "of ax14.plot is the horizontal coordinate: xval, then the values."
-                if swapped
-                else f"evaluate {name} of the data at many times from the first data point to the last, and draw "
-                "its values against those times."
-            )
-        else:
-            most = max(matching, key=lambda ln: ln.x.size)
-            if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS, f"only {most.x.size} points"):
-                check.hint = f"evaluate it at {MIN_POINTS} points or more, so that the curve looks smooth."
-            elif not check.step(
-                "over the whole data range [0, 4]",
-                most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
-                f"from {most.x.min():.3g} to {most.x.max():.3g}",
-            ):
-                check.hint = "let its times run from the first data point to the last."
-            elif not check.step("drawn as a line", most.joined, "drawn as separate markers"):
-                check.hint = "draw the curve as a line, not as separate markers."
-        results.append(check)
-    return results
+        )
+        check.hint = (
+            f"x and y are swapped: {name} is drawn with its values across and xval up. The first argument "
+            "of ax14.plot is the horizontal coordinate: xval, then the values."
+            if swapped
+            else f"evaluate {name} of the data at many times from the first data point to the last, and draw "
+            "its values against those times."
+        )
+        return check
+    most = max(matching, key=lambda ln: ln.x.size)
+    if not check.step(f"at least {MIN_POINTS} points", most.x.size >= MIN_POINTS, f"only {most.x.size} points"):
+        check.hint = f"evaluate it at {MIN_POINTS} points or more, so that the curve looks smooth."
+    elif not check.step(
+        "over the whole data range [0, 4]",
+        most.x.min() <= 1e-9 and most.x.max() >= 4 - 1e-9,
+        f"from {most.x.min():.3g} to {most.x.max():.3g}",
+    ):
+        check.hint = "let its times run from the first data point to the last."
+    elif not check.step("drawn as a line", most.joined, "drawn as separate markers"):
+        check.hint = "draw the curve as a line, not as separate markers."
+    return check
 
 
 def _other(interpolant):

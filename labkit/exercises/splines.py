@@ -60,42 +60,9 @@ def check_ccspline(fn, system=None, seed=None):
         close(sprime, expected),
         "" if close(sprime, expected) else f"got {shown(sprime)}",
     ):
-        rng = case_rng(seed, "splines.ccspline")
-        xr = np.cumsum(rng.uniform(0.2, 1.5, 9))
-        yr = rng.normal(size=9)
-        ok, got = call(result, "random data", fn, xr, yr, 0.3, -0.7)
-        if ok:
-            want = splines.ccspline(xr, yr, 0.3, -0.7)
-            if not result.step("random unequal data agree with labkit.ccspline", close(got, want), worst(got, want)):
-                result.hint = "check the loop bounds: every interior row k uses h(k-1) and h(k)."
+        return _ccspline_random(result, fn, seed)
+    if system is not None and not _complete_matrix_sound(result, system):
         return result
-    if system is not None:
-        ok, AD = call(result, "the matrix A", system, np.array(x), np.array(y), y1p, ynp)
-        if not ok:
-            return result
-        A = _matrix(AD)
-        if A is None:
-            return result.fail(
-                "the matrix A",
-                "complete_system must return (A, D) with A a matrix of numbers",
-                "end the function with `return A, D`.",
-            )
-        natural_rows = A.shape == (4, 4) and np.allclose(A[0], [1, 0, 0, 0]) and np.allclose(A[-1], [0, 0, 0, 1])
-        if natural_rows:
-            return result.fail(
-                "the first and last rows of A",
-                "they say M1 = 0 and Mn = 0",
-                "the first and last rows of A are the natural spline's (M1 = 0, Mn = 0); the complete "
-                "spline's first row is h1/3, h1/6 and its last h(n-1)/6, h(n-1)/3 (equation 11), with "
-                "y1p and ynp in D.",
-            )
-        if not result.step("A is symmetric", A.shape == (4, 4) and np.allclose(A, A.T)):
-            result.hint = _matrix_slip(A, _reference_complete_system(np.array(x), np.array(y), y1p, ynp)[0])
-            return result
-        off = np.abs(A).sum(axis=1) - np.abs(np.diag(A))
-        if not result.step("each diagonal entry exceeds the rest of its row (Gershgorin)", np.all(np.diag(A) > off)):
-            result.hint = "the diagonal is (h(k-1) + h(k))/3 inside and h/3 in the first and last rows."
-            return result
     name2, x2, y2, a2, b2 = SPLINE_CASES[1]
     ok, sprime2 = call(result, name2, fn, np.array(x2), np.array(y2), a2, b2)
     if not ok:
@@ -106,48 +73,106 @@ def check_ccspline(fn, system=None, seed=None):
             "(h(k) = x(k+1) - x(k); row k uses h(k-1) and h(k))."
         )
         return result
-    name3, x3, y3, a3, b3 = SPLINE_CASES[2]
     if system is not None:
-        ok, AD = call(result, "A and D for [0 1 3]", system, np.array(x3), np.array(y3), a3, b3)
-        if not ok:
-            return result
-        A_ref, D_ref = _reference_complete_system(np.array(x3), np.array(y3), a3, b3)
-        if _matrix(AD) is None:
-            return result.fail(
-                "A and D for [0 1 3]",
-                "complete_system must return (A, D) with A a matrix of numbers",
-                "end the function with `return A, D`.",
-            )
-        if not result.step("A for xdata = [0 1 3] matches equation (11)", close(AD[0], A_ref), worst(AD[0], A_ref)):
-            result.hint = "compute the 3 x 3 matrix by hand from (11) and compare entry by entry."
-            return result
-        D = _part(AD, 1)
-        if not result.step("D for xdata = [0 1 3] matches equation (12)", close(D, D_ref), worst(D, D_ref)):
-            flipped = _flipped_ends(D, D_ref)
-            if flipped:
-                which = flipped[0]
-                formula = "(y2 - y1)/h1 - y1p" if which == "first" else "ynp - (yn - y(n-1))/h(n-1)"
-                result.hint = f"D's {which} entry has the wrong sign: it is {formula} (equation 12)."
-            elif _flipped_inside(D, D_ref):
-                result.hint = (
-                    "D's inside entries have the wrong sign (its first and last are right): each is the difference "
-                    "of two neighbouring secants, taken in the order equation (12) takes them."
-                )
-            else:
-                result.hint = "compute D by hand from (12): first and last entries use y1p and ynp."
-            return result
-        result.hint = (
-            "your complete_system's A and D are right, so what ccspline does with them is wrong"
-            + _slopes_slip(sprime, expected, y1p, ynp)
-            + ": it must solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
-            "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp."
-        )
-        return result
+        return _complete_system_slip(result, system, _slopes_slip(sprime, expected, y1p, ynp))
     result.hint = (
         "the slopes are wrong for equal intervals too: check A and D against equations (11) and (12) "
         "(define complete_system so the grader can check them too), then the slopes against (8)."
     )
     return result
+
+
+def _ccspline_random(result, fn, seed):
+    """After the lab's case: random unequal data, against labkit's ccspline."""
+    rng = case_rng(seed, "splines.ccspline")
+    xr = np.cumsum(rng.uniform(0.2, 1.5, 9))
+    yr = rng.normal(size=9)
+    ok, got = call(result, "random data", fn, xr, yr, 0.3, -0.7)
+    if ok:
+        want = splines.ccspline(xr, yr, 0.3, -0.7)
+        if not result.step("random unequal data agree with labkit.ccspline", close(got, want), worst(got, want)):
+            result.hint = "check the loop bounds: every interior row k uses h(k-1) and h(k)."
+    return result
+
+
+def _complete_matrix_sound(result, system):
+    """Whether the student's A for the lab's case is a symmetric, diagonally dominant matrix other than the
+    natural spline's; when it is not, `result` says why."""
+    name, x, y, y1p, ynp = SPLINE_CASES[0]
+    ok, AD = call(result, "the matrix A", system, np.array(x), np.array(y), y1p, ynp)
+    if not ok:
+        return False
+    A = _matrix(AD)
+    if A is None:
+        result.fail(
+            "the matrix A",
+            "complete_system must return (A, D) with A a matrix of numbers",
+            "end the function with `return A, D`.",
+        )
+        return False
+    natural_rows = A.shape == (4, 4) and np.allclose(A[0], [1, 0, 0, 0]) and np.allclose(A[-1], [0, 0, 0, 1])
+    if natural_rows:
+        result.fail(
+            "the first and last rows of A",
+            "they say M1 = 0 and Mn = 0",
+            "the first and last rows of A are the natural spline's (M1 = 0, Mn = 0); the complete "
+            "spline's first row is h1/3, h1/6 and its last h(n-1)/6, h(n-1)/3 (equation 11), with "
+            "y1p and ynp in D.",
+        )
+        return False
+    if not result.step("A is symmetric", A.shape == (4, 4) and np.allclose(A, A.T)):
+        result.hint = _matrix_slip(A, _reference_complete_system(np.array(x), np.array(y), y1p, ynp)[0])
+        return False
+    off = np.abs(A).sum(axis=1) - np.abs(np.diag(A))
+    if not result.step("each diagonal entry exceeds the rest of its row (Gershgorin)", np.all(np.diag(A) > off)):
+        result.hint = "the diagonal is (h(k-1) + h(k))/3 inside and h/3 in the first and last rows."
+        return False
+    return True
+
+
+def _complete_system_slip(result, system, slopes_slip):
+    """Where ccspline goes wrong when both interval cases fail: the student's A and D for [0 1 3] against equations
+    (11) and (12), or, when they are right, the solve (`slopes_slip` says how the slopes are wrong)."""
+    name3, x3, y3, a3, b3 = SPLINE_CASES[2]
+    ok, AD = call(result, "A and D for [0 1 3]", system, np.array(x3), np.array(y3), a3, b3)
+    if not ok:
+        return result
+    A_ref, D_ref = _reference_complete_system(np.array(x3), np.array(y3), a3, b3)
+    if _matrix(AD) is None:
+        return result.fail(
+            "A and D for [0 1 3]",
+            "complete_system must return (A, D) with A a matrix of numbers",
+            "end the function with `return A, D`.",
+        )
+    if not result.step("A for xdata = [0 1 3] matches equation (11)", close(AD[0], A_ref), worst(AD[0], A_ref)):
+        result.hint = "compute the 3 x 3 matrix by hand from (11) and compare entry by entry."
+        return result
+    D = _part(AD, 1)
+    if not result.step("D for xdata = [0 1 3] matches equation (12)", close(D, D_ref), worst(D, D_ref)):
+        result.hint = _d_slip(D, D_ref)
+        return result
+    result.hint = (
+        "your complete_system's A and D are right, so what ccspline does with them is wrong"
+        + slopes_slip
+        + ": it must solve A M = D with complete_system's A and D, then s'(x_k) = -M_k h_k/3 - M_{k+1} h_k/6 + "
+        "(y_{k+1} - y_k)/h_k (equation 8), with s'(x_1) = y1p and s'(x_n) = ynp."
+    )
+    return result
+
+
+def _d_slip(D, D_ref):
+    """The hint for a student's D that differs from equation (12)."""
+    flipped = _flipped_ends(D, D_ref)
+    if flipped:
+        which = flipped[0]
+        formula = "(y2 - y1)/h1 - y1p" if which == "first" else "ynp - (yn - y(n-1))/h(n-1)"
+        return f"D's {which} entry has the wrong sign: it is {formula} (equation 12)."
+    if _flipped_inside(D, D_ref):
+        return (
+            "D's inside entries have the wrong sign (its first and last are right): each is the difference "
+            "of two neighbouring secants, taken in the order equation (12) takes them."
+        )
+    return "compute D by hand from (12): first and last entries use y1p and ynp."
 
 
 def _matrix_slip(A, reference):
@@ -261,32 +286,36 @@ def check_ncspline(fn, seed=None, system=None):
     if not result.step(
         "second derivative zero at both ends (M1 = Mn = 0)", close(ends, [0.0, 0.0]), f"s'' = {np.round(ends, 6)}"
     ):
-        if close(slopes, _natural_slopes(x, y, rows_in_d=False)):
-            result.hint = (
-                "A's first and last rows say M1 = 0 and Mn = 0, but D's first and last entries are still "
-                "the complete spline's: set them to 0 too."
-            )
-        elif close(slopes, _natural_slopes(x, y, rows_in_a=False, rows_in_d=False)):
-            result.hint = (
-                "the first and last rows of A, and the first and last entries of D, are still the complete "
-                "spline's rows: change them so that those two equations say M1 = 0 and Mn = 0."
-            )
-        elif got.shape == want.shape and np.allclose(got[[0, -1]], 0.0) and not np.allclose(want[[0, -1]], 0.0):
-            result.hint = (
-                "your end slopes are 0: the natural spline's ends have zero second derivative (M1 = Mn = 0), "
-                "not zero slope; its end slopes come from the solved M by (8) and (9), as the others do."
-            )
-        else:
-            result.hint = _natural_rows_slip(x, y, got) or (
-                "the second derivative is not 0 at the ends: the first and last equations of the system "
-                "must say M1 = 0 and Mn = 0."
-            )
+        result.hint = _natural_ends_slip(x, y, slopes, got, want)
         return result
     if not result.step("slopes agree with labkit.ncspline", close(slopes, want), worst(slopes, want)) or not linear_ok:
         result.hint = _natural_rows_slip(x, y, got) or (
             "the ends are right, so check the interior rows and the slopes from (8) and, at the last knot, (9)."
         )
     return result
+
+
+def _natural_ends_slip(x, y, slopes, got, want):
+    """The hint for natural spline slopes whose ends have a second derivative other than 0."""
+    if close(slopes, _natural_slopes(x, y, rows_in_d=False)):
+        return (
+            "A's first and last rows say M1 = 0 and Mn = 0, but D's first and last entries are still "
+            "the complete spline's: set them to 0 too."
+        )
+    if close(slopes, _natural_slopes(x, y, rows_in_a=False, rows_in_d=False)):
+        return (
+            "the first and last rows of A, and the first and last entries of D, are still the complete "
+            "spline's rows: change them so that those two equations say M1 = 0 and Mn = 0."
+        )
+    if got.shape == want.shape and np.allclose(got[[0, -1]], 0.0) and not np.allclose(want[[0, -1]], 0.0):
+        return (
+            "your end slopes are 0: the natural spline's ends have zero second derivative (M1 = Mn = 0), "
+            "not zero slope; its end slopes come from the solved M by (8) and (9), as the others do."
+        )
+    return _natural_rows_slip(x, y, got) or (
+        "the second derivative is not 0 at the ends: the first and last equations of the system "
+        "must say M1 = 0 and Mn = 0."
+    )
 
 
 def _curvatures(x, y, slopes, first_left=True):

@@ -33,6 +33,7 @@ _EXPORTS = {
     "grade_submission": "submission.scoring",
     "submission_notebooks": "submission.scoring",
     "GradeOptions": "options",
+    "Submissions": "run.plan",
     "get_backend": "sandbox.backends",
 }
 _MODULES = {"authoring", "options", "reports", "run", "store", "sandbox", "submission"}

@@ -1,4 +1,4 @@
-"""How a grading run is bounded: one options object, its defaults defined once.
+"""How a grading run is bounded and run: one options object, its defaults defined once.
 
 :class:`GradeOptions` is built once, at the edge: by the command line (``labkit grade``, whose
 defaults are read from here) or by the caller of :func:`labkit.grading.grade`.
@@ -7,6 +7,11 @@ and rubric once, :mod:`labkit.grading.run.classrun`), as plain data to each
 submission's grading process (:mod:`labkit.grading.submission.scoring`) and into the
 sandbox (:class:`labkit.grading.sandbox.remote.NotebookHandle`). No other module spells out
 a default of its own: they take the options object, or values from it.
+
+The options are the run's choices, plain data that a flag of ``labkit grade`` sets: its limits, seed,
+sandbox and rubric, and how the class is run (``jobs``, ``shard``, ``fresh``, which student-written
+times count). What one run is asked to grade, this class's paths, names, times, roster and variants,
+is a :class:`labkit.grading.run.plan.Submissions` instead (:mod:`labkit.grading.run.plan` says why).
 """
 
 import os
@@ -42,6 +47,11 @@ class GradeOptions:
     # each student's own data (labkit.exercises.variants), derived by the class run from the roster and the
     # variants file: {submission name: {exercise (text): {parameter: value}}}; None: the lab's data for all
     variants: dict | None = None
+    jobs: int = 2  # submissions graded at once here (the local engine's; labkit.grading.run.engines.LocalEngine)
+    shard: str | tuple | None = None  # "I/N": grade only the I-th of N parts of the class (labkit.grading.run.resume)
+    fresh: bool = False  # delete an earlier run's results in the output folder and grade every submission
+    times_from_submission: bool = False  # a time missing elsewhere is read from the submission's timestamp.txt
+    times_from_mtime: bool = False  # ... else from its notebooks' modification time (both student-supplied)
 
     def __post_init__(self):
         for name in ("cell_timeout", "total_timeout"):

@@ -32,7 +32,7 @@ def graded(tmp_path_factory):
 
 
 def _failed(grade):
-    return {(n, c["name"]) for n, verdict in grade.results.items() for c in verdict["checks"] if not c["passed"]}
+    return {(n, c.name) for n, verdict in grade.results.items() for c in verdict.parts if not c.passed}
 
 
 def _section(grade, number):
@@ -95,7 +95,7 @@ def test_every_slip_costs_exactly_its_part_and_is_named(graded, entry):
     section = _section(grade, entry.exercise)
     assert entry.hint in section, section
     if entry.named:  # a named slip is not left to the line that raised, nor to the traceback
-        hint = next(c["hint"] for c in grade.results[entry.exercise]["checks"] if c["name"] == entry.part)
+        hint = next(c.hint for c in grade.results[entry.exercise].parts if c.name == entry.part)
         assert not hint.endswith(("look at that line.", "the traceback shows where it happened.")), hint
     # only those parts' points are lost: every other exercise of the notebook is complete
     for number in grade.results:
@@ -116,9 +116,9 @@ def test_no_feedback_gives_an_answer_away(graded):
     texts = []
     for name, grade in graded.items():
         for number, verdict in grade.results.items():
-            for check in verdict["checks"]:
-                where = f"{name}: exercise {number}, {check['name']}"
-                texts.append((f"{where} (hint)", check["hint"]))
-                texts += [(where, OWN.sub("got (yours)", f"{s['step']}: {s['detail']}")) for s in check["steps"]]
+            for check in verdict.parts:
+                where = f"{name}: exercise {number}, {check.name}"
+                texts.append((f"{where} (hint)", check.hint))
+                texts += [(where, OWN.sub("got (yours)", f"{s.step}: {s.detail}")) for s in check.steps]
     found = sorted(set(giveaways(texts)))
     assert not found, f"{len(found)} give-aways:\n" + "\n".join(found)

@@ -259,7 +259,7 @@ def graded(tmp_path_factory, released):
     subs["not_json"] = not_json
     out = tmp / "grades"
     results = grading.grade(
-        list(subs.values()), out, grading.GradeOptions(cell_timeout=10, total_timeout=120), jobs=2, progress=False
+        list(subs.values()), out, grading.GradeOptions(cell_timeout=10, total_timeout=120, jobs=2), progress=False
     )
     return {name: r for name, r in zip(subs, results)}, out, sentinel, subs
 
@@ -269,7 +269,7 @@ def test_instructor_notebooks_score_full_marks_and_all_extra_credit(graded):
     grade = results["instructor"]
     assert EVERYTHING == FULL + RUBRIC.branch_extra + sum(RUBRIC.points[n] for n in RUBRIC.extra_credit)
     assert grade.total == EVERYTHING, grade.feedback()
-    assert all(verdict["passed"] for verdict in grade.results.values()) and set(grade.results) == set(EXERCISES)
+    assert all(verdict.passed for verdict in grade.results.values()) and set(grade.results) == set(EXERCISES)
 
 
 def test_spline_branch_alone_is_full_credit_without_extra(graded):
@@ -294,7 +294,7 @@ def test_the_second_branch_is_ten_points_of_extra_credit(graded):
 def test_planted_mistake_loses_exactly_its_part_with_the_matching_hint(graded, name, exercise, part, hint):
     results, *_ = graded
     grade, instructor = results[name], results["instructor"]
-    failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
+    failed = [(n, c.name) for n, v in grade.results.items() for c in v.parts if not c.passed]
     assert failed == [(exercise, part)], grade.feedback()
     lost = (
         RUBRIC.points[exercise]
@@ -334,7 +334,7 @@ def test_planted_bug_loses_exactly_its_function_with_the_matching_hint(graded, n
     # denominator makes the student's own driver's errors stall at 1): it is what the driver measured. But a
     # rate is read from the student's own table, so the planted copy's unchanged answer no longer fits it
     also = {"natural_rows": [(12, "rate_natural")]}.get(name, [])
-    failed = [(n, c["name"]) for n, v in grade.results.items() for c in v["checks"] if not c["passed"]]
+    failed = [(n, c.name) for n, v in grade.results.items() for c in v.parts if not c.passed]
     assert failed == [(exercise, part)] + also, grade.feedback()
     changed = {exercise} | {n for n, _ in also}
     assert {n: p for n, p in grade.points.items() if n not in changed} == {
@@ -457,9 +457,9 @@ def two_runs(tmp_path_factory, released):
     solved, bare = tmp / "alice.ipynb", tmp / "bob.ipynb"
     shutil.copy(NOTEBOOKS / "06_bilinear.ipynb", solved)
     shutil.copy(released / "06_bilinear.ipynb", bare)
-    first = grading.grade([solved], tmp / "job1", grading.GradeOptions(seed=4242), jobs=1, progress=False)
-    second = grading.grade([bare], tmp / "job2", grading.GradeOptions(seed=4242), jobs=1, progress=False)
-    again = grading.grade([solved], tmp / "job3", grading.GradeOptions(seed=4242), jobs=1, progress=False)
+    first = grading.grade([solved], tmp / "job1", grading.GradeOptions(seed=4242, jobs=1), progress=False)
+    second = grading.grade([bare], tmp / "job2", grading.GradeOptions(seed=4242, jobs=1), progress=False)
+    again = grading.grade([solved], tmp / "job3", grading.GradeOptions(seed=4242, jobs=1), progress=False)
     return tmp, first + second, again
 
 
@@ -501,7 +501,7 @@ def test_merge_scores_with_the_runs_rubric_and_refuses_one_with_other_points(tmp
     rubric = tmp_path / "rubric.toml"
     rubric.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 20\n')
     for path, job in ((solved, "job1"), (bare, "job2")):
-        grading.grade([path], tmp_path / job, grading.GradeOptions(seed=4242, rubric=rubric), jobs=1, progress=False)
+        grading.grade([path], tmp_path / job, grading.GradeOptions(seed=4242, rubric=rubric, jobs=1), progress=False)
     tmp = tmp_path
     other = tmp_path / "other.toml"
     other.write_text('title = "bilinear only"\nrequired = [16]\n[points]\n16 = 10\n')

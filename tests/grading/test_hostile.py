@@ -559,8 +559,8 @@ def attacked(tmp_path_factory):
     before = _tree_hash(outside, leave_out=[out])
     leftovers = _temporary_leftovers()
     start = time.perf_counter()
-    options = grading.GradeOptions(cell_timeout=CELL_TIMEOUT, total_timeout=TOTAL_TIMEOUT)
-    results = grading.grade(list(subs.values()), out, options, jobs=2, progress=False)
+    options = grading.GradeOptions(cell_timeout=CELL_TIMEOUT, total_timeout=TOTAL_TIMEOUT, jobs=2)
+    results = grading.grade(list(subs.values()), out, options, progress=False)
     elapsed = time.perf_counter() - start
     time.sleep(0.5)
     try:
@@ -646,8 +646,8 @@ def test_no_hostile_submission_gets_a_point_it_did_not_earn(attacked):
 
 def test_only_the_first_notebook_that_defines_an_exercise_counts(attacked):
     grade = attacked["results"]["best_of_four"]
-    rate = next(c for c in grade.results[3]["checks"] if c["name"] == "rate_pherm")
-    assert not rate["passed"] and "got 1" in json.dumps(rate)
+    rate = next(c for c in grade.results[3].parts if c.name == "rate_pherm")
+    assert not rate.passed and "got 1" in json.dumps(rate.as_dict())
     assert grade.points[3] == 15 * (12 / 15)  # the driver and the table are right, the rate is not
 
 
@@ -967,7 +967,7 @@ def test_a_grading_process_that_dies_costs_only_its_own_submission(tmp_path):
     thread = threading.Thread(target=killer, daemon=True)
     thread.start()
     try:
-        grades = grading.grade([honest, once, twice], tmp_path / "out", jobs=3, progress=False)
+        grades = grading.grade([honest, once, twice], tmp_path / "out", grading.GradeOptions(jobs=3), progress=False)
     finally:
         stop.set()
         thread.join()

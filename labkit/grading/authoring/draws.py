@@ -46,8 +46,8 @@ from pathlib import Path
 from ...errors import InputError
 from ...execute import read_notebook
 from ...exercises import variants as variant_data
-from ...exercises.registry import LAB
-from .release import BEGIN_HIDDEN, END_HIDDEN, with_values
+from ...exercises.registry import LAB, Registry
+from .release import BEGIN_HIDDEN, END_HIDDEN, copy_notebook, with_values
 
 
 @dataclass(frozen=True)
@@ -81,11 +81,7 @@ def load_catalog(path):
 
 def _planted(nb, replace, name):
     """Notebook `nb` with the (old, new) code replacements of a catalog entry (each old once in one code cell)."""
-    import json
-
-    import nbformat
-
-    nb = nbformat.from_dict(json.loads(json.dumps(nb)))
+    nb = copy_notebook(nb)
     for old, new in replace:
         hits = [cell for cell in nb.cells if cell.cell_type == "code" and old in cell.source]
         if len(hits) != 1 or hits[0].source.count(old) != 1:
@@ -185,85 +181,107 @@ def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, s
     for exercise in varied.values():
         by_notebook.setdefault(exercise.notebook, []).append(exercise)
     originals = {name: read_notebook(Path(solutions) / name) for name in by_notebook}
-    troubles = []
-    for number, tied in variant_data.ties(variants, registry, (roster or {}).values()):
-        troubles.append(
-            Trouble(
-                tied[0],
-                {number: variants.values(registry, tied[0])[number]},
-                "a tie",
-                f"exercise {number}: the same data as {', '.join(tied[1:])}, so a copy between them cannot be seen; "
-                f"give all but one a fresh draw (labkit variants --redraw ID --exercise {number})",
-            )
-        )
+    troubles = _ties(variants, registry, roster)
     for index, student in enumerate(students):
         values = variants.values(registry, student)
         other = variants.values(registry, students[index - 1] if len(students) > 1 else f"{student}-other")
-        mine = {n: values[n] for n in varied}
+        draw = _Draw(student, values, other, {n: values[n] for n in varied}, seed + index, registry, troubles)
         for exercise in varied.values():
             why = exercise.sound(values[exercise.number]) if exercise.sound is not None else ""
             if why:
-                troubles.append(Trouble(student, mine, f"exercise {exercise.number}'s data", why))
+                draw.trouble(f"exercise {exercise.number}'s data", why)
         for notebook, exercises in by_notebook.items():
-            numbers = {e.number for e in exercises}
-            names = sorted({name for e in exercises for part in e.parts for name in (*e.names, *part.names())})
-            # the catalog's students read their rates off their own tables, unless the entry keeps them as written
-            entries = [("the solution", (), None, None, (), numbers, False)]
-            entries += [
-                (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not _keeps_rates(e))
-                for e in correct
-                if e.notebook == notebook and set(e.full) & numbers
-            ]
-            entries += [
-                (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not _keeps_rates(e))
-                for e in mistakes
-                if e.notebook == notebook and e.exercise in numbers
-            ]
-            for label, replace, part, hint, also, judged, reads in entries:
-                planted = _planted(originals[notebook], replace, label)
-                nb = with_values(reading_rates(planted, registry) if reads else planted, values, notebook, registry)
-                namespace = run_cells(nb, names)
-                for number in sorted(judged):
-                    verdict = registry.check(number, namespace, seed=seed + index, variant=values[number])
-                    failed = _failed(verdict)
-                    if verdict.get("other_variant"):  # a notebook on its own data is never taken for a copy
-                        troubles.append(
-                            Trouble(student, mine, label, f"exercise {number}: its own data named another's")
-                        )
-                    if part is None and failed:
-                        troubles.append(Trouble(student, mine, label, f"exercise {number} lost {sorted(failed)}"))
-                    elif part is not None:
-                        expected = {part} | {p for n, p in also if n == number}
-                        if failed != expected:
-                            troubles.append(
-                                Trouble(student, mine, label, f"failed {sorted(failed)}, not {sorted(expected)}")
-                            )
-                        elif hint and hint not in _said(verdict, part):
-                            troubles.append(Trouble(student, mine, label, f"the feedback does not say {hint!r}"))
-                _close_figures()
-            # the solution on another student's data: caught, and its varied parts lost
-            if any(other[e.number] != values[e.number] for e in exercises):
-                nb = with_values(originals[notebook], other, notebook, registry)
-                namespace = run_cells(nb, names)
-                for exercise in exercises:
-                    if other[exercise.number] == values[exercise.number]:
-                        continue
-                    verdict = registry.check(
-                        exercise.number, namespace, seed=seed + index, variant=values[exercise.number]
-                    )
-                    dependent = {part.name for part in exercise.parts if part.varied}
-                    if not verdict.get("other_variant"):
-                        troubles.append(Trouble(student, mine, "a copy", "another student's data is not named"))
-                    if not dependent <= _failed(verdict):
-                        troubles.append(
-                            Trouble(
-                                student,
-                                mine,
-                                "a copy",
-                                f"{sorted(dependent - _failed(verdict))} pass on another's data",
-                            )
-                        )
-                _close_figures()
+            _check_notebook(draw, originals[notebook], notebook, exercises, correct, mistakes)
         if progress is not None:
             progress(f"draw {index + 1} of {len(students)}: {student}")
     return troubles
+
+
+@dataclass(frozen=True)
+class _Draw:
+    """One student's draw being checked: its data, another student's, and the troubles found so far."""
+
+    student: str
+    values: dict  # {exercise: {parameter: value}}
+    other: dict  # another student's values, for the copy check
+    mine: dict  # the values of the varied exercises, as a trouble shows them
+    seed: int
+    registry: Registry
+    troubles: list
+
+    def trouble(self, entry, what):
+        self.troubles.append(Trouble(self.student, self.mine, entry, what))
+
+
+def _ties(variants, registry, roster):
+    """A trouble for each exercise that two students of the roster drew alike."""
+    return [
+        Trouble(
+            tied[0],
+            {number: variants.values(registry, tied[0])[number]},
+            "a tie",
+            f"exercise {number}: the same data as {', '.join(tied[1:])}, so a copy between them cannot be seen; "
+            f"give all but one a fresh draw (labkit variants --redraw ID --exercise {number})",
+        )
+        for number, tied in variant_data.ties(variants, registry, (roster or {}).values())
+    ]
+
+
+def _check_notebook(draw, original, notebook, exercises, correct, mistakes):
+    """Run one instructor notebook on the draw's data: the solution and each catalog entry, then the copy check."""
+    numbers = {e.number for e in exercises}
+    names = sorted({name for e in exercises for part in e.parts for name in (*e.names, *part.names())})
+    # the catalog's students read their rates off their own tables, unless the entry keeps them as written
+    entries = [("the solution", (), None, None, (), numbers, False)]
+    entries += [
+        (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not _keeps_rates(e))
+        for e in correct
+        if e.notebook == notebook and set(e.full) & numbers
+    ]
+    entries += [
+        (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not _keeps_rates(e))
+        for e in mistakes
+        if e.notebook == notebook and e.exercise in numbers
+    ]
+    for label, replace, part, hint, also, judged, reads in entries:
+        planted = _planted(original, replace, label)
+        planted = reading_rates(planted, draw.registry) if reads else planted
+        namespace = run_cells(with_values(planted, draw.values, notebook, draw.registry), names)
+        for number in sorted(judged):
+            _judge_entry(draw, namespace, number, label, part, (hint, also))
+        _close_figures()
+    # the solution on another student's data: caught, and its varied parts lost
+    if any(draw.other[e.number] != draw.values[e.number] for e in exercises):
+        namespace = run_cells(with_values(original, draw.other, notebook, draw.registry), names)
+        for exercise in exercises:
+            if draw.other[exercise.number] != draw.values[exercise.number]:
+                _judge_copy(draw, namespace, exercise)
+        _close_figures()
+
+
+def _judge_entry(draw, namespace, number, label, part, expected):
+    """Exercise `number` of one run of a notebook: full marks for the solution and a correct variation, exactly
+    `part` (and the parts of `expected`'s ``also``) lost for a slip, with its hint (`expected`'s first) said."""
+    hint, also = expected
+    verdict = draw.registry.check(number, namespace, seed=draw.seed, variant=draw.values[number])
+    failed = _failed(verdict)
+    if verdict.get("other_variant"):  # a notebook on its own data is never taken for a copy
+        draw.trouble(label, f"exercise {number}: its own data named another's")
+    if part is None and failed:
+        draw.trouble(label, f"exercise {number} lost {sorted(failed)}")
+    elif part is not None:
+        lost = {part} | {p for n, p in also if n == number}
+        if failed != lost:
+            draw.trouble(label, f"failed {sorted(failed)}, not {sorted(lost)}")
+        elif hint and hint not in _said(verdict, part):
+            draw.trouble(label, f"the feedback does not say {hint!r}")
+
+
+def _judge_copy(draw, namespace, exercise):
+    """The solution run on another student's data: named as a copy, and its varied parts lost."""
+    verdict = draw.registry.check(exercise.number, namespace, seed=draw.seed, variant=draw.values[exercise.number])
+    dependent = {part.name for part in exercise.parts if part.varied}
+    if not verdict.get("other_variant"):
+        draw.trouble("a copy", "another student's data is not named")
+    if not dependent <= _failed(verdict):
+        draw.trouble("a copy", f"{sorted(dependent - _failed(verdict))} pass on another's data")

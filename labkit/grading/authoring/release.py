@@ -62,9 +62,7 @@ def strip_solutions(source, where="cell", stub=STUB):
 
 def release_notebook(nb, name="notebook"):
     """The student version of an instructor notebook (a new object)."""
-    import nbformat  # the [grade] extra
-
-    student = nbformat.from_dict(json.loads(json.dumps(nb)))
+    student = copy_notebook(nb)
     student.metadata.pop("widgets", None)
     for index, cell in enumerate(student.cells):
         if cell.cell_type == "code":
@@ -104,11 +102,32 @@ def with_values(nb, values, name="notebook", registry=LAB):
     the grader derives each student's values from the roster, never from the
     notebook.
     """
-    import nbformat
+    copy = copy_notebook(nb)
+    wanted, params = _assignments(values, name, registry)
+    done = set()
+    for index, cell in enumerate(copy.cells):
+        if cell.cell_type == "code" and variant_data.DATA_TAG in cell.metadata.get("tags", []):
+            done |= _assign(cell, f"{name}, cell {index}", wanted, params)
+    missing = sorted(set(wanted) - done)
+    if missing:
+        raise InputError(
+            f"{name} has no data cell assigning {', '.join(missing)}: add a code cell tagged "
+            f"{variant_data.DATA_TAG!r} with `{missing[0]} = <the lab's value>`."
+        )
+    return copy
 
-    copy = nbformat.from_dict(json.loads(json.dumps(nb)))
-    wanted = {}  # notebook name -> the text its assignment gets
-    params = set()  # those of them that are parameters: assigned a plain number
+
+def copy_notebook(nb):
+    """A deep copy of notebook `nb`, as nbformat's own node."""
+    import nbformat  # the [grade] extra
+
+    return nbformat.from_dict(json.loads(json.dumps(nb)))
+
+
+def _assignments(values, name, registry):
+    """({name: the text its assignment gets}, the names among them that are parameters: assigned a plain number)
+    for the exercises of notebook `name`."""
+    wanted, params = {}, set()
     for number, given in values.items():
         exercise = registry.exercises.get(int(number))
         if exercise is None or exercise.notebook != name:
@@ -119,43 +138,37 @@ def with_values(nb, values, name="notebook", registry=LAB):
                 params.add(param.name)
         if exercise.derived is not None and all(param.name in given for param in exercise.params):
             wanted.update(exercise.derived(given))
-    done = set()
-    for index, cell in enumerate(copy.cells):
-        if cell.cell_type != "code" or variant_data.DATA_TAG not in cell.metadata.get("tags", []):
-            continue
-        try:
-            tree = ast.parse(cell.source)
-        except SyntaxError:
-            raise InputError(f"{name}, cell {index}: a data cell must be plain Python assignments.") from None
-        pieces = re.split(r"(\r\n|\r|\n)", cell.source)  # the line breaks ast counts, kept as they were
-        lines, breaks = pieces[0::2], pieces[1::2]
-        edits = []
-        for node in tree.body:
-            if (
-                isinstance(node, ast.Assign)
-                and len(node.targets) == 1
-                and isinstance(node.targets[0], ast.Name)
-                and node.targets[0].id in wanted
-            ):
-                target = node.targets[0].id
-                value = node.value
-                if value.lineno != value.end_lineno:
-                    raise InputError(f"{name}, cell {index}: {target} must be assigned on one line.")
-                if target in params and not _number(value):
-                    raise InputError(f"{name}, cell {index}: {target} must be assigned a number, as `{target} = 1.15`.")
-                edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
-                done.add(target)
-        for line, start, end, text in sorted(edits, reverse=True):
-            row = lines[line].encode("utf-8")  # ast's offsets count bytes
-            lines[line] = (row[:start] + text.encode("utf-8") + row[end:]).decode("utf-8")
-        cell.source = "".join(line + brk for line, brk in zip(lines, [*breaks, ""]))
-    missing = sorted(set(wanted) - done)
-    if missing:
-        raise InputError(
-            f"{name} has no data cell assigning {', '.join(missing)}: add a code cell tagged "
-            f"{variant_data.DATA_TAG!r} with `{missing[0]} = <the lab's value>`."
-        )
-    return copy
+    return wanted, params
+
+
+def _assign(cell, where, wanted, params):
+    """Put the `wanted` texts in one data cell's one-line assignments (in place); the names it assigned."""
+    try:
+        tree = ast.parse(cell.source)
+    except SyntaxError:
+        raise InputError(f"{where}: a data cell must be plain Python assignments.") from None
+    pieces = re.split(r"(\r\n|\r|\n)", cell.source)  # the line breaks ast counts, kept as they were
+    lines, breaks = pieces[0::2], pieces[1::2]
+    edits, done = [], set()
+    for node in tree.body:
+        if (
+            isinstance(node, ast.Assign)
+            and len(node.targets) == 1
+            and isinstance(node.targets[0], ast.Name)
+            and node.targets[0].id in wanted
+        ):
+            target, value = node.targets[0].id, node.value
+            if value.lineno != value.end_lineno:
+                raise InputError(f"{where}: {target} must be assigned on one line.")
+            if target in params and not _number(value):
+                raise InputError(f"{where}: {target} must be assigned a number, as `{target} = 1.15`.")
+            edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
+            done.add(target)
+    for line, start, end, text in sorted(edits, reverse=True):
+        row = lines[line].encode("utf-8")  # ast's offsets count bytes
+        lines[line] = (row[:start] + text.encode("utf-8") + row[end:]).decode("utf-8")
+    cell.source = "".join(line + brk for line, brk in zip(lines, [*breaks, ""]))
+    return done
 
 
 def _number(node):

@@ -1,10 +1,8 @@
-"""The LMSs a class comes from and goes back to: one module per LMS, behind the interface :class:`Lms`.
+"""The LMSs a class comes from and goes back to: one module per LMS, whose ``LMS`` is an :class:`Lms`.
 
-Run in the instructor's process: ``labkit grade`` reads the class as its LMS gives it (:mod:`.intake`, with the
-safe unzip :mod:`.unzip`), ``labkit export`` writes the grades for it (:mod:`.exports`), ``labkit feedback`` the
-feedback zip (:mod:`.delivery`); ``labkit release`` and ``labkit variants`` read the roster (:mod:`.roster`).
-An LMS is a module here that exposes ``LMS``, an instance of an :class:`Lms`: :mod:`.folders`, :mod:`.nbgrader`,
-:mod:`.canvas`, :mod:`.moodle`. :func:`systems` finds them all, so adding an LMS is adding its module.
+:func:`systems` finds them all, so adding an LMS is adding its module. Run in the instructor's process:
+:mod:`.intake` reads a class (with the safe unzip :mod:`.unzip`), :mod:`.exports` writes grades, :mod:`.delivery`
+the feedback zip, :mod:`.roster` the roster.
 """
 
 from __future__ import annotations
@@ -20,13 +18,10 @@ from ..store.report import one_line
 class Lms:
     """One LMS: its download recognised and read, its grade export, its feedback zip, its roster keys.
 
-    ``name`` is its layout (``Student.layout``, the run's record, ``labkit feedback --layout``), ``aliases`` other
-    layouts it hands feedback back for. ``rank`` orders recognition: a name several LMSs claim is the lowest
-    rank's. A ``sole`` LMS takes the class when it claims any entry at its top (nbgrader's ``submitted``); a
-    ``rest`` one claims only what no other claims (a folder per student). ``depth`` is the levels of a path in a
-    class zip that name its student; ``assignments`` whether ``--assignment`` picks among several; ``download``
-    and ``counted`` name its download and its entries in messages; ``keys`` are the roster keys its grade import
-    takes, the default first; ``steps`` say how the feedback zip goes to the LMS.
+    ``name`` is its layout, ``aliases`` others it hands feedback back for. ``rank`` orders recognition (a name
+    several claim is the lowest rank's); a ``sole`` LMS takes the class when it claims any entry at its top, a
+    ``rest`` one what no other claims. ``depth`` is the levels of a class zip's path that name its student;
+    ``download`` and ``counted`` name it in messages; ``keys`` are its roster keys, the default first.
     """
 
     name = ""
@@ -70,8 +65,7 @@ class Lms:
         return {"lms id": student.lms_id, "file": student.lms_file}
 
     def feedback_names(self, name, entry):
-        """The feedback zip's members that hold the page of `name` (`entry`: :meth:`remember`'s); ValueError
-        when the entry lacks what the LMS needs."""
+        """The feedback zip's members for `name`'s page (`entry`: :meth:`remember`'s); ValueError if it lacks some."""
         raise NotImplementedError
 
     def feedback(self, name, entry, page):
@@ -84,7 +78,7 @@ class Lms:
 
 
 def systems() -> list[Lms]:
-    """Every LMS of this package (each module's ``LMS``), in the order of recognition.
+    """Every LMS of this package, in the order of recognition.
 
     >>> [lms.name for lms in systems()]
     ['nbgrader', 'moodle', 'canvas', 'folders']

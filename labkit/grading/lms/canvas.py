@@ -1,24 +1,15 @@
 """Canvas: its "Download Submissions", its gradebook export filled in, its "Re-upload submissions".
 
 The download names each file ``{name}[_LATE]_{user id}_{file id}_{display name}`` (canvas-lms's
-``lib/content_zipper.rb``; real names in mikewesthad/canvas-unzipper's README and canvas-lms issue #2406):
-``{name}`` is the sortable name lower-cased with all but letters, digits and ``_`` dropped (``lovelaceada``), the
-display name as uploaded; anonymous grading is assumed to write ``anon_{anonymous id}``. Both ends are the
-student's choice, so a name can have several readings (:func:`canvas_readings`); :func:`resolve_canvas` takes the
-one the user's other files confirm, else the one whose user is on the roster, else none, and says so. The files
-are grouped per user id, under their original names; the student is ``{name}`` (``{name}_{user id}`` for
-namesakes). A file uploaded again is renamed ``name-1.ext`` (students' reports: nus-cs2103 forum #361, IIC1253
-issue #26): of one name the newest only is kept, under the original name.
+``lib/content_zipper.rb``): ``{name}`` is the sortable name lower-cased, word characters only (``lovelaceada``);
+anonymous grading writes ``anon_{id}``. Both ends are the student's choice, so a name can read several ways
+(:func:`canvas_readings`, settled by :func:`resolve_canvas`). A file uploaded again is renamed ``name-1.ext``:
+the newest is kept, under the original name. The student is ``{name}`` (``{name}_{user id}`` for namesakes).
 
-The gradebook (Canvas's Instructor Guide, "How do I import grades in the Gradebook?"; canvas-lms's
-``lib/gradebook_importer.rb``): the student columns, closed by ``Section``; an assignment per column, ``Title
-(number)``; read-only totals; maybe a ``Muted`` row and the ``Points Possible`` row before the students. Canvas
-finds a student by ``ID``, ``SIS User ID`` or ``SIS Login ID``, and makes a **new assignment** of a header it does
-not know, so :func:`to_canvas` writes the export as it was with one assignment column filled in, and refuses a
-``--column`` that names none unless ``--new-column`` adds it on purpose.
-
-The feedback: "Re-upload submissions" reads the user and file ids as the download wrote them
-(``Assignment#infer_comment_context_from_filename``), so each page is ``{a file's download prefix}_feedback.html``.
+The gradebook (canvas-lms's ``lib/gradebook_importer.rb``): student columns closed by ``Section``, an assignment
+per column ``Title (number)``, read-only totals, maybe ``Muted`` and ``Points Possible`` rows. Canvas makes a
+**new assignment** of a header it does not know, so :func:`to_canvas` fills one existing column unless
+``--new-column``. The feedback page is ``{a file's download prefix}_feedback.html`` ("Re-upload submissions").
 """
 
 from __future__ import annotations
@@ -39,24 +30,18 @@ from .roster import csv_rows, first_row, read_roster, read_text
 
 KEYS = ("ID", "SIS User ID", "SIS Login ID")
 STUDENT_COLUMNS = ("Student", "ID", "SIS User ID", "SIS Login ID", "Integration ID", "Root Account", "Section")
-# headers the Canvas importer takes for totals, and ignores (a group's, and the "Unposted" ones, contain these)
+# headers the Canvas importer takes for totals, and ignores
 TOTALS = re.compile(
     "Current Score|Current Points|Current Grade|Final Score|Final Points|Final Grade|"
     "Override Score|Override Grade|Override Status"
 )
 TEST_STUDENT = "Student, Test"  # the row of the test student Canvas adds to every course ("Test Student")
 MAX_LISTED = 20  # assignment columns named in a message
-FIX = (
-    "give the file that Canvas's Grades > Export > Export Entire Gradebook downloads, as it is "
-    "(or saved from a spreadsheet as 'CSV UTF-8')."
-)
+FIX = "give Canvas's Grades > Export > Export Entire Gradebook file as it is (or saved as 'CSV UTF-8')."
 REUPLOAD = re.compile(r"^(?P<stem>.+)-(?P<number>[1-9][0-9]?)(?P<ext>\.[^.]+)?$", re.DOTALL)
 _FIXED = re.compile(r"(?=(_LATE)?_([0-9]+)_([0-9]+)_(.))", re.DOTALL)
 _ANON = re.compile(r"^(LATE_)?(anon(?:ymous)?)(_LATE)?_([A-Za-z0-9]+)_([0-9]+)_(.+)$", re.DOTALL)
 _NOT_WORD = re.compile(r"\W")
-
-
-# ---------------------------------------------------------------------------------------------- whose file
 
 
 @dataclass(frozen=True)
@@ -70,8 +55,7 @@ class Reading:
     file: str
 
     @property
-    def prefix(self):
-        """What every file of this user starts with."""
+    def prefix(self):  # what every file of this user starts with
         return (self.login, self.late, self.uid)
 
 
@@ -114,9 +98,8 @@ def _padded(number):
 
 
 def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
-    """{file name: its Reading, or None when it is no one's} and notes for the instructor.
-
-    `names` are a download's file names; `roster_ids` the roster's ids (Canvas user ids), if any.
+    """{file name: the Reading its user's other files confirm, else the one whose user is among `roster_ids`,
+    else None} and notes.
 
     >>> names = ["ada_1001_5_a.ipynb", "ada_1001_7_hw_1_2_c.ipynb"]
     >>> resolve_canvas(names)[0]["ada_1001_7_hw_1_2_c.ipynb"] is None  # user 1001, or user 1 named ada_1001_7_hw?
@@ -146,21 +129,14 @@ def _choose(name, found, settled, roster, notes):
         left = [r for r in left if r.uid in roster] or left
     if len(left) == 1:
         others = ", ".join(f"user {one_line(r.uid, 20)} ({one_line(r.login, 60)})" for r in found if r != left[0])
-        notes.append(
-            f"file {shown}: filed under user {one_line(left[0].uid, 20)} by its id; its name, which a student "
-            f"chooses, could also be read as {others}"
-        )
+        notes.append(f"file {shown}: filed under user {one_line(left[0].uid, 20)} by its id; it could also be {others}")
         return left[0]
     readings = ", ".join(f"user {one_line(r.uid, 20)} ({one_line(r.login, 60)})" for r in left or found)
     notes.append(
-        f"file {shown}: filed to no one: its name, which a student chooses, reads as {readings}, and nothing "
-        "tells which (a --roster settles it when only one of those users is on it); ask the student to rename the "
-        "file, and grade it alone"
+        f"file {shown}: filed to no one: its name reads as {readings} (a --roster with one of them settles it); "
+        "ask the student to rename the file, and grade it alone"
     )
     return None
-
-
-# ---------------------------------------------------------------------------------------------- the LMS
 
 
 class Canvas(Lms):
@@ -245,21 +221,16 @@ def _pieces(login, files, notes):
         number, path, given, _ = versions[-1]
         if len(versions) > 1:
             dropped = ", ".join(one_line(v[2], 80) for v in versions[:-1])
-            notes.append(
-                f"{one_line(login, 80)}: kept {one_line(given, 80)} (the newest upload) as "
-                f"{one_line(original, 80)}; older: {dropped}"
-            )
+            kept = f"kept {one_line(given, 80)} (the newest upload) as {one_line(original, 80)}"
+            notes.append(f"{one_line(login, 80)}: {kept}; older: {dropped}")
         pieces.append((Path(safe_part(original)), path))
     return pieces
 
 
-# ---------------------------------------------------------------------------------------------- the gradebook
-
-
 @dataclass
 class CanvasGradebook:
-    """A Canvas gradebook export, as read: its first row, every further row (each as long as the header, empty
-    lines empty), its separator and line ending, whether it had a byte-order mark, and the index of ``Section``."""
+    """A Canvas gradebook export as read: its header, its rows (padded to the header), its CSV dialect, and the
+    index of ``Section``."""
 
     header: list
     rows: list
@@ -269,8 +240,7 @@ class CanvasGradebook:
     section: int
 
     def kind(self, row: list) -> str:
-        """``"points"`` for the Points Possible row, ``"muted"`` for a row that only marks hidden grades
-        (or an empty line), else ``"student"``."""
+        """``"points"``, ``"muted"`` (a row marking hidden grades, or an empty one) or ``"student"``."""
         if row and "Points Possible" in row[0]:
             return "points"
         if all(re.fullmatch(r"\s*(Muted|Manual Posting.*)?\s*", cell, re.IGNORECASE) for cell in row):
@@ -288,9 +258,7 @@ class CanvasGradebook:
 
 
 def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
-    """A Canvas gradebook export (comma or semicolon separated, UTF-8, a byte-order mark allowed), checked to be
-    one: ValueError when it is not UTF-8 CSV, its header does not begin with ``Student``, ``ID`` or has no
-    ``Section`` closing the student columns, or a row has more cells than the header."""
+    """A Canvas gradebook export (UTF-8 CSV, comma or semicolon separated); ValueError when it is not one."""
     text, bom, newline = read_text(path, "the Canvas gradebook", FIX)
     for delimiter in (",", ";"):
         if [cell.strip() for cell in first_row(text, delimiter)][:2] == ["Student", "ID"]:
@@ -298,37 +266,23 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
     else:
         found = ", ".join(repr(one_line(c, 40)) for c in first_row(text, ",")[:6]) or "nothing"
         raise InputError(
-            f"{path} is not a Canvas gradebook export: its header must begin with the columns 'Student' and "
-            f"'ID' (it begins with {found}); {FIX}"
+            f"{path} is not a Canvas gradebook export: its header begins with {found}, not 'Student' and 'ID'; {FIX}"
         )
     rows = csv_rows(text, path, delimiter, FIX)
     header = rows[0]
     section = next((i for i, cell in enumerate(header) if cell.strip() == "Section"), None)
     if section is None or any(cell.strip() not in STUDENT_COLUMNS for cell in header[:section]):
-        raise InputError(
-            f"{path} has no 'Section' column after the student columns (Student, ID, SIS User ID, SIS Login ID), "
-            f"which Canvas needs to import it; {FIX}"
-        )
+        raise InputError(f"{path} has no 'Section' column after the student columns, which Canvas needs; {FIX}")
     width, body = len(header), []
     for number, row in enumerate(rows[1:], start=2):
         if row and len(row) > width and any(cell.strip() for cell in row[width:]):
-            raise InputError(
-                f"{path}, row {number} has {len(row)} cells but the header only {width}: a cell with an unquoted "
-                f"separator? {FIX}"
-            )
+            raise InputError(f"{path}, row {number} has {len(row)} cells but the header only {width}; {FIX}")
         body.append(row[:width] + [""] * (width - len(row)) if row else row)
     return CanvasGradebook(header, body, delimiter, newline, bom, section)
 
 
 def assignment_columns(book: CanvasGradebook) -> list[str]:
-    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only.
-
-    >>> book = CanvasGradebook(
-    ...     ["Student", "ID", "Section", "Quiz 1 (501)", "Current Score"],
-    ...     [["    Points Possible", "", "", "10", "(read only)"]], ",", "\\n", False, 2)
-    >>> assignment_columns(book)
-    ['Quiz 1 (501)']
-    """
+    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only."""
     points_row = book.points_row()
     return [
         cell.strip()
@@ -346,24 +300,21 @@ def _assignment_column(book, column, path):
     found = [i for i, cell in enumerate(book.header) if i > book.section and pattern.fullmatch(cell.strip())]
     if len(found) > 1:
         names = ", ".join(repr(book.header[i]) for i in found)
+        example = repr(book.header[found[0]].strip())
         raise InputError(
-            f"{path} has {len(found)} assignment columns named {column!r} ({names}); give the one to fill with its "
-            "number, e.g. --column " + repr(book.header[found[0]].strip()) + "."
+            f"{path} has {len(found)} assignment columns named {column!r} ({names}); e.g. --column {example}."
         )
     return found[0] if found else None
 
 
 def _assignments_text(book):
-    """The gradebook's assignment columns in words, for a message: bounded, each name on one printable line."""
+    """The gradebook's assignment columns in words, for a message."""
     names = assignment_columns(book)
     if not names:
         return "it has no assignment column yet"
     shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
     more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
     return f"its assignment columns are {shown}{more}"
-
-
-# ---------------------------------------------------------------------------------------------- the export
 
 
 def to_canvas(
@@ -377,15 +328,9 @@ def to_canvas(
     new_column: bool = False,
     force: bool = False,
 ) -> Export:
-    """Fill one assignment column of the Canvas `gradebook` export with the grades' totals, into `out` (and its
-    summary), matching students through `roster` on the gradebook's `key` column.
-
-    `column` is the assignment's title, with or without Canvas's ``(number)``. A title the gradebook lacks is
-    refused (a typo would become a new assignment in Canvas), unless `new_column` adds it at the end, worth the
-    rubric's full credit; `new_column` with a title it has is refused too (Canvas would fill that assignment).
-    `force` replaces an existing `out`. ValueError (and nothing written) for bad input, a `key` the export lacks,
-    two rows with one id, an ambiguous or read-only column, no student matched, or an output that is an input.
-    """
+    """Fill the assignment `column` of the Canvas `gradebook` with the grades' totals into `out` (and its summary),
+    matching students through `roster` on the `key` column; ValueError, and nothing written, for bad input. A
+    `column` it lacks is refused (a typo would be a new assignment in Canvas) unless `new_column`."""
     if key not in KEYS:
         raise InputError(f"--key for Canvas is one of {', '.join(KEYS)} (a gradebook column); got {key!r}.")
     by_name, export = start(grades, out, "Canvas", column)
@@ -393,14 +338,14 @@ def to_canvas(
     book = read_canvas(gradebook)
     check_outputs(export, [gradebook, roster], force)
     at_key = _key_column(book, key, gradebook)
-    full_credit = by_name[next(iter(by_name))].rubric.full_credit
+    full_credit = next(iter(by_name.values())).rubric.full_credit
     target = _target(book, export, gradebook, full_credit, new_column)
     students = _students_by_key(book, at_key, key, gradebook, entries_, export)
     matched = match(export, by_name, entries_, students)
     if not matched:
         raise InputError(
-            f"no submission of the results matched a row of {gradebook} through the roster {roster}: are the "
-            f"roster's ids the gradebook's {key!r} values (--key), and its submissions the names in grades.csv?"
+            f"no submission of the results matched a row of {gradebook} through the roster {roster}: give the "
+            f"gradebook's {key!r} values (--key) as the roster's ids, and grades.csv's names as its submissions."
         )
     roster_ids = set(entries_.values())
     for value, row in students.items():
@@ -412,10 +357,8 @@ def to_canvas(
             row[target] = book.number(by_name[name].total)
             export.exported[name] = (value, by_name[name].total)
     if any(total > full_credit for _, total in export.exported.values()):
-        export.notes.append(
-            f"note: some totals are above full credit ({points_text(full_credit)}) with extra credit; "
-            "Canvas takes them as they are."
-        )
+        full = points_text(full_credit)
+        export.notes.append(f"note: some totals are above full credit ({full}) with extra credit; Canvas takes them.")
     write([book.header, *book.rows], out, delimiter=book.delimiter, newline=book.newline, bom=book.bom)
     write_summary(export, entries_, by_name)
     return export
@@ -425,10 +368,8 @@ def _key_column(book, key, path):
     """The index of the `key` column among the gradebook's student columns."""
     header = [cell.strip() for cell in book.header]
     if key not in header[: book.section]:
-        raise InputError(
-            f"{path} has no {key!r} column (its student columns are {', '.join(header[: book.section + 1])}); "
-            "export the gradebook with that column, or match the roster on another with --key."
-        )
+        columns = ", ".join(header[: book.section + 1])
+        raise InputError(f"{path} has no {key!r} column (it has {columns}); export it with one, or give another --key.")
     return header.index(key)
 
 
@@ -436,22 +377,17 @@ def _target(book, export, path, full_credit, new_column):
     """The index of the assignment column to fill: the export's column, or a new one at the end."""
     column = export.column
     if TOTALS.search(column) or column.strip() in STUDENT_COLUMNS:
-        raise InputError(
-            f"Canvas reads a column named {column!r} as a student column or a total, never as an assignment; "
-            "give the assignment another name with --column."
-        )
+        raise InputError(f"Canvas reads {column!r} as a student column or a total: give another --column.")
     target = _assignment_column(book, column, path)
     if target is None and not new_column:
         raise InputError(
             f"{path} has no assignment column named {column!r}; {_assignments_text(book)}. Give one of them with "
-            "--column (its title, with or without the number), or pass --new-column to add a column of that name "
-            "on purpose (Canvas then creates a new assignment when the file is imported)."
+            "--column, or --new-column to add one on purpose (Canvas then creates a new assignment)."
         )
     if target is not None and new_column:
         raise InputError(
-            f"{path} already has the assignment column {one_line(book.header[target], 80)!r}, which "
-            f"--column {column!r} names (Canvas would fill that assignment, not make a new one): leave out "
-            "--new-column to fill it, or give the new assignment another name with --column."
+            f"{path} already has the assignment column {one_line(book.header[target], 80)!r} that --column "
+            f"{column!r} names: leave out --new-column to fill it, or give the new assignment another --column."
         )
     if target is None:
         book.header.append(column)
@@ -463,25 +399,19 @@ def _target(book, export, path, full_credit, new_column):
     points_row = book.points_row()
     possible = points_row[target].strip() if points_row else ""
     if "read only" in possible.lower():
-        raise InputError(
-            f"the column {book.header[target]!r} of {path} is read-only in Canvas (a total); "
-            "give an assignment's column with --column."
-        )
+        raise InputError(f"the column {book.header[target]!r} of {path} is read-only in Canvas: give another --column.")
     try:
         differs = possible and float(possible.replace(",", ".")) != full_credit
     except ValueError:
         differs = False
     if differs:
-        export.notes.append(
-            f"note: {book.header[target]!r} is worth {possible} points in Canvas, the rubric's full credit is "
-            f"{points_text(full_credit)}: the totals are written as they are."
-        )
+        worth = f"is worth {possible} points in Canvas, {points_text(full_credit)} in the rubric"
+        export.notes.append(f"note: {book.header[target]!r} {worth}: the totals are written as they are.")
     return target
 
 
 def _students_by_key(book, at_key, key, path, roster, export):
-    """{the key's value: its row} of the gradebook's students; Canvas's test student and a row without the key
-    are listed in `export`."""
+    """{the key's value: its row} of the gradebook's students; the test student and rows without it in `export`."""
     students: dict = {}
     rows_of: dict = {}
     for number, row in enumerate(book.rows, start=2):
@@ -489,10 +419,8 @@ def _students_by_key(book, at_key, key, path, roster, export):
             continue
         value = row[at_key].strip()
         if value in students:
-            raise InputError(
-                f"{path} has two rows with {key} {one_line(value, 60)!r} (rows {rows_of[value]} and "
-                f"{number}); export the gradebook again, or match on another column with --key."
-            )
+            lines = f"rows {rows_of[value]} and {number}"
+            raise InputError(f"{path} has two rows with {key} {one_line(value, 60)!r} ({lines}); give another --key.")
         if row[0].strip() == TEST_STUDENT and value not in set(roster.values()):
             export.notes.append(f"note: Canvas's test student ({TEST_STUDENT!r}) is in the gradebook; left as it is.")
         elif not value:  # a student without this id: no roster entry can name it

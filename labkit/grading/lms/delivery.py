@@ -1,8 +1,5 @@
-"""Feedback back to the students through the LMS, with no server: ``labkit feedback OUT`` writes
-``OUT/feedback-upload.zip``, each student's ``feedback.html`` named as the LMS the class came from names it
-(:meth:`~labkit.grading.lms.Lms.feedback`). The run's record knows the layout the class came in and what
-names each student's files there (:func:`remember`, called by ``labkit grade``).
-"""
+"""Feedback back through the LMS: ``OUT/feedback-upload.zip``, each student's page named as the class's LMS names
+it (:meth:`~labkit.grading.lms.Lms.feedback`), from what the run's record kept (:func:`remember`)."""
 
 from __future__ import annotations
 
@@ -18,8 +15,7 @@ UPLOAD = "feedback-upload.zip"
 
 
 def remember(out, intake) -> None:
-    """Enter in `out`'s run record the layout the class came in and each student's names in the LMS
-    (`intake`, an :class:`~labkit.grading.lms.intake.Intake`); a resumed run's earlier students are kept."""
+    """Record in `out` the layout of `intake` and each student's names in the LMS; a resumed run's are kept."""
     record = records.read(out)
     earlier = record.delivery.get("students", {}) if record.delivery.get("layout") == intake.layout else {}
     lms = named(intake.layout)
@@ -29,9 +25,7 @@ def remember(out, intake) -> None:
 
 
 def write_upload(out, layout=None) -> tuple[Path, list[str], list[str]]:
-    """``OUT/feedback-upload.zip`` of a run: (its path, the members written, notes on students left out).
-
-    `layout` overrides the recorded one (``folders`` for a run that recorded none)."""
+    """Write ``OUT/feedback-upload.zip`` for `layout` (or the recorded one): (its path, members, notes)."""
     out = Path(out)
     layout = layout_of(out, layout)
     lms = named(layout)

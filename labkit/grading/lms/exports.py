@@ -1,12 +1,9 @@
-"""Grades into the LMS: what every LMS's export shares; its own file is its module's (:func:`.canvas.to_canvas`,
-:func:`.moodle.to_moodle`; :func:`export` by the LMS's name).
+"""Grades into the LMS: what every LMS's export shares (each LMS module writes its own file).
 
-An export writes, for each student the roster (:mod:`.roster`) matches, the **total under the rubric**
-(``grades.csv``'s ``total``); a submission that could not be graded gets no number, never a zero. Nothing is
-dropped silently: every student who got nothing is listed (:meth:`Export.problems`) and in a summary CSV beside
-the output, with the total of every graded submission, to enter by hand. Bad input raises a ValueError saying
-what to fix, and nothing is written; the output never replaces an input, nor an existing file unless ``force``,
-and is renamed into place when complete.
+An export writes the **total under the rubric** of each student the roster matches; an ungraded submission gets
+no number, never a zero. Every student who got nothing is listed (:meth:`Export.problems`) and in a summary CSV
+beside the output. Bad input writes nothing; the output never replaces an input, nor an existing file unless
+``force``, and is renamed into place when complete.
 """
 
 from __future__ import annotations
@@ -28,10 +25,9 @@ SUMMARY_HEADER = ["submission", "id", "points", "status"]
 
 @dataclass
 class Export:
-    """What an export wrote (`path`, for the LMS `lms`, the points in `column`; `summary_path`) and what it could
-    not match: `exported` {submission: (id, points)}; `not_graded` {submission: why}; `not_in_roster`
-    [submission]; `no_submission`, roster entries without a result, and `not_in_lms`, those no gradebook row has,
-    [(submission, id)]; `lms_only`, gradebook rows with no roster entry, [(name, id)]; `notes` needing no action."""
+    """What an export wrote (`exported` {submission: (id, points)}) and what it could not match: `not_graded`
+    {submission: why}, `not_in_roster` [submission], `no_submission` and `not_in_lms` (roster entries without a
+    result, or a gradebook row) [(submission, id)], `lms_only` (gradebook rows with no roster entry) [(name, id)]."""
 
     path: Path
     summary_path: Path
@@ -53,12 +49,7 @@ class Export:
         return len(names) + len(self.lms_only)
 
     def problems(self) -> list[str]:
-        """One printable line per student who got no points from this export, and why.
-
-        >>> e = Export(Path("g.csv"), Path("g-summary.csv"), "Moodle", "labkit", not_in_roster=["ada\\x1b[2J"])
-        >>> e.problems()
-        ['no roster entry, nothing exported: ada\\ufffd[2J']
-        """
+        """One printable line per student who got no points from this export, and why."""
         gradebook = f"the {self.lms} gradebook"
         lines = [
             f"not graded, no points exported: {one_line(name, 80)} ({one_line(reason, 200)})"
@@ -75,17 +66,14 @@ class Export:
 
     def summary(self) -> str:
         """What was written, in a few lines for a terminal."""
-        lines = [
-            f"wrote {self.path}: the totals of {len(self.exported)} student(s) in the column "
-            f"{one_line(self.column, 80)!r}, for {self.lms}'s grade import",
-        ]
+        column, where = one_line(self.column, 80), self.summary_path
+        wrote = f"wrote {self.path}: the totals of {len(self.exported)} student(s) in the column {column!r}, for "
+        lines = [f"{wrote}{self.lms}'s grade import"]
         if self.listed:
-            lines.append(
-                f"{self.listed} student(s) got nothing from this file (listed above, and in {self.summary_path}): "
-                "enter their grades by hand or fix the roster and export again"
-            )
+            nothing = f"{self.listed} student(s) got nothing from this file (listed above, and in {where})"
+            lines.append(f"{nothing}: enter their grades by hand or fix the roster and export again")
         else:
-            lines.append(f"every submission and roster entry matched; the summary is in {self.summary_path}")
+            lines.append(f"every submission and roster entry matched; the summary is in {where}")
         return "\n".join(lines + self.notes)
 
 
@@ -95,21 +83,13 @@ def export(layout: str, grades: list[SubmissionGrade], roster, out, **options) -
 
 
 def default_file(results_dir: str | os.PathLike, lms: str) -> Path:
-    """Where ``labkit export`` writes when not told: ``<folder>-<lms>.csv`` beside the run's ``--out`` folder.
-
-    >>> default_file("/course/grades", "canvas").as_posix()
-    '/course/grades-canvas.csv'
-    """
+    """Where ``labkit export`` writes when not told: ``<folder>-<lms>.csv`` beside the run's ``--out`` folder."""
     folder = Path(results_dir).resolve()
     return folder.with_name(f"{folder.name}-{lms}.csv")
 
 
 def summary_file(path: str | os.PathLike) -> Path:
-    """The summary CSV that goes with an export file.
-
-    >>> summary_file("/course/grades-canvas.csv").as_posix()
-    '/course/grades-canvas-summary.csv'
-    """
+    """The summary CSV that goes with an export file: ``grades-canvas.csv``'s is ``grades-canvas-summary.csv``."""
     path = Path(path)
     return path.with_name(f"{path.stem}-summary.csv")
 
@@ -118,14 +98,10 @@ def start(grades, out, lms, column):
     """({submission: grade}, the Export to fill) once `column` and `grades` are checked."""
     if not isinstance(column, str) or not column.strip() or column != one_line(column, 200):
         raise InputError(
-            f"the column name {one_line(column, 80)!r} must be one line of text, at most 200 characters; "
-            "give the assignment's name with --column."
+            f"the column name {one_line(column, 80)!r} must be one line of 200 characters at most: fix --column."
         )
     if column.startswith(FORMULA_START):
-        raise InputError(
-            f"the column name {column!r} starts like a spreadsheet formula ({column[0]!r}); give the assignment "
-            "another name with --column."
-        )
+        raise InputError(f"the column name {column!r} starts like a spreadsheet formula: give another --column.")
     by_name = {}
     for grade in grades:
         if not isinstance(grade, SubmissionGrade):
@@ -141,20 +117,17 @@ def check_outputs(export, inputs, force):
     for path in (export.path, export.summary_path):
         for source in inputs:
             if path.resolve() == Path(source).resolve():
-                raise InputError(
-                    f"{path} is an input of this export; it is never overwritten: give --out another file name."
-                )
+                raise InputError(f"{path} is an input of this export; it is never overwritten: give another --out.")
         if not path.parent.is_dir():
             raise InputError(f"the folder {path.parent} does not exist: create it, or give --out another path.")
         if path.exists() and not force:
             raise InputError(
-                f"{path} already exists (an earlier export?); give --out another file name, or --force to replace it."
+                f"{path} already exists (an earlier export?); give another --out, or --force to replace it."
             )
 
 
 def match(export, by_name, roster, rows=None):
-    """{id: submission} of the roster's entries with a submission (and, given the gradebook's `rows` by id, a row);
-    the others listed in `export`."""
+    """{id: submission} of the roster entries with a submission (and a row of `rows`, if given); others in `export`."""
     for name, grade in by_name.items():
         if name not in roster:
             export.not_in_roster.append(name)
@@ -189,8 +162,7 @@ def write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
 
 
 def write_summary(export, roster, by_name):
-    """The summary beside the export: a row per submission, per roster entry without a submission, per
-    unmatched gradebook row."""
+    """The summary beside the export: a row per submission, roster entry without one, and unmatched gradebook row."""
     rows = [SUMMARY_HEADER]
     missing_in_lms = {name for name, _ in export.not_in_lms}
     for name, grade in by_name.items():

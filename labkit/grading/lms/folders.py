@@ -1,9 +1,5 @@
-"""A folder per student: ``CLASS/<student>/…/*.ipynb``, the notebooks at any depth (within
-:data:`~.intake.MAX_DEPTH`); a zip in a student's folder is unpacked. A notebook at the top of ``CLASS`` is a
-student of its own, named after the file (``alice.ipynb`` is ``alice``), as ``labkit grade`` names it.
-
-Feedback: ``{submission}/feedback.html`` in the zip, which unpacks over the class folder.
-"""
+"""A folder per student: ``CLASS/<student>/…/*.ipynb`` (a zip in it unpacked), or a notebook ``CLASS/alice.ipynb``
+for the student ``alice``. Feedback: ``{submission}/feedback.html``, a zip that unpacks over the class folder."""
 
 from __future__ import annotations
 
@@ -44,9 +40,8 @@ class Folders(Lms):
             elif entry.is_dir(follow_symlinks=False):
                 students.append(builder.from_folder(name, Path(entry.path), "folders", key=("folders", name)))
             elif entry.is_file(follow_symlinks=False) and name.endswith(".ipynb"):
-                student = name[: -len(".ipynb")]
-                refused = builder.refusal(student, "folders", ("folders", name))
-                students.append(refused or Student(student, Path(entry.path), None, "folders"))
+                student = Student(name[: -len(".ipynb")], Path(entry.path), None, "folders")
+                students.append(builder.refusal(student, ("folders", name)) or student)
             else:
                 builder.notes.append(f"ignored {one_line(name)}: not a student's folder or notebook")
         return students

@@ -1,12 +1,9 @@
 """The class as the LMS hands it over: one folder or one zip becomes a list of students.
 
-Nothing is graded here, and nothing is written but in the grader's `workspace`; the class folder is only read,
-and no link is ever followed. Which LMS a download is comes from the names at its top (:func:`detect`). A zip
-given as the class is a container: its members are sorted out by student from the LMS's part of their names
-before anything is written, and each student's are checked and unpacked on that student's own budget
-(:class:`~.unzip.UnpackLimits`, over all their files and zips): a member that breaks a rule makes its student
-one who could not be graded, never refuses the class. A student's name is data, never a path
-(:func:`~labkit.grading.store.report.safe_name` names what is made for them).
+Only the grader's `workspace` is written, and no link is followed. Which LMS a download is comes from the names at
+its top (:func:`detect`). A class zip's members are sorted out by student before anything is written, and each
+student's are unpacked on their own budget (:class:`~.unzip.UnpackLimits`, over all their files and zips): a
+member that breaks a rule leaves its student ungraded, never the class. A student's name is data, never a path.
 """
 
 from __future__ import annotations
@@ -38,10 +35,8 @@ FIX = (
 
 @dataclass(frozen=True)
 class Student:
-    """One student of the class: the submission's `name` (grades.csv's, the roster's), the folder or notebook
-    to grade (`path`, maybe in the workspace) or None and the `failure` why not, the `layout` (the LMS's name, or
-    ``listed``), the LMS's own id, whether the LMS marked it late, and how the LMS names the student's files
-    (`lms_file`, Canvas's ``{name}[_LATE]_{user}_{file}``, to hand feedback back)."""
+    """One student: the submission's `name`, the `path` to grade or None and the `failure` why not, the `layout`
+    (the LMS's name, or ``listed``), the LMS's id, its late mark, and how it names the student's files."""
 
     name: str
     path: Path | None
@@ -65,9 +60,6 @@ class Intake:
         return [s for s in self.students if s.path is not None]
 
 
-# ---------------------------------------------------------------------------------------------- reading folders
-
-
 def entries(folder):
     """The entries of `folder` worth looking at, in name order; links never followed."""
     try:
@@ -85,7 +77,7 @@ def walk(folder, notes=None):
         for entry in entries(current):
             seen += 1
             if seen > MAX_FILES:
-                raise InputError(f"{as_text(str(folder))} holds more than {MAX_FILES} files; a submission is a few.")
+                raise InputError(f"{_shown(folder)} holds more than {MAX_FILES} files; a submission is a few.")
             if entry.is_symlink():
                 if notes is not None:
                     notes.append(f"ignored {one_line(as_text(entry.path))}: a link (links are never followed)")
@@ -115,10 +107,8 @@ def _no_notebook(names):
 
 
 class Builder:
-    """Turns one student's files (a folder, loose files, zips) into a Student, writing only in the workspace.
-
-    An LMS module's ``students`` reads its download with it: :meth:`from_folder` and :meth:`from_files` make the
-    student, ``notes`` gathers what to tell the instructor, ``roster_ids`` are the roster's ids."""
+    """Turns one student's files (a folder, loose files, zips) into a Student, writing only in the workspace;
+    an LMS's ``students`` reads its download with it, and tells the instructor in ``notes``."""
 
     def __init__(self, workspace, limits, notes, zip_depth):
         self.workspace = workspace
@@ -139,54 +129,58 @@ class Builder:
         """An entry's name as the LMS gave it."""
         return self.aliases.get(entry.name) or as_text(entry.name)
 
-    def refusal(self, name, layout, key, lms_id=None, late=False):
-        """The student `key` as one who could not be graded, when the class zip's members of theirs were refused."""
+    def on_disk(self, name):
+        """The name a class zip's top-level `name` is written under."""
+        return next((alias for alias, given in self.aliases.items() if given == name), name)
+
+    def refusal(self, student, key):
+        """`student` as one who could not be graded when the class zip's members of theirs were refused, or None."""
         why = self.refused.get(key)
-        return None if why is None else Student(name, None, why, layout, lms_id, late)
+        return None if why is None else dataclasses.replace(student, path=None, failure=why)
 
     def from_folder(self, name, folder, layout, lms_id=None, late=False, keep=(), key=None):
         """A student whose work is the folder `folder` (read only): graded in place unless it holds zips."""
-        key = key if key is not None else (layout, name)
-        if refused := self.refusal(name, layout, key, lms_id, late):
+        who, key = Student(name, None, None, layout, lms_id, late), key or (layout, name)
+        if refused := self.refusal(who, key):
             return refused
         try:
             files = walk(folder, self.notes)
         except ValueError as exc:
-            return Student(name, None, f"{exc} {FIX}", layout, lms_id, late)
+            return dataclasses.replace(who, failure=f"{exc} {FIX}")
         relative = [f.relative_to(folder).as_posix() for f in files]
         zips = [(f.relative_to(folder), f) for f in files if f.suffix.lower() == ".zip"]
         if not zips:
             if not any(f.suffix == ".ipynb" for f in files):
-                return Student(name, None, _no_notebook(as_text(r) for r in relative), layout, lms_id, late)
-            return Student(name, Path(folder), None, layout, lms_id, late)
+                return dataclasses.replace(who, failure=_no_notebook(as_text(r) for r in relative))
+            return dataclasses.replace(who, path=Path(folder))
         pieces = [(f.relative_to(folder), f) for f in files if f.suffix == ".ipynb" or f.name in keep]
-        return self._assemble(name, (pieces, zips, relative), layout, lms_id, late, key)
+        return self._assemble(who, (pieces, zips, relative), key)
 
     def from_files(self, name, pieces, layout, lms_id=None, late=False, key=None):
         """A student given as loose files: `pieces` pairs the name to give each with its path."""
-        key = key if key is not None else (layout, name)
-        if refused := self.refusal(name, layout, key, lms_id, late):
+        who, key = Student(name, None, None, layout, lms_id, late), key or (layout, name)
+        if refused := self.refusal(who, key):
             return refused
         zips = [(relative, path) for relative, path in pieces if path.suffix.lower() == ".zip"]
         shown = [as_text(relative.as_posix()) for relative, _ in pieces]
         gradable = [(relative, path) for relative, path in pieces if path.suffix == ".ipynb"]
-        return self._assemble(name, (gradable, zips, shown), layout, lms_id, late, key)
+        return self._assemble(who, (gradable, zips, shown), key)
 
-    def _assemble(self, name, given, layout, lms_id, late, key):
+    def _assemble(self, who, given, key):
         pieces, zips, shown = given
         if not pieces and not zips:
-            return Student(name, None, _no_notebook(shown), layout, lms_id, late)
-        target = free(self.workspace / "students" / safe_name(name))
+            return dataclasses.replace(who, failure=_no_notebook(shown))
+        target = free(self.workspace / "students" / safe_name(who.name))
         target.mkdir(parents=True)
         try:
-            self._fill(name, target, pieces, zips, key)
-            if not any(f.suffix == ".ipynb" for f in walk(target)):
-                shutil.rmtree(target, ignore_errors=True)
-                return Student(name, None, _no_notebook(shown), layout, lms_id, late)
+            self._fill(who.name, target, pieces, zips, key)
+            failure = None if any(f.suffix == ".ipynb" for f in walk(target)) else _no_notebook(shown)
         except (ValueError, OSError) as exc:
+            failure = f"{one_line(as_text(str(exc)), 400)} {FIX}"
+        if failure is not None:
             shutil.rmtree(target, ignore_errors=True)
-            return Student(name, None, f"{one_line(as_text(str(exc)), 400)} {FIX}", layout, lms_id, late)
-        return Student(name, target, None, layout, lms_id, late)
+            return dataclasses.replace(who, failure=failure)
+        return dataclasses.replace(who, path=target)
 
     def _fill(self, name, target, pieces, zips, key):
         """Copy the student's notebooks into `target` and unpack their zips there, all on the student's budget."""
@@ -195,26 +189,19 @@ class Builder:
             destination = free(target / relative)
             destination.parent.mkdir(parents=True, exist_ok=True)
             size = os.lstat(path).st_size
+            shown = one_line(as_text(str(relative)))
             if size > limits.max_member:
-                raise InputError(
-                    f"{one_line(as_text(str(relative)))} is larger than {size_text(limits.max_member)}; "
-                    "labkit does not copy it."
-                )
+                raise InputError(f"{shown} is larger than {size_text(limits.max_member)}; labkit does not copy it.")
             shutil.copyfile(path, destination, follow_symlinks=False)
             budget.total += 0 if budget.in_class else size  # the class zip's members were counted when unpacked
             if budget.total > limits.max_total:
-                raise InputError(
-                    f"{one_line(as_text(str(relative)))}: more than {size_text(limits.max_total)} in all; "
-                    f"labkit takes at most {size_text(limits.max_total)} from one student."
-                )
+                most = size_text(limits.max_total)
+                raise InputError(f"{shown}: more than {most} in all; labkit takes at most {most} from one student.")
         for relative, archive in zips:
             folder = free(target / relative.parent / safe_part(relative.stem))
             folder.parent.mkdir(parents=True, exist_ok=True)
-            unzip.unpack_into(archive, folder, limits, self.zip_depth, budget)
+            unzip.unpack(archive, folder, limits, self.zip_depth, budget)
             self.notes.append(f"{one_line(name, 80)}: unpacked {one_line(as_text(relative.as_posix()), 80)}")
-
-
-# ---------------------------------------------------------------------------------------------- which LMS
 
 
 def _kind(entry):
@@ -229,8 +216,7 @@ def _named(name, kind):
 
 
 def detect(root):
-    """The LMS (:class:`~labkit.grading.lms.Lms`) whose download the folder `root` is; ValueError saying what
-    is there when none fits, or several do."""
+    """The LMS whose download the folder `root` is; ValueError saying what is there when none or several fit."""
     for lms in systems():
         if lms.whole(root):
             return lms
@@ -238,9 +224,8 @@ def detect(root):
 
 
 def detect_tops(tops, where):
-    """The LMS of a download whose top holds `tops` ([(name, "dir" | "file" | "link")]), from the names each
-    LMS claims: a sole LMS's name decides; a name several claim is the lowest rank's when it is all they have; a
-    folder per student takes what no one claims. ValueError saying what is there when none fits, or several do."""
+    """The LMS of a download whose top holds `tops` ([(name, kind)]): a sole LMS's name decides; a name several
+    claim is the lowest rank's when it is all they have; a ``rest`` LMS takes what no one claims."""
     found = systems()
     for lms in found:
         if lms.sole and any(lms.claims(name, kind) for name, kind in tops):
@@ -259,30 +244,14 @@ def detect_tops(tops, where):
     expected = ", ".join(lms.download for lms in found[:-1]) + f" or {found[-1].download} (a folder or its zip)"
     if not fits:
         shown = ", ".join(one_line(name, 64) for name, _ in tops[:SHOWN]) or "nothing"
-        raise InputError(
-            f"{one_line(where)} holds no students ({shown}); expected {expected}: see docs/instructors.md."
-        )
+        raise InputError(f"{one_line(where)} holds no students ({shown}); expected {expected} (docs/instructors.md).")
     what = ", ".join(lms.described(sorted(claimed[lms])) for lms in found if lms in claimed)
-    raise InputError(
-        f"{one_line(where)} mixes layouts ({what}); expected one of {expected}. "
-        "Give a folder that holds one of them only."
-    )
+    raise InputError(f"{one_line(where)} mixes layouts ({what}); expected one of {expected}. Give one of them only.")
 
 
 def is_class(path: str | os.PathLike) -> bool:
-    """Whether `path` is a whole class (a zip, or a folder in one of the layouts) rather than one student's work.
-
-    A folder that holds notebooks itself, not named as an LMS names a download's files, is one student's
-    submission (``labkit grade submitted/alice``); so is a notebook. Every other folder, and every zip, is a
-    class. A folder that holds both notebooks of its own and folders of notebooks is refused with a ValueError:
-    which of the two it is cannot be told.
-
-    >>> import pathlib, tempfile
-    >>> root = pathlib.Path(tempfile.mkdtemp())
-    >>> (root / "alice").mkdir(); _ = (root / "alice" / "02_convergence.ipynb").write_text("{}")
-    >>> is_class(root), is_class(root / "alice"), is_class(root / "alice" / "02_convergence.ipynb")
-    (True, False, False)
-    """
+    """Whether `path` is a class (a zip, or a folder of an LMS's layout) rather than one student's notebooks;
+    ValueError for a folder of both notebooks (not named as an LMS names them) and folders of notebooks."""
     path = Path(path)
     try:
         info = os.lstat(path)
@@ -304,22 +273,14 @@ def is_class(path: str | os.PathLike) -> bool:
                 folders = True
     if loose and folders:
         raise InputError(
-            f"{one_line(as_text(str(path)))} holds notebooks of its own and folders of notebooks, so it could be a "
-            "class or one student's work: for a class, list its students (labkit grade --out OUT -- "
-            f"{one_line(as_text(str(path)), 60)}/*); for one student, give the notebooks one by one."
+            f"{_shown(path)} holds notebooks and folders of notebooks, so it could be a class or one student's work: "
+            f"list a class's students (labkit grade --out OUT -- {_shown(path, 60)}/*), or one student's notebooks."
         )
     return not loose
 
 
-# ---------------------------------------------------------------------------------------------- the class zip
-
-
 def _class_zip(path, root, builder):
-    """Unpack the class's zip into the folder `root` student by student, each on their own budget; its LMS.
-
-    The zip is a container: its members are sorted out by whose they are (from the LMS's part of their names)
-    before anything is written, and each student's are checked and extracted on that student's budget. A member
-    that breaks a rule refuses its student only (``builder.refused``), never the class."""
+    """Unpack the class's zip into the folder `root` student by student, each on their own budget; its LMS."""
     label = as_text(path.name)
     with unzip.open_zip(path, label) as archive:
         members = [
@@ -353,8 +314,7 @@ def _unwrap(members):
 
 
 def _zip_tops(members, builder):
-    """[(name, kind)] of the top of the class zip, as the LMS gave them; a name too long to write gets a short
-    one on disk (``builder.aliases``)."""
+    """[(name, kind)] of the top of the class zip; a name too long to write gets a short one (``builder.aliases``)."""
     kinds: dict = {}
     for info, parts in members:
         folder = len(parts) > 1 or info.is_dir()
@@ -383,25 +343,18 @@ def _by_owner(lms, members, tops, builder):
 
 
 def _student_plan(key, items, builder, label, skip):
-    """The checked members of one student (see :func:`~.unzip.checked`), or None when one breaks a limit (then
-    ``builder.refused[key]`` says why)."""
+    """The checked members of one student, or None when one breaks a limit (``builder.refused[key]`` says why)."""
     budget = builder.budget(key)
     budget.in_class = True
-    budget.members += len(items)
-    disk = {name: alias for alias, name in builder.aliases.items()}
     parts_of = {id(info): parts for info, parts in items}
 
     def checked_parts(info):
         unzip.member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
         parts = parts_of[id(info)]
-        return [disk.get(parts[0], parts[0]), *parts[1:]]
+        return [builder.on_disk(parts[0]), *parts[1:]]
 
     try:
-        if budget.members > budget.limits.max_members:
-            raise InputError(
-                f"{label}: more than {budget.limits.max_members} members are this student's; labkit extracts at "
-                f"most {budget.limits.max_members} for one student."
-            )
+        unzip.count_members(budget, len(items), label)
         return unzip.checked([info for info, _ in items], budget, label, checked_parts)
     except ValueError as exc:
         builder.refused[key] = f"{exc} {FIX}"
@@ -420,20 +373,16 @@ def _check_space(lms, plans, root, label):
     largest = sorted(sizes, key=lambda key: -sizes[key])[:SHOWN]
     shown = ", ".join(f"{lms.shown(key)} ({size_text(sizes[key])})" for key in largest)
     raise InputError(
-        f"{label} unpacks to {size_text(sum(sizes.values()))}, and only {size_text(free_bytes)} is free in {root} "
-        f"(labkit keeps {size_text(SPARE)} spare); the largest students are {shown}. Free some space, or grade those "
-        "students apart."
+        f"{label} unpacks to {size_text(sum(sizes.values()))}, only {size_text(free_bytes)} is free in {root} (with "
+        f"{size_text(SPARE)} spare); the largest students are {shown}. Free some space, or grade those apart."
     )
 
 
 def _extract_student(archive, key, plan, root, builder, label):
     """Write one student's checked members under `root` on their budget; on a refusal remove them again."""
-    budget, written, made = builder.budget(key), [], []
+    written, made = [], []
     try:
-        for info, parts, is_dir, shown in plan:
-            unzip.make_dirs(root, parts if is_dir else parts[:-1], made, label, shown)
-            if not is_dir:
-                unzip.extract(archive, info, root.joinpath(*parts), budget, label, shown, written)
+        unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
     except ValueError as exc:
         unzip.undo(None, written, made)
         builder.refused[key] = f"{exc} {FIX}"
@@ -443,18 +392,14 @@ def _placeholder(root, key, items, depth, builder):
     """For a refused student, empty stand-ins of what names them at the top, so that the layout finds them."""
     if key not in builder.refused:
         return
-    disk = {name: alias for alias, name in builder.aliases.items()}
     folders = {tuple(p[:depth]) for info, p in items if len(p) > depth or (len(p) == depth and info.is_dir())}
     files = {tuple(p) for _, p in items if len(p) == 1 and depth == 1} - folders
     for parts in sorted(folders)[:SHOWN]:
-        (root / disk.get(parts[0], parts[0])).joinpath(*parts[1:]).mkdir(parents=True, exist_ok=True)
+        (root / builder.on_disk(parts[0])).joinpath(*parts[1:]).mkdir(parents=True, exist_ok=True)
     for (name,) in sorted(files)[:SHOWN]:
-        target = root / disk.get(name, name)
+        target = root / builder.on_disk(name)
         if not os.path.lexists(target):
             target.touch()
-
-
-# ---------------------------------------------------------------------------------------------- the class
 
 
 def find_class(
@@ -465,39 +410,22 @@ def find_class(
     limits: UnpackLimits = LIMITS,
     roster: dict[str, str] | None = None,
 ) -> Intake:
-    """The students of the class in `path`, one folder or one zip as an LMS of :func:`~labkit.grading.lms.systems`
-    gives it, in name order; one that cannot be graded has ``path=None`` and the reason in ``failure``.
+    """The students of the class in `path` (a folder or zip of one LMS), in name order; one that cannot be graded
+    has ``path=None`` and the reason in ``failure``, and never stops the others.
 
-    `workspace` is a folder the caller owns (and deletes), not inside `path`: every zip is unpacked and every
-    folder made there, nothing anywhere else. `assignment` is nbgrader's to take when students have several;
-    `limits` what one student's files and zips may hold in all; `roster` ({submission: LMS id}, ``--roster``)
-    names a student the LMS gives an id the roster has as the roster names that id, whatever their display name.
-    ValueError when no layout fits or they are mixed, two students would share a name, an nbgrader assignment
-    must be picked, or the class's zip cannot be read or has no room. One student's upload never stops the others.
-
-    >>> import pathlib, tempfile
-    >>> top = pathlib.Path(tempfile.mkdtemp())
-    >>> for student in ("bob", "alice"):
-    ...     (top / "class" / student).mkdir(parents=True)
-    ...     _ = (top / "class" / student / "02_convergence.ipynb").write_text("{}")
-    >>> (top / "class" / "carol").mkdir()
-    >>> _ = (top / "class" / "carol" / "notes.pdf").write_bytes(b"%PDF")
-    >>> intake = find_class(top / "class", top / "work")
-    >>> intake.layout, [(s.name, s.failure) for s in intake.students]
-    ('folders', [('alice', None), ('bob', None), ('carol', 'holds no notebook (it holds notes.pdf)')])
+    Everything is written in `workspace` (the caller's, not inside `path`). `assignment` is nbgrader's to take;
+    `limits` what one student's files and zips may hold in all; `roster` ({submission: LMS id}) names a student
+    whose LMS id it has. ValueError when the layout is unclear, two students share a name, or the zip has no room.
     """
     path, workspace = Path(path), Path(workspace)
     try:
         info = os.lstat(path)
     except FileNotFoundError:
-        raise InputError(f"{one_line(as_text(str(path)))} does not exist.") from None
+        raise InputError(f"{_shown(path)} does not exist.") from None
     if stat.S_ISLNK(info.st_mode):
-        raise InputError(f"{one_line(as_text(str(path)))} is a symbolic link; give the folder or zip itself.")
+        raise InputError(f"{_shown(path)} is a symbolic link; give the folder or zip itself.")
     if stat.S_ISDIR(info.st_mode) and workspace.resolve().is_relative_to(path.resolve()):
-        raise InputError(
-            f"the workspace {one_line(as_text(str(workspace)))} is inside the class folder; "
-            "labkit writes nothing there: give a workspace elsewhere."
-        )
+        raise InputError(f"the workspace {_shown(workspace)} is inside the class folder: give a workspace elsewhere.")
     workspace.mkdir(parents=True, exist_ok=True)
     own = Path(tempfile.mkdtemp(prefix="intake-", dir=workspace))
     notes: list[str] = []
@@ -518,19 +446,16 @@ def _class_root(path, info, own, builder):
     if stat.S_ISDIR(info.st_mode):
         return path, detect(path)
     if not stat.S_ISREG(info.st_mode) or path.suffix.lower() != ".zip":
-        raise InputError(f"{one_line(as_text(str(path)))} is neither a folder nor a zip; give the class as one.")
+        raise InputError(f"{_shown(path)} is neither a folder nor a zip; give the class as one.")
     root = own / "class"
     root.mkdir()
     lms = _class_zip(path, root, builder)
-    builder.notes.append(
-        f"unpacked {one_line(as_text(path.name))} into the workspace, each student's files on their own"
-    )
+    builder.notes.append(f"unpacked {one_line(as_text(path.name))} into the workspace, each student's files apart")
     return root, lms
 
 
 def _by_roster(students, roster, notes):
-    """The students named by the roster wherever the LMS gave them an id the roster has (the id decides, never a
-    display name); one whose id it lacks keeps a name no roster entry has."""
+    """The students named by the roster from their LMS id (never a display name), or a name no roster entry has."""
     names = {key: name for name, key in roster.items()}
     with_ids = [s for s in students if s.lms_id is not None]
     if not any(s.lms_id in names for s in with_ids):
@@ -542,10 +467,8 @@ def _by_roster(students, roster, notes):
         name = names.get(student.lms_id) if student.lms_id is not None else student.name
         if name is None:
             name = student.name if student.name not in roster else f"{student.name}_{student.lms_id}"
-            notes.append(
-                f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)}) is not on the roster: "
-                f"graded as {one_line(name, 80)}"
-            )
+            who = f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)})"
+            notes.append(f"{who} is not on the roster: graded as {one_line(name, 80)}")
         renamed.append(dataclasses.replace(student, name=name))
     return renamed
 
@@ -554,27 +477,25 @@ def _one_name_each(students):
     by_name: dict = {}
     for student in students:
         if student.name in by_name:
-            raise InputError(
-                f"two students are both named {one_line(student.name, 80)!r} "
-                f"({_origin(by_name[student.name])} and {_origin(student)}); rename one so that each name is one "
-                "student."
-            )
+            origins = f"{_origin(by_name[student.name])} and {_origin(student)}"
+            raise InputError(f"two students are both named {one_line(student.name, 80)!r} ({origins}); rename one.")
         by_name[student.name] = student
 
 
 def _origin(student):
     if student.lms_id is not None:
         return f"{student.layout} id {one_line(student.lms_id, 40)}"
-    return one_line(as_text(str(student.path)), 120) if student.path is not None else student.layout
+    return _shown(student.path, 120) if student.path is not None else student.layout
+
+
+def _shown(path, width=200):
+    """A path for a message: one printable line."""
+    return one_line(as_text(str(path)), width)
 
 
 def find_students(paths, workspace, *, limits: UnpackLimits = LIMITS) -> Intake:
-    """The students of submissions listed one by one (``labkit grade alice/ bob/ carol.ipynb``).
-
-    Each folder is one student, named after it, whose zips are unpacked into `workspace` (as in
-    :func:`find_class`); a folder with no notebook, even in its zips, is a student with nothing to grade.
-    A notebook, a link or a path that is neither is passed on as it is, for the grader to take or refuse.
-    """
+    """The students of submissions listed one by one (``labkit grade alice/ bob/ carol.ipynb``): each folder is
+    one (its zips unpacked in `workspace`); anything else is passed on as it is, for the grader to take or refuse."""
     workspace = Path(workspace)
     workspace.mkdir(parents=True, exist_ok=True)
     builder = Builder(Path(tempfile.mkdtemp(prefix="listed-", dir=workspace)), limits, [], 0)

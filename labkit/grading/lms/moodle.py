@@ -1,17 +1,13 @@
 """Moodle: its "Download all submissions", a file for its "Import grades from CSV", its feedback files zip.
 
-The download (``mod/assign``'s ``download_submissions``) prefixes each file with the full name, every ``_`` made a
-space, and the participant id (the one blind marking shows): a folder ``{Full Name}_{id}_assignsubmission_
-{plugin}_`` per plugin, or without folders ``{Full Name}_{id}_assignsubmission_{plugin}_{file}``. The student is
-``{Full Name}_{id}``, so namesakes stay apart.
+The download (``mod/assign``'s ``download_submissions``) names a folder ``{Full Name}_{id}_assignsubmission_
+{plugin}_`` per plugin, or files ``{Full Name}_{id}_assignsubmission_{plugin}_{file}`` (``_`` in the name made a
+space, the id the participant id). The student is ``{Full Name}_{id}``, so namesakes stay apart.
 
-The grade import (MoodleDocs, "Grade import"; ``grade/import/csv/classes/load_data.php``) maps the id column to
-"ID number" or "Email address" (``--key``). A row whose user Moodle cannot find stops the whole import, so the
-ids must fit the key: emails under ``email``, none under ``idnumber``. An empty cell would erase a hand-entered
-grade, so only graded students are written. With ``--feedback`` a ``Feedback`` column holds the points in words
-(the grade first, a late penalty then explained) and the student's feedback text.
-
-The feedback (``mod/assign/feedback/file/importziplib.php``): ``{full name}_{id}_assignfeedback_file_/feedback.html``.
+The grade import (``grade/import/csv/classes/load_data.php``) maps the id column to "ID number" or "Email
+address" (``--key``); a user Moodle cannot find stops the whole import, and an empty cell would erase a grade, so
+ids must fit the key and only graded students are written. ``--feedback`` adds the points in words and the
+feedback text. The feedback zip: ``{full name}_{id}_assignfeedback_file_/feedback.html``.
 """
 
 from __future__ import annotations
@@ -42,10 +38,7 @@ class Moodle(Lms):
     download = "Moodle's download"
     counted = "named as Moodle names submissions"
     keys = tuple(KEYS)
-    steps = (
-        "upload it in Moodle: the assignment's 'View all submissions', 'Upload multiple feedback files "
-        "in a zip' (with the 'Feedback files' feedback type on)"
-    )
+    steps = "upload it in Moodle: the assignment's 'View all submissions', 'Upload multiple feedback files in a zip'"
 
     def claims(self, name, kind):
         return _match(name, kind) is not None
@@ -112,12 +105,9 @@ def to_moodle(
     feedback: bool = False,
     force: bool = False,
 ) -> Export:
-    """Write `out`, a CSV for Moodle's "Import grades from CSV" (and its summary): a row per graded student on
-    `roster`, whose ids are the Moodle user field `key` (``idnumber`` or ``email``, the first column's header),
-    the totals in `column`, with `feedback` a ``Feedback`` column. `force` replaces an existing `out`. ValueError
-    (and nothing written) for bad input, ids that do not fit `key` or start like a formula, no student to write,
-    or an output that is an input.
-    """
+    """Write `out` for Moodle's "Import grades from CSV" (and its summary): a row per graded student on `roster`,
+    whose ids are the user field `key`, the totals in `column`, with `feedback` a ``Feedback`` column. `force`
+    replaces an existing `out`. ValueError, and nothing written, for bad input."""
     if key not in KEYS:
         raise InputError(f"--key for Moodle is idnumber or email (the user field of the roster's ids); got {key!r}.")
     by_name, export = start(grades, out, "Moodle", column)
@@ -131,17 +121,14 @@ def to_moodle(
             rows.append([value, points_text(grade.total)] + ([_feedback_cell(grade)] if feedback else []))
             export.exported[name] = (value, grade.total)
     if not export.exported:
-        raise InputError(
-            f"no graded submission of the results is on the roster {roster}: are its submissions the names in "
-            "grades.csv?"
-        )
-    full_credit = by_name[next(iter(by_name))].rubric.full_credit
-    top = max(total for _, total in export.exported.values())
-    if top > full_credit:
+        raise InputError(f"no graded submission of the results is on the roster {roster}: give grades.csv's names.")
+    full_credit = next(iter(by_name.values())).rubric.full_credit
+    highest = max(total for _, total in export.exported.values())
+    if highest > full_credit:
+        top = points_text(highest)
         export.notes.append(
-            f"note: totals reach {points_text(top)}, above full credit ({points_text(full_credit)}), with extra "
-            f"credit: give the Moodle grade item a maximum of at least {points_text(top)} (above 100, Moodle needs "
-            "the site settings 'unlimitedgrades' and 'gradepointmax')."
+            f"note: totals reach {top}, above full credit ({points_text(full_credit)}), with extra credit: give the "
+            f"Moodle grade item a maximum of at least {top} (above 100, with 'unlimitedgrades' and 'gradepointmax')."
         )
     write(rows, out)
     write_summary(export, entries_, by_name)
@@ -149,34 +136,27 @@ def to_moodle(
 
 
 def _check_ids(entries_, roster, key):
-    """Refuse ids Moodle would not find under `key`: not emails under ``email``, emails under ``idnumber``
-    (all of them, or some among ID numbers), and ids that start like a formula."""
+    """Refuse ids Moodle would not find under `key` (not emails under ``email``, emails under ``idnumber``) and
+    ids that start like a formula."""
     for name, value in entries_.items():
+        gives = f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}"
         if key == "email" and not EMAIL.fullmatch(value):
-            raise InputError(
-                f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which is not an "
-                "email address: with --key email every id is one (or use --key idnumber)."
-            )
+            raise InputError(f"{gives}, which is not an email address: give one, or --key idnumber.")
         if value.startswith(FORMULA_START):
-            raise InputError(
-                f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}, which starts like "
-                "a spreadsheet formula; correct the roster."
-            )
+            raise InputError(f"{gives}, which starts like a spreadsheet formula; correct the roster.")
     emails = [name for name, value in entries_.items() if EMAIL.fullmatch(value)]
     if key != "idnumber" or not emails:
         return
     if len(emails) == len(entries_):
         raise InputError(
-            f"the roster {roster} holds email addresses (e.g. {_examples(entries_, emails)}), not ID numbers, and "
-            "--key idnumber (the default) would write them into Moodle's ID number column: give --key email, "
-            "or give the students' ID numbers in the roster."
+            f"the roster {roster} holds email addresses (e.g. {_examples(entries_, emails)}), not ID numbers for "
+            "Moodle's ID number column (--key idnumber): give --key email, or the students' ID numbers."
         )
     others = [name for name in entries_ if name not in emails]
     raise InputError(
-        f"the roster {roster} mixes email addresses ({len(emails)} of {len(entries_)}: "
-        f"{_examples(entries_, emails)}) with other ids (e.g. {_examples(entries_, others)}); with --key idnumber "
-        "(the default) every id is an ID number: correct those rows, or give every student's email address with "
-        "--key email."
+        f"the roster {roster} mixes email addresses ({len(emails)} of {len(entries_)}: {_examples(entries_, emails)}) "
+        f"with other ids (e.g. {_examples(entries_, others)}) under --key idnumber: correct those rows, or give "
+        "every email address with --key email."
     )
 
 
@@ -187,7 +167,7 @@ def _examples(entries_, names):
 
 
 def points_in_words(grade):
-    """The points in words, first the grade written beside them (after any late penalty), then how it was made.
+    """The points in words: the grade (after any late penalty), then how it was made.
 
     >>> from labkit.grading.store.report import SubmissionGrade
     >>> points_in_words(SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}}))
@@ -210,8 +190,7 @@ def points_in_words(grade):
 
 
 def _feedback_cell(grade):
-    """The feedback cell: the points in words on the first line, then the student's whole feedback text,
-    printable, bounded, and never read as a formula (as :func:`csv_cell`, keeping its lines)."""
+    """The points in words, then the student's feedback text, bounded and never read as a formula."""
     if not grade.graded:
         return csv_cell(points_in_words(grade))
     whole = f"{points_in_words(grade)}\n\n{text(build(grade))}"

@@ -1,12 +1,7 @@
-"""nbgrader: ``COURSE/submitted/<student>/<assignment>/*.ipynb`` (or ``submitted/`` itself).
-
-The student's id is the name, and the path is the assignment's folder, so nbgrader's ``timestamp.txt`` stays
-where :mod:`~labkit.grading.store.late` looks for it. With several assignments, ``--assignment`` picks one.
-
-Feedback: ``{student}/feedback.html``, and nbgrader's own feedback folder, ``feedback/{student}/{assignment}/
-{notebook}.html`` with the submission's ``timestamp.txt`` and ``submission_secret.txt``, which ``nbgrader
-release_feedback`` hands to the student's ``nbgrader fetch_feedback``.
-"""
+"""nbgrader: ``COURSE/submitted/<student>/<assignment>/*.ipynb``; the path is the assignment's folder, so
+``timestamp.txt`` stays where :mod:`~labkit.grading.store.late` looks. Feedback: ``{student}/feedback.html`` and
+``feedback/{student}/{assignment}/{notebook}.html`` with the submission's timestamp and secret, for ``nbgrader
+release_feedback``."""
 
 from __future__ import annotations
 
@@ -60,10 +55,9 @@ class Nbgrader(Lms):
             else:
                 missing.append(name)
         if missing:
+            shown = ", ".join(one_line(m, 64) for m in sorted(missing)[:10]) + (" …" if len(missing) > 10 else "")
             builder.notes.append(
-                f"{len(missing)} student(s) in submitted/ without {one_line(assignment, 60)!r}: "
-                + ", ".join(one_line(m, 64) for m in sorted(missing)[:10])
-                + (" …" if len(missing) > 10 else "")
+                f"{len(missing)} student(s) in submitted/ without {one_line(assignment, 60)!r}: {shown}"
             )
         return students
 
@@ -115,17 +109,13 @@ def _chosen(submitted, found, assignment):
     assignments = sorted({a for per in found.values() for a in per})
     where = as_text(str(submitted))
     if not assignments:
-        raise InputError(
-            f"{where} holds no assignment folders: nbgrader's layout is submitted/<student>/<assignment>/*.ipynb."
-        )
+        raise InputError(f"{where} holds no assignment folders: nbgrader's is submitted/<student>/<assignment>/.")
     if assignment is None and len(assignments) > 1:
         shown = ", ".join(one_line(n, 64) for n in assignments)
         raise InputError(f"{where} holds several assignments ({shown}); pass --assignment NAME to grade one.")
     if assignment is not None and assignment not in assignments:
-        raise InputError(
-            f"no student of {where} submitted {one_line(assignment, 60)!r}; "
-            f"the assignments there are {', '.join(one_line(a, 60) for a in assignments)}."
-        )
+        there = ", ".join(one_line(a, 60) for a in assignments)
+        raise InputError(f"no student of {where} submitted {one_line(assignment, 60)!r}; the assignments are {there}.")
     return assignment if assignment is not None else assignments[0]
 
 

@@ -1,9 +1,5 @@
-"""The roster, and reading the CSV files an instructor gives (the roster, an LMS's gradebook).
-
-The roster joins each submission's name (``grades.csv``'s) to the student's identifier in the LMS: a CSV file
-(UTF-8, a byte-order mark allowed; commas, semicolons or tabs) with the columns ``submission`` and ``id``, each
-value once. Which identifier ``id`` is is the LMS's roster key (:attr:`~labkit.grading.lms.Lms.keys`, ``--key``).
-"""
+"""The roster, and reading the CSV files an instructor gives: the roster joins each submission's name to the
+student's id in the LMS (a UTF-8 CSV with the columns ``submission`` and ``id``; ``id`` is the LMS's ``--key``)."""
 
 from __future__ import annotations
 
@@ -56,10 +52,8 @@ def first_row(text, delimiter):
 
 
 def read_roster(path: str | os.PathLike) -> dict[str, str]:
-    """The roster at `path`: {submission name: the student's identifier in the LMS}, in the file's order, both
-    without surrounding spaces. Its header names the columns ``submission`` and ``id`` (any case and order, other
-    columns ignored). ValueError when the file cannot be read, is not UTF-8 CSV, lacks a column, has a row with an
-    empty submission or id, names a submission or an id twice, or has no student.
+    """The roster at `path`: {submission name: the student's id in the LMS}, in the file's order; other columns
+    are ignored. ValueError when it is not UTF-8 CSV, lacks a column or a value, or names one twice.
 
     >>> import pathlib, tempfile
     >>> roster = pathlib.Path(tempfile.mkdtemp()) / "roster.csv"
@@ -75,9 +69,8 @@ def read_roster(path: str | os.PathLike) -> dict[str, str]:
     else:
         found = ", ".join(repr(one_line(c, 40)) for c in first_row(text, ",")[:8]) or "nothing"
         raise InputError(
-            f"the roster {path} needs a header row with the columns 'submission' (the names in grades.csv) "
-            f"and 'id' (the students' identifiers in the LMS); its first row has {found}. For example:\n"
-            "    submission,id\n    ada_lovelace,1815"
+            f"the roster {path} needs a header row with the columns 'submission' (the names in grades.csv) and 'id' "
+            f"(the students' ids in the LMS); its first row has {found}. For example:\n    submission,id\n    ada,1815"
         )
     for name in ("submission", "id"):
         if header.count(name) > 1:
@@ -94,19 +87,17 @@ def read_roster(path: str | os.PathLike) -> dict[str, str]:
         key = row[at_id].strip() if at_id < len(row) else ""
         if not name or not key:
             missing = "submission" if not name else "id"
-            raise InputError(
-                f"the roster {path}, row {number}: the {missing} is empty; give every student both, or delete the row."
-            )
+            raise InputError(f"the roster {path}, row {number}: the {missing} is empty; give both, or delete the row.")
         if name in roster:
+            lines = f"rows {lines_of[name]} and {number}"
             raise InputError(
-                f"the roster {path} names the submission {one_line(name, 80)!r} twice (rows {lines_of[name]} and "
-                f"{number}); keep one row per submission."
+                f"the roster {path} names the submission {one_line(name, 80)!r} twice ({lines}); keep one."
             )
         if key in names_of:
+            lines = f"rows {lines_of[names_of[key]]} and {number}"
+            both = f"{one_line(names_of[key], 60)!r} and {one_line(name, 60)!r}, {lines}"
             raise InputError(
-                f"the roster {path} gives the id {one_line(key, 60)!r} to two submissions "
-                f"({one_line(names_of[key], 60)!r} and {one_line(name, 60)!r}, rows {lines_of[names_of[key]]} and "
-                f"{number}); each student has one id: correct one of the rows."
+                f"the roster {path} gives the id {one_line(key, 60)!r} to two submissions ({both}); correct one."
             )
         roster[name], lines_of[name], names_of[key] = key, number, name
     if not roster:

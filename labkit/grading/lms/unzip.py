@@ -25,14 +25,8 @@ UNREADABLE = (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFEr
 
 @dataclass(frozen=True)
 class UnpackLimits:
-    """What :func:`unpack` extracts at most from one zip and the zips in it; in the class intake, what one
-    student's files and zips may hold in all: bytes (512 MiB), members, folders included (2000), the ratio of
-    uncompressed to compressed size of a member that grows past 1 MiB (100), bytes of one member (64 MiB), levels
-    of zips inside the zip (2: a zip in a zip in the zip).
-
-    >>> UnpackLimits().max_members, UnpackLimits(max_depth=0).max_depth
-    (2000, 0)
-    """
+    """What one student's files and zips may hold in all: bytes, members (folders included), the compression
+    ratio of a member past 1 MiB, bytes of one member, levels of zips inside the zip."""
 
     max_total: int = 512 << 20
     max_members: int = 2000
@@ -53,8 +47,7 @@ LIMITS = UnpackLimits()
 
 @dataclass
 class Budget:
-    """What one student (or one :func:`unpack` call) has spent, nested zips included; ``in_class``: the student's
-    files came in the class zip (counted as they were unpacked)."""
+    """What one student has spent, nested zips included (``in_class``: counted as the class zip was unpacked)."""
 
     limits: UnpackLimits
     members: int = 0
@@ -62,33 +55,21 @@ class Budget:
     in_class: bool = False
 
 
-def unpack(zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS) -> list[Path]:
-    """Extract `zip_path` into the folder `into`, refusing whatever could harm, and return the files written.
-
-    A member whose name is absolute, has a drive letter or a ``..``, a link, a device, and whatever breaks
-    `limits` (counted on the bytes really decompressed; the sizes a zip declares are checked first, never
-    trusted) refuse the zip: ValueError naming it and the rule, after removing what this call wrote. A zip inside
-    is unpacked in its place (``work.zip`` into a folder ``work``) on the same budget; ``__MACOSX/`` is skipped.
-    Nothing is written outside `into`, and no existing file is overwritten.
+def unpack(
+    zip_path: str | os.PathLike, into: str | os.PathLike, limits: UnpackLimits = LIMITS, depth=0, budget=None
+) -> list[Path]:
+    """Extract `zip_path` into `into` (its zips in their place, `depth` levels in, on `budget`), refusing whatever
+    could harm with a ValueError after removing what it wrote; the files written.
 
     >>> import pathlib, tempfile, zipfile
     >>> folder = pathlib.Path(tempfile.mkdtemp())
     >>> with zipfile.ZipFile(folder / "work.zip", "w") as z:
-    ...     z.writestr("lab/02_convergence.ipynb", "{}")
-    >>> [p.relative_to(folder).as_posix() for p in unpack(folder / "work.zip", folder / "out")]
-    ['out/lab/02_convergence.ipynb']
-    >>> with zipfile.ZipFile(folder / "evil.zip", "w") as z:
     ...     z.writestr("../evil.ipynb", "{}")
-    >>> unpack(folder / "evil.zip", folder / "out2")
+    >>> unpack(folder / "work.zip", folder / "out")
     Traceback (most recent call last):
     ...
-    labkit.errors.InputError: evil.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
+    labkit.errors.InputError: work.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
     """
-    return unpack_into(zip_path, into, limits)
-
-
-def unpack_into(zip_path, into, limits, depth=0, budget=None):
-    """:func:`unpack` at `depth` levels of zips in, on `budget` (a student's, shared by all their zips)."""
     into = Path(into)
     created_root = None if os.path.lexists(into) else into
     while created_root is not None and not os.path.lexists(created_root.parent):
@@ -127,22 +108,38 @@ def open_zip(path, label):
         raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
 
 
+def refused(label, shown, why):
+    """The InputError for the member `shown` of the zip `label`."""
+    return InputError(f"{label}: member {shown!r} {why}")
+
+
 def member_parts(name, label, skip=0):
-    """The parts of a member's name, or ValueError when it would leave the folder (or a part past the first
-    `skip` is longer than a file system takes)."""
+    """The parts of a member's name; ValueError when it leaves the folder or a part past `skip` is too long."""
     shown = one_line(name, 120)
     text = name.replace("\\", "/")
     if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
-        raise InputError(f"{label}: member {shown!r} has an absolute path; labkit never extracts it.")
+        raise refused(label, shown, "has an absolute path; labkit never extracts it.")
     parts = [p for p in text.split("/") if p not in ("", ".")]
     if ".." in parts:
-        raise InputError(f"{label}: member {shown!r} leaves the folder; labkit never extracts it.")
+        raise refused(label, shown, "leaves the folder; labkit never extracts it.")
     if any(len(p.encode("utf-8", "surrogateescape")) > MAX_NAME for p in parts[skip:]):
-        raise InputError(
-            f"{label}: member {shown!r} has a name longer than {MAX_NAME} bytes, more than a file system "
-            "takes; rename it shorter."
+        raise refused(
+            label, shown, f"has a name longer than {MAX_NAME} bytes, more than a file system takes; rename it."
         )
     return parts
+
+
+def count_members(budget, count, label):
+    """Add `count` members to `budget`; ValueError when the student now has too many."""
+    budget.members += count
+    if budget.members > budget.limits.max_members:
+        most = budget.limits.max_members
+        raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
+
+
+def _over_total(label, limits, when=""):
+    most = size_text(limits.max_total)
+    return InputError(f"{label}: more than {most} uncompressed{when}; labkit extracts at most {most} for one student.")
 
 
 def _unpack(zip_path, into, budget, depth, written, made, label):
@@ -150,29 +147,12 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
     if depth > limits.max_depth:
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
-        infos = archive.infolist()
-        budget.members += len(infos)
-        if budget.members > limits.max_members:
-            raise InputError(
-                f"{label}: more than {limits.max_members} members; labkit extracts at most {limits.max_members} "
-                "for one student."
-            )
-        plan = checked(infos, budget, label)
-        inner = []
-        for info, parts, is_dir, shown in plan:
-            target = into.joinpath(*parts)
-            make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
-            if is_dir:
-                continue
-            extract(archive, info, target, budget, label, shown, written)
-            if target.suffix.lower() == ".zip":
-                inner.append((target, shown))
+        count_members(budget, len(archive.infolist()), label)
+        plan = checked(archive.infolist(), budget, label)
+        inner = write_plan(archive, plan, into, budget, label, (written, made))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
-            raise InputError(
-                f"{label}: member {shown!r} is a zip nested more than {limits.max_depth} deep; "
-                "labkit never extracts deeper."
-            )
+            raise refused(label, shown, f"is a zip nested more than {limits.max_depth} deep; labkit never goes deeper.")
         folder = free(target.with_suffix(""))
         folder.mkdir()
         made.append(folder)
@@ -182,8 +162,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
 
 
 def checked(infos, budget, label, parts_of=None):
-    """[(info, parts, is_dir, shown)] of the members `infos` to extract, after every check that their names and
-    declared sizes allow on `budget` (ValueError naming the first that fails)."""
+    """[(info, parts, is_dir, shown)] of the members `infos`, once their names and declared sizes fit `budget`."""
     plan, seen, declared = [], set(), 0
     for info in infos:
         parts = member_parts(info.filename, label) if parts_of is None else parts_of(info)
@@ -192,15 +171,13 @@ def checked(infos, budget, label, parts_of=None):
             continue
         shown, key = one_line(info.filename, 120), "/".join(parts)
         if key in seen:
-            raise InputError(f"{label}: member {shown!r} appears twice; labkit extracts each name once.")
+            raise refused(label, shown, "appears twice; labkit extracts each name once.")
         seen.add(key)
         if not is_dir:
-            declared += _declared(info, label, shown, budget.limits)
+            _check_size(label, shown, info.file_size, info.compress_size, budget.limits)
+            declared += info.file_size
             if budget.total + declared > budget.limits.max_total:
-                raise InputError(
-                    f"{label}: more than {size_text(budget.limits.max_total)} uncompressed; "
-                    f"labkit extracts at most {size_text(budget.limits.max_total)} for one student."
-                )
+                raise _over_total(label, budget.limits)
         plan.append((info, parts, is_dir, shown))
     return plan
 
@@ -211,30 +188,36 @@ def _member_kind(info, label):
     mode = info.external_attr >> 16
     kind = stat.S_IFMT(mode)
     if stat.S_ISLNK(mode):
-        raise InputError(f"{label}: member {shown!r} is a symbolic link; labkit never extracts links.")
+        raise refused(label, shown, "is a symbolic link; labkit never extracts links.")
     if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
-        raise InputError(f"{label}: member {shown!r} is a device or a pipe; labkit never extracts those.")
+        raise refused(label, shown, "is a device or a pipe; labkit never extracts those.")
     if info.flag_bits & 0x1:
-        raise InputError(f"{label}: member {shown!r} is encrypted; labkit cannot read it.")
+        raise refused(label, shown, "is encrypted; labkit cannot read it.")
     return info.is_dir() or kind == stat.S_IFDIR
 
 
-def _declared(info, label, shown, limits):
-    if info.file_size > limits.max_member:
-        raise InputError(
-            f"{label}: member {shown!r} is larger than {size_text(limits.max_member)} "
-            f"({size_text(info.file_size)}); labkit extracts at most {size_text(limits.max_member)} a file."
-        )
-    _check_ratio(label, shown, info.file_size, info.compress_size, limits)
-    return info.file_size
-
-
-def _check_ratio(label, shown, size, compressed, limits):
+def _check_size(label, shown, size, compressed, limits, growing=False):
+    """ValueError when a member of `size` bytes (`compressed` in the zip) is too large or compressed too much."""
+    if size > limits.max_member:
+        most = size_text(limits.max_member)
+        grows = f"grows past {most} while extracting" if growing else f"is larger than {most} ({size_text(size)})"
+        raise refused(label, shown, f"{grows}; labkit extracts at most {most} a file.")
     if size > RATIO_FLOOR and size > limits.max_ratio * max(compressed, 1):
-        raise InputError(
-            f"{label}: member {shown!r} is compressed more than {limits.max_ratio:g} times (a zip bomb?); "
-            f"labkit never extracts it."
-        )
+        ratio = f"{limits.max_ratio:g}"
+        raise refused(label, shown, f"is compressed more than {ratio} times (a zip bomb?); labkit never extracts it.")
+
+
+def write_plan(archive, plan, into, budget, label, undo_lists):
+    """Write the checked members `plan` under `into` (recording them in `undo_lists`); [(a zip written, shown)]."""
+    (written, made), inner = undo_lists, []
+    for info, parts, is_dir, shown in plan:
+        make_dirs(into, parts if is_dir else parts[:-1], made, label, shown)
+        if not is_dir:
+            target = into.joinpath(*parts)
+            extract(archive, info, target, budget, label, shown, written)
+            if target.suffix.lower() == ".zip":
+                inner.append((target, shown))
+    return inner
 
 
 def make_dirs(into, parts, made, label, shown):
@@ -246,9 +229,9 @@ def make_dirs(into, parts, made, label, shown):
             made.append(folder)
         except FileExistsError:
             if not stat.S_ISDIR(os.lstat(folder).st_mode):
-                raise InputError(f"{label}: member {shown!r} is inside a file of the zip; labkit refuses it.") from None
+                raise refused(label, shown, "is inside a file of the zip; labkit refuses it.") from None
         except OSError as exc:
-            raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+            raise refused(label, shown, f"cannot be written ({one_line(exc, 120)}).") from None
 
 
 def extract(archive, info, target, budget, label, shown, written):
@@ -256,35 +239,24 @@ def extract(archive, info, target, budget, label, shown, written):
     try:
         descriptor = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o600)
     except OSError as exc:
-        raise InputError(f"{label}: member {shown!r} cannot be written ({one_line(exc, 120)}).") from None
+        raise refused(label, shown, f"cannot be written ({one_line(exc, 120)}).") from None
     written.append(target)
     size = 0
-    # Read as if the member were larger than any limit, so that the bytes it really holds are counted
-    # (zipfile would stop at the size it declares); the declared size is then checked against them.
+    # read past the size the member declares (zipfile stops there), so that the bytes it really holds are counted
     probe = copy.copy(info)
     probe.file_size = max(info.file_size, limits.max_member, limits.max_total) + 1
     try:
         with os.fdopen(descriptor, "wb") as out, archive.open(probe) as source:
             while chunk := source.read(CHUNK):
                 size += len(chunk)
-                if size > limits.max_member:
-                    raise InputError(
-                        f"{label}: member {shown!r} grows past {size_text(limits.max_member)} while extracting; "
-                        f"labkit extracts at most {size_text(limits.max_member)} a file."
-                    )
+                _check_size(label, shown, size, info.compress_size, limits, growing=True)
                 if budget.total + size > limits.max_total:
-                    raise InputError(
-                        f"{label}: more than {size_text(limits.max_total)} uncompressed while extracting; "
-                        f"labkit extracts at most {size_text(limits.max_total)} for one student."
-                    )
-                _check_ratio(label, shown, size, info.compress_size, limits)
+                    raise _over_total(label, limits, " while extracting")
                 out.write(chunk)
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
-        raise InputError(f"{label}: member {shown!r} cannot be read ({one_line(exc, 120)}).") from None
+        raise refused(label, shown, f"cannot be read ({one_line(exc, 120)}).") from None
     if size != info.file_size:
-        raise InputError(
-            f"{label}: member {shown!r} declares {info.file_size} bytes but holds {size}; labkit refuses the zip."
-        )
+        raise refused(label, shown, f"declares {info.file_size} bytes but holds {size}; labkit refuses the zip.")
     budget.total += size
 
 

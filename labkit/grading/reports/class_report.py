@@ -1,28 +1,11 @@
 """The class report: one self-contained HTML page about a grading run (``labkit report OUT``).
 
-:func:`read` reads a grading run's ``results/`` back (a merged run's too),
-:func:`summarise` counts what the class did, and :func:`write` writes
-``OUT/report.html``: the distribution of totals (after any late penalty:
-``grades.csv``'s ``total``), with a rubric's ``[late]`` table a late view
-(who was late, by how much and what it cost, extensions, unknown times and
-times the student supplied, :class:`LateSummary`), each exercise's and part's
-pass rate, the slips the checks named (most frequent first, with who made
-them), the problems (time limits, crashes, cells that raised, refused
-references, ...; each read from the kind code the grader set where it made
-the failed step or the problem, :data:`labkit.exercises.result.KINDS`, never
-from its words), the students with the most failed parts, and pairs of
-similar code side by side (:mod:`labkit.grading.reports.similarity`; similarity never
-changes a grade, it is for a person to judge). Without pygments, which the
-similarity search needs, the page is written all the same and its similar code
-section says "not computed", and why.
-
-The page needs nothing but itself: its figures are inline PNG images drawn
-with matplotlib's Agg canvas (no pyplot state), its style and its one small
-script (``templates/class_report.*``) are inline, and it names no other
-resource. Everything a submission could have influenced (its name, a hint that
-quotes its values, a problem's text, its code) is data: made printable and
-bounded in length (:func:`labkit.grading.store.report.one_line`), then escaped
-by the template (:mod:`labkit.grading.pages`, autoescape on).
+:func:`read` reads a run's results back (a merged run's too), :func:`summarise` counts what the class did,
+:func:`write` writes ``OUT/report.html`` from ``templates/class_report.*``: totals (after any late penalty),
+lateness, pass rates, slips, problems (by the kind codes the grader set, never by their words), the most
+failed parts, held parts, copies and similar code (which never changes a grade; without pygments, "not
+computed" and why). Figures are inline PNGs drawn on matplotlib's Agg canvas; every text a submission could
+have influenced is made printable and bounded (:func:`~labkit.grading.store.report.one_line`), then escaped.
 """
 
 from __future__ import annotations
@@ -32,7 +15,7 @@ import io
 import os
 import statistics
 import tempfile
-from collections import defaultdict
+from collections import Counter, defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from datetime import timedelta
@@ -85,18 +68,10 @@ NOT_GRADED = "not graded"  # a submission whose grading failed (its `failure`): 
 OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER, NOT_DONE)
 # the kinds of problem, in the order the page lists them (its words for each are in the template)
 KINDS = (TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, VARIANT, NOT_GRADED, OTHER)
+BLUE = "#2b5797"
 
 
-@dataclass(frozen=True)
-class ExerciseRate:
-    """How the class did on one exercise: of the graded submissions, how many attempted and passed it."""
-
-    exercise: int
-    graded: int  # graded submissions
-    found: int  # that have the exercise
-    attempted: int  # that have something other than stubs in it (a part passed, slipped or met a problem)
-    passed: int  # that passed every part
-
+class _Rated:
     @property
     def rate(self):
         """The share of the submissions that attempted it which passed it (None when nobody attempted it)."""
@@ -104,7 +79,18 @@ class ExerciseRate:
 
 
 @dataclass(frozen=True)
-class PartRate:
+class ExerciseRate(_Rated):
+    """How the class did on one exercise: of the graded submissions, how many attempted and passed it."""
+
+    exercise: int
+    graded: int
+    found: int  # submissions that have the exercise
+    attempted: int  # that have something other than stubs in it (a part passed, slipped or met a problem)
+    passed: int  # that passed every part
+
+
+@dataclass(frozen=True)
+class PartRate(_Rated):
     """How the class did on one part: what became of it in each graded submission."""
 
     exercise: int
@@ -119,15 +105,6 @@ class PartRate:
     @property
     def attempted(self):
         return self.passed + self.slipped + self.problem
-
-    @property
-    def rate(self):
-        """The share of the submissions that attempted the part which passed it (None when nobody did)."""
-        return self.passed / self.attempted if self.attempted else None
-
-    @property
-    def label(self):
-        return f"{self.exercise} {self.part}"
 
 
 @dataclass(frozen=True)
@@ -144,65 +121,42 @@ class Slip:
 class Problem:
     """What went wrong for one student, of one kind (its texts as the grader worded them)."""
 
-    kind: str
     student: str
     texts: tuple
 
 
 @dataclass(frozen=True)
 class Struggle:
-    """A student's failed parts (of the exercises the submission has)."""
+    """A student's failed parts: "exercise part" labels of those attempted and failed, and those not done."""
 
     student: str
     total: float
-    failed: tuple  # "exercise part" labels of the parts attempted and failed (a slip or a problem)
-    not_done: int  # parts left as released or not defined, counted apart
+    failed: tuple
+    not_done: int
 
 
 @dataclass(frozen=True)
 class LateEntry(lateness.Lateness):
-    """What the rubric's late rule made of one graded submission (a :class:`~labkit.grading.store.late.Lateness`),
-    named, as the instructor sees it."""
+    """What the rubric's late rule made of one graded submission, named."""
 
     student: str = ""
-
-    @property
-    def submitted(self):
-        """When it was handed in; None when the time is unknown."""
-        return self.time.when if self.time is not None else None
-
-    @property
-    def source(self):
-        """Where the time came from (labkit.grading.store.late's ``FROM_...``), None when unknown."""
-        return self.time.source if self.time is not None else None
-
-    @property
-    def late(self):
-        """Late past the deadline and its grace (so penalised, unless it had no points)."""
-        return self.units > 0
-
-    @property
-    def student_supplied(self):
-        """Whether its time is the student's own word (``timestamp.txt``, the notebooks' file times), never the
-        instructor's or the LMS's: :data:`labkit.grading.store.late.STUDENT_SUPPLIED`."""
-        return self.source in lateness.STUDENT_SUPPLIED
 
 
 @dataclass(frozen=True)
 class LateSummary:
-    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission."""
+    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission, by name."""
 
     rule: lateness.Late
-    entries: tuple  # LateEntry, by name
+    entries: tuple
 
     @property
     def late(self):
         """The late submissions, latest first."""
-        return sorted((e for e in self.entries if e.late), key=lambda e: (-e.late_by, e.student))
+        return sorted((e for e in self.entries if e.units > 0), key=lambda e: (-e.late_by, e.student))
 
     @property
     def on_time(self):
-        return [e for e in self.entries if e.known and not e.late]
+        return [e for e in self.entries if e.known and e.units <= 0]
 
     @property
     def within_grace(self):
@@ -218,12 +172,11 @@ class LateSummary:
 
     @property
     def student_supplied(self):
-        """Submissions whose known time the student supplied (an unknown time is listed as unknown)."""
-        return [e for e in self.entries if e.known and e.student_supplied]
+        """Submissions whose known time the student supplied (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)."""
+        return [e for e in self.entries if e.known and e.time.source in lateness.STUDENT_SUPPLIED]
 
     @property
     def penalty(self):
-        """Points taken off the class in all."""
         return round(sum(e.penalty for e in self.entries), 2)
 
     @property
@@ -232,18 +185,19 @@ class LateSummary:
         names = {e.student for e in self.entries}
         return [name for name, _ in self.rule.extensions if name not in names]
 
-
-def _late_summary(rubric, graded):
-    if rubric.late is None:
-        return None
-    entries = (LateEntry(**vars(g.lateness), student=g.name) for g in sorted(graded, key=lambda g: g.name))
-    return LateSummary(rubric.late, tuple(entries))
+    @classmethod
+    def of(cls, rubric, graded):
+        """The late view of `graded`; None when the rubric has no ``[late]`` table."""
+        if rubric.late is None:
+            return None
+        entries = (LateEntry(**vars(g.lateness), student=g.name) for g in sorted(graded, key=lambda g: g.name))
+        return cls(rubric.late, tuple(entries))
 
 
 @dataclass(frozen=True)
 class Held:
-    """A part held for a person: its check passed, but its code is mostly a known source's
-    (:mod:`labkit.grading.submission.known`); its points count only once the rubric's ``[held]`` table releases them."""
+    """A part whose check passed but whose code is mostly a known source's (:mod:`labkit.grading.submission.known`),
+    held for a person until the rubric's ``[held]`` table releases it."""
 
     student: str
     exercise: int
@@ -252,30 +206,23 @@ class Held:
     source: str  # what it matched
     share: float
     released: bool
-    lines: tuple  # (the student's line, the source's line) pairs
-
-    @property
-    def mine(self):
-        return [pair[0] for pair in self.lines]
-
-    @property
-    def theirs(self):
-        return [pair[1] for pair in self.lines]
+    mine: tuple  # the student's lines
+    theirs: tuple  # the source's lines, each facing one of the student's ("" where none does)
 
     @property
     def matched(self):
-        """The lines of the source shown as matched: those facing a line of the student's."""
         return {i for i, line in enumerate(self.theirs) if line}
 
     @classmethod
     def of(cls, grade):
         """The parts of `grade` held for a person."""
-        return [
-            cls(grade.name, number, str(part), str(what.get("definition", "")), str(what.get("source", "")),
-                float(what.get("share", 0) or 0), released,
-                tuple(tuple(map(str, pair)) for pair in what.get("lines", ()) if len(pair) == 2))
-            for number, part, what, released in grade.held()
-        ]  # fmt: skip
+        found = []
+        for number, part, what, released in grade.held():
+            lines = [tuple(map(str, pair)) for pair in what.get("lines", ()) if len(pair) == 2]
+            found.append(cls(grade.name, number, str(part), str(what.get("definition", "")),
+                             str(what.get("source", "")), float(what.get("share", 0) or 0), released,
+                             tuple(mine for mine, _ in lines), tuple(theirs for _, theirs in lines)))  # fmt: skip
+        return found
 
 
 @dataclass
@@ -291,36 +238,24 @@ class ClassSummary:
     problems: dict  # kind -> [Problem], by student
     most_failed: list  # Struggle, most failed parts first
     seeds: list = field(default_factory=list)
-    late: LateSummary | None = None  # the late view, when the rubric has a [late] table
-    held: list = field(default_factory=list)  # Held: parts held for a person (their code matched a known source)
+    late: LateSummary | None = None  # when the rubric has a [late] table
+    held: list = field(default_factory=list)  # Held
     copies: Copies | None = None  # whose data, solution markers, each student's graded functions (copies.py)
-
-    @property
-    def submissions(self):
-        return len(self.totals) + len(self.not_graded)
 
 
 def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
-    """The grades of a grading run's output folder (``labkit grade ... --out OUT``, merged runs too).
+    """The grades, in name order, of a grading run's ``--out`` folder (``labkit grade`` or ``labkit merge``).
 
     Parameters
     ----------
     folder : str or Path
-        The ``--out`` folder of ``labkit grade`` (or of ``labkit merge``).
     rubric : Rubric, optional
-        The rubric the run was scored with (the lab's when None).
-
-    Returns
-    -------
-    list of SubmissionGrade
-        In name order.
+        The rubric the run was scored with (the recorded one when None; another one is refused).
 
     Raises
     ------
     ValueError
-        If the folder does not exist or holds no results, a result file is not a regular file or is too
-        large, a result is not labkit's (another version wrote it, or it grades exercises the rubric's
-        course does not have), or the results were scored under another rubric than `rubric`.
+        If the folder does not exist or holds too many or no results, or a result is not labkit's.
 
     Examples
     --------
@@ -337,25 +272,17 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
             f"{folder / 'results'} holds more than {MAX_SUBMISSIONS:,} result files, more than a class report "
             "shows: split the class and report on each part."
         )
-    # the run's record gives the rubric (a different one is refused) and vouches for each result file
     return read_results([folder], rubric_for([folder], rubric, "the class report"))
 
 
 def check_outcome(check: dict) -> str:
-    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"`` or a problem's kind.
+    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"``, ``"another
+    variant"`` or a problem's kind (:data:`OUTCOMES`; ``"other"``: a fault of the check itself).
 
     Parameters
     ----------
     check : dict
-        One entry of an exercise's ``checks`` in a result: ``name``, ``passed``, ``hint``, ``steps`` (a
-        failed step that is not a slip has its ``kind``, :data:`labkit.exercises.result.KINDS`).
-
-    Returns
-    -------
-    str
-        ``"passed"``; ``"slip"`` (the check named what is wrong); ``"not done"`` (a stub or a missing
-        name); or one of the problem kinds ``"timeout"``, ``"crash"``, ``"raised"``, ``"refused"``,
-        ``"tampered"``, ``"other"`` (a fault of the check itself).
+        One entry of an exercise's ``checks`` in a result.
 
     Examples
     --------
@@ -365,9 +292,6 @@ def check_outcome(check: dict) -> str:
     >>> check_outcome({"passed": False, "hint": "h", "steps": [{"step": "s", "passed": False,
     ...     "detail": "ran past the time limit"}]})  # the words alone: no kind, so the check's slip
     'slip'
-    >>> check_outcome({"passed": False, "hint": "divide by the interval's length", "steps": [
-    ...     {"step": "the values at 5 points", "passed": False, "detail": "off by 0.3"}]})
-    'slip'
     """
     if not isinstance(check, dict):
         raise InputError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
@@ -376,28 +300,14 @@ def check_outcome(check: dict) -> str:
         return PASSED
     if kind in (NOT_DONE, VARIANT, SLIP):
         return kind
-    kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}  # each failed step's code, set where made
+    kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}
     return next((kind for kind in OUTCOMES if kind in kinds), OTHER)
 
 
 def problem_kinds(problem: str) -> list[tuple[str, str]]:
-    """The kinds of a problem the grader recorded for a submission, each with the words to show.
-
-    The kinds are the codes the grader set where it made the problem (a
-    :class:`labkit.grading.store.report.ProblemText`), never read from its words: a
-    notebook whose cells raised has one (kind, description) per cell, a cell
-    the worker stopped at its time limit a time limit, the others errors
-    raised. A bare text, with no codes, is "other".
-
-    Parameters
-    ----------
-    problem : str
-        One of a submission's ``problems``.
-
-    Returns
-    -------
-    list of (str, str)
-        (kind, description) pairs; the description is one printable line, bounded.
+    """The (kind, description) pairs of one of a submission's ``problems``, each description one printable
+    line; the kinds are the codes the grader set (:class:`~labkit.grading.store.report.ProblemText`), "other"
+    for a bare text.
 
     Examples
     --------
@@ -416,36 +326,14 @@ def _steps(check):
 
 
 def _checks(grade, number):
+    """{part name: check} of exercise `number` in `grade`; None when the submission does not have it."""
     verdict = grade.results.get(number)
-    if verdict is None:
-        return None
-    checks = verdict.get("checks") if isinstance(verdict, dict) else None
-    if not isinstance(checks, list) or not all(isinstance(c, dict) for c in checks):
-        raise InputError(
-            f"the result of {one_line(grade.name, MAX_NAME)!r} for exercise {number} has no list of checks: "
-            "it was not written by `labkit grade`; grade the submission again."
-        )
-    return checks
+    return None if verdict is None else {one_line(part.name, MAX_TEXT): part.as_dict() for part in verdict.parts}
 
 
-def _part_names(rubric, number, grades):
-    """The exercise's parts as declared, then any other part name the results hold, in order."""
-    exercise = rubric.registry.exercises.get(number)
-    names = [part.name for part in exercise.parts] if exercise is not None else []
-    for grade in grades:
-        for check in _checks(grade, number) or []:
-            name = one_line(check.get("name", "?"), MAX_TEXT)
-            if name not in names:
-                names.append(name)
-    return names
-
-
-def _weights(rubric, number):
-    exercise = rubric.registry.exercises.get(number)
-    if exercise is None:
-        return {}
+def _weights(rubric, exercise):
     total = sum(part.weight for part in exercise.parts) or 1
-    return {part.name: rubric.points.get(number, 0) * part.weight / total for part in exercise.parts}
+    return {part.name: rubric.points.get(exercise.number, 0) * part.weight / total for part in exercise.parts}
 
 
 def _failed_text(check, number):
@@ -462,7 +350,7 @@ class _Tally:
     """What :func:`summarise` gathers while it reads the parts of each graded submission."""
 
     failed: dict  # student -> "exercise part" labels of the parts attempted and failed
-    not_done: defaultdict = field(default_factory=lambda: defaultdict(int))
+    not_done: Counter = field(default_factory=Counter)
     slips: defaultdict = field(default_factory=lambda: defaultdict(list))  # (number, index, part, hint) -> students
     problems: defaultdict = field(default_factory=lambda: defaultdict(list))  # (kind, student) -> texts
 
@@ -481,30 +369,27 @@ class _Tally:
         return outcome
 
     def exercise(self, rubric, number, graded):
-        """The class's rate of exercise `number` and of each of its parts."""
-        names = _part_names(rubric, number, graded)
-        counts = {name: defaultdict(int) for name in names}
-        found = attempted = passed = 0
-        for grade in graded:
-            checks = _checks(grade, number)
-            if checks is None:
-                for name in names:
-                    counts[name]["missing"] += 1
-                continue
-            found += 1
-            by_name = {one_line(c.get("name", "?"), MAX_TEXT): c for c in checks}
-            outcomes = [self.part(grade, number, name, i, by_name.get(name) or {}) for i, name in enumerate(names)]
+        """The class's rate of exercise `number` and of each of its parts (as declared, then any other the
+        results hold)."""
+        declared = rubric.registry.exercises.get(number)
+        found = [(g, checks) for g in graded if (checks := _checks(g, number)) is not None]
+        names = list(dict.fromkeys([*(part.name for part in getattr(declared, "parts", ())),
+                                    *(name for _, checks in found for name in checks)]))  # fmt: skip
+        counts = {name: Counter(missing=len(graded) - len(found)) for name in names}
+        attempted = passed = 0
+        for grade, checks in found:
+            outcomes = [self.part(grade, number, n, i, checks.get(n) or {}) for i, n in enumerate(names)]
             for name, outcome in zip(names, outcomes):
                 counts[name][outcome] += 1
             attempted += any(outcome != NOT_DONE for outcome in outcomes)
             passed += bool(outcomes) and all(outcome == PASSED for outcome in outcomes)
-        weights = _weights(rubric, number)
+        weights = _weights(rubric, declared) if declared is not None else {}
         parts = [
             PartRate(number, name, weights.get(name, 0.0), c[PASSED], c[SLIP], sum(c[kind] for kind in KINDS),
                      c[NOT_DONE], c["missing"])
             for name, c in counts.items()
         ]  # fmt: skip
-        return ExerciseRate(number, len(graded), found, attempted, passed), parts
+        return ExerciseRate(number, len(graded), len(found), attempted, passed), parts
 
     def run_problems(self, grades):
         """The problems of the run itself: grading that failed, and each notebook's (a stub's cell is counted per
@@ -521,7 +406,7 @@ class _Tally:
         """Each kind's problems, by student."""
         found = {kind: [] for kind in KINDS}
         for (kind, student), texts in sorted(self.problems.items()):
-            found[kind].append(Problem(kind, student, tuple(dict.fromkeys(texts))))
+            found[kind].append(Problem(student, tuple(dict.fromkeys(texts))))
         return {kind: rows for kind, rows in found.items() if rows}
 
     def slip_list(self):
@@ -530,11 +415,8 @@ class _Tally:
         return [Slip(number, name, hint, tuple(sorted(set(who)))) for (number, _, name, hint), who in ordered]
 
     def most_failed(self, totals):
-        struggles = (
-            Struggle(name, totals[name], tuple(labels), self.not_done[name])
-            for name, labels in self.failed.items()
-            if labels
-        )
+        struggles = (Struggle(name, totals[name], tuple(labels), self.not_done[name])
+                     for name, labels in self.failed.items() if labels)  # fmt: skip
         return sorted(struggles, key=lambda s: (-len(s.failed), s.total, s.student))[:MOST_FAILED]
 
 
@@ -562,10 +444,6 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     grades : list of SubmissionGrade
         One per submission, all scored under one rubric (:func:`read` gives them).
 
-    Returns
-    -------
-    ClassSummary
-
     Raises
     ------
     ValueError
@@ -582,37 +460,36 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     rubric = submissions[0].rubric
     graded = [g for g in submissions if g.graded]
     tally = _Tally({g.name: [] for g in graded})
-    exercises, parts = [], []
-    for number in rubric.graded:
-        rate, part_rates = tally.exercise(rubric, number, graded)
-        exercises.append(rate)
-        parts += part_rates
+    rates = [tally.exercise(rubric, number, graded) for number in rubric.graded]
     tally.run_problems(submissions)
     totals = {g.name: g.total for g in graded}
     return ClassSummary(
         rubric=rubric,
         totals=totals,
         not_graded={g.name: g.failure for g in submissions if not g.graded},
-        exercises=exercises,
-        parts=parts,
+        exercises=[exercise for exercise, _ in rates],
+        parts=[part for _, parts in rates for part in parts],
         slips=tally.slip_list(),
         problems=tally.by_kind(),
         most_failed=tally.most_failed(totals),
         seeds=sorted({g.seed for g in submissions if isinstance(g.seed, int)}),
-        late=_late_summary(rubric, graded),
+        late=LateSummary.of(rubric, graded),
         copies=find_copies(submissions),
         held=[held for g in graded for held in Held.of(g)],
     )
 
 
-# ---------------------------------------------------------------------------------------------- figures
+def _figure(width, height):
+    """A matplotlib Figure and its one Axes, on no pyplot state (the figure is garbage once drawn)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure, figure.subplots()
 
 
 def _png(figure):
-    """A matplotlib Figure as a base64 PNG (no pyplot: the figure is garbage once drawn)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    FigureCanvasAgg(figure)
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
     return base64.b64encode(buffer.getvalue()).decode("ascii")
@@ -630,36 +507,19 @@ def _bins(totals, maximum):
     return edges
 
 
-def histogram_of_totals(summary: ClassSummary) -> tuple[str, list[tuple[float, float, int]]]:
-    """The histogram of the graded totals: (base64 PNG, [(low, high, count)]).
-
-    Parameters
-    ----------
-    summary : ClassSummary
-
-    Returns
-    -------
-    tuple
-        The picture, with a dashed line at full credit, and the bins it shows (the page says them in words
-        and as a table).
-    """
-    import numpy as np
-    from matplotlib.figure import Figure
+def _histogram(summary):
+    """The graded totals' histogram (a dashed line at full credit) as a base64 PNG, and its [(low, high, count)]."""
     from matplotlib.ticker import MaxNLocator
 
     totals, full_credit = list(summary.totals.values()), summary.rubric.full_credit
     edges = _bins(totals, summary.rubric.maximum)
-    counts, _ = np.histogram(totals, bins=edges)
-    figure = Figure(figsize=(6.4, 2.8), layout="constrained")
-    axes = figure.subplots()
-    axes.hist(totals, bins=edges, color="#2b5797", edgecolor="white")
+    figure, axes = _figure(6.4, 2.8)
+    counts, _, _ = axes.hist(totals, bins=edges, color=BLUE, edgecolor="white")
     axes.axvline(full_credit, color="black", linestyle="--", linewidth=1.2)
     axes.annotate(f"full credit {points_text(full_credit)}", (full_credit, 1.0), xycoords=("data", "axes fraction"),
                   xytext=(0, 3), textcoords="offset points", ha="center", va="bottom", fontsize=9)  # fmt: skip
-    axes.set_xlabel("total points")
-    axes.set_ylabel("submissions")
+    axes.set(xlabel="total points", ylabel="submissions", xlim=(edges[0], edges[-1]))
     axes.yaxis.set_major_locator(MaxNLocator(integer=True))
-    axes.set_xlim(edges[0], edges[-1])
     return _png(figure), [(float(lo), float(hi), int(n)) for lo, hi, n in zip(edges[:-1], edges[1:], counts)]
 
 
@@ -667,19 +527,13 @@ def _rate_text(rate, attempted):
     return "nobody attempted it" if rate is None else f"{rate:.0%} of {attempted}"
 
 
-def _bars(labels, rates, attempted):
-    from matplotlib.figure import Figure
-
-    height = 0.9 + 0.26 * len(labels)
-    figure = Figure(figsize=(7.5, height), layout="constrained")
-    axes = figure.subplots()
-    positions = list(range(len(labels)))
-    values = [100 * (r or 0.0) for r in rates]
-    axes.barh(positions, values, color="#2b5797", height=0.7)
-    for y, rate, n in zip(positions, rates, attempted):
-        axes.text(
-            (100 * rate if rate is not None else 0) + 1, y, _rate_text(rate, n), va="center", fontsize=8, color="black"
-        )
+def _bars(rated, labels):
+    """Bars of the pass rates of `rated` (ExerciseRate or PartRate), each labelled, its rate written beside it."""
+    figure, axes = _figure(7.5, 0.9 + 0.26 * len(labels))
+    positions = range(len(labels))
+    axes.barh(positions, [100 * (r.rate or 0.0) for r in rated], color=BLUE, height=0.7)
+    for y, r in zip(positions, rated):
+        axes.text(100 * (r.rate or 0) + 1, y, _rate_text(r.rate, r.attempted), va="center", fontsize=8, color="black")
     axes.set_yticks(positions, [one_line(label, 40) for label in labels], fontsize=8)
     axes.invert_yaxis()
     axes.set_xlim(0, 125)
@@ -688,50 +542,16 @@ def _bars(labels, rates, attempted):
     return _png(figure)
 
 
-def pass_rate_figures(summary: ClassSummary) -> list[str]:
-    """Bar charts of the pass rates as base64 PNGs: the exercises', then the parts' (the page gives every rate
-    in numbers in their alt text).
-
-    Parameters
-    ----------
-    summary : ClassSummary
-
-    Returns
-    -------
-    list of str
-    """
-    exercises, parts = summary.exercises, summary.parts
+def _rate_figures(summary):
+    """Bar charts of the pass rates as base64 PNGs: the exercises', then the parts'."""
     return [
-        _bars(
-            [f"exercise {e.exercise}" for e in exercises], [e.rate for e in exercises], [e.attempted for e in exercises]
-        ),
-        _bars([p.label for p in parts], [p.rate for p in parts], [p.attempted for p in parts]),
+        _bars(summary.exercises, [f"exercise {e.exercise}" for e in summary.exercises]),
+        _bars(summary.parts, [f"{p.exercise} {p.part}" for p in summary.parts]),
     ]
 
 
-# ---------------------------------------------------------------------------------------------- the page
-
-
 def _text(value, limit=MAX_TEXT):
-    """A submission's (or the grader's) text as the page shows it: printable, one line, bounded."""
     return one_line(value, limit)
-
-
-def _who(name):
-    """A submission's name as the page shows it: shortened with a hash of the whole name, so two names sharing a
-    beginning never look alike (:func:`labkit.grading.store.names.shown_name`)."""
-    return shown_name(name, MAX_NAME)
-
-
-def _code_rows(lines, shared):
-    """A side of a pair of code as (gutter, line, shared) rows, bounded, and how many lines are left out."""
-    width = len(str(min(len(lines), MAX_LINES)))
-    rows = [
-        (f"{n + 1:>{width}} {'=' if n in shared else ' '} ", printable(str(line)).replace("\t", "    ")
-         .replace("\n", " ")[:MAX_LINE], n in shared)
-        for n, line in enumerate(lines[:MAX_LINES])
-    ]  # fmt: skip
-    return rows, max(len(lines) - MAX_LINES, 0)
 
 
 def _shared(indices, lines):
@@ -741,14 +561,15 @@ def _shared(indices, lines):
 
 def _totals(summary):
     """The graded totals in figures, for the table and the histogram's alt text."""
-    totals, rubric = list(summary.totals.values()), summary.rubric
-    image, bins = histogram_of_totals(summary)
+    totals = list(summary.totals.values())
+    image, bins = _histogram(summary)
     quartiles = statistics.quantiles(totals, n=4, method="inclusive") if len(totals) > 1 else totals * 3
     return {
         "image": image, "bins": bins, "count": len(totals), "median": statistics.median(totals),
         "mean": statistics.fmean(totals), "lowest": min(totals), "highest": max(totals),
         "quartiles": ", ".join(map(points_text, quartiles)),
-        "full": sum(t >= rubric.full_credit for t in totals), "largest": max(bins, key=lambda b: (b[2], -b[0])),
+        "full": sum(t >= summary.rubric.full_credit for t in totals),
+        "largest": max(bins, key=lambda b: (b[2], -b[0])),
     }  # fmt: skip
 
 
@@ -759,23 +580,17 @@ def render(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> str:
-    """The class report as one HTML document (a string), figures inline (``templates/class_report.html``).
+    """The class report as one HTML document, figures inline (``templates/class_report.html``).
 
     Parameters
     ----------
     summary : ClassSummary
-        From :func:`summarise`.
     pairs : list of Pair, optional
         Similar code to show side by side; None when the search was not made.
     threshold : float
-        The similarity from which pairs were listed (said on the page).
+        The similarity from which pairs were listed.
     similarity_note : str, optional
-        Why the pairs were not computed, when `pairs` is None; when not given, the reason the similarity
-        search cannot run here, if it cannot (:func:`labkit.grading.reports.similarity.unavailable`).
-
-    Returns
-    -------
-    str
+        Why `pairs` is None; by default, why the similarity search cannot run here, if it cannot.
     """
     if not isinstance(summary, ClassSummary):
         raise InputError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
@@ -790,7 +605,7 @@ def render(
         late=summary.late,
         limits={name: value for name, value in globals().items() if name.startswith("MAX_")},
         totals=_totals(summary) if summary.totals else None,
-        rate_figures=pass_rate_figures(summary) if summary.totals else None,
+        rate_figures=_rate_figures(summary) if summary.totals else None,
         rate_text=_rate_text,
         held_threshold=THRESHOLD,
         copy_lines=copies.holder_lines(),
@@ -799,11 +614,11 @@ def render(
         threshold=threshold,
         similarity_note=similarity_note,
         text=_text,
-        who=_who,
+        who=lambda name: shown_name(name, MAX_NAME),
         points=points_text,
         time_text=lateness.time_text,
         duration_text=lateness.duration_text,
-        code_rows=_code_rows,
+        printable=printable,
         shared=_shared,
     )
 
@@ -845,28 +660,17 @@ def write(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> Path:
-    """Write ``report.html`` into a grading run's output folder; its path.
-
-    The folder's other files (grades.csv, feedback/, results/, ...) are neither read here nor touched:
-    the page is written to a temporary file in the folder, then renamed over an earlier report.
+    """Write ``report.html`` into a grading run's output folder, through a temporary file renamed over an
+    earlier report, and return its path; the folder's other files are neither read nor touched.
 
     Parameters
     ----------
     out_dir : str or Path
-        The run's ``--out`` folder (it must exist).
+        The run's ``--out`` folder.
     grades : list of SubmissionGrade
         The class (:func:`read` reads them from `out_dir`).
-    pairs : list of Pair, optional
-        Similar code, shown side by side; None says "not computed".
-    threshold : float
-        The similarity from which `pairs` were listed, between 0 and 1.
-    similarity_note : str, optional
-        Why the pairs were not computed.
-
-    Returns
-    -------
-    Path
-        ``out_dir/report.html``.
+    pairs, threshold, similarity_note
+        As for :func:`render`; `threshold` is in (0, 1].
 
     Raises
     ------

@@ -49,7 +49,7 @@ def find(grades, students=None, registry=None) -> Copies:
     found = defaultdict(list)  # (holder, whose data) -> exercises
     for grade in graded:
         for number, verdict in sorted(grade.results.items()):
-            other = verdict.get("other_variant") if isinstance(verdict, dict) else None
+            other = verdict.other_variant
             if other and registry is not None and number in registry.exercises:
                 whose = _whose(grade.name, registry.exercises[number], other, students or {})
                 found[(grade.name, ", ".join(whose))].append(number)

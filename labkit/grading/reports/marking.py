@@ -15,13 +15,9 @@ again. A row equal to the mark already held changes nothing, so importing twice 
 later mark of the same item replaces the earlier one.
 """
 
-import csv
 import functools
-import io
 import json
 import re
-from dataclasses import dataclass
-from datetime import UTC, datetime
 from pathlib import Path
 
 from markupsafe import Markup
@@ -30,167 +26,9 @@ from ...errors import InputError
 from .. import pages
 from ..store import record as records
 from ..store.feedback import blank
-from ..store.names import name_cell, name_from_cell, shown_name
-from ..store.report import csv_cell, one_line, printable, read_results, write_csv, write_result
-from ..store.text import points_text
-
-HEADER = ["submission", "item", "points", "comment"]
-MAX_MARKS_BYTES = 16 * 1024 * 1024  # a marks.csv larger than this is not read
-MAX_COMMENT = 2000  # characters of a comment kept
-HELD_WORDS = ("release", "keep")
-EXCUSE_WORDS = ("excused", "counted")
-
-
-@dataclass(frozen=True)
-class Mark:
-    """One validated row of marks.csv."""
-
-    submission: str
-    item: str
-    points: object  # a number, or one of HELD_WORDS / EXCUSE_WORDS
-    comment: str
-
-
-def items(grade):
-    """What can be marked for `grade`: item -> ("answer", points it is worth) | ("held", None) |
-    ("exercise", None)."""
-    rubric = grade.rubric
-    found = {}
-    for grade_id, (number, _) in rubric.registry.answers.items():
-        if number in rubric.points:
-            found[grade_id] = ("answer", rubric.answers.get(grade_id, 0.0))
-    for number, part, _, _ in grade.held():
-        found[f"exercise{number}/{part}"] = ("held", None)
-    for number in rubric.graded:
-        found[f"exercise{number}"] = ("exercise", None)
-    return found
-
-
-def read_marks(text, grades):
-    """The rows of marks.csv `text`, each checked against `grades` (by name); ValueError listing every bad
-    row (line number and why) when any is bad."""
-    by_name = {grade.name: grade for grade in grades}
-    reader = csv.reader(io.StringIO(text))
-    header = next(reader, None)
-    if header is None or [cell.strip().lower() for cell in header] != HEADER:
-        shown = "nothing" if header is None else one_line(",".join(header), 120)
-        raise InputError(f"marks.csv must start with the header {','.join(HEADER)}; it starts with {shown}.")
-    marks, problems = [], []
-    for line, row in enumerate(reader, start=2):
-        if not any(cell.strip() for cell in row):
-            continue
-        if len(row) not in (3, 4):
-            problems.append(f"line {line}: {len(row)} cells, not 4 ({','.join(HEADER)})")
-            continue
-        cell, item, points, comment = [*row, ""][:4]
-        item, points = item.strip(), points.strip()
-        name = name_from_cell(cell, by_name) or cell.strip()  # the whole name, as the page wrote it
-        grade = by_name.get(name)
-        if grade is None:
-            problems.append(f"line {line}: no submission {one_line(name, 80)!r} in this run")
-            continue
-        if not grade.graded:
-            problems.append(f"line {line}: {one_line(name, 80)} could not be graded, so it cannot be marked")
-            continue
-        known = items(grade)
-        if item not in known:
-            problems.append(
-                f"line {line}: {one_line(item, 80)!r} is nothing to mark for {one_line(name, 80)} (an answer's "
-                "grade id such as exercise12-answer-1, exerciseN/part of a held part, or exerciseN to excuse)"
-            )
-            continue
-        kind, worth = known[item]
-        value, why = _points(kind, worth, points)
-        if not why and kind == "answer" and value and blank(grade.answers.get(item)):
-            why = "the student wrote no answer (blank, or YOUR ANSWER HERE): it is marked 0, no answer"
-        if why:
-            problems.append(f"line {line}: {item} of {one_line(name, 80)}: {why}")
-            continue
-        marks.append(Mark(name, item, value, printable(comment).strip()[:MAX_COMMENT]))
-    if problems:
-        shown = problems[:20] + ([f"... and {len(problems) - 20} more"] if len(problems) > 20 else [])
-        raise InputError("marks.csv was not imported, nothing changed:\n  " + "\n  ".join(shown))
-    return marks
-
-
-def _points(kind, worth, text):
-    """(the points of a row, why they are refused or "")."""
-    word = text.lower()
-    if kind == "held":
-        return (word, "") if word in HELD_WORDS else (None, f"points are release or keep, not {one_line(text, 20)!r}")
-    if kind == "exercise":
-        return (
-            (word, "") if word in EXCUSE_WORDS else (None, f"points are excused or counted, not {one_line(text, 20)!r}")
-        )
-    try:
-        value = float(text.replace(",", "."))
-    except ValueError:
-        return None, f"points {one_line(text, 20)!r} are not a number"
-    if not 0.0 <= value <= worth:  # NaN fails this too
-        if not worth:
-            return None, "the rubric gives this answer no points: add it to the rubric's [answers] table"
-        return None, f"points {one_line(text, 20)} are outside 0 to {points_text(worth)}"
-    return round(value, 2), ""
-
-
-def import_marks(out, path, rubric=None, now=None):
-    """Put the marks of marks.csv `path` into the run in folder `out`; the number of marks that changed.
-
-    Every row is checked first: an unknown submission or item, points outside the item's range or a
-    `rubric` other than the run's (in what it grades) is a ValueError, and nothing is written."""
-    out, path = Path(out), Path(path)
-    try:
-        if path.stat().st_size > MAX_MARKS_BYTES:
-            raise InputError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read the marks {path}: {exc}") from None
-    record = records.read(out)
-    recorded = record.rubric_object(out)
-    if rubric is not None and recorded.digest != rubric.digest:
-        raise InputError(
-            f"{out} was graded under the rubric {recorded.title!r} ({recorded.digest}), not {rubric.title!r} "
-            f"({rubric.digest}): marks are imported under the run's own rubric; leave out --rubric."
-        )
-    grades = read_results([out], recorded)
-    if grades.refused:
-        raise InputError(
-            f"{out} has result files its record does not vouch for ({one_line(grades.refused[0][0], 200)}); "
-            "grade the class again before marking."
-        )
-    marks = read_marks(text, grades)
-    when = (now or datetime.now(UTC)).isoformat(timespec="seconds")
-    by_name = {grade.name: grade for grade in grades}
-    changed = set()
-    for mark in marks:  # a later row replaces an earlier one
-        grade = by_name[mark.submission]
-        held = grade.marks.get(mark.item)
-        if held is not None and held["points"] == mark.points and held["comment"] == mark.comment:
-            continue
-        grade.marks[mark.item] = {"points": mark.points, "comment": mark.comment, "time": when}
-        changed.add((mark.submission, mark.item))
-    for name in sorted({name for name, _ in changed}):
-        grade = by_name[name]
-        content = record.submissions.get(name, {}).get("content")
-        records.note(out, record, name, write_result(out, grade), content, save=False)
-    if changed:
-        records.write(out, record)
-        write_csv(out / "grades.csv", list(grades))
-    return len(changed)
-
-
-def marks_csv(grades):
-    """marks.csv of every mark `grades` hold (the file :func:`import_marks` reads)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer)
-    writer.writerow(HEADER)
-    for grade in grades:
-        for item, mark in sorted(grade.marks.items()):
-            points = mark["points"]
-            writer.writerow([name_cell(grade.name), item, points if isinstance(points, str) else points_text(points),
-                             csv_cell(mark["comment"])])  # fmt: skip
-    return buffer.getvalue()
-
+from ..store.marks import import_marks, marks_csv  # noqa: F401 - labkit mark's import, with the marking page
+from ..store.names import shown_name
+from ..store.report import one_line, printable, read_results
 
 # -- the marking page ---------------------------------------------------------------------------------------------
 
@@ -318,7 +156,8 @@ def _held_tasks(grades):
     held = {}
     for g in grades:
         for number, part, data, _ in g.held() if g.graded else ():
-            pairs = [(one_line(a, 200), one_line(b, 200)) for a, b in _pairs(data.get("lines", ()))]
+            lines = [p for p in data.get("lines", ()) if isinstance(p, (list, tuple)) and len(p) == 2]
+            pairs = [(one_line(a, 200), one_line(b, 200)) for a, b in lines]
             side = _parts().held(float(data.get("share", 0)), one_line(data.get("source", "?"), 120), pairs)
             entry = {"submission": g.name, "shown": shown_name(g.name, 200), "html": str(side)}
             held.setdefault(f"exercise{number}/{part}", []).append(entry)
@@ -327,10 +166,6 @@ def _held_tasks(grades):
          "question": str(_parts().held_question()), "model": "", "answers": entries}
         for item, entries in sorted(held.items())
     ]  # fmt: skip
-
-
-def _pairs(lines):
-    return [p for p in lines if isinstance(p, (list, tuple)) and len(p) == 2]
 
 
 def tasks(grades, marker="instructor"):

@@ -94,4 +94,4 @@ def resumed_notes(out):
 
 def holding_another_variant(grades):
     """How many graded submissions hold another student's data in some exercise."""
-    return sum(any(v.get("other_variant") for v in g.results.values()) for g in grades if g.graded)
+    return sum(any(v.other_variant for v in g.results.values()) for g in grades if g.graded)

@@ -1,33 +1,13 @@
 """Grading a class on a Dask cluster: :class:`DaskEngine`, ``labkit grade --dask ADDRESS`` (or ``--dask local``).
 
-One task per submission. In a Dask worker the task grades the submission as
-``labkit grade --jobs`` does on one machine (:func:`.engines.grade_one`):
-in a grading process of its own, started with :mod:`subprocess`, under the same
-memory and time limits, whose notebooks run in the sandbox of the worker's
-machine. (A Dask worker is a daemonic process, and Python's multiprocessing
-refuses such a process children: the process pool an earlier ``labkit grade``
-used failed there with "daemonic processes are not allowed to have children".)
-The task sends back the result file's data; the client scores it under the
-rubric and writes ``results/<name>.json`` and the feedback as each arrives
-(:mod:`.classrun`), so a run that stops is resumed by
-running it again.
-
-What the workers need: the same labkit version (a result written by another
-one is refused, and its submission reported as not graded), the course's
-exercises module when the rubric names one, the sandbox backend's tool, and the
-submissions at the path the client gives: a file system shared with the
-client (NFS, a cluster's home or scratch). The notebooks are not sent with
-the tasks; the rubric is, and each worker computes the refusals once.
-
-A task whose worker dies is given to another worker by the scheduler (up to
-``distributed.scheduler.allowed-failures`` times, 3 by default), and a task
-that raises is run once more (``retries=1``); one that still fails is
-reported as "could not be graded", which a resumed run grades again. Every
-submission is recorded once, by name: a second arrival for a name already
-recorded is ignored and counted in ``run.json``.
-
-Dask is imported here only, when a run asks for it (the ``labkit[dask]``
-extra); the rest of labkit never imports it.
+One task per submission, graded in a Dask worker as ``--jobs`` grades it here (:func:`.engines.grade_one`:
+a grading process of its own, started with :mod:`subprocess`, since a worker is a daemonic process that
+multiprocessing refuses children). The workers need the same labkit version, the course's exercises
+module, the sandbox's tool and the submissions at the client's path (a shared file system); the rubric
+is sent, the refusals computed once per worker. A task whose worker dies goes to another (the scheduler's
+``allowed-failures``), one that raises runs once more (``retries=1``), then it is "could not be graded",
+which a resumed run grades again. A second arrival for a name is ignored and counted in ``run.json``.
+Dask is imported here only, when a run asks for it (the ``labkit[dask]`` extra).
 """
 
 import functools
@@ -67,12 +47,16 @@ def _dask():
     return distributed
 
 
-def connect(address, workers=2):
-    """A ``distributed.Client`` of the scheduler at `address`, or of a new LocalCluster of `workers` worker
-    processes of one thread each when `address` is ``"local"``; ValueError when it cannot be reached.
+def _check_address(address):
+    if not isinstance(address, str) or not address.strip():
+        raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
 
-    Returns (client, close): call ``close()`` to close the client (and the LocalCluster)."""
+
+def connect(address, workers=2):
+    """(client, close) of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker
+    processes when it is ``"local"``; ``close()`` closes both. ValueError when it cannot be reached."""
     distributed = _dask()
+    _check_address(address)
     if address == LOCAL:
         if int(workers) < 1:
             raise InputError(f"--dask-workers must be at least 1; got {workers}.")
@@ -84,14 +68,7 @@ def connect(address, workers=2):
             silence_logs=logging.ERROR,
         )
         client = distributed.Client(cluster)
-
-        def close():
-            client.close()
-            cluster.close()
-
-        return client, close
-    if not isinstance(address, str) or not address.strip():
-        raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
+        return client, lambda: (client.close(), cluster.close())
     try:
         client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError) as exc:
@@ -103,21 +80,18 @@ def connect(address, workers=2):
 
 
 class DaskEngine(Engine):
-    """Grade on the Dask cluster at `address` (``"local"``: a LocalCluster of `workers` worker processes), one
-    task per submission: ``labkit grade --dask ADDRESS``. Connects when :meth:`grade` starts, and closes the
-    client (and the LocalCluster) when it ends."""
+    """Grade on the Dask cluster at `address` (``"local"``: a LocalCluster of `workers` processes), one task per
+    submission; connected while :meth:`grade` runs."""
 
     name = "dask"
 
     def __init__(self, address: str, workers: int = 2):
-        if address != LOCAL and (not isinstance(address, str) or not address.strip()):
-            raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
+        _check_address(address)
         self.address, self.workers = address, workers
         self._record: dict = {"engine": self.name}
 
     def record(self) -> dict:
-        """The engine, its scheduler, the workers that graded and how many each, the duplicate arrivals ignored,
-        the workers' peak memory."""
+        """The engine, its scheduler, how many each worker graded, the duplicates ignored, the workers' peak."""
         return dict(self._record)
 
     def grade(self, batch: Batch) -> Generator[Outcome, None, None]:
@@ -146,11 +120,8 @@ class DaskEngine(Engine):
                 try:
                     message = future.result()
                 except Exception as exc:  # noqa: BLE001 - KilledWorker, or what the task raised twice
-                    why = (
-                        "the Dask workers grading it died"
-                        if isinstance(exc, distributed.KilledWorker)
-                        else "its Dask task failed"
-                    )
+                    died = isinstance(exc, distributed.KilledWorker)
+                    why = "the Dask workers grading it died" if died else "its Dask task failed"
                     message = {
                         "name": name, "result": None, "failure": f"{why} ({type(exc).__name__}: {one_line(exc)})"
                     }  # fmt: skip
@@ -171,7 +142,6 @@ class DaskEngine(Engine):
                 left = [(future, name) for future, name in futures.values() if name not in seen]
                 client.cancel([future for future, _ in left])
                 for _, name in left:
-                    seen.add(name)
                     yield Outcome(batch.not_graded(name, stopped))
             try:
                 worker_peaks = client.run(_peak_bytes)

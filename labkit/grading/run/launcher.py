@@ -1,23 +1,16 @@
 """The launcher: one warm Python that forks each submission's grading process; its client and its server.
 
-A grading run grades every submission in a process of its own
-(:mod:`.processes`), so that a submission that makes its grading crash, run
-out of memory or hang costs only its own grade. Started as
-``python -m labkit.grading.submission.scoring SPEC``, each of those processes would
-import labkit's checks, numpy and scipy again. The client, :class:`Launcher`,
-starts ``python -m labkit.grading.run.launcher`` once per run instead: the
-server (:func:`main`) imports all that, then forks one child per submission,
-which puts itself in a session, cgroup and address-space limit of its own
-(what ``Popen``'s ``preexec_fn`` does otherwise) and runs
-:func:`labkit.grading.submission.scoring.main`. No student code runs here: student code
-runs only in the sandboxes the child starts.
+Started as ``python -m labkit.grading.submission.scoring SPEC``, each grading process (:mod:`.processes`)
+would import labkit's checks, numpy and scipy again. The client, :class:`Launcher`, starts
+``python -m labkit.grading.run.launcher`` once per run instead: the server (:func:`main`) imports all
+that, then forks one child per submission, which puts itself in a session, cgroup and address-space
+limit of its own (what ``Popen``'s ``preexec_fn`` does otherwise) and runs
+:func:`labkit.grading.submission.scoring.main`. No student code runs here: only in the child's sandboxes.
 
-The server reads one request per line on stdin
-(``{"spec", "log", "memory", "cgroups", "environment", "id"}``) and writes one
-line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id": i}``
-and ``{"ended": pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid
-can be used again once its process has ended), ``c`` as Popen's returncode.
-When its stdin closes (the run is over, or the grader died) it stops every
+The server reads one request per line on stdin (``{"spec", "log", "memory", "cgroups", "environment",
+"id"}``) and writes one line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id":
+i}`` and ``{"ended": pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid can be used again),
+``c`` as Popen's returncode. When its stdin closes (the run is over, or the grader died) it stops every
 child still running and ends.
 """
 
@@ -33,7 +26,7 @@ import threading
 import time
 
 from ..sandbox import protocol
-from .processes import die_with
+from .processes import die_with, one_thread
 
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
 LAUNCHER_READY = 120  # seconds for the launcher to import the grader
@@ -72,7 +65,6 @@ class Launcher:
 
     def __init__(self, options, server=None, wait=True):
         self.ended, self._lines, self._lock = {}, None, threading.RLock()
-        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         parent = os.getpid()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "labkit.grading.run.launcher", options.exercises or ""],
@@ -80,7 +72,7 @@ class Launcher:
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
-            env=environment,
+            env=one_thread(),
             pass_fds=(server.fd,) if server is not None else (),
             preexec_fn=lambda: die_with(parent),
         )
@@ -110,14 +102,17 @@ class Launcher:
     def pump(self, wait):
         """File every ended process the launcher reported (waiting up to `wait` s for one); whether any."""
         with self._lock:
-            message = self._next(time.monotonic() + wait)
-            found = False
+            found, message = False, self._next(time.monotonic() + wait)
             while message is not None:
-                if "ended" in message:
-                    self.ended[message.get("id")] = int(message["code"])
-                    found = True
+                found = self._filed(message) or found
                 message = self._next(time.monotonic())
             return found
+
+    def _filed(self, message):
+        """Whether `message` says a grading process ended (then filed)."""
+        if "ended" in message:
+            self.ended[message.get("id")] = int(message["code"])
+        return "ended" in message
 
     def launch(self, request):
         """Fork a grading process for `request`; a :class:`_Launched` (OSError when the launcher is gone)."""
@@ -132,9 +127,7 @@ class Launcher:
                 message = self._next(time.monotonic() + LAUNCH_TIMEOUT)
                 if message is None:
                     raise OSError("the launcher of grading processes stopped answering")
-                if "ended" in message:
-                    self.ended[message.get("id")] = int(message["code"])
-                elif "started" in message and message.get("id") == key:
+                if not self._filed(message) and "started" in message and message.get("id") == key:
                     return _Launched(self, int(message["started"]), key)
 
     def stop(self):
@@ -167,11 +160,7 @@ def _child(request):
     code = 1
     try:
         os.setsid()
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: die with the launcher
-        if os.getppid() != request["launcher"]:  # it died before the line above
-            os._exit(1)
+        die_with(request["launcher"])
         for procs in request.get("cgroups", ()):
             with open(procs, "w") as handle:
                 handle.write(str(os.getpid()))
@@ -179,9 +168,8 @@ def _child(request):
         resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
         null = os.open(os.devnull, os.O_RDWR)
         log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        os.dup2(null, 0)
-        os.dup2(null, 1)
-        os.dup2(log, 2)
+        for fd, target in ((null, 0), (null, 1), (log, 2)):
+            os.dup2(fd, target)
         os.close(null)
         os.close(log)
         sys.stdin = open(os.devnull)  # noqa: SIM115 - for the rest of this process's life
@@ -209,6 +197,19 @@ def _say(message):
     os.write(1, (json.dumps(message) + "\n").encode())
 
 
+def _reaped(children):
+    """[(pid, its request's id, wait status)] of the `children` that ended, taken out of `children`."""
+    ended = []
+    for pid in list(children):
+        try:
+            done, status = os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            done, status = pid, 0
+        if done:
+            ended.append((pid, children.pop(pid), status))
+    return ended
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     _import_grader(argv[0] if argv and argv[0] else None)
@@ -217,13 +218,8 @@ def main(argv=None):
     try:
         while True:
             readable = select.select([0], [], [], 0.05)[0]
-            for pid in list(children):
-                try:
-                    done, status = os.waitpid(pid, os.WNOHANG)
-                except ChildProcessError:
-                    done, status = pid, 0
-                if done and pid in children:
-                    _say({"ended": pid, "id": children.pop(pid), "code": os.waitstatus_to_exitcode(status)})
+            for pid, key, status in _reaped(children):
+                _say({"ended": pid, "id": key, "code": os.waitstatus_to_exitcode(status)})
             if not readable:
                 continue
             chunk = os.read(0, 1 << 16)
@@ -249,12 +245,7 @@ def main(argv=None):
                 pass
         deadline = time.monotonic() + 5
         while children and time.monotonic() < deadline:
-            for pid in list(children):
-                try:
-                    if os.waitpid(pid, os.WNOHANG)[0]:
-                        children.pop(pid)
-                except ChildProcessError:
-                    children.pop(pid)
+            _reaped(children)
             time.sleep(0.02)
 
 

@@ -1,13 +1,11 @@
 """Each submission's grading process, as the grader supervises it: its limits, its end, its outcome.
 
-A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` for one
-submission (or has the run's launcher fork it: :mod:`.launcher`), inside an
-address-space limit and a memory cgroup of its own (:mod:`labkit.grading.sandbox.cgroup`),
-set to die with the thread that started it (``PR_SET_PDEATHSIG``), and stops
-it when it overruns the submission's time limit plus a grace for the checks.
-A grading process that breaks is started once more (:data:`ATTEMPTS`); its
-outcome is plain data (:meth:`Job.message`), which :func:`settled` scores
-under the run's rubric. No student code runs here.
+A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` for one submission (or has the
+run's launcher fork it: :mod:`.launcher`) in an address-space limit and a memory cgroup of its own
+(:mod:`labkit.grading.sandbox.cgroup`), set to die with the thread that started it, and stops it when it
+overruns the submission's time limit plus a grace for the checks. One that breaks is started once more
+(:data:`ATTEMPTS`); its outcome is plain data (:meth:`Job.message`), which :func:`settled` scores under the
+run's rubric. No student code runs here.
 """
 
 import ctypes
@@ -48,19 +46,19 @@ def low_space(out):
 
 
 class Job:
-    """One submission's grading process."""
+    """One submission's grading process: `server` is the run's fork server (labkit.grading.sandbox.forkserver)
+    and `launcher` its :class:`.launcher.Launcher`, each None where there is none (the plain way)."""
 
     def __init__(self, path, name, work, options, profiles_file, server=None, launcher=None):
         self.path, self.name, self.attempt = Path(path), name, 0
         self.work, self.options, self.profiles_file = work, options, profiles_file
-        self.server = server  # the run's fork server (labkit.grading.sandbox.forkserver), or None
-        self.launcher = launcher  # the run's Launcher of grading processes, or None (each one a new Python)
-        self.process, self.cgroup, self.started = None, None, None
+        self.server, self.launcher = server, launcher
+        self.process, self.cgroup, self.started, self.peaks = None, None, None, []
 
     def start(self):
         self.attempt += 1
-        self.result = self.work / f"{safe_name(self.name)}-{self.attempt}.json"
-        spec = self.work / f"{safe_name(self.name)}-{self.attempt}.spec.json"
+        stem = self.work / f"{safe_name(self.name)}-{self.attempt}"
+        self.result, spec, self.log = Path(f"{stem}.json"), Path(f"{stem}.spec.json"), Path(f"{stem}.log")
         origin = None if self.options.backend in backends.BUILTIN else backends.origin(self.options.backend)
         spec.write_text(
             json.dumps(
@@ -76,9 +74,23 @@ class Job:
             encoding="utf-8",
         )
         memory = self.options.grader_memory
-        self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
-        group = self.cgroup
-
+        group = self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
+        environment = one_thread()
+        if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
+            environment.update(group.sibling_environment())
+        environment.pop(forkserver.ENV, None)
+        if self.server is not None:
+            environment.update(self.server.environment())
+        if self.launcher is not None:
+            folders = [group.path, group.cpu_path] if group is not None else []
+            cgroups = [str(folder / "cgroup.procs") for folder in folders if folder is not None]
+            request = {"spec": str(spec), "log": str(self.log), "memory": memory, "cgroups": cgroups}
+            try:
+                self.process = self.launcher.launch({**request, "environment": environment})
+                self.started = time.monotonic()
+                return
+            except OSError:  # the launcher is gone: this submission and the next start the plain way
+                self.launcher = None
         parent = os.getpid()
 
         def prepare():
@@ -87,30 +99,6 @@ class Job:
             resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
             die_with(parent)
 
-        environment = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-        environment.update(process_environment())
-        if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
-            environment.update(group.sibling_environment())
-        environment.pop(forkserver.ENV, None)
-        if self.server is not None:
-            environment.update(self.server.environment())
-        self.log = self.work / f"{safe_name(self.name)}-{self.attempt}.log"
-        if self.launcher is not None:
-            folders = [group.path, group.cpu_path] if group is not None else []
-            try:
-                self.process = self.launcher.launch(
-                    {
-                        "spec": str(spec),
-                        "log": str(self.log),
-                        "memory": memory,
-                        "cgroups": [str(folder / "cgroup.procs") for folder in folders if folder is not None],
-                        "environment": environment,
-                    }
-                )
-                self.started = time.monotonic()
-                return
-            except OSError:  # the launcher is gone: this submission and the next start the plain way
-                self.launcher = None
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "labkit.grading.submission.scoring", str(spec)],
@@ -127,9 +115,6 @@ class Job:
     @property
     def limit(self):
         return self.options.total_timeout + self.options.grader_grace
-
-    def overdue(self):
-        return time.monotonic() - self.started > self.limit
 
     def stop(self):
         """Kill the grading process and everything it started (its sandboxes die with it)."""
@@ -159,14 +144,14 @@ class Job:
 
     def poll(self):
         """Whether this attempt is over (its process ended, or it overran its limit and was stopped)."""
-        if self.process.poll() is None:
-            if not self.overdue():
-                return False
+        running = self.process.poll() is None
+        if running and time.monotonic() - self.started <= self.limit:
+            return False
+        self.timed_out = running
+        if running:
             self.stop()
-            self.timed_out = True
         else:
             self.finish()
-            self.timed_out = False
         return True
 
     def wait(self):
@@ -183,8 +168,8 @@ class Job:
     def conclude(self):
         """After an attempt: True when the submission is done (:meth:`message`), False when its grading
         process is to be started once more."""
-        self.peaks = [*getattr(self, "peaks", []), self.peak]
-        self.data, self.why = self.read(self.timed_out)
+        self.peaks.append(self.peak)
+        self.data, self.why = self.read()
         return self.data is not None or self.attempt >= ATTEMPTS
 
     def message(self):
@@ -198,20 +183,20 @@ class Job:
             "peak": max((p for p in self.peaks if p), default=None),
         }
 
-    def read(self, timed_out):
+    def read(self):
         """(the result file's data, None), or (None, why the grading process failed)."""
         code = self.process.returncode
-        if timed_out:
+        if self.timed_out:
             return None, (
                 f"its grading took longer than {self.limit} s (the submission's time limit plus "
                 f"{self.options.grader_grace} s for the checks) and was stopped"
             )
         if code != 0 or not self.result.exists():
-            if getattr(self, "out_of_memory", False) or code in (-signal.SIGKILL, -signal.SIGSEGV):
+            if self.out_of_memory or code in (-signal.SIGKILL, -signal.SIGSEGV):
                 return None, (
                     "its grading ran out of memory (the grader's limit of "
                     f"{self.options.grader_memory // 1024**2} MiB) and was stopped"
-                    if getattr(self, "out_of_memory", False) or code == -signal.SIGKILL
+                    if self.out_of_memory or code == -signal.SIGKILL
                     else f"its grading process crashed ({signal.Signals(-code).name})"
                 )
             if code is not None and code < 0:
@@ -228,12 +213,9 @@ class Job:
         return data, None
 
 
-def process_environment():
-    """What each grading process gets in its environment beyond the grader's own (nothing yet).
-
-    Called in the process that starts the grading process: the grader with ``--jobs``, a Dask worker
-    with ``--dask``; the place for whatever a grading process must be handed (the fork server's address)."""
-    return {}
+def one_thread():
+    """The grader's environment, with numpy's libraries held to one thread (a grading process, the launcher)."""
+    return {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
 _LIBC = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None

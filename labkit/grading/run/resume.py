@@ -1,10 +1,9 @@
 """What a run into an output folder takes over from the one before it there, and which part of a class it grades.
 
-:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.store.record`)
-and keeps the submissions graded there whose notebooks did not change since;
-:func:`carried_marks` keeps a person's marks that still apply to a
-submission graded again. :func:`shard` picks the I-th of N parts of a class,
-for batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
+:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.store.record`) and keeps the
+submissions graded there whose notebooks did not change since; :func:`carried_marks` keeps a person's
+marks that still apply to one graded again. :func:`shard` picks the I-th of N parts of a class, for
+batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
 """
 
 from dataclasses import dataclass, field
@@ -12,6 +11,7 @@ from pathlib import Path
 
 from ...errors import InputError
 from ..store import record as records
+from ..store.model import ItemKey
 from ..store.report import SubmissionGrade, labkit_version, one_line
 from ..store.rubric import DEFAULT as DEFAULT_RUBRIC
 from ..store.rubric import Rubric
@@ -35,57 +35,30 @@ def notebooks(path):
 
 @dataclass
 class Resumed:
-    """What an earlier run into the same output folder leaves to this one (:func:`resumed`).
+    """What an earlier run into the same output folder leaves to this one (:func:`resumed`)."""
 
-    Attributes
-    ----------
-    done : dict
-        {name: SubmissionGrade} kept: graded there, and its notebooks unchanged since.
-    seed : int or None
-        The seed to grade with (the earlier run's).
-    rubric : Rubric
-        The rubric to grade with (the earlier run's, when none was given).
-    record : RunRecord or None
-        The earlier run's record, which this run goes on writing.
-    changed : list
-        The submissions graded there whose notebooks changed since: graded again.
-    refused : list
-        (path, why) of result files in the folder that its record does not vouch for: never read.
-    """
-
-    done: dict
-    seed: object
-    rubric: Rubric
-    record: object = None
-    changed: list = field(default_factory=list)
-    refused: list = field(default_factory=list)
+    done: dict  # {name: SubmissionGrade} kept: graded there, and its notebooks unchanged since
+    seed: object  # the seed to grade with (the earlier run's), or None
+    rubric: Rubric  # the rubric to grade with (the earlier run's, when none was given)
+    record: object = None  # the earlier run's RunRecord, which this run goes on writing, or None
+    changed: list = field(default_factory=list)  # the names graded there whose notebooks changed since
+    refused: list = field(default_factory=list)  # (path, why) of result files its record does not vouch for
     # {name: its earlier grade} of the changed submissions: the marks a person gave them carry over where they apply
     earlier: dict = field(default_factory=dict)
 
 
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
-    """What the earlier run in `out` leaves to this one: a :class:`Resumed`.
+    """What the earlier run in `out` leaves to this one: a :class:`Resumed`. Reads, never writes.
 
-    An output folder with a run record (:mod:`labkit.grading.store.record`) is resumed: the submissions graded
-    there are kept, unless their notebooks' digest differs from the recorded one (`contents`, {name:
-    digest}: they changed since, and are graded again), and the run grades the others with the earlier
-    run's seed, which `seed` may repeat but not change, and under the earlier run's rubric, which `rubric`
-    (a Rubric, or None for the recorded one) may repeat but not change. A submission that could not be
-    graded is graded again (such failures are the grader's: a crash, a stopped run, a lost worker). A
-    folder of another labkit version, a merge's folder, results without a record, a different rubric or
-    seed, or a submission graded there that is not in `names` are refused with a ValueError saying what to
-    do, as nothing of them would fit this run's grades.csv. `fresh` deletes the earlier results, feedback
-    and record instead: every submission is graded, with `seed` (a fresh one when None)."""
+    The submissions graded there are kept unless their notebooks' digest differs from the recorded one
+    (`contents`, {name: digest}) or they could not be graded; the others are graded with the earlier run's
+    seed and rubric, which `seed` and `rubric` (None: the recorded one) may repeat but not change. Another
+    labkit version's folder, a merge's, results without a record, or a result of a name not in `names` are
+    refused with a ValueError saying what to do. With `fresh` nothing is kept (:func:`clear` deletes it)."""
     out = Path(out)
     files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
-    if fresh:
-        for path in [*files, *sorted((out / "feedback").glob("*.txt")), *sorted((out / "feedback").glob("*.html"))]:
-            path.unlink()
-        for name in (records.RECORD, records.RUBRIC_COPY):
-            (out / name).unlink(missing_ok=True)
-        return Resumed({}, seed, rubric if rubric is not None else default_rubric())
-    if not (out / records.RECORD).exists():
-        if files:
+    if fresh or not (out / records.RECORD).exists():
+        if files and not fresh:
             raise InputError(
                 f"{out} holds results but no run record ({records.RECORD}; an older labkit wrote none): give "
                 "--fresh to grade every submission again there, or choose a new --out."
@@ -139,17 +112,27 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     return Resumed(done, seed, rubric, record, sorted(changed), refused, earlier=before)
 
 
+def clear(out):
+    """Delete the results, feedback and record of the run in `out` (``--fresh``)."""
+    out = Path(out)
+    for folder, pattern in (("results", "*.json"), ("feedback", "*.txt"), ("feedback", "*.html")):
+        for path in sorted((out / folder).glob(pattern)):
+            path.unlink()
+    for name in (records.RECORD, records.RUBRIC_COPY):
+        (out / name).unlink(missing_ok=True)
+
+
 def carried_marks(earlier, grade):
     """The marks of `earlier` (a submission's grade before its notebooks changed) that still apply to its new
     `grade`: an answer's while its text is the same, a held part's while it is still held, an exercise's
     excuse always; and how many no longer apply."""
     kept, dropped = {}, 0
-    held = {f"exercise{number}/{part}" for number, part, _, _ in grade.held()}
+    held = {ItemKey.held(number, part) for number, part, _, _ in grade.held()}
     for item, mark in earlier.marks.items():
-        if item in grade.rubric.registry.answers:
-            same = str(earlier.answers.get(item, "")) == str(grade.answers.get(item, ""))
+        if item.kind == "answer":
+            same = str(earlier.answers.get(item.answer, "")) == str(grade.answers.get(item.answer, ""))
         else:
-            same = "/" not in item or item in held
+            same = item.kind == "exercise" or item in held
         if same:
             kept[item] = mark
         else:
@@ -192,10 +175,3 @@ def shard(names, index, count):
     index, count = parse_shard((index, count))
     ordered = sorted(names)
     return ordered[(index - 1) * len(ordered) // count : index * len(ordered) // count]
-
-
-def shard_of(submissions, names, part):
-    """The submissions (and their names) of `part`, ``(I, N)``, in name order (:func:`shard`)."""
-    by_name = dict(zip(names, submissions))
-    chosen = shard(names, *part)
-    return [by_name[name] for name in chosen], chosen

@@ -63,34 +63,17 @@ _ModuleType, _CodeType, _FunctionType, _BuiltinFunctionType = (
     types.BuiltinFunctionType,
 )
 
+_HEAP_TYPE = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
 SMALL_CODE = 64  # bytes of bytecode below which a function is only recognised with its name and place
 RUN = "run"  # the profile of the request that runs the cells: nothing is refused, tampering is noted
 BEGIN, CHOSEN, END = "labkit.begin", "labkit.chosen", "labkit.end"  # the worker's sentinels
 # audit events that void the notebook's answers: what reaches the watch's state or goes round it
 TAMPER_EVENTS = frozenset(
-    {
-        "sys.setprofile",
-        "sys.settrace",
-        "sys._current_frames",
-        "sys.addaudithook",
-        "gc.get_objects",
-        "gc.get_referrers",
-        "gc.get_referents",
-        "gc.freeze",
-        "os.fork",
-        "os.forkpty",
-        "os.posix_spawn",
-        "os.exec",
-        "os.spawn",
-        "os.system",
-        "subprocess.Popen",
-        "code.__new__",
-        "function.__new__",
-        "_thread.start_new_thread",
-        "cpython._PySys_ClearAuditHooks",
-        "cpython.run_interactivehook",
-        "sys.monitoring.register_callback",
-    }
+    {"sys.setprofile", "sys.settrace", "sys._current_frames", "sys.addaudithook", "sys.monitoring.register_callback"}
+    | {"gc.get_objects", "gc.get_referrers", "gc.get_referents", "gc.freeze"}
+    | {"os.fork", "os.forkpty", "os.posix_spawn", "os.exec", "os.spawn", "os.system", "subprocess.Popen"}
+    | {"code.__new__", "function.__new__", "_thread.start_new_thread"}
+    | {"cpython._PySys_ClearAuditHooks", "cpython.run_interactivehook"}
 )
 TAMPER_PREFIXES = ("ctypes.",)  # but ctypes.dlopen: scipy's own imports open libraries, which is no harm alone
 HARMLESS = frozenset({"ctypes.dlopen"})
@@ -318,16 +301,40 @@ def install(secret, verdict_fd, profiles, passables, chain):
 
 
 def _install(secret, verdict_fd, profiles, passables, chain):
-    """The watch itself; called by :func:`install` with this module's namespace privately copied."""
+    """The watch itself; called by :func:`install` with this module's namespace privately copied.
+
+    Its state is one dictionary that only the hooks' closures hold; the steps below are this module's functions,
+    which :func:`install` rebound to the private namespace, so they too look up nothing a notebook can rebind."""
     import ctypes
 
-    write, getframe, sha256 = _write, _getframe, _sha256
-    gc_disable, gc_enable, gc_isenabled = _gc_disable, _gc_enable, _gc_isenabled
-    key_of, signed, fields, within, modules = code_key, sign, attestation_text, _within, _modules
-    refused_call, make_stand_in = _stand_in("").__code__, _stand_in
-    handed_code = _handed_over(lambda: None).__code__
-    compiled_types, module_type, str_type, bytes_type, dict_type = (_compiled_types(), _ModuleType, str, bytes, dict)
-    heap_type = 1 << 9  # Py_TPFLAGS_HEAPTYPE: a class made by Python code, not a compiled one
+    profiles, strictest = _kept_profiles(profiles)
+    c_objects = _refused_objects([*profiles.values(), strictest])
+    sizes, holders = _modules_as_found(c_objects)
+    # what the watch was given, and what it took while the process was pristine
+    state = dict(secret=secret, verdict_fd=verdict_fd, chain=chain, profiles=profiles, strictest=strictest)
+    state.update(c_objects=c_objects, sizes=sizes, holders=holders, copies=_trusted_copies(passables))
+    state.update(compiled_types=_compiled_types(), refused_call=_stand_in("").__code__)
+    state.update(handed_code=_handed_over(lambda: None).__code__, cache={})  # cache: id(code) -> (code, key)
+    # the request: mode is "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
+    state.update(mode="idle", rid=None, name=None, profile=None, passables=(), refused=None, tampered=None)
+    state.update(live=frozenset(), stubbed=[], busy=False, gc=True)
+    # the code objects in the filter's table, alive until it is emptied: no other code takes their address
+    state["held"] = []
+    hook_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.py_object, ctypes.c_int, ctypes.c_void_p)
+    hook = hook_type(_profile_hook(state))
+    set_profile = ctypes.pythonapi.PyEval_SetProfile
+    set_profile.argtypes, set_profile.restype = (ctypes.c_void_p, ctypes.c_void_p), None
+    hook_address, seen, page = _call_filter(ctypes.cast(hook, ctypes.c_void_p).value)
+    state.update(set_profile=set_profile, hook_address=hook_address, seen=seen, memset=ctypes.memset)
+    state["seen_size"] = ctypes.sizeof(seen) if seen is not None else 0
+    audit = _audit_hook(state)
+    # the C callback and its filter live as long as the audit hook, which lives as long as the process
+    audit.keep = (hook, page)
+    sys.addaudithook(audit)
+
+
+def _kept_profiles(profiles):
+    """The profiles as the watch keeps them, and the strictest one: every profile's refusals together."""
     profiles = {
         name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in profiles.items()
     }
@@ -336,115 +343,141 @@ def _install(secret, verdict_fd, profiles, passables, chain):
         union[0].update(names)
         union[1].update(mods)
         union[2].update(c_names)
-    strictest = (union[0], tuple(union[1]), frozenset(union[2]))
-    identity = id
-    # the refused compiled functions themselves, taken while the process is pristine: {c_names: {id: (it, name)}}
+    return profiles, (union[0], tuple(union[1]), frozenset(union[2]))
+
+
+def _refused_objects(profiles):
+    """The refused compiled functions themselves, taken while the process is pristine: {c_names: {id: (it, name)}}."""
     c_objects = {}
-    for _names, _mods, c_names in [*profiles.values(), strictest]:
+    for _names, _mods, c_names in profiles:
         found = {}
         for module_name, attribute in c_names:
-            module = modules.get(module_name)
-            namespace = module.__dict__ if type(module) is module_type else {}
+            module = _modules.get(module_name)
+            namespace = module.__dict__ if type(module) is _ModuleType else {}
             if attribute in namespace:
-                found[identity(namespace[attribute])] = (namespace[attribute], f"{module_name}.{attribute}")
+                found[id(namespace[attribute])] = (namespace[attribute], f"{module_name}.{attribute}")
         c_objects[c_names] = found
-    # the modules as the watch found them: how many names each held, and which held a refused compiled function
+    return c_objects
+
+
+def _modules_as_found(c_objects):
+    """The modules as the watch found them: how many names each held, and which held a refused compiled function."""
     sizes, holders, every_target = {}, set(), frozenset(i for found in c_objects.values() for i in found)
-    for module_name, module in list(modules.items()):
-        if type(module_name) is str_type and type(module) is module_type and type(module.__dict__) is dict_type:
+    for module_name, module in list(_modules.items()):
+        if type(module_name) is str and type(module) is _ModuleType and type(module.__dict__) is dict:
             sizes[module_name] = len(module.__dict__)
-            if not every_target.isdisjoint(map(identity, module.__dict__.values())):
+            if not every_target.isdisjoint(map(id, module.__dict__.values())):
                 holders.add(module_name)
+    return sizes, holders
+
+
+def _trusted_copies(passables):
+    """{name: (the code trusted, the function handed over)} for each function the grader may hand to student code."""
     copies = {}
     for name, function in passables.items():
         code = function.__code__.replace()  # equal, but another object: trusted by identity
         copy = _FunctionType(code, function.__globals__, function.__name__, function.__defaults__, function.__closure__)
         copy.__kwdefaults__, copy.__qualname__ = function.__kwdefaults__, function.__qualname__
         copies[name] = (code, _handed_over(copy))
-    # mode: "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
-    state = {
-        "mode": "idle",
-        "rid": None,
-        "name": None,
-        "profile": None,
-        "passables": (),
-        "refused": None,
-        "tampered": None,
-        "live": frozenset(),
-        "stubbed": [],
-        "busy": False,
-        "gc": True,
-    }
-    cache = {}  # id(code) -> (code, key)
+    return copies
 
-    def note_tampering(what):
-        if state["tampered"] is None:
-            state["tampered"] = what
-        try:
-            write(verdict_fd, f"TAMPER\t{what}\n".encode())
-        except OSError:
-            pass
 
-    def genuine(frame):
-        """Whether the Python frame that raised a sentinel is the worker's own serving chain."""
-        caller = frame
-        for expected in chain:
-            if caller is None or caller.f_code is not expected:
-                return False
-            caller = caller.f_back
-        return True
+def _note_tampering(state, what):
+    if state["tampered"] is None:
+        state["tampered"] = what
+    try:
+        _write(state["verdict_fd"], f"TAMPER\t{what}\n".encode())
+    except OSError:
+        pass
 
-    def stub(profile):
-        """Replace the compiled functions and classes of the refused modules (exact types only)."""
-        mods, c_names = profile[1], profile[2]
-        # a refused compiled function is switched off under every name a module holds it by (numpy's interp is
-        # numpy._core._multiarray_umath.interp, numpy._core.multiarray.interp, ...): found by identity only
-        targets = c_objects.get(c_names, {})
-        target_ids = frozenset(targets)
-        for module_name, module in list(modules.items()):
-            if type(module_name) is not str_type or type(module) is not module_type:
-                continue
-            namespace = module.__dict__
-            if type(namespace) is not dict_type:
-                continue
-            whole = within(module_name, mods)
-            # where the process held a target when the watch was installed, and any module loaded or grown since
-            # (ids compared in C: no object of the notebook's is asked anything; a live target's id is its own)
-            held = module_name in holders
-            if target_ids and not held and sizes.get(module_name) != len(namespace):
-                held = not target_ids.isdisjoint(map(identity, namespace.values()))
-                if not held:
-                    sizes[module_name] = len(namespace)  # looked at with this many names: again once it changes
-            if not whole and not held and not any(m == module_name for m, _ in c_names):
-                continue
-            entries = list(namespace.items())
-            if any(type(attribute) is not str_type for attribute, _ in entries):
-                # a key of the notebook's making could run code when the dictionary compares it
-                note_tampering(f"a name that is not a string put in {module_name}")
-                continue
-            for attribute, value in entries:
-                kind = type(value)
-                compiled = kind in compiled_types or (kind is type and not value.__flags__ & heap_type)
-                alias = identity(value) in targets and targets[identity(value)][0] is value
-                if ((module_name, attribute) in c_names) or (whole and compiled) or alias:
-                    name = targets[identity(value)][1] if alias else f"{module_name}.{attribute}"
-                    namespace[attribute] = make_stand_in(name)
-                    state["stubbed"].append((namespace, attribute, value))
 
-    def unstub():
-        for namespace, attribute, value in reversed(state["stubbed"]):
-            namespace[attribute] = value
-        state["stubbed"].clear()
+def _note_busy(state, what):
+    """:func:`_note_tampering` with the audit hook deaf to what that raises."""
+    state["busy"] = True
+    try:
+        _note_tampering(state, what)
+    finally:
+        state["busy"] = False
 
-    def key(code):
-        found = cache.get(id(code))
-        if found is None or found[0] is not code:
-            found = (code, key_of(code))
-            cache[id(code)] = found
-        return found[1]
+
+def _genuine(state, frame):
+    """Whether the Python frame that raised a sentinel is the worker's own serving chain."""
+    caller = frame
+    for expected in state["chain"]:
+        if caller is None or caller.f_code is not expected:
+            return False
+        caller = caller.f_back
+    return True
+
+
+def _stub(state, profile):
+    """Replace the compiled functions and classes of the refused modules (exact types only)."""
+    mods, c_names = profile[1], profile[2]
+    # a refused compiled function is switched off under every name a module holds it by (numpy's interp is
+    # numpy._core._multiarray_umath.interp, numpy._core.multiarray.interp, ...): found by identity only
+    targets = state["c_objects"].get(c_names, {})
+    target_ids = frozenset(targets)
+    for module_name, module in list(_modules.items()):
+        if type(module_name) is not str or type(module) is not _ModuleType:
+            continue
+        namespace = module.__dict__
+        if type(namespace) is not dict:
+            continue
+        whole = _within(module_name, mods)
+        held = _holds_target(state, module_name, namespace, target_ids)
+        if whole or held or any(m == module_name for m, _ in c_names):
+            _stub_module(state, module_name, namespace, whole, targets, c_names)
+
+
+def _holds_target(state, module_name, namespace, target_ids):
+    """Whether a module holds a refused compiled function: where the process held one when the watch was installed,
+    and any module loaded or grown since (ids compared in C: no object of the notebook's is asked anything; a live
+    target's id is its own)."""
+    held = module_name in state["holders"]
+    if target_ids and not held and state["sizes"].get(module_name) != len(namespace):
+        held = not target_ids.isdisjoint(map(id, namespace.values()))
+        if not held:
+            state["sizes"][module_name] = len(namespace)  # looked at with this many names: again once it changes
+    return held
+
+
+def _stub_module(state, module_name, namespace, whole, targets, c_names):
+    """Put stand-ins in one module for what it holds of the refused (its every compiled function when `whole`)."""
+    entries = list(namespace.items())
+    if any(type(attribute) is not str for attribute, _ in entries):
+        # a key of the notebook's making could run code when the dictionary compares it
+        _note_tampering(state, f"a name that is not a string put in {module_name}")
+        return
+    for attribute, value in entries:
+        kind = type(value)
+        compiled = kind in state["compiled_types"] or (kind is type and not value.__flags__ & _HEAP_TYPE)
+        alias = id(value) in targets and targets[id(value)][0] is value
+        if ((module_name, attribute) in c_names) or (whole and compiled) or alias:
+            name = targets[id(value)][1] if alias else f"{module_name}.{attribute}"
+            namespace[attribute] = _stand_in(name)
+            state["stubbed"].append((namespace, attribute, value))
+
+
+def _unstub(state):
+    for namespace, attribute, value in reversed(state["stubbed"]):
+        namespace[attribute] = value
+    state["stubbed"].clear()
+
+
+def _key(state, code):
+    cache = state["cache"]
+    found = cache.get(id(code))
+    if found is None or found[0] is not code:
+        found = (code, code_key(code))
+        cache[id(code)] = found
+    return found[1]
+
+
+def _profile_hook(state):
+    """The hook of every profile event of a graded request (called through the C API): refused calls are noted."""
+    refused_call, handed_code = state["refused_call"], state["handed_code"]
 
     def profile_hook(obj, frame, what, arg):
-        """Every profile event of a graded request (through the C API): refused calls are noted."""
         try:
             if what != 0 or state["refused"] is not None:  # only 'call' events, and only until the first refusal
                 return 0
@@ -452,153 +485,151 @@ def _install(secret, verdict_fd, profiles, passables, chain):
             profile = state["profile"]
             if code is refused_call:
                 name = frame.f_locals.get("name")
-                name = name if type(name) is str_type and name else "a switched-off function"
+                name = name if type(name) is str and name else "a switched-off function"
             else:
-                name = profile[0].get(key(code)) if profile is not None else None
+                name = profile[0].get(_key(state, code)) if profile is not None else None
             if name is not None and not (
                 code in state["live"] and frame.f_back is not None and frame.f_back.f_code is handed_code
             ):
                 state["refused"] = str(name)
             elif name is None:
-                remember(code)
+                _remember(state, code)
         except BaseException:  # noqa: BLE001 - the hook never raises (its traceback would expose the watch)
             state["tampered"] = state["tampered"] or "an error inside the grader's watch"
         return 0
 
-    hook_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.py_object, ctypes.c_int, ctypes.c_void_p)
-    hook = hook_type(profile_hook)
-    set_profile = ctypes.pythonapi.PyEval_SetProfile
-    set_profile.argtypes, set_profile.restype = (ctypes.c_void_p, ctypes.c_void_p), None
-    hook_address, seen, page = _call_filter(ctypes.cast(hook, ctypes.c_void_p).value)
-    held = []  # the code objects in the filter's table, alive until it is emptied: no other code takes their address
+    return profile_hook
 
-    def remember(code):
-        """A code object found clean under this request's profile: the filter passes over its calls from now on."""
-        if seen is not None:
-            seen[(identity(code) >> 4) & (SLOTS - 1)] = identity(code)
-            held.append(code)
 
-    def forget():
-        """Empty the filter's table (a new request, or its profile, starts)."""
-        if seen is not None and held:
-            ctypes.memset(seen, 0, ctypes.sizeof(seen))
-            held.clear()
+def _remember(state, code):
+    """A code object found clean under this request's profile: the filter passes over its calls from now on."""
+    if state["seen"] is not None:
+        state["seen"][(id(code) >> 4) & (SLOTS - 1)] = id(code)
+        state["held"].append(code)
 
-    def begin(frame):
-        if state["mode"] != "idle":
-            note_tampering("a grading request started inside another")
-            return
-        state["gc"] = gc_isenabled()
-        gc_disable()  # no finalizer of the student's runs while a request is watched
-        forget()
-        state.update(
-            mode="reading", rid=None, name=None, profile=strictest, passables=(), refused=None, live=frozenset()
-        )
-        set_profile(hook_address, None)  # sys.getprofile() stays None: nothing to fetch
 
-    def choose(args):
-        if state["mode"] != "reading" or len(args) != 4:
-            note_tampering("a grading request chosen twice")
-            return
-        rid, name, wanted, handoff = args
-        if (
-            type(rid) is not str_type
-            or (name is not None and type(name) is not str_type)
-            or type(wanted) not in (list, tuple)
-            or any(type(w) is not str_type for w in wanted)
-            or type(handoff) is not dict_type
-            or handoff
-        ):
-            note_tampering("a grading request with what no grader sends")
-            return
-        live = set()
-        for passable in wanted:
-            if passable in copies:
-                code, handed = copies[passable]
-                handoff[passable] = handed
-                live.add(code)
-        profile = None if name in (None, RUN) else profiles.get(name, strictest)
-        state.update(
-            rid=rid,
-            name=name,
-            profile=profile,
-            passables=tuple(wanted),
-            live=frozenset(live),
-            mode=RUN if name == RUN else "graded",
-        )
-        if name == RUN:
-            set_profile(None, None)  # the cells run unwatched but for tampering, and at full speed
-            if state["gc"]:
-                gc_enable()
-        elif profile is not None:
-            set_profile(None, None)  # the watch's own walk over the modules runs unprofiled (no student code runs)
-            stub(profile)
-            forget()  # what was clean while the request was read is judged again under its own profile
-            set_profile(hook_address, None)
-        else:
-            set_profile(None, None)  # nothing is refused in this request: nothing to note but tampering
+def _forget(state):
+    """Empty the filter's table (a new request, or its profile, starts)."""
+    if state["seen"] is not None and state["held"]:
+        state["memset"](state["seen"], 0, state["seen_size"])
+        state["held"].clear()
 
-    def end(args):
-        if state["mode"] not in ("graded", RUN) or len(args) != 1 or type(args[0]) is not bytes_type:
-            note_tampering("an answer out of turn")
-            return
-        set_profile(None, None)
-        forget()
-        unstub()
-        status = (
-            f"tampered:{state['tampered']}"
-            if state["tampered"]
-            else f"refused:{state['refused']}"
-            if state["refused"]
-            else "clean"
-        )
-        parts = fields(state["rid"], state["name"], state["passables"], status, sha256(args[0]).hexdigest())
-        state.update(mode="idle", rid=None, name=None, profile=None, passables=(), live=frozenset())
+
+def _begin(state):
+    if state["mode"] != "idle":
+        _note_tampering(state, "a grading request started inside another")
+        return
+    state["gc"] = _gc_isenabled()
+    _gc_disable()  # no finalizer of the student's runs while a request is watched
+    _forget(state)
+    state.update(
+        mode="reading", rid=None, name=None, profile=state["strictest"], passables=(), refused=None, live=frozenset()
+    )
+    state["set_profile"](state["hook_address"], None)  # sys.getprofile() stays None: nothing to fetch
+
+
+def _as_a_worker_sends(rid, name, wanted, handoff):
+    """Whether a request's choice has the exact built-in types the worker sends (and an empty handoff)."""
+    return not (
+        type(rid) is not str
+        or (name is not None and type(name) is not str)
+        or type(wanted) not in (list, tuple)
+        or any(type(w) is not str for w in wanted)
+        or type(handoff) is not dict
+        or handoff
+    )
+
+
+def _choose(state, args):
+    if state["mode"] != "reading" or len(args) != 4:
+        _note_tampering(state, "a grading request chosen twice")
+        return
+    rid, name, wanted, handoff = args
+    if not _as_a_worker_sends(rid, name, wanted, handoff):
+        _note_tampering(state, "a grading request with what no grader sends")
+        return
+    live = set()
+    for passable in wanted:
+        if passable in state["copies"]:
+            code, handed = state["copies"][passable]
+            handoff[passable] = handed
+            live.add(code)
+    profile = None if name in (None, RUN) else state["profiles"].get(name, state["strictest"])
+    state.update(
+        rid=rid,
+        name=name,
+        profile=profile,
+        passables=tuple(wanted),
+        live=frozenset(live),
+        mode=RUN if name == RUN else "graded",
+    )
+    # the cells run unwatched but for tampering, and at full speed; a graded request's walk over the modules runs
+    # unprofiled (no student code runs); a request where nothing is refused is watched for tampering only
+    state["set_profile"](None, None)
+    if name == RUN:
         if state["gc"]:
-            gc_enable()
-        write(verdict_fd, ("\t".join(parts) + "\t" + signed(secret, *parts) + "\n").encode())
+            _gc_enable()
+    elif profile is not None:
+        _stub(state, profile)
+        _forget(state)  # what was clean while the request was read is judged again under its own profile
+        state["set_profile"](state["hook_address"], None)
+
+
+def _end(state, args):
+    if state["mode"] not in ("graded", RUN) or len(args) != 1 or type(args[0]) is not bytes:
+        _note_tampering(state, "an answer out of turn")
+        return
+    state["set_profile"](None, None)
+    _forget(state)
+    _unstub(state)
+    status = (
+        f"tampered:{state['tampered']}"
+        if state["tampered"]
+        else f"refused:{state['refused']}"
+        if state["refused"]
+        else "clean"
+    )
+    parts = attestation_text(state["rid"], state["name"], state["passables"], status, _sha256(args[0]).hexdigest())
+    state.update(mode="idle", rid=None, name=None, profile=None, passables=(), live=frozenset())
+    if state["gc"]:
+        _gc_enable()
+    _write(state["verdict_fd"], ("\t".join(parts) + "\t" + sign(state["secret"], *parts) + "\n").encode())
+
+
+def _audit_hook(state):
+    """The audit hook: tampering is noted the moment it happens, and the worker's sentinels move the watch on."""
 
     def audit(event, args):
         if state["busy"]:
             return
         if event in TAMPER_EVENTS or (event.startswith(TAMPER_PREFIXES) and event not in HARMLESS):
-            state["busy"] = True
-            try:
-                note_tampering(event)
-            finally:
-                state["busy"] = False
+            _note_busy(state, event)
             return
         if event == "object.__setattr__":
-            if len(args) == 3 and type(args[1]) is str_type and args[1] in GUARDED_ATTRIBUTES:
-                state["busy"] = True
-                try:
-                    note_tampering(f"a function's {args[1]} replaced")
-                finally:
-                    state["busy"] = False
+            if len(args) == 3 and type(args[1]) is str and args[1] in GUARDED_ATTRIBUTES:
+                _note_busy(state, f"a function's {args[1]} replaced")
             return
         if event not in (BEGIN, CHOSEN, END):
             return
         state["busy"] = True
         try:
-            gc_disable()
-            if not genuine(getframe(1)):
-                note_tampering(f"{event} raised by the notebook")
+            _gc_disable()
+            if not _genuine(state, _getframe(1)):
+                _note_tampering(state, f"{event} raised by the notebook")
             elif event == BEGIN:
-                begin(None)
+                _begin(state)
             elif event == CHOSEN:
-                choose(args)
+                _choose(state, args)
             else:
-                end(args)
+                _end(state, args)
         except BaseException:  # noqa: BLE001 - the hook never raises (its traceback would expose the watch)
-            note_tampering("an error inside the grader's watch")
+            _note_tampering(state, "an error inside the grader's watch")
         finally:
             if state["mode"] in ("idle", RUN) and state["gc"]:
-                gc_enable()
+                _gc_enable()
             state["busy"] = False
 
-    # the C callback and its filter live as long as the audit hook, which lives as long as the process
-    audit.keep = (hook, page)
-    sys.addaudithook(audit)
+    return audit
 
 
 def unwire(profiles):

@@ -37,6 +37,7 @@ import json
 import math
 import os
 import select
+import signal
 import time
 
 import numpy as np
@@ -309,6 +310,22 @@ def decode(tag, depth=0, functions=None):
             raise ProtocolError(f"the keywords bound to {tag[1]!r} are not at most {MAX_KEYWORDS} finite floats")
         return functools.partial(functions[tag[1]], **bound)
     raise ProtocolError(f"unknown value tag {kind!r}")
+
+
+def write_all(fd, data):
+    """Write all of `data` to the pipe `fd` (a write may take only part of it)."""
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+def ended(signal_number, status):
+    """How a notebook's process ended, in words: killed by `signal_number`, else exited with `status`."""
+    if signal_number is not None:
+        known = signal_number in signal.Signals._value2member_map_
+        name = signal.Signals(signal_number).name if known else str(signal_number)
+        return f"the notebook's process was killed by {name} (a resource limit, or os.kill)"
+    return f"the notebook's process exited with status {status} (os._exit or a crash)"
 
 
 class Lines:

@@ -20,7 +20,6 @@ function ran past its own limit. Callers tell them apart by type.
 """
 
 import secrets
-import signal
 import subprocess
 import sys
 import time
@@ -231,10 +230,7 @@ class NotebookHandle:
             return "the notebook ran out of memory (the sandbox's limit)"
         if code is None:
             return "the notebook's process stopped answering"
-        if code < 0:
-            name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else str(-code)
-            return f"the notebook's process was killed by {name} (a resource limit, or os.kill)"
-        return f"the notebook's process exited with status {code} (os._exit or a crash)"
+        return protocol.ended(-code if code < 0 else None, code)
 
     def _read_line(self, until):
         try:

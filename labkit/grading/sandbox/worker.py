@@ -211,9 +211,7 @@ def _serve_one(notebook, reader, answers):
     answer["id"] = request.get("id")
     payload = protocol.dumps(answer)
     sys.audit(guard.END, payload)
-    view = memoryview(payload)
-    while view:
-        view = view[os.write(answers, view) :]
+    protocol.write_all(answers, payload)
     return True
 
 
@@ -256,10 +254,7 @@ class Supervisor:
         self.tampered = None  # what the watch reported: from then on no answer of this notebook counts
 
     def reply(self, message):
-        data = protocol.dumps(message)
-        view = memoryview(data)
-        while view:
-            view = view[os.write(self.answers, view) :]
+        protocol.write_all(self.answers, protocol.dumps(message))
 
     def serve(self):
         while True:
@@ -366,10 +361,7 @@ class Supervisor:
         passables = [str(p) for p in request.get("passables", ())] if request.get("op") == "call" else []
         message = {**request, "profile": profile, "passables": passables}
         try:
-            data = protocol.dumps(message)
-            view = memoryview(data)
-            while view:
-                view = view[os.write(self.child["requests"], view) :]
+            protocol.write_all(self.child["requests"], protocol.dumps(message))
         except OSError:
             self.stop()
             return _grader_error("WorkerError", self.ended)
@@ -471,11 +463,7 @@ class Supervisor:
 
 
 def _ended(status):
-    if os.WIFSIGNALED(status):
-        number = os.WTERMSIG(status)
-        name = signal.Signals(number).name if number in signal.Signals._value2member_map_ else str(number)
-        return f"the notebook's process was killed by {name} (a resource limit, or os.kill)"
-    return f"the notebook's process exited with status {os.WEXITSTATUS(status)} (os._exit or a crash)"
+    return protocol.ended(os.WTERMSIG(status) if os.WIFSIGNALED(status) else None, os.WEXITSTATUS(status))
 
 
 def drop_privileges(uid):

@@ -49,23 +49,10 @@ from ...errors import InputError
 from . import worker
 from .backends.base import Limits, apply_limits, environment_paths
 
-CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC, CLONE_NEWPID, CLONE_NEWNET = (
-    0x00020000,
-    0x04000000,
-    0x08000000,
-    0x20000000,
-    0x40000000,
-)
-MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REMOUNT, MS_BIND, MS_REC, MS_PRIVATE = (
-    1,
-    2,
-    4,
-    8,
-    32,
-    1 << 12,
-    0x4000,
-    0x40000,
-)
+CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC = 0x00020000, 0x04000000, 0x08000000
+CLONE_NEWPID, CLONE_NEWNET = 0x20000000, 0x40000000
+MS_RDONLY, MS_NOSUID, MS_NODEV, MS_NOEXEC, MS_REMOUNT = 1, 2, 4, 8, 32
+MS_BIND, MS_REC, MS_PRIVATE = 1 << 12, 0x4000, 0x40000
 PR_SET_NO_NEW_PRIVS, PR_GET_DUMPABLE = 38, 3
 MAX_REQUEST = 4 * 1024  # bytes of one request's text
 MAX_FDS = 8  # descriptors passed with one request

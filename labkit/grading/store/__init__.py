@@ -1,4 +1,6 @@
-"""What a grading run writes and reads back: the results' schema, the run's record, the rubric and the late policy.
+"""The typed store of a run: the one reader and writer of its folder, the results' classes, rubric and late rule.
 
-Plain data and text, run in whichever process reads or writes a run's folder; no student code comes near it.
+What it keeps: results, feedback, grades.csv, seed.txt, run.json, the run's record and the marks. Plain data and
+text, run in whichever process reads or writes a run's folder; no student code comes near it. It imports nothing of
+the grader above it (only the sandbox's level, the options and the labkit library).
 """

@@ -24,6 +24,7 @@ import re
 from dataclasses import dataclass, field
 
 from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, VARIANT, part_kind
+from .model import ItemKey
 from .text import one_line, points_text, printable
 
 NO_ANSWER = "YOUR ANSWER HERE"  # an answer in words as released
@@ -136,7 +137,7 @@ def _exercise(grade, number, other_branch):
     if verdict is None:
         note = f"no notebook has its section ('## Exercise {number}'), or it never ran"
         return Exercise(number, 0.0, worth, NOT_DONE, note=note, other_branch=other_branch)
-    parts = tuple(_part(grade, number, check, verdict["checks"]) for check in verdict["checks"])
+    parts = tuple(_part(grade, number, part, verdict.parts) for part in verdict.parts)
     kinds = {part.kind for part in parts}
     if worth and points >= worth - 1e-9:
         status = DONE
@@ -149,25 +150,23 @@ def _exercise(grade, number, other_branch):
     return Exercise(number, points, worth, status, parts, other_branch=other_branch)
 
 
-def _part(grade, number, check, checks):
-    released = bool(check.get("held")) and grade.released(number, check["name"])
-    kind = part_kind(check, released or not check.get("held"))
-    total = sum(c.get("weight", 0) for c in checks) or 1
-    worth = grade.rubric.points[number] * (check.get("weight") or 0) / total
+def _part(grade, number, part, parts):
+    released = bool(part.held) and grade.released(number, part.name)
+    kind = part_kind(part.as_dict(), released or not part.held)
+    total = sum(p.weight for p in parts) or 1
+    worth = grade.rubric.points[number] * (part.weight or 0) / total
     failed = tuple(
-        (one_line(s["step"], 300), one_line(s["detail"], 1000))
-        for s in check.get("steps", [])
-        if not s["passed"] and not (released and s["step"] == HELD_STEP)
+        (one_line(s.step, 300), one_line(s.detail, 1000)) for s in part.failed if not (released and s.step == HELD_STEP)
     )
-    notes = ()
-    if check.get("held") and check.get("passed"):
-        notes = tuple(line.strip() for line in _held_lines(check, released))
-        mark = grade.marks.get(f"exercise{number}/{check['name']}")
-        if mark and mark.get("comment"):
-            notes += (f"your instructor: {one_line(mark['comment'], 1000)}",)
-    hint = one_line(check.get("hint") or "", 1000) if kind not in (PASSED, HELD) else ""
-    figure = _figure(check.get("figure")) if kind not in (PASSED, HELD, NOT_DONE) else ()
-    return Part(one_line(check["name"], 100), kind, worth, failed, hint, notes, figure)
+    notes: tuple = ()
+    if part.held and part.passed:
+        notes = tuple(line.strip() for line in _held_lines(part, released))
+        mark = grade.marks.get(ItemKey.held(number, part.name))
+        if mark and mark.comment:
+            notes += (f"your instructor: {one_line(mark.comment, 1000)}",)
+    hint = one_line(part.hint, 1000) if kind not in (PASSED, HELD) else ""
+    figure = _figure(part.figure) if kind not in (PASSED, HELD, NOT_DONE) else ()
+    return Part(one_line(part.name, 100), kind, worth, failed, hint, notes, figure)
 
 
 FIGURE_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")  # Okabe and Ito
@@ -220,15 +219,15 @@ def _answers(grade):
             continue
         text = str(grade.answers.get(grade_id, "")).strip()
         empty = blank(text)
-        mark, worth = grade.marks.get(grade_id), grade.rubric.answers.get(grade_id, 0.0)
+        mark, worth = grade.marks.get(ItemKey.of_answer(grade_id)), grade.rubric.answers.get(grade_id, 0.0)
         if mark is not None:
-            marked = f"{points_text(mark['points'])} / {points_text(worth)} points"
+            marked = f"{points_text(mark.points)} / {points_text(worth)} points"
         elif empty:
             marked = "no answer" + (f", 0 / {points_text(worth)} points" if worth else "")
         else:
             marked = f"not marked yet, worth {points_text(worth)}" if worth else "not scored"
         lines = () if empty else tuple(one_line(line, 300) for line in text.splitlines()[:20])
-        comment = one_line(mark["comment"], 1000) if mark and mark.get("comment") else ""
+        comment = one_line(mark.comment, 1000) if mark and mark.comment else ""
         found.append((f"Exercise {number}, {what}", marked, lines, comment))
     return tuple(found)
 
@@ -343,9 +342,9 @@ HELD_STEP = (
 )
 
 
-def _held_lines(check, released):
+def _held_lines(part, released):
     """A held part's lines in the feedback: what it matched, and the shared lines side by side."""
-    held = check["held"]
+    held = part.held
     source = one_line(held.get("source", "?"), 120)
     if released:
         lines = [f"    released: your instructor looked at {one_line(held.get('definition', '?'), 80)} and paid it."]
@@ -353,7 +352,7 @@ def _held_lines(check, released):
         lines = [
             f"    HELD: {float(held.get('share', 0)):.0%} of the code of {one_line(held.get('definition', '?'), 80)} "
             f"and what it calls is, names aside, the same as {source}'s; its points wait for your instructor.",
-            f"    hint: {one_line(check['hint'], 1000)}",
+            f"    hint: {one_line(part.hint, 1000)}",
         ]
     pairs = [pair for pair in held.get("lines", ()) if isinstance(pair, (list, tuple)) and len(pair) == 2]
     if pairs and held.get("public", True):

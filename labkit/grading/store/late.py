@@ -1,4 +1,4 @@
-"""Late work: the rubric's ``[late]`` table, when each submission was handed in, and the penalty.
+"""Late work: the rubric's ``[late]`` table, the submission times it reads, and the penalty.
 
 A rubric may say when the work was due and what lateness costs::
 
@@ -18,35 +18,20 @@ rubric, extra credit included): ``min(percent * started units, cap)`` percent
 of it. Lateness is counted from the student's deadline; the grace decides
 only whether a submission is late at all, so one 20 minutes late with 15
 minutes' grace is one started hour (or day) late.
-
-A submission's time (:class:`SubmissionTime`) comes, in this order of
-precedence, from the instructor's ``--times TIMES.csv`` (columns
-``submission`` and ``time``), from nbgrader's ``timestamp.txt`` at the top of
-the submission's folder (:func:`parse_timestamp` reads every format nbgrader
-writes with a UTC offset or UTC itself), and, only when the instructor asks for
-it (``--times-from-mtime``), from the newest modification time of its
-notebooks. A submission with no time while a deadline is set is graded and
-not penalised, and the grades and the feedback say so; an unreadable
-``timestamp.txt`` is reported the same way, with the reason, for the
-instructor to give that time in ``--times``.
 """
 
-import csv
 import math
 import os
 import re
 import stat
 from dataclasses import dataclass, field
-from datetime import UTC, datetime, timedelta, timezone, tzinfo
+from datetime import UTC, datetime, timedelta, tzinfo
 from pathlib import Path
 
 from ...errors import InputError
 from .text import points_text
 
 UNITS = {"day": 86400, "hour": 3600}
-TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
-MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
-MAX_TIMES = 10 * 1024**2  # bytes of a --times file
 FORMAT = "ISO 8601 with a UTC offset, e.g. 2026-12-01T23:59:00+01:00 (or ...T22:59:00Z)"
 FROM_CSV = "the --times file"
 FROM_EXCHANGE = "nbgrader's exchange"
@@ -59,36 +44,12 @@ SHOWN = 80  # characters of a name or a bad value quoted in a message
 MINUTE = timedelta(minutes=1)
 
 _ISO = re.compile(r"\d{4}-\d{2}-\d{2}[T ]\d{2}:\d{2}(?::\d{2}(?:\.\d{1,6})?)?(?:Z|[+-]\d{2}:\d{2})")
-# nbgrader: "%Y-%m-%d %H:%M:%S.%f %Z" (older: without .%f), or an ISO time (what `zip_collect` writes)
-_NBGRADER = re.compile(
-    r"(?P<date>\d{4}-\d{2}-\d{2})[T ](?P<time>\d{2}:\d{2}(?::\d{2}(?:[.,]\d{1,9})?)?)"
-    r"\s*(?P<zone>Z|UTC|GMT|[+-]\d{2}:?\d{2}|[A-Za-z][A-Za-z0-9/_+-]{0,40})?"
-)
 
 
 def parse_deadline(value: str | datetime, where: str = "the deadline") -> datetime:
-    """A deadline as a timezone-aware datetime: ISO 8601 text with a UTC offset, or a TOML offset date-time.
+    """A deadline as a timezone-aware datetime, from ISO 8601 text with a UTC offset (``Z`` is ``+00:00``, the
+    seconds may be left out) or a TOML offset date-time; InputError naming `where` for anything else.
 
-    Parameters
-    ----------
-    value : str or datetime.datetime
-        ``"2026-12-01T23:59:00+01:00"`` (``Z`` stands for ``+00:00``; the seconds may be left out), or
-        an offset date-time as TOML reads an unquoted one.
-    where : str
-        What the value is, for the error message.
-
-    Returns
-    -------
-    datetime.datetime
-        The moment, with its offset.
-
-    Raises
-    ------
-    ValueError
-        If the value has no UTC offset or is not in that format.
-
-    Examples
-    --------
     >>> parse_deadline("2026-12-01T23:59:00+01:00").isoformat()
     '2026-12-01T23:59:00+01:00'
     >>> parse_deadline("2026-12-01T23:59")  # doctest: +ELLIPSIS
@@ -111,69 +72,6 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
         return datetime.fromisoformat(text.replace("Z", "+00:00"))
     except ValueError as exc:
         raise InputError(f"{where} is {value!r}, which is not a real time ({exc}): write it as {FORMAT}.") from None
-
-
-def parse_timestamp(text: str) -> datetime:
-    """The time nbgrader wrote in a ``timestamp.txt``, as a timezone-aware datetime.
-
-    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` in its configured timezone
-    (``2026-12-01 23:59:59.123456 UTC``), older versions the same without the
-    fraction, and ``nbgrader zip_collect`` an ISO time with an offset. All of
-    these are read, as is a numeric offset after the time. A time without any
-    zone, or with a zone name other than UTC or GMT (``CET`` names several),
-    is refused: which moment it means cannot be known.
-
-    Parameters
-    ----------
-    text : str
-        The file's text.
-
-    Returns
-    -------
-    datetime.datetime
-        The moment, with its offset.
-
-    Raises
-    ------
-    ValueError
-        Saying what is wrong with the text (shown to the instructor with the submission's name).
-
-    Examples
-    --------
-    >>> parse_timestamp("2026-12-01 23:59:59.123456 UTC\\n").isoformat()
-    '2026-12-01T23:59:59.123456+00:00'
-    >>> parse_timestamp("2026-12-02 00:30:00+0100").isoformat()
-    '2026-12-02T00:30:00+01:00'
-    """
-    line = str(text).strip().lstrip("\ufeff").strip()
-    match = _NBGRADER.fullmatch(line)
-    if not match:
-        shown = line[:SHOWN] + ("..." if len(line) > SHOWN else "")
-        raise InputError(f"{shown!r} is not a time as nbgrader writes it (e.g. 2026-12-01 23:59:59.123456 UTC)")
-    zone = match["zone"]
-    if zone is None:
-        raise InputError(f"{line!r} has no time zone, so the moment it means is unknown")
-    if zone in ("Z", "UTC", "GMT"):
-        offset = UTC
-    elif zone[0] in "+-":
-        digits = zone[1:].replace(":", "")
-        if int(digits[:2]) > 23 or int(digits[2:]) > 59:
-            raise InputError(f"{line!r} has the offset {zone}, which no time zone has")
-        offset = timezone((1 if zone[0] == "+" else -1) * timedelta(hours=int(digits[:2]), minutes=int(digits[2:])))
-    else:
-        raise InputError(
-            f"{line!r} names the time zone {zone!r}, which labkit cannot place (only UTC, GMT and numeric "
-            "offsets are unambiguous)"
-        )
-    clock = match["time"].replace(",", ".")
-    if "." in clock:
-        whole, fraction = clock.split(".")
-        clock = f"{whole}.{fraction[:6].ljust(6, '0')}"
-    try:
-        naive = datetime.fromisoformat(f"{match['date']}T{clock}")
-    except ValueError as exc:
-        raise InputError(f"{line!r} is not a real time ({exc})") from None
-    return naive.replace(tzinfo=offset)
 
 
 def time_text(moment: datetime, zone: tzinfo | None = None) -> str:
@@ -210,16 +108,9 @@ def duration_text(delta: timedelta) -> str:
 
 @dataclass(frozen=True)
 class SubmissionTime:
-    """When a submission was handed in, where that came from, or why it is not known.
-
-    Attributes
-    ----------
-    when : datetime.datetime or None
-        The moment (timezone-aware), None when unknown.
-    source : str or None
-        Where it came from: :data:`FROM_CSV`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`.
-    problem : str or None
-        Why the time could not be read (an unreadable ``timestamp.txt``), when it could not.
+    """When a submission was handed in (timezone-aware; None when unknown), where that came from
+    (:data:`FROM_CSV`, :data:`FROM_EXCHANGE`, :data:`FROM_NBGRADER` or :data:`FROM_MTIME`), and why it could not
+    be read, when it could not.
     """
 
     when: datetime | None = None
@@ -252,28 +143,10 @@ class SubmissionTime:
 
 @dataclass(frozen=True)
 class Lateness:
-    """What the late rule made of one submission.
-
-    Attributes
-    ----------
-    deadline : datetime.datetime
-        The student's deadline (the rubric's, or their extension).
-    extended : bool
-        Whether that deadline is an extension.
-    time : SubmissionTime or None
-        When the work was handed in (None, or without a moment, when unknown).
-    late_by : datetime.timedelta or None
-        How long after the deadline it came (zero or less: on time); None when the time is unknown.
-    units : int
-        Started days or hours counted for the penalty (0 when on time, within the grace, or unknown).
-    percent : float
-        The penalty in percent of the raw total (the cap applied).
-    raw_total : float
-        The points before the penalty.
-    penalty : float
-        The points taken off (rounded to 0.01).
-    note : str
-        One line saying what happened, for ``grades.csv``.
+    """What the late rule made of one submission: its deadline (the rubric's or an extension), when it came
+    (``late_by`` is None when unknown, zero or less when on time), the started ``units`` counted, the
+    ``percent`` taken (the cap applied) of the ``raw_total``, the ``penalty`` in points (to 0.01), and a
+    ``note`` for ``grades.csv``.
     """
 
     deadline: datetime
@@ -299,22 +172,9 @@ class Lateness:
 
 @dataclass(frozen=True)
 class Late:
-    """The rubric's late rule (see the module's documentation for the table it is read from).
-
-    Attributes
-    ----------
-    deadline : datetime.datetime
-        When the work is due (timezone-aware).
-    per : str
-        ``"day"`` or ``"hour"``: the unit whose started ones are counted.
-    percent : float
-        Percent of the raw total lost per started unit.
-    cap : float
-        The largest penalty, in percent.
-    grace : float
-        Minutes after a deadline that still count as on time.
-    extensions : tuple
-        ``(name, deadline)`` pairs: a student's own deadline.
+    """The rubric's late rule (the module's documentation gives its table): the deadline, the unit whose started
+    ones count (``"day"`` or ``"hour"``), the percent lost per unit, the cap in percent, the grace in minutes,
+    and each extension as a ``(name, deadline)`` pair.
     """
 
     deadline: datetime
@@ -409,25 +269,8 @@ def _amount(table, key, source, low=0.0, high=None, unit=""):
 
 
 def from_dict(table: dict, source: str = "the rubric") -> Late:
-    """A validated :class:`Late` from the rubric's parsed ``[late]`` table.
-
-    Parameters
-    ----------
-    table : dict
-        The table: ``deadline``, ``per``, ``percent`` and ``cap`` (all required), ``grace`` and
-        ``extensions`` (optional).
-    source : str
-        The rubric's name, for error messages.
-
-    Returns
-    -------
-    Late
-        The rule.
-
-    Raises
-    ------
-    ValueError
-        Saying which key is wrong and what it must be.
+    """A validated :class:`Late` from the rubric's parsed ``[late]`` table (``deadline``, ``per``, ``percent`` and
+    ``cap``; ``grace`` and ``extensions`` optional); InputError saying which key is wrong and what it must be.
     """
     if not isinstance(table, dict):
         raise InputError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
@@ -503,242 +346,9 @@ def read_small(path, limit):
         os.close(fd)
 
 
-def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
-    """The time in nbgrader's ``timestamp.txt`` at the top of a submission's folder.
-
-    Parameters
-    ----------
-    submission : path-like
-        A submission: a folder (a single notebook has no ``timestamp.txt``).
-
-    Returns
-    -------
-    SubmissionTime or None
-        None when there is no such file; a time whose ``problem`` says why when the file cannot be read.
-    """
-    path = Path(submission) / TIMESTAMP
-    try:
-        if not stat.S_ISDIR(os.lstat(submission).st_mode):
-            return None
-        os.lstat(path)
-    except OSError:
-        return None
-    try:
-        raw = read_small(path, MAX_TIMESTAMP)
-        return SubmissionTime(parse_timestamp(raw.decode("utf-8")), FROM_NBGRADER)
-    except UnicodeDecodeError:
-        return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP} is not text")
-    except (OSError, ValueError) as exc:
-        return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP}: {exc}")
-
-
-def modification_time(notebooks: list) -> SubmissionTime | None:
-    """The newest modification time of a submission's notebooks (only on the instructor's explicit request).
-
-    Parameters
-    ----------
-    notebooks : list of path-like
-        The submission's notebook files.
-
-    Returns
-    -------
-    SubmissionTime or None
-        None when there are none.
-    """
-    times = []
-    for path in notebooks:
-        try:
-            times.append(os.lstat(path).st_mtime)
-        except OSError:
-            continue
-    if not times:
-        return None
-    return SubmissionTime(datetime.fromtimestamp(max(times), UTC), FROM_MTIME)
-
-
-def read_times(path: str | os.PathLike) -> dict[str, datetime]:
-    """The submission times in a CSV file with the columns ``submission`` and ``time`` (others are ignored).
-
-    Parameters
-    ----------
-    path : path-like
-        The file. A time is ISO 8601 with a UTC offset, or as nbgrader writes it
-        (``2026-12-01 23:59:59 UTC``).
-
-    Returns
-    -------
-    dict
-        {submission name: datetime}.
-
-    Raises
-    ------
-    ValueError
-        When the file cannot be read, lacks a column, names a submission twice or has a bad time (naming the line).
-    """
-    path = Path(path)
-    try:
-        raw = read_small(path, MAX_TIMES)
-        text = raw.decode("utf-8-sig")
-    except FileNotFoundError:
-        raise InputError(f"the times file {path} does not exist.") from None
-    except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError
-        raise InputError(f"cannot read the times file {path}: {exc}.") from None
-    rows = csv.reader(text.splitlines())
-    header = [cell.strip().lower() for cell in next(rows, [])]
-    if "submission" not in header or "time" not in header:
-        raise InputError(
-            f"{path} needs a header row with the columns submission and time "
-            "(e.g. `submission,time` then `alice,2026-12-01T23:10:00+01:00`)."
-        )
-    who, when = header.index("submission"), header.index("time")
-    times = {}
-    for line, row in enumerate(rows, start=2):
-        if not any(cell.strip() for cell in row):
-            continue
-        if len(row) <= max(who, when):
-            raise InputError(f"{path}, line {line}: it has {len(row)} cell(s), fewer than the header's columns.")
-        name = row[who].strip()
-        if not name:
-            raise InputError(f"{path}, line {line}: the submission's name is empty.")
-        if name in times:
-            raise InputError(f"{path}, line {line}: {name[:SHOWN]!r} is listed twice; keep one time per submission.")
-        try:
-            times[name] = parse_timestamp(row[when])
-        except ValueError as exc:
-            raise InputError(f"{path}, line {line} ({name[:SHOWN]!r}): {exc}; write it as {FORMAT}.") from None
-    return times
-
-
-def submission_time(
-    submission: str | os.PathLike | None,
-    name: str,
-    times: dict | None = None,
-    notebooks: list | None = None,
-    from_mtime: bool = False,
-    *,
-    from_submission: bool = False,
-    exchange: dict | None = None,
-) -> SubmissionTime | None:
-    """The time of one submission, by the precedence the module's documentation gives.
-
-    Parameters
-    ----------
-    submission : path-like or None
-        The submission (a folder or a notebook); None when it has nothing on disk.
-    name : str
-        Its name (what the ``--times`` file lists).
-    times : dict, optional
-        {name: datetime} from :func:`read_times`: the LMS's times, which the student cannot write.
-    notebooks : list of path-like, optional
-        Its notebooks, for `from_mtime`.
-    from_mtime : bool
-        Fall back on the notebooks' modification time (never unless the instructor asks; student-supplied).
-    from_submission : bool
-        Fall back on the ``timestamp.txt`` in the submission's folder (never unless the instructor asks: the
-        student's process writes it; student-supplied).
-    exchange : dict, optional
-        {name: datetime} that labkit read from nbgrader's exchange (:func:`read_exchange`).
-
-    Returns
-    -------
-    SubmissionTime or None
-        None when no source has a time.
-    """
-    if times and name in times:
-        return SubmissionTime(times[name], FROM_CSV)
-    if exchange and name in exchange:
-        return SubmissionTime(exchange[name], FROM_EXCHANGE)
-    if submission is None:
-        return None
-    if from_submission:
-        found = read_timestamp(submission)
-        if found is not None:
-            return found
-    if from_mtime:
-        return modification_time(notebooks if notebooks is not None else [submission])
-    return None
-
-
-def _inbound_time(folder, assignment):
-    """The time in the name of an inbound folder of `assignment` (``student+assignment+time[+random]``), why it
-    cannot be read (text), or None for another assignment's folder."""
-    problem = "its name is not student+assignment+time"
-    for cut in (3, 2):
-        parts = folder.rsplit("+", cut)
-        if len(parts) == cut + 1 and parts[1] == assignment:
-            try:
-                return parse_timestamp(parts[2])
-            except ValueError as exc:
-                problem = str(exc)
-    return problem if f"+{assignment}+" in folder else None
-
-
-MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
-
-
-def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datetime]:
-    """The submission times of `assignment` in nbgrader's exchange, read there: {student: datetime}.
-
-    nbgrader's ``submit`` copies a student's work into the course's ``inbound/`` folder, in a folder named
-    ``student+assignment+timestamp`` (newer versions add ``+random``); its ``collect`` step takes each
-    student's newest. The time read here is that newest one, from the folder's name in the exchange itself
-    (never from a ``timestamp.txt`` that travelled with the work).
-
-    Parameters
-    ----------
-    course : path-like
-        The course's folder in the exchange (``<exchange root>/<course id>``, which holds ``inbound/``), or
-        its ``inbound/`` folder itself.
-    assignment : str
-        The assignment's name, as nbgrader knows it.
-
-    Returns
-    -------
-    dict
-        {student id: the newest submission's time}.
-
-    Raises
-    ------
-    ValueError
-        When the folder holds no ``inbound/`` or a folder of that assignment has a time that cannot be read.
-    """
-    course = Path(course)
-    inbound = course if course.name == "inbound" else course / "inbound"
-    if not inbound.is_dir():
-        raise InputError(
-            f"{course} is not a course folder of nbgrader's exchange (it has no inbound/): give "
-            "--times-from-exchange EXCHANGE/COURSE_ID, e.g. /srv/nbgrader/exchange/course101."
-        )
-    found: dict = {}
-    with os.scandir(inbound) as entries:
-        for count, entry in enumerate(entries):
-            if count >= MAX_INBOUND:
-                raise InputError(f"{inbound} holds more than {MAX_INBOUND:,} entries; it is not an exchange folder.")
-            if not entry.is_dir(follow_symlinks=False):
-                continue
-            when = _inbound_time(entry.name, assignment)
-            if when is None:
-                continue
-            if isinstance(when, str):
-                raise InputError(f"{inbound}: the folder {entry.name[:SHOWN]!r} has no readable time ({when}).")
-            student = entry.name.split(f"+{assignment}+")[0]
-            if student not in found or when > found[student]:
-                found[student] = when
-    return found
-
-
 def unknown_times(grades: list) -> list[tuple[str, str, bool]]:
-    """The graded submissions that a rubric's deadline applies to but whose time is unknown, with the reason.
-
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        A run's grades.
-
-    Returns
-    -------
-    list of tuple
-        (name, note, is an error) per such submission: an error is a time that could not be read.
+    """(name, note, whether it is an error) of each graded submission that a rubric's deadline applies to
+    but whose time is unknown; an error is a time that could not be read.
     """
     found = []
     for grade in grades:

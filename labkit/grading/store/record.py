@@ -1,8 +1,8 @@
 """A grading run's record: what was graded, under which rubric and seed, by which labkit, and each result's hash.
 
 Every output folder that labkit writes (``labkit grade --out OUT``, a merge,
-:func:`labkit.grading.store.report.write_report`) holds ``record.json``, written by
-the grader alone and replaced whole each time it changes:
+:func:`labkit.grading.store.report.write_report`) holds ``record.json``, written by the grader alone and replaced
+whole each time it changes:
 
 * ``labkit``: the version that graded;
 * ``kind``: ``"grade"`` (a grading run, resumable) or ``"merge"``;
@@ -15,20 +15,18 @@ the grader alone and replaced whole each time it changes:
 * ``submissions``: for each submission graded, its result file's name and
   SHA-256, and the digest of its notebooks' content (:func:`content_digest`).
 
-Every later command reads the folder through this record
-(:func:`read_results`): ``labkit report``, ``labkit export``, a resumed
-``labkit grade`` and ``labkit merge`` take the recorded rubric when none is given,
-refuse one that grades differently, and take a result file only when the
-record names it with that hash. So a result file that the run did not write
-(a submission's code writing into an output folder, where the sandbox is
-switched off) is never read as a grade, and nothing a submission can write
-(a name, a time, a file) changes what the run's record says it graded.
+Every later command reads the folder through this record (:func:`read_results`): ``labkit report``, ``labkit
+export``, a resumed ``labkit grade`` and ``labkit merge`` take the recorded rubric when none is given, refuse one
+that grades differently, and take a result file only when the record names it with that hash. So a result file that
+the run did not write (a submission's code writing into an output folder, where the sandbox is switched off) is
+never read as a grade, and nothing a submission can write (a name, a time, a file) changes what the run's record
+says it graded.
 """
 
 import hashlib
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ...errors import InputError
@@ -46,28 +44,13 @@ KINDS = ("grade", "merge")
 
 @dataclass
 class RunRecord:
-    """The record of one output folder (see the module's description).
-
-    Attributes
-    ----------
-    kind : str
-        ``"grade"`` or ``"merge"``.
-    labkit : str
-        The labkit version that wrote it.
-    seed : int or list of int or None
-        The run's seed; a merge's seeds.
-    rubric : dict
-        The rubric's data (:attr:`labkit.grading.store.rubric.Rubric.data`).
-    rubric_text : str or None
-        The rubric's TOML text, when it was read from a file.
-    submissions : dict
-        Submission name -> ``{"result": file name, "sha256": the file's hash, "content": the notebooks'
-        digest or None}``.
-    """
+    """The record of one output folder (the module's description gives its fields): the rubric's data and
+    TOML text, and each submission's ``{"result": file name, "sha256": its hash, "content": the notebooks'
+    digest or None}``."""
 
     kind: str
     labkit: str
-    seed: object
+    seed: int | list[int] | None
     rubric: dict
     rubric_text: str | None = None
     submissions: dict = field(default_factory=dict)
@@ -89,21 +72,9 @@ class RunRecord:
 
         return {name: datetime.fromisoformat(when) for name, when in self.times.get(source, {}).items()}
 
-    def as_dict(self):
-        return {
-            "format": FORMAT,
-            "kind": self.kind,
-            "labkit": self.labkit,
-            "seed": self.seed,
-            "rubric": self.rubric,
-            "rubric text": self.rubric_text,
-            "submissions": self.submissions,
-            "times": self.times,
-            "flags": self.flags,
-            "known": self.known,
-            "variants": self.variants,
-            "delivery": self.delivery,
-        }
+    def as_dict(self) -> dict:
+        """The record as ``record.json``'s data: its fields, named with spaces."""
+        return {"format": FORMAT, **{name.replace("_", " "): value for name, value in asdict(self).items()}}
 
     def rubric_object(self, folder):
         """The recorded rubric, read again (its source named after `folder`)."""
@@ -126,12 +97,13 @@ def write(folder, record):
     """Write `record` into `folder` (``record.json``, replaced whole; ``rubric.toml`` beside it)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    _replace(folder / RECORD, json.dumps(record.as_dict(), indent=1))
+    replace_text(folder / RECORD, json.dumps(record.as_dict(), indent=1))
     if record.rubric_text is not None:
-        _replace(folder / RUBRIC_COPY, record.rubric_text)
+        replace_text(folder / RUBRIC_COPY, record.rubric_text)
 
 
-def _replace(path, text):
+def replace_text(path, text):
+    """Write `text` into `path`, replacing it whole: a process killed meanwhile leaves the earlier file or none."""
     partial = path.with_name(f".{path.name}.partial")
     partial.write_text(text, encoding="utf-8")
     os.replace(partial, path)
@@ -159,7 +131,7 @@ NO_RECORD = (
 )
 
 
-def read(folder):
+def read(folder) -> RunRecord:
     """The record of output folder `folder`; ValueError when it has none or it is not one."""
     folder = Path(folder)
     path = folder / RECORD
@@ -169,52 +141,55 @@ def read(folder):
         raise InputError(NO_RECORD.format(folder=folder, record=RECORD)) from None
     try:
         data = json.loads(raw.decode("utf-8"))
-        if not isinstance(data, dict) or data.get("format") != FORMAT:
-            raise InputError(f"its format is not {FORMAT}")
-        if data.get("kind") not in KINDS:
-            raise InputError(f"its kind is not one of {', '.join(KINDS)}")
-        submissions = data.get("submissions")
-        if not isinstance(submissions, dict) or not isinstance(data.get("rubric"), dict):
-            raise InputError("it has no submissions or no rubric")
-        for name, entry in submissions.items():
-            if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("result", "sha256")):
-                raise InputError(f"its entry for {str(name)[:80]!r} has no result file and hash")
-            if Path(entry["result"]).name != entry["result"] or not entry["result"].endswith(".json"):
-                raise InputError(f"its entry for {str(name)[:80]!r} names a result outside results/")
-        text = data.get("rubric text")
-        if text is not None and not isinstance(text, str):
-            raise InputError("its rubric text is not text")
-        times = data.get("times") or {}
-        if not isinstance(times, dict) or not all(
-            isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
-            for given in times.values()
-        ):
-            raise InputError("its times are not times with a UTC offset")
-        seed = data.get("seed")
-        whole = isinstance(seed, int) and not isinstance(seed, bool)
-        listed = isinstance(seed, list) and all(isinstance(s, int) and not isinstance(s, bool) for s in seed)
-        if not (seed is None or (whole if data["kind"] == "grade" else listed)):
-            raise InputError(f"its seed is not {'a number' if data['kind'] == 'grade' else 'a list of numbers'}")
-        flags = data.get("flags") or {}
-        if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
-            raise InputError("its flags are not true or false")
-        known = data.get("known") or {}
-        if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
-            raise InputError("its known sources are not named by text")
-        variants = data.get("variants") or {}
-        if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
-            raise InputError("its variants are not a table of students")
-        delivery = data.get("delivery") or {}
-        if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
-            raise InputError("its delivery is not a table of students")
+        _check(data)
     except (UnicodeDecodeError, ValueError) as exc:
         raise InputError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
+    tables = (data.get(key) or {} for key in ("times", "flags", "known", "variants", "delivery"))
     return RunRecord(
-        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], text, submissions, times, flags,
-        known, variants, delivery,
+        data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], data.get("rubric text"),
+        data["submissions"], *tables,
     )  # fmt: skip
+
+
+def _check(data) -> None:
+    """InputError saying what is wrong with a record's data, when anything is."""
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"its format is not {FORMAT}")
+    if data.get("kind") not in KINDS:
+        raise InputError(f"its kind is not one of {', '.join(KINDS)}")
+    submissions = data.get("submissions")
+    if not isinstance(submissions, dict) or not isinstance(data.get("rubric"), dict):
+        raise InputError("it has no submissions or no rubric")
+    for name, entry in submissions.items():
+        if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("result", "sha256")):
+            raise InputError(f"its entry for {str(name)[:80]!r} has no result file and hash")
+        if Path(entry["result"]).name != entry["result"] or not entry["result"].endswith(".json"):
+            raise InputError(f"its entry for {str(name)[:80]!r} names a result outside results/")
+    text, seed, grade = data.get("rubric text"), data.get("seed"), data["kind"] == "grade"
+    if text is not None and not isinstance(text, str):
+        raise InputError("its rubric text is not text")
+    times, flags, known, variants, delivery = (
+        data.get(key) or {} for key in ("times", "flags", "known", "variants", "delivery")
+    )
+    if not isinstance(times, dict) or not all(
+        isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
+        for given in times.values()
+    ):
+        raise InputError("its times are not times with a UTC offset")
+    whole = isinstance(seed, int) and not isinstance(seed, bool)
+    listed = isinstance(seed, list) and all(isinstance(s, int) and not isinstance(s, bool) for s in seed)
+    if not (seed is None or (whole if grade else listed)):
+        raise InputError(f"its seed is not {'a number' if grade else 'a list of numbers'}")
+    if not isinstance(flags, dict) or not all(isinstance(v, bool) for v in flags.values()):
+        raise InputError("its flags are not true or false")
+    if not isinstance(known, dict) or not all(v is None or isinstance(v, str) for v in known.values()):
+        raise InputError("its known sources are not named by text")
+    if not isinstance(variants, dict) or not isinstance(variants.get("students", {}), dict):
+        raise InputError("its variants are not a table of students")
+    if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
+        raise InputError("its delivery is not a table of students")
 
 
 def _aware(text):
@@ -230,10 +205,10 @@ def _aware(text):
 def results(folder, record):
     """The result files of `folder` that its `record` vouches for, read: ({name: (path, data)}, refused).
 
-    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of
-    ``results/`` that is not read: one the record does not name (a run never graded that submission there),
-    one whose content is not what the run wrote (its hash differs), one that is not a plain file. A
-    submission the record names whose file is missing is refused too. ValueError when a vouched-for file is not JSON."""
+    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of ``results/``
+    that is not read: one the record does not name (a run never graded that submission there), one whose content
+    is not what the run wrote (its hash differs), one that is not a plain file; and a submission the record names
+    whose file is missing. ValueError when a vouched-for file is not JSON."""
     folder = Path(folder)
     by_file = {entry["result"]: name for name, entry in record.submissions.items()}
     found, refused = {}, []
@@ -307,8 +282,8 @@ def content_digest(notebooks, base=None):
 def rubric_for(folders, given, command):
     """The rubric `command` scores the output `folders` with: their recorded one, which all must share.
 
-    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded
-    one; one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
+    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded one;
+    one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
     ValueError saying how to score under it, since `command` shows what the run graded."""
     records = [(Path(folder), read(folder)) for folder in folders]
     first_folder, first = records[0]

@@ -1,21 +1,18 @@
 """The rubric: how the exercises' results become a grade.
 
-A rubric is data (TOML, see ``rubric.toml`` next to this module, the lab's
-own): the exercises everyone does, alternative branches of which the best
-counts towards full credit while each other one is extra credit, and
-extra-credit exercises. An exercise's points are declared once, as the
-weights of its parts (:mod:`labkit.exercises`); a rubric may give an
-exercise other points in a ``[points]`` table, which scales its parts.
-``exercises = "module:attribute"`` names another course's exercises (the
-lab's by default). An optional ``[late]`` table sets a deadline and what
-lateness costs (:mod:`labkit.grading.store.late`). An optional ``[held]`` table releases parts held for a person
-(their code matched a known source, :mod:`labkit.grading.submission.known`): ``release = {"ada" = [2, 10]}`` pays
-ada's held parts of exercises 2 and 10. An optional ``[answers]`` table gives the answers in words points a
-person marks (``labkit mark``): ``exercise12-answer-1 = 2`` (the answer's nbgrader grade id, as in grades.csv);
-they add to their exercise's points, and the lab's rubric gives none. :func:`load` reads and validates one;
-:meth:`Rubric.score` turns the fractions an exercise's parts earned
-(:meth:`labkit.exercises.registry.Registry.check`) into points, the branch
-that counted, the extra credit and the total.
+A rubric is data (TOML, see ``rubric.toml`` next to this module, the lab's own): the exercises everyone does,
+alternative branches of which the best counts towards full credit while each other one is extra credit, and
+extra-credit exercises. An exercise's points are declared once, as the weights of its parts
+(:mod:`labkit.exercises`); a rubric may give an exercise other points in a ``[points]`` table, which scales its
+parts. ``exercises = "module:attribute"`` names another course's exercises (the lab's by default). An optional
+``[late]`` table sets a deadline and what lateness costs (:mod:`labkit.grading.store.late`). An optional ``[held]``
+table releases parts held for a person (their code matched a known source, :mod:`labkit.grading.submission.known`):
+``release = {"ada" = [2, 10]}`` pays ada's held parts of exercises 2 and 10. An optional ``[answers]`` table gives
+the answers in words points a person marks (``labkit mark``): ``exercise12-answer-1 = 2`` (the answer's nbgrader
+grade id, as in grades.csv); they add to their exercise's points, and the lab's rubric gives none. :func:`load`
+reads and validates one; :meth:`Rubric.score` turns the fractions an exercise's parts earned
+(:meth:`labkit.exercises.registry.Registry.check`) into points, the branch that counted, the extra credit and the
+total.
 """
 
 import functools
@@ -110,9 +107,9 @@ class Rubric:
     def digest(self):
         """A fingerprint of what the rubric grades and how: its title, exercises, groups and points.
 
-        Results graded under different rubrics are not merged (:func:`labkit.grading.store.report.read_results`).
-        The ``[late]`` table is left out: ``labkit merge`` applies the late rule of the rubric it is given to the
-        submission times the results carry.
+        Results graded under different rubrics are not merged
+        (:func:`labkit.grading.store.report.read_results`). The ``[late]`` table is left out: ``labkit
+        merge`` applies the late rule of the rubric it is given to the submission times the results carry.
         """
         described = {
             "title": self.title,
@@ -259,7 +256,7 @@ def from_dict(data, source="the rubric"):
     branches, branch_extra = _branches(data.get("branches"), source, registry)
     groups = [("required", required), ("extra_credit", extra_credit)]
     groups += [(f"branch {b.name!r}", b.exercises) for b in branches]
-    seen = {}
+    seen: dict[int, str] = {}
     for group, numbers in groups:
         for number in numbers:
             if number in seen:

@@ -32,7 +32,7 @@ import sys
 import types
 from pathlib import Path
 
-from ..sandbox.guard import code_key, codes_in
+from ..sandbox.guard import _within, code_key, codes_in
 
 
 def _module_files(prefix):
@@ -95,10 +95,6 @@ def _compiled_codes(path):
     return tuple(found)
 
 
-def _inside(qualname, names):
-    return any(qualname == name or qualname.startswith(name + ".") for name in names)
-
-
 @functools.cache
 def recognised(refusal):
     """``(names, modules, c_names)`` for the sandbox: {digest: readable name}, module prefixes, compiled functions."""
@@ -110,7 +106,7 @@ def recognised(refusal):
     for prefix in refusal.modules:
         for module, path in _module_files(prefix):
             for code in _compiled_codes(path):
-                if code.co_name == "<module>" or _inside(code.co_qualname, allowed.get(module, ())):
+                if code.co_name == "<module>" or _within(code.co_qualname, allowed.get(module, ())):
                     continue
                 names.setdefault(code_key(code), f"{module}.{code.co_qualname}")
     for dotted in refusal.functions:
@@ -118,7 +114,7 @@ def recognised(refusal):
         files = _module_files(module)
         if files and files[0][0] == module:
             for code in _compiled_codes(files[0][1]):
-                if _inside(code.co_qualname, (qualname,)):
+                if _within(code.co_qualname, (qualname,)):
                     names.setdefault(code_key(code), dotted)
         else:
             c_names.add((module, qualname))
@@ -145,10 +141,6 @@ def _resolve(dotted):
             return None
         return value
     return None
-
-
-def _within(module, prefixes):
-    return any(module == p or module.startswith(p + ".") for p in prefixes)
 
 
 @functools.cache

@@ -36,30 +36,11 @@ TIME_BUDGET = 20.0  # seconds to read one notebook's code
 
 PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
 # modules a graded function may reach without the scan asking what they are
-KNOWN = {
-    "numpy",
-    "scipy",
-    "math",
-    "cmath",
-    "labkit",
-    "matplotlib",
-    "functools",
-    "itertools",
-    "operator",
-    "collections",
-    "numbers",
-    "fractions",
-    "decimal",
-    "statistics",
-    "typing",
-    "dataclasses",
-    "warnings",
-    "bisect",
-    "heapq",
-    "copy",
-    "enum",
-    "abc",
-}
+KNOWN = (
+    {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator", "collections"}
+    | {"numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings", "bisect", "heapq", "copy"}
+    | {"enum", "abc"}
+)
 DYNAMIC_NAMES = {
     "__import__": "__import__",
     "eval": "eval",
@@ -74,59 +55,21 @@ DYNAMIC_NAMES = {
     "get_ipython": "get_ipython() (the shell's own namespace)",
 }
 STRING_RUNNERS = {"exec", "eval", "compile"}
-DYNAMIC_ATTRIBUTES = {
-    "__code__",
-    "__closure__",
-    "__globals__",
-    "__builtins__",
-    "__dict__",
-    "__subclasses__",
-    "__func__",
-    "f_back",
-    "f_locals",
-    "f_globals",
-    "gi_frame",
-    "tb_frame",
-    "cr_frame",
-    "__wrapped__",
-}
-DYNAMIC_MODULES = {
-    "importlib",
-    "ctypes",
-    "cffi",
-    "gc",
-    "inspect",
-    "marshal",
-    "pickle",
-    "dill",
-    "builtins",
-    "imp",
-    "pkgutil",
-    "runpy",
-    "code",
-    "codeop",
-    "threading",
-    "_thread",
-    "multiprocessing",
-    "subprocess",
-    "signal",
-}
-DYNAMIC_DOTTED = {
-    "sys.modules",
-    "sys._getframe",
-    "sys.setprofile",
-    "sys.getprofile",
-    "sys.settrace",
-    "sys.gettrace",
-    "sys._current_frames",
-    "types.FunctionType",
-    "types.CodeType",
-    "os.system",
-    "os.fork",
-    "os.popen",
-    "os.exec",
-    "os.spawn",
-}
+DYNAMIC_ATTRIBUTES = (
+    {"__code__", "__closure__", "__globals__", "__builtins__"}
+    | {"__dict__", "__subclasses__", "__func__", "__wrapped__"}
+    | {"f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame"}
+)
+DYNAMIC_MODULES = (
+    {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill"}
+    | {"builtins", "imp", "pkgutil", "runpy", "code", "codeop"}
+    | {"threading", "_thread", "multiprocessing", "subprocess", "signal"}
+)
+DYNAMIC_DOTTED = (
+    {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace", "sys.gettrace"}
+    | {"sys._current_frames", "types.FunctionType", "types.CodeType"}
+    | {"os.system", "os.fork", "os.popen", "os.exec", "os.spawn"}
+)
 
 
 class Unreadable(ValueError):
@@ -291,11 +234,7 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
     >>> [name for name, _ in reached_sources(cells, ["f"])]
     ['f', 'h']
     """
-    size = sum(len(s.encode("utf-8", "surrogatepass")) for s in sources)
-    if size > MAX_CODE_BYTES:
-        raise Unreadable(
-            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
-        )
+    _bounded(sources)
     reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
     found, seen = [], set()
     for name in names:
@@ -308,6 +247,20 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
             lines = text.split("\n")[first - 1 : node.end_lineno]
             found.append((owner, "\n".join(lines)))  # whole: a long comment must not push the code out
     return found
+
+
+def _bounded(sources):
+    """Raise :class:`Unreadable` when a notebook's code cells hold more than :data:`MAX_CODE_BYTES`."""
+    size = code_bytes(sources)
+    if size > MAX_CODE_BYTES:
+        raise Unreadable(
+            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
+        )
+
+
+def code_bytes(sources):
+    """The bytes of a notebook's code cells (as UTF-8)."""
+    return sum(len(str(s).encode("utf-8", "surrogatepass")) for s in sources)
 
 
 def drawn_with(sources, names, deadline=None):
@@ -489,11 +442,7 @@ def scan(sources, names, profile, deadline=None):
     takes longer than :data:`TIME_BUDGET` seconds."""
     if profile is None:
         return []
-    size = sum(len(s.encode("utf-8", "surrogatepass")) for s in sources)
-    if size > MAX_CODE_BYTES:
-        raise Unreadable(
-            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
-        )
+    _bounded(sources)
     deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
     reader = _reader(tuple(sources), deadline)
     refused = _Refused(profile)
@@ -581,8 +530,7 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
     {'f': 'def f(x):\\n    return 2 * x'}
     """
     wanted = set(names)
-    size = sum(len(str(s).encode("utf-8", "surrogatepass")) for s in sources)
-    if not wanted or size > MAX_CODE_BYTES:
+    if not wanted or code_bytes(sources) > MAX_CODE_BYTES:
         return {}
     found = {}
     for cell in sources:

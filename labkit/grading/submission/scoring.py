@@ -27,16 +27,18 @@ import os
 import stat
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 from ...errors import InputError
 from ...exercises.model import sections
-from ...exercises.registry import LAB
+from ...exercises.registry import LAB, Registry
 from ...exercises.registry import load as load_registry
 from ...exercises.result import CRASH, NOT_DONE, OTHER, RAISED, REFUSED, TAMPERED, TIMEOUT, VARIANT
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..sandbox import backends, remote, timings
+from ..store.model import ExerciseResult
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from . import holding, known, refusals, scan
 
@@ -394,7 +396,7 @@ def grade_notebook(
     numbers = [n for n in exercises_in(markdown, registry) if n not in skip]
     if not numbers:
         return {}, []
-    size = sum(len(source.encode("utf-8", "surrogatepass")) for source in code)
+    size = scan.code_bytes(code)
     if size > scan.MAX_CODE_BYTES:
         text = (
             f"{name}: its code cells hold {size:,} bytes, more than the {scan.MAX_CODE_BYTES:,} a lab "
@@ -411,7 +413,6 @@ def grade_notebook(
             "by the notebooks before it."
         )
         return {}, [ProblemText.one(text, TIMEOUT)]
-    problems, results = [], {}
     try:
         with timings.phase("sandbox start"):
             notebook = remote.NotebookHandle(options, deadline, _for_sandbox(profiles), registry.passable)
@@ -421,55 +422,80 @@ def grade_notebook(
     except remote.WorkerError as exc:
         return {}, [ProblemText.one(f"{name}: the sandbox could not start ({exc}).", OTHER)]
     with notebook:
-        try:
-            with timings.phase("cells"):
-                ran = notebook.request(
-                    {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
-                )
-        except remote.NotebookTimeout:
-            text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
-            return {}, [ProblemText.one(text, TIMEOUT)]
-        except remote.CellTimeout as exc:
-            return {}, [ProblemText.one(f"{name}: {exc}.", TIMEOUT)]
-        except remote.WorkerError as exc:
-            return {}, [ProblemText.one(f"{name}: {exc} while running its cells.", exc.grader_kind)]
-        if "error" in ran and not notebook.tampered:  # the notebook's process died while its cells ran
-            error = ran["error"] if isinstance(ran["error"], dict) else {}
-            text = f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."
-            return {}, [ProblemText.one(text, CRASH)]
-        problems += _run_problems(name, ran, code)
-        if notebook.tampered:
-            problems.append(ProblemText.one(f"{name}: {notebook.tampered}; none of its answers count.", TAMPERED))
-        for number in numbers:
-            exercise = registry.exercises[number]
-            if notebook.tampered:
-                checks = [_voided(part, notebook.tampered) for part in exercise.parts]
-                results[number] = _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
-                continue
-            mine = None if variant is None else variant.get(str(number), {})
-            verdict = registry.check(number, remote.Namespace(notebook), seed=options.seed, variant=mine)
-            if notebook.stopped:  # what it held can no longer be read: no one is named for it
-                verdict.pop("other_variant", None)
-            other = verdict.get("other_variant")  # kept in the result: the class run names whose data they are
-            if other:
-                shown = "; ".join(
-                    f"{param} = {_number(found)} where yours is {_number(value)}"
-                    for param, (found, value) in sorted(other.items())
-                )
-                text = (
-                    f"{name}: exercise {number}: this notebook holds the data of another variant ({shown}); "
-                    "its parts that depend on the data earn nothing until they are worked on your own."
-                )
-                problems.append(ProblemText.one(text, VARIANT))
-            with timings.phase("recognition"):
-                _judge_code(verdict, exercise, code, profiles, registry, options)
-            results[number] = _rescore(verdict, registry)
-        # copied code earns nothing through what it draws
-        holding.hold_dependents(results, registry, code, registry_graded(registry), _rescore)
-        if notebook.stopped:
-            text = f"{name}: {notebook.stopped} while its functions were being checked."
-            problems.append(ProblemText.one(text, notebook.stopped_kind))
+        graded = _Graded(name, notebook, code, registry, profiles, options)
+        return _grade_in(graded, numbers, variant)
+
+
+@dataclass(frozen=True)
+class _Graded:
+    """One notebook being graded: its name as problems give it, its sandbox, its code cells and how it is judged."""
+
+    name: str
+    notebook: remote.NotebookHandle
+    code: list
+    registry: Registry
+    profiles: dict
+    options: GradeOptions
+
+
+def _grade_in(graded, numbers, variant):
+    """Run the notebook's cells in its sandbox, then check exercises `numbers`: (results, problems)."""
+    name, notebook, code, options = graded.name, graded.notebook, graded.code, graded.options
+    try:
+        with timings.phase("cells"):
+            ran = notebook.request(
+                {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
+            )
+    except remote.NotebookTimeout:
+        text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
+        return {}, [ProblemText.one(text, TIMEOUT)]
+    except remote.CellTimeout as exc:
+        return {}, [ProblemText.one(f"{name}: {exc}.", TIMEOUT)]
+    except remote.WorkerError as exc:
+        return {}, [ProblemText.one(f"{name}: {exc} while running its cells.", exc.grader_kind)]
+    if "error" in ran and not notebook.tampered:  # the notebook's process died while its cells ran
+        error = ran["error"] if isinstance(ran["error"], dict) else {}
+        text = f"{name}: {str(error.get('message', 'it stopped'))[:300]} while running its cells."
+        return {}, [ProblemText.one(text, CRASH)]
+    problems, results = _run_problems(name, ran, code), {}
+    if notebook.tampered:
+        problems.append(ProblemText.one(f"{name}: {notebook.tampered}; none of its answers count.", TAMPERED))
+    for number in numbers:
+        mine = None if variant is None else variant.get(str(number), {})
+        results[number] = _check_exercise(graded, number, mine, problems)
+    # copied code earns nothing through what it draws
+    holding.hold_dependents(results, graded.registry, code, registry_graded(graded.registry), _rescore)
+    if notebook.stopped:
+        text = f"{name}: {notebook.stopped} while its functions were being checked."
+        problems.append(ProblemText.one(text, notebook.stopped_kind))
     return results, problems
+
+
+def _check_exercise(graded, number, variant, problems):
+    """Exercise `number`'s grade dict (voided when the notebook tampered); a notebook that holds another
+    variant's data (`variant`: the student's own) is named in `problems`."""
+    notebook, registry = graded.notebook, graded.registry
+    exercise = registry.exercises[number]
+    if notebook.tampered:
+        checks = [_voided(part, notebook.tampered) for part in exercise.parts]
+        return _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
+    verdict = registry.check(number, remote.Namespace(notebook), seed=graded.options.seed, variant=variant)
+    if notebook.stopped:  # what it held can no longer be read: no one is named for it
+        verdict.pop("other_variant", None)
+    other = verdict.get("other_variant")  # kept in the result: the class run names whose data they are
+    if other:
+        shown = "; ".join(
+            f"{param} = {_number(found)} where yours is {_number(value)}"
+            for param, (found, value) in sorted(other.items())
+        )
+        text = (
+            f"{graded.name}: exercise {number}: this notebook holds the data of another variant ({shown}); "
+            "its parts that depend on the data earn nothing until they are worked on your own."
+        )
+        problems.append(ProblemText.one(text, VARIANT))
+    with timings.phase("recognition"):
+        _judge_code(verdict, exercise, graded.code, graded.profiles, registry, graded.options)
+    return _rescore(verdict, registry)
 
 
 def _judge_code(verdict, exercise, code, profiles, registry, options):
@@ -544,7 +570,7 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
         grade.problems.append(ProblemText.one(str(exc), OTHER))
         return grade
     for notebook in notebooks:
-        claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
+        claimed = {n for n, verdict in grade.results.items() if verdict.defined}
         with timings.phase("notebooks"):
             results, problems = grade_notebook(
                 notebook,
@@ -560,8 +586,8 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)
             current = grade.results.get(number)
-            if current is None or (verdict["defined"] and not current.get("defined")):
-                grade.results[number] = verdict
+            if current is None or (verdict["defined"] and not current.defined):
+                grade.results[number] = ExerciseResult.from_dict(verdict, number, grade.name)
     return grade
 
 

@@ -792,10 +792,8 @@ def test_bad_input_to_the_module_says_what_to_fix(grades, tmp_path):
     with pytest.raises(ValueError, match="is not a plain file: move it away"):
         class_report.write(tmp_path, grades)
     assert (tmp_path / "report.html" / "keep.txt").read_text() == "mine"
-    broken = grade("zed", full(2))
-    broken.results[2]["checks"] = "none"
     with pytest.raises(ValueError, match="'zed' for exercise 2 has no list of checks"):
-        class_report.summarise([broken])
+        class_report.summarise([SubmissionGrade("zed", {2: {**full(2), "checks": "none"}})])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report.html"]  # no temporary file left
 
 

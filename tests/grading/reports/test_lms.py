@@ -600,7 +600,7 @@ def test_labkit_export_refuses_bad_input_with_status_2(tmp_path):
     run = _cli(empty, "--canvas", tmp_path / "gradebook.csv", "--roster", roster, "--feedback")
     assert run.returncode == 2 and "--feedback is for --moodle" in run.stderr
     run = _cli(empty, "--roster", roster)
-    assert run.returncode == 2 and "one of the arguments --canvas --moodle is required" in run.stderr
+    assert run.returncode == 2 and "one of the arguments --canvas --moodle --lms is required" in run.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "roster.csv"]
 
 

@@ -10,6 +10,7 @@ from test_marking import _passed, _rubric
 from labkit.cli import main
 from labkit.grading.lms import moodle
 from labkit.grading.reports import marking
+from labkit.grading.store import marks as store_marks
 from labkit.grading.store import report
 from labkit.grading.store.names import name_from_cell, shown_name
 from labkit.grading.store.report import read_results
@@ -57,7 +58,7 @@ def test_marks_csv_grades_csv_merge_and_export_keep_every_name(tmp_path):
     path = tmp_path / "marks.csv"
     with open(path, "w", newline="", encoding="utf-8") as handle:  # as the page writes it (see templates/marking.js)
         writer = csv.writer(handle)
-        writer.writerow(marking.HEADER)
+        writer.writerow(store_marks.HEADER)
         writer.writerows([[FIRST, "exercise3-answer-1", "5", ""], [SECOND, "exercise3-answer-1", "1", ""]])
         writer.writerow(["'" + ODD, "exercise3-answer-1", "3", ""])
     assert main(["mark", str(out), "--import", str(path), "--quiet"]) == 0
@@ -67,8 +68,8 @@ def test_marks_csv_grades_csv_merge_and_export_keep_every_name(tmp_path):
         cells = [row[0] for row in list(csv.reader(handle))[1:]]
     assert sorted(name_from_cell(cell, totals) for cell in cells) == sorted(totals)
     again = tmp_path / "again.csv"
-    again.write_text(marking.marks_csv(read_results([out])), encoding="utf-8")
-    assert marking.import_marks(out, again) == 0  # labkit's own marks.csv reads back as the same marks
+    again.write_text(store_marks.marks_csv(read_results([out])), encoding="utf-8")
+    assert store_marks.import_marks(out, again) == 0  # labkit's own marks.csv reads back as the same marks
     merged = tmp_path / "merged"
     assert main(["merge", str(out), "--out", str(merged), "--quiet"]) in (0, 1)
     assert {g.name: g.total for g in read_results([merged])} == totals

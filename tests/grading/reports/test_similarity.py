@@ -409,8 +409,8 @@ def test_graded_results_carry_the_sources_and_a_copy_costs_no_points(tmp_path):
     ada = plant(Planted("ada", "02_convergence.ipynb", ()), tmp_path / "ada")
     zoe = plant(Planted("zoe", "02_convergence.ipynb", ((BODY, COPY_BODY),)), tmp_path / "zoe")
     out = tmp_path / "out"
-    options = grading.GradeOptions(cell_timeout=30, total_timeout=300, seed=5)
-    graded = grading.grade([ada.parent, zoe.parent], out, options, jobs=2, progress=False)
+    options = grading.GradeOptions(cell_timeout=30, total_timeout=300, seed=5, jobs=2)
+    graded = grading.grade([ada.parent, zoe.parent], out, options, progress=False)
     assert [g.name for g in graded] == ["ada", "zoe"] and all(g.graded for g in graded)
     assert graded[0].points == graded[1].points and graded[0].points[2] == LAB.points[2] > 0
     assert graded[0].points[3] == LAB.points[3]

@@ -14,7 +14,7 @@ import pytest
 from helpers import processes_with
 from small_class import SEED, cli, files
 
-from labkit.grading.run.resume import resumed
+from labkit.grading.run.resume import clear, resumed
 from labkit.grading.store import rubric as rubrics
 from labkit.grading.store.report import file_stem, safe_name
 from labkit.grading.submission.scoring import submission_name
@@ -115,6 +115,8 @@ def test_resuming_refuses_another_seed_rubric_or_class_and_fresh_starts_over(sma
     assert files(out, "results") == before  # nothing refused was changed
     assert resumed(out, names, None).rubric.same_as(rubrics.default())  # no rubric given: the recorded one
     assert resumed(out, names, None, rubrics.default(), fresh=True).done == {}
+    assert files(out, "results") == before  # working the run out reads; --fresh deletes as the run starts:
+    clear(out)
     assert list((out / "results").iterdir()) == [] and list((out / "feedback").iterdir()) == []
     assert not (out / "record.json").exists()
 

@@ -55,7 +55,7 @@ def shards(small_class, tmp_path_factory):
     for index in range(1, 5):  # each shard is given the whole class, in another order, as each array task is
         given = submissions[index % len(submissions) :] + submissions[: index % len(submissions)]
         grading.grade(
-            given, tmp / f"part{index}", grading.GradeOptions(seed=int(SEED)), shard=f"{index}/4", progress=False
+            given, tmp / f"part{index}", grading.GradeOptions(seed=int(SEED), shard=f"{index}/4"), progress=False
         )
     run = cli("grade", *submissions, "--out", tmp / "empty", "--shard", "1/7", "--seed", SEED, "--quiet")
     assert run.returncode == 0, run.stderr

@@ -156,8 +156,8 @@ def test_a_backend_defined_in_a_test_module_is_all_grading_needs(tmp_path, monke
     """Subclass, register, name it in the options: the grading processes import this module and use it."""
     record = tmp_path / "record.jsonl"
     monkeypatch.setenv(RECORD, str(record))
-    options = GradeOptions(backend="recording", limits=Limits(memory=3 * 1024**3), seed=7)
-    [grade] = grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", options, jobs=1, progress=False)
+    options = GradeOptions(backend="recording", limits=Limits(memory=3 * 1024**3), seed=7, jobs=1)
+    [grade] = grading.grade([NOTEBOOKS / "06_bilinear.ipynb"], tmp_path / "out", options, progress=False)
     assert grade.graded and grade.total == 8, grade.feedback()
     assert "recording backend: student code runs unconfined" in capsys.readouterr().err
     entries = [json.loads(line) for line in record.read_text().splitlines()]

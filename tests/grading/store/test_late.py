@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from labkit.grading import merge
+from labkit.grading.run import times
 from labkit.grading.store import late
 from labkit.grading.store import rubric as rubrics
 from labkit.grading.store.report import CSV_TAIL, SubmissionGrade, safe_name, write_report
@@ -153,11 +154,11 @@ MOMENT = datetime(2026, 12, 1, 22, 59, 59, 123456, tzinfo=UTC)
     ],
 )
 def test_nbgrader_timestamps_are_read_in_every_form_nbgrader_writes(text):
-    assert late.parse_timestamp(text) == MOMENT
+    assert times.parse_timestamp(text) == MOMENT
 
 
 def test_an_older_nbgrader_timestamp_without_a_fraction_is_read():
-    assert late.parse_timestamp("2026-12-01 22:59:59 UTC") == MOMENT.replace(microsecond=0)
+    assert times.parse_timestamp("2026-12-01 22:59:59 UTC") == MOMENT.replace(microsecond=0)
 
 
 @pytest.mark.parametrize(
@@ -173,16 +174,16 @@ def test_an_older_nbgrader_timestamp_without_a_fraction_is_read():
 )
 def test_a_timestamp_that_cannot_be_placed_is_refused_with_the_reason(text, message):
     with pytest.raises(ValueError, match=message):
-        late.parse_timestamp(text)
+        times.parse_timestamp(text)
 
 
 def test_a_submission_folders_timestamp_is_read_and_a_bad_one_is_a_problem_not_a_crash(tmp_path):
     folder = tmp_path / "alice"
     folder.mkdir()
     (folder / "work.ipynb").write_text("{}")
-    assert late.read_timestamp(folder) is None and late.read_timestamp(folder / "work.ipynb") is None
+    assert times.read_timestamp(folder) is None and times.read_timestamp(folder / "work.ipynb") is None
     (folder / "timestamp.txt").write_text("2026-12-01 22:59:59.123456 UTC")
-    assert late.read_timestamp(folder) == late.SubmissionTime(MOMENT, late.FROM_NBGRADER)
+    assert times.read_timestamp(folder) == late.SubmissionTime(MOMENT, late.FROM_NBGRADER)
     cases = {
         b"\x1b[31mnot a time\x07": "is not a time as nbgrader writes it",
         b"\xff\xfe\x00": "timestamp.txt is not text",
@@ -190,18 +191,18 @@ def test_a_submission_folders_timestamp_is_read_and_a_bad_one_is_a_problem_not_a
     }
     for raw, problem in cases.items():
         (folder / "timestamp.txt").write_bytes(raw)
-        found = late.read_timestamp(folder)
+        found = times.read_timestamp(folder)
         assert found.when is None and found.source == late.FROM_NBGRADER and problem in found.problem
     (folder / "timestamp.txt").unlink()
     (tmp_path / "elsewhere.txt").write_text("2026-12-01 22:59:59 UTC")
     (folder / "timestamp.txt").symlink_to(tmp_path / "elsewhere.txt")
-    assert "is a symbolic link" in late.read_timestamp(folder).problem
+    assert "is a symbolic link" in times.read_timestamp(folder).problem
     (folder / "timestamp.txt").unlink()
     os.mkfifo(folder / "timestamp.txt")  # opening a pipe for reading would wait for a writer forever
-    assert "timestamp.txt is not a file" in late.read_timestamp(folder).problem
+    assert "timestamp.txt is not a file" in times.read_timestamp(folder).problem
     (folder / "timestamp.txt").unlink()
     (folder / "timestamp.txt").mkdir()
-    assert "timestamp.txt is not a file" in late.read_timestamp(folder).problem
+    assert "timestamp.txt is not a file" in times.read_timestamp(folder).problem
 
 
 def test_the_times_file_comes_first_and_modification_times_only_when_asked(tmp_path):
@@ -212,26 +213,26 @@ def test_the_times_file_comes_first_and_modification_times_only_when_asked(tmp_p
     stamp = datetime(2026, 12, 3, 12, tzinfo=UTC).timestamp()
     os.utime(notebook, (stamp, stamp))
     # no timestamp.txt, no times file: the file's modification time is never used unless asked for
-    assert late.submission_time(folder, "alice", notebooks=[notebook]) is None
-    by_mtime = late.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True)
+    assert times.submission_time(folder, "alice", notebooks=[notebook]) is None
+    by_mtime = times.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True)
     assert by_mtime == late.SubmissionTime(datetime(2026, 12, 3, 12, tzinfo=UTC), late.FROM_MTIME)
     (folder / "timestamp.txt").write_text("2026-12-01 22:59:59.123456 UTC")
     # the student's own timestamp.txt is never read unless asked for, and then it is marked student-supplied
-    assert late.submission_time(folder, "alice") is None
-    assert late.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True).source == late.FROM_MTIME
-    inside = late.submission_time(folder, "alice", from_submission=True)
+    assert times.submission_time(folder, "alice") is None
+    assert times.submission_time(folder, "alice", notebooks=[notebook], from_mtime=True).source == late.FROM_MTIME
+    inside = times.submission_time(folder, "alice", from_submission=True)
     assert inside.when == MOMENT and inside.source in late.STUDENT_SUPPLIED and "student-supplied" in inside.source
     listed = {"alice": datetime(2026, 12, 2, tzinfo=UTC)}
-    assert late.submission_time(folder, "alice", listed, from_submission=True) == late.SubmissionTime(
+    assert times.submission_time(folder, "alice", listed, from_submission=True) == late.SubmissionTime(
         listed["alice"], late.FROM_CSV
     )
-    assert late.submission_time(folder, "bob", listed, from_submission=True).source == late.FROM_NBGRADER
+    assert times.submission_time(folder, "bob", listed, from_submission=True).source == late.FROM_NBGRADER
     # labkit's own reading of nbgrader's exchange comes after the LMS's times, before anything inside
     exchange = {"alice": datetime(2026, 12, 2, 5, tzinfo=UTC)}
-    assert late.submission_time(folder, "alice", None, exchange=exchange, from_submission=True).source == (
+    assert times.submission_time(folder, "alice", None, exchange=exchange, from_submission=True).source == (
         late.FROM_EXCHANGE
     )
-    assert late.submission_time(folder, "alice", listed, exchange=exchange).source == late.FROM_CSV
+    assert times.submission_time(folder, "alice", listed, exchange=exchange).source == late.FROM_CSV
 
 
 def test_the_exchange_is_read_from_its_folder_names_newest_first(tmp_path):
@@ -247,18 +248,18 @@ def test_the_exchange_is_read_from_its_folder_names_newest_first(tmp_path):
         folder.mkdir(parents=True)
         # what travels with the work is the student's: a forged timestamp.txt changes nothing
         (folder / "timestamp.txt").write_text("2026-11-01 00:00:00 UTC")
-    found = late.read_exchange(tmp_path / "course101", "lab8")
+    found = times.read_exchange(tmp_path / "course101", "lab8")
     assert found == {
         "alice": datetime(2026, 12, 2, 8, 30, tzinfo=UTC),
         "bob": datetime(2026, 12, 1, 20, tzinfo=UTC),
         "d+ave": datetime(2026, 12, 1, 21, 0, 0, 500000, tzinfo=UTC),
     }
-    assert late.read_exchange(inbound, "lab7") == {"carol": datetime(2026, 12, 9, 20, tzinfo=UTC)}
+    assert times.read_exchange(inbound, "lab7") == {"carol": datetime(2026, 12, 9, 20, tzinfo=UTC)}
     (inbound / "eve+lab8+yesterday+r").mkdir()
     with pytest.raises(ValueError, match="no readable time"):
-        late.read_exchange(inbound, "lab8")
+        times.read_exchange(inbound, "lab8")
     with pytest.raises(ValueError, match="no inbound"):
-        late.read_exchange(tmp_path, "lab8")
+        times.read_exchange(tmp_path, "lab8")
 
 
 def test_a_times_file_is_read_with_extra_columns_and_either_time_format(tmp_path):
@@ -267,7 +268,7 @@ def test_a_times_file_is_read_with_extra_columns_and_either_time_format(tmp_path
         "\ufeffTime,Submission,email\n2026-12-01T23:10:00+01:00,alice,a@x\n\n2026-12-01 22:59:59.123456 UTC, bob ,\n",
         encoding="utf-8",
     )
-    assert late.read_times(path) == {"alice": datetime(2026, 12, 1, 22, 10, tzinfo=UTC), "bob": MOMENT}
+    assert times.read_times(path) == {"alice": datetime(2026, 12, 1, 22, 10, tzinfo=UTC), "bob": MOMENT}
 
 
 @pytest.mark.parametrize(
@@ -290,15 +291,15 @@ def test_times_file_errors_name_the_line_and_the_fix(tmp_path, text, message):
     path = tmp_path / "times.csv"
     path.write_text(text)
     with pytest.raises(ValueError, match=_error(message)):
-        late.read_times(path)
+        times.read_times(path)
 
 
 def test_a_missing_or_binary_times_file_is_refused(tmp_path):
     with pytest.raises(ValueError, match="does not exist"):
-        late.read_times(tmp_path / "missing.csv")
+        times.read_times(tmp_path / "missing.csv")
     (tmp_path / "bin.csv").write_bytes(b"\xff\xfe\xfa")
     with pytest.raises(ValueError, match="cannot read the times file"):
-        late.read_times(tmp_path / "bin.csv")
+        times.read_times(tmp_path / "bin.csv")
 
 
 # --- the penalty --------------------------------------------------------------------------------------------------

@@ -316,7 +316,7 @@ def graded_class(tmp_path_factory):
 
 
 def _outcomes(grade, number=16):
-    return {check["name"]: class_report.check_outcome(check) for check in grade.results[number]["checks"]}
+    return {check["name"]: class_report.check_outcome(check.as_dict()) for check in grade.results[number].parts}
 
 
 def _kinds_by_student(summary):
@@ -401,12 +401,13 @@ def test_rewording_every_message_changes_nothing_the_report_says(graded_class):
 
     reworded = []
     for grade in grades:
-        copy = SubmissionGrade.from_dict(json.loads(json.dumps(grade.as_dict())), grade.name, grade.rubric)
-        for verdict in copy.results.values():
+        data = json.loads(json.dumps(grade.as_dict()))
+        for verdict in data["results"].values():
             for check in verdict["checks"]:
                 for step in check["steps"]:
                     step["detail"] = scrambled(step["detail"])
                     step["step"] = scrambled(step["step"])
+        copy = SubmissionGrade.from_dict(data, grade.name, grade.rubric)
         copy.problems = [ProblemText(scrambled(p), [(k, scrambled(d)) for k, d in p.kinds]) for p in copy.problems]
         reworded.append(copy)
     before, after = class_report.summarise(grades), class_report.summarise(reworded)

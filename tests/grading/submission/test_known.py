@@ -11,6 +11,7 @@ import json
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,7 @@ from labkit import grading
 from labkit.exercises.registry import LAB
 from labkit.grading.options import GradeOptions
 from labkit.grading.store import report, rubric
+from labkit.grading.store.model import PartResult
 from labkit.grading.submission import fingerprint, known, scan
 from labkit.grading.submission.scoring import (
     _rescore,
@@ -369,9 +371,9 @@ def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tm
     copier = tmp_path / "copier"  # the solutions, leaked whole
     copier.mkdir()
     shutil.copy(NOTEBOOKS / "03_meshes.ipynb", copier / "03_meshes.ipynb")
-    options = GradeOptions(solutions=str(NOTEBOOKS))
+    options = GradeOptions(solutions=str(NOTEBOOKS), jobs=2)
     out = tmp_path / "out"
-    graded = grading.grade([*subs, copier], out, jobs=2, progress=False, options=options)
+    graded = grading.grade([*subs, copier], out, options, progress=False)
     by_name = {g.name: g for g in graded}
     for style in (s for s in STYLES if s not in PLAIN):
         assert by_name[style].total == rubric.default().maximum, by_name[style].feedback()
@@ -386,7 +388,7 @@ def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tm
     assert record["known"]["solutions"] == str(NOTEBOOKS) and record["known"]["digest"]
     assert solution  # (read as the grader reads it)
     # a resumed run compares with the same sources, recorded: without --solutions they are used again
-    again = grading.grade([*subs, copier], out, jobs=2, progress=False)
+    again = grading.grade([*subs, copier], out, GradeOptions(jobs=2), progress=False)
     assert {(n, p) for n, p, _, _ in {g.name: g for g in again}["copier"].held()} == held
     assert json.loads((out / "record.json").read_text())["known"] == record["known"]
     # other solutions are other known sources: the run is not resumed under them
@@ -394,7 +396,7 @@ def test_independent_solutions_earn_everything_and_copies_are_held_in_one_run(tm
     other.mkdir()
     shutil.copy(NOTEBOOKS / "02_convergence.ipynb", other / "02_convergence.ipynb")
     with pytest.raises(ValueError, match="other known sources"):
-        grading.grade([*subs, copier], out, jobs=2, progress=False, options=GradeOptions(solutions=str(other)))
+        grading.grade([*subs, copier], out, GradeOptions(solutions=str(other), jobs=2), progress=False)
 
 
 def _part(number, name):
@@ -418,8 +420,8 @@ def test_the_grader_holds_a_passed_part_whose_code_is_labkits_and_keeps_one_that
 
 def test_a_release_pays_only_the_held_part_of_a_partly_passed_exercise(tmp_path):
     grade = _held_grade()
-    checks = grade.results[2]["checks"]
-    checks.append({"name": "other", "passed": False, "hint": "h", "weight": 10, "steps": []})  # worth as much
+    other = PartResult("other", False, 10, "h")  # worth as much
+    grade.results[2] = replace(grade.results[2], parts=(*grade.results[2].parts, other))
     path = tmp_path / "rubric.toml"
     path.write_text(rubric.DEFAULT.read_text() + '\n[held]\nrelease = {"ada" = [2]}\n')
     grade.rubric = rubric.load(path)
@@ -432,7 +434,7 @@ def test_the_class_report_lists_a_held_part_side_by_side(tmp_path):
 
     honest = report.SubmissionGrade("bartholomew", results={}, rubric=rubric.default())
     copier = _held_grade()
-    copier.results[2]["checks"][0]["held"]["lines"].append(["x = a < b & c  # </pre><script>", "y"])
+    copier.results[2].parts[0].held["lines"].append(["x = a < b & c  # </pre><script>", "y"])
     page = class_report.render(class_report.summarise([copier, honest]), [])
     section = page[page.index('<h2 id="held">') :]
     section = section[: section.index("</section>")]
@@ -566,7 +568,7 @@ def test_rewritten_and_string_run_copies_are_held_or_refused_in_one_run_with_hon
     forms = {form: rewrite(copy) for form, rewrite in REWRITES.items()} | {"exec": exec_compressed(copy)}
     subs = [_with_cell(tmp_path / form, "02_convergence.ipynb", cell) for form, cell in forms.items()]
     subs += [INDEPENDENT / style for style in STYLES]
-    graded = {g.name: g for g in grading.grade(subs, tmp_path / "out", jobs=2, progress=False)}
+    graded = {g.name: g for g in grading.grade(subs, tmp_path / "out", GradeOptions(jobs=2), progress=False)}
     for style in STYLES:
         assert graded[style].total == rubric.default().maximum and not graded[style].held(), graded[style].feedback()
     for form in forms:

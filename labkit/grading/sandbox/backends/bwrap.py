@@ -56,18 +56,12 @@ INSTALL_HINT = (
 )
 
 
+NAMESPACES = ("--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts", "--unshare-cgroup-try")
+
+
 def _namespaces():
     user = [] if os.geteuid() == 0 else ["--unshare-user"]
-    return [
-        *user,
-        "--unshare-pid",
-        "--unshare-net",
-        "--unshare-ipc",
-        "--unshare-uts",
-        "--unshare-cgroup-try",
-        "--die-with-parent",
-        "--new-session",
-    ]
+    return [*user, *NAMESPACES, "--die-with-parent", "--new-session"]
 
 
 FORKED_UIDS = 1_000_000_000  # forked workers' uids start here (far above sandbox_uid's; pids are below 2**22)
@@ -107,20 +101,8 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     if seccomp_fd is not None:
         args += ["--seccomp", str(seccomp_fd)]
     # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
-    args += [
-        "--proc",
-        "/proc",
-        "--remount-ro",
-        "/proc",
-        "--dev",
-        "/dev",
-        "--perms",
-        "1777",
-        "--size",
-        str(limits.tmp_size),
-        "--tmpfs",
-        "/tmp",
-    ]
+    args += ["--proc", "/proc", "--remount-ro", "/proc", "--dev", "/dev"]
+    args += ["--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
     for name in ("usr", "etc"):
         args += ["--ro-bind", f"/{name}", f"/{name}"]
     for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
@@ -135,17 +117,8 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     courses = course_mounts()
     for origin, shown in courses:
         args += [*_parents(shown, made), "--ro-bind", str(origin), str(shown)]
-    args += [
-        *_parents(HOME, made),
-        "--perms",
-        "1777",
-        "--size",
-        str(limits.home_size),
-        "--tmpfs",
-        HOME,
-        "--chdir",
-        HOME,
-    ]
+    args += [*_parents(HOME, made), "--perms", "1777", "--size", str(limits.home_size), "--tmpfs", HOME]
+    args += ["--chdir", HOME]
     environment = {
         "HOME": HOME,
         "PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin",
@@ -194,32 +167,27 @@ class Bubblewrap(Backend):
 
     def box(self, argv, limits):
         uid = sandbox_uid()
-        seccomp_fd = seccomp.pipe_with_program()
-        try:
-            args = command([*argv, str(uid)], limits, seccomp_fd)
-            # as root the worker becomes `uid`, a uid of its own; otherwise the caller's processes count too
-            base = 0 if uid else processes_of_this_user()
-        except BaseException:
-            if seccomp_fd is not None:
-                os.close(seccomp_fd)
-            raise
-        return Box(args, limits, pass_fds=(seccomp_fd,), processes_base=base)
+        # as root the worker becomes `uid`, a uid of its own; otherwise the caller's processes count too
+        return _box([*argv, str(uid)], limits, processes_base=0 if uid else processes_of_this_user())
 
     def zygote_box(self, argv, limits, pass_fds):
         """As root: a fork server in a sandbox like every notebook's (see :mod:`labkit.grading.sandbox.zygote`).
 
         Not as another user: its workers could not each get a uid of their own."""
-        if os.geteuid() != 0:
-            return None
-        seccomp_fd = seccomp.pipe_with_program()
-        try:
-            args = command(list(argv), limits, seccomp_fd, zygote=True)
-        except BaseException:
-            if seccomp_fd is not None:
-                os.close(seccomp_fd)
-            raise
-        return Box(args, limits, pass_fds=(seccomp_fd, *pass_fds))
+        return _box(list(argv), limits, pass_fds, zygote=True) if os.geteuid() == 0 else None
 
     def notebook_uid(self):
         """As :func:`sandbox_uid`, in a range of their own, and different for each notebook of one process."""
         return FORKED_UIDS + 16 * os.getpid() + next(_FORKED) % 16
+
+
+def _box(argv, limits, pass_fds=(), processes_base=0, zygote=False):
+    """The :class:`~.base.Box` that runs `argv` under bwrap, the sandbox's seccomp filter passed on a pipe."""
+    seccomp_fd = seccomp.pipe_with_program()
+    try:
+        args = command(argv, limits, seccomp_fd, zygote=zygote)
+    except BaseException:
+        if seccomp_fd is not None:
+            os.close(seccomp_fd)
+        raise
+    return Box(args, limits, pass_fds=(seccomp_fd, *pass_fds), processes_base=processes_base)
