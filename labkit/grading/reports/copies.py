@@ -1,9 +1,5 @@
-"""Copies named plainly, for the instructor's class report (never for a student): pairs of students whose graded
-functions look alike, one row per pair; whose data a notebook of another variant holds; and submissions that
-hold the instructor notebooks' solution markers.
-
-Nothing here changes a grade: it tells a person where to look.
-"""
+"""Copies named plainly for the instructor's class report, never changing a grade: students whose graded
+functions look alike, whose data a notebook of another variant holds, and solution markers handed in."""
 
 from __future__ import annotations
 
@@ -30,12 +26,11 @@ class PairRow:
 
 @dataclass
 class Copies:
-    """What the class report says about copies: each student's graded functions, whose data a notebook holds
-    ("fermat holds ada's data for exercises 4, 7, 14"), and the submissions with solution markers."""
+    """{submission: its graded functions}, (holder, whose data or "", exercises), (submission, marked functions)."""
 
-    functions: dict = field(default_factory=dict)  # submission -> frozenset of the graded functions it defines
-    holders: list = field(default_factory=list)  # (holder, whose, exercises), whose "" for no classmate
-    marked: list = field(default_factory=list)  # (submission, functions holding a solution marker)
+    functions: dict = field(default_factory=dict)
+    holders: list = field(default_factory=list)
+    marked: list = field(default_factory=list)
 
     def holder_lines(self):
         """One line per notebook holding another's data, as the report shows it."""
@@ -48,29 +43,24 @@ class Copies:
 
 
 def find(grades, students=None, registry=None) -> Copies:
-    """The copies of a class: `students` is the run's record of each student's variant data ({name: {exercise:
-    {parameter: value}}}), empty for a run without variants."""
+    """The copies of a class; `students`: the run's variant data ({name: {exercise: {parameter: value}}}) or None."""
     graded = [g for g in grades if g.graded]
-    functions = {g.name: frozenset(g.sources) for g in graded}
-    marked = [(g.name, tuple(sorted(f for f, s in g.sources.items() if _marked(s)))) for g in graded]
-    holders = _holders(graded, students or {}, registry or (graded[0].rubric.registry if graded else None))
-    return Copies(functions, holders, [(name, found) for name, found in marked if found])
-
-
-def _marked(source):
-    return any(marker in str(source) for marker in SOLUTION_MARKERS)
-
-
-def _holders(grades, students, registry):
-    """(holder, whose data, exercises) for each notebook holding data of another variant."""
-    found = defaultdict(list)  # (holder, whose) -> exercises
-    for grade in grades:
+    registry = registry or (graded[0].rubric.registry if graded else None)
+    found = defaultdict(list)  # (holder, whose data) -> exercises
+    for grade in graded:
         for number, verdict in sorted(grade.results.items()):
             other = verdict.other_variant
             if other and registry is not None and number in registry.exercises:
-                whose = _whose(grade.name, registry.exercises[number], other, students)
+                whose = _whose(grade.name, registry.exercises[number], other, students or {})
                 found[(grade.name, ", ".join(whose))].append(number)
-    return [(holder, whose, tuple(numbers)) for (holder, whose), numbers in sorted(found.items())]
+    marked = [
+        (g.name, sorted(f for f, s in g.sources.items() if any(m in str(s) for m in SOLUTION_MARKERS))) for g in graded
+    ]
+    return Copies(
+        {g.name: frozenset(g.sources) for g in graded},
+        [(holder, whose, tuple(numbers)) for (holder, whose), numbers in sorted(found.items())],
+        [(name, tuple(functions)) for name, functions in marked if functions],
+    )
 
 
 def _whose(name, exercise, other, students):
@@ -88,15 +78,12 @@ def _whose(name, exercise, other, students):
 
 
 def pair_rows(pairs, functions) -> list[PairRow]:
-    """The similar pairs grouped by the two students, most functions alike first (`functions`: each
-    submission's graded functions, :attr:`Copies.functions`)."""
+    """The similar pairs grouped by the two students, most alike first (`functions`: :attr:`Copies.functions`)."""
     grouped = defaultdict(list)
     for pair in pairs:
         grouped[tuple(sorted((pair.first, pair.second)))].append(pair)
+    both = {pair: len(functions.get(pair[0], set()) & functions.get(pair[1], set())) for pair in grouped}
     rows = [
-        PairRow(
-            a, b, tuple(sorted(found, key=lambda p: -p.score)), len(functions.get(a, set()) & functions.get(b, set()))
-        )
-        for (a, b), found in grouped.items()
+        PairRow(a, b, tuple(sorted(found, key=lambda p: -p.score)), both[a, b]) for (a, b), found in grouped.items()
     ]
     return sorted(rows, key=lambda r: (-len(r.alike), -max(p.score for p in r.alike), r.first, r.second))

@@ -1,20 +1,13 @@
-"""Similar code between classmates, listed for a person to judge in the class report (never a grade).
-
-Each graded function's versions (its definition and what it reaches,
-:func:`labkit.grading.submission.scan.reached_function_sources`) are compared pairwise by the engine of
-:mod:`labkit.grading.submission.fingerprint`, on the source as written, so that the lines shared can be
-marked. A version's corpus is its classmates' versions; the release's code (:func:`boilerplate`) and code
-much of the class wrote alike (a fingerprint in more than :data:`COMMON_SHARE` of the versions and more
-than :data:`COMMON_MIN` of them) are no evidence. A pair's score is the larger, of its two sides, of the
-share of one side's fingerprinted code that the other shares; each source is at most
-:data:`~labkit.grading.store.text.MAX_SOURCE_CHARS` characters, fingerprinted once.
-"""
+"""Similar code between classmates, listed for a person to judge in the class report (never a grade): each
+graded function's versions are fingerprinted as written (so that shared lines can be marked) and compared
+pairwise; the release's code (:func:`boilerplate`) and code much of the class wrote alike are no evidence."""
 
 from __future__ import annotations
 
 import functools
 import math
 import os
+from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,46 +19,32 @@ from ..store.text import MAX_SOURCE_CHARS
 from ..submission import fingerprint
 
 DEFAULT_THRESHOLD = 0.8  # similarity (0..1) from which a pair is shown
-COMMON_SHARE = 0.2  # a fingerprint in more than this share of a function's versions...
-COMMON_MIN = 5  # ...and in more than this many is the class's common code, set aside like the release's
+COMMON_SHARE = 0.2  # a fingerprint in more than this share of a function's versions and more than COMMON_MIN
+COMMON_MIN = 5  # of them is the class's common code, set aside like the release's
 
 
 @dataclass(frozen=True)
 class Pair:
-    """Two submissions' versions of one graded function that look alike."""
+    """Two submissions' alike versions of a `function`: `score` (0..1) shared, ``shared_*`` lines (0-based)."""
 
-    function: str  # the graded function's name, e.g. "eval_pherm"
-    first: str  # submission names
+    function: str
+    first: str
     second: str
-    score: float  # 0..1: how much of the code is shared (the larger of the two directions)
-    first_lines: tuple  # the two sources, line by line
+    score: float
+    first_lines: tuple
     second_lines: tuple
-    shared_first: frozenset  # 0-based numbers of the lines each shares with the other
+    shared_first: frozenset
     shared_second: frozenset
 
 
-@dataclass(frozen=True)
-class Boilerplate:
-    """What a release gives every student, never evidence: the sorted hashes of every fingerprint-sized run
-    of its code, and its lines of code, stripped (a stub's ``def`` line is never marked as shared)."""
-
-    hashes: np.ndarray
-    lines: frozenset
-
-
-@dataclass(frozen=True)
-class _Version:
-    """One student's version of a function, with its own fingerprints (sorted by position)."""
-
-    name: str
-    text: str
-    where: np.ndarray
-    hashes: np.ndarray
-    positions: np.ndarray
+# what a release gives everyone: the hashes of its code, and its stripped lines (a stub's are never shared)
+Boilerplate = namedtuple("Boilerplate", "hashes lines")
+# one student's version of a function, with its own fingerprints (fingerprint.own)
+_Version = namedtuple("_Version", "name text where hashes positions")
 
 
 def unavailable() -> str | None:
-    """Why the search cannot run here (its tokeniser, pygments, cannot be imported), or None.
+    """Why the search cannot run here (pygments cannot be imported), or None.
 
     >>> unavailable() is None
     True
@@ -81,27 +60,10 @@ def unavailable() -> str | None:
 
 
 def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, progress=None) -> list[Pair] | None:
-    """The pairs of submissions whose versions of a graded function look alike, most similar first.
+    """The pairs of `grades` (with a ``name`` and ``sources``) whose versions of a graded function score
+    `threshold` (0..1) or more (never 0), by score, function and names, ``first`` sorting first. `release` is
+    what everyone was given (:func:`boilerplate`); `progress` advances per function. None if :func:`unavailable`.
 
-    Parameters
-    ----------
-    grades : iterable of SubmissionGrade
-        The class's grades (or objects with a ``name`` and ``sources``, {function: source text}).
-    threshold : float, optional
-        The score (0..1) from which a pair is listed; a pair that shares nothing never is.
-    release : path or sequence of str, optional
-        What every student was given (:func:`boilerplate`); None for the lab's packaged release.
-    progress : labkit.grading.progress.Progress, optional
-        Advanced by one after each graded function.
-
-    Returns
-    -------
-    list of Pair or None
-        By score (then function and names), ``first`` the name that sorts first; None when the search
-        cannot run here (:func:`unavailable`). ValueError for a bad threshold, grade or release.
-
-    Examples
-    --------
     >>> from labkit.grading.store.report import SubmissionGrade
     >>> mine = "def area(width, height):\\n    return 0.5 * (width + height) * abs(width - height) ** 2 / 3"
     >>> theirs = "def area(w, h):\\n    # renamed\\n    return 0.5*(w+h)*abs(w-h)**2/3"
@@ -110,23 +72,18 @@ def similar_pairs(grades, threshold: float = DEFAULT_THRESHOLD, release=None, pr
     >>> [(p.first, p.second, round(p.score, 2), sorted(p.shared_second)) for p in similar_pairs(grades, release=[])]
     [('ada', 'bo', 1.0, [0, 2])]
     """
-    threshold = _threshold(threshold)
+    number = not isinstance(threshold, bool) and isinstance(threshold, (int, float, np.integer, np.floating))
+    if not (number and math.isfinite(threshold) and 0 <= threshold <= 1):
+        raise InputError(f"threshold must be a number from 0 to 1 (a share of the code); got {threshold!r}.")
     by_function = _by_function(grades)
     if unavailable() is not None:
         return None
     given, pairs = boilerplate(release), []
     for function, versions in by_function.items():
-        pairs += _function_pairs(function, versions, given, threshold)
+        pairs += _function_pairs(function, versions, given, float(threshold))
         if progress is not None:
             progress.advance()
     return sorted(pairs, key=lambda pair: (-pair.score, pair.function, pair.first, pair.second))
-
-
-def _threshold(threshold):
-    number = not isinstance(threshold, bool) and isinstance(threshold, (int, float, np.integer, np.floating))
-    if not (number and math.isfinite(threshold) and 0 <= threshold <= 1):
-        raise InputError(f"threshold must be a number from 0 to 1 (a share of the code); got {threshold!r}.")
-    return float(threshold)
 
 
 def _by_function(grades) -> dict:
@@ -149,9 +106,9 @@ def _by_function(grades) -> dict:
         seen.add(name)
         for function, source in sources.items():
             if not isinstance(function, str) or not isinstance(source, str):
+                kinds = f"{type(function).__name__}: {type(source).__name__}"
                 raise InputError(
-                    f"the sources of {one_line(name, 80)!r} are not function names and source texts "
-                    f"({type(function).__name__}: {type(source).__name__})."
+                    f"the sources of {one_line(name, 80)!r} are not function names and source texts ({kinds})."
                 )
             by_function.setdefault(function, []).append((name, _clean(source)))
     return by_function
@@ -164,8 +121,8 @@ def _clean(text):
 
 
 def boilerplate(release=None) -> Boilerplate:
-    """The boilerplate of a student release (a folder of notebooks, one notebook, or code texts; None for the
-    packaged student notebooks): the stubs of the graded functions and the lab's given code.
+    """The boilerplate (stubs and given code) of a student release: a folder of notebooks, one notebook, code
+    texts, or None for the packaged student notebooks.
 
     >>> stub = "def f(x):\\n    # YOUR CODE HERE\\n    raise NotImplementedError()"
     >>> sorted(boilerplate([stub]).lines)
@@ -176,7 +133,7 @@ def boilerplate(release=None) -> Boilerplate:
     if isinstance(release, (str, os.PathLike)):
         from ..submission.scoring import submission_notebooks
 
-        return _boilerplate_of(_notebook_code(submission_notebooks(release)))
+        release = _notebook_code(submission_notebooks(release))
     try:
         texts = list(release)
     except TypeError:
@@ -185,14 +142,16 @@ def boilerplate(release=None) -> Boilerplate:
         raise InputError(
             f"release must be a folder of notebooks, a notebook, or a list of code texts; got {release!r:.100}."
         )
-    return _boilerplate_of(texts)
+    texts = [_clean(text) for text in texts]
+    lines = frozenset(line.strip() for text in texts for line in text.split("\n") if line.strip())
+    return Boilerplate(fingerprint.release_grams(texts, rewrite=str), lines)
 
 
 @functools.cache
 def _packaged():
     from ...student_notebooks import paths
 
-    return _boilerplate_of(_notebook_code([Path(str(p)) for p in paths()]))
+    return boilerplate(_notebook_code([Path(str(p)) for p in paths()]))
 
 
 def _notebook_code(paths):
@@ -207,32 +166,14 @@ def _notebook_code(paths):
     return code
 
 
-def _boilerplate_of(texts):
-    texts = [_clean(text) for text in texts]
-    lines = frozenset(line.strip() for text in texts for line in text.split("\n") if line.strip())
-    return Boilerplate(fingerprint.release_grams(texts, rewrite=str), lines)
-
-
 def _version(name, text, given):
-    """The :class:`_Version` of a source without the hashes `given`; None when nothing of its own is left."""
+    """The :class:`_Version` of a source without the hashes `given`; None when nothing is left."""
     version = _Version(name, text, *fingerprint.own(text, given))
     return version if version.hashes.size else None
 
 
-def _without_common(versions):
-    """The versions without the fingerprints that much of the class has (and without those left empty)."""
-    distinct = np.concatenate([np.unique(v.hashes) for v in versions]) if versions else np.zeros(0, np.uint64)
-    hashes, counts = np.unique(distinct, return_counts=True)
-    common = hashes[counts > max(COMMON_MIN, COMMON_SHARE * len(versions))]
-    if not common.size:
-        return versions
-    kept = [(v, ~np.isin(v.hashes, common)) for v in versions]
-    return [_Version(v.name, v.text, v.where, v.hashes[k], v.positions[k]) for v, k in kept if k.any()]
-
-
 def shares(versions) -> np.ndarray:
-    """``S[i, j]``: the share of version i's fingerprinted code that fingerprints j has too cover, for all
-    pairs at once from an index of which versions have each fingerprint (zero on the diagonal)."""
+    """``S[i, j]``: the share of version i's fingerprinted code that fingerprints j has too cover (0 if i == j)."""
     from scipy import sparse
 
     sizes = [v.hashes.size for v in versions]
@@ -251,9 +192,14 @@ def shares(versions) -> np.ndarray:
 
 
 def _function_pairs(function, versions, given, threshold):
-    """The pairs of one function's versions [(submission, source)] at or above the threshold."""
-    kept = [_version(name, text, given.hashes) for name, text in versions]
-    kept = _without_common([version for version in kept if version is not None])
+    """The pairs of one function's versions [(submission, source)] at `threshold` or more, common code aside."""
+    kept = [v for v in (_version(name, text, given.hashes) for name, text in versions) if v is not None]
+    distinct = np.concatenate([np.unique(v.hashes) for v in kept]) if kept else np.zeros(0, np.uint64)
+    hashes, counts = np.unique(distinct, return_counts=True)
+    common = hashes[counts > max(COMMON_MIN, COMMON_SHARE * len(kept))]
+    if common.size:
+        masks = [(v, ~np.isin(v.hashes, common)) for v in kept]
+        kept = [v._replace(hashes=v.hashes[k], positions=v.positions[k]) for v, k in masks if k.any()]
     if len(kept) < 2:
         return []
     scores = shares(kept)
@@ -268,8 +214,7 @@ def _function_pairs(function, versions, given, threshold):
 
 
 def _lines(version, other, given):
-    """0-based numbers of the lines of `version` that its fingerprints shared with `other` cover (comments
-    never are), less those the release gives (in `given`, stripped)."""
+    """0-based numbers of `version`'s lines its fingerprints shared with `other` cover, less those `given`."""
     positions = version.positions[np.isin(version.hashes, other.hashes)]
     lines = version.text.split("\n")
     return frozenset(

@@ -1,19 +1,8 @@
-"""The one fingerprinting engine: code read by what it does, winnowed, and compared run by run.
-
-Known code in a graded part (:mod:`labkit.grading.submission.known`, which holds the part for a person) and
-classmates' similar code (:mod:`labkit.grading.reports.similarity`, for the class report) are both found
-with it, each with its own corpus and threshold. Nothing is ever run:
-
-1. :func:`canonical` (known code only) writes a definition back from its syntax tree without what does
-   nothing, and :func:`units` splits a part's code into functions and methods, trivial wrappers left out.
-2. :func:`normalise` tokenises with pygments: a name is ``V`` (a function's ``F``, a class's ``O``), a
-   string ``S``; comments, docstrings, white space and round brackets go; keywords, operators, numbers,
-   Python's own names and the attribute after a dot stay.
-3. :func:`fingerprints` hashes every run of :data:`NOISE` normalised characters and keeps the smallest of
-   each :data:`WINDOW` (winnowing, Schleimer, Wilkerson and Aiken 2003): a shared run of 30 characters
-   always shares a fingerprint. What the student release gives everyone (:func:`release_grams`) is never
-   evidence.
-"""
+"""The one fingerprinting engine, for known code in a graded part (:mod:`.known`) and classmates' similar code
+(:mod:`labkit.grading.reports.similarity`), each with its own corpus and threshold. Nothing is ever run:
+:func:`canonical` (known code only) writes code back without what does nothing, :func:`normalise` keeps what
+the tokens do, not their names, and :func:`fingerprints` winnows runs of :data:`NOISE` characters (Schleimer,
+Wilkerson and Aiken 2003). What the student release gives everyone (:func:`release_grams`) is never evidence."""
 
 from __future__ import annotations
 
@@ -25,12 +14,7 @@ import numpy as np
 
 NOISE = 25  # normalised characters hashed together: a shorter shared run is never evidence
 WINDOW = 6  # winnowing window: a shared run of NOISE + WINDOW - 1 = 30 characters always shares a fingerprint
-UNWRAPPED = {"staticmethod", "classmethod"}
-SELF = {"self", "cls"}
-PARENTHESES = {"(", ")"}  # a formatter adds and drops them around tuples and long lines
-BASE = np.uint64(1_000_003)
-POWERS = BASE ** np.arange(NOISE - 1, -1, -1, dtype=np.uint64)  # wraps modulo 2**64, as the hashes do
-BLOCKS = ("body", "orelse", "finalbody")
+POWERS = np.uint64(1_000_003) ** np.arange(NOISE - 1, -1, -1, dtype=np.uint64)  # wraps modulo 2**64, as hashes do
 
 
 def parse(text):
@@ -42,13 +26,10 @@ def parse(text):
 
 
 def canonical(text, namespaces=frozenset()):
-    """`text` written back from its normalised syntax tree (`text` itself when it does not parse): docstrings,
-    statements with no effect and dead stores go, ``getattr(x, "name")`` is ``x.name``, ``x += y`` is
-    ``x = x + y``, accumulating loops and generators are list comprehensions, ``staticmethod`` goes, and
-    ``Name.attr`` of one of the `namespaces` (the notebook's classes) is ``attr``.
+    """`text` written back from its normalised syntax tree (itself if it does not parse): no docstrings, dead
+    stores or ``staticmethod``; ``getattr(x, "name")`` is ``x.name``, ``x += y`` ``x = x + y``, accumulating
+    loops and generators list comprehensions, and ``Name.attr`` of one of the `namespaces` ``attr``.
 
-    Examples
-    --------
     >>> text = "def f(x):\\n    '''Doc.'''\\n    _ = None\\n    y = getattr(x, 'size')\\n    y += 1\\n    return y"
     >>> print(canonical(text))
     def f(x):
@@ -71,12 +52,14 @@ class _Canon(ast.NodeTransformer):
     """The rewrites :func:`canonical` makes, node by node."""
 
     def __init__(self, namespaces):
-        self.namespaces = namespaces | SELF
+        self.namespaces = namespaces | {"self", "cls"}
 
     def visit_FunctionDef(self, node):
-        node.decorator_list = [d for d in node.decorator_list if not _named(d, UNWRAPPED)]
+        node.decorator_list = [d for d in node.decorator_list if not _named(d, {"staticmethod", "classmethod"})]
         self.generic_visit(node)
-        node.body = _pruned(_as_comprehensions(node.body), _read_names(node)) or [ast.Pass()]
+        body = _as_comprehensions(node.body)
+        read = {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        node.body = _pruned(body, read) or [ast.Pass()]
         return node
 
     visit_AsyncFunctionDef = visit_FunctionDef
@@ -92,8 +75,10 @@ class _Canon(ast.NodeTransformer):
 
     def visit_Call(self, node):
         self.generic_visit(node)
-        if _named(node.func, {"getattr"}) and len(node.args) == 2 and not node.keywords and _identifier(node.args[1]):
-            return ast.Attribute(value=node.args[0], attr=node.args[1].value, ctx=ast.Load())
+        if _named(node.func, {"getattr"}) and len(node.args) == 2 and not node.keywords:
+            attr = node.args[1].value if isinstance(node.args[1], ast.Constant) else None
+            if isinstance(attr, str) and attr.isidentifier():
+                return ast.Attribute(value=node.args[0], attr=attr, ctx=ast.Load())
         if _named(node.func, {"list"}) and len(node.args) == 1 and isinstance(node.args[0], ast.ListComp):
             return node.args[0]
         return node
@@ -122,20 +107,11 @@ def _named(node, names):
     return isinstance(node, ast.Name) and node.id in names
 
 
-def _identifier(node):
-    return isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value.isidentifier()
-
-
-def _read_names(function):
-    """Every name a function reads, in itself and the functions inside it."""
-    return {n.id for n in ast.walk(function) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
-
-
 def _no_effect(statement):
-    """A statement that does nothing: a bare constant (a docstring), a bare name, ``pass``."""
-    if isinstance(statement, ast.Pass):
-        return True
-    return isinstance(statement, ast.Expr) and isinstance(statement.value, (ast.Constant, ast.Name))
+    """A bare constant (a docstring), a bare name, ``pass``."""
+    return isinstance(statement, ast.Pass) or (
+        isinstance(statement, ast.Expr) and isinstance(statement.value, (ast.Constant, ast.Name))
+    )
 
 
 def _dead(statement, read):
@@ -145,21 +121,20 @@ def _dead(statement, read):
     targets = statement.targets if isinstance(statement, ast.Assign) else [statement.target]
     if not all(isinstance(t, ast.Name) for t in targets):
         return False
-    if isinstance(statement.value, ast.Name) and all(t.id == statement.value.id for t in targets):
-        return True
-    return all(t.id not in read for t in targets)
+    itself = isinstance(statement.value, ast.Name) and all(t.id == statement.value.id for t in targets)
+    return itself or all(t.id not in read for t in targets)
 
 
 def _blocks(statement):
-    """(field, block) of each block of statements inside `statement` (a loop's body, an if's else...)."""
-    for field in BLOCKS:
+    """(field, block) of each block of statements inside `statement` (a loop's body, an if's else)."""
+    for field in ("body", "orelse", "finalbody"):
         block = getattr(statement, field, None)
         if isinstance(block, list) and block and isinstance(block[0], ast.stmt):
             yield field, block
 
 
 def _pruned(body, read):
-    """A function body without its statements of no effect and its dead stores (nested blocks too)."""
+    """`body` without statements of no effect and dead stores, nested blocks too."""
     kept = []
     for statement in body:
         if not (_no_effect(statement) or _dead(statement, read)):
@@ -170,10 +145,7 @@ def _pruned(body, read):
 
 
 def _as_comprehensions(body):
-    """A block with its accumulating loops written as the comprehensions they equal, nested blocks too:
-    ``xs = []`` then ``for v in it: xs.append(e)`` (or ``if c: xs.append(e)``) is ``xs = [e for v in it (if c)]``,
-    and ``s = 0`` then ``for v in it: s = s + e`` is ``s = sum([e for v in it])``; a value named only to be
-    returned is returned (``y = e`` then ``return y`` is ``return e``)."""
+    """`body` with loops folded (:func:`_folded`), nested blocks too, and ``y = e; return y`` as ``return e``."""
     kept: list = []
     for statement in body:
         for field, block in _blocks(statement):
@@ -183,90 +155,64 @@ def _as_comprehensions(body):
             kept[-1] = ast.copy_location(folded, kept[-1])
         else:
             kept.append(statement)
-    return _returned(kept)
-
-
-def _returned(block):
-    """`block` with ``name = e`` then ``return name`` at its end written ``return e``."""
-    if len(block) >= 2 and isinstance(block[-1], ast.Return) and isinstance(block[-1].value, ast.Name):
-        last = block[-2]
-        if isinstance(last, ast.Assign) and len(last.targets) == 1 and _named(last.targets[0], {block[-1].value.id}):
-            return block[:-2] + [ast.copy_location(ast.Return(value=last.value), last)]
-    return block
+    if len(kept) >= 2 and isinstance(kept[-1], ast.Return) and isinstance(kept[-1].value, ast.Name):
+        last = kept[-2]
+        if isinstance(last, ast.Assign) and len(last.targets) == 1 and _named(last.targets[0], {kept[-1].value.id}):
+            return kept[:-2] + [ast.copy_location(ast.Return(value=last.value), last)]
+    return kept
 
 
 def _folded(start, loop):
-    """``name = <comprehension>`` for a start value and the loop that fills it, or None when they are not one."""
-    if not (isinstance(start, ast.Assign) and len(start.targets) == 1 and isinstance(start.targets[0], ast.Name)):
-        return None
-    if not isinstance(loop, ast.For) or loop.orelse or len(loop.body) != 1:
-        return None
-    name, step, conditions = start.targets[0].id, loop.body[0], []
+    """``xs = [e for v in it if c]`` for ``xs = []`` and ``for v in it: (if c:) xs.append(e)``, ``s = sum([e for v
+    in it])`` for ``s = 0`` and ``for v in it: s = s + e``; else None."""
+    match start, loop:
+        case ast.Assign(targets=[ast.Name(id=name)], value=first), ast.For(body=[step], orelse=[]):
+            conditions = []
+        case _:
+            return None
     if isinstance(step, ast.If) and not step.orelse and len(step.body) == 1:
         conditions, step = [step.test], step.body[0]
-    element = _appended(step, name) if isinstance(start.value, ast.List) and not start.value.elts else None
-    total = _added(step, name) if _zero(start.value) and element is None else None
-    if element is None and total is None:
-        return None
     generator = ast.comprehension(target=loop.target, iter=loop.iter, ifs=conditions, is_async=0)
-    made = ast.ListComp(elt=element if element is not None else total, generators=[generator])
-    value = made if element is not None else ast.Call(func=ast.Name(id="sum", ctx=ast.Load()), args=[made], keywords=[])
+    match first, step:
+        case ast.List(elts=[]), ast.Expr(
+            value=ast.Call(func=ast.Attribute(value=ast.Name(id=owner), attr="append"), args=[element], keywords=[])
+        ) if owner == name:
+            value = ast.ListComp(elt=element, generators=[generator])
+        case ast.Constant(value=zero), ast.Assign(
+            targets=[ast.Name(id=owner)], value=ast.BinOp(left=ast.Name(id=left), op=ast.Add(), right=element)
+        ) if type(zero) in (int, float) and zero == 0 and owner == left == name:
+            made = ast.ListComp(elt=element, generators=[generator])
+            value = ast.Call(func=ast.Name(id="sum", ctx=ast.Load()), args=[made], keywords=[])
+        case _:
+            return None
     return ast.Assign(targets=[ast.Name(id=name, ctx=ast.Store())], value=value)
 
 
-def _appended(step, name):
-    """`e` of ``name.append(e)``, else None."""
-    call = step.value if isinstance(step, ast.Expr) else None
-    if isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute) and call.func.attr == "append":
-        if _named(call.func.value, {name}) and len(call.args) == 1 and not call.keywords:
-            return call.args[0]
-    return None
-
-
-def _added(step, name):
-    """`e` of ``name = name + e`` (``name += e`` is already written so), else None."""
-    if isinstance(step, ast.Assign) and len(step.targets) == 1 and _named(step.targets[0], {name}):
-        value = step.value
-        if isinstance(value, ast.BinOp) and isinstance(value.op, ast.Add) and _named(value.left, {name}):
-            return value.right
-    return None
-
-
-def _zero(node):
-    return isinstance(node, ast.Constant) and type(node.value) in (int, float) and node.value == 0
-
-
 def units(definitions):
-    """``[(name, canonical text)]``: a part's definitions as :func:`canonical` writes them, a class's methods
-    each on its own and trivial wrappers left out (they hand a call on, so the code is where they point).
+    """``[(name, canonical text)]`` of a part's definitions, a class's methods each on its own, trivial wrappers
+    left out (the code is where they point).
 
-    Examples
-    --------
     >>> box = "class K:\\n    @staticmethod\\n    def g(x):\\n        return x * x + 1"
     >>> found = units([("f", "def f(x):\\n    return K.g(x)"), ("K", box)])
     >>> [name for name, _ in found]
     ['K.g']
     """
     definitions = list(definitions)
-    trees = [parse(text) for _, text in definitions]
-    namespaces = frozenset(
-        n.name for tree in trees if tree is not None for n in tree.body if isinstance(n, ast.ClassDef)
-    )
-    return [unit for name, text in definitions for unit in _split(name, text, namespaces)]
-
-
-def _split(name, text, namespaces):
-    tree = parse(canonical(text, namespaces))
-    if tree is None:
-        return [(name, str(text))]
-    pieces = []
-    for node in tree.body:
-        if isinstance(node, ast.ClassDef):
-            methods = [m for m in node.body if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef))]
-            pieces += [(f"{node.name}.{m.name}", m) for m in methods if not _trivial(m)]
-        elif not _trivial(node):
-            pieces.append((name, node))
-    return [(label, ast.unparse(node)) for label, node in pieces]
+    trees = [tree for _, text in definitions if (tree := parse(text)) is not None]
+    namespaces = frozenset(n.name for tree in trees for n in tree.body if isinstance(n, ast.ClassDef))
+    found = []
+    for name, text in definitions:
+        tree = parse(canonical(text, namespaces))
+        if tree is None:
+            found.append((name, str(text)))
+            continue
+        for node in tree.body:
+            if isinstance(node, ast.ClassDef):
+                methods = [m for m in node.body if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef))]
+                found += [(f"{node.name}.{m.name}", ast.unparse(m)) for m in methods if not _trivial(m)]
+            elif not _trivial(node):
+                found.append((name, ast.unparse(node)))
+    return found
 
 
 def _trivial(node):
@@ -281,11 +227,9 @@ def _trivial(node):
 
 
 def normalise(text):
-    """``(normalised, where)``: `text`'s tokens as :func:`fingerprints` reads them, and the index in `text`
-    of each normalised character.
+    """``(normalised, where)``: `text`'s tokens with a name ``V`` (a function's ``F``, a class's ``O``), a string
+    ``S``, no comments, docstrings, white space or round brackets; and the index in `text` of each character.
 
-    Examples
-    --------
     >>> normalise("def area(w, h):\\n    '''Doc.'''\\n    return w * h  # cm2")[0]
     'defFV,V:returnV*V'
     >>> normalise("y = np.searchsorted(x, 'a')")[0]
@@ -294,7 +238,8 @@ def normalise(text):
     out, where, previous = [], [], None
     for start, kind, value in _lexer().get_tokens_unprocessed(str(text)):
         piece = _written(kind)
-        if piece == "" or value in PARENTHESES or (piece == "S" and previous == "S"):  # adjacent strings are one
+        # a formatter adds and drops round brackets; adjacent strings are one
+        if piece == "" or value in ("(", ")") or (piece == "S" and previous == "S"):
             continue
         piece = value if piece is None or (piece == "V" and previous == ".") else piece
         out.append(piece)
@@ -312,8 +257,7 @@ def _lexer():
 
 @functools.cache
 def _written(kind):
-    """How :func:`normalise` writes a token of this kind: "" left out, a letter, or None as itself (Python's own
-    names too: builtins, exceptions, ``self``)."""
+    """How :func:`normalise` writes a token of this kind: "" left out, a letter, or None as itself."""
     from pygments import token
 
     if kind in token.Text or kind in token.Comment or kind in token.String.Doc:
@@ -334,10 +278,9 @@ def kgrams(normalised):
 
 
 def fingerprints(normalised):
-    """``(hashes, positions)``: the winnowed fingerprints of a normalised text, in order of position.
+    """``(hashes, positions)``: the winnowed fingerprints of a normalised text, in order of position (a shared
+    run of ``NOISE + WINDOW - 1`` characters always shares one).
 
-    Examples
-    --------
     >>> hashes, positions = fingerprints("V=V+1" * 20)
     >>> bool(len(hashes)) and bool(np.all(np.diff(positions) > 0))
     True
@@ -349,22 +292,18 @@ def fingerprints(normalised):
         return grams, np.zeros(0, dtype=np.int64)
     width = min(WINDOW, grams.size)
     windows = np.lib.stride_tricks.sliding_window_view(grams, width)
-    # robust winnowing: the rightmost smallest hash of each window
     chosen = np.unique(np.arange(windows.shape[0]) + (width - 1 - np.argmin(windows[:, ::-1], axis=1)))
     return grams[chosen], chosen
 
 
 def release_grams(cells, rewrite=canonical):
-    """Every :data:`NOISE`-character hash of a release's code cells, each written by `rewrite` first (sorted):
-    what every student was given, so never evidence; every run, not only those winnowing keeps, so that a
-    stub the student's code cuts off elsewhere leaves nothing behind."""
+    """Every :data:`NOISE`-character hash of the release `cells`, written by `rewrite` (all: a cut stub leaves none)."""
     found = [kgrams(normalise(rewrite(cell))[0]) for cell in cells]
     return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.uint64)
 
 
 def own(text, given):
-    """``(where, hashes, positions)``: :func:`normalise`'s `where` of `text`, and its fingerprints that the
-    sorted hashes `given` (:func:`release_grams`) do not have."""
+    """``(where, hashes, positions)``: :func:`normalise`'s `where`, and `text`'s fingerprints not `given`."""
     normalised, where = normalise(text)
     hashes, positions = fingerprints(normalised)
     mine = ~np.isin(hashes, given)
@@ -372,8 +311,7 @@ def own(text, given):
 
 
 def coverage(positions, has):
-    """For each row of `has` (which of the fingerprints at sorted `positions` count), how many normalised
-    characters those fingerprints cover (each covers the :data:`NOISE` it hashes)."""
+    """For each row of `has` (which fingerprints at sorted `positions` count), the characters they cover."""
     spots = np.asarray(positions, dtype=float)
     at = np.where(has, spots, np.inf)
     after = np.minimum.accumulate(at[:, ::-1], axis=1)[:, ::-1]  # the first counted position from each on
@@ -382,8 +320,7 @@ def coverage(positions, has):
 
 
 def shared_lines(text, where, positions):
-    """The numbers (0-based) of the lines of `text` with a normalised character that a fingerprint at one of
-    `positions` covers (`where`: :func:`normalise`'s of `text`)."""
+    """The 0-based numbers of `text`'s lines that a fingerprint at one of `positions` covers."""
     marks = np.zeros(len(where) + NOISE + 1, dtype=np.int64)
     np.add.at(marks, positions, 1)
     np.add.at(marks, np.asarray(positions) + NOISE, -1)

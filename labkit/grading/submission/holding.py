@@ -1,9 +1,6 @@
-"""Parts built on code that is not the student's (:func:`labkit.grading.submission.scoring.grade_notebook`).
-
-A part a refusal guards is judged for known code where it is graded; any other (a plot, a table) is judged on
-the definitions that draw it (:func:`judge_plain`); and every part whose code reaches a held definition, or
-a graded name that a string run as code may have defined, waits or fails with it (:func:`hold_dependents`).
-"""
+"""Parts built on code that is not the student's (:func:`labkit.grading.submission.scoring.grade_notebook`):
+parts without a refusal judged for known code on what draws them, and parts reaching held or string-run
+definitions holding or failing with them."""
 
 from __future__ import annotations
 
@@ -12,29 +9,31 @@ from ..store.report import HELD_STEP
 from . import scan
 
 
-def _read(part):
-    return [name for name in part.names() if name.isidentifier()]
-
-
 def judge_plain(check, part, code, graded, judge):
-    """A part without a refusal (a plot, a table of values), judged for known code on what draws it: `judge`
-    (check, [(name, source)]) is given the notebook's definitions that draw it, less the `graded` names (each
-    judged in its own part), and returns the check, held or as it was."""
+    """A passed part without a refusal, `judge`d (check, [(name, source)]) on what draws it but `graded` names."""
     if not check["passed"]:
         return check
+    readable = [n for n in part.names() if n.isidentifier()]
     try:
-        names = scan.drawn_with(code, _read(part))
-        reached = scan.reached_sources(code, sorted(names))
+        reached = scan.reached_sources(code, sorted(scan.drawn_with(code, readable)))
     except scan.Unreadable:
         return check
     return judge(check, [(n, t) for n, t in reached if n not in graded])
 
 
 def hold_dependents(results, registry, code, graded, rescore):
-    """Hold, in `results` ({exercise: verdict} of one notebook), every passed part whose code reaches a held
-    definition, and fail every one that reaches one of the `graded` names a string run as code may have
-    defined; `rescore` (verdict, registry) counts an exercise's points again."""
-    held, strung = _held_names(results, registry), _strung(code, graded)
+    """Hold, in `results` ({exercise: verdict}), every passed part whose code reaches a held definition, and
+    fail those reaching a `graded` name a string run as code may have defined; `rescore` (verdict, registry)."""
+    held = {}  # name: its held match, for the held parts' graded names and the copies
+    for number, verdict in results.items():
+        for part, check in zip(registry.exercises[number].parts, verdict["checks"]):
+            if check.get("held") and check.get("passed"):
+                for name in (*part.scanned, check["held"].get("definition", "")):
+                    held.setdefault(name, check["held"])
+    try:
+        strung = {name: why for name, _, why in scan.run_strings(code, sorted(graded))}
+    except scan.Unreadable:
+        strung = {}
     if not held and not strung:
         return results
     for number, verdict in results.items():
@@ -42,7 +41,12 @@ def hold_dependents(results, registry, code, graded, rescore):
         for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
             if not check.get("passed") or check.get("held"):
                 continue
-            names = _reaches(part, code) - set(part.scanned)
+            readable = [n for n in (*part.names(), *part.scanned) if n.isidentifier()]
+            try:
+                names = set(part.uses) | scan.drawn_with(code, readable)
+            except scan.Unreadable:
+                names = set(part.uses)
+            names -= set(part.scanned)
             on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
             if on_held:
                 verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
@@ -52,48 +56,19 @@ def hold_dependents(results, registry, code, graded, rescore):
     return results
 
 
-def _held_names(results, registry):
-    """{name: its held match} of the definitions held in `results`: the parts' graded names and the copies."""
-    held = {}
-    for number, verdict in results.items():
-        for part, check in zip(registry.exercises[number].parts, verdict["checks"]):
-            if check.get("held") and check.get("passed"):
-                for name in (*part.scanned, check["held"].get("definition", "")):
-                    held.setdefault(name, check["held"])
-    return held
-
-
-def _strung(code, graded):
-    """{graded name: why}: the graded names a string run as code may have defined."""
-    try:
-        return {name: why for name, _, why in scan.run_strings(code, sorted(graded))}
-    except scan.Unreadable:
-        return {}
-
-
-def _reaches(part, code):
-    try:
-        return set(part.uses) | scan.drawn_with(code, _read(part) + [n for n in part.scanned if n.isidentifier()])
-    except scan.Unreadable:
-        return set(part.uses)
-
-
 def _held_with(check, name, held):
-    step = {
-        "step": HELD_STEP,
-        "passed": False,
-        "detail": f"it is built on {name}, held for your instructor to look at: its code is mostly "
-        f"{held.get('source', '?')}'s",
-    }
+    detail = (
+        f"it is built on {name}, held for your instructor to look at: its code is mostly {held.get('source', '?')}'s"
+    )
     hint = (
         f"this part waits with {name}, which it is built on; write {name} in your own way to be paid without waiting."
     )
-    return {**check, "held": {**held, "through": name}, "steps": list(check.get("steps", [])) + [step], "hint": hint}
+    steps = list(check.get("steps", [])) + [{"step": HELD_STEP, "passed": False, "detail": detail}]
+    return {**check, "held": {**held, "through": name}, "steps": steps, "hint": hint}
 
 
 def run_from_a_string(check, findings):
-    """The part's check, failed: a graded name may have been defined by code run from a string
-    (:func:`labkit.grading.submission.scan.run_strings` `findings`), which the grader cannot read."""
+    """The part's check, failed: a graded name may have been defined by code run from a string (`findings`)."""
     name, _, why = findings[0]
     return _refused_with(check, name, why, step="its code can be read")
 

@@ -1,11 +1,8 @@
 """Code every student has on disk (labkit's, scipy's, the solutions' if they leak), recognised in a graded part.
 
-The scan and the sandbox refuse *calls* of that code; this module recognises *copies* of it however they
-are renamed or reordered, so that a part built on one is held for a person instead of paid
-(:func:`labkit.grading.submission.scoring.judge_known`). The engine is
-:mod:`labkit.grading.submission.fingerprint`, syntax trees normalised first; the corpus is every function
-and method of the known sources, fingerprinted once per file and cached under its SHA-256 (:func:`corpus`).
-"""
+The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*,
+so that a part built on one is held for a person instead of paid (:func:`.scoring.judge_known`). The corpus,
+every known function and method fingerprinted (syntax trees normalised first), is cached per file."""
 
 from __future__ import annotations
 
@@ -16,6 +13,7 @@ import hashlib
 import json
 import os
 import tempfile
+from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,32 +22,26 @@ import numpy as np
 from . import fingerprint
 from .fingerprint import canonical, normalise
 
-# measured on copies, on independent solutions and on honest variants written for the purpose
-# (docs/grading-security.md): honest work shares at most 46 fingerprints; the copies tried, 98 or more
+# measured on copies, independent solutions and honest variants (docs/grading-security.md):
+# honest work shares at most 46 fingerprints; the copies tried, 98 or more
 THRESHOLD = 0.5
 MIN_SHARED = 70
 SHOWN = 12  # shared lines shown side by side
 VERSION = "labkit-known/5"  # the cache's format and normalisation: a change here recomputes every fingerprint
 
 
-@dataclass(frozen=True)
-class Unit:
-    """One definition of a known source: a function, or a method of a class."""
-
-    name: str  # as the feedback names it: labkit.piecewise.eval_pherm, scipy.interpolate._cubic.pchip...
-    path: str  # its file
-    first: int  # its lines in the file (1-based, inclusive)
-    last: int
-    text: str | None = None  # a notebook's definition itself (a module's is read from its file when shown)
+# a known function or method: its name as the feedback names it (labkit.piecewise.eval_pherm), its file, its
+# lines (1-based), and a notebook's text (a module's is read from its file when shown)
+Unit = namedtuple("Unit", "name path first last text", defaults=[None])
 
 
 @dataclass(frozen=True)
 class Corpus:
-    """The fingerprints of the known sources, and the unit each one comes from."""
+    """The fingerprints of the known sources: sorted hashes, one entry per (hash, unit), and each one's unit."""
 
-    units: tuple  # Unit
-    hashes: np.ndarray  # sorted fingerprint hashes, one entry per (hash, unit)
-    unit_of: np.ndarray  # the unit of each entry
+    units: tuple
+    hashes: np.ndarray
+    unit_of: np.ndarray
     digest: str  # what the corpus was made of (its files' SHA-256), for the run's record
 
     def holders(self, hashes):
@@ -59,36 +51,30 @@ class Corpus:
         return np.repeat(left - np.cumsum(np.r_[0, counts[:-1]]), counts) + np.arange(counts.sum())
 
 
-def cache_folder():
-    """Where the known sources' fingerprints are kept between runs: ``$LABKIT_CACHE`` or the user's cache."""
-    base = os.environ.get("LABKIT_CACHE") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "labkit"
-    )
-    return Path(base) / "known"
-
-
-def _definitions(tree, prefix):
-    """(name, first line, last line) of each top-level function and each method of a top-level class."""
+def _definitions(text, prefix, source=None):
+    """[name, first line, last line, text] of each function and class method of `text` (or bytes `source`)."""
+    try:
+        tree = ast.parse(text if source is None else source)
+    except (SyntaxError, ValueError):
+        return []  # it cannot run either: it defines nothing
+    lines, found = text.split("\n"), []
     for node in tree.body:
         for inner in node.body if isinstance(node, ast.ClassDef) else [node]:
             if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 first = min([inner.lineno] + [d.lineno for d in inner.decorator_list])
                 name = inner.name if inner is node else f"{node.name}.{inner.name}"
-                yield f"{prefix}{name}", first, inner.end_lineno
-
-
-@functools.cache
-def _tokeniser():
-    from importlib.metadata import version
-
-    return f"{VERSION} pygments {version('pygments')}"
+                last = inner.end_lineno
+                found.append([f"{prefix}{name}", first, last, "\n".join(lines[first - 1 : last])])
+    return found
 
 
 def _cached(name, raw, compute):
-    """`compute()` (JSON data), kept in the cache folder under the SHA-256 of `raw`, its `name`,
-    :data:`VERSION` and the tokeniser's version (pygments')."""
-    key = hashlib.sha256(f"{_tokeniser()}\0{name}\0".encode() + raw).hexdigest()
-    folder = cache_folder()
+    """``(compute(), key)``: JSON data cached under `key`, the SHA-256 of `raw`, `name` and the versions."""
+    import pygments
+
+    key = hashlib.sha256(f"{VERSION} pygments {pygments.__version__}\0{name}\0".encode() + raw).hexdigest()
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    folder = Path(os.environ.get("LABKIT_CACHE") or os.path.join(cache, "labkit")) / "known"
     path = folder / f"{key}.json"
     try:
         return json.loads(path.read_text(encoding="utf-8")), key
@@ -114,64 +100,40 @@ def _entry(units, texts):
 
 
 def _module_entry(module, path):
-    """The units and fingerprints of one Python source file, cached."""
+    """The units (their text left out) and fingerprints of one Python source file, cached."""
     raw = Path(path).read_bytes()
 
     def compute():
-        try:
-            tree = ast.parse(raw)
-        except (SyntaxError, ValueError):
-            return _entry([], [])
-        lines = raw.decode("utf-8", "replace").split("\n")
-        found = [list(unit) for unit in _definitions(tree, f"{module}.")]
-        return _entry(found, ["\n".join(lines[a - 1 : b]) for _, a, b in found])
+        found = _definitions(raw.decode("utf-8", "replace"), f"{module}.", raw)
+        return _entry([unit[:3] for unit in found], [unit[3] for unit in found])
 
     return _cached(module, raw, compute)
 
 
 def _notebook_entry(name, cells):
-    """The units and fingerprints of one instructor notebook's code cells, cached."""
+    """The units and fingerprints of one instructor notebook's code cells, as the grader reads them, cached."""
 
     def compute():
         from .scan import python_source
 
-        units = []
-        for cell in cells:
-            text = python_source(cell)  # as the grader reads a notebook: magics and shell lines left out
-            try:
-                tree = ast.parse(text or "")
-            except (SyntaxError, ValueError):
-                continue  # IPython could not run it either: it defines nothing
-            lines = text.split("\n")
-            units += [[unit, a, b, "\n".join(lines[a - 1 : b])] for unit, a, b in _definitions(tree, f"{name}: ")]
+        units = [unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")]
         return _entry(units, [unit[3] for unit in units])
 
     return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), compute)
 
 
-def known_modules(refusals):
-    """(module, file) of every Python source a student has that the lab's answers are in: labkit's library
-    (its grader left out: it holds no answer) and the Python modules the refusals switch off."""
-    from .refusals import _module_files
-
-    prefixes = ["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]
-    found = {}
-    for prefix in dict.fromkeys(prefixes):
-        for module, path in _module_files(prefix):
-            if not module.startswith("labkit.grading"):
-                found.setdefault(str(path), module)
-    return sorted((module, path) for path, module in found.items())
-
-
 @functools.lru_cache(maxsize=4)
 def corpus(refusals=(), solutions=()):
-    """The known sources' fingerprints: labkit's library and the refused modules' Python sources, and the
-    definitions of the instructor notebooks' code cells.
+    """The :class:`Corpus` of labkit's library (but its grader: no answer there), the modules `refusals` refuse,
+    and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.solutions` gives them."""
+    from .refusals import _module_files
 
-    `refusals` are :class:`labkit.exercises.model.Refusal` objects; `solutions` is a tuple of (notebook
-    name, tuple of its code cells), the instructor notebooks as the grader reads them
-    (:func:`labkit.grading.submission.scoring.solutions`)."""
-    entries = [(str(path), _module_entry(module, path)) for module, path in known_modules(refusals)]
+    modules = {}  # file: module
+    for prefix in dict.fromkeys(["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]):
+        for module, path in _module_files(prefix):
+            if not module.startswith("labkit.grading"):
+                modules.setdefault(str(path), module)
+    entries = [(path, _module_entry(module, path)) for module, path in sorted((m, p) for p, m in modules.items())]
     entries += [(name, _notebook_entry(name, cells)) for name, cells in solutions]
     units, hashes, unit_of = [], [np.zeros(0, dtype=np.uint64)], [np.zeros(0, dtype=np.int64)]
     for path, (data, _) in entries:
@@ -185,22 +147,22 @@ def corpus(refusals=(), solutions=()):
 
 @dataclass(frozen=True)
 class Match:
-    """A definition of the notebook that is, for the most part, a known source's code."""
+    """A `definition` of the notebook that is mostly known code: `shared` fingerprints, `share` (0..1) of its
+    own, are known, most from `source`; `lines` are (student's, known) lines; `public`: not the solutions."""
 
-    definition: str  # the notebook's name that holds it (the graded function or a helper it reaches)
-    source: str  # the known unit it shares most with, e.g. "labkit.piecewise.eval_pherm"
-    share: float  # 0..1: the part of the part's own fingerprints that known units have
-    shared: int  # how many fingerprints they share
-    lines: tuple  # (the student's line, the known source's line) pairs of shared code, at most SHOWN
-    public: bool = True  # whether the source is on every student's disk (labkit, scipy), not the solutions
+    definition: str
+    source: str
+    share: float
+    shared: int
+    lines: tuple
+    public: bool = True
 
     def as_dict(self):
         return dataclasses.asdict(self)
 
 
 class Given:
-    """Every fingerprint-sized hash of the release's code cells: what every student was given (one per run:
-    :func:`match` caches by it)."""
+    """The release's code cells' hashes (:func:`.fingerprint.release_grams`), cached by identity, one per run."""
 
     def __init__(self, cells):
         self.array = fingerprint.release_grams(cells)
@@ -210,15 +172,10 @@ release_grams = Given
 
 
 def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
-    """The :class:`Match` of a part's code, when known sources have `threshold` or more of it; else None.
-
-    The part's code is `definitions`, [(name, source)] of a graded function and what it reaches. Each unit
-    of it (:func:`~labkit.grading.submission.fingerprint.units`) is set against the one known unit of
-    `known` (:func:`corpus`) that has most of its own fingerprints (those the release, `given`, does not
-    give everyone, each counted once). It matches when those units have `threshold` of all its own
-    fingerprints (0: whatever the share) and at least `minimum`: the lab's formulas make short code come
-    out alike from everyone, so only a long shared stretch is evidence.
-    """
+    """The :class:`Match` of `definitions` ([(name, source)] of a graded function and what it reaches), or None.
+    Each unit (:func:`.fingerprint.units`) is set against the unit of `known` that has most of its own
+    fingerprints (not `given`). It matches when those have `threshold` of its own fingerprints and at least
+    `minimum`: the lab's formulas make short code alike in everyone, so only a long shared stretch is evidence."""
     total, judged = 0, []
     for name, text in fingerprint.units(definitions):
         where, hashes, positions = _read(text, given)
@@ -239,22 +196,18 @@ def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
 
 @functools.lru_cache(maxsize=256)
 def _read(text, given):
-    """:func:`labkit.grading.submission.fingerprint.own` of a definition (`given` is hashed by identity)."""
     return fingerprint.own(text, given.array)
 
 
-def _unit_text(unit):
-    if unit.text is not None:
-        return unit.text
-    lines = Path(unit.path).read_text(encoding="utf-8", errors="replace").split("\n")
-    return "\n".join(lines[unit.first - 1 : unit.last])
-
-
 def _side_by_side(text, numbers, unit):
-    """Up to :data:`SHOWN` pairs of shared lines (`numbers` of `text`'s): the student's, and the known unit's
-    line most like it."""
+    """Up to :data:`SHOWN` pairs (student's line `numbers` of `text`, the next known line of the same shape)."""
     try:
-        theirs = _unit_text(unit).split("\n")
+        if unit.text is None:
+            theirs = (
+                Path(unit.path).read_text(encoding="utf-8", errors="replace").split("\n")[unit.first - 1 : unit.last]
+            )
+        else:
+            theirs = unit.text.split("\n")
     except (OSError, IndexError, ValueError):
         theirs = [""]
     mine, their_normal = text.split("\n"), [normalise(line)[0] for line in theirs]
@@ -264,7 +217,6 @@ def _side_by_side(text, numbers, unit):
         normal = normalise(line)[0]
         if not normal:
             continue
-        # the known line of the same shape, the first after the last one paired (copies keep their order)
         order = list(range(after, len(their_normal))) + list(range(after))
         found = next((i for i in order if their_normal[i] == normal), None)
         if found is not None:
