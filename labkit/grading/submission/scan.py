@@ -1,28 +1,14 @@
 """Reading a notebook's source for refused references, on the grader's side (``ast``; nothing is run).
 
-For a graded name, :func:`scan` follows what its last definition in the
-notebook reaches: the functions, classes and module-level variables of the
-notebook it names (``ref = labkit.eval_pherm``, ``eval_pherm = ...``,
-``class H(CubicHermiteSpline)``), through import aliases, and reports
+For a graded name, :func:`scan` follows what its last definition reaches in the notebook (its functions, classes
+and module-level variables, through import aliases) and reports every reference into a refused module or to a
+refused function under any name it has (``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``), and every way
+of reaching code a reader cannot follow (``__import__``, ``eval``, ``getattr`` with a computed name,
+``sys.modules``, a function's ``__globals__``, a module the notebook wrote itself, ...).
 
-* every reference into a refused module (``scipy.interpolate.X``,
-  ``labkit.splines._any_private_helper``) or to a refused function under any
-  name it has (``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``);
-* every way of reaching code that a reader cannot follow: ``__import__``,
-  ``importlib``, ``eval``/``exec``, ``getattr`` with a computed name,
-  ``globals()``, ``sys.modules``, ``gc``, ``ctypes``, a function's
-  ``__code__`` or ``__globals__``, a frame's locals, or a module the
-  notebook wrote itself.
-
-The scan is bounded: a notebook's code cells may hold at most
-:data:`MAX_CODE_BYTES`, and reading them may take at most
-:data:`TIME_BUDGET` seconds (:class:`Unreadable` otherwise). Cell magics
-that run Python (``%%time``, ``%%capture``) are read as Python; other cells
-that IPython would hand to another program are skipped.
-
-:func:`function_sources` reads the same cells for the text of the graded
-functions' definitions, which the grade keeps for the similarity search
-(:mod:`labkit.grading.reports.similarity`).
+The scan is bounded by :data:`MAX_CODE_BYTES` and :data:`TIME_BUDGET` (:class:`Unreadable` otherwise). Cell magics
+that run Python (``%%time``) are read as Python; cells IPython hands to another program are skipped.
+:func:`function_sources` reads the graded functions' text, which the grade keeps for the similarity search.
 """
 
 import ast
@@ -41,19 +27,9 @@ KNOWN = (
     | {"numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings", "bisect", "heapq", "copy"}
     | {"enum", "abc"}
 )
-DYNAMIC_NAMES = {
-    "__import__": "__import__",
-    "eval": "eval",
-    "exec": "exec",
-    "compile": "compile",
-    "globals": "globals()",
-    "vars": "vars()",
-    "locals": "locals()",
-    "setattr": "setattr",
-    "delattr": "delattr",
-    "breakpoint": "breakpoint",
-    "get_ipython": "get_ipython() (the shell's own namespace)",
-}
+DYNAMIC_NAMES = {name: name for name in ("__import__", "eval", "exec", "compile", "setattr", "delattr", "breakpoint")}
+DYNAMIC_NAMES |= {"globals": "globals()", "vars": "vars()", "locals": "locals()"}
+DYNAMIC_NAMES["get_ipython"] = "get_ipython() (the shell's own namespace)"
 STRING_RUNNERS = {"exec", "eval", "compile"}
 DYNAMIC_ATTRIBUTES = (
     {"__code__", "__closure__", "__globals__", "__builtins__"}
@@ -190,7 +166,7 @@ def _runs_strings(node, definitions=None):
             found += [f"{what} (in {called.name})" for what in _runs_strings(ast.Module(called.body, []))]
     literal = set()
     for inner in ast.walk(node):
-        if isinstance(inner, ast.Call) and _named_call(inner, STRING_RUNNERS):
+        if isinstance(inner, ast.Call) and isinstance(inner.func, ast.Name) and inner.func.id in STRING_RUNNERS:
             if inner.args and isinstance(inner.args[0], ast.Constant) and isinstance(inner.args[0].value, str):
                 literal.add(id(inner.func))
     for inner in ast.walk(node):
@@ -199,15 +175,11 @@ def _runs_strings(node, definitions=None):
     return found
 
 
-def _named_call(node, names):
-    return isinstance(node.func, ast.Name) and node.func.id in names
-
-
 def run_strings(sources, names, deadline=None):
     """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec``/``eval``/``compile``
     of a built string may have defined: the name is bound nowhere the reader can see after that statement.
     Code that arrives in a string cannot be read, so it is never graded (as ``exec`` of labkit's file is not)."""
-    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    reader = _reader(sources, deadline)
     findings = []
     for name in names:
         bound = reader.when.get(name, (-1, 0)) if name in reader.definitions else (-1, 0)  # (cell, line)
@@ -235,7 +207,7 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
     ['f', 'h']
     """
     _bounded(sources)
-    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    reader = _reader(sources, deadline)
     found, seen = [], set()
     for name in names:
         for owner, node, _ in reader.reached(name, frozenset(stop)):
@@ -273,7 +245,7 @@ def drawn_with(sources, names, deadline=None):
     >>> sorted(drawn_with(cells, ["ax"]) & {"ax", "g", "h"})
     ['ax', 'h']
     """
-    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    reader = _reader(sources, deadline)
     wanted, found = set(names), set()
     starts = list(names)
     for node in reader.statements:
@@ -388,10 +360,6 @@ class _Refused:
             dotted = dotted.rpartition(".")[0]
         return None
 
-    def is_module(self, dotted):
-        """Whether `dotted` names a refused module itself (its uses are judged, not its import)."""
-        return dotted in self.submodules
-
 
 def _dynamic(node, aliases):
     """A way of reaching code that the scan cannot follow, written at `node`, or None."""
@@ -443,8 +411,7 @@ def scan(sources, names, profile, deadline=None):
     if profile is None:
         return []
     _bounded(sources)
-    deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
-    reader = _reader(tuple(sources), deadline)
+    reader = _reader(sources, deadline)
     refused = _Refused(profile)
     findings = set()
     for name in names:
@@ -457,7 +424,7 @@ def scan(sources, names, profile, deadline=None):
                     for alias_name, dotted in _imported(node):
                         local[alias_name] = dotted
                         # a refused module imported is judged by its uses (``pw.bracket`` is allowed)
-                        why = (None if refused.is_module(dotted) else refused.chain(dotted)) or (
+                        why = (None if dotted in refused.submodules else refused.chain(dotted)) or (
                             dotted.split(".")[0] if dotted.split(".")[0] in DYNAMIC_MODULES else None
                         )
                         if why:
@@ -488,40 +455,26 @@ def scan(sources, names, profile, deadline=None):
 _READERS: dict = {}
 
 
-def _reader(sources, deadline):
+def _reader(sources, deadline=None):
+    """The notebook's :class:`_Reader` (kept for the last notebook read), reading until `deadline` (monotonic),
+    :data:`TIME_BUDGET` from now when None."""
+    sources = tuple(sources)
+    deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
     found = _READERS.get(sources)
     if found is None:
-        _READERS.clear()  # one notebook at a time
+        _READERS.clear()
         found = _READERS[sources] = _Reader(sources, deadline)
     found.deadline = deadline
     return found
 
 
 def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
-    """The source text of the last top-level definition of each of `names` in a notebook's code cells.
+    """``{name: source}``, from its first decorator to its last line (at most `limit` characters, whole lines),
+    of the last top-level ``def`` of each of `names` in a notebook's code cells (parsed, never run).
 
-    The cells are parsed with :mod:`ast`, never run. A definition counts
-    where the cells, run in order, would leave it bound to its name: at the
-    top level of a cell (or inside a top-level ``if``, ``for``, ``while``,
-    ``with`` or ``try``); a later assignment or import of the name drops it
-    (the graded object is then not a function written here). A cell that
-    does not parse defines nothing, as when IPython runs it.
-
-    Parameters
-    ----------
-    sources : sequence of str
-        The notebook's code cells, in order.
-    names : iterable of str
-        The function names wanted.
-    limit : int, optional
-        Characters kept of one definition (whole lines while they fit).
-
-    Returns
-    -------
-    dict
-        ``{name: source}`` for each of `names` the cells define with ``def``;
-        a source runs from its first decorator to its last line. Nothing at
-        all when the cells hold more than :data:`MAX_CODE_BYTES`.
+    A definition counts where the cells, run in order, leave it bound (at a cell's top level or inside a
+    top-level compound statement); a later assignment or import of the name drops it, and a cell that does not
+    parse defines nothing. Nothing at all when the cells hold more than :data:`MAX_CODE_BYTES`.
 
     Examples
     --------

@@ -1,24 +1,14 @@
 """Grading one notebook and one submission, on the grader's (trusted) side.
 
-For each notebook: check its size and read it here (JSON only, nothing
-run), start the sandboxed worker, have it run the code cells, then run
-every exercise's checks here through proxies into the worker
-(:mod:`labkit.grading.sandbox.remote`), each part with its references switched off
-in the sandbox (:mod:`labkit.grading.sandbox.guard`) and named if the source
-reaches for them (:mod:`labkit.grading.submission.scan`). A part whose code is, for the
-most part, code the student has on disk (labkit's, scipy's, the solutions':
-:mod:`labkit.grading.submission.known`) is held for a person: its points wait until the
-rubric's ``[held]`` table releases them. Scores, hints and problems are all
-computed on this side.
+Each notebook is read here (JSON only, nothing run), its code cells run in a sandboxed worker, and every
+exercise's checks run here through proxies into it (:mod:`labkit.grading.sandbox.remote`), each part with its
+references switched off in the sandbox and named if the source reaches for them (:mod:`.scan`). A part whose code
+is mostly code the student has on disk (:mod:`.known`) is held for a person until the rubric's ``[held]`` table
+releases it. One time limit covers a submission's notebooks; an exercise counts from the first notebook (in name
+order) that defines its names.
 
-A submission has one time limit for all its notebooks together. An
-exercise counts from the first notebook (in name order) that defines its
-names; later notebooks are not checked for it.
-
-``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a
-process of its own and writes its result file: :mod:`labkit.grading.run.processes`
-starts one per submission, so whatever one submission does to the grader's
-memory or time costs only its own grade.
+``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a process of its own
+(:mod:`labkit.grading.run.processes` starts one each) and writes its result file.
 """
 
 import functools
@@ -51,11 +41,8 @@ MAX_ANSWER = 4_000  # characters of one answer in words kept for the instructor
 
 
 def read_cells(path, answers=None, registry=LAB):
-    """(code sources, markdown sources) of a notebook file; ValueError says why it is not one.
-
-    The size is checked before anything is read, and a link is never followed.
-    The student's answers in words (markdown cells with an answer's nbgrader
-    grade id) go into `answers`, {grade id: text}, when it is given."""
+    """(code sources, markdown sources) of a notebook file (size checked first, no link followed); ValueError
+    says why it is not one. Answers in words (markdown with an answer's grade id) go into `answers`, if given."""
     path = Path(path)
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode):
@@ -107,11 +94,8 @@ def exercises_in(markdown, registry=LAB):
 
 
 def submission_notebooks(path):
-    """The notebooks of a submission: one .ipynb file, or the .ipynb files in a folder.
-
-    No link is ever followed, at any level: a submission that is a link, a
-    linked folder or a linked notebook inside is refused or left out. The
-    walk is bounded in depth and in entries."""
+    """The notebooks of a submission: one .ipynb file, or the .ipynb files in a folder (walked to a bounded depth
+    and size; a link, at any level, is refused or left out)."""
     path = Path(path)
     try:
         info = os.lstat(path)
@@ -232,14 +216,18 @@ def _student_frames(traceback):
     return kept
 
 
-def _released_cells():
-    """The code cells of the packaged student release, each with its whitespace collapsed: a cell of a
-    submission among them is one the student never changed."""
-    if not hasattr(_released_cells, "value"):
-        from ...student_notebooks import paths
+@functools.cache
+def _release_code():
+    """The code cells of the packaged student release."""
+    from ...student_notebooks import paths
 
-        _released_cells.value = {" ".join(c.split()) for p in paths() for c in read_cells(Path(str(p)))[0]}
-    return _released_cells.value
+    return [cell for path in paths() for cell in read_cells(Path(str(path)))[0]]
+
+
+@functools.cache
+def _released_cells():
+    """The release's code cells, whitespace collapsed: a submission's cell among them was never changed."""
+    return {" ".join(cell.split()) for cell in _release_code()}
 
 
 def _untouched(error, code):
@@ -351,12 +339,9 @@ def registry_graded(registry):
     return registry_graded.value
 
 
+@functools.cache
 def _release_grams():
-    if not hasattr(_release_grams, "value"):
-        from ...student_notebooks import paths
-
-        _release_grams.value = known.release_grams([c for p in paths() for c in read_cells(Path(str(p)))[0]])
-    return _release_grams.value
+    return known.release_grams(_release_code())
 
 
 def _for_sandbox(profiles):
@@ -373,16 +358,11 @@ def graded_functions(exercise):
 def grade_notebook(
     path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None, variant=None
 ):
-    """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
+    """Run one notebook in the sandbox and check it: ({exercise: grade dict}, [problems]).
 
-    `options` (a :class:`GradeOptions`, the defaults when None) bound it;
-    `deadline` (monotonic) is the submission's; exercises in `skip` are not
-    checked here. The notebook's answers in words go into `answers`
-    ({grade id: text}) when it is given, and the source of each graded
-    function it defines (read with ``ast``, never run) into `sources`
-    ({function name: text}), unless an earlier notebook gave it. `variant`
-    ({exercise (text): {parameter: value}}) is the student's own data; a
-    notebook holding another's is named as a problem of its own."""
+    `deadline` (monotonic) is the submission's; exercises in `skip` are not checked. Answers in words go into
+    `answers` and the source of each graded function not yet there into `sources`, when given. `variant`
+    ({exercise (text): {parameter: value}}) is the student's own data; holding another's is a problem."""
     options = _options(options)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     registry = load_registry(options.exercises)
@@ -416,13 +396,16 @@ def grade_notebook(
         with timings.phase("sandbox start"):
             notebook = remote.NotebookHandle(options, deadline, _for_sandbox(profiles), registry.passable)
     except remote.NotebookTimeout:  # its sandbox was still starting when the submission's time ran out
-        text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
-        return {}, [ProblemText.one(text, TIMEOUT)]
+        return {}, [_stopped(name, options)]
     except remote.WorkerError as exc:
         return {}, [ProblemText.one(f"{name}: the sandbox could not start ({exc}).", OTHER)]
     with notebook:
         graded = _Graded(name, notebook, code, registry, profiles, options)
         return _grade_in(graded, numbers, variant)
+
+
+def _stopped(name, options):
+    return ProblemText.one(f"{name}: stopped after the submission's time limit of {options.total_timeout} s.", TIMEOUT)
 
 
 @dataclass(frozen=True)
@@ -446,8 +429,7 @@ def _grade_in(graded, numbers, variant):
                 {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
             )
     except remote.NotebookTimeout:
-        text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
-        return {}, [ProblemText.one(text, TIMEOUT)]
+        return {}, [_stopped(name, options)]
     except remote.CellTimeout as exc:
         return {}, [ProblemText.one(f"{name}: {exc}.", TIMEOUT)]
     except remote.WorkerError as exc:
@@ -544,9 +526,8 @@ def submission_name(path):
 def grade_submission(path, options=None, *, profiles=None, name=None):
     """Grade one submission (a notebook or a folder of them), scored with the options' rubric (else the lab's).
 
-    `options` (a :class:`GradeOptions`, the defaults when None) bound it. One
-    time limit covers every notebook of the submission. `name` is the submission's name in the run (its
-    folder's by default): with variants, its data are the options' for that name."""
+    `name` is the submission's name in the run (its folder's by default); with variants, its data are the
+    options' for that name."""
     options = _options(options)
     rubric = None
     if options.rubric is not None:
