@@ -1,35 +1,16 @@
 """Every draw checked before it is handed out: ``labkit variants --check N``.
 
-For N made-up students (and, with a roster, for the class itself) this
-derives each one's data from the course's variants file, puts it in the
-instructor notebooks' data cells, runs each notebook's code here and checks
-its varied exercises with that student's data:
+For N made-up students (and the roster's) each one's data go into the instructor notebooks' data cells, the
+notebooks run here and their varied exercises are checked on those data: the solution and each correct variation
+of a catalog (``CORRECT``) earn full marks; each slip (``MISTAKES``) costs exactly its part (and its ``also``) with
+its ``hint`` said; no notebook on its own data is named as holding another variant, while the solution on another
+student's data is, and loses its varied parts; no two students of the roster drew alike; and each exercise's
+``sound`` still holds (the data teach its lesson).
 
-* the instructor's solution earns full marks;
-* each correct variation of a catalog (``CORRECT``) earns full marks;
-* no notebook on its own data (the solution, a variation, a slip) is named
-  as holding another variant;
-* each slip of a catalog (``MISTAKES``) costs exactly its part (and the
-  parts its entry names in ``also``), and that part's feedback names it (its
-  entry's ``hint``);
-* the solution worked on another student's data is caught: its varied parts
-  fail, and the notebook is named as holding another variant;
-* no two students of the roster drew the same data of an exercise (a copy
-  between them could not be seen);
-* the data still teach the exercise's lesson (its ``sound`` says why not:
-  a spline that no longer overshoots, say).
-
-A catalog is a Python file of the instructor's (a course's ``tests/catalog.py``)
-with lists ``CORRECT`` and ``MISTAKES`` whose entries have ``name``,
-``notebook``, ``replace`` ((old, new) pairs of code, each old once in the
-notebook), ``exercise``, ``part``, ``hint``, ``also`` and ``full``. Only the
-entries of varied exercises are run.
-
-The code run is the instructor's own (the solutions and the catalog), so it
-runs in this process, with matplotlib drawing off screen: no student code is
-ever run here. Every draw where something is not as it should be is
-reported with its values: narrow the parameter's range (its
-:class:`~labkit.exercises.variants.Param`) until none is left.
+A catalog is the instructor's Python file (a course's ``tests/catalog.py``) with lists ``CORRECT`` and ``MISTAKES``
+of entries with ``name``, ``notebook``, ``replace`` ((old, new) code pairs), ``exercise``, ``part``, ``hint``,
+``also`` and ``full``. Only the instructor's code runs here (matplotlib off screen), never a student's. Each bad
+draw is reported with its values: narrow the parameter's range until none is left.
 """
 
 from __future__ import annotations
@@ -121,7 +102,7 @@ def _without_hidden_tests(source):
 def run_cells(nb, names):
     """The names a notebook defines once its code cells have run here, up to the last that mentions `names`.
 
-    A cell that raises is noted and the next one runs, as in the grader; hidden tests and magics are left out.
+    A cell that raises is passed over, as in the grader; hidden tests and magics are left out.
     """
     import matplotlib
 
@@ -141,16 +122,6 @@ def run_cells(nb, names):
             except Exception:  # noqa: BLE001 - a slip may raise; the checks say what it costs
                 pass
     return namespace
-
-
-def _keeps_rates(entry):
-    return bool(getattr(entry, "keep_rates", False))
-
-
-def _close_figures():
-    import matplotlib.pyplot as plt
-
-    plt.close("all")
 
 
 def _failed(verdict):
@@ -229,17 +200,19 @@ def _ties(variants, registry, roster):
 
 def _check_notebook(draw, original, notebook, exercises, correct, mistakes):
     """Run one instructor notebook on the draw's data: the solution and each catalog entry, then the copy check."""
+    import matplotlib.pyplot as plt
+
     numbers = {e.number for e in exercises}
     names = sorted({name for e in exercises for part in e.parts for name in (*e.names, *part.names())})
     # the catalog's students read their rates off their own tables, unless the entry keeps them as written
     entries = [("the solution", (), None, None, (), numbers, False)]
     entries += [
-        (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not _keeps_rates(e))
+        (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not getattr(e, "keep_rates", False))
         for e in correct
         if e.notebook == notebook and set(e.full) & numbers
     ]
     entries += [
-        (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not _keeps_rates(e))
+        (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not getattr(e, "keep_rates", False))
         for e in mistakes
         if e.notebook == notebook and e.exercise in numbers
     ]
@@ -249,14 +222,14 @@ def _check_notebook(draw, original, notebook, exercises, correct, mistakes):
         namespace = run_cells(with_values(planted, draw.values, notebook, draw.registry), names)
         for number in sorted(judged):
             _judge_entry(draw, namespace, number, label, part, (hint, also))
-        _close_figures()
+        plt.close("all")
     # the solution on another student's data: caught, and its varied parts lost
     if any(draw.other[e.number] != draw.values[e.number] for e in exercises):
         namespace = run_cells(with_values(original, draw.other, notebook, draw.registry), names)
         for exercise in exercises:
             if draw.other[exercise.number] != draw.values[exercise.number]:
                 _judge_copy(draw, namespace, exercise)
-        _close_figures()
+        plt.close("all")
 
 
 def _judge_entry(draw, namespace, number, label, part, expected):
