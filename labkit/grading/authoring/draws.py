@@ -1,19 +1,12 @@
 """Every draw checked before it is handed out: ``labkit variants --check N``.
 
-For N made-up students (and the roster's) each one's data go into the instructor notebooks' data cells, the
-notebooks run here and their varied exercises are checked on those data: the solution and each correct variation
-of a catalog (``CORRECT``) earn full marks; each slip (``MISTAKES``) costs exactly its part (and its ``also``) with
-its ``hint`` said; no notebook on its own data is named as holding another variant, while the solution on another
-student's data is, and loses its varied parts; no two students of the roster drew alike; and each exercise's
-``sound`` still holds (the data teach its lesson).
-
-A catalog is the instructor's Python file (a course's ``tests/catalog.py``) with lists ``CORRECT`` and ``MISTAKES``
-of entries with ``name``, ``notebook``, ``replace`` ((old, new) code pairs), ``exercise``, ``part``, ``hint``,
-``also`` and ``full``. Only the instructor's code runs here (matplotlib off screen), never a student's. Each bad
-draw is reported with its values: narrow the parameter's range until none is left.
+For N made-up students (and the roster's) the instructor notebooks run here (never a student's code) on each one's
+data: the solution and each correct variation of a catalog (``CORRECT``) earn full marks; each slip (``MISTAKES``)
+costs exactly its part (and its ``also``) with its ``hint`` said; only the solution on another student's data is
+named as holding another variant, and it loses its varied parts; no two students of the roster drew alike; each
+exercise's ``sound`` holds. A catalog (a course's ``tests/catalog.py``) lists entries with ``name``, ``notebook``,
+``replace`` ((old, new) code pairs), ``exercise``, ``part``, ``hint``, ``also`` and ``full``.
 """
-
-from __future__ import annotations
 
 import contextlib
 import importlib.util
@@ -72,9 +65,8 @@ def _planted(nb, replace, name):
 
 
 def reading_rates(nb, registry=LAB):
-    """Notebook `nb` (in place) with each experiment's rate answer, a whole number ``rate_... = 4``, read off the
-    student's own table instead, the way the printout is read (the mean of the last three log2 ratios, rounded):
-    a slip upstream changes the table, and a student who reads their own table answers what it shows."""
+    """Notebook `nb` (in place) with each experiment's whole-number rate answer (``rate_... = 4``) read off the
+    student's own table as the printout is read (the mean of the last three log2 ratios, rounded)."""
     for experiment in registry.experiments.values():
         reading = (
             f"{experiment.rate} = int(np.rint(np.mean(np.log2(np.asarray({experiment.table}[-4:-1]) "
@@ -107,7 +99,6 @@ def run_cells(nb, names):
     import matplotlib
 
     matplotlib.use("Agg", force=True)
-
     cells = [_without_hidden_tests(cell.source) for cell in nb.cells if cell.cell_type == "code"]
     last = max((i for i, source in enumerate(cells) if any(name in source for name in names)), default=-1)
     namespace = {"__name__": "__main__"}
@@ -124,23 +115,22 @@ def run_cells(nb, names):
     return namespace
 
 
+def _said(checks, part):
+    """The hint and step details `part`'s check gives."""
+    said = [
+        [c.get("hint") or ""] + [f"{s['step']}: {s['detail']}" for s in c["steps"]] for c in checks if c["name"] == part
+    ]
+    return " ".join(said[0]) if said else ""
+
+
 def _failed(verdict):
     return {check["name"] for check in verdict["checks"] if not check["passed"]}
 
 
-def _said(verdict, part):
-    for check in verdict["checks"]:
-        if check["name"] == part:
-            return " ".join([check.get("hint") or ""] + [f"{s['step']}: {s['detail']}" for s in check["steps"]])
-    return ""
-
-
 def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, seed=0, progress=None):
-    """Check `count` made-up students' draws (and the `roster`'s, {name: id}) of every varied exercise.
-
-    `variants` is a :class:`~labkit.exercises.variants.VariantsFile`, `solutions` the instructor notebooks'
-    folder, `catalog` a catalog file (or None). Returns the :class:`Trouble` found, an empty list when every
-    draw is as it should be. `progress` (a function of one text) hears of each draw."""
+    """The :class:`Trouble` found in `count` made-up students' draws (and the `roster`'s, {name: id}) of every
+    varied exercise of `variants`, run on the instructor notebooks of `solutions` and the `catalog` file's entries.
+    `progress` (a function of one text) hears of each draw."""
     if isinstance(count, bool) or not isinstance(count, int) or count < 1:
         raise InputError(f"--check needs a whole number of draws, at least 1; got {count!r}.")
     correct, mistakes = load_catalog(catalog) if catalog is not None else ((), ())
@@ -246,15 +236,15 @@ def _judge_entry(draw, namespace, number, label, part, expected):
         lost = {part} | {p for n, p in also if n == number}
         if failed != lost:
             draw.trouble(label, f"failed {sorted(failed)}, not {sorted(lost)}")
-        elif hint and hint not in _said(verdict, part):
+        elif hint and hint not in _said(verdict["checks"], part):
             draw.trouble(label, f"the feedback does not say {hint!r}")
 
 
 def _judge_copy(draw, namespace, exercise):
     """The solution run on another student's data: named as a copy, and its varied parts lost."""
     verdict = draw.registry.check(exercise.number, namespace, seed=draw.seed, variant=draw.values[exercise.number])
-    dependent = {part.name for part in exercise.parts if part.varied}
+    passing = {part.name for part in exercise.parts if part.varied} - _failed(verdict)
     if not verdict.get("other_variant"):
         draw.trouble("a copy", "another student's data is not named")
-    if not dependent <= _failed(verdict):
-        draw.trouble("a copy", f"{sorted(dependent - _failed(verdict))} pass on another's data")
+    if passing:
+        draw.trouble("a copy", f"{sorted(passing)} pass on another's data")

@@ -16,7 +16,6 @@ from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
 SCHEMA_VERSION = 3
 EXERCISE_OF_TESTS = re.compile(r"^# tests for exercise (\d+)\s*$", re.MULTILINE)
 
-
 # a self-check call: labkit.check.<name>(...) in the lab, or a course's own check_<name>(...); the first
 # argument, when quoted, is an experiment's key
 CHECK_CALL = re.compile(r"(?:\blabkit\.check\.|\bcheck_)(\w+)\(\s*(?:\"(\w+)\")?")
@@ -26,8 +25,7 @@ def test_points(source, where="a test cell", rubric=None):
     """(exercise, points) of a hidden-test cell: the weights of the parts its ``labkit.check.f(...)`` (or
     ``check_f(...)``) calls check (of the experiment the first argument names), scaled to `rubric`'s points."""
     rubric = rubric or rubrics.default()
-    registry = rubric.registry
-    found = EXERCISE_OF_TESTS.search(source)
+    registry, found = rubric.registry, EXERCISE_OF_TESTS.search(source)
     if not found or int(found.group(1)) not in registry.exercises:
         raise InputError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
     number = int(found.group(1))
@@ -65,8 +63,8 @@ def answer_ids(nb):
 
 def mark(nb, name="notebook", rubric=None):
     """Give every cell of an instructor notebook nbgrader's metadata (in place); returns `nb`."""
-    counters = {}
-    answers = iter(answer_ids(nb))
+    counters, answers = {}, iter(answer_ids(nb))
+    stem = re.sub(r"[^a-zA-Z0-9_-]+", "-", name.rsplit(".", 1)[0])
 
     def grade_id(kind):
         counters[kind] = counters.get(kind, 0) + 1
@@ -77,15 +75,11 @@ def mark(nb, name="notebook", rubric=None):
         if cell.cell_type == "markdown" and BEGIN_SOLUTION in cell.source:
             meta.update(solution=True, grade=True, locked=False, points=0, grade_id=next(answers))
         elif cell.cell_type == "code" and BEGIN_SOLUTION in cell.source:
-            meta.update(solution=True, locked=False, grade_id=grade_id(f"{_stem(name)}-solution"))
+            meta.update(solution=True, locked=False, grade_id=grade_id(f"{stem}-solution"))
         elif cell.cell_type == "code" and BEGIN_HIDDEN in cell.source:
             number, points = test_points(cell.source, f"{name}, cell {index}", rubric)
             meta.update(grade=True, points=points, grade_id=grade_id(f"exercise{number}-tests"))
         else:
-            meta["grade_id"] = grade_id(f"{_stem(name)}-locked")
+            meta["grade_id"] = grade_id(f"{stem}-locked")
         cell.metadata["nbgrader"] = meta
     return nb
-
-
-def _stem(name):
-    return re.sub(r"[^a-zA-Z0-9_-]+", "-", name.rsplit(".", 1)[0])
