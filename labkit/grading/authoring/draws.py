@@ -82,20 +82,16 @@ def _without_hidden_tests(source):
     kept, hidden = [], False
     for line in source.split("\n"):
         marker = line.strip()
-        if marker == BEGIN_HIDDEN:
-            hidden = True
-        elif marker == END_HIDDEN:
-            hidden = False
+        if marker in (BEGIN_HIDDEN, END_HIDDEN):
+            hidden = marker == BEGIN_HIDDEN
         elif not hidden and not marker.startswith("%"):
             kept.append(line)
     return "\n".join(kept)
 
 
 def run_cells(nb, names):
-    """The names a notebook defines once its code cells have run here, up to the last that mentions `names`.
-
-    A cell that raises is passed over, as in the grader; hidden tests and magics are left out.
-    """
+    """The names a notebook defines once its code cells (hidden tests and magics left out) have run here, up to the
+    last that mentions `names`; a cell that raises is passed over, as in the grader."""
     import matplotlib
 
     matplotlib.use("Agg", force=True)
@@ -214,11 +210,11 @@ def _check_notebook(draw, original, notebook, exercises, correct, mistakes):
             _judge_entry(draw, namespace, number, label, part, (hint, also))
         plt.close("all")
     # the solution on another student's data: caught, and its varied parts lost
-    if any(draw.other[e.number] != draw.values[e.number] for e in exercises):
+    copied = [e for e in exercises if draw.other[e.number] != draw.values[e.number]]
+    if copied:
         namespace = run_cells(with_values(original, draw.other, notebook, draw.registry), names)
-        for exercise in exercises:
-            if draw.other[exercise.number] != draw.values[exercise.number]:
-                _judge_copy(draw, namespace, exercise)
+        for exercise in copied:
+            _judge_copy(draw, namespace, exercise)
         plt.close("all")
 
 

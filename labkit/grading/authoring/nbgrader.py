@@ -16,8 +16,7 @@ from .release import BEGIN_HIDDEN, BEGIN_SOLUTION, END_HIDDEN
 SCHEMA_VERSION = 3
 EXERCISE_OF_TESTS = re.compile(r"^# tests for exercise (\d+)\s*$", re.MULTILINE)
 
-# a self-check call: labkit.check.<name>(...) in the lab, or a course's own check_<name>(...); the first
-# argument, when quoted, is an experiment's key
+# a self-check call, labkit.check.<name>(...) or a course's check_<name>(...); a quoted first argument is an experiment
 CHECK_CALL = re.compile(r"(?:\blabkit\.check\.|\bcheck_)(\w+)\(\s*(?:\"(\w+)\")?")
 
 
@@ -37,21 +36,16 @@ def test_points(source, where="a test cell", rubric=None):
     }
     weights = sum(part.weight for part in exercise.parts if part.name in checked)
     if not weights:
-        raise InputError(
-            f"{where} tests exercise {number} but checks none of its parts "
-            f"({', '.join(p.name for p in exercise.parts)})."
-        )
-    scale = rubric.points.get(number, exercise.points) / exercise.points if exercise.points else 0
-    points = weights * scale
+        parts = ", ".join(p.name for p in exercise.parts)
+        raise InputError(f"{where} tests exercise {number} but checks none of its parts ({parts}).")
+    points = weights * (rubric.points.get(number, exercise.points) / exercise.points if exercise.points else 0)
     return number, int(points) if points == int(points) else round(points, 2)
 
 
 def answer_ids(nb):
     """The grade ids of a notebook's answers in words, in order: ``exerciseN-answer-K``."""
     ids, exercise, counters = [], None, {}
-    for cell in nb.cells:
-        if cell.cell_type != "markdown":
-            continue
+    for cell in (cell for cell in nb.cells if cell.cell_type == "markdown"):
         found = sections(cell.source)
         if found:
             exercise = found[-1]

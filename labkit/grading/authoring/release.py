@@ -33,9 +33,8 @@ def strip_solutions(source, where="cell", stub=STUB):
             if region:
                 raise InputError(f"{where}, line {number}: {marker!r} inside an open {region!r} region.")
             region = marker
-            if marker == BEGIN_SOLUTION:
-                indent = line[: len(line) - len(line.lstrip())]
-                out.extend(indent + line for line in stub)
+            if marker == BEGIN_SOLUTION:  # the stub, indented as the marker
+                out.extend(line[: len(line) - len(line.lstrip())] + stub_line for stub_line in stub)
         elif marker in (END_SOLUTION, END_HIDDEN):
             expected = BEGIN_SOLUTION if marker == END_SOLUTION else BEGIN_HIDDEN
             if region != expected:
@@ -75,12 +74,9 @@ def tag_raising(nb, folder, name="notebook", timeout=300):
 
 
 def with_values(nb, values, name="notebook", registry=LAB):
-    """Notebook `nb` (a new object) with its data cells holding `values` ({exercise: {parameter: value}}).
-
-    In the code cells tagged ``variant-data``, each parameter's plain ``name = number`` assignment and each
-    derived value's one-line ``name = ...`` (``Exercise.derived``) get the value as the notebook shows it; all
-    else stays. A missing assignment is refused (ValueError), so no student gets the lab's data by mistake.
-    """
+    """Notebook `nb` (a new object) whose ``variant-data`` cells' one-line assignments of its exercises' parameters
+    (a plain number) and derived values hold `values` ({exercise: {parameter: value}}) as the notebook shows them;
+    a missing assignment is refused (ValueError), so no student gets the lab's data by mistake."""
     copy = copy_notebook(nb)
     wanted, params = _assignments(values, name, registry)
     done = set()
@@ -104,8 +100,7 @@ def copy_notebook(nb):
 
 
 def _assignments(values, name, registry):
-    """({name: the text its assignment gets}, the names among them that are parameters: assigned a plain number)
-    for the exercises of notebook `name`."""
+    """({name: the text its assignment gets}, the parameters among them) for the exercises of notebook `name`."""
     wanted, params = {}, set()
     for number, given in values.items():
         exercise = registry.exercises.get(int(number))
@@ -130,19 +125,17 @@ def _assign(cell, where, wanted, params):
     lines, breaks = pieces[0::2], pieces[1::2]
     edits, done = [], set()
     for node in tree.body:
-        if (
-            isinstance(node, ast.Assign)
-            and len(node.targets) == 1
-            and isinstance(node.targets[0], ast.Name)
-            and node.targets[0].id in wanted
-        ):
-            target, value = node.targets[0].id, node.value
-            if value.lineno != value.end_lineno:
-                raise InputError(f"{where}: {target} must be assigned on one line.")
-            if target in params and not _number(value):
-                raise InputError(f"{where}: {target} must be assigned a number, as `{target} = 1.15`.")
-            edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
-            done.add(target)
+        if not (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)):
+            continue
+        target, value = node.targets[0].id, node.value
+        if target not in wanted:
+            continue
+        if value.lineno != value.end_lineno:
+            raise InputError(f"{where}: {target} must be assigned on one line.")
+        if target in params and not _number(value):
+            raise InputError(f"{where}: {target} must be assigned a number, as `{target} = 1.15`.")
+        edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
+        done.add(target)
     for line, start, end, text in sorted(edits, reverse=True):
         row = lines[line].encode("utf-8")  # ast's offsets count bytes
         lines[line] = (row[:start] + text.encode("utf-8") + row[end:]).decode("utf-8")
