@@ -12,7 +12,9 @@ that run Python (``%%time``) are read as Python; cells IPython hands to another 
 """
 
 import ast
+import importlib.util
 import re
+import sys
 import time
 
 from ..store.text import MAX_SOURCE_CHARS
@@ -112,20 +114,14 @@ class _Reader:
             for local, dotted in _imported(node):
                 self.aliases[local] = dotted
                 self.definitions.pop(local, None)
-        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-            self.definitions[node.name] = node
-            self.aliases.pop(node.name, None)
-        elif isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
-            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
-            for target in targets:
-                for name in ast.walk(target):
-                    if isinstance(name, ast.Name):
-                        self.definitions[name.id] = node
-                        self.aliases.pop(name.id, None)
         elif isinstance(node, (ast.If, ast.For, ast.While, ast.With, ast.Try)):
             for child in ast.iter_child_nodes(node):
                 if isinstance(child, ast.stmt):
                     self._record(child)
+        else:
+            for name in _bound_names(node):
+                self.definitions[name] = node
+                self.aliases.pop(name, None)
 
     def reached(self, name, stop=frozenset()):
         """(definition name, definition node, its local names) of everything the definition of `name` reaches
@@ -164,13 +160,12 @@ def _runs_strings(node, definitions=None):
         called = definitions.get(inner.func.id) if by_name else None
         if isinstance(called, (ast.FunctionDef, ast.AsyncFunctionDef)):
             found += [f"{what} (in {called.name})" for what in _runs_strings(ast.Module(called.body, []))]
-    literal = set()
+    literal = set()  # the runners called on a literal string; ast.walk meets a call before its function's name
     for inner in ast.walk(node):
-        if isinstance(inner, ast.Call) and isinstance(inner.func, ast.Name) and inner.func.id in STRING_RUNNERS:
-            if inner.args and isinstance(inner.args[0], ast.Constant) and isinstance(inner.args[0].value, str):
+        if isinstance(inner, ast.Call) and inner.args and isinstance(inner.args[0], ast.Constant):
+            if isinstance(inner.args[0].value, str):
                 literal.add(id(inner.func))
-    for inner in ast.walk(node):
-        if isinstance(inner, ast.Name) and inner.id in STRING_RUNNERS and id(inner) not in literal:
+        elif isinstance(inner, ast.Name) and inner.id in STRING_RUNNERS and id(inner) not in literal:
             found.append(inner.id)
     return found
 
@@ -390,9 +385,6 @@ def _dynamic(node, aliases):
 
 def _installed(top):
     """Whether a top-level module is the standard library's or installed here (found, never imported)."""
-    import importlib.util
-    import sys
-
     if top in sys.stdlib_module_names:
         return True
     try:
@@ -543,10 +535,10 @@ def _top_level(body):
 
 
 def _bound_names(node):
-    """The names a top-level statement other than a function definition binds."""
+    """The names a top-level statement binds."""
     if isinstance(node, (ast.Import, ast.ImportFrom)):
         return [local for local, _ in _imported(node)]
-    if isinstance(node, ast.ClassDef):
+    if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
         return [node.name]
     if isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
         targets = node.targets if isinstance(node, ast.Assign) else [node.target]

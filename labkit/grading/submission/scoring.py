@@ -135,26 +135,25 @@ def submission_notebooks(path):
 
 
 def _failed_part(check, name, step, detail, hint, kind=None):
-    """The part's check, failed at one step (of `kind`, :data:`labkit.exercises.result.KINDS`, unless a slip)."""
-    return {
-        "name": name,
-        "passed": False,
-        "hint": hint,
-        "weight": check.get("weight", 0),
-        "steps": [{"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}],
-    }
+    """The part's check, failed at one step."""
+    base = {"name": name, "passed": False, "hint": hint, "weight": check.get("weight", 0)}
+    return _with_step(base, _step(step, detail, kind), hint)
+
+
+def _step(step, detail, kind=None):
+    """A failed step of a check (of `kind`, :data:`labkit.exercises.result.KINDS`, unless a slip)."""
+    return {"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}
+
+
+def _with_step(check, step, hint, **more):
+    """`check` (updated with `more`) with one more `step` and `hint`."""
+    return {**check, **more, "steps": [*check.get("steps", []), step], "hint": hint}
 
 
 def _voided(part, tampered):
     """The check of a part of a notebook that tampered with the grader's watch: none of its answers count."""
-    return _failed_part(
-        {"weight": part.weight},
-        part.name,
-        "the notebook's answers can be trusted",
-        tampered,
-        "remove what the message names and hand it in again.",
-        TAMPERED,
-    )
+    step, hint = "the notebook's answers can be trusted", "remove what the message names and hand it in again."
+    return _failed_part({"weight": part.weight}, part.name, step, tampered, hint, TAMPERED)
 
 
 def _own_code(check, findings):
@@ -162,33 +161,22 @@ def _own_code(check, findings):
     details = "; ".join(
         f"{function} (line {line} of its definition) reaches for {name}" for function, line, name in findings[:8]
     )
-    return {
-        **check,
-        "passed": False,
-        "steps": list(check.get("steps", []))
-        + [{"step": "calls no reference implementation", "passed": False, "detail": details, "kind": REFUSED}],
-        "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names "
-        "stay available.",
-    }
+    step = _step("calls no reference implementation", details, REFUSED)
+    hint = "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names stay available."
+    return _with_step(check, step, hint, passed=False)
 
 
 def _held(check, found):
     """The part's check, held for a person: it passed, but its code is mostly a known source's."""
-    return {
-        **check,
-        "held": found.as_dict(),
-        "steps": list(check.get("steps", []))
-        + [
-            {
-                "step": HELD_STEP,
-                "passed": False,
-                "detail": f"{found.share:.0%} of the code of {found.definition} (names aside) is the same as "
-                f"{found.source}'s; held for your instructor to look at",
-            }
-        ],
-        "hint": "this part's points wait until your instructor has compared your code with the one it "
-        "resembles (shown below); write the exercise in your own way to be paid without waiting.",
-    }
+    detail = (
+        f"{found.share:.0%} of the code of {found.definition} (names aside) is the same as {found.source}'s; "
+        "held for your instructor to look at"
+    )
+    hint = (
+        "this part's points wait until your instructor has compared your code with the one it resembles (shown "
+        "below); write the exercise in your own way to be paid without waiting."
+    )
+    return _with_step(check, _step(HELD_STEP, detail), hint, held=found.as_dict())
 
 
 def _rescore(verdict, registry):
