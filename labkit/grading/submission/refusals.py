@@ -13,6 +13,7 @@ import __future__
 
 import ast
 import codeop
+import contextlib
 import functools
 import importlib
 import importlib.util
@@ -131,10 +132,8 @@ def spellings(refusal):
     """({spelling: the refused object's own name}, [spellings of allowed objects]) in labkit, scipy and numpy."""
     for prefix in refusal.modules:
         if prefix.split(".")[0] in LIBRARIES:
-            try:
+            with contextlib.suppress(ImportError):
                 importlib.import_module(prefix)
-            except ImportError:
-                pass
     libraries = [
         (name, module)
         for name, module in list(sys.modules.items())

@@ -261,11 +261,8 @@ def _locals(node):
     for inner in ast.walk(node):
         if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
             arguments = inner.args
-            for arg in (
-                arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg, arguments.kwarg]
-            ):
-                if arg is not None:
-                    bound.add(arg.arg)
+            every = arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg, arguments.kwarg]
+            bound.update(arg.arg for arg in every if arg is not None)
             if inner is not node and not isinstance(inner, ast.Lambda):
                 bound.add(inner.name)
         elif isinstance(inner, ast.Name) and isinstance(inner.ctx, (ast.Store, ast.Del)):
@@ -307,14 +304,21 @@ def _dotted(node, aliases):
 def _constant_getattr(node):
     """Whether `node` is ``getattr(value, "name")`` (or with a default): an attribute written as a string."""
     return (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id == "getattr"
-        and len(node.args) in (2, 3)
+        _getattr_call(node)
+        and len(node.args) <= 3
         and not node.keywords
         and isinstance(node.args[1], ast.Constant)
         and isinstance(node.args[1].value, str)
         and node.args[1].value.isidentifier()
+    )
+
+
+def _getattr_call(node):
+    return (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id == "getattr"
+        and len(node.args) >= 2
     )
 
 
@@ -331,17 +335,6 @@ class _Refused:
         self.allowed = set(profile["allowed"])
         self.submodules = set(profile.get("submodules", ()))  # the refused modules themselves, as loaded
 
-    def reason(self, dotted):
-        """Why `dotted` (a name as the notebook writes it, aliases resolved) is refused, or None."""
-        if dotted in self.allowed:
-            return None
-        if dotted in self.spellings:
-            own = self.spellings[dotted]
-            return dotted if own == dotted else f"{own} (as {dotted})"
-        if _within(dotted, self.modules):
-            return dotted
-        return None
-
     def chain(self, dotted):
         """Why a whole attribute chain is refused, or None: its longest refused prefix, unless a longer
         prefix is an allowed helper (``labkit.piecewise.bracket`` is allowed however ``labkit.piecewise`` is
@@ -349,9 +342,11 @@ class _Refused:
         while dotted:
             if dotted in self.allowed:
                 return None
-            what = self.reason(dotted)
-            if what:
-                return what
+            if dotted in self.spellings:
+                own = self.spellings[dotted]
+                return dotted if own == dotted else f"{own} (as {dotted})"
+            if _within(dotted, self.modules):
+                return dotted
             dotted = dotted.rpartition(".")[0]
         return None
 
@@ -362,13 +357,7 @@ def _dynamic(node, aliases):
         return DYNAMIC_NAMES[node.id]
     if isinstance(node, ast.Attribute) and node.attr in DYNAMIC_ATTRIBUTES:
         return node.attr
-    if (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id == "getattr"
-        and len(node.args) >= 2
-        and not isinstance(node.args[1], ast.Constant)
-    ):
+    if _getattr_call(node) and not isinstance(node.args[1], ast.Constant):
         return "getattr with a computed name"
     if isinstance(node, (ast.Name, ast.Attribute)):
         dotted = _dotted(node, aliases)
