@@ -137,14 +137,9 @@ class _Reader:
             found.append((current, node, local))
             for inner in ast.walk(node):
                 self._tick()
-                if (
-                    isinstance(inner, ast.Name)
-                    and isinstance(inner.ctx, ast.Load)
-                    and inner.id in self.definitions
-                    and inner.id not in seen
-                    and inner.id not in local
-                ):
-                    todo.append(inner.id)
+                if isinstance(inner, ast.Name) and isinstance(inner.ctx, ast.Load) and inner.id in self.definitions:
+                    if inner.id not in seen and inner.id not in local:
+                        todo.append(inner.id)
         return found
 
 
@@ -241,8 +236,7 @@ def drawn_with(sources, names, deadline=None):
     ['ax', 'h']
     """
     reader = _reader(sources, deadline)
-    wanted, found = set(names), set()
-    starts = list(names)
+    wanted, found, starts = set(names), set(), list(names)
     for node in reader.statements:
         loaded = {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
         if loaded & wanted:
@@ -383,12 +377,9 @@ def _installed(top):
 
 
 def scan(sources, names, profile, deadline=None):
-    """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a
-    reference that `profile` switches off, or reach for code in a way the scan cannot follow.
-
-    `profile` is one refusal as :func:`labkit.grading.submission.refusals.wire` gives it (modules, spellings,
-    allowed). Raises :class:`Unreadable` when the code is over :data:`MAX_CODE_BYTES` or reading it
-    takes longer than :data:`TIME_BUDGET` seconds."""
+    """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a reference
+    that `profile` (one refusal, as :func:`.refusals.wire` gives it) switches off, or reach for code in a way the
+    scan cannot follow. Raises :class:`Unreadable` past :data:`MAX_CODE_BYTES` or :data:`TIME_BUDGET`."""
     if profile is None:
         return []
     _bounded(sources)

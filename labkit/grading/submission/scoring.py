@@ -28,6 +28,7 @@ from ...exercises.result import CRASH, NOT_DONE, OTHER, RAISED, REFUSED, TAMPERE
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..sandbox import backends, remote, timings
+from ..store import rubric as rubrics
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from . import holding, known, refusals, scan
 
@@ -53,8 +54,7 @@ def read_cells(path, answers=None, registry=LAB):
             f"{MAX_NOTEBOOK_BYTES // 1024**2} MB a lab notebook needs (clear its outputs and hand it in "
             "again); it was not graded."
         )
-    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
-    with os.fdopen(fd, "rb") as handle:
+    with os.fdopen(os.open(path, os.O_RDONLY | os.O_NOFOLLOW), "rb") as handle:
         raw = handle.read(MAX_NOTEBOOK_BYTES + 1)
     if len(raw) > MAX_NOTEBOOK_BYTES:
         raise InputError(f"{path.name} is more than {MAX_NOTEBOOK_BYTES // 1024**2} MB; it was not graded.")
@@ -182,9 +182,8 @@ def _held(check, found):
 def _rescore(verdict, registry):
     exercise = registry.exercises[verdict["exercise"]]
     points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"] and not check.get("held"))
-    verdict.update(
-        points=points, passed=points == exercise.points, fraction=points / exercise.points if exercise.points else 1.0
-    )
+    fraction = points / exercise.points if exercise.points else 1.0
+    verdict.update(points=points, passed=points == exercise.points, fraction=fraction)
     return verdict
 
 
@@ -517,19 +516,13 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
     `name` is the submission's name in the run (its folder's by default); with variants, its data are the
     options' for that name."""
     options = _options(options)
-    rubric = None
-    if options.rubric is not None:
-        from ..store.rubric import load
-
-        rubric = load(options.rubric)
+    rubric = rubrics.load(options.rubric) if options.rubric is not None else None
     deadline = time.monotonic() + options.total_timeout
     grade = SubmissionGrade(submission_name(path) if name is None else str(name), seed=options.seed)
-    variant = None
-    if options.variants is not None:
-        variant = options.variants.get(grade.name)
-        if variant is None:
-            grade.failure = "no variant in this run's roster: add the submission to the roster and grade again."
-            return grade
+    variant = options.variants.get(grade.name) if options.variants is not None else None
+    if options.variants is not None and variant is None:
+        grade.failure = "no variant in this run's roster: add the submission to the roster and grade again."
+        return grade
     if rubric is not None:
         grade.rubric = rubric
     try:
@@ -537,19 +530,11 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
     except ValueError as exc:
         grade.problems.append(ProblemText.one(str(exc), OTHER))
         return grade
+    shared = {"deadline": deadline, "profiles": profiles, "answers": grade.answers, "sources": grade.sources}
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.get("defined")}
         with timings.phase("notebooks"):
-            results, problems = grade_notebook(
-                notebook,
-                options=options,
-                deadline=deadline,
-                skip=claimed,
-                profiles=profiles,
-                answers=grade.answers,
-                sources=grade.sources,
-                variant=variant,
-            )
+            results, problems = grade_notebook(notebook, options, skip=claimed, variant=variant, **shared)
         grade.problems.extend(problems)
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)
