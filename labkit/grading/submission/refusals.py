@@ -1,12 +1,9 @@
-"""What a graded function may not reach, as the sandbox's watch recognises it (the grader's side).
+"""What a graded function may not reach (a part's :class:`labkit.exercises.model.Refusal`), as the grader sees it.
 
-A part's :class:`labkit.exercises.model.Refusal` (whole modules, single functions, and the functions the lab lets
-students reuse) becomes what :mod:`labkit.grading.sandbox.guard` needs: a digest (``guard.code_key``) of every
-Python function of those modules, compiled here from the library's own files so nothing a notebook does to the
-live modules changes what is recognised; the module prefixes, whose compiled routines are refused by name; and
-single compiled functions ``(module, name)``. For the source scan (:mod:`.scan`) it lists every dotted spelling
-under which labkit, scipy and numpy export a refused or an allowed object. :func:`wire` computes it all once per
-grading run.
+For the sandbox's watch (:mod:`labkit.grading.sandbox.guard`): the digest of every Python function of the refused
+modules, compiled here from the library's files so nothing a notebook does to the live modules changes it, the
+module prefixes and the single compiled functions. For the source scan (:mod:`.scan`): every dotted spelling of a
+refused or an allowed object in labkit, scipy and numpy. :func:`wire` computes it all once per grading run.
 """
 
 import __future__
@@ -119,11 +116,9 @@ def _resolve(dotted):
         except (ImportError, ValueError, TypeError):
             continue
         try:
-            for attribute in parts[split:]:
-                value = getattr(value, attribute)
+            return functools.reduce(getattr, parts[split:], value)
         except AttributeError:
             return None
-        return value
     return None
 
 

@@ -284,12 +284,8 @@ def _dotted(node, aliases):
     """The dotted name an attribute chain spells, aliases resolved (``getattr(m, "name")`` is ``m.name``)."""
     parts = []
     while isinstance(node, ast.Attribute) or _constant_getattr(node):
-        if isinstance(node, ast.Attribute):
-            parts.append(node.attr)
-            node = node.value
-        else:
-            parts.append(node.args[1].value)
-            node = node.args[0]
+        part, node = (node.attr, node.value) if isinstance(node, ast.Attribute) else (node.args[1].value, node.args[0])
+        parts.append(part)
     if not isinstance(node, ast.Name) or node.id not in aliases:
         return None
     return ".".join([aliases[node.id]] + parts[::-1])

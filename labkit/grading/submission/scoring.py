@@ -223,9 +223,7 @@ def _untouched(error, code):
     if error.get("kind") == "NotImplementedError":
         return True
     cell = error.get("cell")
-    if not isinstance(cell, int) or not 0 <= cell < len(code):
-        return False
-    return " ".join(code[cell].split()) in _released_cells()
+    return isinstance(cell, int) and 0 <= cell < len(code) and " ".join(code[cell].split()) in _released_cells()
 
 
 def _run_problems(name, ran, code=()):
