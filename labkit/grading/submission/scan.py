@@ -1,14 +1,10 @@
 """Reading a notebook's source for refused references, on the grader's side (``ast``; nothing is run).
 
-For a graded name, :func:`scan` follows what its last definition reaches in the notebook (its functions, classes
-and module-level variables, through import aliases) and reports every reference into a refused module or to a
-refused function under any name it has (``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``), and every way
-of reaching code a reader cannot follow (``__import__``, ``eval``, ``getattr`` with a computed name,
-``sys.modules``, a function's ``__globals__``, a module the notebook wrote itself, ...).
-
-The scan is bounded by :data:`MAX_CODE_BYTES` and :data:`TIME_BUDGET` (:class:`Unreadable` otherwise). Cell magics
-that run Python (``%%time``) are read as Python; cells IPython hands to another program are skipped.
-:func:`function_sources` reads the graded functions' text, which the grade keeps for the similarity search.
+For a graded name, :func:`scan` follows what its last definition reaches in the notebook (through import aliases)
+and reports every reference into a refused module or to a refused function under any name it has, and every way of
+reaching code a reader cannot follow (``eval``, ``getattr`` with a computed name, ``sys.modules``, ...), within
+:data:`MAX_CODE_BYTES` and :data:`TIME_BUDGET`. Cell magics that run Python (``%%time``) are read as Python; cells
+IPython hands to another program are skipped. :func:`function_sources` reads the graded functions' text.
 """
 
 import ast
@@ -24,30 +20,21 @@ TIME_BUDGET = 20.0  # seconds to read one notebook's code
 
 PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
 # modules a graded function may reach without the scan asking what they are
-KNOWN = (
-    {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator", "collections"}
-    | {"numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings", "bisect", "heapq", "copy"}
-    | {"enum", "abc"}
-)
+KNOWN = {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator", "abc"}
+KNOWN |= {"collections", "numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings", "enum"}
+KNOWN |= {"bisect", "heapq", "copy"}
 DYNAMIC_NAMES = {name: name for name in ("__import__", "eval", "exec", "compile", "setattr", "delattr", "breakpoint")}
 DYNAMIC_NAMES |= {"globals": "globals()", "vars": "vars()", "locals": "locals()"}
 DYNAMIC_NAMES["get_ipython"] = "get_ipython() (the shell's own namespace)"
 STRING_RUNNERS = {"exec", "eval", "compile"}
-DYNAMIC_ATTRIBUTES = (
-    {"__code__", "__closure__", "__globals__", "__builtins__"}
-    | {"__dict__", "__subclasses__", "__func__", "__wrapped__"}
-    | {"f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame"}
-)
-DYNAMIC_MODULES = (
-    {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill"}
-    | {"builtins", "imp", "pkgutil", "runpy", "code", "codeop"}
-    | {"threading", "_thread", "multiprocessing", "subprocess", "signal"}
-)
-DYNAMIC_DOTTED = (
-    {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace", "sys.gettrace"}
-    | {"sys._current_frames", "types.FunctionType", "types.CodeType"}
-    | {"os.system", "os.fork", "os.popen", "os.exec", "os.spawn"}
-)
+DYNAMIC_ATTRIBUTES = {"__code__", "__closure__", "__globals__", "__builtins__", "__dict__", "__subclasses__"}
+DYNAMIC_ATTRIBUTES |= {"__func__", "__wrapped__", "f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame"}
+DYNAMIC_MODULES = {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill", "builtins", "imp"}
+DYNAMIC_MODULES |= {"pkgutil", "runpy", "code", "codeop", "threading", "_thread", "multiprocessing", "subprocess"}
+DYNAMIC_MODULES.add("signal")
+DYNAMIC_DOTTED = {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace", "sys.gettrace"}
+DYNAMIC_DOTTED |= {"sys._current_frames", "types.FunctionType", "types.CodeType", "os.system", "os.fork"}
+DYNAMIC_DOTTED |= {"os.popen", "os.exec", "os.spawn"}
 
 
 class Unreadable(ValueError):
