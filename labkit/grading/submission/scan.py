@@ -64,24 +64,21 @@ class _Reader:
     """The notebook's top-level definitions and import aliases, and the walk from a graded name."""
 
     def __init__(self, sources, deadline):
-        self.deadline = deadline
-        self.trees, self.texts, self.cells = [], {}, []
+        self.deadline, self.trees, self.texts, self.aliases, self.definitions = deadline, [], {}, {}, {}
+        self.when, self.strings = {}, []  # where each name was last bound; where a string is run as code
+        self.statements = []  # the top-level statements that are not definitions (plots are drawn there)
         for cell, source in enumerate(sources):
             text = python_source(source)
             if text is None:
                 continue
             self._tick()
             try:
-                self.trees.append(ast.parse(text))
+                tree = ast.parse(text)
             except (SyntaxError, ValueError, RecursionError, MemoryError):
                 continue  # IPython could not run it either: it defines nothing
-            self.cells.append(cell)
-            for node in _top_level(self.trees[-1].body):
+            self.trees.append(tree)  # kept alive: `texts` is keyed by its nodes' ids
+            for node in _top_level(tree.body):
                 self.texts[id(node)] = text
-        self.aliases, self.definitions = {}, {}
-        self.when, self.strings = {}, []  # where each name was last bound; where a string is run as code
-        self.statements = []  # the top-level statements that are not definitions (plots are drawn there)
-        for cell, tree in zip(self.cells, self.trees):
             for node in tree.body:
                 before = {name: id(found) for name, found in self.definitions.items()}
                 self._record(node)
