@@ -108,8 +108,7 @@ class _Reader:
                 self.aliases.pop(name, None)
 
     def reached(self, name, stop=frozenset()):
-        """(definition name, definition node, its local names) of everything the definition of `name` reaches
-        (not through the names in `stop`)."""
+        """(name, node, its local names) of every definition `name`'s reaches (not through those in `stop`)."""
         seen, todo, found = set(), [name], []
         while todo:
             current = todo.pop()
@@ -169,10 +168,8 @@ def run_strings(sources, names, deadline=None):
 
 
 def reached_sources(sources, names, deadline=None, stop=frozenset()):
-    """``[(name, source text)]`` of every definition in a notebook's code cells that the graded `names` reach
-    (the names themselves first), as :func:`scan` follows them, not through the names in `stop`; nothing is run.
-
-    Raises :class:`Unreadable` as :func:`scan` does.
+    """``[(name, source text)]`` of every definition the graded `names` reach (themselves first) as :func:`scan`
+    follows them, not through the names in `stop`; :class:`Unreadable` as :func:`scan` raises it.
 
     Examples
     --------
@@ -310,9 +307,8 @@ class _Refused:
         self.submodules = set(profile.get("submodules", ()))  # the refused modules themselves, as loaded
 
     def chain(self, dotted):
-        """Why a whole attribute chain is refused, or None: its longest refused prefix, unless a longer
-        prefix is an allowed helper (``labkit.piecewise.bracket`` is allowed however ``labkit.piecewise`` is
-        reached)."""
+        """Why a whole attribute chain is refused (its longest refused prefix), or None: also when a longer prefix
+        is an allowed helper (``labkit.piecewise.bracket``, however ``labkit.piecewise`` is reached)."""
         while dotted:
             if dotted in self.allowed:
                 return None
@@ -408,8 +404,7 @@ _READERS: dict = {}
 
 
 def _reader(sources, deadline=None):
-    """The notebook's :class:`_Reader` (kept for the last notebook read), reading until `deadline` (monotonic),
-    :data:`TIME_BUDGET` from now when None."""
+    """The notebook's :class:`_Reader` (the last one kept), reading until `deadline` (default: the budget)."""
     sources = tuple(sources)
     deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
     found = _READERS.get(sources)
@@ -459,9 +454,8 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
 
 
 def reached_function_sources(sources, names, graded=(), limit=MAX_SOURCE_CHARS):
-    """:func:`function_sources` of `names`, each followed by the definitions it reaches in the notebook (its
-    helpers, as :func:`reached_sources` follows them; other `graded` names are left to their own entries), so
-    that code moved into a helper is compared where the graded function uses it.
+    """:func:`function_sources` of `names`, each followed by the helpers it reaches (other `graded` names aside), so
+    code moved into a helper is compared where the graded function uses it.
 
     Examples
     --------

@@ -94,8 +94,7 @@ def exercises_in(markdown, registry=LAB):
 
 
 def submission_notebooks(path):
-    """The notebooks of a submission: one .ipynb file, or the .ipynb files in a folder (walked to a bounded depth
-    and size; a link, at any level, is refused or left out)."""
+    """A submission's notebooks: one .ipynb file, or the folder's (a bounded walk; links refused or left out)."""
     path = Path(path)
     try:
         info = os.lstat(path)
@@ -188,8 +187,7 @@ def _rescore(verdict, registry):
 
 
 def _student_frames(traceback):
-    """The lines of a traceback that are about the student's code: the header and the frames of the
-    interpreter's own machinery (IPython's ``run_code``, libraries) are left out, the error line kept."""
+    """The lines of a traceback about the student's code (not its header, nor IPython's or libraries' frames)."""
     kept, skipping = [], False
     for line in traceback.splitlines():
         if line.startswith("Traceback (most recent call last)"):
@@ -218,8 +216,7 @@ def _released_cells():
 
 
 def _untouched(error, code):
-    """Whether a cell that raised is work not done: it still raises NotImplementedError, or it is a cell of the
-    release the student never changed (its error comes from a stub above it, or from a branch not chosen)."""
+    """Whether a cell that raised is work not done: a stub's NotImplementedError, or a release cell left as is."""
     if error.get("kind") == "NotImplementedError":
         return True
     cell = error.get("cell")
@@ -284,14 +281,12 @@ def _solutions(stamps):
 
 
 def known_sources(registry, folder=None):
-    """The known sources a graded part's code is compared with (:func:`labkit.grading.submission.known.corpus`):
-    labkit's, the refused modules' and, with `folder`, the instructor notebooks'."""
+    """The known code a part's is compared with: labkit's, the refused modules' and `folder`'s notebooks'."""
     return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
 
 
 def judge_known(check, part, code, registry, options):
-    """A part's check, held for a person when it passed and its code is mostly known code
-    (:func:`labkit.grading.submission.known.match`); else as it was. `code` is the notebook's code cells."""
+    """A part's check, held for a person when it passed and its code (`code`: the cells) is mostly known code."""
     if not check["passed"] or part.refused is None:
         return check
     try:
@@ -310,8 +305,7 @@ def _judge_reached(check, reached, registry, options):
 
 
 def judge_plain(check, part, code, registry, options):
-    """A part without a refusal (a plot, a table of values), held when the code that draws it is mostly known
-    code (:func:`labkit.grading.submission.holding.judge_plain`)."""
+    """A part without a refusal (a plot, a table), held when the code that draws it is mostly known code."""
     judge = lambda check, reached: _judge_reached(check, reached, registry, options)
     return holding.judge_plain(check, part, code, registry_graded(registry), judge)
 
@@ -334,8 +328,7 @@ def _for_sandbox(profiles):
 
 
 def graded_functions(exercise):
-    """The names of an exercise whose source the grade keeps, if the notebook defines them with ``def``:
-    its names and the names its parts scan, in order."""
+    """The names whose ``def`` source the grade keeps: the exercise's and those its parts scan, in order."""
     names = list(exercise.names) + [name for part in exercise.parts for name in part.scanned]
     return [name for name in dict.fromkeys(names) if name.isidentifier()]
 
@@ -438,8 +431,7 @@ def _grade_in(graded, numbers, variant):
 
 
 def _check_exercise(graded, number, variant, problems):
-    """Exercise `number`'s grade dict (voided when the notebook tampered); a notebook that holds another
-    variant's data (`variant`: the student's own) is named in `problems`."""
+    """Exercise `number`'s grade dict; holding data other than `variant` (the student's) is named in `problems`."""
     notebook, registry = graded.notebook, graded.registry
     exercise = registry.exercises[number]
     if notebook.tampered:
@@ -509,10 +501,8 @@ def submission_name(path):
 
 
 def grade_submission(path, options=None, *, profiles=None, name=None):
-    """Grade one submission (a notebook or a folder of them), scored with the options' rubric (else the lab's).
-
-    `name` is the submission's name in the run (its folder's by default); with variants, its data are the
-    options' for that name."""
+    """Grade one submission (a notebook or a folder of them) with the options' rubric (else the lab's); `name` (its
+    folder's by default) picks its variant's data."""
     options = _options(options)
     rubric = rubrics.load(options.rubric) if options.rubric is not None else None
     deadline = time.monotonic() + options.total_timeout
@@ -543,8 +533,7 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
 
 
 def main(argv=None):
-    """Grade the submission a spec file describes; write its result file (started by
-    :mod:`labkit.grading.run.processes`)."""
+    """Grade the submission a spec file describes and write its result file (:mod:`labkit.grading.run.processes`)."""
     argv = sys.argv[1:] if argv is None else argv
     spec = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     profiles = json.loads(Path(spec["profiles"]).read_text(encoding="utf-8"))
