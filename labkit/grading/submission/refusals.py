@@ -52,9 +52,8 @@ CELL_FLAGS = codeop.PyCF_DONT_IMPLY_DEDENT | getattr(codeop, "PyCF_ALLOW_INCOMPL
 
 @functools.cache
 def _compiled_codes(path):
-    """Every code object of one source file, compiled whole (as imported) and each top-level statement on its own
-    with a cell's flags, with and without the file's ``__future__`` features (as IPython compiles a cell): the
-    bytecode differs (``np.diff(x)`` is a global and an attribute load in a file, a method load in a cell)."""
+    """Every code object of a source file compiled whole (as imported) and statement by statement as IPython
+    compiles a cell (its flags, with and without the file's futures), whose bytecode differs (``np.diff(x)``)."""
     source = Path(path).read_bytes()
     whole = compile(source, str(path), "exec", dont_inherit=True)
     found = list(codes_in(whole))

@@ -127,9 +127,8 @@ class _Reader:
 
 
 def _runs_strings(node, definitions=None):
-    """How a top-level statement runs code handed to it as a string it builds (``exec(zlib.decompress(...))``):
-    ``exec``, ``eval`` or ``compile`` of anything but a literal string, itself or in a function of the
-    notebook (`definitions`) that it calls."""
+    """How a top-level statement, or a function of the notebook (`definitions`) it calls, runs a string it builds
+    as code: ``exec``, ``eval`` or ``compile`` of anything but a literal (``exec(zlib.decompress(...))``)."""
     if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
         return []
     found = []
@@ -149,9 +148,8 @@ def _runs_strings(node, definitions=None):
 
 
 def run_strings(sources, names, deadline=None):
-    """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec``/``eval``/``compile``
-    of a built string may have defined: the name is bound nowhere the reader can see after that statement.
-    Code that arrives in a string cannot be read, so it is never graded (as ``exec`` of labkit's file is not)."""
+    """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec`` of a built string may have
+    defined (no readable binding after it): code that arrives in a string cannot be read, so it is never graded."""
     reader = _reader(sources, deadline)
     findings = []
     for name in names:
@@ -185,9 +183,8 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
             if id(node) in seen or id(node) not in reader.texts:
                 continue
             seen.add(id(node))
-            text = reader.texts[id(node)]
             first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
-            lines = text.split("\n")[first - 1 : node.end_lineno]
+            lines = reader.texts[id(node)].split("\n")[first - 1 : node.end_lineno]
             found.append((owner, "\n".join(lines)))  # whole: a long comment must not push the code out
     return found
 
@@ -207,8 +204,7 @@ def code_bytes(sources):
 
 
 def drawn_with(sources, names, deadline=None):
-    """The names of the notebook's definitions that `names` reach, and that the top-level statements
-    mentioning `names` reach (``ax4.plot(t, my_eval(...))`` draws ``ax4`` with ``my_eval``); nothing is run.
+    """The definitions `names` reach, and those the statements mentioning them reach (``ax.plot(my_eval(t))``).
 
     Examples
     --------
@@ -360,8 +356,7 @@ def scan(sources, names, profile, deadline=None):
         return []
     _bounded(sources)
     reader = _reader(sources, deadline)
-    refused = _Refused(profile)
-    findings = set()
+    refused, findings = _Refused(profile), set()
     for name in names:
         for owner, definition, own_names in reader.reached(name):
             local = {k: v for k, v in reader.aliases.items() if k not in own_names}
@@ -419,9 +414,8 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
     """``{name: source}``, from its first decorator to its last line (at most `limit` characters, whole lines),
     of the last top-level ``def`` of each of `names` in a notebook's code cells (parsed, never run).
 
-    A definition counts where the cells, run in order, leave it bound (at a cell's top level or inside a
-    top-level compound statement); a later assignment or import of the name drops it, and a cell that does not
-    parse defines nothing. Nothing at all when the cells hold more than :data:`MAX_CODE_BYTES`.
+    A definition counts where the cells, run in order, leave it bound (a later assignment or import drops it; a
+    cell that does not parse defines nothing). Nothing at all past :data:`MAX_CODE_BYTES`.
 
     Examples
     --------

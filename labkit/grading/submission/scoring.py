@@ -42,8 +42,8 @@ MAX_ANSWER = 4_000  # characters of one answer in words kept for the instructor
 
 
 def read_cells(path, answers=None, registry=LAB):
-    """(code sources, markdown sources) of a notebook file (size checked first, no link followed); ValueError
-    says why it is not one. Answers in words (markdown with an answer's grade id) go into `answers`, if given."""
+    """(code, markdown) cell sources of a notebook file, or a ValueError saying why it is not one (size checked
+    first, no link followed). Answers in words (markdown with an answer's grade id) go into `answers`, if given."""
     path = Path(path)
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode):
@@ -261,8 +261,7 @@ def _profiles(registry):
 
 
 def solutions(folder):
-    """The instructor notebooks of `folder` as :func:`labkit.grading.submission.known.corpus` takes them: a tuple of
-    (notebook name, tuple of its code cells); ValueError when the folder holds none."""
+    """`folder`'s instructor notebooks, ((name, code cells), ...) as :func:`.known.corpus` takes them, or ValueError."""
     folder = Path(folder)
     notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
     if not notebooks:
@@ -336,11 +335,9 @@ def graded_functions(exercise):
 def grade_notebook(
     path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None, variant=None
 ):
-    """Run one notebook in the sandbox and check it: ({exercise: grade dict}, [problems]).
-
-    `deadline` (monotonic) is the submission's; exercises in `skip` are not checked. Answers in words go into
-    `answers` and the source of each graded function not yet there into `sources`, when given. `variant`
-    ({exercise (text): {parameter: value}}) is the student's own data; holding another's is a problem."""
+    """Run one notebook in the sandbox and check it: ({exercise: grade dict}, [problems]). `deadline` (monotonic)
+    is the submission's; exercises in `skip` are not checked. Answers in words go into `answers` and the source of
+    each graded function not yet there into `sources`, when given; `variant` is the student's own data."""
     options = _options(options)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     registry = load_registry(options.exercises)
@@ -401,11 +398,10 @@ class _Graded:
 def _grade_in(graded, numbers, variant):
     """Run the notebook's cells in its sandbox, then check exercises `numbers`: (results, problems)."""
     name, notebook, code, options = graded.name, graded.notebook, graded.code, graded.options
+    run = {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}
     try:
         with timings.phase("cells"):
-            ran = notebook.request(
-                {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
-            )
+            ran = notebook.request(run, options.total_timeout)
     except remote.NotebookTimeout:
         return {}, [_stopped(name, options)]
     except remote.CellTimeout as exc:
@@ -432,8 +428,7 @@ def _grade_in(graded, numbers, variant):
 
 def _check_exercise(graded, number, variant, problems):
     """Exercise `number`'s grade dict; holding data other than `variant` (the student's) is named in `problems`."""
-    notebook, registry = graded.notebook, graded.registry
-    exercise = registry.exercises[number]
+    notebook, registry, exercise = graded.notebook, graded.registry, graded.registry.exercises[number]
     if notebook.tampered:
         checks = [_voided(part, notebook.tampered) for part in exercise.parts]
         return _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
@@ -457,8 +452,7 @@ def _check_exercise(graded, number, variant, problems):
 
 
 def _judge_code(verdict, exercise, code, profiles, registry, options):
-    """Each part of `verdict`: failed for a refused reference in its code or a name code run from a string may
-    define, held when its code is known (plain parts: when they reach known code)."""
+    """Each part's check in `verdict`, failed for a refused reference or a string run as code, held for known code."""
     for index, part in enumerate(exercise.parts):
         check = verdict["checks"][index]
         if part.refused is None:
