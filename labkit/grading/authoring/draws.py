@@ -1,38 +1,12 @@
 """Every draw checked before it is handed out: ``labkit variants --check N``.
 
-For N made-up students (and, with a roster, for the class itself) this
-derives each one's data from the course's variants file, puts it in the
-instructor notebooks' data cells, runs each notebook's code here and checks
-its varied exercises with that student's data:
-
-* the instructor's solution earns full marks;
-* each correct variation of a catalog (``CORRECT``) earns full marks;
-* no notebook on its own data (the solution, a variation, a slip) is named
-  as holding another variant;
-* each slip of a catalog (``MISTAKES``) costs exactly its part (and the
-  parts its entry names in ``also``), and that part's feedback names it (its
-  entry's ``hint``);
-* the solution worked on another student's data is caught: its varied parts
-  fail, and the notebook is named as holding another variant;
-* no two students of the roster drew the same data of an exercise (a copy
-  between them could not be seen);
-* the data still teach the exercise's lesson (its ``sound`` says why not:
-  a spline that no longer overshoots, say).
-
-A catalog is a Python file of the instructor's (a course's ``tests/catalog.py``)
-with lists ``CORRECT`` and ``MISTAKES`` whose entries have ``name``,
-``notebook``, ``replace`` ((old, new) pairs of code, each old once in the
-notebook), ``exercise``, ``part``, ``hint``, ``also`` and ``full``. Only the
-entries of varied exercises are run.
-
-The code run is the instructor's own (the solutions and the catalog), so it
-runs in this process, with matplotlib drawing off screen: no student code is
-ever run here. Every draw where something is not as it should be is
-reported with its values: narrow the parameter's range (its
-:class:`~labkit.exercises.variants.Param`) until none is left.
+For N made-up students (and the roster's) the instructor notebooks run here (never a student's code) on each one's
+data: the solution and each correct variation of a catalog (``CORRECT``) earn full marks; each slip (``MISTAKES``)
+costs exactly its part (and its ``also``) with its ``hint`` said; only the solution on another student's data is
+named as holding another variant, and it loses its varied parts; no two students of the roster drew alike; each
+exercise's ``sound`` holds. A catalog (a course's ``tests/catalog.py``) lists entries with ``name``, ``notebook``,
+``replace`` ((old, new) code pairs), ``exercise``, ``part``, ``hint``, ``also`` and ``full``.
 """
-
-from __future__ import annotations
 
 import contextlib
 import importlib.util
@@ -91,9 +65,8 @@ def _planted(nb, replace, name):
 
 
 def reading_rates(nb, registry=LAB):
-    """Notebook `nb` (in place) with each experiment's rate answer, a whole number ``rate_... = 4``, read off the
-    student's own table instead, the way the printout is read (the mean of the last three log2 ratios, rounded):
-    a slip upstream changes the table, and a student who reads their own table answers what it shows."""
+    """Notebook `nb` (in place) with each experiment's whole-number rate answer (``rate_... = 4``) read off the
+    student's own table as the printout is read (the mean of the last three log2 ratios, rounded)."""
     for experiment in registry.experiments.values():
         reading = (
             f"{experiment.rate} = int(np.rint(np.mean(np.log2(np.asarray({experiment.table}[-4:-1]) "
@@ -109,24 +82,19 @@ def _without_hidden_tests(source):
     kept, hidden = [], False
     for line in source.split("\n"):
         marker = line.strip()
-        if marker == BEGIN_HIDDEN:
-            hidden = True
-        elif marker == END_HIDDEN:
-            hidden = False
+        if marker in (BEGIN_HIDDEN, END_HIDDEN):
+            hidden = marker == BEGIN_HIDDEN
         elif not hidden and not marker.startswith("%"):
             kept.append(line)
     return "\n".join(kept)
 
 
 def run_cells(nb, names):
-    """The names a notebook defines once its code cells have run here, up to the last that mentions `names`.
-
-    A cell that raises is noted and the next one runs, as in the grader; hidden tests and magics are left out.
-    """
+    """The names a notebook defines once its code cells (hidden tests and magics left out) have run here, up to the
+    last that mentions `names`; a cell that raises is passed over, as in the grader."""
     import matplotlib
 
     matplotlib.use("Agg", force=True)
-
     cells = [_without_hidden_tests(cell.source) for cell in nb.cells if cell.cell_type == "code"]
     last = max((i for i, source in enumerate(cells) if any(name in source for name in names)), default=-1)
     namespace = {"__name__": "__main__"}
@@ -143,33 +111,22 @@ def run_cells(nb, names):
     return namespace
 
 
-def _keeps_rates(entry):
-    return bool(getattr(entry, "keep_rates", False))
-
-
-def _close_figures():
-    import matplotlib.pyplot as plt
-
-    plt.close("all")
+def _said(checks, part):
+    """The hint and step details `part`'s check gives."""
+    said = [
+        [c.get("hint") or ""] + [f"{s['step']}: {s['detail']}" for s in c["steps"]] for c in checks if c["name"] == part
+    ]
+    return " ".join(said[0]) if said else ""
 
 
 def _failed(verdict):
     return {check["name"] for check in verdict["checks"] if not check["passed"]}
 
 
-def _said(verdict, part):
-    for check in verdict["checks"]:
-        if check["name"] == part:
-            return " ".join([check.get("hint") or ""] + [f"{s['step']}: {s['detail']}" for s in check["steps"]])
-    return ""
-
-
 def check(variants, count, solutions, catalog=None, roster=None, registry=LAB, seed=0, progress=None):
-    """Check `count` made-up students' draws (and the `roster`'s, {name: id}) of every varied exercise.
-
-    `variants` is a :class:`~labkit.exercises.variants.VariantsFile`, `solutions` the instructor notebooks'
-    folder, `catalog` a catalog file (or None). Returns the :class:`Trouble` found, an empty list when every
-    draw is as it should be. `progress` (a function of one text) hears of each draw."""
+    """The :class:`Trouble` found in `count` made-up students' draws (and the `roster`'s, {name: id}) of every
+    varied exercise of `variants`, run on the instructor notebooks of `solutions` and the `catalog` file's entries.
+    `progress` (a function of one text) hears of each draw."""
     if isinstance(count, bool) or not isinstance(count, int) or count < 1:
         raise InputError(f"--check needs a whole number of draws, at least 1; got {count!r}.")
     correct, mistakes = load_catalog(catalog) if catalog is not None else ((), ())
@@ -229,17 +186,19 @@ def _ties(variants, registry, roster):
 
 def _check_notebook(draw, original, notebook, exercises, correct, mistakes):
     """Run one instructor notebook on the draw's data: the solution and each catalog entry, then the copy check."""
+    import matplotlib.pyplot as plt
+
     numbers = {e.number for e in exercises}
     names = sorted({name for e in exercises for part in e.parts for name in (*e.names, *part.names())})
     # the catalog's students read their rates off their own tables, unless the entry keeps them as written
     entries = [("the solution", (), None, None, (), numbers, False)]
     entries += [
-        (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not _keeps_rates(e))
+        (f"correct: {e.name}", e.replace, None, None, (), set(e.full) & numbers, not getattr(e, "keep_rates", False))
         for e in correct
         if e.notebook == notebook and set(e.full) & numbers
     ]
     entries += [
-        (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not _keeps_rates(e))
+        (f"slip: {e.name}", e.replace, e.part, e.hint, tuple(e.also), {e.exercise}, not getattr(e, "keep_rates", False))
         for e in mistakes
         if e.notebook == notebook and e.exercise in numbers
     ]
@@ -249,14 +208,14 @@ def _check_notebook(draw, original, notebook, exercises, correct, mistakes):
         namespace = run_cells(with_values(planted, draw.values, notebook, draw.registry), names)
         for number in sorted(judged):
             _judge_entry(draw, namespace, number, label, part, (hint, also))
-        _close_figures()
+        plt.close("all")
     # the solution on another student's data: caught, and its varied parts lost
-    if any(draw.other[e.number] != draw.values[e.number] for e in exercises):
+    copied = [e for e in exercises if draw.other[e.number] != draw.values[e.number]]
+    if copied:
         namespace = run_cells(with_values(original, draw.other, notebook, draw.registry), names)
-        for exercise in exercises:
-            if draw.other[exercise.number] != draw.values[exercise.number]:
-                _judge_copy(draw, namespace, exercise)
-        _close_figures()
+        for exercise in copied:
+            _judge_copy(draw, namespace, exercise)
+        plt.close("all")
 
 
 def _judge_entry(draw, namespace, number, label, part, expected):
@@ -273,15 +232,15 @@ def _judge_entry(draw, namespace, number, label, part, expected):
         lost = {part} | {p for n, p in also if n == number}
         if failed != lost:
             draw.trouble(label, f"failed {sorted(failed)}, not {sorted(lost)}")
-        elif hint and hint not in _said(verdict, part):
+        elif hint and hint not in _said(verdict["checks"], part):
             draw.trouble(label, f"the feedback does not say {hint!r}")
 
 
 def _judge_copy(draw, namespace, exercise):
     """The solution run on another student's data: named as a copy, and its varied parts lost."""
     verdict = draw.registry.check(exercise.number, namespace, seed=draw.seed, variant=draw.values[exercise.number])
-    dependent = {part.name for part in exercise.parts if part.varied}
+    passing = {part.name for part in exercise.parts if part.varied} - _failed(verdict)
     if not verdict.get("other_variant"):
         draw.trouble("a copy", "another student's data is not named")
-    if not dependent <= _failed(verdict):
-        draw.trouble("a copy", f"{sorted(dependent - _failed(verdict))} pass on another's data")
+    if passing:
+        draw.trouble("a copy", f"{sorted(passing)} pass on another's data")

@@ -1,23 +1,11 @@
-"""The student version of the instructor notebooks.
+"""The student version of the instructor notebooks (nbgrader's markers and stubs).
 
-Code between ``### BEGIN SOLUTION`` / ``### END SOLUTION`` becomes a stub
-that raises ``NotImplementedError``; in a markdown cell the same region is
-an answer in words (a remark, an explanation) and becomes ``YOUR ANSWER
-HERE``, for the student to write and the instructor to read. Hidden tests
-between ``### BEGIN HIDDEN TESTS`` / ``### END HIDDEN TESTS`` disappear, leaving
-the cell's comment saying it is the grader's (and the cell read-only and not deletable, as nbgrader's
-release leaves it), outputs are cleared. The markers and the stubs are nbgrader's.
-
-The cells that raise in the release (the stubs, and the cells that use what the stubs
-leave undefined) carry the tag ``raises-exception``, which :func:`tag_raising`
-gives the instructor notebook (``labkit execute`` calls it): Run All then goes on to
-the Explore section of a notebook nobody has written in yet, the self-checks saying
-what fails on the way, and nbgrader's release (which keeps tags) does the same.
-
-With a roster and a variants file (:mod:`labkit.exercises.variants`),
-:func:`release` writes one folder per student instead, each notebook's data
-cells (tagged ``variant-data``) holding that student's values
-(:func:`with_values`); every other cell is the same for the whole class.
+A ``### BEGIN SOLUTION`` / ``### END SOLUTION`` region becomes a stub raising ``NotImplementedError`` in code, and
+``YOUR ANSWER HERE`` in markdown (an answer in words). Hidden-test regions disappear, their cell left read-only and
+not deletable as nbgrader leaves it; outputs are cleared. :func:`tag_raising` tags ``raises-exception`` the cells
+that raise in the release, so Run All of an unwritten notebook goes on to its end. With a roster and a variants
+file, :func:`release` writes one folder per student, each notebook's ``variant-data`` cells holding that student's
+values (:func:`with_values`).
 """
 
 import ast
@@ -45,9 +33,8 @@ def strip_solutions(source, where="cell", stub=STUB):
             if region:
                 raise InputError(f"{where}, line {number}: {marker!r} inside an open {region!r} region.")
             region = marker
-            if marker == BEGIN_SOLUTION:
-                indent = line[: len(line) - len(line.lstrip())]
-                out.extend(indent + line for line in stub)
+            if marker == BEGIN_SOLUTION:  # the stub, indented as the marker
+                out.extend(line[: len(line) - len(line.lstrip())] + stub_line for stub_line in stub)
         elif marker in (END_SOLUTION, END_HIDDEN):
             expected = BEGIN_SOLUTION if marker == END_SOLUTION else BEGIN_HIDDEN
             if region != expected:
@@ -77,10 +64,8 @@ def release_notebook(nb, name="notebook"):
 
 
 def tag_raising(nb, folder, name="notebook", timeout=300):
-    """Tag ``raises-exception`` the cells of instructor notebook `nb` that raise in its release, in place.
-
-    The release is run in `folder` (the notebook's own, for its data files); a cell that no longer
-    raises loses the tag. Returns the indices of the tagged cells."""
+    """Tag ``raises-exception`` (in place) the cells of instructor notebook `nb` that raise in its release, run in
+    `folder` (for its data files), and untag the others; the indices of the tagged cells."""
     raising = set(raising_cells(release_notebook(nb, name), folder, timeout))
     for index, cell in enumerate(nb.cells):
         if cell.cell_type == "code":
@@ -89,19 +74,9 @@ def tag_raising(nb, folder, name="notebook", timeout=300):
 
 
 def with_values(nb, values, name="notebook", registry=LAB):
-    """Notebook `nb` (a new object) with its data cells holding `values` ({exercise: {parameter: value}}).
-
-    The data cells are the code cells tagged ``variant-data``; in them each
-    parameter of the notebook's exercises is a plain ``name = number``
-    assignment, whose number is replaced by the value as the notebook shows it,
-    and each value an exercise derives from them (``Exercise.derived``) a
-    one-line ``name = ...`` assignment, replaced the same way (comments and
-    everything else stay). A notebook whose exercises vary but
-    whose data cells lack an assignment is refused (ValueError), so no student
-    is ever given the lab's data by mistake. The cell's metadata gets nothing:
-    the grader derives each student's values from the roster, never from the
-    notebook.
-    """
+    """Notebook `nb` (a new object) whose ``variant-data`` cells' one-line assignments of its exercises' parameters
+    (a plain number) and derived values hold `values` ({exercise: {parameter: value}}) as the notebook shows them;
+    a missing assignment is refused (ValueError), so no student gets the lab's data by mistake."""
     copy = copy_notebook(nb)
     wanted, params = _assignments(values, name, registry)
     done = set()
@@ -125,8 +100,7 @@ def copy_notebook(nb):
 
 
 def _assignments(values, name, registry):
-    """({name: the text its assignment gets}, the names among them that are parameters: assigned a plain number)
-    for the exercises of notebook `name`."""
+    """({name: the text its assignment gets}, the parameters among them) for the exercises of notebook `name`."""
     wanted, params = {}, set()
     for number, given in values.items():
         exercise = registry.exercises.get(int(number))
@@ -151,19 +125,17 @@ def _assign(cell, where, wanted, params):
     lines, breaks = pieces[0::2], pieces[1::2]
     edits, done = [], set()
     for node in tree.body:
-        if (
-            isinstance(node, ast.Assign)
-            and len(node.targets) == 1
-            and isinstance(node.targets[0], ast.Name)
-            and node.targets[0].id in wanted
-        ):
-            target, value = node.targets[0].id, node.value
-            if value.lineno != value.end_lineno:
-                raise InputError(f"{where}: {target} must be assigned on one line.")
-            if target in params and not _number(value):
-                raise InputError(f"{where}: {target} must be assigned a number, as `{target} = 1.15`.")
-            edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
-            done.add(target)
+        if not (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)):
+            continue
+        target, value = node.targets[0].id, node.value
+        if target not in wanted:
+            continue
+        if value.lineno != value.end_lineno:
+            raise InputError(f"{where}: {target} must be assigned on one line.")
+        if target in params and not _number(value):
+            raise InputError(f"{where}: {target} must be assigned a number, as `{target} = 1.15`.")
+        edits.append((value.lineno - 1, value.col_offset, value.end_col_offset, wanted[target]))
+        done.add(target)
     for line, start, end, text in sorted(edits, reverse=True):
         row = lines[line].encode("utf-8")  # ast's offsets count bytes
         lines[line] = (row[:start] + text.encode("utf-8") + row[end:]).decode("utf-8")
@@ -187,12 +159,10 @@ def folder_name(name):
 
 
 def release(notebook_dir, out_dir, roster=None, variants=None, registry=LAB):
-    """Write the student version of every notebook of `notebook_dir` into `out_dir`.
+    """Write the student version of every notebook of `notebook_dir` into `out_dir`; the paths written.
 
-    With `roster` ({submission name: roster id}, :func:`labkit.grading.lms.roster.read_roster`)
-    and `variants` (a :class:`labkit.exercises.variants.VariantsFile`), each
-    student gets a folder ``out_dir/<submission name>/`` whose notebooks hold
-    that student's data. Returns the paths written."""
+    With `roster` ({submission name: roster id}) and `variants` (a :class:`~labkit.exercises.variants.VariantsFile`)
+    each student gets a folder ``out_dir/<submission name>/`` whose notebooks hold their data."""
     import nbformat
 
     if (roster is None) != (variants is None):

@@ -1,30 +1,16 @@
-"""What a graded function may not reach, as the sandbox's watch recognises it (the grader's side).
+"""What a graded function may not reach (a part's :class:`labkit.exercises.model.Refusal`), as the grader sees it.
 
-An exercise's part declares a :class:`labkit.exercises.model.Refusal`:
-whole modules (scipy's interpolation and spline modules, labkit's
-interpolation modules and the grader's own references), a few single
-functions, and the few functions the lab lets students reuse. This module
-turns one into what :mod:`labkit.grading.sandbox.guard` needs inside the sandbox:
-
-* a digest (:func:`labkit.grading.sandbox.guard.code_key`) of every Python function,
-  method and nested function of those modules, computed here by compiling
-  the library's own files, so nothing the notebook did to the live modules
-  (a patched class, a saved code object) changes what is recognised;
-* the module prefixes, whose compiled routines are refused by name;
-* single compiled functions ``(module, name)``.
-
-For the source scan (:mod:`labkit.grading.submission.scan`) it also lists every dotted
-spelling under which labkit, scipy and numpy export a refused object
-(``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``) and every
-spelling of the allowed ones. Everything is computed once per grading run
-(:func:`wire`) and sent to the sandbox before the notebook's first cell
-runs.
+For the sandbox's watch (:mod:`labkit.grading.sandbox.guard`): the digest of every Python function of the refused
+modules, compiled here from the library's files so nothing a notebook does to the live modules changes it, the
+module prefixes and the single compiled functions. For the source scan (:mod:`.scan`): every dotted spelling of a
+refused or an allowed object in labkit, scipy and numpy. :func:`wire` computes it all once per grading run.
 """
 
 import __future__
 
 import ast
 import codeop
+import contextlib
 import functools
 import importlib
 import importlib.util
@@ -66,14 +52,8 @@ CELL_FLAGS = codeop.PyCF_DONT_IMPLY_DEDENT | getattr(codeop, "PyCF_ALLOW_INCOMPL
 
 @functools.cache
 def _compiled_codes(path):
-    """Every code object of one source file, compiled as the import system does and as a notebook does.
-
-    The import system compiles the whole file; IPython compiles each top-level
-    statement of a cell on its own. The bytecode differs: a call through a
-    module the same compilation imports (``np.diff(x)`` under ``import numpy as
-    np``) is a global load and an attribute load in the file, a method load in a
-    cell. So each top-level statement is also compiled on its own, with the
-    flags of a cell, with and without the file's ``__future__`` features."""
+    """Every code object of a source file compiled whole (as imported) and statement by statement as IPython
+    compiles a cell (its flags, with and without the file's futures), whose bytecode differs (``np.diff(x)``)."""
     source = Path(path).read_bytes()
     whole = compile(source, str(path), "exec", dont_inherit=True)
     found = list(codes_in(whole))
@@ -135,11 +115,9 @@ def _resolve(dotted):
         except (ImportError, ValueError, TypeError):
             continue
         try:
-            for attribute in parts[split:]:
-                value = getattr(value, attribute)
+            return functools.reduce(getattr, parts[split:], value)
         except AttributeError:
             return None
-        return value
     return None
 
 
@@ -148,10 +126,8 @@ def spellings(refusal):
     """({spelling: the refused object's own name}, [spellings of allowed objects]) in labkit, scipy and numpy."""
     for prefix in refusal.modules:
         if prefix.split(".")[0] in LIBRARIES:
-            try:
+            with contextlib.suppress(ImportError):
                 importlib.import_module(prefix)
-            except ImportError:
-                pass
     libraries = [
         (name, module)
         for name, module in list(sys.modules.items())
@@ -183,25 +159,22 @@ def spellings(refusal):
     return spelled, sorted(allowed_spellings)
 
 
-def submodules(refusal):
-    """The loaded modules inside the refusal's module prefixes (the scan judges their uses, not their import)."""
-    spellings(refusal)  # imports the refused modules
-    loaded = list(sys.modules.items())
-    return sorted(name for name, module in loaded if module is not None and _within(name, refusal.modules))
-
-
 def wire(refusals):
     """The profiles of these refusals as JSON-ready data for the sandbox and the scan: {name: {...}}."""
     profiles = {}
     for refusal in refusals:
         names, modules, c_names = recognised(refusal)
-        spelled, allowed = spellings(refusal)
+        spelled, allowed = spellings(refusal)  # imports the refused modules
+        loaded = list(sys.modules.items())
         profiles[refusal.name] = {
             "names": {key.hex(): name for key, name in names.items()},
             "modules": list(modules),
             "c_names": sorted(map(list, c_names)),
             "spellings": spelled,
             "allowed": allowed,
-            "submodules": submodules(refusal),
+            # the refused modules themselves: the scan judges their uses, not their import
+            "submodules": sorted(
+                name for name, module in loaded if module is not None and _within(name, refusal.modules)
+            ),
         }
     return profiles

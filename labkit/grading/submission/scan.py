@@ -1,32 +1,16 @@
 """Reading a notebook's source for refused references, on the grader's side (``ast``; nothing is run).
 
-For a graded name, :func:`scan` follows what its last definition in the
-notebook reaches: the functions, classes and module-level variables of the
-notebook it names (``ref = labkit.eval_pherm``, ``eval_pherm = ...``,
-``class H(CubicHermiteSpline)``), through import aliases, and reports
-
-* every reference into a refused module (``scipy.interpolate.X``,
-  ``labkit.splines._any_private_helper``) or to a refused function under any
-  name it has (``labkit.eval_pherm`` is ``labkit.piecewise.eval_pherm``);
-* every way of reaching code that a reader cannot follow: ``__import__``,
-  ``importlib``, ``eval``/``exec``, ``getattr`` with a computed name,
-  ``globals()``, ``sys.modules``, ``gc``, ``ctypes``, a function's
-  ``__code__`` or ``__globals__``, a frame's locals, or a module the
-  notebook wrote itself.
-
-The scan is bounded: a notebook's code cells may hold at most
-:data:`MAX_CODE_BYTES`, and reading them may take at most
-:data:`TIME_BUDGET` seconds (:class:`Unreadable` otherwise). Cell magics
-that run Python (``%%time``, ``%%capture``) are read as Python; other cells
-that IPython would hand to another program are skipped.
-
-:func:`function_sources` reads the same cells for the text of the graded
-functions' definitions, which the grade keeps for the similarity search
-(:mod:`labkit.grading.reports.similarity`).
+For a graded name, :func:`scan` follows what its last definition reaches in the notebook (through import aliases)
+and reports every reference into a refused module or to a refused function under any name it has, and every way of
+reaching code a reader cannot follow (``eval``, ``getattr`` with a computed name, ``sys.modules``, ...), within
+:data:`MAX_CODE_BYTES` and :data:`TIME_BUDGET`. Cell magics that run Python (``%%time``) are read as Python; cells
+IPython hands to another program are skipped. :func:`function_sources` reads the graded functions' text.
 """
 
 import ast
+import importlib.util
 import re
+import sys
 import time
 
 from ..store.text import MAX_SOURCE_CHARS
@@ -36,40 +20,21 @@ TIME_BUDGET = 20.0  # seconds to read one notebook's code
 
 PYTHON_CELL_MAGICS = {"time", "timeit", "capture", "prun", "debug"}
 # modules a graded function may reach without the scan asking what they are
-KNOWN = (
-    {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator", "collections"}
-    | {"numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings", "bisect", "heapq", "copy"}
-    | {"enum", "abc"}
-)
-DYNAMIC_NAMES = {
-    "__import__": "__import__",
-    "eval": "eval",
-    "exec": "exec",
-    "compile": "compile",
-    "globals": "globals()",
-    "vars": "vars()",
-    "locals": "locals()",
-    "setattr": "setattr",
-    "delattr": "delattr",
-    "breakpoint": "breakpoint",
-    "get_ipython": "get_ipython() (the shell's own namespace)",
-}
+KNOWN = {"numpy", "scipy", "math", "cmath", "labkit", "matplotlib", "functools", "itertools", "operator", "abc"}
+KNOWN |= {"collections", "numbers", "fractions", "decimal", "statistics", "typing", "dataclasses", "warnings", "enum"}
+KNOWN |= {"bisect", "heapq", "copy"}
+DYNAMIC_NAMES = {name: name for name in ("__import__", "eval", "exec", "compile", "setattr", "delattr", "breakpoint")}
+DYNAMIC_NAMES |= {"globals": "globals()", "vars": "vars()", "locals": "locals()"}
+DYNAMIC_NAMES["get_ipython"] = "get_ipython() (the shell's own namespace)"
 STRING_RUNNERS = {"exec", "eval", "compile"}
-DYNAMIC_ATTRIBUTES = (
-    {"__code__", "__closure__", "__globals__", "__builtins__"}
-    | {"__dict__", "__subclasses__", "__func__", "__wrapped__"}
-    | {"f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame"}
-)
-DYNAMIC_MODULES = (
-    {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill"}
-    | {"builtins", "imp", "pkgutil", "runpy", "code", "codeop"}
-    | {"threading", "_thread", "multiprocessing", "subprocess", "signal"}
-)
-DYNAMIC_DOTTED = (
-    {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace", "sys.gettrace"}
-    | {"sys._current_frames", "types.FunctionType", "types.CodeType"}
-    | {"os.system", "os.fork", "os.popen", "os.exec", "os.spawn"}
-)
+DYNAMIC_ATTRIBUTES = {"__code__", "__closure__", "__globals__", "__builtins__", "__dict__", "__subclasses__"}
+DYNAMIC_ATTRIBUTES |= {"__func__", "__wrapped__", "f_back", "f_locals", "f_globals", "gi_frame", "tb_frame", "cr_frame"}
+DYNAMIC_MODULES = {"importlib", "ctypes", "cffi", "gc", "inspect", "marshal", "pickle", "dill", "builtins", "imp"}
+DYNAMIC_MODULES |= {"pkgutil", "runpy", "code", "codeop", "threading", "_thread", "multiprocessing", "subprocess"}
+DYNAMIC_MODULES.add("signal")
+DYNAMIC_DOTTED = {"sys.modules", "sys._getframe", "sys.setprofile", "sys.getprofile", "sys.settrace", "sys.gettrace"}
+DYNAMIC_DOTTED |= {"sys._current_frames", "types.FunctionType", "types.CodeType", "os.system", "os.fork"}
+DYNAMIC_DOTTED |= {"os.popen", "os.exec", "os.spawn"}
 
 
 class Unreadable(ValueError):
@@ -99,24 +64,21 @@ class _Reader:
     """The notebook's top-level definitions and import aliases, and the walk from a graded name."""
 
     def __init__(self, sources, deadline):
-        self.deadline = deadline
-        self.trees, self.texts, self.cells = [], {}, []
+        self.deadline, self.trees, self.texts, self.aliases, self.definitions = deadline, [], {}, {}, {}
+        self.when, self.strings = {}, []  # where each name was last bound; where a string is run as code
+        self.statements = []  # the top-level statements that are not definitions (plots are drawn there)
         for cell, source in enumerate(sources):
             text = python_source(source)
             if text is None:
                 continue
             self._tick()
             try:
-                self.trees.append(ast.parse(text))
+                tree = ast.parse(text)
             except (SyntaxError, ValueError, RecursionError, MemoryError):
                 continue  # IPython could not run it either: it defines nothing
-            self.cells.append(cell)
-            for node in _top_level(self.trees[-1].body):
+            self.trees.append(tree)  # kept alive: `texts` is keyed by its nodes' ids
+            for node in _top_level(tree.body):
                 self.texts[id(node)] = text
-        self.aliases, self.definitions = {}, {}
-        self.when, self.strings = {}, []  # where each name was last bound; where a string is run as code
-        self.statements = []  # the top-level statements that are not definitions (plots are drawn there)
-        for cell, tree in zip(self.cells, self.trees):
             for node in tree.body:
                 before = {name: id(found) for name, found in self.definitions.items()}
                 self._record(node)
@@ -136,24 +98,17 @@ class _Reader:
             for local, dotted in _imported(node):
                 self.aliases[local] = dotted
                 self.definitions.pop(local, None)
-        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-            self.definitions[node.name] = node
-            self.aliases.pop(node.name, None)
-        elif isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
-            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
-            for target in targets:
-                for name in ast.walk(target):
-                    if isinstance(name, ast.Name):
-                        self.definitions[name.id] = node
-                        self.aliases.pop(name.id, None)
         elif isinstance(node, (ast.If, ast.For, ast.While, ast.With, ast.Try)):
             for child in ast.iter_child_nodes(node):
                 if isinstance(child, ast.stmt):
                     self._record(child)
+        else:
+            for name in _bound_names(node):
+                self.definitions[name] = node
+                self.aliases.pop(name, None)
 
     def reached(self, name, stop=frozenset()):
-        """(definition name, definition node, its local names) of everything the definition of `name` reaches
-        (not through the names in `stop`)."""
+        """(name, node, its local names) of every definition `name`'s reaches (not through those in `stop`)."""
         seen, todo, found = set(), [name], []
         while todo:
             current = todo.pop()
@@ -165,21 +120,15 @@ class _Reader:
             found.append((current, node, local))
             for inner in ast.walk(node):
                 self._tick()
-                if (
-                    isinstance(inner, ast.Name)
-                    and isinstance(inner.ctx, ast.Load)
-                    and inner.id in self.definitions
-                    and inner.id not in seen
-                    and inner.id not in local
-                ):
-                    todo.append(inner.id)
+                if isinstance(inner, ast.Name) and isinstance(inner.ctx, ast.Load) and inner.id in self.definitions:
+                    if inner.id not in seen and inner.id not in local:
+                        todo.append(inner.id)
         return found
 
 
 def _runs_strings(node, definitions=None):
-    """How a top-level statement runs code handed to it as a string it builds (``exec(zlib.decompress(...))``):
-    ``exec``, ``eval`` or ``compile`` of anything but a literal string, itself or in a function of the
-    notebook (`definitions`) that it calls."""
+    """How a top-level statement, or a function of the notebook (`definitions`) it calls, runs a string it builds
+    as code: ``exec``, ``eval`` or ``compile`` of anything but a literal (``exec(zlib.decompress(...))``)."""
     if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
         return []
     found = []
@@ -188,26 +137,20 @@ def _runs_strings(node, definitions=None):
         called = definitions.get(inner.func.id) if by_name else None
         if isinstance(called, (ast.FunctionDef, ast.AsyncFunctionDef)):
             found += [f"{what} (in {called.name})" for what in _runs_strings(ast.Module(called.body, []))]
-    literal = set()
+    literal = set()  # the runners called on a literal string; ast.walk meets a call before its function's name
     for inner in ast.walk(node):
-        if isinstance(inner, ast.Call) and _named_call(inner, STRING_RUNNERS):
-            if inner.args and isinstance(inner.args[0], ast.Constant) and isinstance(inner.args[0].value, str):
+        if isinstance(inner, ast.Call) and inner.args and isinstance(inner.args[0], ast.Constant):
+            if isinstance(inner.args[0].value, str):
                 literal.add(id(inner.func))
-    for inner in ast.walk(node):
-        if isinstance(inner, ast.Name) and inner.id in STRING_RUNNERS and id(inner) not in literal:
+        elif isinstance(inner, ast.Name) and inner.id in STRING_RUNNERS and id(inner) not in literal:
             found.append(inner.id)
     return found
 
 
-def _named_call(node, names):
-    return isinstance(node.func, ast.Name) and node.func.id in names
-
-
 def run_strings(sources, names, deadline=None):
-    """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec``/``eval``/``compile``
-    of a built string may have defined: the name is bound nowhere the reader can see after that statement.
-    Code that arrives in a string cannot be read, so it is never graded (as ``exec`` of labkit's file is not)."""
-    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec`` of a built string may have
+    defined (no readable binding after it): code that arrives in a string cannot be read, so it is never graded."""
+    reader = _reader(sources, deadline)
     findings = []
     for name in names:
         bound = reader.when.get(name, (-1, 0)) if name in reader.definitions else (-1, 0)  # (cell, line)
@@ -223,10 +166,8 @@ def run_strings(sources, names, deadline=None):
 
 
 def reached_sources(sources, names, deadline=None, stop=frozenset()):
-    """``[(name, source text)]`` of every definition in a notebook's code cells that the graded `names` reach
-    (the names themselves first), as :func:`scan` follows them, not through the names in `stop`; nothing is run.
-
-    Raises :class:`Unreadable` as :func:`scan` does.
+    """``[(name, source text)]`` of every definition the graded `names` reach (themselves first) as :func:`scan`
+    follows them, not through the names in `stop`; :class:`Unreadable` as :func:`scan` raises it.
 
     Examples
     --------
@@ -235,16 +176,15 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
     ['f', 'h']
     """
     _bounded(sources)
-    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
+    reader = _reader(sources, deadline)
     found, seen = [], set()
     for name in names:
         for owner, node, _ in reader.reached(name, frozenset(stop)):
             if id(node) in seen or id(node) not in reader.texts:
                 continue
             seen.add(id(node))
-            text = reader.texts[id(node)]
             first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
-            lines = text.split("\n")[first - 1 : node.end_lineno]
+            lines = reader.texts[id(node)].split("\n")[first - 1 : node.end_lineno]
             found.append((owner, "\n".join(lines)))  # whole: a long comment must not push the code out
     return found
 
@@ -264,8 +204,7 @@ def code_bytes(sources):
 
 
 def drawn_with(sources, names, deadline=None):
-    """The names of the notebook's definitions that `names` reach, and that the top-level statements
-    mentioning `names` reach (``ax4.plot(t, my_eval(...))`` draws ``ax4`` with ``my_eval``); nothing is run.
+    """The definitions `names` reach, and those the statements mentioning them reach (``ax.plot(my_eval(t))``).
 
     Examples
     --------
@@ -273,9 +212,8 @@ def drawn_with(sources, names, deadline=None):
     >>> sorted(drawn_with(cells, ["ax"]) & {"ax", "g", "h"})
     ['ax', 'h']
     """
-    reader = _reader(tuple(sources), deadline if deadline is not None else time.monotonic() + TIME_BUDGET)
-    wanted, found = set(names), set()
-    starts = list(names)
+    reader = _reader(sources, deadline)
+    wanted, found, starts = set(names), set(), list(names)
     for node in reader.statements:
         loaded = {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
         if loaded & wanted:
@@ -294,11 +232,8 @@ def _locals(node):
     for inner in ast.walk(node):
         if isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
             arguments = inner.args
-            for arg in (
-                arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg, arguments.kwarg]
-            ):
-                if arg is not None:
-                    bound.add(arg.arg)
+            every = arguments.posonlyargs + arguments.args + arguments.kwonlyargs + [arguments.vararg, arguments.kwarg]
+            bound.update(arg.arg for arg in every if arg is not None)
             if inner is not node and not isinstance(inner, ast.Lambda):
                 bound.add(inner.name)
         elif isinstance(inner, ast.Name) and isinstance(inner.ctx, (ast.Store, ast.Del)):
@@ -326,12 +261,8 @@ def _dotted(node, aliases):
     """The dotted name an attribute chain spells, aliases resolved (``getattr(m, "name")`` is ``m.name``)."""
     parts = []
     while isinstance(node, ast.Attribute) or _constant_getattr(node):
-        if isinstance(node, ast.Attribute):
-            parts.append(node.attr)
-            node = node.value
-        else:
-            parts.append(node.args[1].value)
-            node = node.args[0]
+        part, node = (node.attr, node.value) if isinstance(node, ast.Attribute) else (node.args[1].value, node.args[0])
+        parts.append(part)
     if not isinstance(node, ast.Name) or node.id not in aliases:
         return None
     return ".".join([aliases[node.id]] + parts[::-1])
@@ -340,14 +271,21 @@ def _dotted(node, aliases):
 def _constant_getattr(node):
     """Whether `node` is ``getattr(value, "name")`` (or with a default): an attribute written as a string."""
     return (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id == "getattr"
-        and len(node.args) in (2, 3)
+        _getattr_call(node)
+        and len(node.args) <= 3
         and not node.keywords
         and isinstance(node.args[1], ast.Constant)
         and isinstance(node.args[1].value, str)
         and node.args[1].value.isidentifier()
+    )
+
+
+def _getattr_call(node):
+    return (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id == "getattr"
+        and len(node.args) >= 2
     )
 
 
@@ -364,33 +302,19 @@ class _Refused:
         self.allowed = set(profile["allowed"])
         self.submodules = set(profile.get("submodules", ()))  # the refused modules themselves, as loaded
 
-    def reason(self, dotted):
-        """Why `dotted` (a name as the notebook writes it, aliases resolved) is refused, or None."""
-        if dotted in self.allowed:
-            return None
-        if dotted in self.spellings:
-            own = self.spellings[dotted]
-            return dotted if own == dotted else f"{own} (as {dotted})"
-        if _within(dotted, self.modules):
-            return dotted
-        return None
-
     def chain(self, dotted):
-        """Why a whole attribute chain is refused, or None: its longest refused prefix, unless a longer
-        prefix is an allowed helper (``labkit.piecewise.bracket`` is allowed however ``labkit.piecewise`` is
-        reached)."""
+        """Why a whole attribute chain is refused (its longest refused prefix), or None: also when a longer prefix
+        is an allowed helper (``labkit.piecewise.bracket``, however ``labkit.piecewise`` is reached)."""
         while dotted:
             if dotted in self.allowed:
                 return None
-            what = self.reason(dotted)
-            if what:
-                return what
+            if dotted in self.spellings:
+                own = self.spellings[dotted]
+                return dotted if own == dotted else f"{own} (as {dotted})"
+            if _within(dotted, self.modules):
+                return dotted
             dotted = dotted.rpartition(".")[0]
         return None
-
-    def is_module(self, dotted):
-        """Whether `dotted` names a refused module itself (its uses are judged, not its import)."""
-        return dotted in self.submodules
 
 
 def _dynamic(node, aliases):
@@ -399,13 +323,7 @@ def _dynamic(node, aliases):
         return DYNAMIC_NAMES[node.id]
     if isinstance(node, ast.Attribute) and node.attr in DYNAMIC_ATTRIBUTES:
         return node.attr
-    if (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id == "getattr"
-        and len(node.args) >= 2
-        and not isinstance(node.args[1], ast.Constant)
-    ):
+    if _getattr_call(node) and not isinstance(node.args[1], ast.Constant):
         return "getattr with a computed name"
     if isinstance(node, (ast.Name, ast.Attribute)):
         dotted = _dotted(node, aliases)
@@ -422,9 +340,6 @@ def _dynamic(node, aliases):
 
 def _installed(top):
     """Whether a top-level module is the standard library's or installed here (found, never imported)."""
-    import importlib.util
-    import sys
-
     if top in sys.stdlib_module_names:
         return True
     try:
@@ -434,19 +349,14 @@ def _installed(top):
 
 
 def scan(sources, names, profile, deadline=None):
-    """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a
-    reference that `profile` switches off, or reach for code in a way the scan cannot follow.
-
-    `profile` is one refusal as :func:`labkit.grading.submission.refusals.wire` gives it (modules, spellings,
-    allowed). Raises :class:`Unreadable` when the code is over :data:`MAX_CODE_BYTES` or reading it
-    takes longer than :data:`TIME_BUDGET` seconds."""
+    """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a reference
+    that `profile` (one refusal, as :func:`.refusals.wire` gives it) switches off, or reach for code in a way the
+    scan cannot follow. Raises :class:`Unreadable` past :data:`MAX_CODE_BYTES` or :data:`TIME_BUDGET`."""
     if profile is None:
         return []
     _bounded(sources)
-    deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
-    reader = _reader(tuple(sources), deadline)
-    refused = _Refused(profile)
-    findings = set()
+    reader = _reader(sources, deadline)
+    refused, findings = _Refused(profile), set()
     for name in names:
         for owner, definition, own_names in reader.reached(name):
             local = {k: v for k, v in reader.aliases.items() if k not in own_names}
@@ -457,7 +367,7 @@ def scan(sources, names, profile, deadline=None):
                     for alias_name, dotted in _imported(node):
                         local[alias_name] = dotted
                         # a refused module imported is judged by its uses (``pw.bracket`` is allowed)
-                        why = (None if refused.is_module(dotted) else refused.chain(dotted)) or (
+                        why = (None if dotted in refused.submodules else refused.chain(dotted)) or (
                             dotted.split(".")[0] if dotted.split(".")[0] in DYNAMIC_MODULES else None
                         )
                         if why:
@@ -488,40 +398,24 @@ def scan(sources, names, profile, deadline=None):
 _READERS: dict = {}
 
 
-def _reader(sources, deadline):
+def _reader(sources, deadline=None):
+    """The notebook's :class:`_Reader` (the last one kept), reading until `deadline` (default: the budget)."""
+    sources = tuple(sources)
+    deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
     found = _READERS.get(sources)
     if found is None:
-        _READERS.clear()  # one notebook at a time
+        _READERS.clear()
         found = _READERS[sources] = _Reader(sources, deadline)
     found.deadline = deadline
     return found
 
 
 def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
-    """The source text of the last top-level definition of each of `names` in a notebook's code cells.
+    """``{name: source}``, from its first decorator to its last line (at most `limit` characters, whole lines),
+    of the last top-level ``def`` of each of `names` in a notebook's code cells (parsed, never run).
 
-    The cells are parsed with :mod:`ast`, never run. A definition counts
-    where the cells, run in order, would leave it bound to its name: at the
-    top level of a cell (or inside a top-level ``if``, ``for``, ``while``,
-    ``with`` or ``try``); a later assignment or import of the name drops it
-    (the graded object is then not a function written here). A cell that
-    does not parse defines nothing, as when IPython runs it.
-
-    Parameters
-    ----------
-    sources : sequence of str
-        The notebook's code cells, in order.
-    names : iterable of str
-        The function names wanted.
-    limit : int, optional
-        Characters kept of one definition (whole lines while they fit).
-
-    Returns
-    -------
-    dict
-        ``{name: source}`` for each of `names` the cells define with ``def``;
-        a source runs from its first decorator to its last line. Nothing at
-        all when the cells hold more than :data:`MAX_CODE_BYTES`.
+    A definition counts where the cells, run in order, leave it bound (a later assignment or import drops it; a
+    cell that does not parse defines nothing). Nothing at all past :data:`MAX_CODE_BYTES`.
 
     Examples
     --------
@@ -554,9 +448,8 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
 
 
 def reached_function_sources(sources, names, graded=(), limit=MAX_SOURCE_CHARS):
-    """:func:`function_sources` of `names`, each followed by the definitions it reaches in the notebook (its
-    helpers, as :func:`reached_sources` follows them; other `graded` names are left to their own entries), so
-    that code moved into a helper is compared where the graded function uses it.
+    """:func:`function_sources` of `names`, each followed by the helpers it reaches (other `graded` names aside), so
+    code moved into a helper is compared where the graded function uses it.
 
     Examples
     --------
@@ -590,10 +483,10 @@ def _top_level(body):
 
 
 def _bound_names(node):
-    """The names a top-level statement other than a function definition binds."""
+    """The names a top-level statement binds."""
     if isinstance(node, (ast.Import, ast.ImportFrom)):
         return [local for local, _ in _imported(node)]
-    if isinstance(node, ast.ClassDef):
+    if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
         return [node.name]
     if isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
         targets = node.targets if isinstance(node, ast.Assign) else [node.target]

@@ -1,24 +1,14 @@
 """Grading one notebook and one submission, on the grader's (trusted) side.
 
-For each notebook: check its size and read it here (JSON only, nothing
-run), start the sandboxed worker, have it run the code cells, then run
-every exercise's checks here through proxies into the worker
-(:mod:`labkit.grading.sandbox.remote`), each part with its references switched off
-in the sandbox (:mod:`labkit.grading.sandbox.guard`) and named if the source
-reaches for them (:mod:`labkit.grading.submission.scan`). A part whose code is, for the
-most part, code the student has on disk (labkit's, scipy's, the solutions':
-:mod:`labkit.grading.submission.known`) is held for a person: its points wait until the
-rubric's ``[held]`` table releases them. Scores, hints and problems are all
-computed on this side.
+Each notebook is read here (JSON only, nothing run), its code cells run in a sandboxed worker, and every
+exercise's checks run here through proxies into it (:mod:`labkit.grading.sandbox.remote`), each part with its
+references switched off in the sandbox and named if the source reaches for them (:mod:`.scan`). A part whose code
+is mostly code the student has on disk (:mod:`.known`) is held for a person until the rubric's ``[held]`` table
+releases it. One time limit covers a submission's notebooks; an exercise counts from the first notebook (in name
+order) that defines its names.
 
-A submission has one time limit for all its notebooks together. An
-exercise counts from the first notebook (in name order) that defines its
-names; later notebooks are not checked for it.
-
-``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a
-process of its own and writes its result file: :mod:`labkit.grading.run.processes`
-starts one per submission, so whatever one submission does to the grader's
-memory or time costs only its own grade.
+``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a process of its own
+(:mod:`labkit.grading.run.processes` starts one each) and writes its result file.
 """
 
 import functools
@@ -38,6 +28,7 @@ from ...exercises.result import CRASH, NOT_DONE, OTHER, RAISED, REFUSED, TAMPERE
 from ...notebook import prompt_numbers
 from ..options import GradeOptions
 from ..sandbox import backends, remote, timings
+from ..store import rubric as rubrics
 from ..store.model import ExerciseResult
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from . import holding, known, refusals, scan
@@ -52,11 +43,8 @@ MAX_ANSWER = 4_000  # characters of one answer in words kept for the instructor
 
 
 def read_cells(path, answers=None, registry=LAB):
-    """(code sources, markdown sources) of a notebook file; ValueError says why it is not one.
-
-    The size is checked before anything is read, and a link is never followed.
-    The student's answers in words (markdown cells with an answer's nbgrader
-    grade id) go into `answers`, {grade id: text}, when it is given."""
+    """(code, markdown) cell sources of a notebook file, or a ValueError saying why it is not one (size checked
+    first, no link followed). Answers in words (markdown with an answer's grade id) go into `answers`, if given."""
     path = Path(path)
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode):
@@ -67,8 +55,7 @@ def read_cells(path, answers=None, registry=LAB):
             f"{MAX_NOTEBOOK_BYTES // 1024**2} MB a lab notebook needs (clear its outputs and hand it in "
             "again); it was not graded."
         )
-    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
-    with os.fdopen(fd, "rb") as handle:
+    with os.fdopen(os.open(path, os.O_RDONLY | os.O_NOFOLLOW), "rb") as handle:
         raw = handle.read(MAX_NOTEBOOK_BYTES + 1)
     if len(raw) > MAX_NOTEBOOK_BYTES:
         raise InputError(f"{path.name} is more than {MAX_NOTEBOOK_BYTES // 1024**2} MB; it was not graded.")
@@ -108,11 +95,7 @@ def exercises_in(markdown, registry=LAB):
 
 
 def submission_notebooks(path):
-    """The notebooks of a submission: one .ipynb file, or the .ipynb files in a folder.
-
-    No link is ever followed, at any level: a submission that is a link, a
-    linked folder or a linked notebook inside is refused or left out. The
-    walk is bounded in depth and in entries."""
+    """A submission's notebooks: one .ipynb file, or the folder's (a bounded walk; links refused or left out)."""
     path = Path(path)
     try:
         info = os.lstat(path)
@@ -152,26 +135,25 @@ def submission_notebooks(path):
 
 
 def _failed_part(check, name, step, detail, hint, kind=None):
-    """The part's check, failed at one step (of `kind`, :data:`labkit.exercises.result.KINDS`, unless a slip)."""
-    return {
-        "name": name,
-        "passed": False,
-        "hint": hint,
-        "weight": check.get("weight", 0),
-        "steps": [{"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}],
-    }
+    """The part's check, failed at one step."""
+    base = {"name": name, "passed": False, "hint": hint, "weight": check.get("weight", 0)}
+    return _with_step(base, _step(step, detail, kind), hint)
+
+
+def _step(step, detail, kind=None):
+    """A failed step of a check (of `kind`, :data:`labkit.exercises.result.KINDS`, unless a slip)."""
+    return {"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}
+
+
+def _with_step(check, step, hint, **more):
+    """`check` (updated with `more`) with one more `step` and `hint`."""
+    return {**check, **more, "steps": [*check.get("steps", []), step], "hint": hint}
 
 
 def _voided(part, tampered):
     """The check of a part of a notebook that tampered with the grader's watch: none of its answers count."""
-    return _failed_part(
-        {"weight": part.weight},
-        part.name,
-        "the notebook's answers can be trusted",
-        tampered,
-        "remove what the message names and hand it in again.",
-        TAMPERED,
-    )
+    step, hint = "the notebook's answers can be trusted", "remove what the message names and hand it in again."
+    return _failed_part({"weight": part.weight}, part.name, step, tampered, hint, TAMPERED)
 
 
 def _own_code(check, findings):
@@ -179,47 +161,34 @@ def _own_code(check, findings):
     details = "; ".join(
         f"{function} (line {line} of its definition) reaches for {name}" for function, line, name in findings[:8]
     )
-    return {
-        **check,
-        "passed": False,
-        "steps": list(check.get("steps", []))
-        + [{"step": "calls no reference implementation", "passed": False, "detail": details, "kind": REFUSED}],
-        "hint": "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names "
-        "stay available.",
-    }
+    step = _step("calls no reference implementation", details, REFUSED)
+    hint = "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names stay available."
+    return _with_step(check, step, hint, passed=False)
 
 
 def _held(check, found):
     """The part's check, held for a person: it passed, but its code is mostly a known source's."""
-    return {
-        **check,
-        "held": found.as_dict(),
-        "steps": list(check.get("steps", []))
-        + [
-            {
-                "step": HELD_STEP,
-                "passed": False,
-                "detail": f"{found.share:.0%} of the code of {found.definition} (names aside) is the same as "
-                f"{found.source}'s; held for your instructor to look at",
-            }
-        ],
-        "hint": "this part's points wait until your instructor has compared your code with the one it "
-        "resembles (shown below); write the exercise in your own way to be paid without waiting.",
-    }
+    detail = (
+        f"{found.share:.0%} of the code of {found.definition} (names aside) is the same as {found.source}'s; "
+        "held for your instructor to look at"
+    )
+    hint = (
+        "this part's points wait until your instructor has compared your code with the one it resembles (shown "
+        "below); write the exercise in your own way to be paid without waiting."
+    )
+    return _with_step(check, _step(HELD_STEP, detail), hint, held=found.as_dict())
 
 
 def _rescore(verdict, registry):
     exercise = registry.exercises[verdict["exercise"]]
     points = sum(check.get("weight", 0) for check in verdict["checks"] if check["passed"] and not check.get("held"))
-    verdict.update(
-        points=points, passed=points == exercise.points, fraction=points / exercise.points if exercise.points else 1.0
-    )
+    fraction = points / exercise.points if exercise.points else 1.0
+    verdict.update(points=points, passed=points == exercise.points, fraction=fraction)
     return verdict
 
 
 def _student_frames(traceback):
-    """The lines of a traceback that are about the student's code: the header and the frames of the
-    interpreter's own machinery (IPython's ``run_code``, libraries) are left out, the error line kept."""
+    """The lines of a traceback about the student's code (not its header, nor IPython's or libraries' frames)."""
     kept, skipping = [], False
     for line in traceback.splitlines():
         if line.startswith("Traceback (most recent call last)"):
@@ -233,25 +202,26 @@ def _student_frames(traceback):
     return kept
 
 
-def _released_cells():
-    """The code cells of the packaged student release, each with its whitespace collapsed: a cell of a
-    submission among them is one the student never changed."""
-    if not hasattr(_released_cells, "value"):
-        from ...student_notebooks import paths
+@functools.cache
+def _release_code():
+    """The code cells of the packaged student release."""
+    from ...student_notebooks import paths
 
-        _released_cells.value = {" ".join(c.split()) for p in paths() for c in read_cells(Path(str(p)))[0]}
-    return _released_cells.value
+    return [cell for path in paths() for cell in read_cells(Path(str(path)))[0]]
+
+
+@functools.cache
+def _released_cells():
+    """The release's code cells, whitespace collapsed: a submission's cell among them was never changed."""
+    return {" ".join(cell.split()) for cell in _release_code()}
 
 
 def _untouched(error, code):
-    """Whether a cell that raised is work not done: it still raises NotImplementedError, or it is a cell of the
-    release the student never changed (its error comes from a stub above it, or from a branch not chosen)."""
+    """Whether a cell that raised is work not done: a stub's NotImplementedError, or a release cell left as is."""
     if error.get("kind") == "NotImplementedError":
         return True
     cell = error.get("cell")
-    if not isinstance(cell, int) or not 0 <= cell < len(code):
-        return False
-    return " ".join(code[cell].split()) in _released_cells()
+    return isinstance(cell, int) and 0 <= cell < len(code) and " ".join(code[cell].split()) in _released_cells()
 
 
 def _run_problems(name, ran, code=()):
@@ -292,8 +262,7 @@ def _profiles(registry):
 
 
 def solutions(folder):
-    """The instructor notebooks of `folder` as :func:`labkit.grading.submission.known.corpus` takes them: a tuple of
-    (notebook name, tuple of its code cells); ValueError when the folder holds none."""
+    """`folder`'s instructor notebooks, ((name, code cells), ...) as :func:`.known.corpus` takes them, or ValueError."""
     folder = Path(folder)
     notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
     if not notebooks:
@@ -312,14 +281,12 @@ def _solutions(stamps):
 
 
 def known_sources(registry, folder=None):
-    """The known sources a graded part's code is compared with (:func:`labkit.grading.submission.known.corpus`):
-    labkit's, the refused modules' and, with `folder`, the instructor notebooks'."""
+    """The known code a part's is compared with: labkit's, the refused modules' and `folder`'s notebooks'."""
     return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
 
 
 def judge_known(check, part, code, registry, options):
-    """A part's check, held for a person when it passed and its code is mostly known code
-    (:func:`labkit.grading.submission.known.match`); else as it was. `code` is the notebook's code cells."""
+    """A part's check, held for a person when it passed and its code (`code`: the cells) is mostly known code."""
     if not check["passed"] or part.refused is None:
         return check
     try:
@@ -338,8 +305,7 @@ def _judge_reached(check, reached, registry, options):
 
 
 def judge_plain(check, part, code, registry, options):
-    """A part without a refusal (a plot, a table of values), held when the code that draws it is mostly known
-    code (:func:`labkit.grading.submission.holding.judge_plain`)."""
+    """A part without a refusal (a plot, a table), held when the code that draws it is mostly known code."""
     judge = lambda check, reached: _judge_reached(check, reached, registry, options)
     return holding.judge_plain(check, part, code, registry_graded(registry), judge)
 
@@ -352,12 +318,9 @@ def registry_graded(registry):
     return registry_graded.value
 
 
+@functools.cache
 def _release_grams():
-    if not hasattr(_release_grams, "value"):
-        from ...student_notebooks import paths
-
-        _release_grams.value = known.release_grams([c for p in paths() for c in read_cells(Path(str(p)))[0]])
-    return _release_grams.value
+    return known.release_grams(_release_code())
 
 
 def _for_sandbox(profiles):
@@ -365,8 +328,7 @@ def _for_sandbox(profiles):
 
 
 def graded_functions(exercise):
-    """The names of an exercise whose source the grade keeps, if the notebook defines them with ``def``:
-    its names and the names its parts scan, in order."""
+    """The names whose ``def`` source the grade keeps: the exercise's and those its parts scan, in order."""
     names = list(exercise.names) + [name for part in exercise.parts for name in part.scanned]
     return [name for name in dict.fromkeys(names) if name.isidentifier()]
 
@@ -374,16 +336,9 @@ def graded_functions(exercise):
 def grade_notebook(
     path, options=None, *, deadline=None, skip=(), profiles=None, answers=None, sources=None, variant=None
 ):
-    """Run one notebook in the sandbox and check it; returns ({exercise: grade dict}, [problems]).
-
-    `options` (a :class:`GradeOptions`, the defaults when None) bound it;
-    `deadline` (monotonic) is the submission's; exercises in `skip` are not
-    checked here. The notebook's answers in words go into `answers`
-    ({grade id: text}) when it is given, and the source of each graded
-    function it defines (read with ``ast``, never run) into `sources`
-    ({function name: text}), unless an earlier notebook gave it. `variant`
-    ({exercise (text): {parameter: value}}) is the student's own data; a
-    notebook holding another's is named as a problem of its own."""
+    """Run one notebook in the sandbox and check it: ({exercise: grade dict}, [problems]). `deadline` (monotonic)
+    is the submission's; exercises in `skip` are not checked. Answers in words go into `answers` and the source of
+    each graded function not yet there into `sources`, when given; `variant` is the student's own data."""
     options = _options(options)
     deadline = deadline if deadline is not None else time.monotonic() + options.total_timeout
     registry = load_registry(options.exercises)
@@ -417,13 +372,16 @@ def grade_notebook(
         with timings.phase("sandbox start"):
             notebook = remote.NotebookHandle(options, deadline, _for_sandbox(profiles), registry.passable)
     except remote.NotebookTimeout:  # its sandbox was still starting when the submission's time ran out
-        text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
-        return {}, [ProblemText.one(text, TIMEOUT)]
+        return {}, [_stopped(name, options)]
     except remote.WorkerError as exc:
         return {}, [ProblemText.one(f"{name}: the sandbox could not start ({exc}).", OTHER)]
     with notebook:
         graded = _Graded(name, notebook, code, registry, profiles, options)
         return _grade_in(graded, numbers, variant)
+
+
+def _stopped(name, options):
+    return ProblemText.one(f"{name}: stopped after the submission's time limit of {options.total_timeout} s.", TIMEOUT)
 
 
 @dataclass(frozen=True)
@@ -441,14 +399,12 @@ class _Graded:
 def _grade_in(graded, numbers, variant):
     """Run the notebook's cells in its sandbox, then check exercises `numbers`: (results, problems)."""
     name, notebook, code, options = graded.name, graded.notebook, graded.code, graded.options
+    run = {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}
     try:
         with timings.phase("cells"):
-            ran = notebook.request(
-                {"op": "run", "cells": code, "cell_timeout": options.cell_timeout}, options.total_timeout
-            )
+            ran = notebook.request(run, options.total_timeout)
     except remote.NotebookTimeout:
-        text = f"{name}: stopped after the submission's time limit of {options.total_timeout} s."
-        return {}, [ProblemText.one(text, TIMEOUT)]
+        return {}, [_stopped(name, options)]
     except remote.CellTimeout as exc:
         return {}, [ProblemText.one(f"{name}: {exc}.", TIMEOUT)]
     except remote.WorkerError as exc:
@@ -472,10 +428,8 @@ def _grade_in(graded, numbers, variant):
 
 
 def _check_exercise(graded, number, variant, problems):
-    """Exercise `number`'s grade dict (voided when the notebook tampered); a notebook that holds another
-    variant's data (`variant`: the student's own) is named in `problems`."""
-    notebook, registry = graded.notebook, graded.registry
-    exercise = registry.exercises[number]
+    """Exercise `number`'s grade dict; holding data other than `variant` (the student's) is named in `problems`."""
+    notebook, registry, exercise = graded.notebook, graded.registry, graded.registry.exercises[number]
     if notebook.tampered:
         checks = [_voided(part, notebook.tampered) for part in exercise.parts]
         return _rescore({"exercise": number, "defined": True, "checks": checks}, registry)
@@ -499,8 +453,7 @@ def _check_exercise(graded, number, variant, problems):
 
 
 def _judge_code(verdict, exercise, code, profiles, registry, options):
-    """Each part of `verdict`: failed for a refused reference in its code or a name code run from a string may
-    define, held when its code is known (plain parts: when they reach known code)."""
+    """Each part's check in `verdict`, failed for a refused reference or a string run as code, held for known code."""
     for index, part in enumerate(exercise.parts):
         check = verdict["checks"][index]
         if part.refused is None:
@@ -543,25 +496,16 @@ def submission_name(path):
 
 
 def grade_submission(path, options=None, *, profiles=None, name=None):
-    """Grade one submission (a notebook or a folder of them), scored with the options' rubric (else the lab's).
-
-    `options` (a :class:`GradeOptions`, the defaults when None) bound it. One
-    time limit covers every notebook of the submission. `name` is the submission's name in the run (its
-    folder's by default): with variants, its data are the options' for that name."""
+    """Grade one submission (a notebook or a folder of them) with the options' rubric (else the lab's); `name` (its
+    folder's by default) picks its variant's data."""
     options = _options(options)
-    rubric = None
-    if options.rubric is not None:
-        from ..store.rubric import load
-
-        rubric = load(options.rubric)
+    rubric = rubrics.load(options.rubric) if options.rubric is not None else None
     deadline = time.monotonic() + options.total_timeout
     grade = SubmissionGrade(submission_name(path) if name is None else str(name), seed=options.seed)
-    variant = None
-    if options.variants is not None:
-        variant = options.variants.get(grade.name)
-        if variant is None:
-            grade.failure = "no variant in this run's roster: add the submission to the roster and grade again."
-            return grade
+    variant = options.variants.get(grade.name) if options.variants is not None else None
+    if options.variants is not None and variant is None:
+        grade.failure = "no variant in this run's roster: add the submission to the roster and grade again."
+        return grade
     if rubric is not None:
         grade.rubric = rubric
     try:
@@ -569,19 +513,11 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
     except ValueError as exc:
         grade.problems.append(ProblemText.one(str(exc), OTHER))
         return grade
+    shared = {"deadline": deadline, "profiles": profiles, "answers": grade.answers, "sources": grade.sources}
     for notebook in notebooks:
         claimed = {n for n, verdict in grade.results.items() if verdict.defined}
         with timings.phase("notebooks"):
-            results, problems = grade_notebook(
-                notebook,
-                options=options,
-                deadline=deadline,
-                skip=claimed,
-                profiles=profiles,
-                answers=grade.answers,
-                sources=grade.sources,
-                variant=variant,
-            )
+            results, problems = grade_notebook(notebook, options, skip=claimed, variant=variant, **shared)
         grade.problems.extend(problems)
         for number, verdict in results.items():
             # an exercise counts from the first notebook that defines its names (or else the first to mention it)
@@ -592,8 +528,7 @@ def grade_submission(path, options=None, *, profiles=None, name=None):
 
 
 def main(argv=None):
-    """Grade the submission a spec file describes; write its result file (started by
-    :mod:`labkit.grading.run.processes`)."""
+    """Grade the submission a spec file describes and write its result file (:mod:`labkit.grading.run.processes`)."""
     argv = sys.argv[1:] if argv is None else argv
     spec = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     profiles = json.loads(Path(spec["profiles"]).read_text(encoding="utf-8"))
