@@ -126,7 +126,7 @@ def test_the_tests_mirror_the_packages():
 
 def package_of(module, known):
     """The subpackage a module belongs to: `labkit.grading.<room>` inside the grader, `labkit.<part>` elsewhere;
-    a top-level module (labkit/cli.py, labkit/grading/options.py) stands for itself."""
+    a top-level module (labkit/errors.py, labkit/grading/options.py) stands for itself."""
     parts = module.split(".")
     for depth in (3, 2):
         prefix = ".".join(parts[:depth])

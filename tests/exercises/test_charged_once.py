@@ -166,7 +166,7 @@ def test_the_sandbox_charges_the_issues_three_slips_once(tmp_path):
     grades = grading.grade(folders, tmp_path / "out", grading.GradeOptions(seed=SEED, jobs=2), progress=False)
     rubric = default()
     for grade, (entry, (number, part), downstream) in zip(grades, GRADED):
-        failed = {(n, c["name"]) for n, v in grade.results.items() for c in v.parts if not c.passed}
+        failed = {(n, c.name) for n, v in grade.results.items() for c in v.parts if not c.passed}
         assert failed == {(number, part)}, (entry.name, grade.feedback())
         assert grade.points[downstream] == rubric.points[downstream], grade.feedback()
 

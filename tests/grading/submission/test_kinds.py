@@ -316,7 +316,7 @@ def graded_class(tmp_path_factory):
 
 
 def _outcomes(grade, number=16):
-    return {check["name"]: class_report.check_outcome(check.as_dict()) for check in grade.results[number].parts}
+    return {check.name: class_report.check_outcome(check.as_dict()) for check in grade.results[number].parts}
 
 
 def _kinds_by_student(summary):
