@@ -1,18 +1,7 @@
-"""What only a person can mark: answers in words, held parts and excused exercises (``labkit mark``).
+"""What only a person can mark, as a page: answers in words, held parts and excused exercises (``labkit mark``).
 
-A mark is one row of ``marks.csv``, ``submission,item,points,comment``:
-
-* ``exercise12-answer-1`` (an answer's nbgrader grade id, as in grades.csv's "to read" columns) with
-  points between 0 and what the rubric's ``[answers]`` table gives it;
-* ``exercise2/eval_pherm`` (a part held for a person, :mod:`labkit.grading.submission.known`) with ``release``
-  (its points are paid) or ``keep`` (they are not);
-* ``exercise12`` with ``excused`` (out of the student's total and full credit) or ``counted`` (back in).
-
-:func:`import_marks` checks every row against the run (its recorded rubric, its submissions, what each
-item is worth) before it changes anything; then each marked submission's result (which holds its marks,
-each with the time it was first imported), feedback and the run's record and grades.csv are written
-again. A row equal to the mark already held changes nothing, so importing twice is importing once; a
-later mark of the same item replaces the earlier one.
+The page writes ``marks.csv``; :mod:`labkit.grading.store.marks` says what a row holds and reads it into the
+run (``labkit mark OUT --import marks.csv``).
 """
 
 import functools
