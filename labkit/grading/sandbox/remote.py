@@ -1,12 +1,8 @@
 """The grader's handle on one sandboxed notebook: start it, run it, call into it, stop it.
 
-:class:`NotebookHandle` starts the worker (:mod:`labkit.grading.sandbox.worker`) in the sandbox of the backend its
-:class:`Settings` name, reads its answers with a deadline and a size limit, and stops every process of the sandbox
-when it is done, stuck or misbehaving. :class:`Namespace` is the mapping the checks read: a function comes back
-as a :class:`Function` proxy that forwards each call into the sandbox, data as plain numbers, so the checks of
-:mod:`labkit.exercises` run unchanged here, never in the student's process. Time limits are types of their own:
-:class:`NotebookTimeout` (the submission's total time is used up) and :class:`CellTimeout` (one cell, request or
-call ran past its own limit).
+:class:`NotebookHandle` runs the worker (:mod:`labkit.grading.sandbox.worker`) in a sandbox; :class:`Namespace` is
+the mapping the checks read, its functions :class:`Function` proxies that call into the sandbox, so the checks of
+:mod:`labkit.exercises` run unchanged here, never in the student's process.
 """
 
 import contextlib
@@ -141,15 +137,11 @@ class NotebookHandle:
     def __exit__(self, *exc):
         self.close()
 
-    def peak_memory(self):
-        return self.box.peak_memory()
-
     def close(self):
         """Stop the worker and everything it started; nothing of it is left on the machine."""
         self.box.stop()
         if self.stopped is None and not self.box.closed and self.box.out_of_memory():
-            self.stopped = "the notebook ran out of memory"
-            self.stopped_kind = CRASH
+            self.stopped, self.stopped_kind = "the notebook ran out of memory", CRASH
         self.box.close()
 
     def _stop(self, why, error=WorkerError):
@@ -165,11 +157,22 @@ class NotebookHandle:
         try:
             self.process.stdin.write(protocol.dumps({**message, "id": rid}))
             self.process.stdin.flush()
-        except (BrokenPipeError, OSError):
+        except OSError:
             self._stop(self._ended())
         until = min(self.deadline, time.monotonic() + timeout)
         while True:
-            line = self._read_line(until)
+            try:
+                line = self._lines.readline(until)
+            except TimeoutError:
+                error = NotebookTimeout if until >= self.deadline else CellTimeout
+                limit = "total time limit" if error.total else "time limit"
+                self._stop(f"stopped after the {limit}: the notebook did not answer in time", error)
+            except protocol.ProtocolError:
+                self._stop("the notebook's process sent an answer larger than the protocol allows")
+            if line is None:
+                with contextlib.suppress(subprocess.TimeoutExpired):
+                    self.process.wait(timeout=5)
+                self._stop(self._ended())
             try:
                 answer = protocol.loads(line)
             except protocol.ProtocolError as exc:
@@ -200,21 +203,6 @@ class NotebookHandle:
             return "the notebook's process stopped answering"
         return protocol.ended(-code if code < 0 else None, code)
 
-    def _read_line(self, until):
-        try:
-            line = self._lines.readline(until)
-        except TimeoutError:
-            if until >= self.deadline:
-                self._stop("stopped after the total time limit: the notebook did not answer in time", NotebookTimeout)
-            self._stop("stopped after the time limit: the notebook did not answer in time", CellTimeout)
-        except protocol.ProtocolError:
-            self._stop("the notebook's process sent an answer larger than the protocol allows")
-        if line is None:
-            with contextlib.suppress(subprocess.TimeoutExpired):
-                self.process.wait(timeout=5)
-            self._stop(self._ended())
-        return line
-
 
 class Function:
     """Calls the student's function of this name inside the sandbox, with `refusal` switched off."""
@@ -233,8 +221,7 @@ class Function:
             "profile": self.refusal.name if self.refusal is not None and not _UNWATCHED else None,
             "passables": sorted(protocol.function_names(tags)),
         }
-        answer = self.notebook.answered(request, self.timeout + 5)
-        return _value(answer)
+        return _value(self.notebook.answered(request, self.timeout + 5))
 
     def __repr__(self):
         return f"<student function {self.name} in the sandbox>"
@@ -277,10 +264,8 @@ class Namespace:
         if name not in self._kinds:
             try:
                 with timings.phase("reads"):
-                    answer = self.notebook.request({"op": "names", "names": [name]}, self.timeout)
-                kind = (
-                    answer.get("names", {}).get(name, "missing") if isinstance(answer.get("names"), dict) else "missing"
-                )
+                    names = self.notebook.request({"op": "names", "names": [name]}, self.timeout).get("names")
+                kind = names.get(name) if isinstance(names, dict) else None
             except WorkerError:
                 kind = "function"  # every call on it then says why the notebook cannot answer
             self._kinds[name] = kind if kind in ("function", "data") else "missing"
