@@ -1,17 +1,13 @@
 """The sandboxed side of grading: a pristine supervisor and the notebook's process it watches.
 
-Run as ``python -I -m labkit.grading.sandbox.worker [UID]`` in a backend's sandbox; started as root it becomes
-UID, an otherwise unused uid, so the sandbox's process limit holds. The **supervisor** holds the grader's pipes,
-imports what notebooks need once and never runs a line of student code. It forks the **notebook's process**,
-which installs the watch (:mod:`labkit.grading.sandbox.guard`) before anything else, closes the grader's pipes,
-runs the cells and answers, through the supervisor, one JSON line per request (:mod:`.protocol`): ``setup``
-(what the watch refuses and the functions the checks may hand over; always first), ``run`` (the cells, each
-interrupted after ``cell_timeout``), ``names``, ``get`` and ``call`` (with a ``profile`` refused).
-
-The supervisor forwards an answer only with the watch's valid attestation for that very request (its profile,
-the functions handed over, a digest of the answer); a refused call, tampering, a time limit or a dead notebook it
-answers itself. A dead notebook's process is replaced at the next request, which runs the cells again, so one
-bad call costs only its own part. All of it is evidence only: the grader checks it and computes every score.
+Run as ``python -I -m labkit.grading.sandbox.worker [UID]`` in a backend's sandbox (as root it becomes UID, an
+otherwise unused uid, so the sandbox's process limit holds). The **supervisor** holds the grader's pipes, imports
+what notebooks need once and never runs student code. It forks the **notebook's process**, which installs the
+watch (:mod:`labkit.grading.sandbox.guard`) first and answers one JSON line per request (:mod:`.protocol`):
+``setup`` (always first), ``run``, ``names``, ``get`` and ``call``. The supervisor forwards only answers the
+watch attests for that very request; a refused call, tampering, a time limit or a dead notebook it answers
+itself, and a dead notebook's process is replaced at the next request, which runs the cells again. The grader
+checks all of it and computes every score.
 """
 
 import contextlib
@@ -58,16 +54,10 @@ def _alarm(signum, frame):
     raise _Interrupted()
 
 
-def _error(kind, message, refused=None):
-    return {"error": {"kind": kind, "message": message, "refused": refused}}
-
-
-def _grader_error(kind, message):
-    """The supervisor's own error, marked as the grader's: the grader trusts the mark, never a kind's name, which a
-    student's exception may share."""
-    answer = _error(kind, message)
-    answer["error"]["grader"] = True
-    return answer
+def _error(kind, message, refused=None, **marks):
+    """An error answer; the supervisor's own are marked ``grader=True``: the grader trusts the mark, never a kind's
+    name, which a student's exception may share."""
+    return {"error": {"kind": kind, "message": message, "refused": refused, **marks}}
 
 
 def _describe(exc):
@@ -282,31 +272,30 @@ class Supervisor:
         for fd in (self.child["requests"], self.child["answers"].fd, self.child["verdicts"].fd):
             os.close(fd)
         self.child = None
-        self.ended = why or _ended(status)
+        signal_number = os.WTERMSIG(status) if os.WIFSIGNALED(status) else None
+        self.ended = why or protocol.ended(signal_number, os.WEXITSTATUS(status))
 
     def _ensure_child(self, op):
         if self.child is not None:
             return None
         if self.setup is None:
             return _error("ProtocolError", "the first request must be setup")
-        if self.run_request is not None and op != "run":
-            if self.restarts >= RESTARTS:
-                return _grader_error("WorkerError", f"{self.ended}; no more answers from this notebook")
-            self.restarts += 1
+        if self.run_request is None or op == "run":
             self.start()
-            replayed = self._exchange(self.run_request, None)  # the cells again, in a new process
-            if self.child is None:
-                return _grader_error("WorkerError", f"{self.ended} while its cells ran again")
-            if "errors" not in replayed and "error" in replayed:
-                return replayed
             return None
+        if self.restarts >= RESTARTS:
+            return _error("WorkerError", f"{self.ended}; no more answers from this notebook", grader=True)
+        self.restarts += 1
         self.start()
-        return None
+        replayed = self._exchange(self.run_request, None)  # the cells again, in a new process
+        if self.child is None:
+            return _error("WorkerError", f"{self.ended} while its cells ran again", grader=True)
+        return replayed if "errors" not in replayed and "error" in replayed else None
 
     def forward(self, request):
         op = request.get("op")
         if self.tampered:
-            return _grader_error("Tampered", self._tamper_text())
+            return _error("Tampered", self._tamper_text(), grader=True)
         if op == "run":
             self.run_request = request
         problem = self._ensure_child(op)
@@ -317,17 +306,14 @@ class Supervisor:
 
     def _exchange(self, request, timeout):
         """Send one request to the notebook's process; its attested answer, or the supervisor's own."""
-        rid = str(request.get("id"))
-        profile = request.get("profile") if request.get("op") == "call" else None
-        if request.get("op") == "run":
-            profile = guard.RUN
-        passables = [str(p) for p in request.get("passables", ())] if request.get("op") == "call" else []
+        op = request.get("op")
+        profile = guard.RUN if op == "run" else request.get("profile") if op == "call" else None
+        passables = [str(p) for p in request.get("passables", ())] if op == "call" else []
         message = {**request, "profile": profile, "passables": passables}
         try:
             protocol.write_all(self.child["requests"], protocol.dumps(message))
         except OSError:
-            self.stop()
-            return _grader_error("WorkerError", self.ended)
+            return self._stopped()
         until = None if timeout is None else time.monotonic() + float(timeout) + 1.0
         answers, verdicts = self.child["answers"], self.child["verdicts"]
         while True:
@@ -338,32 +324,31 @@ class Supervisor:
                     if remaining is not None and remaining <= 0:
                         raise TimeoutError()
                     ready = select.select([answers.fd, verdicts.fd], [], [], remaining)[0]
-                    if verdicts.fd in ready:
-                        verdicts.pump()
-                        if self._read_verdicts():
-                            self.stop("the grader's watch reported tampering")
-                            return _grader_error("Tampered", self._tamper_text())
+                    if verdicts.fd in ready and self._read_verdicts():
+                        self.stop("the grader's watch reported tampering")
+                        return _error("Tampered", self._tamper_text(), grader=True)
                     if answers.fd in ready:
                         break
                 line = answers.readline(until)
             except TimeoutError:
                 self.stop("stopped after the time limit: the notebook did not answer in time")
-                answer = _grader_error("Timeout", "interrupted: it ran longer than the time limit")
-                answer["error"]["timeout"] = True  # the grader raises its CellTimeout for this mark, not the words
-                return answer
+                # the grader raises its CellTimeout for the timeout mark, not the words
+                return _error("Timeout", "interrupted: it ran longer than the time limit", grader=True, timeout=True)
             except protocol.ProtocolError as exc:
-                self.stop(f"the notebook's process answered out of protocol ({exc})")
-                return _grader_error("WorkerError", self.ended)
+                return self._stopped(f"the notebook's process answered out of protocol ({exc})")
             if line is None:
-                self.stop()
-                return _grader_error("WorkerError", self.ended)
+                return self._stopped()
             try:
                 answer = protocol.loads(line)
             except protocol.ProtocolError:
                 continue  # not an answer: something the notebook wrote itself
-            if isinstance(answer, dict) and answer.get("id") == request.get("id"):
-                break
-        return self._verified(answer, line + b"\n", rid, profile, passables)
+            if answer.get("id") == request.get("id"):
+                return self._verified(answer, line + b"\n", str(request.get("id")), profile, passables)
+
+    def _stopped(self, why=None):
+        """Stop the notebook's process; the grader's error saying how it ended."""
+        self.stop(why)
+        return _error("WorkerError", self.ended, grader=True)
 
     def _tamper_text(self):
         return (
@@ -387,25 +372,19 @@ class Supervisor:
         expected = guard.attestation_text(rid, profile, passables, None, hashlib.sha256(payload).hexdigest())
         if self._read_verdicts():
             self.stop("the grader's watch reported tampering")
-            return _grader_error("Tampered", self._tamper_text())
+            return _error("Tampered", self._tamper_text(), grader=True)
         pending, self.child["attestations"] = self.child["attestations"], []
         # exactly one line may speak for this request, and it must be the watch's: a second one, or one
         # that does not verify, means the notebook found the request's id and wrote to the watch's pipe
         mine = [text.split("\t") for text in pending if text.split("\t", 1)[0] == expected[0]]
-        if len(mine) != 1:
-            return _grader_error(
-                "Tampered",
-                "the answer came without the grader's watch (it was switched off, or the answer was forged)"
-                if not mine
-                else "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers",
-            )
-        parts = mine[0]
-        *fields, signature = parts if len(parts) == 6 else ([""] * 6)
+        if not mine:
+            why = "the answer came without the grader's watch (it was switched off, or the answer was forged)"
+            return _error("Tampered", why, grader=True)
+        *fields, signature = mine[0] if len(mine[0]) == 6 else [""] * 6
         matches = [fields[i] for i in (0, 1, 2, 4)] == [expected[i] for i in (0, 1, 2, 4)]  # all but the status
-        if not matches or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
-            return _grader_error(
-                "Tampered", "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers"
-            )
+        if len(mine) > 1 or not matches or not hmac.compare_digest(signature, guard.sign(self.secret, *fields)):
+            why = "the notebook wrote to the grader's watch, so the grader cannot vouch for its answers"
+            return _error("Tampered", why, grader=True)
         status = fields[3]
         if status == "clean":
             if isinstance(answer.get("error"), dict):  # only the supervisor speaks as the grader
@@ -418,11 +397,7 @@ class Supervisor:
                 "RefusedReference", f"called {detail}, which is switched off while this part is graded", detail
             )
         self.tampered = self.tampered or detail
-        return _grader_error("Tampered", self._tamper_text())
-
-
-def _ended(status):
-    return protocol.ended(os.WTERMSIG(status) if os.WIFSIGNALED(status) else None, os.WEXITSTATUS(status))
+        return _error("Tampered", self._tamper_text(), grader=True)
 
 
 def drop_privileges(uid):
@@ -435,12 +410,10 @@ def drop_privileges(uid):
 
 def not_dumpable():
     """No other process of the sandbox's user may read or write this one's memory (PR_SET_DUMPABLE 0)."""
-    try:
+    with contextlib.suppress(OSError, AttributeError):
         import ctypes
 
         ctypes.CDLL(None, use_errno=True).prctl(4, 0, 0, 0, 0)
-    except (OSError, AttributeError):
-        pass
 
 
 def preload(everything=False):
