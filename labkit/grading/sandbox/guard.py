@@ -1,21 +1,13 @@
 """The watch over a notebook's process while it is graded (the sandbox's side).
 
-Anything a notebook's cells leave behind (a patched module, a saved code object, rewritten grading code) lives
-in its process, so the pristine supervisor (:mod:`labkit.grading.sandbox.worker`) installs the watch before the
-first cell, and nothing of it is reachable from Python afterwards:
-
-* an **audit hook** (it cannot be removed or listed) holds the watch's state and signing key. It reports
-  *tampering* at once on a pipe the supervisor reads (switching the profile hook off, the garbage collector's
-  lists, ctypes, new processes, new code objects, a replaced ``__code__``); from then on nothing the notebook
-  does counts, even if it reads the process's memory. It also takes the worker's sentinels (``labkit.begin``,
-  ``labkit.chosen``, ``labkit.end``), accepted only from the pristine code of the serving functions;
-* during a graded request a **profile hook**, set through the C API (``sys.getprofile()`` stays None: nothing
-  to fetch), notes every call of a refused function, recognised by a digest of its code computed from the
-  library's files (a subclass, a saved code object, a private helper or a pasted copy are caught alike); the
-  refused modules' compiled routines are replaced for the length of the request;
-* after each answer the audit hook writes a signed **attestation** (request, profile, functions handed over,
-  clean or the first refusal, digest of the answer) with a key that never existed in the notebook's memory
-  outside the watch. The supervisor forwards only attested answers.
+The pristine supervisor (:mod:`labkit.grading.sandbox.worker`) installs it before the first cell, and nothing of
+it is reachable from Python afterwards. An **audit hook** (it cannot be removed or listed) holds its state and
+key, reports *tampering* at once on a pipe the supervisor reads (from then on nothing the notebook does counts),
+and takes the worker's sentinels (``labkit.begin``, ``labkit.chosen``, ``labkit.end``) only from the pristine
+serving code. During a graded request a **profile hook**, set through the C API, notes every call of a refused
+function, recognised by a digest of its code (:func:`code_key`); the refused modules' compiled routines are
+replaced for the request. After each answer the audit hook writes a signed **attestation**, and the supervisor
+forwards only attested answers.
 
 Neither hook touches a student's object (no attribute, comparison or hash): they read code objects, frames and
 exact built-in types, with the garbage collector off, so no student code runs while the watch's frames are on
@@ -234,10 +226,8 @@ def install(secret, verdict_fd, profiles, passables, chain):
 
     Its code runs in a private copy of this module's namespace and builtins, so no name it looks up can be
     rebound by a notebook; the functions student code can hold (:data:`EXPOSED`) get another copy, so their
-    ``__globals__`` lead nowhere. `profiles`: name -> ``(names, modules, c_names)``, the refused Python code as
-    {:func:`code_key`: readable name}, refused module prefixes and refused compiled ``(module, name)``.
-    `passables`: name -> pristine function; each gets a copy with its own code object, trusted (not what it calls)
-    only during its request and only through the function handed over, which makes its arguments plain numbers.
+    ``__globals__`` lead nowhere. `profiles`: as :func:`unwire` returns them. `passables`: name -> pristine
+    function, trusted (not what it calls) only during its request and only through the function handed over.
     `chain`: the pristine code of the serving functions, innermost first, that must raise the sentinels.
     """
     private = dict(globals())
@@ -289,12 +279,10 @@ def _kept_profiles(profiles):
     profiles = {
         name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in profiles.items()
     }
-    union = ({}, set(), set())
-    for names, mods, c_names in profiles.values():
-        union[0].update(names)
-        union[1].update(mods)
-        union[2].update(c_names)
-    return profiles, (union[0], tuple(union[1]), frozenset(union[2]))
+    kept = profiles.values()
+    names = {key: text for each, _, _ in kept for key, text in each.items()}
+    mods = tuple({prefix for _, each, _ in kept for prefix in each})
+    return profiles, (names, mods, frozenset().union(*(each for _, _, each in kept)))
 
 
 def _refused_objects(profiles):
@@ -505,14 +493,8 @@ def _choose(state, args):
             handoff[passable] = handed
             live.add(code)
     profile = None if name in (None, RUN) else state["profiles"].get(name, state["strictest"])
-    state.update(
-        rid=rid,
-        name=name,
-        profile=profile,
-        passables=tuple(wanted),
-        live=frozenset(live),
-        mode=RUN if name == RUN else "graded",
-    )
+    state.update(rid=rid, name=name, profile=profile, passables=tuple(wanted), live=frozenset(live))
+    state["mode"] = RUN if name == RUN else "graded"
     # cells: watched for tampering only, at full speed; the walk over the modules runs unprofiled (no student code)
     state["set_profile"](None, None)
     if name == RUN:
@@ -531,13 +513,8 @@ def _end(state, args):
     state["set_profile"](None, None)
     _forget(state)
     _unstub(state)
-    status = (
-        f"tampered:{state['tampered']}"
-        if state["tampered"]
-        else f"refused:{state['refused']}"
-        if state["refused"]
-        else "clean"
-    )
+    status = f"refused:{state['refused']}" if state["refused"] else "clean"
+    status = f"tampered:{state['tampered']}" if state["tampered"] else status
     parts = attestation_text(state["rid"], state["name"], state["passables"], status, _sha256(args[0]).hexdigest())
     state.update(mode="idle", rid=None, name=None, profile=None, passables=(), live=frozenset())
     if state["gc"]:
@@ -582,7 +559,9 @@ def _audit_hook(state):
 
 
 def unwire(profiles):
-    """The profiles the grader sent (:func:`labkit.grading.submission.refusals.wire`) as :func:`install` takes them."""
+    """The profiles the grader sent (:func:`labkit.grading.submission.refusals.wire`) as :func:`install` takes them:
+    name -> ``(names, modules, c_names)``, the refused Python code as {:func:`code_key`: readable name}, refused
+    module prefixes and refused compiled ``(module, name)``."""
     return {
         name: (
             {bytes.fromhex(key): text for key, text in profile["names"].items()},

@@ -15,12 +15,15 @@ float, anything else a :class:`NotNumbers` that fails every comparison. Nothing 
 
 import base64
 import functools
+import importlib
 import json
 import math
 import os
 import select
 import signal
+import sys
 import time
+import types
 
 import numpy as np
 
@@ -106,8 +109,6 @@ def encode(value, passable=frozenset(), depth=0):
 
 def _is_plot(value):
     """A matplotlib Axes or Figure (matplotlib is only imported if the notebook did)."""
-    import sys
-
     module = sys.modules.get("matplotlib.artist")
     return (
         module is not None
@@ -168,9 +169,6 @@ def dumps(message):
 
 def passable(name):
     """The pristine labkit function a ``["fn", name]`` stands for (the watch copies it before any cell runs)."""
-    import importlib
-    import types
-
     module, _, attribute = str(name).partition(":")
     if not module.startswith("labkit.") or module.startswith("labkit.grading") or not attribute.isidentifier():
         raise ProtocolError(f"{name!r} is not a labkit function the checks may pass")
@@ -215,8 +213,7 @@ def _array(tag):
         raw = base64.b64decode(tag[2], validate=True)
     except ValueError:
         raise ProtocolError("array data is not base64") from None
-    arr = np.frombuffer(raw, dtype="<f8").astype(float).reshape(shape)
-    return arr
+    return np.frombuffer(raw, dtype="<f8").astype(float).reshape(shape)
 
 
 def _line(item):
