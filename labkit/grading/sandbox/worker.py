@@ -71,15 +71,16 @@ def _describe(exc):
     return kind, text[:500]
 
 
-def _tail(exc, lines=40):
-    """The last lines of an exception's traceback, as the student's cell would show them."""
+def _failure(exc, lines=40):
+    """An exception as the student's cell would show it: its kind, message and the last lines of its traceback."""
     import traceback
 
+    kind, text = _describe(exc)
     try:
-        text = "".join(traceback.format_exception(exc))
+        trace = "".join(traceback.format_exception(exc))
     except Exception:  # noqa: BLE001 - a hostile exception
-        return ""
-    return "\n".join(text.rstrip().splitlines()[-lines:])[-4000:]
+        trace = ""
+    return {"kind": kind, "message": text, "traceback": "\n".join(trace.rstrip().splitlines()[-lines:])[-4000:]}
 
 
 # -- the notebook's process -----------------------------------------------------
@@ -116,17 +117,8 @@ class NotebookProcess:
             finally:
                 signal.setitimer(signal.ITIMER_REAL, 0)
             failure = (result.error_before_exec or result.error_in_exec) if result is not None else failure
-            if failure is not None:
-                kind, text = _describe(failure)
-                errors.append(
-                    {
-                        "cell": index,
-                        "kind": kind,
-                        "message": text,
-                        "traceback": _tail(failure),
-                        "timeout": isinstance(failure, _Interrupted),  # the worker's own time limit, not a name
-                    }
-                )
+            if failure is not None:  # timeout: the worker's own time limit, not a name
+                errors.append({"cell": index, **_failure(failure), "timeout": isinstance(failure, _Interrupted)})
             plt.close("all")  # as the inline backend does after each cell
         return {
             "errors": errors,
@@ -138,10 +130,7 @@ class NotebookProcess:
     def names(self, names):
         namespace, kinds = self.shell.user_ns, {}
         for name in names:
-            if name not in namespace:
-                kinds[name] = "missing"
-            else:
-                kinds[name] = "function" if callable(namespace[name]) else "data"
+            kinds[name] = "missing" if name not in namespace else "function" if callable(namespace[name]) else "data"
         return {"names": kinds}
 
     def get(self, name):
@@ -159,7 +148,7 @@ class NotebookProcess:
         except BaseException as exc:  # noqa: BLE001 - the student's error is the answer
             if isinstance(exc, SystemExit):
                 exc = RuntimeError(f"called sys.exit({exc.code!r})")
-            return {"error": {"kind": _describe(exc)[0], "message": _describe(exc)[1], "traceback": _tail(exc)}}
+            return {"error": _failure(exc)}
 
 
 def _serve_one(notebook, reader, answers):
@@ -216,25 +205,16 @@ class Supervisor:
         self.child, self.restarts, self.ended = None, 0, None
         self.tampered = None  # what the watch reported: from then on no answer of this notebook counts
 
-    def reply(self, message):
-        protocol.write_all(self.answers, protocol.dumps(message))
-
     def serve(self):
-        while True:
-            line = self.requests.readline()
-            if line is None:
-                break
+        for line in iter(self.requests.readline, None):
             request = protocol.loads(line)
-            op = request.get("op")
-            if op == "bye":
+            if request.get("op") == "bye":
                 break
-            if op == "setup":
-                self.setup = request
-                self.reply({"id": request.get("id"), "ready": True})
-                continue
-            answer = self.forward(request)
-            answer["id"] = request.get("id")
-            self.reply(answer)
+            if request.get("op") == "setup":
+                self.setup, answer = request, {"ready": True}
+            else:
+                answer = self.forward(request)
+            protocol.write_all(self.answers, protocol.dumps({**answer, "id": request.get("id")}))
         self.stop()
 
     # the notebook's process
