@@ -184,17 +184,6 @@ _CALL_FILTER = {
 SLOTS = 1 << 12  # the filter's table of code objects found clean: the slot of one is (its address >> 4) & (SLOTS - 1)
 
 
-def _frames_as_the_filter_reads_them():
-    """Whether this Python lays frames out as the filter reads them (CPython 3.11: frame->f_frame->f_code)."""
-    import ctypes
-
-    if sys.implementation.name != "cpython" or sys.version_info[:2] != (3, 11):
-        return False
-    frame = _getframe()
-    inner = ctypes.c_void_p.from_address(id(frame) + 24).value
-    return inner is not None and ctypes.c_void_p.from_address(inner + 32).value == id(frame.f_code)
-
-
 def _call_filter(hook_address):
     """(the filter's address in front of the hook at `hook_address`, its table, what keeps both alive), or
     (`hook_address`, None, None) where it cannot run: the hook then sees every event. Called while pristine."""
@@ -203,7 +192,11 @@ def _call_filter(hook_address):
     import platform
 
     parts = _CALL_FILTER.get(platform.machine())
-    if parts is None or not _frames_as_the_filter_reads_them():
+    if parts is None or sys.implementation.name != "cpython" or sys.version_info[:2] != (3, 11):
+        return hook_address, None, None
+    frame = _getframe()  # does this Python lay frames out as the filter reads them (frame->f_frame->f_code)?
+    inner = ctypes.c_void_p.from_address(id(frame) + 24).value
+    if inner is None or ctypes.c_void_p.from_address(inner + 32).value != id(frame.f_code):
         return hook_address, None, None
     table = (ctypes.c_uint64 * SLOTS)()
     table_at, hook_at = (address.to_bytes(8, "little") for address in (ctypes.addressof(table), hook_address))

@@ -320,19 +320,14 @@ class Lines:
         line, _, self.buffer = self.buffer.partition(b"\n")
         return line
 
-    def pump(self):
-        """Read what is there now (one chunk); ProtocolError when more piles up than `limit`."""
-        if select.select([self.fd], [], [], 0)[0]:
+    def available(self):
+        """Every whole line that can be read now without waiting; ProtocolError when more piles up than `limit`."""
+        while select.select([self.fd], [], [], 0)[0]:
             chunk = os.read(self.fd, 1 << 16)
             self.buffer += chunk
             if len(self.buffer) > self.limit:
                 raise ProtocolError(f"more than {self.limit} bytes written to the grader's watch")
-            return bool(chunk)
-        return False
-
-    def available(self):
-        """Every whole line that can be read now without waiting."""
-        while self.pump():
-            pass
+            if not chunk:
+                break
         *lines, self.buffer = self.buffer.split(b"\n")
         return lines

@@ -52,9 +52,7 @@ class StudentError(Exception):
 
     def __init__(self, kind, message, refused=None, traceback=""):
         super().__init__(message)
-        self.kind = kind
-        self.refused = refused
-        self.traceback = traceback
+        self.kind, self.refused, self.traceback = kind, refused, traceback
 
 
 class CallEnded(StudentError):
