@@ -59,9 +59,6 @@ class NotNumbers:
     __repr__ = __str__
 
 
-# -- the notebook's side --------------------------------------------------------
-
-
 def _array_tag(value):
     arr = np.asarray(value)
     if arr.dtype.kind not in "biuf":
@@ -176,9 +173,6 @@ def passable(name):
     if type(found) is not types.FunctionType or (found.__module__, found.__qualname__) != (module, attribute):
         raise ProtocolError(f"{name!r} is not a module-level labkit function the checks may pass")
     return found
-
-
-# -- the grader's side -----------------------------------------------------------
 
 
 def loads(line):

@@ -83,9 +83,6 @@ def _failure(exc, lines=40):
     return {"kind": kind, "message": text, "traceback": "\n".join(trace.rstrip().splitlines()[-lines:])[-4000:]}
 
 
-# -- the notebook's process -----------------------------------------------------
-
-
 class NotebookProcess:
     """The student's namespace in an IPython shell, and the answers to the grader's requests about it."""
 
@@ -120,12 +117,8 @@ class NotebookProcess:
             if failure is not None:  # timeout: the worker's own time limit, not a name
                 errors.append({"cell": index, **_failure(failure), "timeout": isinstance(failure, _Interrupted)})
             plt.close("all")  # as the inline backend does after each cell
-        return {
-            "errors": errors,
-            "cells": len(cells),
-            "output_chars": self.output.chars,
-            "seconds": time.perf_counter() - start,
-        }
+        seconds = time.perf_counter() - start
+        return {"errors": errors, "cells": len(cells), "output_chars": self.output.chars, "seconds": seconds}
 
     def names(self, names):
         namespace, kinds = self.shell.user_ns, {}
@@ -191,9 +184,6 @@ def _notebook_main(shell, pipes, setup):
     guard.install(os.read(key, 32), pipes["verdict"][1], guard.unwire(setup["profiles"]), passables, chain=chain)
     os.close(key)
     _serve(NotebookProcess(shell, output), protocol.Lines(pipes["requests"][0]), pipes["answers"][1])
-
-
-# -- the supervisor -------------------------------------------------------------
 
 
 class Supervisor:
