@@ -102,7 +102,14 @@ class NotebookHandle:
         self._answers: dict[bytes, dict] = {}  # the answers to calls, by the call (see answered)
         self._kept = 0  # the bytes of the calls kept
         self.backend = backends.get_backend(self.options.backend)
-        self.box = self._forked() if self.options.fork_server else None
+        # a worker from this process's fork server when there is one, else from a sandbox of its own
+        self.box = forkserver.box(self.backend, self.options.limits) if self.options.fork_server else None
+        if self.box is not None:
+            try:
+                self.process = self.box.start()
+            except (forkserver.ForkServerError, OSError):
+                self.box.close()
+                self.box = None
         if self.box is None:
             self.box = self.backend.box(list(WORKER), self.options.limits)
             try:
@@ -116,18 +123,6 @@ class NotebookHandle:
                 raise
         self._lines = protocol.Lines(self.process.stdout.fileno())  # each answer at most protocol.MAX_LINE
         self.request({"op": "setup", "profiles": profiles or {}, "passables": sorted(self.passables)}, SETUP_TIMEOUT)
-
-    def _forked(self):
-        """A worker from this process's fork server, or None (then the notebook gets a sandbox the plain way)."""
-        box = forkserver.box(self.backend, self.options.limits)
-        if box is None:
-            return None
-        try:
-            self.process = box.start()
-        except (forkserver.ForkServerError, OSError):
-            box.close()
-            return None
-        return box
 
     def __enter__(self):
         return self
