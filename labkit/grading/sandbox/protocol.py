@@ -76,13 +76,11 @@ def encode(value, passable=frozenset(), depth=0):
         return ["obj", "a value nested too deeply"]
     if value is None:
         return ["none"]
-    if isinstance(value, (bool, np.bool_)):
+    if isinstance(value, (bool, np.bool_, float, np.floating)):  # booleans before int, their base class
         return ["f", float(value)]
     if isinstance(value, (int, np.integer)):
         number = int(value)
         return ["i", number] if abs(number) < 2**53 else ["f", float(number)]
-    if isinstance(value, (float, np.floating)):
-        return ["f", float(value)]
     if isinstance(value, str):
         return ["s", value[:MAX_TEXT]]
     if isinstance(value, np.ndarray):
