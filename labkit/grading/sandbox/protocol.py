@@ -135,13 +135,10 @@ def _bound(keywords):
         if not (type(key) is str and key.isidentifier()) or type(value) not in (int, float):
             return None
         try:
-            number = float(value)
+            bound[key] = float(value)
         except OverflowError:  # an integer too large for a float
             return None
-        if not math.isfinite(number):
-            return None
-        bound[key] = number
-    return bound
+    return bound if all(map(math.isfinite, bound.values())) else None
 
 
 def function_names(tags):
