@@ -207,8 +207,6 @@ class Supervisor:
             protocol.write_all(self.answers, protocol.dumps({**answer, "id": request.get("id")}))
         self.stop()
 
-    # the notebook's process
-
     def start(self):
         pipes = {name: os.pipe() for name in ("key", "verdict", "requests", "answers")}
         pid = os.fork()
