@@ -241,7 +241,7 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     """The watch itself, run in the private namespace; its state is one dict only the hooks' closures hold."""
     import ctypes
 
-    profiles, strictest = _kept_profiles(profiles)
+    strictest = _strictest(profiles)
     c_objects = _refused_objects([*profiles.values(), strictest])
     sizes, holders = _modules_as_found(c_objects)
     # what the watch was given, and what it took while the process was pristine
@@ -267,15 +267,12 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     sys.addaudithook(audit)
 
 
-def _kept_profiles(profiles):
-    """The profiles as the watch keeps them, and the strictest one: every profile's refusals together."""
-    profiles = {
-        name: (dict(names), tuple(mods), frozenset(c_names)) for name, (names, mods, c_names) in profiles.items()
-    }
+def _strictest(profiles):
+    """The strictest profile: every profile's refusals together."""
     kept = profiles.values()
     names = {key: text for each, _, _ in kept for key, text in each.items()}
     mods = tuple({prefix for _, each, _ in kept for prefix in each})
-    return profiles, (names, mods, frozenset().union(*(each for _, _, each in kept)))
+    return names, mods, frozenset().union(*(each for _, _, each in kept))
 
 
 def _refused_objects(profiles):

@@ -398,7 +398,6 @@ def preload(everything=False):
     from IPython.core.interactiveshell import InteractiveShell
     from traitlets.config import Config
 
-    import labkit
     import labkit.plotdata  # noqa: F401 - what encode reads plots with
 
     # only in a fork server: a plain worker would pay for them in the notebook's time, imported or not
