@@ -1,13 +1,10 @@
 """The grader's side of the fork server: imports paid once per run, not once per notebook.
 
-A plain worker (:meth:`.backends.base.Backend.box`) costs a new sandbox and a Python that imports numpy, scipy,
-matplotlib, IPython and labkit: most of a submission's grading time. A :class:`ForkServer` runs one zygote
-(:mod:`labkit.grading.sandbox.zygote`) that imports all of that once and forks each notebook a worker isolated
-from every other notebook before any student code runs. A grading run starts one and passes its socket to each
-grading process (descriptor in :data:`ENV`), where :func:`box` makes a :class:`ForkedBox`. Without a server, or
-when it cannot give a worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
-Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (the default one as root);
-``--no-fork-server`` keeps the plain way.
+A :class:`ForkServer` runs one zygote (:mod:`labkit.grading.sandbox.zygote`) that imports numpy, scipy,
+matplotlib, IPython and labkit once and forks each notebook a worker isolated from every other notebook. A grading
+run starts one and passes its socket to each grading process (:data:`ENV`), where :func:`box` makes a
+:class:`ForkedBox`. Without a server, or when it cannot give a worker, the notebook gets a plain sandbox
+(:meth:`.backends.base.Backend.box`): a broken server costs time, never a grade.
 """
 
 import array
@@ -27,6 +24,10 @@ ENV = "LABKIT_FORK_SERVER"  # the descriptor of a fork server's socket, in a gra
 ZYGOTE = (sys.executable, "-I", "-m", "labkit.grading.sandbox.zygote")
 READY_TIMEOUT = 180  # seconds for a new server to import what notebooks need
 START_TIMEOUT = 30  # seconds for one forked worker to be isolated and running
+# what a worker's keeper writes on its status pipe: STARTED once the worker runs, or FAILED and why (MAX_WHY
+# characters at most); then, at the worker's end, ENDED and its wait status
+STARTED, FAILED, ENDED = b"S", b"E", b"W"
+MAX_WHY = 500
 
 
 class ForkServerError(RuntimeError):
@@ -170,7 +171,7 @@ class ForkedProcess:
                 self.returncode = -9
                 return
             self._said += chunk
-            if self._said.startswith(b"W") and self._said[1:].lstrip(b"-").isdigit():
+            if self._said.startswith(ENDED) and self._said[1:].lstrip(b"-").isdigit():
                 self.returncode = os.waitstatus_to_exitcode(int(self._said[1:]))
 
     def poll(self):
@@ -207,16 +208,15 @@ class ForkedBox(Box):
         self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
         if self.cgroup is None and self.needs_cgroup:  # it would share the server's, and could take it down
             raise ForkServerError("no cgroup of its own could be made for the notebook")
-        joins = []
+        (requests_r, requests_w), (answers_r, answers_w), (control_r, control_w), (status_r, status_w) = (
+            os.pipe() for _ in range(4)
+        )
+        theirs = [requests_r, answers_w, control_r, status_w]  # closed here once sent, as the cgroup's files
+        ours = [requests_w, answers_r, control_w, status_r]
         try:
-            if self.cgroup is not None:
-                for folder in (self.cgroup.path, self.cgroup.cpu_path):
-                    if folder is not None:
-                        joins.append(os.open(folder / "cgroup.procs", os.O_WRONLY))
-            pipes = [os.pipe() for _ in range(4)]  # requests, answers, control, status
-            (requests_r, requests_w), (answers_r, answers_w), (control_r, control_w), (status_r, status_w) = pipes
-            theirs = [requests_r, answers_w, control_r, status_w, *joins]
-            text = json.dumps({"uid": self.uid, "limits": vars(self.limits), "cgroup": len(joins)}).encode()
+            for folder in self.cgroup.folders if self.cgroup is not None else ():
+                theirs.append(os.open(folder / "cgroup.procs", os.O_WRONLY))
+            text = json.dumps({"uid": self.uid, "limits": vars(self.limits), "cgroup": len(theirs) - 4}).encode()
             try:
                 # never blocks on a server that stopped reading: its socket is shared, so it cannot be made
                 # non-blocking for everyone; wait until it can take the request, then send without waiting
@@ -225,34 +225,27 @@ class ForkedBox(Box):
                 message = [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", theirs))]
                 self.server.sendmsg([text], message, socket.MSG_DONTWAIT)
             except OSError as exc:
-                for fd in (requests_w, answers_r, control_w, status_r):
-                    os.close(fd)
                 _broken(self.server)
                 raise ForkServerError(f"the fork server is gone ({exc})") from None
-            finally:
-                for fd in theirs:
-                    os.close(fd)
-                joins = []
-        finally:
-            for fd in joins:
+        except BaseException:
+            for fd in ours:
                 os.close(fd)
-        process = ForkedProcess(requests_w, answers_r, control_w, status_r)
+            raise
+        finally:
+            for fd in theirs:
+                os.close(fd)
+        self.process = ForkedProcess(*ours)  # closed by close(), whether the worker starts or not
         said = b""
-        until = time.monotonic() + START_TIMEOUT
-        if _wait_readable(status_r, until):
-            said = os.read(status_r, 1)  # S: isolated and running; E: why not; W or nothing: it died
-            if said == b"E":
-                said += os.read(status_r, 500)
-        if said != b"S":
-            process.close()
-            process.stdin.close()
-            process.stdout.close()
+        if _wait_readable(status_r, time.monotonic() + START_TIMEOUT):
+            said = os.read(status_r, 1)
+            if said == FAILED:
+                said += os.read(status_r, MAX_WHY)
+        if said != STARTED:
             if not said:  # no answer at all: the server dropped the request, or is stuck
                 _broken(self.server)
-            why = said[1:].decode("utf-8", "replace") if said.startswith(b"E") else "no answer"
+            why = said[1:].decode("utf-8", "replace") if said.startswith(FAILED) else "no answer"
             raise ForkServerError(f"the fork server could not isolate a worker ({why})")
-        self.process = process
-        return process
+        return self.process
 
     def stop(self):
         if self.process is None:

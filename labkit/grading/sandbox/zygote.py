@@ -1,19 +1,11 @@
 """The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
 
 Run by :mod:`labkit.grading.sandbox.forkserver` as ``python -I -m labkit.grading.sandbox.zygote FD`` in a sandbox
-with the capabilities to make namespaces and change uid. It preloads (:func:`~.worker.preload`), says ``ready``
-and then takes requests on socket FD, one datagram each: JSON (the notebook's uid and limits) with the new
-worker's descriptors (requests, answers, control and status pipes, and the files that join the notebook's
-cgroup). It never reads a notebook and no student code runs in it.
-
-Per request it forks a **keeper**, which isolates the notebook before any student code exists: new mount,
-network, IPC, UTS and PID namespaces; empty tmpfs on ``/tmp``, the home folder and ``/dev/shm`` (no file of one
-notebook is seen by another); a read-only ``/proc`` of its own. The keeper forks the **worker**, the first
-process of the PID namespace (when it ends the kernel ends the whole namespace): it joins the cgroup, takes the
-rlimits, closes every descriptor but its pipes (the server's socket too), becomes the notebook's own uid (no
-capability left), sets no-new-privileges and runs the supervisor. The keeper stays outside as root running only
-this module: ``S`` on the status pipe once the worker runs (``E`` and why not), then it waits for the worker's
-end or the control pipe's closing (the grader is done or died), kills the worker and writes its wait status.
+that may make namespaces and change uid. It preloads (:func:`~.worker.preload`), says ``ready``, then takes
+requests on socket FD: a notebook's uid and limits with the new worker's descriptors. It never reads a notebook
+and no student code runs in it. Per request a **keeper** isolates the notebook (:func:`isolate`) and forks the
+**worker** (:func:`_become_worker`), then reports on the status pipe; docs/grading-security.md says what each
+step guards against.
 """
 
 import contextlib
@@ -23,12 +15,12 @@ import os
 import select
 import signal
 import socket
-import struct
 import sys
 
 from ...errors import InputError
 from . import worker
 from .backends.base import Limits, apply_limits, environment_paths
+from .forkserver import ENDED, FAILED, MAX_WHY, STARTED
 
 CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC = 0x00020000, 0x04000000, 0x08000000
 CLONE_NEWPID, CLONE_NEWNET = 0x20000000, 0x40000000
@@ -88,9 +80,9 @@ def isolate(limits, home, keep=()):
 
 
 def _say_failed(fd, exc):
-    """Write ``E`` and why the worker could not start on the status pipe `fd`; False where it cannot be written."""
+    """Write why the worker could not start on the status pipe `fd`; False where it cannot be written."""
     try:
-        os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+        os.write(fd, FAILED + str(exc)[: MAX_WHY - 1].encode("utf-8", "replace"))
     except OSError:
         return False
     return True
@@ -125,7 +117,7 @@ def _become_worker(fds, uid, limits):
     if _libc.prctl(PR_GET_DUMPABLE, 0, 0, 0, 0) != 0:
         raise OSError("the worker's memory would be readable by its notebook")
     _reseed()
-    os.write(FIRST_FD + 2, b"S")
+    os.write(FIRST_FD + 2, STARTED)
     os.close(FIRST_FD + 2)
     return FIRST_FD, FIRST_FD + 1
 
@@ -140,11 +132,12 @@ def _reseed():
 
 
 def _keeper(fds, uid, limits, home, shell):
-    """The child of the server for one notebook; never returns."""
+    """The child of the server for one notebook (never returns): it forks the worker, and kills it when the grader
+    closes the control pipe; the worker's end, either way, goes on the status pipe."""
     status = fds["status"]
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     try:
-        isolate(limits, home, KEEP)
+        isolate(limits, home, [str(path) for path in environment_paths()])
         pid = os.fork()
     except OSError as exc:
         _say_failed(status, exc)
@@ -161,44 +154,27 @@ def _keeper(fds, uid, limits, home, shell):
                 if _say_failed(fd, exc):
                     break
         os._exit(code)
-    for name in ("requests", "answers"):
-        os.close(fds[name])
-    for fd in fds["cgroup"]:
+    for fd in (fds["requests"], fds["answers"], *fds["cgroup"]):
         os.close(fd)
     try:
         watch = [os.pidfd_open(pid)]
     except (AttributeError, OSError):  # a kernel before 5.3: look at the worker ten times a second instead
         watch = []
     control = fds["control"]
-    wait_status = None
-    while wait_status is None:
+    while True:
         ready = select.select([*watch, control], [], [], None if watch else 0.1)[0]
         if not watch or watch[0] in ready:
-            done, found = os.waitpid(pid, 0 if watch else os.WNOHANG)
+            done, wait_status = os.waitpid(pid, 0 if watch else os.WNOHANG)
             if done:
-                wait_status = found
                 break
         if control in ready:  # closed (or written to): the grader is done with this notebook
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-            _, wait_status = os.waitpid(pid, 0)
+            wait_status = os.waitpid(pid, 0)[1]
+            break
     with contextlib.suppress(OSError):  # the grader is gone
-        os.write(status, f"W{wait_status}".encode())
+        os.write(status, ENDED + str(wait_status).encode())
     os._exit(0)
-
-
-def _receive(server):
-    """(request dict, [descriptors]) of the next request, or None when the grader closed its end."""
-    space = socket.CMSG_SPACE(MAX_FDS * struct.calcsize("i"))
-    data, ancillary, flags, _ = server.recvmsg(MAX_REQUEST, space)
-    fds = []
-    for level, kind, payload in ancillary:
-        if level == socket.SOL_SOCKET and kind == socket.SCM_RIGHTS:
-            usable = len(payload) - len(payload) % struct.calcsize("i")
-            fds += list(struct.unpack(f"{usable // struct.calcsize('i')}i", payload[:usable]))
-    if not data and not fds:
-        return None
-    return data, fds, flags
 
 
 def _parse(data, fds):
@@ -218,10 +194,9 @@ def serve_forks(server, shell, home):
     """Fork an isolated worker for each request until the grader closes its end of the socket."""
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # keepers are reaped by the kernel
     while True:
-        received = _receive(server)
-        if received is None:
+        data, fds, flags, _ = socket.recv_fds(server, MAX_REQUEST, MAX_FDS)
+        if not data and not fds:  # the grader closed its end
             return
-        data, fds, flags = received
         try:
             if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
                 raise InputError("a request larger than the server takes")
@@ -245,13 +220,8 @@ def serve_forks(server, shell, home):
             os.close(fd)
 
 
-KEEP = ()  # the sandbox's read-only folders (the Python environment, labkit): set by main
-
-
 def main(argv=None):
-    global KEEP
     argv = sys.argv[1:] if argv is None else argv
-    KEEP = tuple(str(path) for path in environment_paths())
     server = socket.socket(fileno=int(argv[0]))
     worker.not_dumpable()
     null = os.open(os.devnull, os.O_RDWR)
