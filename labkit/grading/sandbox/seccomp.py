@@ -1,14 +1,11 @@
 """The system calls a sandboxed notebook may not make: small classic-BPF seccomp filters, written out here.
 
-The sandbox's filter (:func:`pipe_with_program`) refuses ``memfd_create`` and ``memfd_secret`` (memory an
-address-space limit does not count); ``add_key``, ``request_key`` and ``keyctl`` (keyrings outlive the sandbox
-and are shared per uid: one submission could leave a key for the next); ``ptrace`` and ``process_vm_readv``/
-``writev`` (no reading or writing another process's memory); new threads (``clone`` with ``CLONE_THREAD``;
-``clone3``, whose flags a filter cannot read, gets "not implemented" so libc falls back to ``clone``): the watch
-follows one thread and a second would run unwatched. The notebook's process installs the same again plus
-``rt_sigaction`` (:func:`install_for_notebook`), so no signal handler can interrupt the watch and see its frames,
-whatever the backend (``--sandbox none`` included). Calls of another architecture are refused too: they reach
-the same functions under other numbers.
+The sandbox's filter (:func:`pipe_with_program`) refuses memory an address-space limit does not count
+(``memfd_create``, ``memfd_secret``), keyrings, which outlive the sandbox and are shared per uid (``add_key``,
+``request_key``, ``keyctl``), another process's memory (``ptrace``, ``process_vm_readv``/``writev``), and new
+threads, which the watch would not follow (``clone`` with ``CLONE_THREAD``; ``clone3``, whose flags a filter cannot
+read, gets "not implemented" so libc falls back to ``clone``). The notebook's process adds ``rt_sigaction``
+(:func:`install_for_notebook`), whatever the backend. Calls of another architecture are refused too.
 """
 
 import errno

@@ -1,12 +1,9 @@
 """Sandbox backends: where a student's notebook runs while it is graded.
 
-Grading knows a backend only through :class:`~.base.Backend`: whether it can run here, a warning once per run,
-and a :class:`~.base.Box` per notebook that starts the worker in the sandbox and cleans up after it. Built in:
-``bwrap`` (the default: namespaces, seccomp, rlimits and a memory cgroup) and ``none`` (no sandbox of labkit's
-own, for submissions already isolated outside, e.g. a pod each; it warns). A new backend (Docker, podman) is one
-module ``backends/<name>.py`` with a :func:`register`-ed subclass named ``<name>``: :data:`BUILTIN` is read from
-the package, so ``labkit grade --sandbox`` and GradeOptions take it. A backend registered outside labkit works
-too: each grading process imports its module (:func:`origin`, :func:`import_origin`).
+Grading knows a backend only through :class:`~.base.Backend`. Built in: ``bwrap`` (the default) and ``none``. A
+new backend is one module ``backends/<name>.py`` with a :func:`register`-ed subclass named ``<name>``; one
+registered outside labkit works too: each grading process imports its module (:func:`origin`,
+:func:`import_origin`).
 """
 
 import importlib

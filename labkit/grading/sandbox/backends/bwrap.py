@@ -1,13 +1,9 @@
 """The default backend: a bubblewrap sandbox on this machine.
 
-:func:`command` builds one notebook's ``bwrap`` command line: a new empty root with only ``/usr``, ``/etc`` and
-the Python environment read-only (no other home, course, instructor or submission folder); ``HOME`` and
-``/tmp`` as small private tmpfs, the only writable places, gone with the sandbox; a read-only ``/proc`` of its
-own (no writing one's memory through ``/proc/self/mem``) and a minimal ``/dev``; the seccomp filter
-(:mod:`labkit.grading.sandbox.seccomp`, on a pipe); no network, its own PID, IPC and UTS namespaces, a new
-session (no terminal to inject into) and ``--die-with-parent``; every capability dropped but the two the worker
-needs to become an otherwise unused uid (:func:`sandbox_uid`, so the process limit holds). The rlimits are set
-before ``bwrap`` starts and a memory cgroup surrounds it where one can be made.
+:func:`command` builds one notebook's ``bwrap`` command line: a new root with only the system and the Python
+environment, read-only; small private tmpfs ``HOME`` and ``/tmp``; no network; its own ``/proc``, PID, IPC and UTS
+namespaces; the seccomp filter; and no capability but the two the worker needs to become an unused uid
+(:func:`sandbox_uid`). docs/grading-security.md says what each of these guards against.
 """
 
 import itertools
