@@ -83,15 +83,8 @@ class ForkServer:
 
     def wait_ready(self):
         """Wait until the server is ready and let this process ask it; else stop it and raise ForkServerError."""
-        process = self.box.process
-        line = b""
-        until = time.monotonic() + READY_TIMEOUT
-        while not line.endswith(b"\n") and _wait_readable(process.stdout.fileno(), until):
-            chunk = os.read(process.stdout.fileno(), 64)
-            if not chunk:
-                break
-            line += chunk
-        if line != b"ready\n":
+        said = self.box.process.stdout.fileno()  # "ready" comes in one write, so in one read
+        if not (_wait_readable(said, time.monotonic() + READY_TIMEOUT) and os.read(said, 64) == b"ready\n"):
             self.stop()
             raise ForkServerError("the fork server did not get ready (it could not import what notebooks need)")
         global _client
@@ -255,8 +248,6 @@ class ForkedBox(Box):
             self.process.wait(timeout=10)
 
     def close(self):
-        if self.closed:
-            return
         if self.process is not None:
             self.process.close()
         super().close()

@@ -12,6 +12,7 @@ import contextlib
 import ctypes
 import json
 import os
+import random
 import select
 import signal
 import socket
@@ -43,12 +44,8 @@ def _checked(result, what):
 
 
 def _mount(source, target, kind, flags, data=None):
-    _checked(
-        _libc.mount(
-            source.encode(), target.encode(), kind.encode() if kind else None, flags, data.encode() if data else None
-        ),
-        f"mount {target}",
-    )
+    kind, data = (text.encode() if text else None for text in (kind, data))
+    _checked(_libc.mount(source.encode(), target.encode(), kind, flags, data), f"mount {target}")
 
 
 def isolate(limits, home, keep=()):
@@ -88,13 +85,6 @@ def _say_failed(fd, exc):
     return True
 
 
-def _capabilities():
-    """The worker's permitted, effective and ambient capability sets (from /proc/self/status), as numbers."""
-    with open("/proc/self/status") as status:
-        fields = dict(line.split(":", 1) for line in status if ":" in line)
-    return [int(fields[name].strip(), 16) for name in ("CapPrm", "CapEff", "CapAmb")]
-
-
 def _become_worker(fds, uid, limits):
     """In the worker (pid 1 of its namespace): everything up to the student's uid, then ``S`` on the status pipe."""
     if uid <= 0:
@@ -103,8 +93,7 @@ def _become_worker(fds, uid, limits):
     for fd in fds["cgroup"]:
         os.write(fd, b"0")  # 0: the writing process
     # the worker's pipes at 3 and 4, its status pipe at 5; every other descriptor (the server's socket too) closes
-    wanted = [fds["requests"], fds["answers"], fds["status"]]
-    moved = [os.dup(fd) for fd in wanted]
+    moved = [os.dup(fds[name]) for name in ("requests", "answers", "status")]
     for index, fd in enumerate(moved):
         os.dup2(fd, FIRST_FD + index)
     os.closerange(FIRST_FD + len(moved), 2**31 - 1)
@@ -112,23 +101,19 @@ def _become_worker(fds, uid, limits):
     worker.drop_privileges(uid)
     worker.not_dumpable()  # the change of uid made the process dumpable again (fs.suid_dumpable)
     _checked(_libc.prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0), "no new privileges")
-    if os.getuid() != uid or os.geteuid() != uid or any(_capabilities()):
+    with open("/proc/self/status") as status:
+        fields = dict(line.split(":", 1) for line in status if ":" in line)
+    capabilities = [int(fields[name], 16) for name in ("CapPrm", "CapEff", "CapAmb")]  # permitted, effective, ambient
+    if os.getuid() != uid or os.geteuid() != uid or any(capabilities):
         raise OSError("the worker kept root's uid or a capability")
     if _libc.prctl(PR_GET_DUMPABLE, 0, 0, 0, 0) != 0:
         raise OSError("the worker's memory would be readable by its notebook")
-    _reseed()
+    random.seed()  # fresh random states, as a new Python would have: every worker forked from the server starts alike
+    if "numpy" in sys.modules:
+        sys.modules["numpy"].random.seed()
     os.write(FIRST_FD + 2, STARTED)
     os.close(FIRST_FD + 2)
     return FIRST_FD, FIRST_FD + 1
-
-
-def _reseed():
-    """Fresh random states, as a new Python would have: every worker forked from the server starts alike."""
-    import random
-
-    random.seed()
-    if "numpy" in sys.modules:
-        sys.modules["numpy"].random.seed()
 
 
 def _keeper(fds, uid, limits, home, shell):
@@ -177,17 +162,16 @@ def _keeper(fds, uid, limits, home, shell):
     os._exit(0)
 
 
-def _parse(data, fds):
-    """The request's fields, its descriptors named; ValueError when it is not a request of the grader's."""
+def _parse(data, fds, flags):
+    """The request's descriptors named, uid and limits; ValueError when it is not a request of the grader's."""
+    if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
+        raise InputError("a request larger than the server takes")
     request = json.loads(data.decode("utf-8"))
     count = int(request.get("cgroup", 0))
     if len(fds) != 4 + count or not 0 <= count <= MAX_FDS - 4:
         raise InputError("a request with the wrong descriptors")
-    named = dict(zip(("requests", "answers", "control", "status"), fds[:4]))
-    named["cgroup"] = fds[4:]
-    uid = int(request["uid"])
-    limits = Limits(**{key: int(value) for key, value in request["limits"].items()})
-    return named, uid, limits
+    named = {**dict(zip(("requests", "answers", "control", "status"), fds)), "cgroup": fds[4:]}
+    return named, int(request["uid"]), Limits(**{key: int(value) for key, value in request["limits"].items()})
 
 
 def serve_forks(server, shell, home):
@@ -198,9 +182,7 @@ def serve_forks(server, shell, home):
         if not data and not fds:  # the grader closed its end
             return
         try:
-            if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
-                raise InputError("a request larger than the server takes")
-            named, uid, limits = _parse(data, fds)
+            named, uid, limits = _parse(data, fds, flags)
         except Exception:  # noqa: BLE001 - not a request of the grader's: dropped (its sender sees the pipes close)
             for fd in fds:
                 os.close(fd)
@@ -220,9 +202,8 @@ def serve_forks(server, shell, home):
             os.close(fd)
 
 
-def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    server = socket.socket(fileno=int(argv[0]))
+def main():
+    server = socket.socket(fileno=int(sys.argv[1]))
     worker.not_dumpable()
     null = os.open(os.devnull, os.O_RDWR)
     ready = os.dup(1)
