@@ -72,20 +72,13 @@ class MemoryCgroup:
             with open(folder / "cgroup.procs", "w") as handle:
                 handle.write(str(os.getpid()))
 
-    def pids(self):
-        try:
-            return [int(p) for p in (self.path / "cgroup.procs").read_text().split()]
-        except (OSError, ValueError):
-            return []
-
     def peak(self):
         """The most memory the cgroup held at once, in bytes (None if the kernel does not say)."""
-        for name in ("memory.max_usage_in_bytes", "memory.peak"):
-            try:
-                return int((self.path / name).read_text().split()[0])
-            except (OSError, ValueError, IndexError):
-                continue
-        return None
+        name = "memory.max_usage_in_bytes" if self.version == "v1" else "memory.peak"
+        try:
+            return int((self.path / name).read_text().split()[0])
+        except (OSError, ValueError, IndexError):
+            return None
 
     def out_of_memory(self):
         """Whether the kernel stopped a process of the cgroup for going over the limit."""
@@ -99,7 +92,10 @@ class MemoryCgroup:
     def remove(self):
         """Stop every process still in the cgroup and remove it."""
         for _ in range(200):
-            pids = self.pids()
+            try:
+                pids = [int(p) for p in (self.path / "cgroup.procs").read_text().split()]
+            except (OSError, ValueError):
+                pids = []
             if not pids:
                 break
             for pid in pids:

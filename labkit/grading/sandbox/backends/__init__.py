@@ -15,11 +15,8 @@ from ....errors import InputError
 
 DEFAULT = "bwrap"
 # one module each, backends/<name>.py, found in this package (the default first)
-BUILTIN = tuple(
-    sorted(
-        (m.name for m in pkgutil.iter_modules(__path__) if m.name != "base"), key=lambda name: (name != DEFAULT, name)
-    )
-)
+_FOUND = sorted(module.name for module in pkgutil.iter_modules(__path__) if module.name != "base")
+BUILTIN = tuple(sorted(_FOUND, key=lambda name: name != DEFAULT))
 UNCONFINED = "none"  # the backend the old switch --no-sandbox stands for
 
 _registered: dict = {}  # name -> Backend subclass
@@ -74,9 +71,8 @@ def get_backend(name):
 
 def origin(name):
     """(module name, file) where backend `name` is defined, so that another process can import it."""
-    cls = backend_class(name)
-    module = sys.modules[cls.__module__]
-    return cls.__module__, getattr(module, "__file__", None)
+    module = backend_class(name).__module__
+    return module, getattr(sys.modules[module], "__file__", None)
 
 
 def import_origin(module, path=None):

@@ -112,12 +112,11 @@ class Box:
     def start(self):
         """Start the worker; its process (a Popen with pipes on stdin and stdout)."""
         self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
-        group, limits, base = self.cgroup, self.limits, self.processes_base
 
         def prepare():
-            if group is not None:
-                group.join()
-            apply_limits(limits, base)
+            if self.cgroup is not None:
+                self.cgroup.join()
+            apply_limits(self.limits, self.processes_base)
 
         try:
             self.process = subprocess.Popen(

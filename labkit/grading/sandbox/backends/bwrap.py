@@ -15,15 +15,7 @@ from pathlib import Path
 
 from .. import seccomp
 from . import register
-from .base import (
-    Backend,
-    Box,
-    Limits,
-    SandboxUnavailable,
-    course_mounts,
-    environment_paths,
-    processes_of_this_user,
-)
+from .base import Backend, Box, Limits, SandboxUnavailable, course_mounts, environment_paths, processes_of_this_user
 
 HOME = "/home/student"
 INSTALL_HINT = (
@@ -77,8 +69,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
     args += ["--proc", "/proc", "--remount-ro", "/proc", "--dev", "/dev"]
     args += ["--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
-    for name in ("usr", "etc"):
-        args += ["--ro-bind", f"/{name}", f"/{name}"]
+    args += ["--ro-bind", "/usr", "/usr", "--ro-bind", "/etc", "/etc"]
     for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
         top = Path("/") / name
         if top.is_symlink():
@@ -88,8 +79,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     made = {Path("/tmp")}
     for path in environment_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
-    courses = course_mounts()
-    for origin, shown in courses:
+    for origin, shown in course_mounts():
         args += [*_parents(shown, made), "--ro-bind", str(origin), str(shown)]
     args += [*_parents(HOME, made), "--perms", "1777", "--size", str(limits.home_size), "--tmpfs", HOME]
     args += ["--chdir", HOME]
@@ -104,9 +94,8 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
         "OMP_NUM_THREADS": "1",
         "MKL_NUM_THREADS": "1",
     }
-    for name in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE"):  # set on some machines for correct results
-        if name in os.environ:
-            environment[name] = os.environ[name]
+    kept = ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE")  # set on some machines for correct results
+    environment |= {name: os.environ[name] for name in kept if name in os.environ}
     for name, value in environment.items():
         args += ["--setenv", name, value]
     return args + ["--", *argv]
@@ -127,12 +116,8 @@ class Bubblewrap(Backend):
         bwrap = shutil.which("bwrap")
         if bwrap is None:
             raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
-        probe = subprocess.run(
-            [bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev", "true"],
-            capture_output=True,
-            text=True,
-            timeout=30,
-        )
+        trial = [bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev", "true"]
+        probe = subprocess.run(trial, capture_output=True, text=True, timeout=30)
         if probe.returncode != 0:
             raise SandboxUnavailable(
                 f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): {INSTALL_HINT}."
