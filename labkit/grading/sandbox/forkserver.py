@@ -143,59 +143,17 @@ def box(backend, limits):
     return ForkedBox(found[0], limits, backend.notebook_uid(), needs_cgroup=found[2])
 
 
-class ForkedProcess:
-    """The part of a Popen that :class:`labkit.grading.sandbox.remote.NotebookHandle` uses, for a forked worker."""
+class ForkedBox(Box):
+    """One notebook's worker, forked by the server on `server` and isolated by it. The box is the worker's process
+    too: the part of a Popen that :class:`labkit.grading.sandbox.remote.NotebookHandle` uses."""
 
     pid = None
-
-    def __init__(self, requests, answers, control, status):
-        self.stdin = os.fdopen(requests, "wb")
-        self.stdout = os.fdopen(answers, "rb", buffering=0)
-        self.control, self.status = control, status
-        self.returncode = None
-        self._said = b""
-
-    def _read_status(self, until):
-        while self.returncode is None:
-            if until is not None and not _wait_readable(self.status, until):
-                return
-            chunk = os.read(self.status, 64)
-            if not chunk:  # the keeper is gone without saying how the worker ended
-                self.returncode = -9
-                return
-            self._said += chunk
-            if self._said.startswith(ENDED) and self._said[1:].lstrip(b"-").isdigit():
-                self.returncode = os.waitstatus_to_exitcode(int(self._said[1:]))
-
-    def poll(self):
-        self._read_status(time.monotonic())
-        return self.returncode
-
-    def wait(self, timeout=None):
-        self._read_status(None if timeout is None else time.monotonic() + timeout)
-        if self.returncode is None:
-            raise subprocess.TimeoutExpired("forked worker", timeout)
-        return self.returncode
-
-    def kill(self):
-        """Tell the keeper to stop the worker and every process of its namespace."""
-        if self.control is not None:
-            os.close(self.control)
-            self.control = None
-
-    def close(self):
-        self.kill()
-        if self.status is not None:
-            os.close(self.status)
-            self.status = None
-
-
-class ForkedBox(Box):
-    """One notebook's worker, forked by the server on `server` and isolated by it (see the module)."""
 
     def __init__(self, server, limits, uid, needs_cgroup=False):
         super().__init__([], limits)
         self.server, self.uid, self.needs_cgroup = server, uid, needs_cgroup
+        self.stdin = self.stdout = self.control = self.status = self.returncode = None
+        self._said = b""
 
     def start(self):
         self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
@@ -227,7 +185,9 @@ class ForkedBox(Box):
         finally:
             for fd in theirs:
                 os.close(fd)
-        self.process = ForkedProcess(*ours)  # closed by close(), whether the worker starts or not
+        self.stdin, self.stdout = os.fdopen(requests_w, "wb"), os.fdopen(answers_r, "rb", buffering=0)
+        self.control, self.status = control_w, status_r
+        self.process = self  # closed by close(), whether the worker starts or not
         said = b""
         if _wait_readable(status_r, time.monotonic() + START_TIMEOUT):
             said = os.read(status_r, 1)
@@ -240,14 +200,41 @@ class ForkedBox(Box):
             raise ForkServerError(f"the fork server could not isolate a worker ({why})")
         return self.process
 
+    def _read_status(self, until):
+        while self.returncode is None:
+            if until is not None and not _wait_readable(self.status, until):
+                return
+            chunk = os.read(self.status, 64)
+            if not chunk:  # the keeper is gone without saying how the worker ended
+                self.returncode = -9
+                return
+            self._said += chunk
+            if self._said.startswith(ENDED) and self._said[1:].lstrip(b"-").isdigit():
+                self.returncode = os.waitstatus_to_exitcode(int(self._said[1:]))
+
+    def poll(self):
+        self._read_status(time.monotonic())
+        return self.returncode
+
+    def wait(self, timeout=None):
+        self._read_status(None if timeout is None else time.monotonic() + timeout)
+        if self.returncode is None:
+            raise subprocess.TimeoutExpired("forked worker", timeout)
+        return self.returncode
+
     def stop(self):
+        """Close the control pipe: the keeper stops the worker and every process of its namespace."""
         if self.process is None:
             return
-        self.process.kill()
+        if self.control is not None:
+            os.close(self.control)
+            self.control = None
         with contextlib.suppress(subprocess.TimeoutExpired):
-            self.process.wait(timeout=10)
+            self.wait(timeout=10)
 
     def close(self):
-        if self.process is not None:
-            self.process.close()
+        for fd in (self.control, self.status):
+            if fd is not None:
+                os.close(fd)
+        self.control = self.status = None
         super().close()
