@@ -1,9 +1,9 @@
 """A cgroup per sandbox: a memory limit that counts every page, a CPU limit, and a list of every process.
 
 ``RLIMIT_AS`` counts what one process maps, not an anonymous file's or a tmpfs's pages, nor children together; a
-memory cgroup counts them all, and lists every process so the grader can stop them all. One core per sandbox keeps
-a spinning submission from slowing a classmate. Where no cgroup can be made (v2, or v1's memory and cpu
-hierarchies) :func:`create` returns None and the sandbox relies on its other limits.
+memory cgroup counts them all and lists every process, and one core per sandbox keeps a spinning submission from
+slowing a classmate. Where no cgroup can be made (v2, or v1's memory and cpu hierarchies) :func:`create` returns
+None.
 """
 
 import contextlib

@@ -1,10 +1,9 @@
 """The grader's side of the fork server: imports paid once per run, not once per notebook.
 
-A :class:`ForkServer` runs one zygote (:mod:`labkit.grading.sandbox.zygote`) that imports numpy, scipy,
-matplotlib, IPython and labkit once and forks each notebook a worker isolated from every other notebook. A grading
-run starts one and passes its socket to each grading process (:data:`ENV`), where :func:`box` makes a
-:class:`ForkedBox`. Without a server, or when it cannot give a worker, the notebook gets a plain sandbox
-(:meth:`.backends.base.Backend.box`): a broken server costs time, never a grade.
+A :class:`ForkServer` runs one zygote (:mod:`labkit.grading.sandbox.zygote`) that imports what notebooks need once
+and forks each notebook a worker isolated from every other. A grading run passes its socket to each grading
+process (:data:`ENV`), where :func:`box` makes a :class:`ForkedBox`; without a server, or when it cannot give a
+worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
 """
 
 import array
@@ -146,8 +145,6 @@ def box(backend, limits):
 class ForkedBox(Box):
     """One notebook's worker, forked by the server on `server` and isolated by it. The box is the worker's process
     too: the part of a Popen that :class:`labkit.grading.sandbox.remote.NotebookHandle` uses."""
-
-    pid = None
 
     def __init__(self, server, limits, uid, needs_cgroup=False):
         super().__init__([], limits)

@@ -1,11 +1,10 @@
 """The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
 
 Run by :mod:`labkit.grading.sandbox.forkserver` as ``python -I -m labkit.grading.sandbox.zygote FD`` in a sandbox
-that may make namespaces and change uid. It preloads (:func:`~.worker.preload`), says ``ready``, then takes
+that may make namespaces and change uid, it preloads (:func:`~.worker.preload`), says ``ready``, then takes
 requests on socket FD: a notebook's uid and limits with the new worker's descriptors. It never reads a notebook
-and no student code runs in it. Per request a **keeper** isolates the notebook (:func:`isolate`) and forks the
-**worker** (:func:`_become_worker`), then reports on the status pipe; docs/grading-security.md says what each
-step guards against.
+and runs no student code. Per request a keeper isolates the notebook (:func:`isolate`) and forks the worker
+(:func:`_become_worker`); docs/grading-security.md says what each step guards against.
 """
 
 import contextlib
@@ -86,7 +85,7 @@ def _say_failed(fd, exc):
 
 
 def _become_worker(fds, uid, limits):
-    """In the worker (pid 1 of its namespace): everything up to the student's uid, then ``S`` on the status pipe."""
+    """In the worker (pid 1 of its namespace): everything up to the student's uid, then STARTED on the status pipe."""
     if uid <= 0:
         raise OSError(f"refusing to run a notebook as uid {uid}: a forked worker needs a uid of its own")
     _mount("proc", "/proc", "proc", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC)
