@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 ROOT = Path("/sys/fs/cgroup")
+PARENT = "LABKIT_CGROUP_PARENT"  # where a grading process makes its sandboxes' cgroups (beside its own)
 
 
 def _own(controller):
@@ -26,9 +27,6 @@ def _own(controller):
         if (number == "0" and controllers == "") if controller == "v2" else controller in controllers.split(","):
             return path
     return None
-
-
-PARENT = "LABKIT_CGROUP_PARENT"  # where a grading process makes its sandboxes' cgroups (beside its own)
 
 
 def _candidates():

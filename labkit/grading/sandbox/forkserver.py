@@ -27,6 +27,7 @@ START_TIMEOUT = 30  # seconds for one forked worker to be isolated and running
 # characters at most); then, at the worker's end, ENDED and its wait status
 STARTED, FAILED, ENDED = b"S", b"E", b"W"
 MAX_WHY = 500
+_client = None  # (socket, backend name, whether each notebook needs a cgroup) of the server this process asks
 
 
 class ForkServerError(RuntimeError):
@@ -107,11 +108,8 @@ class ForkServer:
         self.stop()
 
 
-_client = None  # (socket, backend name) of the server this process asks
-
-
 def client():
-    """(socket, backend name) of the fork server this process may ask, or None."""
+    """(socket, backend name, whether each notebook needs a cgroup) of the server this process may ask, or None."""
     global _client
     fd, name, needs = (os.environ.get(ENV, "").split(":") + ["", "", ""])[:3]
     if _client is None and fd.isdigit() and name:

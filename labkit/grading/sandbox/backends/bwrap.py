@@ -24,18 +24,14 @@ INSTALL_HINT = (
     "allows them; where each submission is already isolated (a pod or container of its own), "
     "`labkit grade --sandbox none` runs student code without a sandbox of labkit's own"
 )
-
-
 NAMESPACES = ("--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts", "--unshare-cgroup-try")
+FORKED_UIDS = 1_000_000_000  # forked workers' uids start here (far above sandbox_uid's; pids are below 2**22)
+_FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def _namespaces():
     user = [] if os.geteuid() == 0 else ["--unshare-user"]
     return [*user, *NAMESPACES, "--die-with-parent", "--new-session"]
-
-
-FORKED_UIDS = 1_000_000_000  # forked workers' uids start here (far above sandbox_uid's; pids are below 2**22)
-_FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def sandbox_uid():
