@@ -1,11 +1,9 @@
 """A cgroup per sandbox: a memory limit that counts every page, a CPU limit, and a list of every process.
 
 ``RLIMIT_AS`` counts what one process maps, not an anonymous file's or a tmpfs's pages, nor children together; a
-memory cgroup counts them all, and its ``cgroup.procs`` lists every process so the grader can stop them all. One
-core per sandbox keeps a spinning submission from slowing a classmate. :class:`MemoryCgroup` is made under the
-grading process's cgroup (v2, or v1's memory and cpu hierarchies), joined by the new process before it starts the
-sandbox, and removed afterwards. Where none can be made :func:`create` returns None and the sandbox relies on its
-other limits (the instructors' documentation says what that leaves open).
+memory cgroup counts them all and lists every process, and one core per sandbox keeps a spinning submission from
+slowing a classmate. Where no cgroup can be made (v2, or v1's memory and cpu hierarchies) :func:`create` returns
+None.
 """
 
 import contextlib
@@ -15,24 +13,20 @@ import time
 from pathlib import Path
 
 ROOT = Path("/sys/fs/cgroup")
+PARENT = "LABKIT_CGROUP_PARENT"  # where a grading process makes its sandboxes' cgroups (beside its own)
 
 
-def _own(path_in_hierarchy):
-    """The grading process's cgroup in the v1 hierarchy of a controller, or in v2 ("v2"); None if none."""
+def _own(controller):
+    """The grading process's cgroup in the v1 hierarchy of `controller`, or in v2 ("v2"); None if none."""
     try:
         lines = Path("/proc/self/cgroup").read_text().splitlines()
     except OSError:
         return None
     for line in lines:
         number, controllers, path = line.split(":", 2)
-        if path_in_hierarchy == "v2" and number == "0" and controllers == "":
-            return path
-        if path_in_hierarchy != "v2" and path_in_hierarchy in controllers.split(","):
+        if (number == "0" and controllers == "") if controller == "v2" else controller in controllers.split(","):
             return path
     return None
-
-
-PARENT = "LABKIT_CGROUP_PARENT"  # where a grading process makes its sandboxes' cgroups (beside its own)
 
 
 def _candidates():
@@ -56,11 +50,12 @@ def _candidates():
 
 
 class MemoryCgroup:
-    """One sandbox's cgroup with a memory limit in bytes (and, with v1, a cpu cgroup beside it)."""
+    """One sandbox's cgroup with a memory limit (and, with v1, a cpu cgroup beside it)."""
 
-    def __init__(self, version, path, limit, cpu_path=None):
-        self.version, self.path, self.limit = version, Path(path), int(limit)
+    def __init__(self, version, path, cpu_path=None):
+        self.version, self.path = version, Path(path)
         self.cpu_path = Path(cpu_path) if cpu_path is not None else None
+        self.folders = [folder for folder in (self.path, self.cpu_path) if folder is not None]
 
     def sibling_environment(self):
         """What to put in the environment of a process in this cgroup so its own cgroups are made beside it."""
@@ -71,25 +66,17 @@ class MemoryCgroup:
 
     def join(self):
         """Move the calling process (and so everything it starts) into the cgroup: call it in the child."""
-        for folder in (self.path, self.cpu_path):
-            if folder is not None:
-                with open(folder / "cgroup.procs", "w") as handle:
-                    handle.write(str(os.getpid()))
-
-    def pids(self):
-        try:
-            return [int(p) for p in (self.path / "cgroup.procs").read_text().split()]
-        except (OSError, ValueError):
-            return []
+        for folder in self.folders:
+            with open(folder / "cgroup.procs", "w") as handle:
+                handle.write(str(os.getpid()))
 
     def peak(self):
         """The most memory the cgroup held at once, in bytes (None if the kernel does not say)."""
-        for name in ("memory.max_usage_in_bytes", "memory.peak"):
-            try:
-                return int((self.path / name).read_text().split()[0])
-            except (OSError, ValueError, IndexError):
-                continue
-        return None
+        name = "memory.max_usage_in_bytes" if self.version == "v1" else "memory.peak"
+        try:
+            return int((self.path / name).read_text().split()[0])
+        except (OSError, ValueError, IndexError):
+            return None
 
     def out_of_memory(self):
         """Whether the kernel stopped a process of the cgroup for going over the limit."""
@@ -103,17 +90,18 @@ class MemoryCgroup:
     def remove(self):
         """Stop every process still in the cgroup and remove it."""
         for _ in range(200):
-            pids = self.pids()
+            try:
+                pids = [int(p) for p in (self.path / "cgroup.procs").read_text().split()]
+            except (OSError, ValueError):
+                pids = []
             if not pids:
                 break
             for pid in pids:
                 with contextlib.suppress(ProcessLookupError, PermissionError):
                     os.kill(pid, signal.SIGKILL)
             time.sleep(0.005)  # a killed process leaves its cgroup within milliseconds
-        for folder in (self.path, self.cpu_path):
+        for folder in self.folders:
             for _ in range(50):
-                if folder is None:
-                    break
                 try:
                     folder.rmdir()
                     break
@@ -167,5 +155,5 @@ def create(limit, label="labkit", cores=1):
                 path.rmdir()
             continue
         cpu = _cpu_v1(name, cores) if version == "v1" and cores else None
-        return MemoryCgroup(version, path, limit, cpu)
+        return MemoryCgroup(version, path, cpu)
     return None

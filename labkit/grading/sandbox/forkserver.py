@@ -1,13 +1,9 @@
 """The grader's side of the fork server: imports paid once per run, not once per notebook.
 
-A plain worker (:meth:`.backends.base.Backend.box`) costs a new sandbox and a Python that imports numpy, scipy,
-matplotlib, IPython and labkit: most of a submission's grading time. A :class:`ForkServer` runs one zygote
-(:mod:`labkit.grading.sandbox.zygote`) that imports all of that once and forks each notebook a worker isolated
-from every other notebook before any student code runs. A grading run starts one and passes its socket to each
-grading process (descriptor in :data:`ENV`), where :func:`box` makes a :class:`ForkedBox`. Without a server, or
-when it cannot give a worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
-Backends offer a server through :meth:`~.backends.base.Backend.zygote_box` (the default one as root);
-``--no-fork-server`` keeps the plain way.
+A :class:`ForkServer` runs one zygote (:mod:`labkit.grading.sandbox.zygote`) that imports what notebooks need once
+and forks each notebook a worker isolated from every other. A grading run passes its socket to each grading
+process (:data:`ENV`), where :func:`box` makes a :class:`ForkedBox`; without a server, or when it cannot give a
+worker, the notebook gets a plain sandbox: a broken server costs time, never a grade.
 """
 
 import array
@@ -27,6 +23,11 @@ ENV = "LABKIT_FORK_SERVER"  # the descriptor of a fork server's socket, in a gra
 ZYGOTE = (sys.executable, "-I", "-m", "labkit.grading.sandbox.zygote")
 READY_TIMEOUT = 180  # seconds for a new server to import what notebooks need
 START_TIMEOUT = 30  # seconds for one forked worker to be isolated and running
+# what a worker's keeper writes on its status pipe: STARTED once the worker runs, or FAILED and why (MAX_WHY
+# characters at most); then, at the worker's end, ENDED and its wait status
+STARTED, FAILED, ENDED = b"S", b"E", b"W"
+MAX_WHY = 500
+_client = None  # (socket, backend name, whether each notebook needs a cgroup) of the server this process asks
 
 
 class ForkServerError(RuntimeError):
@@ -82,15 +83,8 @@ class ForkServer:
 
     def wait_ready(self):
         """Wait until the server is ready and let this process ask it; else stop it and raise ForkServerError."""
-        process = self.box.process
-        line = b""
-        until = time.monotonic() + READY_TIMEOUT
-        while not line.endswith(b"\n") and _wait_readable(process.stdout.fileno(), until):
-            chunk = os.read(process.stdout.fileno(), 64)
-            if not chunk:
-                break
-            line += chunk
-        if line != b"ready\n":
+        said = self.box.process.stdout.fileno()  # "ready" comes in one write, so in one read
+        if not (_wait_readable(said, time.monotonic() + READY_TIMEOUT) and os.read(said, 64) == b"ready\n"):
             self.stop()
             raise ForkServerError("the fork server did not get ready (it could not import what notebooks need)")
         global _client
@@ -114,11 +108,8 @@ class ForkServer:
         self.stop()
 
 
-_client = None  # (socket, backend name) of the server this process asks
-
-
 def client():
-    """(socket, backend name) of the fork server this process may ask, or None."""
+    """(socket, backend name, whether each notebook needs a cgroup) of the server this process may ask, or None."""
     global _client
     fd, name, needs = (os.environ.get(ENV, "").split(":") + ["", "", ""])[:3]
     if _client is None and fd.isdigit() and name:
@@ -149,17 +140,60 @@ def box(backend, limits):
     return ForkedBox(found[0], limits, backend.notebook_uid(), needs_cgroup=found[2])
 
 
-class ForkedProcess:
-    """The part of a Popen that :class:`labkit.grading.sandbox.remote.NotebookHandle` uses, for a forked worker."""
+class ForkedBox(Box):
+    """One notebook's worker, forked by the server on `server` and isolated by it. The box is the worker's process
+    too: the part of a Popen that :class:`labkit.grading.sandbox.remote.NotebookHandle` uses."""
 
-    pid = None
-
-    def __init__(self, requests, answers, control, status):
-        self.stdin = os.fdopen(requests, "wb")
-        self.stdout = os.fdopen(answers, "rb", buffering=0)
-        self.control, self.status = control, status
-        self.returncode = None
+    def __init__(self, server, limits, uid, needs_cgroup=False):
+        super().__init__([], limits)
+        self.server, self.uid, self.needs_cgroup = server, uid, needs_cgroup
+        self.stdin = self.stdout = self.control = self.status = self.returncode = None
         self._said = b""
+
+    def start(self):
+        self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
+        if self.cgroup is None and self.needs_cgroup:  # it would share the server's, and could take it down
+            raise ForkServerError("no cgroup of its own could be made for the notebook")
+        (requests_r, requests_w), (answers_r, answers_w), (control_r, control_w), (status_r, status_w) = (
+            os.pipe() for _ in range(4)
+        )
+        theirs = [requests_r, answers_w, control_r, status_w]  # closed here once sent, as the cgroup's files
+        ours = [requests_w, answers_r, control_w, status_r]
+        try:
+            for folder in self.cgroup.folders if self.cgroup is not None else ():
+                theirs.append(os.open(folder / "cgroup.procs", os.O_WRONLY))
+            text = json.dumps({"uid": self.uid, "limits": vars(self.limits), "cgroup": len(theirs) - 4}).encode()
+            try:
+                # never blocks on a server that stopped reading: its socket is shared, so it cannot be made
+                # non-blocking for everyone; wait until it can take the request, then send without waiting
+                if not select.select([], [self.server], [], START_TIMEOUT)[1]:
+                    raise OSError("it takes no requests")
+                message = [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", theirs))]
+                self.server.sendmsg([text], message, socket.MSG_DONTWAIT)
+            except OSError as exc:
+                _broken(self.server)
+                raise ForkServerError(f"the fork server is gone ({exc})") from None
+        except BaseException:
+            for fd in ours:
+                os.close(fd)
+            raise
+        finally:
+            for fd in theirs:
+                os.close(fd)
+        self.stdin, self.stdout = os.fdopen(requests_w, "wb"), os.fdopen(answers_r, "rb", buffering=0)
+        self.control, self.status = control_w, status_r
+        self.process = self  # closed by close(), whether the worker starts or not
+        said = b""
+        if _wait_readable(status_r, time.monotonic() + START_TIMEOUT):
+            said = os.read(status_r, 1)
+            if said == FAILED:
+                said += os.read(status_r, MAX_WHY)
+        if said != STARTED:
+            if not said:  # no answer at all: the server dropped the request, or is stuck
+                _broken(self.server)
+            why = said[1:].decode("utf-8", "replace") if said.startswith(FAILED) else "no answer"
+            raise ForkServerError(f"the fork server could not isolate a worker ({why})")
+        return self.process
 
     def _read_status(self, until):
         while self.returncode is None:
@@ -170,7 +204,7 @@ class ForkedProcess:
                 self.returncode = -9
                 return
             self._said += chunk
-            if self._said.startswith(b"W") and self._said[1:].lstrip(b"-").isdigit():
+            if self._said.startswith(ENDED) and self._said[1:].lstrip(b"-").isdigit():
                 self.returncode = os.waitstatus_to_exitcode(int(self._said[1:]))
 
     def poll(self):
@@ -183,87 +217,19 @@ class ForkedProcess:
             raise subprocess.TimeoutExpired("forked worker", timeout)
         return self.returncode
 
-    def kill(self):
-        """Tell the keeper to stop the worker and every process of its namespace."""
+    def stop(self):
+        """Close the control pipe: the keeper stops the worker and every process of its namespace."""
+        if self.process is None:
+            return
         if self.control is not None:
             os.close(self.control)
             self.control = None
-
-    def close(self):
-        self.kill()
-        if self.status is not None:
-            os.close(self.status)
-            self.status = None
-
-
-class ForkedBox(Box):
-    """One notebook's worker, forked by the server on `server` and isolated by it (see the module)."""
-
-    def __init__(self, server, limits, uid, needs_cgroup=False):
-        super().__init__([], limits)
-        self.server, self.uid, self.needs_cgroup = server, uid, needs_cgroup
-
-    def start(self):
-        self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
-        if self.cgroup is None and self.needs_cgroup:  # it would share the server's, and could take it down
-            raise ForkServerError("no cgroup of its own could be made for the notebook")
-        joins = []
-        try:
-            if self.cgroup is not None:
-                for folder in (self.cgroup.path, self.cgroup.cpu_path):
-                    if folder is not None:
-                        joins.append(os.open(folder / "cgroup.procs", os.O_WRONLY))
-            pipes = [os.pipe() for _ in range(4)]  # requests, answers, control, status
-            (requests_r, requests_w), (answers_r, answers_w), (control_r, control_w), (status_r, status_w) = pipes
-            theirs = [requests_r, answers_w, control_r, status_w, *joins]
-            text = json.dumps({"uid": self.uid, "limits": vars(self.limits), "cgroup": len(joins)}).encode()
-            try:
-                # never blocks on a server that stopped reading: its socket is shared, so it cannot be made
-                # non-blocking for everyone; wait until it can take the request, then send without waiting
-                if not select.select([], [self.server], [], START_TIMEOUT)[1]:
-                    raise OSError("it takes no requests")
-                message = [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", theirs))]
-                self.server.sendmsg([text], message, socket.MSG_DONTWAIT)
-            except OSError as exc:
-                for fd in (requests_w, answers_r, control_w, status_r):
-                    os.close(fd)
-                _broken(self.server)
-                raise ForkServerError(f"the fork server is gone ({exc})") from None
-            finally:
-                for fd in theirs:
-                    os.close(fd)
-                joins = []
-        finally:
-            for fd in joins:
-                os.close(fd)
-        process = ForkedProcess(requests_w, answers_r, control_w, status_r)
-        said = b""
-        until = time.monotonic() + START_TIMEOUT
-        if _wait_readable(status_r, until):
-            said = os.read(status_r, 1)  # S: isolated and running; E: why not; W or nothing: it died
-            if said == b"E":
-                said += os.read(status_r, 500)
-        if said != b"S":
-            process.close()
-            process.stdin.close()
-            process.stdout.close()
-            if not said:  # no answer at all: the server dropped the request, or is stuck
-                _broken(self.server)
-            why = said[1:].decode("utf-8", "replace") if said.startswith(b"E") else "no answer"
-            raise ForkServerError(f"the fork server could not isolate a worker ({why})")
-        self.process = process
-        return process
-
-    def stop(self):
-        if self.process is None:
-            return
-        self.process.kill()
         with contextlib.suppress(subprocess.TimeoutExpired):
-            self.process.wait(timeout=10)
+            self.wait(timeout=10)
 
     def close(self):
-        if self.closed:
-            return
-        if self.process is not None:
-            self.process.close()
+        for fd in (self.control, self.status):
+            if fd is not None:
+                os.close(fd)
+        self.control = self.status = None
         super().close()

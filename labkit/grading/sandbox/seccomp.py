@@ -1,14 +1,11 @@
 """The system calls a sandboxed notebook may not make: small classic-BPF seccomp filters, written out here.
 
-The sandbox's filter (:func:`pipe_with_program`) refuses ``memfd_create`` and ``memfd_secret`` (memory an
-address-space limit does not count); ``add_key``, ``request_key`` and ``keyctl`` (keyrings outlive the sandbox
-and are shared per uid: one submission could leave a key for the next); ``ptrace`` and ``process_vm_readv``/
-``writev`` (no reading or writing another process's memory); new threads (``clone`` with ``CLONE_THREAD``;
-``clone3``, whose flags a filter cannot read, gets "not implemented" so libc falls back to ``clone``): the watch
-follows one thread and a second would run unwatched. The notebook's process installs the same again plus
-``rt_sigaction`` (:func:`install_for_notebook`), so no signal handler can interrupt the watch and see its frames,
-whatever the backend (``--sandbox none`` included). Calls of another architecture are refused too: they reach
-the same functions under other numbers.
+The sandbox's filter (:func:`pipe_with_program`) refuses memory an address-space limit does not count
+(``memfd_create``, ``memfd_secret``), keyrings, which outlive the sandbox and are shared per uid (``add_key``,
+``request_key``, ``keyctl``), another process's memory (``ptrace``, ``process_vm_readv``/``writev``), and new
+threads, which the watch would not follow (``clone`` with ``CLONE_THREAD``; ``clone3``, whose flags a filter cannot
+read, gets "not implemented" so libc falls back to ``clone``). The notebook's process adds ``rt_sigaction``
+(:func:`install_for_notebook`), whatever the backend. Calls of another architecture are refused too.
 """
 
 import errno
@@ -47,9 +44,9 @@ def _instruction(code, jt, jf, k):
     return struct.pack("=HBBI", code, jt, jf, k)
 
 
-def program(machine=None, deny=SANDBOX, threads=True):
-    """A filter as bytes (struct sock_filter[]), or None on an unknown architecture: `deny` get EPERM; with
-    `threads`, ``clone`` with ``CLONE_THREAD`` gets EPERM and ``clone3`` ENOSYS."""
+def program(machine=None, deny=SANDBOX):
+    """A filter as bytes (struct sock_filter[]), or None on an unknown architecture: `deny` get EPERM, as ``clone``
+    with ``CLONE_THREAD`` does, and ``clone3`` ENOSYS."""
     machine = machine or platform.machine()
     if machine not in SYSCALLS:
         return None
@@ -59,13 +56,13 @@ def program(machine=None, deny=SANDBOX, threads=True):
     if machine == "x86_64":
         body.append((_JGE_K, "deny", 0, X32_BIT))
     body += [(_JEQ_K, "deny", 0, numbers[name]) for name in deny]
-    if threads:  # last: the flags check leaves the accumulator holding the flags, not the number
-        body += [
-            (_JEQ_K, "nosys", 0, numbers["clone3"]),
-            (_JEQ_K, 0, 2, numbers["clone"]),
-            (_LD_W_ABS, 0, 0, _ARG0),
-            (_JSET_K, "deny", 0, CLONE_THREAD),
-        ]
+    # threads last: the flags check leaves the accumulator holding the flags, not the number
+    body += [
+        (_JEQ_K, "nosys", 0, numbers["clone3"]),
+        (_JEQ_K, 0, 2, numbers["clone"]),
+        (_LD_W_ABS, 0, 0, _ARG0),
+        (_JSET_K, "deny", 0, CLONE_THREAD),
+    ]
     body += [(_RET_K, 0, 0, _ALLOW), (_RET_K, 0, 0, _ERRNO | errno.EPERM), (_RET_K, 0, 0, _ERRNO | errno.ENOSYS)]
     targets = {"allow": len(body) - 3, "deny": len(body) - 2, "nosys": len(body) - 1}
 
@@ -89,7 +86,7 @@ def pipe_with_program():
 def install_for_notebook():
     """From now on, the sandbox's refusals and ``rt_sigaction`` here (True), or False where that cannot be done.
     The notebook's process calls it after its timer's handler is set and before any student code runs."""
-    code = program(deny=SANDBOX + ("rt_sigaction",), threads=True)
+    code = program(deny=SANDBOX + ("rt_sigaction",))
     if code is None:
         return False
     import ctypes

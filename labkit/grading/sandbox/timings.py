@@ -1,8 +1,6 @@
-"""Where a submission's grading time goes: seconds per phase, measured in the grading process.
-
-:func:`phase` adds up the seconds of starting sandboxes, running cells, the checks' calls and reads of student
-code, recognising known code and the whole notebook. The class run keeps them per submission
-(the store's ``timings.json``) for the instructor and ``benchmarks/``; they never reach a student's feedback.
+"""Where a submission's grading time goes: seconds per phase (starting sandboxes, cells, the checks' calls and
+reads, recognising known code, whole notebooks), measured in the grading process. The class run keeps them per
+submission (the store's ``timings.json``) for the instructor and ``benchmarks/``, never for a student's feedback.
 """
 
 import contextlib
@@ -10,7 +8,6 @@ import json
 import time
 from pathlib import Path
 
-PHASES = ("sandbox start", "cells", "calls", "reads", "recognition", "notebooks")
 SUFFIX = ".timings.json"  # beside a grading process's result file
 _seconds: dict[str, float] = {}
 _counts: dict[str, int] = {}
@@ -18,7 +15,7 @@ _counts: dict[str, int] = {}
 
 @contextlib.contextmanager
 def phase(name):
-    """Add the seconds the block takes to phase `name` (one of :data:`PHASES`)."""
+    """Add the seconds the block takes to phase `name`."""
     start = time.perf_counter()
     try:
         yield

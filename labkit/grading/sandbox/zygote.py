@@ -1,34 +1,26 @@
 """The fork server inside the sandbox: imports once, then a freshly isolated worker per notebook.
 
 Run by :mod:`labkit.grading.sandbox.forkserver` as ``python -I -m labkit.grading.sandbox.zygote FD`` in a sandbox
-with the capabilities to make namespaces and change uid. It preloads (:func:`~.worker.preload`), says ``ready``
-and then takes requests on socket FD, one datagram each: JSON (the notebook's uid and limits) with the new
-worker's descriptors (requests, answers, control and status pipes, and the files that join the notebook's
-cgroup). It never reads a notebook and no student code runs in it.
-
-Per request it forks a **keeper**, which isolates the notebook before any student code exists: new mount,
-network, IPC, UTS and PID namespaces; empty tmpfs on ``/tmp``, the home folder and ``/dev/shm`` (no file of one
-notebook is seen by another); a read-only ``/proc`` of its own. The keeper forks the **worker**, the first
-process of the PID namespace (when it ends the kernel ends the whole namespace): it joins the cgroup, takes the
-rlimits, closes every descriptor but its pipes (the server's socket too), becomes the notebook's own uid (no
-capability left), sets no-new-privileges and runs the supervisor. The keeper stays outside as root running only
-this module: ``S`` on the status pipe once the worker runs (``E`` and why not), then it waits for the worker's
-end or the control pipe's closing (the grader is done or died), kills the worker and writes its wait status.
+that may make namespaces and change uid, it preloads (:func:`~.worker.preload`), says ``ready``, then takes
+requests on socket FD: a notebook's uid and limits with the new worker's descriptors. It never reads a notebook
+and runs no student code. Per request a keeper isolates the notebook (:func:`isolate`) and forks the worker
+(:func:`_become_worker`); docs/grading-security.md says what each step guards against.
 """
 
 import contextlib
 import ctypes
 import json
 import os
+import random
 import select
 import signal
 import socket
-import struct
 import sys
 
 from ...errors import InputError
 from . import worker
 from .backends.base import Limits, apply_limits, environment_paths
+from .forkserver import ENDED, FAILED, MAX_WHY, STARTED
 
 CLONE_NEWNS, CLONE_NEWUTS, CLONE_NEWIPC = 0x00020000, 0x04000000, 0x08000000
 CLONE_NEWPID, CLONE_NEWNET = 0x20000000, 0x40000000
@@ -51,12 +43,8 @@ def _checked(result, what):
 
 
 def _mount(source, target, kind, flags, data=None):
-    _checked(
-        _libc.mount(
-            source.encode(), target.encode(), kind.encode() if kind else None, flags, data.encode() if data else None
-        ),
-        f"mount {target}",
-    )
+    kind, data = (text.encode() if text else None for text in (kind, data))
+    _checked(_libc.mount(source.encode(), target.encode(), kind, flags, data), f"mount {target}")
 
 
 def isolate(limits, home, keep=()):
@@ -88,31 +76,23 @@ def isolate(limits, home, keep=()):
 
 
 def _say_failed(fd, exc):
-    """Write ``E`` and why the worker could not start on the status pipe `fd`; False where it cannot be written."""
+    """Write why the worker could not start on the status pipe `fd`; False where it cannot be written."""
     try:
-        os.write(fd, f"E{exc}"[:500].encode("utf-8", "replace"))
+        os.write(fd, FAILED + str(exc)[: MAX_WHY - 1].encode("utf-8", "replace"))
     except OSError:
         return False
     return True
 
 
-def _capabilities():
-    """The worker's permitted, effective and ambient capability sets (from /proc/self/status), as numbers."""
-    with open("/proc/self/status") as status:
-        fields = dict(line.split(":", 1) for line in status if ":" in line)
-    return [int(fields[name].strip(), 16) for name in ("CapPrm", "CapEff", "CapAmb")]
-
-
 def _become_worker(fds, uid, limits):
-    """In the worker (pid 1 of its namespace): everything up to the student's uid, then ``S`` on the status pipe."""
+    """In the worker (pid 1 of its namespace): everything up to the student's uid, then STARTED on the status pipe."""
     if uid <= 0:
         raise OSError(f"refusing to run a notebook as uid {uid}: a forked worker needs a uid of its own")
     _mount("proc", "/proc", "proc", MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC)
     for fd in fds["cgroup"]:
         os.write(fd, b"0")  # 0: the writing process
     # the worker's pipes at 3 and 4, its status pipe at 5; every other descriptor (the server's socket too) closes
-    wanted = [fds["requests"], fds["answers"], fds["status"]]
-    moved = [os.dup(fd) for fd in wanted]
+    moved = [os.dup(fds[name]) for name in ("requests", "answers", "status")]
     for index, fd in enumerate(moved):
         os.dup2(fd, FIRST_FD + index)
     os.closerange(FIRST_FD + len(moved), 2**31 - 1)
@@ -120,31 +100,28 @@ def _become_worker(fds, uid, limits):
     worker.drop_privileges(uid)
     worker.not_dumpable()  # the change of uid made the process dumpable again (fs.suid_dumpable)
     _checked(_libc.prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0), "no new privileges")
-    if os.getuid() != uid or os.geteuid() != uid or any(_capabilities()):
+    with open("/proc/self/status") as status:
+        fields = dict(line.split(":", 1) for line in status if ":" in line)
+    capabilities = [int(fields[name], 16) for name in ("CapPrm", "CapEff", "CapAmb")]  # permitted, effective, ambient
+    if os.getuid() != uid or os.geteuid() != uid or any(capabilities):
         raise OSError("the worker kept root's uid or a capability")
     if _libc.prctl(PR_GET_DUMPABLE, 0, 0, 0, 0) != 0:
         raise OSError("the worker's memory would be readable by its notebook")
-    _reseed()
-    os.write(FIRST_FD + 2, b"S")
+    random.seed()  # fresh random states, as a new Python would have: every worker forked from the server starts alike
+    if "numpy" in sys.modules:
+        sys.modules["numpy"].random.seed()
+    os.write(FIRST_FD + 2, STARTED)
     os.close(FIRST_FD + 2)
     return FIRST_FD, FIRST_FD + 1
 
 
-def _reseed():
-    """Fresh random states, as a new Python would have: every worker forked from the server starts alike."""
-    import random
-
-    random.seed()
-    if "numpy" in sys.modules:
-        sys.modules["numpy"].random.seed()
-
-
 def _keeper(fds, uid, limits, home, shell):
-    """The child of the server for one notebook; never returns."""
+    """The child of the server for one notebook (never returns): it forks the worker, and kills it when the grader
+    closes the control pipe; the worker's end, either way, goes on the status pipe."""
     status = fds["status"]
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     try:
-        isolate(limits, home, KEEP)
+        isolate(limits, home, [str(path) for path in environment_paths()])
         pid = os.fork()
     except OSError as exc:
         _say_failed(status, exc)
@@ -161,71 +138,50 @@ def _keeper(fds, uid, limits, home, shell):
                 if _say_failed(fd, exc):
                     break
         os._exit(code)
-    for name in ("requests", "answers"):
-        os.close(fds[name])
-    for fd in fds["cgroup"]:
+    for fd in (fds["requests"], fds["answers"], *fds["cgroup"]):
         os.close(fd)
     try:
         watch = [os.pidfd_open(pid)]
     except (AttributeError, OSError):  # a kernel before 5.3: look at the worker ten times a second instead
         watch = []
     control = fds["control"]
-    wait_status = None
-    while wait_status is None:
+    while True:
         ready = select.select([*watch, control], [], [], None if watch else 0.1)[0]
         if not watch or watch[0] in ready:
-            done, found = os.waitpid(pid, 0 if watch else os.WNOHANG)
+            done, wait_status = os.waitpid(pid, 0 if watch else os.WNOHANG)
             if done:
-                wait_status = found
                 break
         if control in ready:  # closed (or written to): the grader is done with this notebook
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-            _, wait_status = os.waitpid(pid, 0)
+            wait_status = os.waitpid(pid, 0)[1]
+            break
     with contextlib.suppress(OSError):  # the grader is gone
-        os.write(status, f"W{wait_status}".encode())
+        os.write(status, ENDED + str(wait_status).encode())
     os._exit(0)
 
 
-def _receive(server):
-    """(request dict, [descriptors]) of the next request, or None when the grader closed its end."""
-    space = socket.CMSG_SPACE(MAX_FDS * struct.calcsize("i"))
-    data, ancillary, flags, _ = server.recvmsg(MAX_REQUEST, space)
-    fds = []
-    for level, kind, payload in ancillary:
-        if level == socket.SOL_SOCKET and kind == socket.SCM_RIGHTS:
-            usable = len(payload) - len(payload) % struct.calcsize("i")
-            fds += list(struct.unpack(f"{usable // struct.calcsize('i')}i", payload[:usable]))
-    if not data and not fds:
-        return None
-    return data, fds, flags
-
-
-def _parse(data, fds):
-    """The request's fields, its descriptors named; ValueError when it is not a request of the grader's."""
+def _parse(data, fds, flags):
+    """The request's descriptors named, uid and limits; ValueError when it is not a request of the grader's."""
+    if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
+        raise InputError("a request larger than the server takes")
     request = json.loads(data.decode("utf-8"))
     count = int(request.get("cgroup", 0))
     if len(fds) != 4 + count or not 0 <= count <= MAX_FDS - 4:
         raise InputError("a request with the wrong descriptors")
-    named = dict(zip(("requests", "answers", "control", "status"), fds[:4]))
-    named["cgroup"] = fds[4:]
-    uid = int(request["uid"])
-    limits = Limits(**{key: int(value) for key, value in request["limits"].items()})
-    return named, uid, limits
+    named = {**dict(zip(("requests", "answers", "control", "status"), fds)), "cgroup": fds[4:]}
+    return named, int(request["uid"]), Limits(**{key: int(value) for key, value in request["limits"].items()})
 
 
 def serve_forks(server, shell, home):
     """Fork an isolated worker for each request until the grader closes its end of the socket."""
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # keepers are reaped by the kernel
     while True:
-        received = _receive(server)
-        if received is None:
+        data, fds, flags, _ = socket.recv_fds(server, MAX_REQUEST, MAX_FDS)
+        if not data and not fds:  # the grader closed its end
             return
-        data, fds, flags = received
         try:
-            if flags & (socket.MSG_TRUNC | socket.MSG_CTRUNC):
-                raise InputError("a request larger than the server takes")
-            named, uid, limits = _parse(data, fds)
+            named, uid, limits = _parse(data, fds, flags)
         except Exception:  # noqa: BLE001 - not a request of the grader's: dropped (its sender sees the pipes close)
             for fd in fds:
                 os.close(fd)
@@ -245,14 +201,8 @@ def serve_forks(server, shell, home):
             os.close(fd)
 
 
-KEEP = ()  # the sandbox's read-only folders (the Python environment, labkit): set by main
-
-
-def main(argv=None):
-    global KEEP
-    argv = sys.argv[1:] if argv is None else argv
-    KEEP = tuple(str(path) for path in environment_paths())
-    server = socket.socket(fileno=int(argv[0]))
+def main():
+    server = socket.socket(fileno=int(sys.argv[1]))
     worker.not_dumpable()
     null = os.open(os.devnull, os.O_RDWR)
     ready = os.dup(1)

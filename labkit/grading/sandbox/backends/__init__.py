@@ -1,12 +1,9 @@
 """Sandbox backends: where a student's notebook runs while it is graded.
 
-Grading knows a backend only through :class:`~.base.Backend`: whether it can run here, a warning once per run,
-and a :class:`~.base.Box` per notebook that starts the worker in the sandbox and cleans up after it. Built in:
-``bwrap`` (the default: namespaces, seccomp, rlimits and a memory cgroup) and ``none`` (no sandbox of labkit's
-own, for submissions already isolated outside, e.g. a pod each; it warns). A new backend (Docker, podman) is one
-module ``backends/<name>.py`` with a :func:`register`-ed subclass named ``<name>``: :data:`BUILTIN` is read from
-the package, so ``labkit grade --sandbox`` and GradeOptions take it. A backend registered outside labkit works
-too: each grading process imports its module (:func:`origin`, :func:`import_origin`).
+Grading knows a backend only through :class:`~.base.Backend`. Built in: ``bwrap`` (the default) and ``none``. A
+new backend is one module ``backends/<name>.py`` with a :func:`register`-ed subclass named ``<name>``; one
+registered outside labkit works too: each grading process imports its module (:func:`origin`,
+:func:`import_origin`).
 """
 
 import importlib
@@ -18,11 +15,8 @@ from ....errors import InputError
 
 DEFAULT = "bwrap"
 # one module each, backends/<name>.py, found in this package (the default first)
-BUILTIN = tuple(
-    sorted(
-        (m.name for m in pkgutil.iter_modules(__path__) if m.name != "base"), key=lambda name: (name != DEFAULT, name)
-    )
-)
+_FOUND = sorted(module.name for module in pkgutil.iter_modules(__path__) if module.name != "base")
+BUILTIN = tuple(sorted(_FOUND, key=lambda name: name != DEFAULT))
 UNCONFINED = "none"  # the backend the old switch --no-sandbox stands for
 
 _registered: dict = {}  # name -> Backend subclass
@@ -77,9 +71,8 @@ def get_backend(name):
 
 def origin(name):
     """(module name, file) where backend `name` is defined, so that another process can import it."""
-    cls = backend_class(name)
-    module = sys.modules[cls.__module__]
-    return cls.__module__, getattr(module, "__file__", None)
+    module = backend_class(name).__module__
+    return module, getattr(sys.modules[module], "__file__", None)
 
 
 def import_origin(module, path=None):

@@ -1,11 +1,8 @@
 """What every sandbox backend provides, and what backends share.
 
-Grading uses a backend only through :class:`Backend`: :meth:`~Backend.available` raises
-:class:`SandboxUnavailable` (saying what to do) once before a run, :meth:`~Backend.warning` is printed once per
-run, and :meth:`~Backend.box` makes one notebook's :class:`Box` from the worker's command and its
-:class:`Limits`. A :class:`Box` runs the command in a session of its own, in a memory cgroup of its own where one
-can be made (:mod:`labkit.grading.sandbox.cgroup`) and under the rlimits (:func:`apply_limits`); a backend whose
-sandbox lives elsewhere overrides :meth:`Box.start` and :meth:`Box.stop`.
+Grading uses a backend only through :class:`Backend`, which makes a :class:`Box` per notebook: the worker in a
+session of its own, in a memory cgroup of its own where one can be made (:mod:`labkit.grading.sandbox.cgroup`) and
+under the rlimits (:func:`apply_limits`).
 """
 
 import abc
@@ -44,7 +41,7 @@ def apply_limits(limits, processes_base=0):
     """Set the rlimits of the calling process (a child about to exec the sandbox or the worker)."""
 
     def cap(kind, value):
-        soft, hard = resource.getrlimit(kind)
+        hard = resource.getrlimit(kind)[1]
         value = value if hard == resource.RLIM_INFINITY else min(value, hard)
         resource.setrlimit(kind, (value, value))
 
@@ -69,9 +66,6 @@ def environment_paths():
     return sorted(p for p in paths if not any(q != p and q in p.parents for q in paths))
 
 
-COURSE_FOLDER = protocol.COURSE_FOLDER
-
-
 def course_mounts():
     """(course module's file or package, where the sandbox shows it) for each course module graded here and not in
     the environment: only the module, never the folder around it (with the course's submissions and grades)."""
@@ -81,7 +75,7 @@ def course_mounts():
     mounts = []
     for name, origin in sorted(COURSES.items()):
         if origin.exists() and not any(origin == p or p in origin.parents for p in environment):
-            mounts.append((origin, Path(COURSE_FOLDER) / (name if origin.is_dir() else origin.name)))
+            mounts.append((origin, Path(protocol.COURSE_FOLDER) / (name if origin.is_dir() else origin.name)))
     return mounts
 
 
@@ -100,10 +94,8 @@ def remove_tree(path):
     """Delete a folder however deep it is and whatever its permissions, without Python's recursion."""
     if not os.path.lexists(path):
         return
-    subprocess.run(["chmod", "-R", "u+rwx", "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    subprocess.run(
-        ["rm", "-rf", "--one-file-system", "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
-    )
+    for command in (["chmod", "-R", "u+rwx"], ["rm", "-rf", "--one-file-system"]):
+        subprocess.run([*command, "--", str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
 class Box:
@@ -120,12 +112,11 @@ class Box:
     def start(self):
         """Start the worker; its process (a Popen with pipes on stdin and stdout)."""
         self.cgroup = cgroup.create(self.limits.memory + WORKER_IMPORTS)
-        group, limits, base = self.cgroup, self.limits, self.processes_base
 
         def prepare():
-            if group is not None:
-                group.join()
-            apply_limits(limits, base)
+            if self.cgroup is not None:
+                self.cgroup.join()
+            apply_limits(self.limits, self.processes_base)
 
         try:
             self.process = subprocess.Popen(

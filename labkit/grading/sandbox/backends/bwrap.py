@@ -1,13 +1,9 @@
 """The default backend: a bubblewrap sandbox on this machine.
 
-:func:`command` builds one notebook's ``bwrap`` command line: a new empty root with only ``/usr``, ``/etc`` and
-the Python environment read-only (no other home, course, instructor or submission folder); ``HOME`` and
-``/tmp`` as small private tmpfs, the only writable places, gone with the sandbox; a read-only ``/proc`` of its
-own (no writing one's memory through ``/proc/self/mem``) and a minimal ``/dev``; the seccomp filter
-(:mod:`labkit.grading.sandbox.seccomp`, on a pipe); no network, its own PID, IPC and UTS namespaces, a new
-session (no terminal to inject into) and ``--die-with-parent``; every capability dropped but the two the worker
-needs to become an otherwise unused uid (:func:`sandbox_uid`, so the process limit holds). The rlimits are set
-before ``bwrap`` starts and a memory cgroup surrounds it where one can be made.
+:func:`command` builds one notebook's ``bwrap`` command line: a new root with only the system and the Python
+environment, read-only; small private tmpfs ``HOME`` and ``/tmp``; no network; its own ``/proc``, PID, IPC and UTS
+namespaces; the seccomp filter; and no capability but the two the worker needs to become an unused uid
+(:func:`sandbox_uid`). docs/grading-security.md says what each of these guards against.
 """
 
 import itertools
@@ -19,15 +15,7 @@ from pathlib import Path
 
 from .. import seccomp
 from . import register
-from .base import (
-    Backend,
-    Box,
-    Limits,
-    SandboxUnavailable,
-    course_mounts,
-    environment_paths,
-    processes_of_this_user,
-)
+from .base import Backend, Box, Limits, SandboxUnavailable, course_mounts, environment_paths, processes_of_this_user
 
 HOME = "/home/student"
 INSTALL_HINT = (
@@ -36,18 +24,14 @@ INSTALL_HINT = (
     "allows them; where each submission is already isolated (a pod or container of its own), "
     "`labkit grade --sandbox none` runs student code without a sandbox of labkit's own"
 )
-
-
 NAMESPACES = ("--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts", "--unshare-cgroup-try")
+FORKED_UIDS = 1_000_000_000  # forked workers' uids start here (far above sandbox_uid's; pids are below 2**22)
+_FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def _namespaces():
     user = [] if os.geteuid() == 0 else ["--unshare-user"]
     return [*user, *NAMESPACES, "--die-with-parent", "--new-session"]
-
-
-FORKED_UIDS = 1_000_000_000  # forked workers' uids start here (far above sandbox_uid's; pids are below 2**22)
-_FORKED = itertools.count()  # notebooks forked for this process so far
 
 
 def sandbox_uid():
@@ -81,8 +65,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     # the private /tmp first: an environment that lives under /tmp is then mounted back on top of it
     args += ["--proc", "/proc", "--remount-ro", "/proc", "--dev", "/dev"]
     args += ["--perms", "1777", "--size", str(limits.tmp_size), "--tmpfs", "/tmp"]
-    for name in ("usr", "etc"):
-        args += ["--ro-bind", f"/{name}", f"/{name}"]
+    args += ["--ro-bind", "/usr", "/usr", "--ro-bind", "/etc", "/etc"]
     for name in ("bin", "sbin", "lib", "lib32", "lib64", "libx32"):
         top = Path("/") / name
         if top.is_symlink():
@@ -92,8 +75,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
     made = {Path("/tmp")}
     for path in environment_paths():
         args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
-    courses = course_mounts()
-    for origin, shown in courses:
+    for origin, shown in course_mounts():
         args += [*_parents(shown, made), "--ro-bind", str(origin), str(shown)]
     args += [*_parents(HOME, made), "--perms", "1777", "--size", str(limits.home_size), "--tmpfs", HOME]
     args += ["--chdir", HOME]
@@ -108,9 +90,8 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
         "OMP_NUM_THREADS": "1",
         "MKL_NUM_THREADS": "1",
     }
-    for name in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE"):  # set on some machines for correct results
-        if name in os.environ:
-            environment[name] = os.environ[name]
+    kept = ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE")  # set on some machines for correct results
+    environment |= {name: os.environ[name] for name in kept if name in os.environ}
     for name, value in environment.items():
         args += ["--setenv", name, value]
     return args + ["--", *argv]
@@ -131,12 +112,8 @@ class Bubblewrap(Backend):
         bwrap = shutil.which("bwrap")
         if bwrap is None:
             raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
-        probe = subprocess.run(
-            [bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev", "true"],
-            capture_output=True,
-            text=True,
-            timeout=30,
-        )
+        trial = [bwrap, *_namespaces(), "--ro-bind", "/", "/", "--proc", "/proc", "--dev", "/dev", "true"]
+        probe = subprocess.run(trial, capture_output=True, text=True, timeout=30)
         if probe.returncode != 0:
             raise SandboxUnavailable(
                 f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): {INSTALL_HINT}."

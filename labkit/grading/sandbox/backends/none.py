@@ -1,10 +1,7 @@
-"""No sandbox of labkit's own: for when each submission is already isolated outside labkit.
-
-For one ``labkit grade`` per submission in a throw-away container (a Kubernetes pod, a batch job), combined with
-``labkit merge``: the container is the sandbox. The worker runs as a plain process in a session of its own with
-a private temporary home (removed afterwards), the same rlimits and memory cgroup where one can be made; the
-notebook's seccomp filter and the grader's watch hold too. Everything else is open, so every run starts with
-:data:`WARNING` on stderr.
+"""No sandbox of labkit's own: for when each submission is already isolated outside labkit, e.g. one
+``labkit grade`` per submission in a throw-away container (then ``labkit merge``). The worker keeps a private home,
+the rlimits, a memory cgroup where one can be made, the seccomp filter and the watch; everything else is open, so
+every run starts with :data:`WARNING` on stderr.
 """
 
 import os
