@@ -1,24 +1,14 @@
 """When each submission was handed in, read on the grader's side before any student code runs.
 
-A submission's time (:class:`SubmissionTime`) comes, in this order of
-precedence, from the instructor's ``--times TIMES.csv`` (columns
-``submission`` and ``time``), from nbgrader's ``timestamp.txt`` at the top of
-the submission's folder (:func:`parse_timestamp` reads every format nbgrader
-writes with a UTC offset or UTC itself), and, only when the instructor asks for
-it (``--times-from-mtime``), from the newest modification time of its
-notebooks. A submission with no time while a deadline is set is graded and
-not penalised, and the grades and the feedback say so; an unreadable
-``timestamp.txt`` is reported the same way, with the reason, for the
-instructor to give that time in ``--times``.
-
-What a time costs is the store's (:mod:`labkit.grading.store.late`); this module only reads the times.
+Where a time comes from, first match wins, is :func:`submission_time`'s (and ``docs/instructors.md``'s, "Late
+work"); what a time costs is the store's (:mod:`labkit.grading.store.late`). This module only reads the times.
 """
 
 import csv
 import os
 import re
 import stat
-from datetime import UTC, datetime, timedelta, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 from ...errors import InputError
@@ -55,27 +45,19 @@ def parse_timestamp(text: str) -> datetime:
     zone = match["zone"]
     if zone is None:
         raise InputError(f"{line!r} has no time zone, so the moment it means is unknown")
-    if zone in ("Z", "UTC", "GMT"):
-        offset = UTC
-    elif zone[0] in "+-":
-        digits = zone[1:].replace(":", "")
-        if int(digits[:2]) > 23 or int(digits[2:]) > 59:
-            raise InputError(f"{line!r} has the offset {zone}, which no time zone has")
-        offset = timezone((1 if zone[0] == "+" else -1) * timedelta(hours=int(digits[:2]), minutes=int(digits[2:])))
-    else:
+    if zone in ("UTC", "GMT"):
+        zone = "Z"
+    elif zone[0] in "+-" and (int(zone[1:3]) > 23 or int(zone[-2:]) > 59):
+        raise InputError(f"{line!r} has the offset {zone}, which no time zone has")
+    elif zone != "Z" and zone[0] not in "+-":
         raise InputError(
             f"{line!r} names the time zone {zone!r}, which labkit cannot place (only UTC, GMT and numeric "
             "offsets are unambiguous)"
         )
-    clock = match["time"].replace(",", ".")
-    if "." in clock:
-        whole, fraction = clock.split(".")
-        clock = f"{whole}.{fraction[:6].ljust(6, '0')}"
-    try:
-        naive = datetime.fromisoformat(f"{match['date']}T{clock}")
+    try:  # fromisoformat reads a comma and cuts a fraction to microseconds
+        return datetime.fromisoformat(f"{match['date']}T{match['time']}{zone}")
     except ValueError as exc:
         raise InputError(f"{line!r} is not a real time ({exc})") from None
-    return naive.replace(tzinfo=offset)
 
 
 def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:

@@ -1,23 +1,7 @@
-"""Late work: the rubric's ``[late]`` table, the submission times it reads, and the penalty.
+"""Late work: the rubric's ``[late]`` table (:func:`from_dict`), the submission times it reads, and the penalty.
 
-A rubric may say when the work was due and what lateness costs::
-
-    [late]
-    deadline = "2026-12-01T23:59:00+01:00"  # ISO 8601 with its UTC offset
-    per = "day"                             # the penalty counts started days ("day") or hours ("hour")
-    percent = 10                            # percent of the submission's points lost per started day
-    cap = 50                                # the most it can lose, in percent
-    grace = 15                              # minutes after a deadline that still count as on time (optional)
-
-    [late.extensions]                       # optional: a student's own deadline
-    alice = "2026-12-03T23:59:00+01:00"     # a new deadline
-    bob = 48                                # or hours added to the deadline
-
-The penalty is a share of the submission's own points (its total under the
-rubric, extra credit included): ``min(percent * started units, cap)`` percent
-of it. Lateness is counted from the student's deadline; the grace decides
-only whether a submission is late at all, so one 20 minutes late with 15
-minutes' grace is one started hour (or day) late.
+The table and its rule are documented for instructors in ``docs/instructors.md`` ("Late work");
+:meth:`Late.assess` applies the rule to one submission, counting lateness from the student's own deadline.
 """
 
 import math
@@ -69,7 +53,7 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
         why = "which has no UTC offset" if plain else "which is not in that format"
         raise InputError(f"{where} is {value[:SHOWN]!r}, {why}: write it as {FORMAT}.")
     try:
-        return datetime.fromisoformat(text.replace("Z", "+00:00"))
+        return datetime.fromisoformat(text)
     except ValueError as exc:
         raise InputError(f"{where} is {value!r}, which is not a real time ({exc}): write it as {FORMAT}.") from None
 
@@ -211,7 +195,7 @@ class Late:
         late_by = time.when - deadline
         grace = timedelta(minutes=self.grace)
         if late_by <= timedelta(0) or late_by <= grace:
-            note = "on time" if late_by <= timedelta(0) else f"on time (within the {_minutes(self.grace)} grace)"
+            note = "on time" if late_by <= timedelta(0) else f"on time (within the {_number(self.grace)}-minute grace)"
             return Lateness(deadline, extended, time, late_by, 0, 0.0, raw_total, 0.0, note)
         units = math.ceil(late_by.total_seconds() / UNITS[self.per])
         percent = min(units * self.percent, self.cap)
@@ -252,10 +236,6 @@ class Late:
 
 def _number(value):
     return f"{int(value)}" if float(value) == int(value) else f"{value:g}"
-
-
-def _minutes(value):
-    return f"{_number(value)}-minute" if value != 1 else "1-minute"
 
 
 def _amount(table, key, source, low=0.0, high=None, unit=""):
