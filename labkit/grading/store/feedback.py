@@ -1,20 +1,12 @@
 """A student's feedback, in the order a student reads it: the total first, then what to fix, errors last.
 
 :func:`build` turns a :class:`~labkit.grading.store.report.SubmissionGrade` into a :class:`Feedback`, the one
-model both forms are made from: :func:`text` (``feedback/<submission>.txt``) and :func:`html`
-(``feedback/<submission>.html``, one self-contained page from an autoescaped Jinja template,
-:mod:`labkit.grading.pages`). Every part's kind comes from
-:func:`labkit.exercises.result.part_kind`, as in the class report and ``labkit handin``:
-
-1. the total, the late penalty if any, and a table of the exercises: points, and done, partly or not done;
-2. exercise by exercise, each part that failed in the student's words, with its hint; a part not done says so
-   in one line, never as a slip or a traceback;
-3. what went wrong while the notebook ran: only the errors of cells the student changed; the cells that still
-   raise ``NotImplementedError`` counted in one line; the cells of the release left as they were (a branch
-   not chosen, a stub above them) not listed.
-
-Every text in the model is printable and bounded (:func:`~labkit.grading.store.report.one_line`); the HTML
-template escapes it.
+model both forms are rendered from, by autoescaped Jinja templates (:mod:`labkit.grading.pages`): :func:`text`
+(``feedback/<submission>.txt``) and :func:`html` (``feedback/<submission>.html``, one self-contained page).
+A part's kind comes from :func:`labkit.exercises.result.part_kind`, as in the class report and ``labkit
+handin``; a part not done says so in one line, never as a slip or a traceback. Of what went wrong while the
+notebook ran, only the errors of cells the student changed are listed, and the cells that still raise
+``NotImplementedError`` are counted. Every text in the model is printable and bounded (:func:`one_line`).
 """
 
 from __future__ import annotations
@@ -245,51 +237,20 @@ def _run_errors(grade):
 
 
 def text(feedback: Feedback) -> str:
-    """The feedback as plain text: the total on the first line."""
-    if feedback.failure:
-        return printable(
-            f"Not graded: {feedback.name}\n\nIt could not be graded: {feedback.failure}\n"
-            "Your instructor has been told; nothing of this submission was scored.\n"
-        )
-    lines = [
-        f"Total: {feedback.total}",
-        *(f"  {line}" for line in feedback.headline),
-        f"Feedback for {feedback.name}",
-        "",
-    ]
-    lines += _table_lines(feedback) + [""]
-    lines += [line for exercise in feedback.exercises for line in _exercise_lines(exercise)]
-    lines += _answer_lines(feedback) + _error_lines(feedback)
-    if feedback.seed is not None:
-        lines += ["", f"(random test data from seed {feedback.seed})"]
-    return printable("\n".join(lines) + "\n")
+    """The feedback as plain text (``templates/feedback.txt``): the total on the first line."""
+    return printable(_render("feedback.txt", feedback))
 
 
-def _table_lines(feedback):
-    lines = [f"{'exercise':>8}  {'points':>13}  status"]
-    for e in feedback.exercises:
-        status = e.status + (" (the other branch)" if e.other_branch else "")
-        lines.append(f"{e.number:>8}  {points_text(e.points) + ' / ' + points_text(e.worth):>13}  {status}")
-    return lines + [""] + list(feedback.summary)
+def html(feedback: Feedback) -> str:
+    """The feedback as one self-contained HTML page (no request, everything escaped)."""
+    return _render("feedback.html", feedback)
 
 
-def _exercise_lines(exercise):
-    if not exercise.to_fix:
-        return []
-    lines = [f"Exercise {exercise.number}: {points_text(exercise.points)} / {points_text(exercise.worth)}"]
-    for part in exercise.to_fix:
-        lines += _part_lines(part)
-    return lines + [""]
+def _render(template: str, feedback: Feedback) -> str:
+    from ..pages import render
 
-
-def _part_lines(part):
-    worth = f" ({points_text(part.worth)} point{'' if part.worth == 1 else 's'})" if part.worth else ""
-    if part.kind == NOT_DONE:  # one line: what is left to do
-        return [f"  {part.name}{worth}: not done" + (f": {part.hint}" if part.hint else ".")]
-    lines = [f"  {part.name}{worth}: {_kind_words(part.kind)}"]
-    lines += [f"    {step}: {detail}" if detail else f"    {step}" for step, detail in part.failed]
-    lines += [f"    hint: {part.hint}"] if part.hint else []
-    return lines + [f"    {note}" for note in part.notes]
+    values = {"points": points_text, "kind_words": _kind_words, "box": FIGURE_BOX, "colours": FIGURE_COLOURS}
+    return render(template, feedback=feedback, **values)
 
 
 def _kind_words(kind):
@@ -299,35 +260,6 @@ def _kind_words(kind):
         HELD: "held for your instructor",
         PASSED: "passed",
     }.get(kind, kind)
-
-
-def _answer_lines(feedback):
-    if not feedback.answers:
-        return []
-    lines = ["Answers in words (marked by your instructor, not by labkit):"]
-    for title, marked, text_lines, comment in feedback.answers:
-        lines.append(f"  {title}: {marked}")
-        lines += [f"    | {line}" for line in text_lines]
-        lines += [f"    your instructor: {comment}"] if comment else []
-    return lines + [""]
-
-
-def _error_lines(feedback):
-    lines = []
-    if feedback.errors:
-        lines += ["What went wrong while your notebook ran:"] + [f"  ! {line}" for line in feedback.errors]
-    if feedback.stubs:
-        cells = "1 cell still raises" if feedback.stubs == 1 else f"{feedback.stubs} cells still raise"
-        lines.append(f"{cells} NotImplementedError (work not done yet).")
-    return lines
-
-
-def html(feedback: Feedback) -> str:
-    """The feedback as one self-contained HTML page (no request, everything escaped)."""
-    from ..pages import render
-
-    values = {"points": points_text, "kind_words": _kind_words, "box": FIGURE_BOX, "colours": FIGURE_COLOURS}
-    return render("feedback.html", feedback=feedback, **values)
 
 
 def problem_kinds(problem):
