@@ -200,8 +200,33 @@ def _numbers(values) -> list:
     return [float(v) for v in values[:300] if math.isfinite(v)] if all(math.isfinite(v) for v in values[:300]) else []
 
 
-def _summary(grade):
-    return tuple(grade._summary().split("\n")) + tuple(grade.rubric.describe().split("\n"))
+def _summary(grade) -> tuple:
+    """The lines under the score table: the required exercises, the branch that counts, extra credit, the late
+    rule's line, the total, then the rubric in words."""
+    score, rubric, lateness = grade.score, grade.rubric, grade.lateness
+    lines = [
+        f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
+        f"{points_text(sum(rubric.worth(n) for n in rubric.required if n not in grade.excused))}"
+    ]
+    if score.branch == "none":
+        lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
+    elif score.branch:
+        full = sum(rubric.worth(n) for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
+        lines.append(
+            f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
+            "(the better of the branches)"
+        )
+    lines += [f"Extra credit, {what}: {points_text(value)}" for what, value in score.extra.items()]
+    if lateness is not None and rubric.late is not None:
+        lines.append(rubric.late.feedback(lateness))
+    if lateness is not None and lateness.penalty:
+        lines.append(
+            f"Total: {points_text(lateness.total)} ({points_text(score.total)} less "
+            f"{points_text(lateness.penalty)} for late work; full credit is {points_text(score.full_credit)})"
+        )
+    else:
+        lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
+    return tuple("\n".join([*lines, rubric.describe()]).split("\n"))
 
 
 def _answers(grade):

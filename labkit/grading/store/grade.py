@@ -18,7 +18,7 @@ from .feedback import problem_kinds
 from .late import Lateness, SubmissionTime
 from .model import ExerciseResult, ItemKey, Mark
 from .rubric import Score
-from .text import MAX_SOURCE_CHARS, one_line, points_text, printable
+from .text import MAX_SOURCE_CHARS, one_line, printable
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
 OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again
@@ -185,33 +185,6 @@ class SubmissionGrade:
     def feedback(self) -> str:
         """The feedback text a student reads: the total first (labkit.grading.store.feedback)."""
         return feedbacks.text(feedbacks.build(self))
-
-    def _summary(self) -> str:
-        score, rubric = self.score, self.rubric
-        lines = [
-            f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
-            f"{points_text(sum(rubric.worth(n) for n in rubric.required if n not in self.excused))}"
-        ]
-        if score.branch == "none":
-            lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
-        elif score.branch:
-            full = sum(rubric.worth(n) for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
-            lines.append(
-                f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
-                "(the better of the branches)"
-            )
-        lines += [f"Extra credit, {what}: {points_text(value)}" for what, value in score.extra.items()]
-        lateness = self.lateness
-        if lateness is not None and rubric.late is not None:
-            lines += rubric.late.feedback(lateness)
-            if lateness.penalty:
-                lines.append(
-                    f"Total: {points_text(lateness.total)} ({points_text(score.total)} less "
-                    f"{points_text(lateness.penalty)} for late work; full credit is {points_text(score.full_credit)})"
-                )
-                return "\n".join(lines)
-        lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
-        return "\n".join(lines)
 
     def as_dict(self) -> dict:
         """The grade as a result file's data (:data:`FORMAT`)."""

@@ -170,10 +170,8 @@ class Late:
 
     def deadline_for(self, name: str) -> tuple[datetime, bool]:
         """(the deadline of submission `name`, whether it is an extension)."""
-        for student, deadline in self.extensions:
-            if student == name:
-                return deadline, True
-        return self.deadline, False
+        extended = dict(self.extensions).get(name)
+        return (self.deadline, False) if extended is None else (extended, True)
 
     def assess(self, name: str, time: SubmissionTime | None, raw_total: float) -> Lateness:
         """The :class:`Lateness` of submission `name`, handed in at `time` (a :class:`SubmissionTime` or
@@ -217,21 +215,19 @@ class Late:
             f"off per started {self.per} late, at most {_number(self.cap)}%"
         )
 
-    def feedback(self, lateness: Lateness) -> list[str]:
-        """The lines of one submission's feedback about its lateness."""
+    def feedback(self, lateness: Lateness) -> str:
+        """The line of one submission's feedback about its lateness."""
         zone = self.deadline.tzinfo
         due = f"{time_text(lateness.deadline, zone)}{' (your extension)' if lateness.extended else ''}"
         if not lateness.known or lateness.time is None or lateness.time.when is None:
-            return [
-                f"Late work: due {due}; this submission's time is not known, so no late penalty was applied.",
-            ]
+            return f"Late work: due {due}; this submission's time is not known, so no late penalty was applied."
         handed_in = f"handed in {time_text(lateness.time.when, zone)} ({lateness.time.source})"
         if not lateness.units:
-            return [f"Late work: due {due}; {handed_in}: {lateness.note}."]
-        return [
+            return f"Late work: due {due}; {handed_in}: {lateness.note}."
+        return (
             f"Late work: due {due}; {handed_in}: {lateness.note}: "
-            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points.",
-        ]
+            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points."
+        )
 
 
 def _number(value):
