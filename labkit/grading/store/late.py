@@ -156,7 +156,7 @@ class Lateness:
 
 @dataclass(frozen=True)
 class Late:
-    """The rubric's late rule (the module's documentation gives its table): the deadline, the unit whose started
+    """The rubric's late rule (``docs/instructors.md`` gives its table): the deadline, the unit whose started
     ones count (``"day"`` or ``"hour"``), the percent lost per unit, the cap in percent, the grace in minutes,
     and each extension as a ``(name, deadline)`` pair.
     """
@@ -310,14 +310,8 @@ def read_small(path, limit):
             raise InputError(f"{path.name} is not a file")
         if info.st_size > limit:
             raise InputError(f"{path.name} is {info.st_size:,} bytes, more than the {limit:,} it can be")
-        chunks, size = [], 0
-        while size < limit:
-            chunk = os.read(fd, limit - size)
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-        return b"".join(chunks)
+        with os.fdopen(fd, "rb", closefd=False) as handle:
+            return handle.read(limit)
     finally:
         os.close(fd)
 
@@ -326,9 +320,8 @@ def unknown_times(grades: list) -> list[tuple[str, str, bool]]:
     """(name, note, whether it is an error) of each graded submission that a rubric's deadline applies to
     but whose time is unknown; an error is a time that could not be read.
     """
-    found = []
-    for grade in grades:
-        lateness = grade.lateness
-        if grade.graded and lateness is not None and not lateness.known:
-            found.append((grade.name, lateness.note, bool(lateness.time and lateness.time.problem)))
-    return found
+    return [
+        (grade.name, lateness.note, bool(lateness.time and lateness.time.problem))
+        for grade in grades
+        if grade.graded and (lateness := grade.lateness) is not None and not lateness.known
+    ]
