@@ -4,10 +4,10 @@ Where a time comes from, first match wins, is :func:`submission_time`'s (and ``d
 work"); what a time costs is the store's (:mod:`labkit.grading.store.late`). This module only reads the times.
 """
 
+import contextlib
 import csv
 import os
 import re
-import stat
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -65,11 +65,7 @@ def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
     such file (a single notebook has none), a time whose ``problem`` says why when it cannot be read.
     """
     path = Path(submission) / TIMESTAMP
-    try:
-        if not stat.S_ISDIR(os.lstat(submission).st_mode):
-            return None
-        os.lstat(path)
-    except OSError:
+    if os.path.islink(submission) or not os.path.isdir(submission) or not os.path.lexists(path):
         return None
     try:
         raw = read_small(path, MAX_TIMESTAMP)
@@ -78,21 +74,6 @@ def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
         return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP} is not text")
     except (OSError, ValueError) as exc:
         return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP}: {exc}")
-
-
-def modification_time(notebooks: list) -> SubmissionTime | None:
-    """The newest modification time of a submission's notebooks (only on the instructor's explicit
-    request: the student sets it); None when there are none.
-    """
-    times = []
-    for path in notebooks:
-        try:
-            times.append(os.lstat(path).st_mtime)
-        except OSError:
-            continue
-    if not times:
-        return None
-    return SubmissionTime(datetime.fromtimestamp(max(times), UTC), FROM_MTIME)
 
 
 def read_times(path: str | os.PathLike) -> dict[str, datetime]:
@@ -161,9 +142,13 @@ def submission_time(
         found = read_timestamp(submission)
         if found is not None:
             return found
-    if from_mtime:
-        return modification_time(notebooks if notebooks is not None else [submission])
-    return None
+    if not from_mtime:
+        return None
+    stamps = []
+    for path in notebooks if notebooks is not None else [submission]:
+        with contextlib.suppress(OSError):
+            stamps.append(os.lstat(path).st_mtime)
+    return SubmissionTime(datetime.fromtimestamp(max(stamps), UTC), FROM_MTIME) if stamps else None
 
 
 def _inbound_time(folder, assignment):
@@ -186,12 +171,10 @@ MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
 def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datetime]:
     """{student: the newest submission's time} of `assignment` in nbgrader's exchange, read there.
 
-    nbgrader's ``submit`` copies a student's work into the course's ``inbound/`` folder, in a folder named
-    ``student+assignment+timestamp`` (newer versions add ``+random``), and ``collect`` takes each student's
-    newest; the time is read from that folder's name in the exchange itself, never from a ``timestamp.txt`` that
-    travelled with the work. `course` is the course's folder in the exchange (it holds ``inbound/``) or
-    ``inbound/`` itself. InputError when there is no ``inbound/`` or a folder of that assignment has a time
-    that cannot be read.
+    The time is read from the name nbgrader's ``submit`` gives the work's folder in ``inbound/``
+    (``student+assignment+timestamp[+random]``), never from a ``timestamp.txt`` that travelled with the work.
+    `course` is the course's folder in the exchange or its ``inbound/``. InputError when there is no
+    ``inbound/`` or a folder of that assignment has a time that cannot be read.
     """
     course = Path(course)
     inbound = course if course.name == "inbound" else course / "inbound"

@@ -216,10 +216,8 @@ class SubmissionGrade:
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "a result file", rubric: rubrics.Rubric | None = None):
-        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file.
-
-        A result of an earlier format is refused, saying to grade again: ``labkit-grade/2`` kept its problems as
-        words only, and guessing their kinds from the words is what format 3 ended."""
+        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file. A result
+        of an earlier format is refused, saying to grade again (its problems' kinds would be guesses)."""
         if isinstance(data, dict) and data.get("format") in OLD_FORMATS:
             raise InputError(
                 f"{source} is in the results format {data['format']}, which keeps a problem's words but not its "
