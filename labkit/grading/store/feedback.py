@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, VARIANT, part_kind
 from .model import ItemKey
@@ -47,7 +47,6 @@ class Exercise:
     worth: float
     status: str
     parts: tuple = ()
-    note: str = ""  # one line in place of the parts (not found, excused)
     other_branch: bool = False  # of the branch that is not the better one (extra credit at most)
 
     @property
@@ -70,7 +69,6 @@ class Feedback:
     stubs: int = 0  # cells that still raise NotImplementedError
     seed: int | None = None
     failure: str = ""
-    other_branch: tuple = field(default=())  # exercises of the branch that does not count
 
 
 def blank(answer) -> bool:
@@ -97,7 +95,6 @@ def build(grade) -> Feedback:
         errors,
         stubs,
         grade.seed,
-        other_branch=tuple(sorted(other)),
     )
 
 
@@ -124,11 +121,10 @@ def _exercise(grade, number, other_branch):
     rubric, points = grade.rubric, grade.points.get(number, 0.0)
     worth = rubric.worth(number)
     if number in grade.excused:
-        return Exercise(number, 0.0, 0.0, "excused", note="excused by your instructor")
+        return Exercise(number, 0.0, 0.0, "excused")
     verdict = grade.results.get(number)
-    if verdict is None:
-        note = f"no notebook has its section ('## Exercise {number}'), or it never ran"
-        return Exercise(number, 0.0, worth, NOT_DONE, note=note, other_branch=other_branch)
+    if verdict is None:  # no notebook has its section ("## Exercise N"), or it never ran
+        return Exercise(number, 0.0, worth, NOT_DONE, other_branch=other_branch)
     parts = tuple(_part(grade, number, part, verdict.parts) for part in verdict.parts)
     kinds = {part.kind for part in parts}
     if worth and points >= worth - 1e-9:
