@@ -68,8 +68,7 @@ def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
     if os.path.islink(submission) or not os.path.isdir(submission) or not os.path.lexists(path):
         return None
     try:
-        raw = read_small(path, MAX_TIMESTAMP)
-        return SubmissionTime(parse_timestamp(raw.decode("utf-8")), FROM_NBGRADER)
+        return SubmissionTime(parse_timestamp(read_small(path, MAX_TIMESTAMP).decode("utf-8")), FROM_NBGRADER)
     except UnicodeDecodeError:
         return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP} is not text")
     except (OSError, ValueError) as exc:
@@ -84,8 +83,7 @@ def read_times(path: str | os.PathLike) -> dict[str, datetime]:
     """
     path = Path(path)
     try:
-        raw = read_small(path, MAX_TIMES)
-        text = raw.decode("utf-8-sig")
+        text = read_small(path, MAX_TIMES).decode("utf-8-sig")
     except FileNotFoundError:
         raise InputError(f"the times file {path} does not exist.") from None
     except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError

@@ -176,24 +176,20 @@ def _figure(lines) -> tuple:
         return ()
     xs, ys = [v for x, _, _ in kept for v in x], [v for _, y, _ in kept for v in y]
     width, height, margin = FIGURE_BOX
-    sx = (width - 2 * margin) / ((max(xs) - min(xs)) or 1.0)
-    sy = (height - 2 * margin) / ((max(ys) - min(ys)) or 1.0)
+    x0, y0 = min(xs), min(ys)
+    sx = (width - 2 * margin) / ((max(xs) - x0) or 1.0)
+    sy = (height - 2 * margin) / ((max(ys) - y0) or 1.0)
     return tuple(
-        (
-            " ".join(
-                f"{margin + (a - min(xs)) * sx:.1f},{height - margin - (b - min(ys)) * sy:.1f}" for a, b in zip(x, y)
-            ),
-            joined,
-        )
+        (" ".join(f"{margin + (a - x0) * sx:.1f},{height - margin - (b - y0) * sy:.1f}" for a, b in zip(x, y)), joined)
         for x, y, joined in kept
     )
 
 
 def _numbers(values) -> list:
     """The finite numbers of a list read back from a result file (at most 300), or [] when it holds anything else."""
-    if not isinstance(values, list) or not all(type(v) in (int, float) for v in values[:300]):
+    if not isinstance(values, list) or not all(type(v) in (int, float) and math.isfinite(v) for v in values[:300]):
         return []
-    return [float(v) for v in values[:300] if math.isfinite(v)] if all(math.isfinite(v) for v in values[:300]) else []
+    return [float(v) for v in values[:300]]
 
 
 def _summary(grade) -> tuple:

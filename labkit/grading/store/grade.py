@@ -14,10 +14,8 @@ from ...errors import InputError
 from ...exercises.result import KINDS
 from . import feedback as feedbacks
 from . import rubric as rubrics
-from .feedback import problem_kinds
 from .late import Lateness, SubmissionTime
 from .model import ExerciseResult, ItemKey, Mark
-from .rubric import Score
 from .text import MAX_SOURCE_CHARS, one_line, printable
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
@@ -46,12 +44,10 @@ class ProblemText(str):
 
     def __new__(cls, text: str, kinds) -> ProblemText:
         self = super().__new__(cls, text)
-        pairs = []
-        for kind, description in kinds:
+        self.kinds = tuple((str(kind), str(description)) for kind, description in kinds)
+        for kind, _ in self.kinds:
             if kind not in KINDS:
                 raise InputError(f"a problem's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
-            pairs.append((str(kind), str(description)))
-        self.kinds = tuple(pairs)
         return self
 
     @classmethod
@@ -155,7 +151,7 @@ class SubmissionGrade:
         ]
 
     @property
-    def score(self) -> Score:
+    def score(self) -> rubrics.Score:
         return self.rubric.score(self.fractions, self.marked, self.excused)
 
     @property
@@ -200,7 +196,7 @@ class SubmissionGrade:
             "name": self.name,
             "seed": self.seed,
             "problems": [str(p) for p in self.problems],
-            "problem_kinds": [[list(pair) for pair in problem_kinds(p)] for p in self.problems],
+            "problem_kinds": [[list(pair) for pair in feedbacks.problem_kinds(p)] for p in self.problems],
             "failure": self.failure,
             "answers": dict(self.answers),
             "sources": dict(self.sources),

@@ -116,9 +116,7 @@ class SubmissionTime:
             return None
         if not isinstance(data, dict) or set(data) - {"time", "source", "problem"}:
             raise InputError("its submission time is not a time, source and problem")
-        when = data.get("time")
-        if when is not None:
-            when = parse_deadline(when, "its submission time")
+        when = None if data.get("time") is None else parse_deadline(data["time"], "its submission time")
         source, problem = data.get("source"), data.get("problem")
         if not all(v is None or isinstance(v, str) for v in (source, problem)):
             raise InputError("its submission time's source and problem must be text")

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any
 
 from ...errors import InputError
 from .text import one_line
@@ -36,7 +35,7 @@ class Step:
         )
 
     def as_dict(self) -> dict:
-        found: dict[str, Any] = {"step": self.step, "passed": self.passed, "detail": self.detail}
+        found = {"step": self.step, "passed": self.passed, "detail": self.detail}
         return found if self.kind is None else {**found, "kind": self.kind}
 
 
