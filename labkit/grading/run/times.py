@@ -17,7 +17,6 @@ from ..store.late import FORMAT, FROM_CSV, FROM_EXCHANGE, FROM_MTIME, FROM_NBGRA
 MAX_TIMES = 10 * 1024**2  # bytes of a --times file
 MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
 TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
-# nbgrader: "%Y-%m-%d %H:%M:%S.%f %Z" (older: without .%f), or an ISO time (what `zip_collect` writes)
 _NBGRADER = re.compile(
     r"(?P<date>\d{4}-\d{2}-\d{2})[T ](?P<time>\d{2}:\d{2}(?::\d{2}(?:[.,]\d{1,9})?)?)"
     r"\s*(?P<zone>Z|UTC|GMT|[+-]\d{2}:?\d{2}|[A-Za-z][A-Za-z0-9/_+-]{0,40})?"
@@ -27,10 +26,9 @@ _NBGRADER = re.compile(
 def parse_timestamp(text: str) -> datetime:
     """The time nbgrader wrote in a ``timestamp.txt``, as a timezone-aware datetime.
 
-    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` in its configured timezone, older versions without the
-    fraction, ``nbgrader zip_collect`` an ISO time with an offset; all are read, as is a numeric offset. A time
-    without a zone, or with a zone name other than UTC or GMT (``CET`` names several), is an InputError: which
-    moment it means cannot be known.
+    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` (older versions without the fraction), ``zip_collect`` an ISO
+    time with an offset. A time without a zone, or with a zone name other than UTC or GMT (``CET`` names several),
+    is an InputError: which moment it means cannot be known.
 
     >>> parse_timestamp("2026-12-01 23:59:59.123456 UTC\\n").isoformat()
     '2026-12-01T23:59:59.123456+00:00'
@@ -149,9 +147,9 @@ def submission_time(
     return SubmissionTime(datetime.fromtimestamp(max(stamps), UTC), FROM_MTIME) if stamps else None
 
 
-def _inbound_time(folder, assignment):
-    """The time in the name of an inbound folder of `assignment` (``student+assignment+time[+random]``), why it
-    cannot be read (text), or None for another assignment's folder."""
+def _inbound_time(inbound, folder, assignment):
+    """The time in the name of an inbound folder of `assignment` (``student+assignment+time[+random]``), or None
+    for another assignment's folder; InputError when it cannot be read."""
     problem = "its name is not student+assignment+time"
     for cut in (3, 2):
         parts = folder.rsplit("+", cut)
@@ -160,7 +158,9 @@ def _inbound_time(folder, assignment):
                 return parse_timestamp(parts[2])
             except ValueError as exc:
                 problem = str(exc)
-    return problem if f"+{assignment}+" in folder else None
+    if f"+{assignment}+" in folder:
+        raise InputError(f"{inbound}: the folder {folder[:SHOWN]!r} has no readable time ({problem}).")
+    return None
 
 
 MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
@@ -188,11 +188,9 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
                 raise InputError(f"{inbound} holds more than {MAX_INBOUND:,} entries; it is not an exchange folder.")
             if not entry.is_dir(follow_symlinks=False):
                 continue
-            when = _inbound_time(entry.name, assignment)
+            when = _inbound_time(inbound, entry.name, assignment)
             if when is None:
                 continue
-            if isinstance(when, str):
-                raise InputError(f"{inbound}: the folder {entry.name[:SHOWN]!r} has no readable time ({when}).")
             student = entry.name.split(f"+{assignment}+")[0]
             if student not in found or when > found[student]:
                 found[student] = when

@@ -1,12 +1,10 @@
 """A student's feedback, in the order a student reads it: the total first, then what to fix, errors last.
 
 :func:`build` turns a :class:`~labkit.grading.store.report.SubmissionGrade` into a :class:`Feedback`, the one
-model both forms are rendered from, by autoescaped Jinja templates (:mod:`labkit.grading.pages`): :func:`text`
+model both forms are rendered from by autoescaped Jinja templates (:mod:`labkit.grading.pages`): :func:`text`
 (``feedback/<submission>.txt``) and :func:`html` (``feedback/<submission>.html``, one self-contained page).
-A part's kind comes from :func:`labkit.exercises.result.part_kind`, as in the class report and ``labkit
-handin``; a part not done says so in one line, never as a slip or a traceback. Of what went wrong while the
-notebook ran, only the errors of cells the student changed are listed, and the cells that still raise
-``NotImplementedError`` are counted. Every text in the model is printable and bounded (:func:`one_line`).
+Every text in the model is printable and bounded (:func:`one_line`); a part's kind is
+:func:`labkit.exercises.result.part_kind`'s, as in the class report and ``labkit handin``.
 """
 
 from __future__ import annotations
@@ -242,7 +240,8 @@ def _answers(grade):
 
 
 def _run_errors(grade):
-    """(cells that still raise NotImplementedError, one line per error the student caused or other problem)."""
+    """(cells that still raise NotImplementedError, one line per error of a cell the student changed or other
+    problem): the cells of the release left as they were are not listed."""
     stubs, errors = 0, []
     for problem in grade.problems:
         for kind, line in problem_kinds(problem):

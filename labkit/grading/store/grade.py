@@ -23,10 +23,9 @@ OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to 
 
 
 class ProblemText(str):
-    """A problem of a submission: its text as the feedback shows it, and its ``kinds``, the codes of what went
-    wrong (:data:`labkit.exercises.result.KINDS`), set where the problem is made: (kind, one-line
-    description) pairs, one per thing that went wrong (each cell that raised, say). The class report reads the
-    kinds, never the words.
+    """A problem of a submission: its text as the feedback shows it, and its ``kinds``, set where the problem is
+    made: (kind, one-line description) pairs (:data:`labkit.exercises.result.KINDS`), one per thing that went
+    wrong (each cell that raised, say). The class report reads the kinds, never the words.
 
     Examples
     --------

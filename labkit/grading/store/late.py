@@ -246,38 +246,33 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
     """A validated :class:`Late` from the rubric's parsed ``[late]`` table (``deadline``, ``per``, ``percent`` and
     ``cap``; ``grace`` and ``extensions`` optional); InputError saying which key is wrong and what it must be.
     """
+    section = f"{source}: [late]"
     if not isinstance(table, dict):
-        raise InputError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
+        raise InputError(f"{section} must be a table with deadline, per, percent and cap.")
     unknown = sorted(map(str, set(table) - KEYS))
     if unknown:
         raise InputError(f"{source}: unknown key(s) {', '.join(unknown)} in [late]; it has {', '.join(sorted(KEYS))}.")
     missing = [key for key in ("deadline", "per", "percent", "cap") if key not in table]
     if missing:
         raise InputError(
-            f'{source}: [late] needs {", ".join(missing)} (e.g. deadline = "2026-12-01T23:59:00+01:00", '
+            f'{section} needs {", ".join(missing)} (e.g. deadline = "2026-12-01T23:59:00+01:00", '
             'per = "day", percent = 10, cap = 50).'
         )
-    deadline = parse_deadline(table["deadline"], f"{source}: [late] deadline")
+    deadline = parse_deadline(table["deadline"], f"{section} deadline")
     per = table["per"]
     if per not in UNITS:
-        raise InputError(
-            f'{source}: [late] per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.'
-        )
+        raise InputError(f'{section} per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.')
     percent = _amount(table, "percent", source, 0, 100, " (percent of the points per started unit)")
     cap = _amount(table, "cap", source, 0, 100, " (the largest penalty, in percent)")
     grace = _amount(table, "grace", source, 0, unit=" of minutes") if "grace" in table else 0.0
-    extensions = table.get("extensions", {})
+    extensions, listing = table.get("extensions", {}), f"{source}: [late.extensions]"
     if not isinstance(extensions, dict):
-        raise InputError(
-            f'{source}: [late.extensions] must be a table of `name = "new deadline"` or `name = hours` lines.'
-        )
+        raise InputError(f'{listing} must be a table of `name = "new deadline"` or `name = hours` lines.')
     granted = []
     for name, value in extensions.items():
         if not isinstance(name, str) or not name.strip():
-            raise InputError(
-                f"{source}: [late.extensions] has the name {name!r}; a name is a submission's name, as text."
-            )
-        where = f"{source}: [late.extensions] {name[:SHOWN]!r}"
+            raise InputError(f"{listing} has the name {name!r}; a name is a submission's name, as text.")
+        where = f"{listing} {name[:SHOWN]!r}"
         if isinstance(value, (str, datetime)):
             new = parse_deadline(value, where)
         elif isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):

@@ -1,9 +1,7 @@
 """The typed data of a run: a submission's results by exercise, part and step, its marks, and their keys.
 
-A submission's grading process gives each exercise's result as :meth:`labkit.exercises.registry.Registry.check`
-makes it (plain JSON data); :meth:`ExerciseResult.from_dict` reads that once, at the store's edge, and
-everything after it reads these classes. :meth:`ExerciseResult.as_dict` gives the same data back for a result
-file, so a run's files keep their format.
+:meth:`ExerciseResult.from_dict` reads :meth:`labkit.exercises.registry.Registry.check`'s plain JSON data once,
+at the store's edge; :meth:`ExerciseResult.as_dict` gives the same data back for a result file.
 """
 
 from __future__ import annotations
