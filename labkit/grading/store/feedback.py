@@ -82,17 +82,9 @@ def build(grade) -> Feedback:
     score, rubric = grade.score, grade.rubric
     other = _other_branch(rubric, score.branch)
     exercises = tuple(_exercise(grade, number, number in other) for number in rubric.graded)
-    stubs, errors = _run_errors(grade)
+    total = f"{points_text(grade.total)} / {points_text(score.full_credit)} points"
     return Feedback(
-        name,
-        f"{points_text(grade.total)} / {points_text(score.full_credit)} points",
-        _headline(grade),
-        exercises,
-        _summary(grade),
-        _answers(grade),
-        errors,
-        stubs,
-        grade.seed,
+        name, total, _headline(grade), exercises, _summary(grade), _answers(grade), *_run_errors(grade), grade.seed
     )
 
 
@@ -240,8 +232,8 @@ def _answers(grade):
 
 
 def _run_errors(grade):
-    """(cells that still raise NotImplementedError, one line per error of a cell the student changed or other
-    problem): the cells of the release left as they were are not listed."""
+    """(one line per error of a cell the student changed or other problem, cells that still raise
+    NotImplementedError): the cells of the release left as they were are not listed."""
     stubs, errors = 0, []
     for problem in grade.problems:
         for kind, line in problem_kinds(problem):
@@ -249,7 +241,7 @@ def _run_errors(grade):
                 stubs += bool(STUB_CELL.search(line))
             elif kind != VARIANT or line not in errors:
                 errors.append(one_line(line, 1000))
-    return stubs, tuple(errors)
+    return tuple(errors), stubs
 
 
 def text(feedback: Feedback) -> str:
@@ -269,13 +261,11 @@ def _render(template: str, feedback: Feedback) -> str:
     return render(template, feedback=feedback, **values)
 
 
+KIND_WORDS = {ERROR: "an error", VARIANT: "another variant's data", HELD: "held for your instructor", PASSED: "passed"}
+
+
 def _kind_words(kind):
-    return {
-        ERROR: "an error",
-        VARIANT: "another variant's data",
-        HELD: "held for your instructor",
-        PASSED: "passed",
-    }.get(kind, kind)
+    return KIND_WORDS.get(kind, kind)
 
 
 def problem_kinds(problem):
