@@ -231,7 +231,7 @@ def _answers(grade):
     return tuple(found)
 
 
-def _run_errors(grade):
+def _run_errors(grade) -> tuple[tuple, int]:
     """(one line per error of a cell the student changed or other problem, cells that still raise
     NotImplementedError): the cells of the release left as they were are not listed."""
     stubs, errors = 0, []
