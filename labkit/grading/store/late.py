@@ -25,7 +25,6 @@ FROM_MTIME = "the notebooks' file times, student-supplied"
 STUDENT_SUPPLIED = (FROM_NBGRADER, FROM_MTIME)
 KEYS = {"deadline", "per", "percent", "cap", "grace", "extensions"}
 SHOWN = 80  # characters of a name or a bad value quoted in a message
-MINUTE = timedelta(minutes=1)
 
 _ISO = re.compile(r"\d{4}-\d{2}-\d{2}[T ]\d{2}:\d{2}(?::\d{2}(?:\.\d{1,6})?)?(?:Z|[+-]\d{2}:\d{2})")
 
@@ -79,14 +78,14 @@ def duration_text(delta: timedelta) -> str:
     >>> duration_text(timedelta(seconds=42))
     '42 s'
     """
-    if delta < MINUTE:
-        return f"{int(delta.total_seconds())} s"
-    days, rest = divmod(int(delta.total_seconds()), UNITS["day"])
+    seconds = int(delta.total_seconds())
+    if seconds < 60:
+        return f"{seconds} s"
+    days, rest = divmod(seconds, UNITS["day"])
     hours, rest = divmod(rest, UNITS["hour"])
-    minutes = rest // int(MINUTE.total_seconds())
     parts = [f"{days} day{'s' if days != 1 else ''}"] if days else []
     parts += [f"{hours} h"] if hours else []
-    parts += [f"{minutes} min"] if minutes else []
+    parts += [f"{rest // 60} min"] if rest >= 60 else []
     return " ".join(parts)
 
 
@@ -103,11 +102,8 @@ class SubmissionTime:
 
     def as_dict(self) -> dict:
         """The time as JSON data (UTC, ISO 8601), for a result file."""
-        return {
-            "time": None if self.when is None else self.when.astimezone(UTC).isoformat(),
-            "source": self.source,
-            "problem": self.problem,
-        }
+        time = None if self.when is None else self.when.astimezone(UTC).isoformat()
+        return {"time": time, "source": self.source, "problem": self.problem}
 
     @classmethod
     def from_dict(cls, data: dict | None) -> "SubmissionTime | None":
