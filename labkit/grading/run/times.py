@@ -17,6 +17,7 @@ from ..store.late import FORMAT, FROM_CSV, FROM_EXCHANGE, FROM_MTIME, FROM_NBGRA
 MAX_TIMES = 10 * 1024**2  # bytes of a --times file
 MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
 TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
+MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
 _NBGRADER = re.compile(
     r"(?P<date>\d{4}-\d{2}-\d{2})[T ](?P<time>\d{2}:\d{2}(?::\d{2}(?:[.,]\d{1,9})?)?)"
     r"\s*(?P<zone>Z|UTC|GMT|[+-]\d{2}:?\d{2}|[A-Za-z][A-Za-z0-9/_+-]{0,40})?"
@@ -161,9 +162,6 @@ def _inbound_time(inbound, folder, assignment):
     if f"+{assignment}+" in folder:
         raise InputError(f"{inbound}: the folder {folder[:SHOWN]!r} has no readable time ({problem}).")
     return None
-
-
-MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
 
 
 def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datetime]:

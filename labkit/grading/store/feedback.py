@@ -275,9 +275,8 @@ def problem_kinds(problem):
 
 
 SIDE = 56  # characters of a line shown on each side of a held part's shared lines
-HELD_STEP = (
-    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
-)
+# the step a held part fails until it is released (labkit.grading.submission.known)
+HELD_STEP = "is the student's own code"
 
 
 def _held_lines(part, released):

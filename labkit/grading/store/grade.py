@@ -1,8 +1,7 @@
 """A submission's grade: its results (:mod:`.model`), its problems and marks, and its score under a rubric.
 
-:class:`SubmissionGrade` is what a submission's grading process hands back and what the store reads from a
-result file (:meth:`SubmissionGrade.from_dict`, the one reader of that format); everything else reads its
-typed fields and properties.
+:class:`SubmissionGrade` is what a grading process hands back and what :meth:`SubmissionGrade.from_dict`, the
+one reader of a result file, reads back; everything else reads its typed fields and properties.
 """
 
 from __future__ import annotations
