@@ -26,8 +26,6 @@ class ProblemText(str):
     made: (kind, one-line description) pairs (:data:`labkit.exercises.result.KINDS`), one per thing that went
     wrong (each cell that raised, say). The class report reads the kinds, never the words.
 
-    Examples
-    --------
     >>> p = ProblemText("a.ipynb: it stopped.", [("crash", "a.ipynb: it stopped.")])
     >>> p, p.kinds
     ('a.ipynb: it stopped.', (('crash', 'a.ipynb: it stopped.'),))

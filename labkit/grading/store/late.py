@@ -60,8 +60,6 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
 def time_text(moment: datetime, zone: tzinfo | None = None) -> str:
     """A moment as ISO 8601 text to the second, in the offset of `zone` (a tzinfo) when given.
 
-    Examples
-    --------
     >>> time_text(parse_deadline("2026-12-01T22:59:00Z"), parse_deadline("2026-12-01T00:00+01:00").tzinfo)
     '2026-12-01T23:59:00+01:00'
     """
@@ -71,8 +69,6 @@ def time_text(moment: datetime, zone: tzinfo | None = None) -> str:
 def duration_text(delta: timedelta) -> str:
     """A positive duration in days, hours and minutes (seconds below one minute).
 
-    Examples
-    --------
     >>> duration_text(timedelta(days=1, hours=2, minutes=5, seconds=30))
     '1 day 2 h 5 min'
     >>> duration_text(timedelta(seconds=42))
@@ -171,8 +167,6 @@ class Late:
         """The :class:`Lateness` of submission `name`, handed in at `time` (a :class:`SubmissionTime` or
         None), whose points before the penalty are `raw_total`.
 
-        Examples
-        --------
         >>> rule = from_dict({"deadline": "2026-12-01T23:59:00+01:00", "per": "day", "percent": 10, "cap": 50})
         >>> handed_in = SubmissionTime(parse_deadline("2026-12-03T08:00:00+01:00"), FROM_CSV)
         >>> late = rule.assess("ada", handed_in, 80)
