@@ -73,7 +73,7 @@ def test_the_wheel_ships_the_student_notebooks_and_no_solved_one(fresh):
     # the pages' templates, stylesheets and scripts (labkit.grading.pages): the feedback page labkit grade renders for
     # each student, the class report (labkit report) and the marking page (labkit mark)
     pages = ["feedback.html", "feedback.css", "class_report.html", "class_report.css", "class_report.js"]
-    pages += ["marking.html", "marking_parts.html", "marking.css", "marking.js"]
+    pages += ["marking.html", "marking_parts.html", "marking.css", "marking.js", "feedback.txt"]
     assert {f"labkit/grading/templates/{name}" for name in pages} <= set(names)
 
 

@@ -1,24 +1,14 @@
 """When each submission was handed in, read on the grader's side before any student code runs.
 
-A submission's time (:class:`SubmissionTime`) comes, in this order of
-precedence, from the instructor's ``--times TIMES.csv`` (columns
-``submission`` and ``time``), from nbgrader's ``timestamp.txt`` at the top of
-the submission's folder (:func:`parse_timestamp` reads every format nbgrader
-writes with a UTC offset or UTC itself), and, only when the instructor asks for
-it (``--times-from-mtime``), from the newest modification time of its
-notebooks. A submission with no time while a deadline is set is graded and
-not penalised, and the grades and the feedback say so; an unreadable
-``timestamp.txt`` is reported the same way, with the reason, for the
-instructor to give that time in ``--times``.
-
-What a time costs is the store's (:mod:`labkit.grading.store.late`); this module only reads the times.
+Where a time comes from, first match wins, is :func:`submission_time`'s (and ``docs/instructors.md``'s, "Late
+work"); what a time costs is the store's (:mod:`labkit.grading.store.late`). This module only reads the times.
 """
 
+import contextlib
 import csv
 import os
 import re
-import stat
-from datetime import UTC, datetime, timedelta, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 from ...errors import InputError
@@ -27,7 +17,7 @@ from ..store.late import FORMAT, FROM_CSV, FROM_EXCHANGE, FROM_MTIME, FROM_NBGRA
 MAX_TIMES = 10 * 1024**2  # bytes of a --times file
 MAX_TIMESTAMP = 256  # bytes: nbgrader writes about 30
 TIMESTAMP = "timestamp.txt"  # nbgrader's name, in the submission's folder
-# nbgrader: "%Y-%m-%d %H:%M:%S.%f %Z" (older: without .%f), or an ISO time (what `zip_collect` writes)
+MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
 _NBGRADER = re.compile(
     r"(?P<date>\d{4}-\d{2}-\d{2})[T ](?P<time>\d{2}:\d{2}(?::\d{2}(?:[.,]\d{1,9})?)?)"
     r"\s*(?P<zone>Z|UTC|GMT|[+-]\d{2}:?\d{2}|[A-Za-z][A-Za-z0-9/_+-]{0,40})?"
@@ -37,10 +27,9 @@ _NBGRADER = re.compile(
 def parse_timestamp(text: str) -> datetime:
     """The time nbgrader wrote in a ``timestamp.txt``, as a timezone-aware datetime.
 
-    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` in its configured timezone, older versions without the
-    fraction, ``nbgrader zip_collect`` an ISO time with an offset; all are read, as is a numeric offset. A time
-    without a zone, or with a zone name other than UTC or GMT (``CET`` names several), is an InputError: which
-    moment it means cannot be known.
+    nbgrader writes ``"%Y-%m-%d %H:%M:%S.%f %Z"`` (older versions without the fraction), ``zip_collect`` an ISO
+    time with an offset. A time without a zone, or with a zone name other than UTC or GMT (``CET`` names several),
+    is an InputError: which moment it means cannot be known.
 
     >>> parse_timestamp("2026-12-01 23:59:59.123456 UTC\\n").isoformat()
     '2026-12-01T23:59:59.123456+00:00'
@@ -55,27 +44,19 @@ def parse_timestamp(text: str) -> datetime:
     zone = match["zone"]
     if zone is None:
         raise InputError(f"{line!r} has no time zone, so the moment it means is unknown")
-    if zone in ("Z", "UTC", "GMT"):
-        offset = UTC
-    elif zone[0] in "+-":
-        digits = zone[1:].replace(":", "")
-        if int(digits[:2]) > 23 or int(digits[2:]) > 59:
-            raise InputError(f"{line!r} has the offset {zone}, which no time zone has")
-        offset = timezone((1 if zone[0] == "+" else -1) * timedelta(hours=int(digits[:2]), minutes=int(digits[2:])))
-    else:
+    if zone in ("UTC", "GMT"):
+        zone = "Z"
+    elif zone[0] in "+-" and (int(zone[1:3]) > 23 or int(zone[-2:]) > 59):
+        raise InputError(f"{line!r} has the offset {zone}, which no time zone has")
+    elif zone != "Z" and zone[0] not in "+-":
         raise InputError(
             f"{line!r} names the time zone {zone!r}, which labkit cannot place (only UTC, GMT and numeric "
             "offsets are unambiguous)"
         )
-    clock = match["time"].replace(",", ".")
-    if "." in clock:
-        whole, fraction = clock.split(".")
-        clock = f"{whole}.{fraction[:6].ljust(6, '0')}"
-    try:
-        naive = datetime.fromisoformat(f"{match['date']}T{clock}")
+    try:  # fromisoformat reads a comma and cuts a fraction to microseconds
+        return datetime.fromisoformat(f"{match['date']}T{match['time']}{zone}")
     except ValueError as exc:
         raise InputError(f"{line!r} is not a real time ({exc})") from None
-    return naive.replace(tzinfo=offset)
 
 
 def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
@@ -83,34 +64,14 @@ def read_timestamp(submission: str | os.PathLike) -> SubmissionTime | None:
     such file (a single notebook has none), a time whose ``problem`` says why when it cannot be read.
     """
     path = Path(submission) / TIMESTAMP
-    try:
-        if not stat.S_ISDIR(os.lstat(submission).st_mode):
-            return None
-        os.lstat(path)
-    except OSError:
+    if os.path.islink(submission) or not os.path.isdir(submission) or not os.path.lexists(path):
         return None
     try:
-        raw = read_small(path, MAX_TIMESTAMP)
-        return SubmissionTime(parse_timestamp(raw.decode("utf-8")), FROM_NBGRADER)
+        return SubmissionTime(parse_timestamp(read_small(path, MAX_TIMESTAMP).decode("utf-8")), FROM_NBGRADER)
     except UnicodeDecodeError:
         return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP} is not text")
     except (OSError, ValueError) as exc:
         return SubmissionTime(None, FROM_NBGRADER, f"{TIMESTAMP}: {exc}")
-
-
-def modification_time(notebooks: list) -> SubmissionTime | None:
-    """The newest modification time of a submission's notebooks (only on the instructor's explicit
-    request: the student sets it); None when there are none.
-    """
-    times = []
-    for path in notebooks:
-        try:
-            times.append(os.lstat(path).st_mtime)
-        except OSError:
-            continue
-    if not times:
-        return None
-    return SubmissionTime(datetime.fromtimestamp(max(times), UTC), FROM_MTIME)
 
 
 def read_times(path: str | os.PathLike) -> dict[str, datetime]:
@@ -121,8 +82,7 @@ def read_times(path: str | os.PathLike) -> dict[str, datetime]:
     """
     path = Path(path)
     try:
-        raw = read_small(path, MAX_TIMES)
-        text = raw.decode("utf-8-sig")
+        text = read_small(path, MAX_TIMES).decode("utf-8-sig")
     except FileNotFoundError:
         raise InputError(f"the times file {path} does not exist.") from None
     except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError
@@ -179,14 +139,18 @@ def submission_time(
         found = read_timestamp(submission)
         if found is not None:
             return found
-    if from_mtime:
-        return modification_time(notebooks if notebooks is not None else [submission])
-    return None
+    if not from_mtime:
+        return None
+    stamps = []
+    for path in notebooks if notebooks is not None else [submission]:
+        with contextlib.suppress(OSError):
+            stamps.append(os.lstat(path).st_mtime)
+    return SubmissionTime(datetime.fromtimestamp(max(stamps), UTC), FROM_MTIME) if stamps else None
 
 
-def _inbound_time(folder, assignment):
-    """The time in the name of an inbound folder of `assignment` (``student+assignment+time[+random]``), why it
-    cannot be read (text), or None for another assignment's folder."""
+def _inbound_time(inbound, folder, assignment):
+    """The time in the name of an inbound folder of `assignment` (``student+assignment+time[+random]``), or None
+    for another assignment's folder; InputError when it cannot be read."""
     problem = "its name is not student+assignment+time"
     for cut in (3, 2):
         parts = folder.rsplit("+", cut)
@@ -195,21 +159,18 @@ def _inbound_time(folder, assignment):
                 return parse_timestamp(parts[2])
             except ValueError as exc:
                 problem = str(exc)
-    return problem if f"+{assignment}+" in folder else None
-
-
-MAX_INBOUND = 100_000  # entries of an exchange's inbound folder read
+    if f"+{assignment}+" in folder:
+        raise InputError(f"{inbound}: the folder {folder[:SHOWN]!r} has no readable time ({problem}).")
+    return None
 
 
 def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datetime]:
     """{student: the newest submission's time} of `assignment` in nbgrader's exchange, read there.
 
-    nbgrader's ``submit`` copies a student's work into the course's ``inbound/`` folder, in a folder named
-    ``student+assignment+timestamp`` (newer versions add ``+random``), and ``collect`` takes each student's
-    newest; the time is read from that folder's name in the exchange itself, never from a ``timestamp.txt`` that
-    travelled with the work. `course` is the course's folder in the exchange (it holds ``inbound/``) or
-    ``inbound/`` itself. InputError when there is no ``inbound/`` or a folder of that assignment has a time
-    that cannot be read.
+    The time is read from the name nbgrader's ``submit`` gives the work's folder in ``inbound/``
+    (``student+assignment+timestamp[+random]``), never from a ``timestamp.txt`` that travelled with the work.
+    `course` is the course's folder in the exchange or its ``inbound/``. InputError when there is no
+    ``inbound/`` or a folder of that assignment has a time that cannot be read.
     """
     course = Path(course)
     inbound = course if course.name == "inbound" else course / "inbound"
@@ -225,11 +186,9 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
                 raise InputError(f"{inbound} holds more than {MAX_INBOUND:,} entries; it is not an exchange folder.")
             if not entry.is_dir(follow_symlinks=False):
                 continue
-            when = _inbound_time(entry.name, assignment)
+            when = _inbound_time(inbound, entry.name, assignment)
             if when is None:
                 continue
-            if isinstance(when, str):
-                raise InputError(f"{inbound}: the folder {entry.name[:SHOWN]!r} has no readable time ({when}).")
             student = entry.name.split(f"+{assignment}+")[0]
             if student not in found or when > found[student]:
                 found[student] = when

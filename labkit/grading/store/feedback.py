@@ -1,27 +1,17 @@
 """A student's feedback, in the order a student reads it: the total first, then what to fix, errors last.
 
 :func:`build` turns a :class:`~labkit.grading.store.report.SubmissionGrade` into a :class:`Feedback`, the one
-model both forms are made from: :func:`text` (``feedback/<submission>.txt``) and :func:`html`
-(``feedback/<submission>.html``, one self-contained page from an autoescaped Jinja template,
-:mod:`labkit.grading.pages`). Every part's kind comes from
-:func:`labkit.exercises.result.part_kind`, as in the class report and ``labkit handin``:
-
-1. the total, the late penalty if any, and a table of the exercises: points, and done, partly or not done;
-2. exercise by exercise, each part that failed in the student's words, with its hint; a part not done says so
-   in one line, never as a slip or a traceback;
-3. what went wrong while the notebook ran: only the errors of cells the student changed; the cells that still
-   raise ``NotImplementedError`` counted in one line; the cells of the release left as they were (a branch
-   not chosen, a stub above them) not listed.
-
-Every text in the model is printable and bounded (:func:`~labkit.grading.store.report.one_line`); the HTML
-template escapes it.
+model both forms are rendered from by autoescaped Jinja templates (:mod:`labkit.grading.pages`): :func:`text`
+(``feedback/<submission>.txt``) and :func:`html` (``feedback/<submission>.html``, one self-contained page).
+Every text in the model is printable and bounded (:func:`one_line`); a part's kind is
+:func:`labkit.exercises.result.part_kind`'s, as in the class report and ``labkit handin``.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ...exercises.result import ERROR, HELD, NOT_DONE, OTHER, PASSED, VARIANT, part_kind
 from .model import ItemKey
@@ -55,7 +45,6 @@ class Exercise:
     worth: float
     status: str
     parts: tuple = ()
-    note: str = ""  # one line in place of the parts (not found, excused)
     other_branch: bool = False  # of the branch that is not the better one (extra credit at most)
 
     @property
@@ -78,7 +67,6 @@ class Feedback:
     stubs: int = 0  # cells that still raise NotImplementedError
     seed: int | None = None
     failure: str = ""
-    other_branch: tuple = field(default=())  # exercises of the branch that does not count
 
 
 def blank(answer) -> bool:
@@ -94,18 +82,9 @@ def build(grade) -> Feedback:
     score, rubric = grade.score, grade.rubric
     other = _other_branch(rubric, score.branch)
     exercises = tuple(_exercise(grade, number, number in other) for number in rubric.graded)
-    stubs, errors = _run_errors(grade)
+    total = f"{points_text(grade.total)} / {points_text(score.full_credit)} points"
     return Feedback(
-        name,
-        f"{points_text(grade.total)} / {points_text(score.full_credit)} points",
-        _headline(grade),
-        exercises,
-        _summary(grade),
-        _answers(grade),
-        errors,
-        stubs,
-        grade.seed,
-        other_branch=tuple(sorted(other)),
+        name, total, _headline(grade), exercises, _summary(grade), _answers(grade), *_run_errors(grade), grade.seed
     )
 
 
@@ -132,11 +111,10 @@ def _exercise(grade, number, other_branch):
     rubric, points = grade.rubric, grade.points.get(number, 0.0)
     worth = rubric.worth(number)
     if number in grade.excused:
-        return Exercise(number, 0.0, 0.0, "excused", note="excused by your instructor")
+        return Exercise(number, 0.0, 0.0, "excused")
     verdict = grade.results.get(number)
-    if verdict is None:
-        note = f"no notebook has its section ('## Exercise {number}'), or it never ran"
-        return Exercise(number, 0.0, worth, NOT_DONE, note=note, other_branch=other_branch)
+    if verdict is None:  # no notebook has its section ("## Exercise N"), or it never ran
+        return Exercise(number, 0.0, worth, NOT_DONE, other_branch=other_branch)
     parts = tuple(_part(grade, number, part, verdict.parts) for part in verdict.parts)
     kinds = {part.kind for part in parts}
     if worth and points >= worth - 1e-9:
@@ -188,28 +166,49 @@ def _figure(lines) -> tuple:
         return ()
     xs, ys = [v for x, _, _ in kept for v in x], [v for _, y, _ in kept for v in y]
     width, height, margin = FIGURE_BOX
-    sx = (width - 2 * margin) / ((max(xs) - min(xs)) or 1.0)
-    sy = (height - 2 * margin) / ((max(ys) - min(ys)) or 1.0)
+    x0, y0 = min(xs), min(ys)
+    sx = (width - 2 * margin) / ((max(xs) - x0) or 1.0)
+    sy = (height - 2 * margin) / ((max(ys) - y0) or 1.0)
     return tuple(
-        (
-            " ".join(
-                f"{margin + (a - min(xs)) * sx:.1f},{height - margin - (b - min(ys)) * sy:.1f}" for a, b in zip(x, y)
-            ),
-            joined,
-        )
+        (" ".join(f"{margin + (a - x0) * sx:.1f},{height - margin - (b - y0) * sy:.1f}" for a, b in zip(x, y)), joined)
         for x, y, joined in kept
     )
 
 
 def _numbers(values) -> list:
     """The finite numbers of a list read back from a result file (at most 300), or [] when it holds anything else."""
-    if not isinstance(values, list) or not all(type(v) in (int, float) for v in values[:300]):
+    if not isinstance(values, list) or not all(type(v) in (int, float) and math.isfinite(v) for v in values[:300]):
         return []
-    return [float(v) for v in values[:300] if math.isfinite(v)] if all(math.isfinite(v) for v in values[:300]) else []
+    return [float(v) for v in values[:300]]
 
 
-def _summary(grade):
-    return tuple(grade._summary().split("\n")) + tuple(grade.rubric.describe().split("\n"))
+def _summary(grade) -> tuple:
+    """The lines under the score table: the required exercises, the branch that counts, extra credit, the late
+    rule's line, the total, then the rubric in words."""
+    score, rubric, lateness = grade.score, grade.rubric, grade.lateness
+    lines = [
+        f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
+        f"{points_text(sum(rubric.worth(n) for n in rubric.required if n not in grade.excused))}"
+    ]
+    if score.branch == "none":
+        lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
+    elif score.branch:
+        full = sum(rubric.worth(n) for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
+        lines.append(
+            f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
+            "(the better of the branches)"
+        )
+    lines += [f"Extra credit, {what}: {points_text(value)}" for what, value in score.extra.items()]
+    if lateness is not None and rubric.late is not None:
+        lines.append(rubric.late.feedback(lateness))
+    if lateness is not None and lateness.penalty:
+        lines.append(
+            f"Total: {points_text(lateness.total)} ({points_text(score.total)} less "
+            f"{points_text(lateness.penalty)} for late work; full credit is {points_text(score.full_credit)})"
+        )
+    else:
+        lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
+    return tuple("\n".join([*lines, rubric.describe()]).split("\n"))
 
 
 def _answers(grade):
@@ -232,8 +231,9 @@ def _answers(grade):
     return tuple(found)
 
 
-def _run_errors(grade):
-    """(cells that still raise NotImplementedError, one line per error the student caused or other problem)."""
+def _run_errors(grade) -> tuple[tuple, int]:
+    """(one line per error of a cell the student changed or other problem, cells that still raise
+    NotImplementedError): the cells of the release left as they were are not listed."""
     stubs, errors = 0, []
     for problem in grade.problems:
         for kind, line in problem_kinds(problem):
@@ -241,93 +241,31 @@ def _run_errors(grade):
                 stubs += bool(STUB_CELL.search(line))
             elif kind != VARIANT or line not in errors:
                 errors.append(one_line(line, 1000))
-    return stubs, tuple(errors)
+    return tuple(errors), stubs
 
 
 def text(feedback: Feedback) -> str:
-    """The feedback as plain text: the total on the first line."""
-    if feedback.failure:
-        return printable(
-            f"Not graded: {feedback.name}\n\nIt could not be graded: {feedback.failure}\n"
-            "Your instructor has been told; nothing of this submission was scored.\n"
-        )
-    lines = [
-        f"Total: {feedback.total}",
-        *(f"  {line}" for line in feedback.headline),
-        f"Feedback for {feedback.name}",
-        "",
-    ]
-    lines += _table_lines(feedback) + [""]
-    lines += [line for exercise in feedback.exercises for line in _exercise_lines(exercise)]
-    lines += _answer_lines(feedback) + _error_lines(feedback)
-    if feedback.seed is not None:
-        lines += ["", f"(random test data from seed {feedback.seed})"]
-    return printable("\n".join(lines) + "\n")
-
-
-def _table_lines(feedback):
-    lines = [f"{'exercise':>8}  {'points':>13}  status"]
-    for e in feedback.exercises:
-        status = e.status + (" (the other branch)" if e.other_branch else "")
-        lines.append(f"{e.number:>8}  {points_text(e.points) + ' / ' + points_text(e.worth):>13}  {status}")
-    return lines + [""] + list(feedback.summary)
-
-
-def _exercise_lines(exercise):
-    if not exercise.to_fix:
-        return []
-    lines = [f"Exercise {exercise.number}: {points_text(exercise.points)} / {points_text(exercise.worth)}"]
-    for part in exercise.to_fix:
-        lines += _part_lines(part)
-    return lines + [""]
-
-
-def _part_lines(part):
-    worth = f" ({points_text(part.worth)} point{'' if part.worth == 1 else 's'})" if part.worth else ""
-    if part.kind == NOT_DONE:  # one line: what is left to do
-        return [f"  {part.name}{worth}: not done" + (f": {part.hint}" if part.hint else ".")]
-    lines = [f"  {part.name}{worth}: {_kind_words(part.kind)}"]
-    lines += [f"    {step}: {detail}" if detail else f"    {step}" for step, detail in part.failed]
-    lines += [f"    hint: {part.hint}"] if part.hint else []
-    return lines + [f"    {note}" for note in part.notes]
-
-
-def _kind_words(kind):
-    return {
-        ERROR: "an error",
-        VARIANT: "another variant's data",
-        HELD: "held for your instructor",
-        PASSED: "passed",
-    }.get(kind, kind)
-
-
-def _answer_lines(feedback):
-    if not feedback.answers:
-        return []
-    lines = ["Answers in words (marked by your instructor, not by labkit):"]
-    for title, marked, text_lines, comment in feedback.answers:
-        lines.append(f"  {title}: {marked}")
-        lines += [f"    | {line}" for line in text_lines]
-        lines += [f"    your instructor: {comment}"] if comment else []
-    return lines + [""]
-
-
-def _error_lines(feedback):
-    lines = []
-    if feedback.errors:
-        lines += ["What went wrong while your notebook ran:"] + [f"  ! {line}" for line in feedback.errors]
-    if feedback.stubs:
-        cells = "1 cell still raises" if feedback.stubs == 1 else f"{feedback.stubs} cells still raise"
-        lines.append(f"{cells} NotImplementedError (work not done yet).")
-    return lines
+    """The feedback as plain text (``templates/feedback.txt``): the total on the first line."""
+    return printable(_render("feedback.txt", feedback))
 
 
 def html(feedback: Feedback) -> str:
     """The feedback as one self-contained HTML page (no request, everything escaped)."""
+    return _render("feedback.html", feedback)
+
+
+def _render(template: str, feedback: Feedback) -> str:
     from ..pages import render
 
     values = {"points": points_text, "kind_words": _kind_words, "box": FIGURE_BOX, "colours": FIGURE_COLOURS}
-    return render("feedback.html", feedback=feedback, **values)
+    return render(template, feedback=feedback, **values)
+
+
+KIND_WORDS = {ERROR: "an error", VARIANT: "another variant's data", HELD: "held for your instructor", PASSED: "passed"}
+
+
+def _kind_words(kind):
+    return KIND_WORDS.get(kind, kind)
 
 
 def problem_kinds(problem):
@@ -337,9 +275,8 @@ def problem_kinds(problem):
 
 
 SIDE = 56  # characters of a line shown on each side of a held part's shared lines
-HELD_STEP = (
-    "is the student's own code"  # the step a held part fails until it is released (labkit.grading.submission.known)
-)
+# the step a held part fails until it is released (labkit.grading.submission.known)
+HELD_STEP = "is the student's own code"
 
 
 def _held_lines(part, released):

@@ -1,8 +1,7 @@
 """A submission's grade: its results (:mod:`.model`), its problems and marks, and its score under a rubric.
 
-:class:`SubmissionGrade` is what a submission's grading process hands back and what the store reads from a
-result file (:meth:`SubmissionGrade.from_dict`, the one reader of that format); everything else reads its
-typed fields and properties.
+:class:`SubmissionGrade` is what a grading process hands back and what :meth:`SubmissionGrade.from_dict`, the
+one reader of a result file, reads back; everything else reads its typed fields and properties.
 """
 
 from __future__ import annotations
@@ -14,24 +13,19 @@ from ...errors import InputError
 from ...exercises.result import KINDS
 from . import feedback as feedbacks
 from . import rubric as rubrics
-from .feedback import problem_kinds
 from .late import Lateness, SubmissionTime
 from .model import ExerciseResult, ItemKey, Mark
-from .rubric import Score
-from .text import MAX_SOURCE_CHARS, one_line, points_text, printable
+from .text import MAX_SOURCE_CHARS, one_line, printable
 
 FORMAT = "labkit-grade/3"  # 3: a problem's kinds as codes ("problem_kinds"), a failed step's in its "kind"
 OLD_FORMATS = ("labkit-grade/1", "labkit-grade/2")  # refused with a message to grade again
 
 
 class ProblemText(str):
-    """A problem of a submission: its text as the feedback shows it, and its ``kinds``, the codes of what went
-    wrong (:data:`labkit.exercises.result.KINDS`), set where the problem is made: (kind, one-line
-    description) pairs, one per thing that went wrong (each cell that raised, say). The class report reads the
-    kinds, never the words.
+    """A problem of a submission: its text as the feedback shows it, and its ``kinds``, set where the problem is
+    made: (kind, one-line description) pairs (:data:`labkit.exercises.result.KINDS`), one per thing that went
+    wrong (each cell that raised, say). The class report reads the kinds, never the words.
 
-    Examples
-    --------
     >>> p = ProblemText("a.ipynb: it stopped.", [("crash", "a.ipynb: it stopped.")])
     >>> p, p.kinds
     ('a.ipynb: it stopped.', (('crash', 'a.ipynb: it stopped.'),))
@@ -46,12 +40,10 @@ class ProblemText(str):
 
     def __new__(cls, text: str, kinds) -> ProblemText:
         self = super().__new__(cls, text)
-        pairs = []
-        for kind, description in kinds:
+        self.kinds = tuple((str(kind), str(description)) for kind, description in kinds)
+        for kind, _ in self.kinds:
             if kind not in KINDS:
                 raise InputError(f"a problem's kind is one of {', '.join(map(repr, KINDS))}, not {kind!r}.")
-            pairs.append((str(kind), str(description)))
-        self.kinds = tuple(pairs)
         return self
 
     @classmethod
@@ -155,7 +147,7 @@ class SubmissionGrade:
         ]
 
     @property
-    def score(self) -> Score:
+    def score(self) -> rubrics.Score:
         return self.rubric.score(self.fractions, self.marked, self.excused)
 
     @property
@@ -186,33 +178,6 @@ class SubmissionGrade:
         """The feedback text a student reads: the total first (labkit.grading.store.feedback)."""
         return feedbacks.text(feedbacks.build(self))
 
-    def _summary(self) -> str:
-        score, rubric = self.score, self.rubric
-        lines = [
-            f"Exercises {', '.join(map(str, rubric.required))}: {points_text(score.required)} / "
-            f"{points_text(sum(rubric.worth(n) for n in rubric.required if n not in self.excused))}"
-        ]
-        if score.branch == "none":
-            lines.append("Branch that counts: none yet (no exercise of either branch earned points)")
-        elif score.branch:
-            full = sum(rubric.worth(n) for n in next(b for b in rubric.branches if b.name == score.branch).exercises)
-            lines.append(
-                f"Branch that counts: {score.branch}, {points_text(score.counted)} / {points_text(full)} "
-                "(the better of the branches)"
-            )
-        lines += [f"Extra credit, {what}: {points_text(value)}" for what, value in score.extra.items()]
-        lateness = self.lateness
-        if lateness is not None and rubric.late is not None:
-            lines += rubric.late.feedback(lateness)
-            if lateness.penalty:
-                lines.append(
-                    f"Total: {points_text(lateness.total)} ({points_text(score.total)} less "
-                    f"{points_text(lateness.penalty)} for late work; full credit is {points_text(score.full_credit)})"
-                )
-                return "\n".join(lines)
-        lines.append(f"Total: {points_text(score.total)} (full credit is {points_text(score.full_credit)})")
-        return "\n".join(lines)
-
     def as_dict(self) -> dict:
         """The grade as a result file's data (:data:`FORMAT`)."""
         score, lateness = self.score, self.lateness
@@ -227,7 +192,7 @@ class SubmissionGrade:
             "name": self.name,
             "seed": self.seed,
             "problems": [str(p) for p in self.problems],
-            "problem_kinds": [[list(pair) for pair in problem_kinds(p)] for p in self.problems],
+            "problem_kinds": [[list(pair) for pair in feedbacks.problem_kinds(p)] for p in self.problems],
             "failure": self.failure,
             "answers": dict(self.answers),
             "sources": dict(self.sources),
@@ -243,10 +208,8 @@ class SubmissionGrade:
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "a result file", rubric: rubrics.Rubric | None = None):
-        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file.
-
-        A result of an earlier format is refused, saying to grade again: ``labkit-grade/2`` kept its problems as
-        words only, and guessing their kinds from the words is what format 3 ended."""
+        """Read back what :meth:`as_dict` wrote (scored again with `rubric`); ValueError names the file. A result
+        of an earlier format is refused, saying to grade again (its problems' kinds would be guesses)."""
         if isinstance(data, dict) and data.get("format") in OLD_FORMATS:
             raise InputError(
                 f"{source} is in the results format {data['format']}, which keeps a problem's words but not its "

@@ -1,23 +1,7 @@
-"""Late work: the rubric's ``[late]`` table, the submission times it reads, and the penalty.
+"""Late work: the rubric's ``[late]`` table (:func:`from_dict`), the submission times it reads, and the penalty.
 
-A rubric may say when the work was due and what lateness costs::
-
-    [late]
-    deadline = "2026-12-01T23:59:00+01:00"  # ISO 8601 with its UTC offset
-    per = "day"                             # the penalty counts started days ("day") or hours ("hour")
-    percent = 10                            # percent of the submission's points lost per started day
-    cap = 50                                # the most it can lose, in percent
-    grace = 15                              # minutes after a deadline that still count as on time (optional)
-
-    [late.extensions]                       # optional: a student's own deadline
-    alice = "2026-12-03T23:59:00+01:00"     # a new deadline
-    bob = 48                                # or hours added to the deadline
-
-The penalty is a share of the submission's own points (its total under the
-rubric, extra credit included): ``min(percent * started units, cap)`` percent
-of it. Lateness is counted from the student's deadline; the grace decides
-only whether a submission is late at all, so one 20 minutes late with 15
-minutes' grace is one started hour (or day) late.
+The table and its rule are documented for instructors in ``docs/instructors.md`` ("Late work");
+:meth:`Late.assess` applies the rule to one submission, counting lateness from the student's own deadline.
 """
 
 import math
@@ -41,7 +25,6 @@ FROM_MTIME = "the notebooks' file times, student-supplied"
 STUDENT_SUPPLIED = (FROM_NBGRADER, FROM_MTIME)
 KEYS = {"deadline", "per", "percent", "cap", "grace", "extensions"}
 SHOWN = 80  # characters of a name or a bad value quoted in a message
-MINUTE = timedelta(minutes=1)
 
 _ISO = re.compile(r"\d{4}-\d{2}-\d{2}[T ]\d{2}:\d{2}(?::\d{2}(?:\.\d{1,6})?)?(?:Z|[+-]\d{2}:\d{2})")
 
@@ -69,7 +52,7 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
         why = "which has no UTC offset" if plain else "which is not in that format"
         raise InputError(f"{where} is {value[:SHOWN]!r}, {why}: write it as {FORMAT}.")
     try:
-        return datetime.fromisoformat(text.replace("Z", "+00:00"))
+        return datetime.fromisoformat(text)
     except ValueError as exc:
         raise InputError(f"{where} is {value!r}, which is not a real time ({exc}): write it as {FORMAT}.") from None
 
@@ -77,8 +60,6 @@ def parse_deadline(value: str | datetime, where: str = "the deadline") -> dateti
 def time_text(moment: datetime, zone: tzinfo | None = None) -> str:
     """A moment as ISO 8601 text to the second, in the offset of `zone` (a tzinfo) when given.
 
-    Examples
-    --------
     >>> time_text(parse_deadline("2026-12-01T22:59:00Z"), parse_deadline("2026-12-01T00:00+01:00").tzinfo)
     '2026-12-01T23:59:00+01:00'
     """
@@ -88,21 +69,19 @@ def time_text(moment: datetime, zone: tzinfo | None = None) -> str:
 def duration_text(delta: timedelta) -> str:
     """A positive duration in days, hours and minutes (seconds below one minute).
 
-    Examples
-    --------
     >>> duration_text(timedelta(days=1, hours=2, minutes=5, seconds=30))
     '1 day 2 h 5 min'
     >>> duration_text(timedelta(seconds=42))
     '42 s'
     """
-    if delta < MINUTE:
-        return f"{int(delta.total_seconds())} s"
-    days, rest = divmod(int(delta.total_seconds()), UNITS["day"])
+    seconds = int(delta.total_seconds())
+    if seconds < 60:
+        return f"{seconds} s"
+    days, rest = divmod(seconds, UNITS["day"])
     hours, rest = divmod(rest, UNITS["hour"])
-    minutes = rest // int(MINUTE.total_seconds())
     parts = [f"{days} day{'s' if days != 1 else ''}"] if days else []
     parts += [f"{hours} h"] if hours else []
-    parts += [f"{minutes} min"] if minutes else []
+    parts += [f"{rest // 60} min"] if rest >= 60 else []
     return " ".join(parts)
 
 
@@ -119,11 +98,8 @@ class SubmissionTime:
 
     def as_dict(self) -> dict:
         """The time as JSON data (UTC, ISO 8601), for a result file."""
-        return {
-            "time": None if self.when is None else self.when.astimezone(UTC).isoformat(),
-            "source": self.source,
-            "problem": self.problem,
-        }
+        time = None if self.when is None else self.when.astimezone(UTC).isoformat()
+        return {"time": time, "source": self.source, "problem": self.problem}
 
     @classmethod
     def from_dict(cls, data: dict | None) -> "SubmissionTime | None":
@@ -132,9 +108,7 @@ class SubmissionTime:
             return None
         if not isinstance(data, dict) or set(data) - {"time", "source", "problem"}:
             raise InputError("its submission time is not a time, source and problem")
-        when = data.get("time")
-        if when is not None:
-            when = parse_deadline(when, "its submission time")
+        when = None if data.get("time") is None else parse_deadline(data["time"], "its submission time")
         source, problem = data.get("source"), data.get("problem")
         if not all(v is None or isinstance(v, str) for v in (source, problem)):
             raise InputError("its submission time's source and problem must be text")
@@ -172,7 +146,7 @@ class Lateness:
 
 @dataclass(frozen=True)
 class Late:
-    """The rubric's late rule (the module's documentation gives its table): the deadline, the unit whose started
+    """The rubric's late rule (``docs/instructors.md`` gives its table): the deadline, the unit whose started
     ones count (``"day"`` or ``"hour"``), the percent lost per unit, the cap in percent, the grace in minutes,
     and each extension as a ``(name, deadline)`` pair.
     """
@@ -186,17 +160,13 @@ class Late:
 
     def deadline_for(self, name: str) -> tuple[datetime, bool]:
         """(the deadline of submission `name`, whether it is an extension)."""
-        for student, deadline in self.extensions:
-            if student == name:
-                return deadline, True
-        return self.deadline, False
+        extended = dict(self.extensions).get(name)
+        return (self.deadline, False) if extended is None else (extended, True)
 
     def assess(self, name: str, time: SubmissionTime | None, raw_total: float) -> Lateness:
         """The :class:`Lateness` of submission `name`, handed in at `time` (a :class:`SubmissionTime` or
         None), whose points before the penalty are `raw_total`.
 
-        Examples
-        --------
         >>> rule = from_dict({"deadline": "2026-12-01T23:59:00+01:00", "per": "day", "percent": 10, "cap": 50})
         >>> handed_in = SubmissionTime(parse_deadline("2026-12-03T08:00:00+01:00"), FROM_CSV)
         >>> late = rule.assess("ada", handed_in, 80)
@@ -211,7 +181,7 @@ class Late:
         late_by = time.when - deadline
         grace = timedelta(minutes=self.grace)
         if late_by <= timedelta(0) or late_by <= grace:
-            note = "on time" if late_by <= timedelta(0) else f"on time (within the {_minutes(self.grace)} grace)"
+            note = "on time" if late_by <= timedelta(0) else f"on time (within the {_number(self.grace)}-minute grace)"
             return Lateness(deadline, extended, time, late_by, 0, 0.0, raw_total, 0.0, note)
         units = math.ceil(late_by.total_seconds() / UNITS[self.per])
         percent = min(units * self.percent, self.cap)
@@ -233,29 +203,23 @@ class Late:
             f"off per started {self.per} late, at most {_number(self.cap)}%"
         )
 
-    def feedback(self, lateness: Lateness) -> list[str]:
-        """The lines of one submission's feedback about its lateness."""
+    def feedback(self, lateness: Lateness) -> str:
+        """The line of one submission's feedback about its lateness."""
         zone = self.deadline.tzinfo
         due = f"{time_text(lateness.deadline, zone)}{' (your extension)' if lateness.extended else ''}"
         if not lateness.known or lateness.time is None or lateness.time.when is None:
-            return [
-                f"Late work: due {due}; this submission's time is not known, so no late penalty was applied.",
-            ]
+            return f"Late work: due {due}; this submission's time is not known, so no late penalty was applied."
         handed_in = f"handed in {time_text(lateness.time.when, zone)} ({lateness.time.source})"
         if not lateness.units:
-            return [f"Late work: due {due}; {handed_in}: {lateness.note}."]
-        return [
+            return f"Late work: due {due}; {handed_in}: {lateness.note}."
+        return (
             f"Late work: due {due}; {handed_in}: {lateness.note}: "
-            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points.",
-        ]
+            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points."
+        )
 
 
 def _number(value):
     return f"{int(value)}" if float(value) == int(value) else f"{value:g}"
-
-
-def _minutes(value):
-    return f"{_number(value)}-minute" if value != 1 else "1-minute"
 
 
 def _amount(table, key, source, low=0.0, high=None, unit=""):
@@ -272,38 +236,33 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
     """A validated :class:`Late` from the rubric's parsed ``[late]`` table (``deadline``, ``per``, ``percent`` and
     ``cap``; ``grace`` and ``extensions`` optional); InputError saying which key is wrong and what it must be.
     """
+    section = f"{source}: [late]"
     if not isinstance(table, dict):
-        raise InputError(f"{source}: [late] must be a table with deadline, per, percent and cap.")
+        raise InputError(f"{section} must be a table with deadline, per, percent and cap.")
     unknown = sorted(map(str, set(table) - KEYS))
     if unknown:
         raise InputError(f"{source}: unknown key(s) {', '.join(unknown)} in [late]; it has {', '.join(sorted(KEYS))}.")
     missing = [key for key in ("deadline", "per", "percent", "cap") if key not in table]
     if missing:
         raise InputError(
-            f'{source}: [late] needs {", ".join(missing)} (e.g. deadline = "2026-12-01T23:59:00+01:00", '
+            f'{section} needs {", ".join(missing)} (e.g. deadline = "2026-12-01T23:59:00+01:00", '
             'per = "day", percent = 10, cap = 50).'
         )
-    deadline = parse_deadline(table["deadline"], f"{source}: [late] deadline")
+    deadline = parse_deadline(table["deadline"], f"{section} deadline")
     per = table["per"]
     if per not in UNITS:
-        raise InputError(
-            f'{source}: [late] per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.'
-        )
+        raise InputError(f'{section} per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.')
     percent = _amount(table, "percent", source, 0, 100, " (percent of the points per started unit)")
     cap = _amount(table, "cap", source, 0, 100, " (the largest penalty, in percent)")
     grace = _amount(table, "grace", source, 0, unit=" of minutes") if "grace" in table else 0.0
-    extensions = table.get("extensions", {})
+    extensions, listing = table.get("extensions", {}), f"{source}: [late.extensions]"
     if not isinstance(extensions, dict):
-        raise InputError(
-            f'{source}: [late.extensions] must be a table of `name = "new deadline"` or `name = hours` lines.'
-        )
+        raise InputError(f'{listing} must be a table of `name = "new deadline"` or `name = hours` lines.')
     granted = []
     for name, value in extensions.items():
         if not isinstance(name, str) or not name.strip():
-            raise InputError(
-                f"{source}: [late.extensions] has the name {name!r}; a name is a submission's name, as text."
-            )
-        where = f"{source}: [late.extensions] {name[:SHOWN]!r}"
+            raise InputError(f"{listing} has the name {name!r}; a name is a submission's name, as text.")
+        where = f"{listing} {name[:SHOWN]!r}"
         if isinstance(value, (str, datetime)):
             new = parse_deadline(value, where)
         elif isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
@@ -334,14 +293,8 @@ def read_small(path, limit):
             raise InputError(f"{path.name} is not a file")
         if info.st_size > limit:
             raise InputError(f"{path.name} is {info.st_size:,} bytes, more than the {limit:,} it can be")
-        chunks, size = [], 0
-        while size < limit:
-            chunk = os.read(fd, limit - size)
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-        return b"".join(chunks)
+        with os.fdopen(fd, "rb", closefd=False) as handle:
+            return handle.read(limit)
     finally:
         os.close(fd)
 
@@ -350,9 +303,8 @@ def unknown_times(grades: list) -> list[tuple[str, str, bool]]:
     """(name, note, whether it is an error) of each graded submission that a rubric's deadline applies to
     but whose time is unknown; an error is a time that could not be read.
     """
-    found = []
-    for grade in grades:
-        lateness = grade.lateness
-        if grade.graded and lateness is not None and not lateness.known:
-            found.append((grade.name, lateness.note, bool(lateness.time and lateness.time.problem)))
-    return found
+    return [
+        (grade.name, lateness.note, bool(lateness.time and lateness.time.problem))
+        for grade in grades
+        if grade.graded and (lateness := grade.lateness) is not None and not lateness.known
+    ]

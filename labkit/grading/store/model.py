@@ -1,16 +1,13 @@
 """The typed data of a run: a submission's results by exercise, part and step, its marks, and their keys.
 
-A submission's grading process gives each exercise's result as :meth:`labkit.exercises.registry.Registry.check`
-makes it (plain JSON data); :meth:`ExerciseResult.from_dict` reads that once, at the store's edge, and
-everything after it reads these classes. :meth:`ExerciseResult.as_dict` gives the same data back for a result
-file, so a run's files keep their format.
+:meth:`ExerciseResult.from_dict` reads :meth:`labkit.exercises.registry.Registry.check`'s plain JSON data once,
+at the store's edge; :meth:`ExerciseResult.as_dict` gives the same data back for a result file.
 """
 
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any
 
 from ...errors import InputError
 from .text import one_line
@@ -36,7 +33,7 @@ class Step:
         )
 
     def as_dict(self) -> dict:
-        found: dict[str, Any] = {"step": self.step, "passed": self.passed, "detail": self.detail}
+        found = {"step": self.step, "passed": self.passed, "detail": self.detail}
         return found if self.kind is None else {**found, "kind": self.kind}
 
 

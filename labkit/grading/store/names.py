@@ -1,12 +1,5 @@
-"""A submission's name is its key: kept whole wherever it is looked up, shortened only where a person reads it.
-
-The name the intake gives a student (a folder's name, an LMS's prefix, the
-roster's name) keys grades.csv, the results, ``labkit merge``, the report, the
-LMS export and the marking page's ``marks.csv``. It is never cut there: any
-name, however long or odd, comes back from a file labkit wrote as itself.
-:func:`shown_name` is for display only, and two names that differ are shown
-apart even when their first characters agree (a hash of the whole name ends a
-shortened one).
+"""A submission's name is its key: kept whole wherever it is looked up (grades.csv, the results, ``labkit
+merge``, the report, the LMS export, ``marks.csv``), shortened only where a person reads it (:func:`shown_name`).
 """
 
 from __future__ import annotations

@@ -38,5 +38,4 @@ def write_variants(out, grades, students, roster, registry):
     with open(Path(out) / VARIANTS_CSV, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(["submission", "id", *(f"exercise {e.number}" for e in varied), "holds the data of"])
-        for row in rows:
-            writer.writerow([csv_cell(cell) for cell in row])
+        writer.writerows([csv_cell(cell) for cell in row] for row in rows)
