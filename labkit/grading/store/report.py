@@ -12,8 +12,8 @@ Layout of an output folder::
     record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.store.record)
     merge.json               (labkit merge only) the folders merged and the results a later one replaced
 
-``labkit grade`` writes through :func:`write_result`, :func:`write_report`, :func:`write_seed` and
-:func:`write_run`; ``labkit merge`` is :func:`merge`; ``labkit mark`` is :func:`.marks.import_marks`.
+``labkit grade`` writes through :func:`enter` and the ``write_*`` functions, ``labkit merge`` is :func:`merge`,
+``labkit mark`` is :func:`.marks.import_marks`; each file is replaced whole (:func:`.record.replace_text`).
 Nothing in a run folder comes from a student's process but plain numbers and short texts, and those are
 data: a submission's name becomes a file name through :func:`safe_name` (a hash keeps two students apart),
 every text is stripped of control characters (:func:`printable`) before it reaches a file or a terminal,
@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import io
 import json
 import re
 from dataclasses import dataclass
@@ -55,9 +56,8 @@ PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$"
 
 def file_stem(name: str) -> str:
     """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
-    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
-    :func:`~labkit.grading.store.report.safe_name`'s, with a hash of the whole name. A plain name never ends
-    as a hashed one does, so two submissions never share a file.
+    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else :func:`safe_name`'s.
+    A plain name never ends as a hashed one does, so two submissions never share a file.
 
     >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
     ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
@@ -82,6 +82,13 @@ def name_cell(name):
     """
     text = CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", str(name))
     return "'" + text if text.startswith(FORMULA_START) else text
+
+
+def csv_text(rows) -> str:
+    """`rows` as CSV text, in the csv module's dialect (its lines end in ``\\r\\n``)."""
+    buffer = io.StringIO()
+    csv.writer(buffer).writerows(rows)
+    return buffer.getvalue()
 
 
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
@@ -118,20 +125,15 @@ def held_text(grade: SubmissionGrade) -> str:
     )
 
 
-def _read_ids(graded: list, registry) -> list[str]:
-    """The grade ids of the answers in words of the graded exercises: one column each, for a person to fill in."""
-    return [grade_id for grade_id, (number, _) in registry.answers.items() if number in graded]
-
-
 def _mark_cell(grade: SubmissionGrade, grade_id: str) -> str:
     """An answer's cell in grades.csv: the points a person gave it, empty until then."""
     mark = grade.marks.get(ItemKey.of_answer(grade_id))
     return "" if mark is None else points_text(mark.points)
 
 
-def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool) -> list:
-    """One submission's row of grades.csv; `width` is the number of cells after its points."""
-    ids = _read_ids(graded, grade.rubric.registry)
+def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool, ids: list) -> list:
+    """One submission's row of grades.csv; `width` is the number of cells after its points, `ids` the grade ids
+    of the answers in words to read (a column each, for a person to fill in)."""
     if not grade.graded:
         return (
             [name_cell(grade.name)] + [""] * (len(graded) + width - 1)
@@ -155,32 +157,13 @@ def write_csv(path: str | Path, grades: list[SubmissionGrade]) -> None:
     A submission that could not be graded has empty points and says why in its status."""
     rubric = grades[0].rubric if grades else None
     graded = rubric.graded if rubric is not None else []
-    to_read = (
-        [f"to read: exercise {n}, {what}" for n, what in rubric.registry.answers.values() if n in graded]
-        if rubric
-        else []
-    )
+    answers = rubric.registry.answers.items() if rubric is not None else ()
+    to_read = {grade_id: f"to read: exercise {n}, {what}" for grade_id, (n, what) in answers if n in graded}
     tail = CSV_TAIL[:4] + CSV_LATE + CSV_TAIL[4:] if rubric is not None and rubric.late is not None else CSV_TAIL
     held = any(g.graded and g.held() for g in grades)
-    with open(path, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + tail + [CSV_HELD] * held + to_read)
-        writer.writerows(_csv_row(g, graded, len(tail), held) for g in grades)
-
-
-def write_result(out_dir: str | Path, grade: SubmissionGrade) -> records.Written:
-    """Write results/<name>.json and feedback/<name>.txt and .html of one submission, each replaced whole; the
-    result file and the SHA-256 of what was written (:class:`labkit.grading.store.record.Written`), for the record.
-    """
-    out = Path(out_dir)
-    prepare(out)
-    model, stem = feedbacks.build(grade), file_stem(grade.name)
-    replace_text(out / "feedback" / f"{stem}.txt", feedbacks.text(model))
-    replace_text(out / "feedback" / f"{stem}.html", feedbacks.html(model))
-    path = out / "results" / f"{safe_name(grade.name)}.json"
-    text = json.dumps(grade.as_dict(), indent=1)
-    replace_text(path, text)
-    return records.Written(path, hashlib.sha256(text.encode("utf-8")).hexdigest())
+    header = ["submission"] + [f"exercise {n}" for n in graded] + tail + [CSV_HELD] * held + list(to_read.values())
+    rows = [_csv_row(g, graded, len(tail), held, list(to_read)) for g in grades]
+    replace_text(Path(path), csv_text([header, *rows]))
 
 
 def prepare(out_dir: str | Path) -> None:
@@ -190,9 +173,18 @@ def prepare(out_dir: str | Path) -> None:
 
 
 def enter(out_dir: str | Path, record: records.RunRecord, grade: SubmissionGrade, content=None, save=True) -> None:
-    """Write `grade`'s result and feedback, and enter the result in the run's `record` (written too unless
-    `save` is False: the caller writes it)."""
-    records.note(out_dir, record, grade.name, write_result(out_dir, grade), content, save=save)
+    """Write `grade`'s results/<name>.json and feedback/<name>.txt and .html, and enter the result in the run's
+    `record` (:func:`.record.note`), which is written too unless `save` is False (the caller writes it)."""
+    out = Path(out_dir)
+    prepare(out)
+    model, stem = feedbacks.build(grade), file_stem(grade.name)
+    replace_text(out / "feedback" / f"{stem}.txt", feedbacks.text(model))
+    replace_text(out / "feedback" / f"{stem}.html", feedbacks.html(model))
+    path, text = out / "results" / f"{safe_name(grade.name)}.json", json.dumps(grade.as_dict(), indent=1)
+    replace_text(path, text)
+    records.note(record, grade.name, path, text, content)
+    if save:
+        records.write(out, record)
 
 
 def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: records.RunRecord | None = None):
@@ -215,18 +207,18 @@ def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: rec
 def write_seed(out_dir: str | Path, seeds: int | list[int] | None) -> None:
     """seed.txt: the run's seed (a merge's seeds), one a line."""
     seeds = seeds if isinstance(seeds, list) else [] if seeds is None else [seeds]
-    (Path(out_dir) / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")
+    replace_text(Path(out_dir) / "seed.txt", "".join(f"{s}\n" for s in seeds))
 
 
 def write_timings(out_dir: str | Path, found: dict) -> None:
     """timings.json: where each submission's grading time went, by phase (only when something was measured)."""
     if found:
-        (Path(out_dir) / "timings.json").write_text(json.dumps(found, indent=1), encoding="utf-8")
+        replace_text(Path(out_dir) / "timings.json", json.dumps(found, indent=1))
 
 
 def write_run(out_dir: str | Path, summary: dict) -> None:
     """run.json: how the run went (its seed, counts, time and the engine's record)."""
-    (Path(out_dir) / "run.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
+    replace_text(Path(out_dir) / "run.json", json.dumps(summary, indent=1))
 
 
 def _seed_of(grades: list[SubmissionGrade]):
@@ -256,10 +248,6 @@ class Merged(list):
         self.replaced = tuple(replaced)
         self.refused = tuple(refused)
         self.rubric = rubric
-
-    def refused_lines(self) -> list[str]:
-        """One printable line per result file that was not read, and why."""
-        return [f"not read: {one_line(path, 200)}: {one_line(why, 300)}" for path, why in self.refused]
 
 
 def _folders(folders) -> list[Path]:
@@ -297,14 +285,13 @@ def _vouched(folder: Path, rubric: rubrics.Rubric) -> records.RunRecord:
 
 def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list | None = None) -> Merged:
     """Every result of the output `folders` that their run records vouch for, in name order, scored with `rubric`
-    (their recorded rubric when None).
+    (their recorded one when None).
 
-    A submission with results in several folders counts from the last of them (a regrade replaces the class's
-    result); a later result without a submission time keeps the earlier one's, and each replacement is appended to
-    `replaced` when given. A result file a record does not name with that hash is never read: it is listed in the
-    :class:`Merged`'s ``refused``. InputError when a folder has no record or is given twice, no folder has results,
-    the results come from another labkit, or the folders' rubrics differ from each other or from `rubric` in their
-    exercises, groups or points (the ``[late]`` table may differ when `rubric` is given: it is the one applied).
+    A submission in several folders counts from the last, keeping the earlier time when the later result has none;
+    each replacement is appended to `replaced` when given. A result file a record does not name with that hash is
+    never read but listed in ``refused``. InputError when a folder has no record or is given twice, none has
+    results, they come from another labkit, or their rubrics differ from each other or from `rubric` in exercises,
+    groups or points (their ``[late]`` tables may differ: `rubric`'s applies).
     """
     folders = _folders(folders)
     if rubric is None:
@@ -337,10 +324,9 @@ def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list |
     return Merged([grades[name] for name in sorted(grades)], replaced or (), refused, rubric)
 
 
-def _merged_record(folders: list, grades: Merged) -> records.RunRecord:
-    """The record of a merge of `folders`: their seeds, known sources, deliveries and variants as one, a later
-    folder's students replacing an earlier one's."""
-    read = [records.read(folder) for folder in folders]
+def _merged_record(read: list[records.RunRecord], grades: Merged) -> records.RunRecord:
+    """The record of a merge of the folders whose records are `read`: their seeds, known sources, deliveries and
+    variants as one, a later folder's students replacing an earlier one's."""
     record = records.new(
         "merge", labkit_version(), sorted({g.seed for g in grades if g.seed is not None}), grades.rubric
     )
@@ -349,15 +335,11 @@ def _merged_record(folders: list, grades: Merged) -> records.RunRecord:
     }
     layouts = {r.delivery.get("layout") for r in read if r.delivery}
     if len(layouts) == 1:  # none when the runs came in different layouts
-        students: dict = {}
-        for r in read:
-            students.update(r.delivery.get("students", {}))
+        students = {name: key for r in read for name, key in r.delivery.get("students", {}).items()}
         record.delivery = {"layout": layouts.pop(), "students": students}
     drawn = {r.variants.get("digest") for r in read}
     if drawn != {None}:
-        students = {}
-        for r in read:
-            students.update(r.variants.get("students", {}))
+        students = {name: data for r in read for name, data in r.variants.get("students", {}).items()}
         record.variants = {"digest": drawn.pop(), "students": students}
     return record
 
@@ -379,19 +361,20 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         raise InputError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
     if rubric is not None and not isinstance(rubric, rubrics.Rubric):
         rubric = rubrics.load(rubric)
-    if len({records.read(folder).variants.get("digest") for folder in folders}) > 1:
+    read = [records.read(folder) for folder in folders]
+    if len({r.variants.get("digest") for r in read}) > 1:
         raise InputError(
             "the folders were graded with different variants (or some without): each student's data would differ "
             "from one result to the next. Merge only runs graded with the same --variants file."
         )
     replaced: list[Replaced] = []
     grades = read_results(folders, rubric, replaced)
-    contents = {name: entry.get("content") for f in folders for name, entry in records.read(f).submissions.items()}
+    contents = {name: entry.get("content") for r in read for name, entry in r.submissions.items()}
     for grade in grades:
         if times and grade.name in times:
             grade.time = SubmissionTime(times[grade.name], FROM_CSV)
     out.mkdir(parents=True, exist_ok=True)
-    record = _merged_record(folders, grades)
+    record = _merged_record(read, grades)
     with Progress(len(grades), "merging", enabled=progress) as bar:
         for grade in grades:
             grade.rubric = grades.rubric
@@ -408,5 +391,5 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         ],
         "not merged": [{"file": str(path), "why": why} for path, why in grades.refused],
     }
-    (out / "merge.json").write_text(json.dumps(merged, indent=1), encoding="utf-8")
+    replace_text(out / "merge.json", json.dumps(merged, indent=1))
     return Merged(list(grades), replaced, grades.refused, grades.rubric)
