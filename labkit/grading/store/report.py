@@ -2,11 +2,9 @@
 
 Layout of an output folder::
 
-    grades.csv               one row per submission: points per exercise, the branch that
-                             counted, the extra credit, the total (under the rubric); with a
-                             [late] table also the raw total, the time, the lateness and penalty
-    feedback/<name>.txt      the total, the exercises' points, what failed in the student's words and its
-                             hint, the errors of cells the student changed; .html the same as one page
+    grades.csv               one row per submission (:func:`write_csv`): points per exercise, branch, extra
+                             credit, total under the rubric; with a [late] table the time, lateness and penalty
+    feedback/<name>.txt      the student's feedback (labkit.grading.store.feedback); .html the same as one page
     results/<name>.json      the same grade as data (:class:`~.grade.SubmissionGrade`), read by :func:`read_results`
     seed.txt, run.json       the seed of the run's random test data; how the run went (:func:`write_run`)
     record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.store.record)
@@ -14,10 +12,9 @@ Layout of an output folder::
 
 ``labkit grade`` writes through :func:`enter` and the ``write_*`` functions, ``labkit merge`` is :func:`merge`,
 ``labkit mark`` is :func:`.marks.import_marks`; each file is replaced whole (:func:`.record.replace_text`).
-Nothing in a run folder comes from a student's process but plain numbers and short texts, and those are
-data: a submission's name becomes a file name through :func:`safe_name` (a hash keeps two students apart),
-every text is stripped of control characters (:func:`printable`) before it reaches a file or a terminal,
-and every CSV cell that a spreadsheet would run as a formula is neutralised (:func:`csv_cell`).
+Nothing in a run folder comes from a student's process but plain numbers and short texts, and those are data:
+a name becomes a file name through :func:`safe_name`, every text is stripped of control characters
+(:func:`printable`), and every CSV cell a spreadsheet would run as a formula is neutralised (:func:`csv_cell`).
 """
 
 from __future__ import annotations
@@ -55,9 +52,8 @@ PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$"
 
 
 def file_stem(name: str) -> str:
-    """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
-    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else :func:`safe_name`'s.
-    A plain name never ends as a hashed one does, so two submissions never share a file.
+    """The name of a submission's feedback files: its own name when it is a plain file name (letters, digits,
+    ``.``, ``_``, ``-``; at most 60, never ending as a hashed one does), else :func:`safe_name`'s.
 
     >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
     ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
@@ -68,9 +64,7 @@ def file_stem(name: str) -> str:
 def csv_cell(value):
     """A cell a spreadsheet shows as text: one starting like a formula gets a leading apostrophe (OWASP)."""
     text = one_line(value, 500) if isinstance(value, str) else value
-    if isinstance(text, str) and text.startswith(FORMULA_START):
-        return "'" + text
-    return text
+    return "'" + text if isinstance(text, str) and text.startswith(FORMULA_START) else text
 
 
 def name_cell(name):
@@ -229,9 +223,8 @@ def _seed_of(grades: list[SubmissionGrade]):
 
 @dataclass(frozen=True)
 class Replaced:
-    """A submission's result that a later folder's result replaced in a merge: the submission, the result
-    file replaced and the one that counts, and whether the later result had no submission time and kept the
-    earlier one's."""
+    """A submission's result file that a later folder's replaced in a merge, and whether the later result kept
+    the earlier one's submission time (it had none)."""
 
     name: str
     earlier: Path
@@ -283,12 +276,12 @@ def _vouched(folder: Path, rubric: rubrics.Rubric) -> records.RunRecord:
     return record
 
 
-def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list | None = None) -> Merged:
+def read_results(folders, rubric: rubrics.Rubric | None = None) -> Merged:
     """Every result of the output `folders` that their run records vouch for, in name order, scored with `rubric`
     (their recorded one when None).
 
-    A submission in several folders counts from the last, keeping the earlier time when the later result has none;
-    each replacement is appended to `replaced` when given. A result file a record does not name with that hash is
+    A submission in several folders counts from the last, keeping the earlier time when the later result has none
+    (each replacement is listed in ``replaced``). A result file a record does not name with that hash is
     never read but listed in ``refused``. InputError when a folder has no record or is given twice, none has
     results, they come from another labkit, or their rubrics differ from each other or from `rubric` in exercises,
     groups or points (their ``[late]`` tables may differ: `rubric`'s applies).
@@ -299,6 +292,7 @@ def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list |
     grades: dict[str, SubmissionGrade] = {}
     files: dict[str, Path] = {}
     refused: list = []
+    replaced: list[Replaced] = []
     for folder in folders:
         found, bad = records.results(folder, _vouched(folder, rubric))
         refused += bad
@@ -313,15 +307,14 @@ def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list |
                 kept = grade.time is None and earlier.time is not None
                 if kept:
                     grade.time = earlier.time
-                if replaced is not None:
-                    replaced.append(Replaced(grade.name, files[grade.name], path, kept))
+                replaced.append(Replaced(grade.name, files[grade.name], path, kept))
             grades[grade.name], files[grade.name] = grade, path
     if not grades:
         what = "no result their records vouch for" if refused else "no results (only empty shards)"
         raise InputError(
             f"{', '.join(map(str, folders))} hold {what}: give the --out folders of earlier `labkit grade` runs."
         )
-    return Merged([grades[name] for name in sorted(grades)], replaced or (), refused, rubric)
+    return Merged([grades[name] for name in sorted(grades)], replaced, refused, rubric)
 
 
 def _merged_record(read: list[records.RunRecord], grades: Merged) -> records.RunRecord:
@@ -345,14 +338,11 @@ def _merged_record(read: list[records.RunRecord], grades: Merged) -> records.Run
 
 
 def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
-    """Combine the results of several grading runs' `folders` (one per batch job, say, or a class's run and a
-    regrade) into the new folder `out_dir`, scored with `rubric` (a Rubric or a TOML path; the folders' recorded one
-    when None), whose exercises, groups and points must be theirs and whose ``[late]`` table applies.
-
-    A submission in several folders counts from the last one (:func:`read_results`), and a result file a folder's
-    record does not vouch for is never merged. `times` ({name: datetime}, :func:`labkit.grading.run.times.read_times`)
-    replace the stored times of the submissions they name; `progress` shows a bar on a terminal. Returns the grades
-    in name order, with the results a later folder replaced (also in ``merge.json``) and the files not merged.
+    """Combine the results of several grading runs' `folders` (batch jobs, say, or a run and a regrade) into the
+    new folder `out_dir` as :func:`read_results` reads them, scored with `rubric` (a Rubric or a TOML path; None:
+    the recorded one), whose ``[late]`` table applies. `times` ({name: datetime},
+    :func:`labkit.grading.run.times.read_times`) replace the stored times of the submissions they name. The grades,
+    with the results a later folder replaced (also in ``merge.json``) and the files not merged.
     """
     from ..progress import Progress
 
@@ -367,8 +357,7 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
             "the folders were graded with different variants (or some without): each student's data would differ "
             "from one result to the next. Merge only runs graded with the same --variants file."
         )
-    replaced: list[Replaced] = []
-    grades = read_results(folders, rubric, replaced)
+    grades = read_results(folders, rubric)
     contents = {name: entry.get("content") for r in read for name, entry in r.submissions.items()}
     for grade in grades:
         if times and grade.name in times:
@@ -387,9 +376,9 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         "folders": [str(folder) for folder in folders],
         "replaced": [
             {"submission": r.name, "earlier": str(r.earlier), "later": str(r.later), "time kept": r.time_kept}
-            for r in replaced
+            for r in grades.replaced
         ],
         "not merged": [{"file": str(path), "why": why} for path, why in grades.refused],
     }
     replace_text(out / "merge.json", json.dumps(merged, indent=1))
-    return Merged(list(grades), replaced, grades.refused, grades.rubric)
+    return grades

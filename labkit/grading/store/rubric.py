@@ -15,6 +15,7 @@ import hashlib
 import json
 import tomllib
 from dataclasses import dataclass, field, replace
+from operator import methodcaller
 from pathlib import Path
 
 from ...errors import InputError
@@ -347,11 +348,7 @@ def _released(table, source, registry, points):
 
 def plain(value):
     """Parsed TOML as JSON data: its date-times as ISO 8601 text (the [late] table reads both)."""
-    return json.loads(json.dumps(value, default=_iso_text))
-
-
-def _iso_text(moment):
-    return moment.isoformat()
+    return json.loads(json.dumps(value, default=methodcaller("isoformat")))
 
 
 def _branches(table, source, registry):
