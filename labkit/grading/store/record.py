@@ -1,14 +1,12 @@
 """A grading run's record, ``record.json``: what was graded, under which rubric and seed, by which labkit, and each
 result file's SHA-256 (the fields of :class:`RunRecord`).
 
-Every output folder labkit writes (a grading run, a merge,
-:func:`~labkit.grading.store.report.write_report`) holds one, written by the grader alone and replaced whole each
-time it changes, with the rubric's TOML copied to ``rubric.toml`` beside it for a person to read. Every later
-command reads the folder through it: ``labkit report``, ``labkit export``, a resumed ``labkit grade`` and ``labkit
-merge`` take the recorded rubric when none is given and refuse one that grades differently (:func:`rubric_for`),
-and read a result file only when the record names it with that hash (:func:`results`). So a result file the run
-did not write (a submission's code writing into the folder, where the sandbox is switched off) is never read as a
-grade, and nothing a submission can write (a name, a time, a file) changes what the record says it graded.
+Every output folder labkit writes holds one, written by the grader alone and replaced whole each time it changes,
+with the rubric's TOML copied to ``rubric.toml`` beside it for a person to read. Every later command reads the
+folder through it: it takes the recorded rubric when none is given and refuses one that grades differently
+(:func:`rubric_for`), and reads a result file only when the record names it with that hash (:func:`results`). So
+a file the run did not write (a submission's code writing into the folder, where the sandbox is switched off) is
+never read as a grade, and nothing a submission can write changes what the record says it graded.
 """
 
 import hashlib
@@ -180,10 +178,9 @@ def _aware(text):
 def results(folder, record):
     """The result files of `folder` that its `record` vouches for, read: ({name: (path, data)}, refused).
 
-    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of ``results/``
-    that is not read: one the record does not name (a run never graded that submission there), one whose content
-    is not what the run wrote (its hash differs), one that is not a plain file; and a submission the record names
-    whose file is missing. ValueError when a vouched-for file is not JSON."""
+    `refused` lists as (path, why), not yet printable, every file of ``results/`` not read (one the record does not
+    name, one whose hash differs, one that is not a plain file) and every result the record names that is missing.
+    InputError when a vouched-for file is not JSON."""
     folder = Path(folder)
     by_file = {entry["result"]: name for name, entry in record.submissions.items()}
     found, refused = {}, []
@@ -257,9 +254,8 @@ def content_digest(notebooks, base=None):
 def rubric_for(folders, given, command):
     """The rubric `command` scores the output `folders` with: their recorded one, which all must share.
 
-    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded one;
-    one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
-    ValueError saying how to score under it, since `command` shows what the run graded."""
+    `given` (a Rubric, a TOML path, or None) is the one the instructor named; one that grades otherwise
+    (:meth:`.rubric.Rubric.differences`) is refused saying how to score under it, as `command` shows what was graded."""
     records = [(Path(folder), read(folder)) for folder in folders]
     first_folder, first = records[0]
     recorded = first.rubric_object(first_folder)
