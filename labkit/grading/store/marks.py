@@ -126,15 +126,6 @@ def _points(kind: str, worth: float, text: str) -> tuple[float | str | None, str
     return round(value, 2), ""
 
 
-def _read_text(path: Path) -> str:
-    try:
-        if path.stat().st_size > MAX_MARKS_BYTES:
-            raise InputError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
-        return path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read the marks {path}: {exc}") from None
-
-
 def import_marks(out, path, rubric: Rubric | None = None, now: datetime | None = None) -> int:
     """Put the marks of marks.csv `path` into the run in folder `out`; the number of marks that changed.
 
@@ -143,7 +134,12 @@ def import_marks(out, path, rubric: Rubric | None = None, now: datetime | None =
     submission's result (its marks, each with the time it was first imported) and feedback, the record and
     grades.csv are written again. A row equal to the mark held changes nothing; a later row replaces an earlier."""
     out, path = Path(out), Path(path)
-    text = _read_text(path)
+    try:
+        if path.stat().st_size > MAX_MARKS_BYTES:
+            raise InputError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read the marks {path}: {exc}") from None
     record = records.read(out)
     recorded = record.rubric_object(out)
     if rubric is not None and recorded.digest != rubric.digest:

@@ -119,19 +119,13 @@ def held_text(grade: SubmissionGrade) -> str:
     )
 
 
-def _mark_cell(grade: SubmissionGrade, grade_id: str) -> str:
-    """An answer's cell in grades.csv: the points a person gave it, empty until then."""
-    mark = grade.marks.get(ItemKey.of_answer(grade_id))
-    return "" if mark is None else points_text(mark.points)
-
-
-def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool, ids: list) -> list:
-    """One submission's row of grades.csv; `width` is the number of cells after its points, `ids` the grade ids
-    of the answers in words to read (a column each, for a person to fill in)."""
+def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool, answers: list[ItemKey]) -> list:
+    """One submission's row of grades.csv; `width` is the number of cells after its points, `answers` the answers
+    in words to read, a column each for the points a person gave (empty until then)."""
     if not grade.graded:
         return (
             [name_cell(grade.name)] + [""] * (len(graded) + width - 1)
-            + [csv_cell(f"not graded: {grade.failure}")] + [""] * (held + len(ids))
+            + [csv_cell(f"not graded: {grade.failure}")] + [""] * (held + len(answers))
         )  # fmt: skip
     s, lateness = grade.score, grade.lateness
     return (
@@ -141,7 +135,7 @@ def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool, ids: 
         + (_late_cells(grade, lateness) if lateness is not None else [])
         + [points_text(grade.total), points_text(s.full_credit), "graded"]
         + ([csv_cell(held_text(grade))] if held else [])
-        + [_mark_cell(grade, grade_id) for grade_id in ids]
+        + ["" if key not in grade.marks else points_text(grade.marks[key].points) for key in answers]
     )
 
 
@@ -152,7 +146,9 @@ def write_csv(path: str | Path, grades: list[SubmissionGrade]) -> None:
     rubric = grades[0].rubric if grades else None
     graded = rubric.graded if rubric is not None else []
     answers = rubric.registry.answers.items() if rubric is not None else ()
-    to_read = {grade_id: f"to read: exercise {n}, {what}" for grade_id, (n, what) in answers if n in graded}
+    to_read = {
+        ItemKey.of_answer(grade_id): f"to read: exercise {n}, {what}" for grade_id, (n, what) in answers if n in graded
+    }
     tail = CSV_TAIL[:4] + CSV_LATE + CSV_TAIL[4:] if rubric is not None and rubric.late is not None else CSV_TAIL
     held = any(g.graded and g.held() for g in grades)
     header = ["submission"] + [f"exercise {n}" for n in graded] + tail + [CSV_HELD] * held + list(to_read.values())
@@ -189,7 +185,8 @@ def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: rec
     out.mkdir(parents=True, exist_ok=True)
     if record is None:
         rubric = grades[0].rubric if grades else rubrics.default()
-        seed = _seed_of(grades)  # grades of several seeds are a merge's
+        seeds = sorted({g.seed for g in grades if g.seed is not None})
+        seed = None if not seeds else seeds[0] if len(seeds) == 1 else seeds  # several seeds: a merge's grades
         record = records.new("merge" if isinstance(seed, list) else "grade", labkit_version(), seed, rubric)
     for grade in grades:
         enter(out, record, grade, record.submissions.get(grade.name, {}).get("content"), save=False)
@@ -213,12 +210,6 @@ def write_timings(out_dir: str | Path, found: dict) -> None:
 def write_run(out_dir: str | Path, summary: dict) -> None:
     """run.json: how the run went (its seed, counts, time and the engine's record)."""
     replace_text(Path(out_dir) / "run.json", json.dumps(summary, indent=1))
-
-
-def _seed_of(grades: list[SubmissionGrade]):
-    """The seed of a run's grades: one number, the list of them (a merge's), or None when none has one."""
-    seeds = sorted({g.seed for g in grades if g.seed is not None})
-    return None if not seeds else seeds[0] if len(seeds) == 1 else seeds
 
 
 @dataclass(frozen=True)
