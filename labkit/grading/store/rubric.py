@@ -178,10 +178,8 @@ class Rubric:
             extra = ", ".join(f"exercise {n} ({points_text(self.worth(n))})" for n in self.extra_credit)
             lines.append(("  " if not self.branches else "  and ") + f"extra credit: {extra}")
         if self.answers:
-            lines.append(
-                "  answers in words marked by a person: "
-                + ", ".join(f"{grade_id} ({points_text(p)})" for grade_id, p in self.answers.items())
-            )
+            marked = ", ".join(f"{grade_id} ({points_text(p)})" for grade_id, p in self.answers.items())
+            lines.append(f"  answers in words marked by a person: {marked}")
         if self.late is not None:
             lines.append(f"  {self.late.describe()}")
         return "\n".join(lines)
