@@ -9,11 +9,8 @@ A mark is one row of ``marks.csv``, ``submission,item,points,comment``; its item
   (its points are paid) or ``keep`` (they are not);
 * ``exercise12`` with ``excused`` (out of the student's total and full credit) or ``counted`` (back in).
 
-:func:`import_marks` checks every row against the run (its recorded rubric, its submissions, what each
-item is worth) before it changes anything; then each marked submission's result (which holds its marks,
-each with the time it was first imported), feedback and the run's record and grades.csv are written
-again. A row equal to the mark already held changes nothing, so importing twice is importing once; a
-later mark of the same item replaces the earlier one.
+:func:`import_marks` checks every row against the run before it changes anything, and importing twice is
+importing once.
 """
 
 from __future__ import annotations
@@ -30,15 +27,14 @@ from .feedback import blank
 from .grade import SubmissionGrade
 from .model import ItemKey, Mark
 from .names import name_cell, name_from_cell
-from .report import csv_cell, enter, read_results, write_csv
+from .report import csv_cell, csv_text, enter, read_results, write_csv
 from .rubric import Rubric
 from .text import one_line, points_text, printable
 
 HEADER = ["submission", "item", "points", "comment"]
 MAX_MARKS_BYTES = 16 * 1024 * 1024  # a marks.csv larger than this is not read
 MAX_COMMENT = 2000  # characters of a comment kept
-HELD_WORDS = ("release", "keep")
-EXCUSE_WORDS = ("excused", "counted")
+WORDS = {"held": ("release", "keep"), "exercise": ("excused", "counted")}  # the points of an item not paid in points
 
 
 @dataclass(frozen=True)
@@ -116,13 +112,9 @@ def _row(row: list[str], by_name: dict[str, SubmissionGrade]) -> MarkRow | str:
 
 def _points(kind: str, worth: float, text: str) -> tuple[float | str | None, str]:
     """(the points of a row, why they are refused or "")."""
-    word = text.lower()
-    if kind == "held":
-        return (word, "") if word in HELD_WORDS else (None, f"points are release or keep, not {one_line(text, 20)!r}")
-    if kind == "exercise":
-        return (
-            (word, "") if word in EXCUSE_WORDS else (None, f"points are excused or counted, not {one_line(text, 20)!r}")
-        )
+    if kind in WORDS:
+        word, words = text.lower(), WORDS[kind]
+        return (word, "") if word in words else (None, f"points are {' or '.join(words)}, not {one_line(text, 20)!r}")
     try:
         value = float(text.replace(",", "."))
     except ValueError:
@@ -134,22 +126,20 @@ def _points(kind: str, worth: float, text: str) -> tuple[float | str | None, str
     return round(value, 2), ""
 
 
-def _read_text(path: Path) -> str:
-    try:
-        if path.stat().st_size > MAX_MARKS_BYTES:
-            raise InputError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
-        return path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read the marks {path}: {exc}") from None
-
-
 def import_marks(out, path, rubric: Rubric | None = None, now: datetime | None = None) -> int:
     """Put the marks of marks.csv `path` into the run in folder `out`; the number of marks that changed.
 
-    Every row is checked first: an unknown submission or item, points outside the item's range or a
-    `rubric` other than the run's (in what it grades) is a ValueError, and nothing is written."""
+    Every row is checked first: an unknown submission or item, points outside the item's range or a `rubric`
+    other than the run's (in what it grades) is an InputError, and nothing is written. Then each marked
+    submission's result (its marks, each with the time it was first imported) and feedback, the record and
+    grades.csv are written again. A row equal to the mark held changes nothing; a later row replaces an earlier."""
     out, path = Path(out), Path(path)
-    text = _read_text(path)
+    try:
+        if path.stat().st_size > MAX_MARKS_BYTES:
+            raise InputError(f"{path} is larger than {MAX_MARKS_BYTES} bytes; it is not read.")
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read the marks {path}: {exc}") from None
     record = records.read(out)
     recorded = record.rubric_object(out)
     if rubric is not None and recorded.digest != rubric.digest:
@@ -182,11 +172,9 @@ def import_marks(out, path, rubric: Rubric | None = None, now: datetime | None =
 
 def marks_csv(grades: list[SubmissionGrade]) -> str:
     """marks.csv of every mark `grades` hold (the file :func:`import_marks` reads)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer)
-    writer.writerow(HEADER)
+    rows = [HEADER]
     for grade in grades:
         for item, mark in sorted(grade.marks.items(), key=lambda pair: str(pair[0])):
             points = mark.points if isinstance(mark.points, str) else points_text(mark.points)
-            writer.writerow([name_cell(grade.name), str(item), points, csv_cell(mark.comment)])
-    return buffer.getvalue()
+            rows.append([name_cell(grade.name), str(item), points, csv_cell(mark.comment)])
+    return csv_text(rows)

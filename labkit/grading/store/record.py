@@ -1,32 +1,19 @@
-"""A grading run's record: what was graded, under which rubric and seed, by which labkit, and each result's hash.
+"""A grading run's record, ``record.json``: what was graded, under which rubric and seed, by which labkit, and each
+result file's SHA-256 (the fields of :class:`RunRecord`).
 
-Every output folder that labkit writes (``labkit grade --out OUT``, a merge,
-:func:`labkit.grading.store.report.write_report`) holds ``record.json``, written by the grader alone and replaced
-whole each time it changes:
-
-* ``labkit``: the version that graded;
-* ``kind``: ``"grade"`` (a grading run, resumable) or ``"merge"``;
-* ``seed``: the run's seed (a list of seeds for a merge);
-* ``rubric``: the rubric in force, in full (its TOML as JSON data, the
-  ``[late]`` table and its extensions included), also copied to
-  ``rubric.toml`` beside it for a person to read;
-* ``variants``: with a variants file, its digest (never its secret) and
-  each student's data as graded;
-* ``submissions``: for each submission graded, its result file's name and
-  SHA-256, and the digest of its notebooks' content (:func:`content_digest`).
-
-Every later command reads the folder through this record (:func:`read_results`): ``labkit report``, ``labkit
-export``, a resumed ``labkit grade`` and ``labkit merge`` take the recorded rubric when none is given, refuse one
-that grades differently, and take a result file only when the record names it with that hash. So a result file that
-the run did not write (a submission's code writing into an output folder, where the sandbox is switched off) is
-never read as a grade, and nothing a submission can write (a name, a time, a file) changes what the run's record
-says it graded.
+Every output folder labkit writes holds one, written by the grader alone and replaced whole each time it changes,
+with the rubric's TOML copied to ``rubric.toml`` beside it for a person to read. Every later command reads the
+folder through it: it takes the recorded rubric when none is given and refuses one that grades differently
+(:func:`rubric_for`), and reads a result file only when the record names it with that hash (:func:`results`). So
+a file the run did not write (a submission's code writing into the folder, where the sandbox is switched off) is
+never read as a grade, and nothing a submission can write changes what the record says it graded.
 """
 
 import hashlib
 import json
 import os
 from dataclasses import asdict, dataclass, field
+from datetime import datetime
 from pathlib import Path
 
 from ...errors import InputError
@@ -40,27 +27,28 @@ MAX_RESULT = 32 * 1024**2  # bytes of one submission's result file, as the grade
 MAX_RECORD = 256 * 1024**2  # bytes of a record (a few hundred bytes per submission)
 MAX_HASHED = 1024**3  # bytes of a submission's notebooks hashed; beyond that only their sizes count
 KINDS = ("grade", "merge")
+TABLES = ("times", "flags", "known", "variants", "delivery")  # the record's optional tables, empty when left out
 
 
 @dataclass
 class RunRecord:
-    """The record of one output folder (the module's description gives its fields): the rubric's data and
-    TOML text, and each submission's ``{"result": file name, "sha256": its hash, "content": the notebooks'
-    digest or None}``."""
+    """The record of one output folder; ``record.json`` holds its fields (:meth:`as_dict`)."""
 
-    kind: str
-    labkit: str
-    seed: int | list[int] | None
-    rubric: dict
-    rubric_text: str | None = None
+    kind: str  # one of KINDS: "grade" (a grading run, resumable) or "merge"
+    labkit: str  # the version that graded
+    seed: int | list[int] | None  # the run's seed (a list of seeds for a merge)
+    rubric: dict  # the rubric in force, in full: its TOML as JSON data, the [late] table and its extensions included
+    rubric_text: str | None = None  # its TOML text
+    # each submission graded: {"result": its result file's name, "sha256": that file's hash, "content": the
+    # digest of its notebooks (content_digest) or None}
     submissions: dict = field(default_factory=dict)
     times: dict = field(default_factory=dict)  # source ("csv", "exchange") -> {name: ISO time}: the times given
     flags: dict = field(default_factory=dict)  # the run's switches that change grades ("times from submission", ...)
     # the known sources graded parts were compared with (labkit.grading.submission.known):
     # {"digest": ..., "solutions": path}
     known: dict = field(default_factory=dict)
-    # the students' own data (labkit.exercises.variants): {"digest": the variants file's, "students": {name:
-    # {exercise: {parameter: value}}}}, empty for a run without variants
+    # the students' own data (labkit.exercises.variants): {"digest": the variants file's (never its secret),
+    # "students": {name: {exercise: {parameter: value}}}}, empty for a run without variants
     variants: dict = field(default_factory=dict)
     # how the class came (labkit.grading.lms.delivery): {"layout": "canvas", "moodle", "folders", "nbgrader" or
     # "listed", "students": {name: what names that student's files in the LMS}}; empty for a run before it
@@ -68,8 +56,6 @@ class RunRecord:
 
     def given_times(self, source):
         """{name: datetime} of the times the run was given from `source` (``"csv"``: ``--times``; ``"exchange"``)."""
-        from datetime import datetime
-
         return {name: datetime.fromisoformat(when) for name, when in self.times.get(source, {}).items()}
 
     def as_dict(self) -> dict:
@@ -103,58 +89,47 @@ def write(folder, record):
 
 
 def replace_text(path, text):
-    """Write `text` into `path`, replacing it whole: a process killed meanwhile leaves the earlier file or none."""
+    """Write `text` into `path` as UTF-8, exactly (no newline translation), replacing it whole: a process killed
+    meanwhile leaves the earlier file or none. Every file of a run folder is written through it."""
     partial = path.with_name(f".{path.name}.partial")
-    partial.write_text(text, encoding="utf-8")
+    partial.write_bytes(text.encode("utf-8"))
     os.replace(partial, path)
 
 
-@dataclass(frozen=True)
-class Written:
-    """A result file as the grader wrote it: its path and the SHA-256 of the bytes it wrote."""
-
-    path: Path
-    sha256: str
-
-
-def note(folder, record, name, written, content=None, save=True):
-    """Enter submission `name`'s result file into `record`, with the hash of what the grader wrote (never
-    read back from the folder), and write the record (unless `save` is False: the caller writes it)."""
-    record.submissions[name] = {"result": written.path.name, "sha256": written.sha256, "content": content}
-    if save:
-        write(folder, record)
-
-
-NO_RECORD = (
-    "{folder} has no run record ({record}): it was not written by `labkit grade` of this version (an older "
-    "labkit wrote none). Grade the class again into a new --out."
-)
+def note(record, name, path, text, content=None):
+    """Enter submission `name`'s result file `path` into `record`, with the SHA-256 of `text`, what the grader
+    wrote there (never read back from the folder), and `content`, its notebooks' :func:`content_digest`."""
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    record.submissions[name] = {"result": path.name, "sha256": digest, "content": content}
 
 
 def read(folder) -> RunRecord:
-    """The record of output folder `folder`; ValueError when it has none or it is not one."""
+    """The record of output folder `folder`; InputError when it has none or it is not one."""
     folder = Path(folder)
     path = folder / RECORD
     try:
         raw = read_small(path, MAX_RECORD)
     except FileNotFoundError:
-        raise InputError(NO_RECORD.format(folder=folder, record=RECORD)) from None
+        raise InputError(
+            f"{folder} has no run record ({RECORD}): it was not written by `labkit grade` of this version (an older "
+            "labkit wrote none). Grade the class again into a new --out."
+        ) from None
     try:
         data = json.loads(raw.decode("utf-8"))
-        _check(data)
+        tables = _check(data)
     except (UnicodeDecodeError, ValueError) as exc:
         raise InputError(
             f"{path} is not a labkit run record ({str(exc)[:200]}); grade the class again into a new --out."
         ) from None
-    tables = (data.get(key) or {} for key in ("times", "flags", "known", "variants", "delivery"))
     return RunRecord(
         data["kind"], str(data.get("labkit")), data.get("seed"), data["rubric"], data.get("rubric text"),
         data["submissions"], *tables,
     )  # fmt: skip
 
 
-def _check(data) -> None:
-    """InputError saying what is wrong with a record's data, when anything is."""
+def _check(data) -> list[dict]:
+    """A record's optional tables (:data:`TABLES`, each {} when left out); InputError saying what is wrong with
+    the record's data, when anything is."""
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise InputError(f"its format is not {FORMAT}")
     if data.get("kind") not in KINDS:
@@ -170,9 +145,8 @@ def _check(data) -> None:
     text, seed, grade = data.get("rubric text"), data.get("seed"), data["kind"] == "grade"
     if text is not None and not isinstance(text, str):
         raise InputError("its rubric text is not text")
-    times, flags, known, variants, delivery = (
-        data.get(key) or {} for key in ("times", "flags", "known", "variants", "delivery")
-    )
+    tables = [data.get(key) or {} for key in TABLES]
+    times, flags, known, variants, delivery = tables
     if not isinstance(times, dict) or not all(
         isinstance(given, dict) and all(isinstance(v, str) and _aware(v) for v in given.values())
         for given in times.values()
@@ -190,12 +164,11 @@ def _check(data) -> None:
         raise InputError("its variants are not a table of students")
     if not isinstance(delivery, dict) or not isinstance(delivery.get("students", {}), dict):
         raise InputError("its delivery is not a table of students")
+    return tables
 
 
 def _aware(text):
     """Whether `text` is an ISO 8601 time with a UTC offset."""
-    from datetime import datetime
-
     try:
         return datetime.fromisoformat(text).utcoffset() is not None
     except ValueError:
@@ -205,10 +178,9 @@ def _aware(text):
 def results(folder, record):
     """The result files of `folder` that its `record` vouches for, read: ({name: (path, data)}, refused).
 
-    `refused` lists, as (path, why) pairs (not yet printable: the caller shows them), every file of ``results/``
-    that is not read: one the record does not name (a run never graded that submission there), one whose content
-    is not what the run wrote (its hash differs), one that is not a plain file; and a submission the record names
-    whose file is missing. ValueError when a vouched-for file is not JSON."""
+    `refused` lists as (path, why), not yet printable, every file of ``results/`` not read (one the record does not
+    name, one whose hash differs, one that is not a plain file) and every result the record names that is missing.
+    InputError when a vouched-for file is not JSON."""
     folder = Path(folder)
     by_file = {entry["result"]: name for name, entry in record.submissions.items()}
     found, refused = {}, []
@@ -282,9 +254,8 @@ def content_digest(notebooks, base=None):
 def rubric_for(folders, given, command):
     """The rubric `command` scores the output `folders` with: their recorded one, which all must share.
 
-    `given` (a Rubric, a TOML path, or None) is the rubric the instructor named: None takes the recorded one;
-    one that grades otherwise (:meth:`~labkit.grading.store.rubric.Rubric.differences`) is refused with a
-    ValueError saying how to score under it, since `command` shows what the run graded."""
+    `given` (a Rubric, a TOML path, or None) is the one the instructor named; one that grades otherwise
+    (:meth:`.rubric.Rubric.differences`) is refused saying how to score under it, as `command` shows what was graded."""
     records = [(Path(folder), read(folder)) for folder in folders]
     first_folder, first = records[0]
     recorded = first.rubric_object(first_folder)

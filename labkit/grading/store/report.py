@@ -2,28 +2,26 @@
 
 Layout of an output folder::
 
-    grades.csv               one row per submission: points per exercise, the branch that
-                             counted, the extra credit, the total (under the rubric); with a
-                             [late] table also the raw total, the time, the lateness and penalty
-    feedback/<name>.txt      the total, the exercises' points, what failed in the student's words and its
-                             hint, the errors of cells the student changed; .html the same as one page
+    grades.csv               one row per submission (:func:`write_csv`): points per exercise, branch, extra
+                             credit, total under the rubric; with a [late] table the time, lateness and penalty
+    feedback/<name>.txt      the student's feedback (labkit.grading.store.feedback); .html the same as one page
     results/<name>.json      the same grade as data (:class:`~.grade.SubmissionGrade`), read by :func:`read_results`
     seed.txt, run.json       the seed of the run's random test data; how the run went (:func:`write_run`)
     record.json, rubric.toml the run's record: rubric, seed, version, each result's hash (labkit.grading.store.record)
     merge.json               (labkit merge only) the folders merged and the results a later one replaced
 
-``labkit grade`` writes through :func:`write_result`, :func:`write_report`, :func:`write_seed` and
-:func:`write_run`; ``labkit merge`` is :func:`merge`; ``labkit mark`` is :func:`.marks.import_marks`.
-Nothing in a run folder comes from a student's process but plain numbers and short texts, and those are
-data: a submission's name becomes a file name through :func:`safe_name` (a hash keeps two students apart),
-every text is stripped of control characters (:func:`printable`) before it reaches a file or a terminal,
-and every CSV cell that a spreadsheet would run as a formula is neutralised (:func:`csv_cell`).
+``labkit grade`` writes through :func:`enter` and the ``write_*`` functions, ``labkit merge`` is :func:`merge`,
+``labkit mark`` is :func:`.marks.import_marks`; each file is replaced whole (:func:`.record.replace_text`).
+Nothing in a run folder comes from a student's process but plain numbers and short texts, and those are data:
+a name becomes a file name through :func:`safe_name`, every text is stripped of control characters
+(:func:`printable`), and every CSV cell a spreadsheet would run as a formula is neutralised (:func:`csv_cell`).
 """
 
 from __future__ import annotations
 
 import csv
 import hashlib
+import io
 import json
 import re
 from dataclasses import dataclass
@@ -54,10 +52,8 @@ PLAIN_NAME = re.compile(r"^(?!.*-[0-9a-f]{10}$)[A-Za-z0-9][A-Za-z0-9._-]{0,59}$"
 
 
 def file_stem(name: str) -> str:
-    """The name of a submission's feedback files, ``feedback/<stem>.txt`` and ``.html``: the submission's own
-    name when it is a plain file name (letters, digits, ``.``, ``_``, ``-``; at most 60), else
-    :func:`~labkit.grading.store.report.safe_name`'s, with a hash of the whole name. A plain name never ends
-    as a hashed one does, so two submissions never share a file.
+    """The name of a submission's feedback files: its own name when it is a plain file name (letters, digits,
+    ``.``, ``_``, ``-``; at most 60, never ending as a hashed one does), else :func:`safe_name`'s.
 
     >>> file_stem("lovelaceada"), file_stem("Ada Lovelace_101")
     ('lovelaceada', 'Ada_Lovelace_101-8dd2908744')
@@ -68,9 +64,7 @@ def file_stem(name: str) -> str:
 def csv_cell(value):
     """A cell a spreadsheet shows as text: one starting like a formula gets a leading apostrophe (OWASP)."""
     text = one_line(value, 500) if isinstance(value, str) else value
-    if isinstance(text, str) and text.startswith(FORMULA_START):
-        return "'" + text
-    return text
+    return "'" + text if isinstance(text, str) and text.startswith(FORMULA_START) else text
 
 
 def name_cell(name):
@@ -82,6 +76,13 @@ def name_cell(name):
     """
     text = CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", str(name))
     return "'" + text if text.startswith(FORMULA_START) else text
+
+
+def csv_text(rows) -> str:
+    """`rows` as CSV text, in the csv module's dialect (its lines end in ``\\r\\n``)."""
+    buffer = io.StringIO()
+    csv.writer(buffer).writerows(rows)
+    return buffer.getvalue()
 
 
 CSV_TAIL = ["required", "branch", "branch points", "extra credit", "total", "full credit", "status"]
@@ -118,24 +119,13 @@ def held_text(grade: SubmissionGrade) -> str:
     )
 
 
-def _read_ids(graded: list, registry) -> list[str]:
-    """The grade ids of the answers in words of the graded exercises: one column each, for a person to fill in."""
-    return [grade_id for grade_id, (number, _) in registry.answers.items() if number in graded]
-
-
-def _mark_cell(grade: SubmissionGrade, grade_id: str) -> str:
-    """An answer's cell in grades.csv: the points a person gave it, empty until then."""
-    mark = grade.marks.get(ItemKey.of_answer(grade_id))
-    return "" if mark is None else points_text(mark.points)
-
-
-def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool) -> list:
-    """One submission's row of grades.csv; `width` is the number of cells after its points."""
-    ids = _read_ids(graded, grade.rubric.registry)
+def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool, answers: list[ItemKey]) -> list:
+    """One submission's row of grades.csv; `width` is the number of cells after its points, `answers` the answers
+    in words to read, a column each for the points a person gave (empty until then)."""
     if not grade.graded:
         return (
             [name_cell(grade.name)] + [""] * (len(graded) + width - 1)
-            + [csv_cell(f"not graded: {grade.failure}")] + [""] * (held + len(ids))
+            + [csv_cell(f"not graded: {grade.failure}")] + [""] * (held + len(answers))
         )  # fmt: skip
     s, lateness = grade.score, grade.lateness
     return (
@@ -145,7 +135,7 @@ def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool) -> li
         + (_late_cells(grade, lateness) if lateness is not None else [])
         + [points_text(grade.total), points_text(s.full_credit), "graded"]
         + ([csv_cell(held_text(grade))] if held else [])
-        + [_mark_cell(grade, grade_id) for grade_id in ids]
+        + ["" if key not in grade.marks else points_text(grade.marks[key].points) for key in answers]
     )
 
 
@@ -155,32 +145,15 @@ def write_csv(path: str | Path, grades: list[SubmissionGrade]) -> None:
     A submission that could not be graded has empty points and says why in its status."""
     rubric = grades[0].rubric if grades else None
     graded = rubric.graded if rubric is not None else []
-    to_read = (
-        [f"to read: exercise {n}, {what}" for n, what in rubric.registry.answers.values() if n in graded]
-        if rubric
-        else []
-    )
+    answers = rubric.registry.answers.items() if rubric is not None else ()
+    to_read = {
+        ItemKey.of_answer(grade_id): f"to read: exercise {n}, {what}" for grade_id, (n, what) in answers if n in graded
+    }
     tail = CSV_TAIL[:4] + CSV_LATE + CSV_TAIL[4:] if rubric is not None and rubric.late is not None else CSV_TAIL
     held = any(g.graded and g.held() for g in grades)
-    with open(path, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["submission"] + [f"exercise {n}" for n in graded] + tail + [CSV_HELD] * held + to_read)
-        writer.writerows(_csv_row(g, graded, len(tail), held) for g in grades)
-
-
-def write_result(out_dir: str | Path, grade: SubmissionGrade) -> records.Written:
-    """Write results/<name>.json and feedback/<name>.txt and .html of one submission, each replaced whole; the
-    result file and the SHA-256 of what was written (:class:`labkit.grading.store.record.Written`), for the record.
-    """
-    out = Path(out_dir)
-    prepare(out)
-    model, stem = feedbacks.build(grade), file_stem(grade.name)
-    replace_text(out / "feedback" / f"{stem}.txt", feedbacks.text(model))
-    replace_text(out / "feedback" / f"{stem}.html", feedbacks.html(model))
-    path = out / "results" / f"{safe_name(grade.name)}.json"
-    text = json.dumps(grade.as_dict(), indent=1)
-    replace_text(path, text)
-    return records.Written(path, hashlib.sha256(text.encode("utf-8")).hexdigest())
+    header = ["submission"] + [f"exercise {n}" for n in graded] + tail + [CSV_HELD] * held + list(to_read.values())
+    rows = [_csv_row(g, graded, len(tail), held, list(to_read)) for g in grades]
+    replace_text(Path(path), csv_text([header, *rows]))
 
 
 def prepare(out_dir: str | Path) -> None:
@@ -190,9 +163,18 @@ def prepare(out_dir: str | Path) -> None:
 
 
 def enter(out_dir: str | Path, record: records.RunRecord, grade: SubmissionGrade, content=None, save=True) -> None:
-    """Write `grade`'s result and feedback, and enter the result in the run's `record` (written too unless
-    `save` is False: the caller writes it)."""
-    records.note(out_dir, record, grade.name, write_result(out_dir, grade), content, save=save)
+    """Write `grade`'s results/<name>.json and feedback/<name>.txt and .html, and enter the result in the run's
+    `record` (:func:`.record.note`), which is written too unless `save` is False (the caller writes it)."""
+    out = Path(out_dir)
+    prepare(out)
+    model, stem = feedbacks.build(grade), file_stem(grade.name)
+    replace_text(out / "feedback" / f"{stem}.txt", feedbacks.text(model))
+    replace_text(out / "feedback" / f"{stem}.html", feedbacks.html(model))
+    path, text = out / "results" / f"{safe_name(grade.name)}.json", json.dumps(grade.as_dict(), indent=1)
+    replace_text(path, text)
+    records.note(record, grade.name, path, text, content)
+    if save:
+        records.write(out, record)
 
 
 def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: records.RunRecord | None = None):
@@ -203,7 +185,8 @@ def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: rec
     out.mkdir(parents=True, exist_ok=True)
     if record is None:
         rubric = grades[0].rubric if grades else rubrics.default()
-        seed = _seed_of(grades)  # grades of several seeds are a merge's
+        seeds = sorted({g.seed for g in grades if g.seed is not None})
+        seed = None if not seeds else seeds[0] if len(seeds) == 1 else seeds  # several seeds: a merge's grades
         record = records.new("merge" if isinstance(seed, list) else "grade", labkit_version(), seed, rubric)
     for grade in grades:
         enter(out, record, grade, record.submissions.get(grade.name, {}).get("content"), save=False)
@@ -215,31 +198,24 @@ def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: rec
 def write_seed(out_dir: str | Path, seeds: int | list[int] | None) -> None:
     """seed.txt: the run's seed (a merge's seeds), one a line."""
     seeds = seeds if isinstance(seeds, list) else [] if seeds is None else [seeds]
-    (Path(out_dir) / "seed.txt").write_text("".join(f"{s}\n" for s in seeds), encoding="utf-8")
+    replace_text(Path(out_dir) / "seed.txt", "".join(f"{s}\n" for s in seeds))
 
 
 def write_timings(out_dir: str | Path, found: dict) -> None:
     """timings.json: where each submission's grading time went, by phase (only when something was measured)."""
     if found:
-        (Path(out_dir) / "timings.json").write_text(json.dumps(found, indent=1), encoding="utf-8")
+        replace_text(Path(out_dir) / "timings.json", json.dumps(found, indent=1))
 
 
 def write_run(out_dir: str | Path, summary: dict) -> None:
     """run.json: how the run went (its seed, counts, time and the engine's record)."""
-    (Path(out_dir) / "run.json").write_text(json.dumps(summary, indent=1), encoding="utf-8")
-
-
-def _seed_of(grades: list[SubmissionGrade]):
-    """The seed of a run's grades: one number, the list of them (a merge's), or None when none has one."""
-    seeds = sorted({g.seed for g in grades if g.seed is not None})
-    return None if not seeds else seeds[0] if len(seeds) == 1 else seeds
+    replace_text(Path(out_dir) / "run.json", json.dumps(summary, indent=1))
 
 
 @dataclass(frozen=True)
 class Replaced:
-    """A submission's result that a later folder's result replaced in a merge: the submission, the result
-    file replaced and the one that counts, and whether the later result had no submission time and kept the
-    earlier one's."""
+    """A submission's result file that a later folder's replaced in a merge, and whether the later result kept
+    the earlier one's submission time (it had none)."""
 
     name: str
     earlier: Path
@@ -256,10 +232,6 @@ class Merged(list):
         self.replaced = tuple(replaced)
         self.refused = tuple(refused)
         self.rubric = rubric
-
-    def refused_lines(self) -> list[str]:
-        """One printable line per result file that was not read, and why."""
-        return [f"not read: {one_line(path, 200)}: {one_line(why, 300)}" for path, why in self.refused]
 
 
 def _folders(folders) -> list[Path]:
@@ -295,16 +267,15 @@ def _vouched(folder: Path, rubric: rubrics.Rubric) -> records.RunRecord:
     return record
 
 
-def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list | None = None) -> Merged:
+def read_results(folders, rubric: rubrics.Rubric | None = None) -> Merged:
     """Every result of the output `folders` that their run records vouch for, in name order, scored with `rubric`
-    (their recorded rubric when None).
+    (their recorded one when None).
 
-    A submission with results in several folders counts from the last of them (a regrade replaces the class's
-    result); a later result without a submission time keeps the earlier one's, and each replacement is appended to
-    `replaced` when given. A result file a record does not name with that hash is never read: it is listed in the
-    :class:`Merged`'s ``refused``. InputError when a folder has no record or is given twice, no folder has results,
-    the results come from another labkit, or the folders' rubrics differ from each other or from `rubric` in their
-    exercises, groups or points (the ``[late]`` table may differ when `rubric` is given: it is the one applied).
+    A submission in several folders counts from the last, keeping the earlier time when the later result has none
+    (each replacement is listed in ``replaced``). A result file a record does not name with that hash is
+    never read but listed in ``refused``. InputError when a folder has no record or is given twice, none has
+    results, they come from another labkit, or their rubrics differ from each other or from `rubric` in exercises,
+    groups or points (their ``[late]`` tables may differ: `rubric`'s applies).
     """
     folders = _folders(folders)
     if rubric is None:
@@ -312,6 +283,7 @@ def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list |
     grades: dict[str, SubmissionGrade] = {}
     files: dict[str, Path] = {}
     refused: list = []
+    replaced: list[Replaced] = []
     for folder in folders:
         found, bad = records.results(folder, _vouched(folder, rubric))
         refused += bad
@@ -326,21 +298,19 @@ def read_results(folders, rubric: rubrics.Rubric | None = None, replaced: list |
                 kept = grade.time is None and earlier.time is not None
                 if kept:
                     grade.time = earlier.time
-                if replaced is not None:
-                    replaced.append(Replaced(grade.name, files[grade.name], path, kept))
+                replaced.append(Replaced(grade.name, files[grade.name], path, kept))
             grades[grade.name], files[grade.name] = grade, path
     if not grades:
         what = "no result their records vouch for" if refused else "no results (only empty shards)"
         raise InputError(
             f"{', '.join(map(str, folders))} hold {what}: give the --out folders of earlier `labkit grade` runs."
         )
-    return Merged([grades[name] for name in sorted(grades)], replaced or (), refused, rubric)
+    return Merged([grades[name] for name in sorted(grades)], replaced, refused, rubric)
 
 
-def _merged_record(folders: list, grades: Merged) -> records.RunRecord:
-    """The record of a merge of `folders`: their seeds, known sources, deliveries and variants as one, a later
-    folder's students replacing an earlier one's."""
-    read = [records.read(folder) for folder in folders]
+def _merged_record(read: list[records.RunRecord], grades: Merged) -> records.RunRecord:
+    """The record of a merge of the folders whose records are `read`: their seeds, known sources, deliveries and
+    variants as one, a later folder's students replacing an earlier one's."""
     record = records.new(
         "merge", labkit_version(), sorted({g.seed for g in grades if g.seed is not None}), grades.rubric
     )
@@ -349,28 +319,21 @@ def _merged_record(folders: list, grades: Merged) -> records.RunRecord:
     }
     layouts = {r.delivery.get("layout") for r in read if r.delivery}
     if len(layouts) == 1:  # none when the runs came in different layouts
-        students: dict = {}
-        for r in read:
-            students.update(r.delivery.get("students", {}))
+        students = {name: key for r in read for name, key in r.delivery.get("students", {}).items()}
         record.delivery = {"layout": layouts.pop(), "students": students}
     drawn = {r.variants.get("digest") for r in read}
     if drawn != {None}:
-        students = {}
-        for r in read:
-            students.update(r.variants.get("students", {}))
+        students = {name: data for r in read for name, data in r.variants.get("students", {}).items()}
         record.variants = {"digest": drawn.pop(), "students": students}
     return record
 
 
 def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
-    """Combine the results of several grading runs' `folders` (one per batch job, say, or a class's run and a
-    regrade) into the new folder `out_dir`, scored with `rubric` (a Rubric or a TOML path; the folders' recorded one
-    when None), whose exercises, groups and points must be theirs and whose ``[late]`` table applies.
-
-    A submission in several folders counts from the last one (:func:`read_results`), and a result file a folder's
-    record does not vouch for is never merged. `times` ({name: datetime}, :func:`labkit.grading.run.times.read_times`)
-    replace the stored times of the submissions they name; `progress` shows a bar on a terminal. Returns the grades
-    in name order, with the results a later folder replaced (also in ``merge.json``) and the files not merged.
+    """Combine the results of several grading runs' `folders` (batch jobs, say, or a run and a regrade) into the
+    new folder `out_dir` as :func:`read_results` reads them, scored with `rubric` (a Rubric or a TOML path; None:
+    the recorded one), whose ``[late]`` table applies. `times` ({name: datetime},
+    :func:`labkit.grading.run.times.read_times`) replace the stored times of the submissions they name. The grades,
+    with the results a later folder replaced (also in ``merge.json``) and the files not merged.
     """
     from ..progress import Progress
 
@@ -379,19 +342,19 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         raise InputError(f"{out} is one of the folders merged; write the merge into a new folder (--out).")
     if rubric is not None and not isinstance(rubric, rubrics.Rubric):
         rubric = rubrics.load(rubric)
-    if len({records.read(folder).variants.get("digest") for folder in folders}) > 1:
+    read = [records.read(folder) for folder in folders]
+    if len({r.variants.get("digest") for r in read}) > 1:
         raise InputError(
             "the folders were graded with different variants (or some without): each student's data would differ "
             "from one result to the next. Merge only runs graded with the same --variants file."
         )
-    replaced: list[Replaced] = []
-    grades = read_results(folders, rubric, replaced)
-    contents = {name: entry.get("content") for f in folders for name, entry in records.read(f).submissions.items()}
+    grades = read_results(folders, rubric)
+    contents = {name: entry.get("content") for r in read for name, entry in r.submissions.items()}
     for grade in grades:
         if times and grade.name in times:
             grade.time = SubmissionTime(times[grade.name], FROM_CSV)
     out.mkdir(parents=True, exist_ok=True)
-    record = _merged_record(folders, grades)
+    record = _merged_record(read, grades)
     with Progress(len(grades), "merging", enabled=progress) as bar:
         for grade in grades:
             grade.rubric = grades.rubric
@@ -404,9 +367,9 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         "folders": [str(folder) for folder in folders],
         "replaced": [
             {"submission": r.name, "earlier": str(r.earlier), "later": str(r.later), "time kept": r.time_kept}
-            for r in replaced
+            for r in grades.replaced
         ],
         "not merged": [{"file": str(path), "why": why} for path, why in grades.refused],
     }
-    (out / "merge.json").write_text(json.dumps(merged, indent=1), encoding="utf-8")
-    return Merged(list(grades), replaced, grades.refused, grades.rubric)
+    replace_text(out / "merge.json", json.dumps(merged, indent=1))
+    return grades

@@ -1,18 +1,13 @@
 """The rubric: how the exercises' results become a grade.
 
-A rubric is data (TOML, see ``rubric.toml`` next to this module, the lab's own): the exercises everyone does,
-alternative branches of which the best counts towards full credit while each other one is extra credit, and
-extra-credit exercises. An exercise's points are declared once, as the weights of its parts
-(:mod:`labkit.exercises`); a rubric may give an exercise other points in a ``[points]`` table, which scales its
-parts. ``exercises = "module:attribute"`` names another course's exercises (the lab's by default). An optional
-``[late]`` table sets a deadline and what lateness costs (:mod:`labkit.grading.store.late`). An optional ``[held]``
-table releases parts held for a person (their code matched a known source, :mod:`labkit.grading.submission.known`):
-``release = {"ada" = [2, 10]}`` pays ada's held parts of exercises 2 and 10. An optional ``[answers]`` table gives
-the answers in words points a person marks (``labkit mark``): ``exercise12-answer-1 = 2`` (the answer's nbgrader
-grade id, as in grades.csv); they add to their exercise's points, and the lab's rubric gives none. :func:`load`
-reads and validates one; :meth:`Rubric.score` turns the fractions an exercise's parts earned
-(:meth:`labkit.exercises.registry.Registry.check`) into points, the branch that counted, the extra credit and the
-total.
+A rubric is data, TOML (``rubric.toml`` beside this module is the lab's own, its comments a guide): the exercises
+everyone does, alternative branches of which the best counts towards full credit and each other one is extra
+credit, and extra-credit exercises. An exercise's points are its parts' weights (:mod:`labkit.exercises`) unless a
+``[points]`` table scales them. Optional tables: ``[late]``, the deadline and what lateness costs
+(:mod:`labkit.grading.store.late`); ``[held]``, parts held for a person (:mod:`labkit.grading.submission.known`)
+that a person released, ``release = {"ada" = [2, 10]}``; ``[answers]``, the points a person gives answers in words
+(``labkit mark``), ``exercise12-answer-1 = 2`` by nbgrader grade id. :func:`load` reads and validates a rubric;
+:meth:`Rubric.score` turns the fractions of an exercise's parts that passed into a grade.
 """
 
 import functools
@@ -20,6 +15,7 @@ import hashlib
 import json
 import tomllib
 from dataclasses import dataclass, field, replace
+from operator import methodcaller
 from pathlib import Path
 
 from ...errors import InputError
@@ -105,12 +101,9 @@ class Rubric:
 
     @property
     def digest(self):
-        """A fingerprint of what the rubric grades and how: its title, exercises, groups and points.
-
-        Results graded under different rubrics are not merged
-        (:func:`labkit.grading.store.report.read_results`). The ``[late]`` table is left out: ``labkit
-        merge`` applies the late rule of the rubric it is given to the submission times the results carry.
-        """
+        """A fingerprint of what the rubric grades and how: its title, exercises, groups and points. Results of
+        different digests are not merged (:func:`.report.read_results`); the ``[late]`` table is left out, since
+        ``labkit merge`` applies the given rubric's late rule to the submission times the results carry."""
         described = {
             "title": self.title,
             "exercises": self.registry.source,
@@ -185,10 +178,8 @@ class Rubric:
             extra = ", ".join(f"exercise {n} ({points_text(self.worth(n))})" for n in self.extra_credit)
             lines.append(("  " if not self.branches else "  and ") + f"extra credit: {extra}")
         if self.answers:
-            lines.append(
-                "  answers in words marked by a person: "
-                + ", ".join(f"{grade_id} ({points_text(p)})" for grade_id, p in self.answers.items())
-            )
+            marked = ", ".join(f"{grade_id} ({points_text(p)})" for grade_id, p in self.answers.items())
+            lines.append(f"  answers in words marked by a person: {marked}")
         if self.late is not None:
             lines.append(f"  {self.late.describe()}")
         return "\n".join(lines)
@@ -222,7 +213,7 @@ def _exercise_list(value, where, source, registry):
 
 
 def from_dict(data, source="the rubric"):
-    """A validated :class:`Rubric` from parsed TOML; ValueError says what is wrong and where."""
+    """A validated :class:`Rubric` from parsed TOML; InputError says what is wrong and where."""
     known = {"title", "exercises", "required", "extra_credit", "points", "branches", "late", "held", "answers"}
     unknown = sorted(set(data) - known)
     if unknown:
@@ -305,14 +296,9 @@ def _answers(table, source, registry, points):
     found, lines = {}, {}
     for grade_id, value in table.items():
         if isinstance(value, dict):  # {points = 2, rubric = ["what earns a point", ...]}
-            unknown = sorted(set(value) - {"points", "rubric"})
             given = value.get("rubric", [])
-            if (
-                unknown
-                or "points" not in value
-                or not isinstance(given, list)
-                or not all(isinstance(line, str) for line in given)
-            ):
+            lined = isinstance(given, list) and all(isinstance(line, str) for line in given)
+            if set(value) - {"points", "rubric"} or "points" not in value or not lined:
                 raise InputError(
                     f"{source}: [answers] {grade_id} must be points, or a table of points and rubric lines: "
                     f'{grade_id} = {{points = 2, rubric = ["names the order", "says why"]}}.'
@@ -360,13 +346,7 @@ def _released(table, source, registry, points):
 
 def plain(value):
     """Parsed TOML as JSON data: its date-times as ISO 8601 text (the [late] table reads both)."""
-    if isinstance(value, dict):
-        return {str(key): plain(item) for key, item in value.items()}
-    if isinstance(value, list):
-        return [plain(item) for item in value]
-    if hasattr(value, "isoformat"):
-        return value.isoformat()
-    return value
+    return json.loads(json.dumps(value, default=methodcaller("isoformat")))
 
 
 def _branches(table, source, registry):
