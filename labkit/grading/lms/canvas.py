@@ -1,15 +1,11 @@
 """Canvas: its "Download Submissions", its gradebook export filled in, its "Re-upload submissions".
 
 The download names each file ``{name}[_LATE]_{user id}_{file id}_{display name}`` (canvas-lms's
-``lib/content_zipper.rb``): ``{name}`` is the sortable name lower-cased, word characters only (``lovelaceada``);
-anonymous grading writes ``anon_{id}``. Both ends are the student's choice, so a name can read several ways
-(:func:`canvas_readings`, settled by :func:`resolve_canvas`). A file uploaded again is renamed ``name-1.ext``:
-the newest is kept, under the original name. The student is ``{name}`` (``{name}_{user id}`` for namesakes).
-
-The gradebook (canvas-lms's ``lib/gradebook_importer.rb``): student columns closed by ``Section``, an assignment
-per column ``Title (number)``, read-only totals, maybe ``Muted`` and ``Points Possible`` rows. Canvas makes a
-**new assignment** of a header it does not know, so :func:`to_canvas` fills one existing column unless
-``--new-column``. The feedback page is ``{a file's download prefix}_feedback.html`` ("Re-upload submissions").
+``lib/content_zipper.rb``): ``{name}`` is the sortable name lower-cased, word characters only (``lovelaceada``),
+or ``anon_{id}``. Both ends are the student's choice, so a name can read several ways (:func:`resolve_canvas`).
+The gradebook (``lib/gradebook_importer.rb``): student columns closed by ``Section``, an assignment per column
+``Title (number)``, read-only totals, maybe ``Muted`` and ``Points Possible`` rows; Canvas makes a **new
+assignment** of a header it does not know, so :func:`to_canvas` fills an existing column unless ``--new-column``.
 """
 
 from __future__ import annotations
@@ -39,9 +35,9 @@ TEST_STUDENT = "Student, Test"  # the row of the test student Canvas adds to eve
 MAX_LISTED = 20  # assignment columns named in a message
 FIX = "give Canvas's Grades > Export > Export Entire Gradebook file as it is (or saved as 'CSV UTF-8')."
 REUPLOAD = re.compile(r"^(?P<stem>.+)-(?P<number>[1-9][0-9]?)(?P<ext>\.[^.]+)?$", re.DOTALL)
-_FIXED = re.compile(r"(?=(_LATE)?_([0-9]+)_([0-9]+)_(.))", re.DOTALL)
+_FIXED = re.compile(r"(?=(_LATE)?_(0|[1-9][0-9]*)_(0|[1-9][0-9]*)_(.))", re.DOTALL)  # ids have no leading 0
 _ANON = re.compile(r"^(LATE_)?(anon(?:ymous)?)(_LATE)?_([A-Za-z0-9]+)_([0-9]+)_(.+)$", re.DOTALL)
-_NOT_WORD = re.compile(r"\W")
+_WORD = re.compile(r"\w*")
 
 
 @dataclass(frozen=True)
@@ -79,22 +75,15 @@ def _readings(name):
     anon = _ANON.match(name)
     if anon:
         return (Reading(f"{anon[2]}_{anon[4]}", bool(anon[1] or anon[3]), anon[4], anon[5], anon[6]),)
-    stop = _NOT_WORD.search(name)
-    end = len(name) if stop is None else stop.start()  # the name part holds word characters only
+    end = len(_WORD.match(name)[0])  # the name part holds word characters only
     found = []
     for match_ in _FIXED.finditer(name):
-        at = match_.start()
-        if at > end:
+        login = name[: match_.start()]
+        if match_.start() > end:
             break
-        login = name[:at]
-        if login != login.lower() or _padded(match_[2]) or _padded(match_[3]):
-            continue  # Canvas lower-cases the name, and writes its ids without leading zeros
-        found.append(Reading(login, bool(match_[1]), match_[2], match_[3], name[match_.end(3) + 1 :]))
+        if login == login.lower():  # Canvas lower-cases the name
+            found.append(Reading(login, bool(match_[1]), match_[2], match_[3], name[match_.end(3) + 1 :]))
     return tuple(found)
-
-
-def _padded(number):
-    return len(number) > 1 and number.startswith("0")
 
 
 def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
@@ -200,7 +189,7 @@ def _files(root, builder):
     files = {}
     for entry in entries(root):
         name = builder.name(entry)
-        if entry.is_file(follow_symlinks=False) and not entry.is_symlink() and canvas_readings(name):
+        if entry.is_file(follow_symlinks=False) and canvas_readings(name):
             files[name] = Path(entry.path)
         else:
             builder.notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
@@ -229,8 +218,7 @@ def _pieces(login, files, notes):
 
 @dataclass
 class CanvasGradebook:
-    """A Canvas gradebook export as read: its header, its rows (padded to the header), its CSV dialect, and the
-    index of ``Section``."""
+    """A Canvas gradebook export as read: its header, its rows padded to it, its CSV dialect, where ``Section`` is."""
 
     header: list
     rows: list
@@ -281,10 +269,10 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
     return CanvasGradebook(header, body, delimiter, newline, bom, section)
 
 
-def assignment_columns(book: CanvasGradebook) -> list[str]:
-    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only."""
+def _assignments_text(book):
+    """The gradebook's assignment columns (after ``Section``, neither a total nor read-only) in words."""
     points_row = book.points_row()
-    return [
+    names = [
         cell.strip()
         for i, cell in enumerate(book.header)
         if i > book.section
@@ -292,6 +280,11 @@ def assignment_columns(book: CanvasGradebook) -> list[str]:
         and TOTALS.search(cell) is None
         and not (points_row and "read only" in points_row[i].lower())
     ]
+    if not names:
+        return "it has no assignment column yet"
+    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
+    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
+    return f"its assignment columns are {shown}{more}"
 
 
 def _assignment_column(book, column, path):
@@ -305,16 +298,6 @@ def _assignment_column(book, column, path):
             f"{path} has {len(found)} assignment columns named {column!r} ({names}); e.g. --column {example}."
         )
     return found[0] if found else None
-
-
-def _assignments_text(book):
-    """The gradebook's assignment columns in words, for a message."""
-    names = assignment_columns(book)
-    if not names:
-        return "it has no assignment column yet"
-    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
-    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
-    return f"its assignment columns are {shown}{more}"
 
 
 def to_canvas(
