@@ -55,7 +55,8 @@ class Reading:
         return (self.login, self.late, self.uid)
 
 
-def canvas_readings(name: str) -> list[Reading]:
+@functools.lru_cache(maxsize=1 << 14)
+def canvas_readings(name: str) -> tuple[Reading, ...]:
     """Every reading of `name` as Canvas names a submission's file, shortest name part first.
 
     >>> [(r.login, r.uid, r.file) for r in canvas_readings("ada_1001_9_lab.ipynb")]
@@ -65,15 +66,9 @@ def canvas_readings(name: str) -> list[Reading]:
     >>> [(r.login, r.uid, r.file) for r in canvas_readings("ada_LATE_1001_98765_02_convergence.ipynb")]
     [('ada', '1001', '02_convergence.ipynb')]
     >>> canvas_readings("Ada Lovelace.ipynb")
-    []
+    ()
     """
-    return list(_readings(name))
-
-
-@functools.lru_cache(maxsize=1 << 14)
-def _readings(name):
-    anon = _ANON.match(name)
-    if anon:
+    if anon := _ANON.match(name):
         return (Reading(f"{anon[2]}_{anon[4]}", bool(anon[1] or anon[3]), anon[4], anon[5], anon[6]),)
     end = len(_WORD.match(name)[0])  # the name part holds word characters only
     found = []
@@ -102,16 +97,14 @@ def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
     for found in readings.values():
         if len(found) == 1:
             settled.setdefault(found[0].uid, set()).add(found[0].prefix)
-    chosen: dict = {}
     notes: list[str] = []
-    for name, found in readings.items():
-        chosen[name] = found[0] if len(found) == 1 else _choose(name, found, settled, set(roster_ids), notes)
+    chosen = {name: _choose(name, found, settled, set(roster_ids), notes) for name, found in readings.items()}
     return chosen, notes
 
 
 def _choose(name, found, settled, roster, notes):
-    if not found:
-        return None
+    if len(found) < 2:
+        return found[0] if found else None
     shown = one_line(name, 120)
     left = [r for r in found if r.uid not in settled or r.prefix in settled[r.uid]]
     if len(left) > 1 and roster:

@@ -1,9 +1,8 @@
 """The class as the LMS hands it over: one folder or one zip becomes a list of students.
 
-Only the grader's `workspace` is written, and no link is followed. Which LMS a download is comes from the names at
-its top (:func:`detect`). A class zip's members are sorted out by student before anything is written, and each
-student's are unpacked on their own budget (:class:`~.unzip.UnpackLimits`, over all their files and zips): a
-member that breaks a rule leaves its student ungraded, never the class. A student's name is data, never a path.
+Only the grader's `workspace` is written, no link is followed, and a student's name is data, never a path. A class
+zip is sorted out by student before anything is written, each student on their own budget: a member that breaks a
+rule leaves its student ungraded, never the class.
 """
 
 from __future__ import annotations
@@ -154,7 +153,7 @@ class Builder:
                 return dataclasses.replace(who, failure=_no_notebook(as_text(r) for r in relative))
             return dataclasses.replace(who, path=Path(folder))
         pieces = [(f.relative_to(folder), f) for f in files if f.suffix == ".ipynb" or f.name in keep]
-        return self._assemble(who, (pieces, zips, relative), key)
+        return self._assemble(who, key, pieces, zips, relative)
 
     def from_files(self, name, pieces, layout, lms_id=None, late=False, key=None):
         """A student given as loose files: `pieces` pairs the name to give each with its path."""
@@ -164,10 +163,9 @@ class Builder:
         zips = [(relative, path) for relative, path in pieces if path.suffix.lower() == ".zip"]
         shown = [as_text(relative.as_posix()) for relative, _ in pieces]
         gradable = [(relative, path) for relative, path in pieces if path.suffix == ".ipynb"]
-        return self._assemble(who, (gradable, zips, shown), key)
+        return self._assemble(who, key, gradable, zips, shown)
 
-    def _assemble(self, who, given, key):
-        pieces, zips, shown = given
+    def _assemble(self, who, key, pieces, zips, shown):
         if not pieces and not zips:
             return dataclasses.replace(who, failure=_no_notebook(shown))
         target = free(self.workspace / "students" / safe_name(who.name))
@@ -293,8 +291,13 @@ def _class_zip(path, root, builder):
         plans = {key: _student_plan(key, items, builder, label, len(prefix)) for key, items in groups.items()}
         _check_space(lms, plans, root, label)
         for key, plan in plans.items():
-            if plan is not None:
-                _extract_student(archive, key, plan, root, builder, label)
+            written, made = [], []
+            try:
+                if plan is not None:
+                    unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
+            except ValueError as exc:
+                unzip.undo(None, written, made)  # a refused student's members are removed again
+                builder.refused[key] = f"{exc} {FIX}"
             _placeholder(root, key, groups[key], lms.depth, builder)
     return lms
 
@@ -378,16 +381,6 @@ def _check_space(lms, plans, root, label):
     )
 
 
-def _extract_student(archive, key, plan, root, builder, label):
-    """Write one student's checked members under `root` on their budget; on a refusal remove them again."""
-    written, made = [], []
-    try:
-        unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
-    except ValueError as exc:
-        unzip.undo(None, written, made)
-        builder.refused[key] = f"{exc} {FIX}"
-
-
 def _placeholder(root, key, items, depth, builder):
     """For a refused student, empty stand-ins of what names them at the top, so that the layout finds them."""
     if key not in builder.refused:
@@ -411,12 +404,10 @@ def find_class(
     roster: dict[str, str] | None = None,
 ) -> Intake:
     """The students of the class in `path` (a folder or zip of one LMS), in name order; one that cannot be graded
-    has ``path=None`` and the reason in ``failure``, and never stops the others.
-
-    Everything is written in `workspace` (the caller's, not inside `path`). `assignment` is nbgrader's to take;
-    `limits` what one student's files and zips may hold in all; `roster` ({submission: LMS id}) names a student
-    whose LMS id it has. ValueError when the layout is unclear, two students share a name, or the zip has no room.
-    """
+    has ``path=None`` and the reason in ``failure``, and never stops the others. Everything is written in
+    `workspace`, never inside `path`. `assignment` is nbgrader's to take; `roster` ({submission: LMS id}) names
+    a student whose LMS id it has. ValueError when the layout is unclear, two students share a name, or the zip
+    has no room."""
     path, workspace = Path(path), Path(workspace)
     try:
         info = os.lstat(path)
