@@ -1,9 +1,8 @@
 """Grades into the LMS: what every LMS's export shares (each LMS module writes its own file).
 
 An export writes the **total under the rubric** of each student the roster matches; an ungraded submission gets
-no number, never a zero. Every student who got nothing is listed (:meth:`Export.problems`) and in a summary CSV
-beside the output. Bad input writes nothing; the output never replaces an input, nor an existing file unless
-``force``, and is renamed into place when complete.
+no number, never a zero, and every student who got nothing is listed. Bad input writes nothing, and the output
+never replaces an input, nor an existing file unless ``force``.
 """
 
 from __future__ import annotations

@@ -146,26 +146,23 @@ class Builder:
             files = walk(folder, self.notes)
         except ValueError as exc:
             return dataclasses.replace(who, failure=f"{exc} {FIX}")
-        relative = [f.relative_to(folder).as_posix() for f in files]
-        zips = [(f.relative_to(folder), f) for f in files if f.suffix.lower() == ".zip"]
-        if not zips:
-            if not any(f.suffix == ".ipynb" for f in files):
-                return dataclasses.replace(who, failure=_no_notebook(as_text(r) for r in relative))
-            return dataclasses.replace(who, path=Path(folder))
-        pieces = [(f.relative_to(folder), f) for f in files if f.suffix == ".ipynb" or f.name in keep]
-        return self._assemble(who, key, pieces, zips, relative)
+        pieces = [(f.relative_to(folder), f) for f in files]
+        if any(f.suffix.lower() == ".zip" for f in files):
+            return self._assemble(who, key, pieces, [r.as_posix() for r, _ in pieces], keep)
+        if not any(f.suffix == ".ipynb" for f in files):
+            return dataclasses.replace(who, failure=_no_notebook(as_text(r.as_posix()) for r, _ in pieces))
+        return dataclasses.replace(who, path=Path(folder))
 
     def from_files(self, name, pieces, layout, lms_id=None, late=False, key=None):
         """A student given as loose files: `pieces` pairs the name to give each with its path."""
         who, key = Student(name, None, None, layout, lms_id, late), key or (layout, name)
-        if refused := self.refusal(who, key):
-            return refused
-        zips = [(relative, path) for relative, path in pieces if path.suffix.lower() == ".zip"]
         shown = [as_text(relative.as_posix()) for relative, _ in pieces]
-        gradable = [(relative, path) for relative, path in pieces if path.suffix == ".ipynb"]
-        return self._assemble(who, key, gradable, zips, shown)
+        return self.refusal(who, key) or self._assemble(who, key, pieces, shown)
 
-    def _assemble(self, who, key, pieces, zips, shown):
+    def _assemble(self, who, key, given, shown, keep=()):
+        """`who` with their notebooks (and files named in `keep`) copied and their zips unpacked in the workspace."""
+        zips = [(relative, path) for relative, path in given if path.suffix.lower() == ".zip"]
+        pieces = [(relative, path) for relative, path in given if path.suffix == ".ipynb" or path.name in keep]
         if not pieces and not zips:
             return dataclasses.replace(who, failure=_no_notebook(shown))
         target = free(self.workspace / "students" / safe_name(who.name))
