@@ -293,7 +293,7 @@ def _class_zip(path, root, builder):
                 if plan is not None:
                     unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
             except ValueError as exc:
-                unzip.undo(None, written, made)  # a refused student's members are removed again
+                unzip.undo(written, made)  # a refused student's members are removed again
                 builder.refused[key] = f"{exc} {FIX}"
             _placeholder(root, key, groups[key], lms.depth, builder)
     return lms

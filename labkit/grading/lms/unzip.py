@@ -6,7 +6,6 @@ from __future__ import annotations
 import copy
 import os
 import re
-import shutil
 import stat
 import zipfile
 import zlib
@@ -71,29 +70,21 @@ def unpack(
     labkit.errors.InputError: work.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
     """
     into = Path(into)
-    created_root = None if os.path.lexists(into) else into
-    while created_root is not None and not os.path.lexists(created_root.parent):
-        created_root = created_root.parent  # the first folder this call creates, removed again on failure
+    made = [p for p in (*reversed(into.parents), into) if not os.path.lexists(p)]  # what this call creates
     written: list[Path] = []
-    made: list[Path] = []
     try:
-        if created_root is not None:
-            into.mkdir(parents=True)
-        elif not stat.S_ISDIR(os.lstat(into).st_mode):
+        if not made and not stat.S_ISDIR(os.lstat(into).st_mode):
             raise InputError(f"{into} is not a folder to unpack into.")
-        budget = budget if budget is not None else Budget(limits)
-        _unpack(Path(zip_path), into, budget, depth, written, made, as_text(Path(zip_path).name))
+        into.mkdir(parents=True, exist_ok=True)
+        _unpack(Path(zip_path), into, budget or Budget(limits), depth, written, made, as_text(Path(zip_path).name))
     except BaseException:
-        undo(created_root, written, made)
+        undo(written, made)
         raise
     return sorted(p for p in written if os.path.lexists(p))
 
 
-def undo(root, written, made):
-    """Remove what a refused unzip wrote: the folder `root` it created, else its files and folders."""
-    if root is not None:
-        shutil.rmtree(root, ignore_errors=True)
-        return
+def undo(written, made):
+    """Remove what a refused unzip wrote: its files, then its folders."""
     for remove, paths in ((os.unlink, written), (os.rmdir, made)):
         for path in reversed(paths):
             with suppress(OSError):
