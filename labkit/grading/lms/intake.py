@@ -354,7 +354,6 @@ def _student_plan(key, items, builder, label, skip):
         return [builder.on_disk(parts[0]), *parts[1:]]
 
     try:
-        unzip.count_members(budget, len(items), label)
         return unzip.checked([info for info, _ in items], budget, label, checked_parts)
     except ValueError as exc:
         builder.refused[key] = f"{exc} {FIX}"

@@ -19,7 +19,6 @@ from ..store.report import one_line
 MAX_NAME = 255  # bytes of one file or folder name in a zip (what file systems take)
 RATIO_FLOOR = 1 << 20  # the compression ratio is checked for members that grow past this many bytes
 CHUNK = 1 << 16
-UNREADABLE = (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError)
 
 
 @dataclass(frozen=True)
@@ -95,7 +94,7 @@ def open_zip(path, label):
     """The zip `path`, opened; ValueError naming `label` when it is none labkit can read."""
     try:
         return zipfile.ZipFile(path)
-    except UNREADABLE as exc:
+    except (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError) as exc:
         raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
 
 
@@ -120,14 +119,6 @@ def member_parts(name, label, skip=0):
     return parts
 
 
-def count_members(budget, count, label):
-    """Add `count` members to `budget`; ValueError when the student now has too many."""
-    budget.members += count
-    if budget.members > budget.limits.max_members:
-        most = budget.limits.max_members
-        raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
-
-
 def _over_total(label, limits, when=""):
     most = size_text(limits.max_total)
     return InputError(f"{label}: more than {most} uncompressed{when}; labkit extracts at most {most} for one student.")
@@ -138,7 +129,6 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
     if depth > limits.max_depth:
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
-        count_members(budget, len(archive.infolist()), label)
         plan = checked(archive.infolist(), budget, label)
         inner = write_plan(archive, plan, into, budget, label, (written, made))
     for target, shown in inner:
@@ -153,7 +143,12 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
 
 
 def checked(infos, budget, label, parts_of=None):
-    """[(info, parts, is_dir, shown)] of the members `infos`, once their names and declared sizes fit `budget`."""
+    """[(info, parts, is_dir, shown)] of the members `infos`, once their number, names and declared sizes fit
+    `budget` (their number counted in it)."""
+    budget.members += len(infos)
+    if budget.members > budget.limits.max_members:
+        most = budget.limits.max_members
+        raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
     plan, seen, declared = [], set(), 0
     for info in infos:
         parts = member_parts(info.filename, label) if parts_of is None else parts_of(info)
