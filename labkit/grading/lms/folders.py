@@ -38,7 +38,7 @@ class Folders(Lms):
             if entry.is_symlink():  # a student all the same, with nothing labkit will read: never a silent gap
                 students.append(Student(name, None, "is a link, and links are never followed", "folders"))
             elif entry.is_dir(follow_symlinks=False):
-                students.append(builder.from_folder(name, Path(entry.path), "folders", key=("folders", name)))
+                students.append(builder.from_folder(name, Path(entry.path), "folders"))
             elif entry.is_file(follow_symlinks=False) and name.endswith(".ipynb"):
                 student = Student(name[: -len(".ipynb")], Path(entry.path), None, "folders")
                 students.append(builder.refusal(student, ("folders", name)) or student)

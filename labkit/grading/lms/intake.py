@@ -109,7 +109,7 @@ class Builder:
     """Turns one student's files (a folder, loose files, zips) into a Student, writing only in the workspace;
     an LMS's ``students`` reads its download with it, and tells the instructor in ``notes``."""
 
-    def __init__(self, workspace, limits, notes, zip_depth):
+    def __init__(self, workspace, limits, notes, zip_depth, roster_ids=()):
         self.workspace = workspace
         self.limits = limits
         self.notes = notes
@@ -117,7 +117,7 @@ class Builder:
         self.budgets: dict = {}  # a student's key -> the Budget all their zips share (the class zip's included)
         self.refused: dict = {}  # a student's key -> why the class zip's members of theirs were not extracted
         self.aliases: dict = {}  # a name written in the workspace -> the class zip's own (too long to write)
-        self.roster_ids: tuple = ()  # the roster's ids, which settle whose a file is when its name reads two ways
+        self.roster_ids = roster_ids  # the roster's ids, which settle whose a file is when its name reads two ways
         self.noted = False  # the class zip's owners() said already how each name was read
 
     def budget(self, key):
@@ -415,17 +415,15 @@ def find_class(
         raise InputError(f"the workspace {_shown(workspace)} is inside the class folder: give a workspace elsewhere.")
     workspace.mkdir(parents=True, exist_ok=True)
     own = Path(tempfile.mkdtemp(prefix="intake-", dir=workspace))
-    notes: list[str] = []
-    builder = Builder(own, limits, notes, 1 if stat.S_ISREG(info.st_mode) else 0)
-    builder.roster_ids = tuple(roster.values()) if roster else ()
+    builder = Builder(own, limits, [], 1 if stat.S_ISREG(info.st_mode) else 0, tuple(roster.values()) if roster else ())
     root, lms = _class_root(path, info, own, builder)
     students = lms.students(root, builder, assignment)
     if assignment is not None and not lms.assignments:
-        notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
-    students = _by_roster(students, roster, notes) if roster else students
+        builder.notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
+    students = _by_roster(students, roster, builder.notes) if roster else students
     _one_name_each(students)
     students.sort(key=lambda s: (s.name.casefold(), s.name))
-    return Intake(students, lms.name, notes)
+    return Intake(students, lms.name, builder.notes)
 
 
 def _class_root(path, info, own, builder):
