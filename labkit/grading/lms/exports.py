@@ -19,7 +19,6 @@ from ..store.text import points_text
 from . import named
 
 DEFAULT_COLUMN = "labkit"
-SUMMARY_HEADER = ["submission", "id", "points", "status"]
 
 
 @dataclass
@@ -162,7 +161,7 @@ def write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
 
 def write_summary(export, roster, by_name):
     """The summary beside the export: a row per submission, roster entry without one, and unmatched gradebook row."""
-    rows = [SUMMARY_HEADER]
+    rows = [["submission", "id", "points", "status"]]
     missing_in_lms = {name for name, _ in export.not_in_lms}
     for name, grade in by_name.items():
         status = []
