@@ -1,5 +1,7 @@
-"""The LMSs a class comes from and goes back to: one module per LMS, whose ``LMS`` is an :class:`Lms`, found by
-:func:`systems`, so adding an LMS is adding its module."""
+"""The LMSs a class comes from and goes back to: one module per LMS, whose ``LMS`` is an :class:`Lms`.
+
+:func:`systems` finds them all, so adding an LMS is adding its module. It all runs in the instructor's process.
+"""
 
 from __future__ import annotations
 

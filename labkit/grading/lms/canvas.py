@@ -27,10 +27,7 @@ from .roster import csv_rows, first_row, read_roster, read_text
 KEYS = ("ID", "SIS User ID", "SIS Login ID")
 STUDENT_COLUMNS = ("Student", "ID", "SIS User ID", "SIS Login ID", "Integration ID", "Root Account", "Section")
 # headers the Canvas importer takes for totals, and ignores
-TOTALS = re.compile(
-    "Current Score|Current Points|Current Grade|Final Score|Final Points|Final Grade|"
-    "Override Score|Override Grade|Override Status"
-)
+TOTALS = re.compile("(Current|Final) (Score|Points|Grade)|Override (Score|Grade|Status)")
 TEST_STUDENT = "Student, Test"  # the row of the test student Canvas adds to every course ("Test Student")
 MAX_LISTED = 20  # assignment columns named in a message
 FIX = "give Canvas's Grades > Export > Export Entire Gradebook file as it is (or saved as 'CSV UTF-8')."

@@ -48,7 +48,7 @@ class Folders(Lms):
 
     def feedback_names(self, name, entry):
         """``{submission}/feedback.html`` (a name that is no plain folder name, hashed)."""
-        plain = name not in (".", "..") and not re.search(r"[/\\\x00]", name) and not name.startswith(".")
+        plain = not re.search(r"[/\\\x00]", name) and not name.startswith(".")
         return [f"{name if plain else file_stem(name)}/{PAGE}"]
 
 
