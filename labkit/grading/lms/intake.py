@@ -346,15 +346,9 @@ def _student_plan(key, items, builder, label, skip):
     """The checked members of one student, or None when one breaks a limit (``builder.refused[key]`` says why)."""
     budget = builder.budget(key)
     budget.in_class = True
-    parts_of = {id(info): parts for info, parts in items}
-
-    def checked_parts(info):
-        unzip.member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
-        parts = parts_of[id(info)]
-        return [builder.on_disk(parts[0]), *parts[1:]]
-
-    try:
-        return unzip.checked([info for info, _ in items], budget, label, checked_parts)
+    on_disk = [(info, [builder.on_disk(parts[0]), *parts[1:]]) for info, parts in items]
+    try:  # a name at the top too long to write has a short one on disk, so its length is not refused
+        return unzip.checked(on_disk, budget, label, skip + 1)
     except ValueError as exc:
         builder.refused[key] = f"{exc} {FIX}"
         return None

@@ -129,7 +129,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
     if depth > limits.max_depth:
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
-        plan = checked(archive.infolist(), budget, label)
+        plan = checked([(info, None) for info in archive.infolist()], budget, label)
         inner = write_plan(archive, plan, into, budget, label, (written, made))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
@@ -142,16 +142,17 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
         written.remove(target)
 
 
-def checked(infos, budget, label, parts_of=None):
-    """[(info, parts, is_dir, shown)] of the members `infos`, once their number, names and declared sizes fit
-    `budget` (their number counted in it)."""
-    budget.members += len(infos)
+def checked(members, budget, label, skip=0):
+    """[(info, parts, is_dir, shown)] of `members` ([(info, the parts to write it under, or None for its name's)]),
+    once their number, names (past `skip` parts) and declared sizes fit `budget` (their number counted in it)."""
+    budget.members += len(members)
     if budget.members > budget.limits.max_members:
         most = budget.limits.max_members
         raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
     plan, seen, declared = [], set(), 0
-    for info in infos:
-        parts = member_parts(info.filename, label) if parts_of is None else parts_of(info)
+    for info, given in members:
+        parts = member_parts(info.filename, label, skip)  # refuses what leaves the folder, and too long a name
+        parts = parts if given is None else given
         is_dir = _member_kind(info, label)
         if not parts or parts[0] == "__MACOSX":
             continue
