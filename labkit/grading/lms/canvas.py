@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import os
 import re
+from contextlib import suppress
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -373,13 +374,10 @@ def _target(book, export, path, full_credit, new_column):
     possible = points_row[target].strip() if points_row else ""
     if "read only" in possible.lower():
         raise InputError(f"the column {book.header[target]!r} of {path} is read-only in Canvas: give another --column.")
-    try:
-        differs = possible and float(possible.replace(",", ".")) != full_credit
-    except ValueError:
-        differs = False
-    if differs:
-        worth = f"is worth {possible} points in Canvas, {points_text(full_credit)} in the rubric"
-        export.notes.append(f"note: {book.header[target]!r} {worth}: the totals are written as they are.")
+    with suppress(ValueError):  # points Canvas does not write as a number are not compared
+        if possible and float(possible.replace(",", ".")) != full_credit:
+            worth = f"is worth {possible} points in Canvas, {points_text(full_credit)} in the rubric"
+            export.notes.append(f"note: {book.header[target]!r} {worth}: the totals are written as they are.")
     return target
 
 

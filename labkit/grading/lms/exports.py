@@ -113,9 +113,8 @@ def start(grades, out, lms, column):
 def check_outputs(export, inputs, force):
     """ValueError when the export's files would replace an input, or an existing file without `force`."""
     for path in (export.path, export.summary_path):
-        for source in inputs:
-            if path.resolve() == Path(source).resolve():
-                raise InputError(f"{path} is an input of this export; it is never overwritten: give another --out.")
+        if any(path.resolve() == Path(source).resolve() for source in inputs):
+            raise InputError(f"{path} is an input of this export; it is never overwritten: give another --out.")
         if not path.parent.is_dir():
             raise InputError(f"the folder {path.parent} does not exist: create it, or give --out another path.")
         if path.exists() and not force:
@@ -173,8 +172,7 @@ def write_summary(export, roster, by_name):
             status.append(f"not in the {export.lms} gradebook")
         points = points_text(grade.total) if grade.graded else ""
         rows.append([csv_cell(name), csv_cell(roster.get(name, "")), points, csv_cell("; ".join(status) or "exported")])
-    for name, key in export.no_submission:
-        rows.append([csv_cell(name), csv_cell(key), "", "no submission (in the roster)"])
+    rows += [[csv_cell(name), csv_cell(key), "", "no submission (in the roster)"] for name, key in export.no_submission]
     for name, key in export.lms_only:
         status = f"in the {export.lms} gradebook ({one_line(name, 80)}), not in the roster"
         rows.append(["", csv_cell(key), "", csv_cell(status)])

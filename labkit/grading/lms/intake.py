@@ -337,8 +337,7 @@ def _by_owner(lms, members, tops, builder):
             groups.setdefault(key, []).append((info, parts))
         elif parts[0] not in owners:  # (a name in owners without a student has its note already)
             ignored.add(parts[0])
-    for name in sorted(ignored):
-        builder.notes.append(f"ignored {one_line(name)}: not a student's, in {lms.name}'s layout")
+    builder.notes += [f"ignored {one_line(name)}: not a student's, in {lms.name}'s layout" for name in sorted(ignored)]
     return groups
 
 
