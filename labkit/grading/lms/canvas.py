@@ -35,7 +35,7 @@ FIX = "give Canvas's Grades > Export > Export Entire Gradebook file as it is (or
 REUPLOAD = re.compile(r"^(?P<stem>.+)-(?P<number>[1-9][0-9]?)(?P<ext>\.[^.]+)?$", re.DOTALL)
 _FIXED = re.compile(r"(?=(_LATE)?_(0|[1-9][0-9]*)_(0|[1-9][0-9]*)_(.))", re.DOTALL)  # ids have no leading 0
 _ANON = re.compile(r"^(LATE_)?(anon(?:ymous)?)(_LATE)?_([A-Za-z0-9]+)_([0-9]+)_(.+)$", re.DOTALL)
-_WORD = re.compile(r"\w*")
+_NOT_WORD = re.compile(r"\W")
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,8 @@ def canvas_readings(name: str) -> tuple[Reading, ...]:
     """
     if anon := _ANON.match(name):
         return (Reading(f"{anon[2]}_{anon[4]}", bool(anon[1] or anon[3]), anon[4], anon[5], anon[6]),)
-    end = len(_WORD.match(name)[0])  # the name part holds word characters only
+    stop = _NOT_WORD.search(name)
+    end = len(name) if stop is None else stop.start()  # the name part holds word characters only
     found = []
     for match_ in _FIXED.finditer(name):
         login = name[: match_.start()]
