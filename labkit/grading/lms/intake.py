@@ -77,12 +77,10 @@ def walk(folder, notes=None):
             seen += 1
             if seen > MAX_FILES:
                 raise InputError(f"{_shown(folder)} holds more than {MAX_FILES} files; a submission is a few.")
-            if entry.is_symlink():
-                if notes is not None:
-                    notes.append(f"ignored {one_line(as_text(entry.path))}: a link (links are never followed)")
-            elif entry.is_dir(follow_symlinks=False):
-                if depth < MAX_DEPTH:
-                    todo.append((Path(entry.path), depth + 1))
+            if entry.is_symlink() and notes is not None:  # (a link is neither a folder nor a file below)
+                notes.append(f"ignored {one_line(as_text(entry.path))}: a link (links are never followed)")
+            elif entry.is_dir(follow_symlinks=False) and depth < MAX_DEPTH:
+                todo.append((Path(entry.path), depth + 1))
             elif entry.is_file(follow_symlinks=False):
                 found.append(Path(entry.path))
     return sorted(found)
