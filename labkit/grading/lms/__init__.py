@@ -1,8 +1,6 @@
 """The LMSs a class comes from and goes back to: one module per LMS, whose ``LMS`` is an :class:`Lms`.
 
-:func:`systems` finds them all, so adding an LMS is adding its module. Run in the instructor's process:
-:mod:`.intake` reads a class (with the safe unzip :mod:`.unzip`), :mod:`.exports` writes grades, :mod:`.delivery`
-the feedback zip, :mod:`.roster` the roster.
+:func:`systems` finds them all, so adding an LMS is adding its module. It all runs in the instructor's process.
 """
 
 from __future__ import annotations

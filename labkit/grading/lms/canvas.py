@@ -1,15 +1,11 @@
 """Canvas: its "Download Submissions", its gradebook export filled in, its "Re-upload submissions".
 
 The download names each file ``{name}[_LATE]_{user id}_{file id}_{display name}`` (canvas-lms's
-``lib/content_zipper.rb``): ``{name}`` is the sortable name lower-cased, word characters only (``lovelaceada``);
-anonymous grading writes ``anon_{id}``. Both ends are the student's choice, so a name can read several ways
-(:func:`canvas_readings`, settled by :func:`resolve_canvas`). A file uploaded again is renamed ``name-1.ext``:
-the newest is kept, under the original name. The student is ``{name}`` (``{name}_{user id}`` for namesakes).
-
-The gradebook (canvas-lms's ``lib/gradebook_importer.rb``): student columns closed by ``Section``, an assignment
-per column ``Title (number)``, read-only totals, maybe ``Muted`` and ``Points Possible`` rows. Canvas makes a
-**new assignment** of a header it does not know, so :func:`to_canvas` fills one existing column unless
-``--new-column``. The feedback page is ``{a file's download prefix}_feedback.html`` ("Re-upload submissions").
+``lib/content_zipper.rb``): ``{name}`` is the sortable name lower-cased, word characters only (``lovelaceada``),
+or ``anon_{id}``. Both ends are the student's choice, so a name can read several ways (:func:`resolve_canvas`).
+The gradebook (``lib/gradebook_importer.rb``): student columns closed by ``Section``, an assignment per column
+``Title (number)``, read-only totals, maybe ``Muted`` and ``Points Possible`` rows; Canvas makes a **new
+assignment** of a header it does not know, so :func:`to_canvas` fills an existing column unless ``--new-column``.
 """
 
 from __future__ import annotations
@@ -17,6 +13,7 @@ from __future__ import annotations
 import functools
 import os
 import re
+from contextlib import suppress
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -31,15 +28,12 @@ from .roster import csv_rows, first_row, read_roster, read_text
 KEYS = ("ID", "SIS User ID", "SIS Login ID")
 STUDENT_COLUMNS = ("Student", "ID", "SIS User ID", "SIS Login ID", "Integration ID", "Root Account", "Section")
 # headers the Canvas importer takes for totals, and ignores
-TOTALS = re.compile(
-    "Current Score|Current Points|Current Grade|Final Score|Final Points|Final Grade|"
-    "Override Score|Override Grade|Override Status"
-)
+TOTALS = re.compile("(Current|Final) (Score|Points|Grade)|Override (Score|Grade|Status)")
 TEST_STUDENT = "Student, Test"  # the row of the test student Canvas adds to every course ("Test Student")
 MAX_LISTED = 20  # assignment columns named in a message
 FIX = "give Canvas's Grades > Export > Export Entire Gradebook file as it is (or saved as 'CSV UTF-8')."
 REUPLOAD = re.compile(r"^(?P<stem>.+)-(?P<number>[1-9][0-9]?)(?P<ext>\.[^.]+)?$", re.DOTALL)
-_FIXED = re.compile(r"(?=(_LATE)?_([0-9]+)_([0-9]+)_(.))", re.DOTALL)
+_FIXED = re.compile(r"(?=(_LATE)?_(0|[1-9][0-9]*)_(0|[1-9][0-9]*)_(.))", re.DOTALL)  # ids have no leading 0
 _ANON = re.compile(r"^(LATE_)?(anon(?:ymous)?)(_LATE)?_([A-Za-z0-9]+)_([0-9]+)_(.+)$", re.DOTALL)
 _NOT_WORD = re.compile(r"\W")
 
@@ -59,7 +53,8 @@ class Reading:
         return (self.login, self.late, self.uid)
 
 
-def canvas_readings(name: str) -> list[Reading]:
+@functools.lru_cache(maxsize=1 << 14)
+def canvas_readings(name: str) -> tuple[Reading, ...]:
     """Every reading of `name` as Canvas names a submission's file, shortest name part first.
 
     >>> [(r.login, r.uid, r.file) for r in canvas_readings("ada_1001_9_lab.ipynb")]
@@ -69,32 +64,20 @@ def canvas_readings(name: str) -> list[Reading]:
     >>> [(r.login, r.uid, r.file) for r in canvas_readings("ada_LATE_1001_98765_02_convergence.ipynb")]
     [('ada', '1001', '02_convergence.ipynb')]
     >>> canvas_readings("Ada Lovelace.ipynb")
-    []
+    ()
     """
-    return list(_readings(name))
-
-
-@functools.lru_cache(maxsize=1 << 14)
-def _readings(name):
-    anon = _ANON.match(name)
-    if anon:
+    if anon := _ANON.match(name):
         return (Reading(f"{anon[2]}_{anon[4]}", bool(anon[1] or anon[3]), anon[4], anon[5], anon[6]),)
     stop = _NOT_WORD.search(name)
     end = len(name) if stop is None else stop.start()  # the name part holds word characters only
     found = []
     for match_ in _FIXED.finditer(name):
-        at = match_.start()
-        if at > end:
+        login = name[: match_.start()]
+        if match_.start() > end:
             break
-        login = name[:at]
-        if login != login.lower() or _padded(match_[2]) or _padded(match_[3]):
-            continue  # Canvas lower-cases the name, and writes its ids without leading zeros
-        found.append(Reading(login, bool(match_[1]), match_[2], match_[3], name[match_.end(3) + 1 :]))
+        if login == login.lower():  # Canvas lower-cases the name
+            found.append(Reading(login, bool(match_[1]), match_[2], match_[3], name[match_.end(3) + 1 :]))
     return tuple(found)
-
-
-def _padded(number):
-    return len(number) > 1 and number.startswith("0")
 
 
 def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
@@ -113,16 +96,14 @@ def resolve_canvas(names, roster_ids=()) -> tuple[dict, list[str]]:
     for found in readings.values():
         if len(found) == 1:
             settled.setdefault(found[0].uid, set()).add(found[0].prefix)
-    chosen: dict = {}
     notes: list[str] = []
-    for name, found in readings.items():
-        chosen[name] = found[0] if len(found) == 1 else _choose(name, found, settled, set(roster_ids), notes)
+    chosen = {name: _choose(name, found, settled, set(roster_ids), notes) for name, found in readings.items()}
     return chosen, notes
 
 
 def _choose(name, found, settled, roster, notes):
-    if not found:
-        return None
+    if len(found) < 2:
+        return found[0] if found else None
     shown = one_line(name, 120)
     left = [r for r in found if r.uid not in settled or r.prefix in settled[r.uid]]
     if len(left) > 1 and roster:
@@ -200,7 +181,7 @@ def _files(root, builder):
     files = {}
     for entry in entries(root):
         name = builder.name(entry)
-        if entry.is_file(follow_symlinks=False) and not entry.is_symlink() and canvas_readings(name):
+        if entry.is_file(follow_symlinks=False) and canvas_readings(name):
             files[name] = Path(entry.path)
         else:
             builder.notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
@@ -229,8 +210,7 @@ def _pieces(login, files, notes):
 
 @dataclass
 class CanvasGradebook:
-    """A Canvas gradebook export as read: its header, its rows (padded to the header), its CSV dialect, and the
-    index of ``Section``."""
+    """A Canvas gradebook export as read: its header, its rows padded to it, its CSV dialect, where ``Section`` is."""
 
     header: list
     rows: list
@@ -281,10 +261,10 @@ def read_canvas(path: str | os.PathLike) -> CanvasGradebook:
     return CanvasGradebook(header, body, delimiter, newline, bom, section)
 
 
-def assignment_columns(book: CanvasGradebook) -> list[str]:
-    """The headers of a gradebook's assignment columns: after ``Section``, neither a total nor read-only."""
+def _assignments_text(book):
+    """The gradebook's assignment columns (after ``Section``, neither a total nor read-only) in words."""
     points_row = book.points_row()
-    return [
+    names = [
         cell.strip()
         for i, cell in enumerate(book.header)
         if i > book.section
@@ -292,6 +272,11 @@ def assignment_columns(book: CanvasGradebook) -> list[str]:
         and TOTALS.search(cell) is None
         and not (points_row and "read only" in points_row[i].lower())
     ]
+    if not names:
+        return "it has no assignment column yet"
+    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
+    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
+    return f"its assignment columns are {shown}{more}"
 
 
 def _assignment_column(book, column, path):
@@ -305,16 +290,6 @@ def _assignment_column(book, column, path):
             f"{path} has {len(found)} assignment columns named {column!r} ({names}); e.g. --column {example}."
         )
     return found[0] if found else None
-
-
-def _assignments_text(book):
-    """The gradebook's assignment columns in words, for a message."""
-    names = assignment_columns(book)
-    if not names:
-        return "it has no assignment column yet"
-    shown = ", ".join(repr(one_line(name, 80)) for name in names[:MAX_LISTED])
-    more = f", and {len(names) - MAX_LISTED} more" if len(names) > MAX_LISTED else ""
-    return f"its assignment columns are {shown}{more}"
 
 
 def to_canvas(
@@ -400,13 +375,10 @@ def _target(book, export, path, full_credit, new_column):
     possible = points_row[target].strip() if points_row else ""
     if "read only" in possible.lower():
         raise InputError(f"the column {book.header[target]!r} of {path} is read-only in Canvas: give another --column.")
-    try:
-        differs = possible and float(possible.replace(",", ".")) != full_credit
-    except ValueError:
-        differs = False
-    if differs:
-        worth = f"is worth {possible} points in Canvas, {points_text(full_credit)} in the rubric"
-        export.notes.append(f"note: {book.header[target]!r} {worth}: the totals are written as they are.")
+    with suppress(ValueError):  # points Canvas does not write as a number are not compared
+        if possible and float(possible.replace(",", ".")) != full_credit:
+            worth = f"is worth {possible} points in Canvas, {points_text(full_credit)} in the rubric"
+            export.notes.append(f"note: {book.header[target]!r} {worth}: the totals are written as they are.")
     return target
 
 

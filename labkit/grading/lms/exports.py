@@ -1,9 +1,8 @@
 """Grades into the LMS: what every LMS's export shares (each LMS module writes its own file).
 
 An export writes the **total under the rubric** of each student the roster matches; an ungraded submission gets
-no number, never a zero. Every student who got nothing is listed (:meth:`Export.problems`) and in a summary CSV
-beside the output. Bad input writes nothing; the output never replaces an input, nor an existing file unless
-``force``, and is renamed into place when complete.
+no number, never a zero, and every student who got nothing is listed. Bad input writes nothing, and the output
+never replaces an input, nor an existing file unless ``force``.
 """
 
 from __future__ import annotations
@@ -20,7 +19,6 @@ from ..store.text import points_text
 from . import named
 
 DEFAULT_COLUMN = "labkit"
-SUMMARY_HEADER = ["submission", "id", "points", "status"]
 
 
 @dataclass
@@ -115,9 +113,8 @@ def start(grades, out, lms, column):
 def check_outputs(export, inputs, force):
     """ValueError when the export's files would replace an input, or an existing file without `force`."""
     for path in (export.path, export.summary_path):
-        for source in inputs:
-            if path.resolve() == Path(source).resolve():
-                raise InputError(f"{path} is an input of this export; it is never overwritten: give another --out.")
+        if any(path.resolve() == Path(source).resolve() for source in inputs):
+            raise InputError(f"{path} is an input of this export; it is never overwritten: give another --out.")
         if not path.parent.is_dir():
             raise InputError(f"the folder {path.parent} does not exist: create it, or give --out another path.")
         if path.exists() and not force:
@@ -163,7 +160,7 @@ def write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
 
 def write_summary(export, roster, by_name):
     """The summary beside the export: a row per submission, roster entry without one, and unmatched gradebook row."""
-    rows = [SUMMARY_HEADER]
+    rows = [["submission", "id", "points", "status"]]
     missing_in_lms = {name for name, _ in export.not_in_lms}
     for name, grade in by_name.items():
         status = []
@@ -175,8 +172,7 @@ def write_summary(export, roster, by_name):
             status.append(f"not in the {export.lms} gradebook")
         points = points_text(grade.total) if grade.graded else ""
         rows.append([csv_cell(name), csv_cell(roster.get(name, "")), points, csv_cell("; ".join(status) or "exported")])
-    for name, key in export.no_submission:
-        rows.append([csv_cell(name), csv_cell(key), "", "no submission (in the roster)"])
+    rows += [[csv_cell(name), csv_cell(key), "", "no submission (in the roster)"] for name, key in export.no_submission]
     for name, key in export.lms_only:
         status = f"in the {export.lms} gradebook ({one_line(name, 80)}), not in the roster"
         rows.append(["", csv_cell(key), "", csv_cell(status)])

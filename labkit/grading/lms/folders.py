@@ -38,7 +38,7 @@ class Folders(Lms):
             if entry.is_symlink():  # a student all the same, with nothing labkit will read: never a silent gap
                 students.append(Student(name, None, "is a link, and links are never followed", "folders"))
             elif entry.is_dir(follow_symlinks=False):
-                students.append(builder.from_folder(name, Path(entry.path), "folders", key=("folders", name)))
+                students.append(builder.from_folder(name, Path(entry.path), "folders"))
             elif entry.is_file(follow_symlinks=False) and name.endswith(".ipynb"):
                 student = Student(name[: -len(".ipynb")], Path(entry.path), None, "folders")
                 students.append(builder.refusal(student, ("folders", name)) or student)
@@ -48,7 +48,7 @@ class Folders(Lms):
 
     def feedback_names(self, name, entry):
         """``{submission}/feedback.html`` (a name that is no plain folder name, hashed)."""
-        plain = name not in (".", "..") and not re.search(r"[/\\\x00]", name) and not name.startswith(".")
+        plain = not re.search(r"[/\\\x00]", name) and not name.startswith(".")
         return [f"{name if plain else file_stem(name)}/{PAGE}"]
 
 

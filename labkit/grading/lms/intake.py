@@ -1,9 +1,8 @@
 """The class as the LMS hands it over: one folder or one zip becomes a list of students.
 
-Only the grader's `workspace` is written, and no link is followed. Which LMS a download is comes from the names at
-its top (:func:`detect`). A class zip's members are sorted out by student before anything is written, and each
-student's are unpacked on their own budget (:class:`~.unzip.UnpackLimits`, over all their files and zips): a
-member that breaks a rule leaves its student ungraded, never the class. A student's name is data, never a path.
+Only the grader's `workspace` is written, no link is followed, and a student's name is data, never a path. A class
+zip is sorted out by student before anything is written, each student on their own budget: a member that breaks a
+rule leaves its student ungraded, never the class.
 """
 
 from __future__ import annotations
@@ -78,12 +77,10 @@ def walk(folder, notes=None):
             seen += 1
             if seen > MAX_FILES:
                 raise InputError(f"{_shown(folder)} holds more than {MAX_FILES} files; a submission is a few.")
-            if entry.is_symlink():
-                if notes is not None:
-                    notes.append(f"ignored {one_line(as_text(entry.path))}: a link (links are never followed)")
-            elif entry.is_dir(follow_symlinks=False):
-                if depth < MAX_DEPTH:
-                    todo.append((Path(entry.path), depth + 1))
+            if entry.is_symlink() and notes is not None:  # (a link is neither a folder nor a file below)
+                notes.append(f"ignored {one_line(as_text(entry.path))}: a link (links are never followed)")
+            elif entry.is_dir(follow_symlinks=False) and depth < MAX_DEPTH:
+                todo.append((Path(entry.path), depth + 1))
             elif entry.is_file(follow_symlinks=False):
                 found.append(Path(entry.path))
     return sorted(found)
@@ -110,7 +107,7 @@ class Builder:
     """Turns one student's files (a folder, loose files, zips) into a Student, writing only in the workspace;
     an LMS's ``students`` reads its download with it, and tells the instructor in ``notes``."""
 
-    def __init__(self, workspace, limits, notes, zip_depth):
+    def __init__(self, workspace, limits, notes, zip_depth, roster_ids=()):
         self.workspace = workspace
         self.limits = limits
         self.notes = notes
@@ -118,7 +115,7 @@ class Builder:
         self.budgets: dict = {}  # a student's key -> the Budget all their zips share (the class zip's included)
         self.refused: dict = {}  # a student's key -> why the class zip's members of theirs were not extracted
         self.aliases: dict = {}  # a name written in the workspace -> the class zip's own (too long to write)
-        self.roster_ids: tuple = ()  # the roster's ids, which settle whose a file is when its name reads two ways
+        self.roster_ids = roster_ids  # the roster's ids, which settle whose a file is when its name reads two ways
         self.noted = False  # the class zip's owners() said already how each name was read
 
     def budget(self, key):
@@ -147,27 +144,23 @@ class Builder:
             files = walk(folder, self.notes)
         except ValueError as exc:
             return dataclasses.replace(who, failure=f"{exc} {FIX}")
-        relative = [f.relative_to(folder).as_posix() for f in files]
-        zips = [(f.relative_to(folder), f) for f in files if f.suffix.lower() == ".zip"]
-        if not zips:
-            if not any(f.suffix == ".ipynb" for f in files):
-                return dataclasses.replace(who, failure=_no_notebook(as_text(r) for r in relative))
-            return dataclasses.replace(who, path=Path(folder))
-        pieces = [(f.relative_to(folder), f) for f in files if f.suffix == ".ipynb" or f.name in keep]
-        return self._assemble(who, (pieces, zips, relative), key)
+        pieces = [(f.relative_to(folder), f) for f in files]
+        if any(f.suffix.lower() == ".zip" for f in files):
+            return self._assemble(who, key, pieces, [r.as_posix() for r, _ in pieces], keep)
+        if not any(f.suffix == ".ipynb" for f in files):
+            return dataclasses.replace(who, failure=_no_notebook(as_text(r.as_posix()) for r, _ in pieces))
+        return dataclasses.replace(who, path=Path(folder))
 
     def from_files(self, name, pieces, layout, lms_id=None, late=False, key=None):
         """A student given as loose files: `pieces` pairs the name to give each with its path."""
         who, key = Student(name, None, None, layout, lms_id, late), key or (layout, name)
-        if refused := self.refusal(who, key):
-            return refused
-        zips = [(relative, path) for relative, path in pieces if path.suffix.lower() == ".zip"]
         shown = [as_text(relative.as_posix()) for relative, _ in pieces]
-        gradable = [(relative, path) for relative, path in pieces if path.suffix == ".ipynb"]
-        return self._assemble(who, (gradable, zips, shown), key)
+        return self.refusal(who, key) or self._assemble(who, key, pieces, shown)
 
-    def _assemble(self, who, given, key):
-        pieces, zips, shown = given
+    def _assemble(self, who, key, given, shown, keep=()):
+        """`who` with their notebooks (and files named in `keep`) copied and their zips unpacked in the workspace."""
+        zips = [(relative, path) for relative, path in given if path.suffix.lower() == ".zip"]
+        pieces = [(relative, path) for relative, path in given if path.suffix == ".ipynb" or path.name in keep]
         if not pieces and not zips:
             return dataclasses.replace(who, failure=_no_notebook(shown))
         target = free(self.workspace / "students" / safe_name(who.name))
@@ -293,8 +286,13 @@ def _class_zip(path, root, builder):
         plans = {key: _student_plan(key, items, builder, label, len(prefix)) for key, items in groups.items()}
         _check_space(lms, plans, root, label)
         for key, plan in plans.items():
-            if plan is not None:
-                _extract_student(archive, key, plan, root, builder, label)
+            written, made = [], []
+            try:
+                if plan is not None:
+                    unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
+            except ValueError as exc:
+                unzip.undo(written, made)  # a refused student's members are removed again
+                builder.refused[key] = f"{exc} {FIX}"
             _placeholder(root, key, groups[key], lms.depth, builder)
     return lms
 
@@ -337,8 +335,7 @@ def _by_owner(lms, members, tops, builder):
             groups.setdefault(key, []).append((info, parts))
         elif parts[0] not in owners:  # (a name in owners without a student has its note already)
             ignored.add(parts[0])
-    for name in sorted(ignored):
-        builder.notes.append(f"ignored {one_line(name)}: not a student's, in {lms.name}'s layout")
+    builder.notes += [f"ignored {one_line(name)}: not a student's, in {lms.name}'s layout" for name in sorted(ignored)]
     return groups
 
 
@@ -346,16 +343,9 @@ def _student_plan(key, items, builder, label, skip):
     """The checked members of one student, or None when one breaks a limit (``builder.refused[key]`` says why)."""
     budget = builder.budget(key)
     budget.in_class = True
-    parts_of = {id(info): parts for info, parts in items}
-
-    def checked_parts(info):
-        unzip.member_parts(info.filename, label, skip + 1)  # refuses what leaves the folder, and too long a name
-        parts = parts_of[id(info)]
-        return [builder.on_disk(parts[0]), *parts[1:]]
-
-    try:
-        unzip.count_members(budget, len(items), label)
-        return unzip.checked([info for info, _ in items], budget, label, checked_parts)
+    on_disk = [(info, [builder.on_disk(parts[0]), *parts[1:]]) for info, parts in items]
+    try:  # a name at the top too long to write has a short one on disk, so its length is not refused
+        return unzip.checked(on_disk, budget, label, skip + 1)
     except ValueError as exc:
         builder.refused[key] = f"{exc} {FIX}"
         return None
@@ -376,16 +366,6 @@ def _check_space(lms, plans, root, label):
         f"{label} unpacks to {size_text(sum(sizes.values()))}, only {size_text(free_bytes)} is free in {root} (with "
         f"{size_text(SPARE)} spare); the largest students are {shown}. Free some space, or grade those apart."
     )
-
-
-def _extract_student(archive, key, plan, root, builder, label):
-    """Write one student's checked members under `root` on their budget; on a refusal remove them again."""
-    written, made = [], []
-    try:
-        unzip.write_plan(archive, plan, root, builder.budget(key), label, (written, made))
-    except ValueError as exc:
-        unzip.undo(None, written, made)
-        builder.refused[key] = f"{exc} {FIX}"
 
 
 def _placeholder(root, key, items, depth, builder):
@@ -411,12 +391,10 @@ def find_class(
     roster: dict[str, str] | None = None,
 ) -> Intake:
     """The students of the class in `path` (a folder or zip of one LMS), in name order; one that cannot be graded
-    has ``path=None`` and the reason in ``failure``, and never stops the others.
-
-    Everything is written in `workspace` (the caller's, not inside `path`). `assignment` is nbgrader's to take;
-    `limits` what one student's files and zips may hold in all; `roster` ({submission: LMS id}) names a student
-    whose LMS id it has. ValueError when the layout is unclear, two students share a name, or the zip has no room.
-    """
+    has ``path=None`` and the reason in ``failure``, and never stops the others. Everything is written in
+    `workspace`, never inside `path`. `assignment` is nbgrader's to take; `roster` ({submission: LMS id}) names
+    a student whose LMS id it has. ValueError when the layout is unclear, two students share a name, or the zip
+    has no room."""
     path, workspace = Path(path), Path(workspace)
     try:
         info = os.lstat(path)
@@ -428,17 +406,15 @@ def find_class(
         raise InputError(f"the workspace {_shown(workspace)} is inside the class folder: give a workspace elsewhere.")
     workspace.mkdir(parents=True, exist_ok=True)
     own = Path(tempfile.mkdtemp(prefix="intake-", dir=workspace))
-    notes: list[str] = []
-    builder = Builder(own, limits, notes, 1 if stat.S_ISREG(info.st_mode) else 0)
-    builder.roster_ids = tuple(roster.values()) if roster else ()
+    builder = Builder(own, limits, [], 1 if stat.S_ISREG(info.st_mode) else 0, tuple(roster.values()) if roster else ())
     root, lms = _class_root(path, info, own, builder)
     students = lms.students(root, builder, assignment)
     if assignment is not None and not lms.assignments:
-        notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
-    students = _by_roster(students, roster, notes) if roster else students
+        builder.notes.append(f"--assignment {one_line(assignment, 60)} ignored: only nbgrader's layout has assignments")
+    students = _by_roster(students, roster, builder.notes) if roster else students
     _one_name_each(students)
     students.sort(key=lambda s: (s.name.casefold(), s.name))
-    return Intake(students, lms.name, notes)
+    return Intake(students, lms.name, builder.notes)
 
 
 def _class_root(path, info, own, builder):

@@ -1,13 +1,10 @@
 """Moodle: its "Download all submissions", a file for its "Import grades from CSV", its feedback files zip.
 
 The download (``mod/assign``'s ``download_submissions``) names a folder ``{Full Name}_{id}_assignsubmission_
-{plugin}_`` per plugin, or files ``{Full Name}_{id}_assignsubmission_{plugin}_{file}`` (``_`` in the name made a
-space, the id the participant id). The student is ``{Full Name}_{id}``, so namesakes stay apart.
-
-The grade import (``grade/import/csv/classes/load_data.php``) maps the id column to "ID number" or "Email
-address" (``--key``); a user Moodle cannot find stops the whole import, and an empty cell would erase a grade, so
-ids must fit the key and only graded students are written. ``--feedback`` adds the points in words and the
-feedback text. The feedback zip: ``{full name}_{id}_assignfeedback_file_/feedback.html``.
+{plugin}_`` per plugin, or files ``…_assignsubmission_{plugin}_{file}`` (``_`` in the name made a space, the id
+the participant id); the student ``{Full Name}_{id}`` keeps namesakes apart. The grade import
+(``grade/import/csv/classes/load_data.php``) stops at a user it cannot find, and an empty cell would erase a
+grade, so ids must fit ``--key`` and only graded students are written.
 """
 
 from __future__ import annotations
@@ -28,8 +25,8 @@ from .roster import read_roster
 KEYS = {"idnumber": "ID number", "email": "Email address"}
 EMAIL = re.compile(r"[^@\s]+@[^@\s]+\.[^@\s]+")  # what looks like an email address, for --key
 MAX_FEEDBACK = 30_000  # characters of a feedback cell (the student's feedback text, bounded)
-FOLDER = re.compile(r"^(?P<name>[^_]+)_(?P<pid>[0-9]+)_assignsubmission_(?P<plugin>[a-z0-9]+)_$", re.DOTALL)
-FILE = re.compile(r"^(?P<name>[^_]+)_(?P<pid>[0-9]+)_assignsubmission_(?P<plugin>[a-z0-9]+)_(?P<file>.+)$", re.DOTALL)
+# a folder per plugin (``file`` empty), or a file
+NAME = re.compile(r"^(?P<name>[^_]+)_(?P<pid>[0-9]+)_assignsubmission_(?P<plugin>[a-z0-9]+)_(?P<file>.*)$", re.DOTALL)
 
 
 class Moodle(Lms):
@@ -53,9 +50,9 @@ class Moodle(Lms):
             name = builder.name(entry)
             if entry.is_symlink():
                 builder.notes.append(f"ignored {one_line(name)}: a link (links are never followed)")
-            elif entry.is_dir(follow_symlinks=False) and (found := FOLDER.match(name)):
+            elif entry.is_dir(follow_symlinks=False) and (found := _match(name, "dir")):
                 folders.setdefault((found["name"], found["pid"]), []).append(Path(entry.path))
-            elif entry.is_file(follow_symlinks=False) and (found := FILE.match(name)):
+            elif entry.is_file(follow_symlinks=False) and (found := _match(name, "file")):
                 loose.setdefault((found["name"], found["pid"]), []).append((found["file"], Path(entry.path)))
             else:
                 builder.notes.append(f"ignored {one_line(name)}: not named as Moodle names a submission")
@@ -71,13 +68,12 @@ class Moodle(Lms):
         return [f"{full}_{pid}_assignfeedback_file_/feedback.html"]
 
     def export(self, grades, roster, out, **options):
-        """:func:`to_moodle`."""
         return to_moodle(grades, roster, out, **options)
 
 
 def _match(name, kind):
-    pattern = {"dir": FOLDER, "file": FILE}.get(kind)
-    return None if pattern is None else pattern.match(name)
+    found = NAME.match(name)
+    return found if found and kind == ("file" if found["file"] else "dir") else None
 
 
 def _student(key, folders, loose, builder):
@@ -136,8 +132,7 @@ def to_moodle(
 
 
 def _check_ids(entries_, roster, key):
-    """Refuse ids Moodle would not find under `key` (not emails under ``email``, emails under ``idnumber``) and
-    ids that start like a formula."""
+    """Refuse ids Moodle would not find under `key`, and ids that start like a formula."""
     for name, value in entries_.items():
         gives = f"the roster {roster} gives {one_line(name, 60)!r} the id {one_line(value, 60)!r}"
         if key == "email" and not EMAIL.fullmatch(value):

@@ -35,7 +35,6 @@ class Nbgrader(Lms):
         found = entries(root)
         return (
             os.path.basename(os.path.normpath(root)) == "submitted"
-            and bool(found)
             and all(e.is_dir(follow_symlinks=False) for e in found)
             and any(any(i.is_dir(follow_symlinks=False) for i in entries(e.path)) for e in found)
         )
@@ -50,8 +49,7 @@ class Nbgrader(Lms):
         students, missing = [], []
         for name, per in found.items():
             if assignment in per:
-                key = ("nbgrader", name)
-                students.append(builder.from_folder(name, per[assignment], "nbgrader", keep=FILES[:1], key=key))
+                students.append(builder.from_folder(name, per[assignment], "nbgrader", keep=FILES[:1]))
             else:
                 missing.append(name)
         if missing:
@@ -92,12 +90,12 @@ def _assignments(submitted, notes):
     found: dict = {}
     for entry in entries(submitted):
         name = as_text(entry.name)
-        if entry.is_symlink() or not entry.is_dir(follow_symlinks=False):
+        if not entry.is_dir(follow_symlinks=False):  # a link is no folder here
             notes.append(f"ignored {one_line(name)} in submitted/: not a student's folder")
             continue
         found[name] = {}
         for inner in entries(entry.path):
-            if inner.is_dir(follow_symlinks=False) and not inner.is_symlink():
+            if inner.is_dir(follow_symlinks=False):
                 found[name][as_text(inner.name)] = Path(inner.path)
             else:
                 notes.append(f"ignored {one_line(name)}/{one_line(as_text(inner.name))}: not an assignment's folder")

@@ -6,7 +6,6 @@ from __future__ import annotations
 import copy
 import os
 import re
-import shutil
 import stat
 import zipfile
 import zlib
@@ -20,7 +19,6 @@ from ..store.report import one_line
 MAX_NAME = 255  # bytes of one file or folder name in a zip (what file systems take)
 RATIO_FLOOR = 1 << 20  # the compression ratio is checked for members that grow past this many bytes
 CHUNK = 1 << 16
-UNREADABLE = (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError)
 
 
 @dataclass(frozen=True)
@@ -71,29 +69,21 @@ def unpack(
     labkit.errors.InputError: work.zip: member '../evil.ipynb' leaves the folder; labkit never extracts it.
     """
     into = Path(into)
-    created_root = None if os.path.lexists(into) else into
-    while created_root is not None and not os.path.lexists(created_root.parent):
-        created_root = created_root.parent  # the first folder this call creates, removed again on failure
+    made = [p for p in (*reversed(into.parents), into) if not os.path.lexists(p)]  # what this call creates
     written: list[Path] = []
-    made: list[Path] = []
     try:
-        if created_root is not None:
-            into.mkdir(parents=True)
-        elif not stat.S_ISDIR(os.lstat(into).st_mode):
+        if not made and not stat.S_ISDIR(os.lstat(into).st_mode):
             raise InputError(f"{into} is not a folder to unpack into.")
-        budget = budget if budget is not None else Budget(limits)
-        _unpack(Path(zip_path), into, budget, depth, written, made, as_text(Path(zip_path).name))
+        into.mkdir(parents=True, exist_ok=True)
+        _unpack(Path(zip_path), into, budget or Budget(limits), depth, written, made, as_text(Path(zip_path).name))
     except BaseException:
-        undo(created_root, written, made)
+        undo(written, made)
         raise
     return sorted(p for p in written if os.path.lexists(p))
 
 
-def undo(root, written, made):
-    """Remove what a refused unzip wrote: the folder `root` it created, else its files and folders."""
-    if root is not None:
-        shutil.rmtree(root, ignore_errors=True)
-        return
+def undo(written, made):
+    """Remove what a refused unzip wrote: its files, then its folders."""
     for remove, paths in ((os.unlink, written), (os.rmdir, made)):
         for path in reversed(paths):
             with suppress(OSError):
@@ -104,7 +94,7 @@ def open_zip(path, label):
     """The zip `path`, opened; ValueError naming `label` when it is none labkit can read."""
     try:
         return zipfile.ZipFile(path)
-    except UNREADABLE as exc:
+    except (zipfile.BadZipFile, OSError, UnicodeDecodeError, ValueError, EOFError) as exc:
         raise InputError(f"{label}: not a zip labkit can read ({one_line(exc, 120)}).") from None
 
 
@@ -129,14 +119,6 @@ def member_parts(name, label, skip=0):
     return parts
 
 
-def count_members(budget, count, label):
-    """Add `count` members to `budget`; ValueError when the student now has too many."""
-    budget.members += count
-    if budget.members > budget.limits.max_members:
-        most = budget.limits.max_members
-        raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
-
-
 def _over_total(label, limits, when=""):
     most = size_text(limits.max_total)
     return InputError(f"{label}: more than {most} uncompressed{when}; labkit extracts at most {most} for one student.")
@@ -147,8 +129,7 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
     if depth > limits.max_depth:
         raise InputError(f"{label}: a zip nested more than {limits.max_depth} deep; labkit never extracts deeper.")
     with open_zip(zip_path, label) as archive:
-        count_members(budget, len(archive.infolist()), label)
-        plan = checked(archive.infolist(), budget, label)
+        plan = checked([(info, None) for info in archive.infolist()], budget, label)
         inner = write_plan(archive, plan, into, budget, label, (written, made))
     for target, shown in inner:
         if depth + 1 > limits.max_depth:
@@ -161,11 +142,17 @@ def _unpack(zip_path, into, budget, depth, written, made, label):
         written.remove(target)
 
 
-def checked(infos, budget, label, parts_of=None):
-    """[(info, parts, is_dir, shown)] of the members `infos`, once their names and declared sizes fit `budget`."""
+def checked(members, budget, label, skip=0):
+    """[(info, parts, is_dir, shown)] of `members` ([(info, the parts to write it under, or None for its name's)]),
+    once their number, names (past `skip` parts) and declared sizes fit `budget` (their number counted in it)."""
+    budget.members += len(members)
+    if budget.members > budget.limits.max_members:
+        most = budget.limits.max_members
+        raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
     plan, seen, declared = [], set(), 0
-    for info in infos:
-        parts = member_parts(info.filename, label) if parts_of is None else parts_of(info)
+    for info, given in members:
+        parts = member_parts(info.filename, label, skip)  # refuses what leaves the folder, and too long a name
+        parts = parts if given is None else given
         is_dir = _member_kind(info, label)
         if not parts or parts[0] == "__MACOSX":
             continue
