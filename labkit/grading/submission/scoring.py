@@ -31,7 +31,7 @@ from ..sandbox import backends, remote, timings
 from ..store import rubric as rubrics
 from ..store.model import ExerciseResult
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
-from . import holding, known, refusals, scan
+from . import known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -289,25 +289,87 @@ def judge_known(check, part, code, registry, options):
     """A part's check, held for a person when it passed and its code (`code`: the cells) is mostly known code."""
     if not check["passed"] or part.refused is None:
         return check
+    # a graded function another part judges (the driver's interpolant) is judged there, once
+    return _judge_reached(check, code, part.scanned, registry, options, own=part.scanned)
+
+
+def judge_plain(check, part, code, registry, options):
+    """A passed part without a refusal (a plot, a table), held when the code that draws it (graded functions
+    aside, each judged in its own part) is mostly known code."""
+    if not check["passed"]:
+        return check
     try:
-        reached = scan.reached_sources(code, part.scanned)
+        drawn = scan.drawn_with(code, [n for n in part.names() if n.isidentifier()])
+    except scan.Unreadable:
+        return check
+    return _judge_reached(check, code, sorted(drawn), registry, options)
+
+
+def _judge_reached(check, code, names, registry, options, own=()):
+    """`check`, held when the definitions `names` reach (graded names but `own` aside) are mostly known code."""
+    try:
+        reached = scan.reached_sources(code, names)
     except scan.Unreadable:
         return check  # the refusal scan read the same cells in time: not reached here
-    # a graded function another part judges (the driver's interpolant) is judged there, once
-    reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
-    return _judge_reached(check, reached, registry, options)
-
-
-def _judge_reached(check, reached, registry, options):
-    """`check`, held when the definitions `reached` ([(name, source)]) are mostly known code."""
+    graded = registry_graded(registry)
+    reached = [(n, t) for n, t in reached if n in own or n not in graded]
     found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
     return check if found is None else _held(check, found)
 
 
-def judge_plain(check, part, code, registry, options):
-    """A part without a refusal (a plot, a table), held when the code that draws it is mostly known code."""
-    judge = lambda check, reached: _judge_reached(check, reached, registry, options)
-    return holding.judge_plain(check, part, code, registry_graded(registry), judge)
+def hold_dependents(results, registry, code):
+    """Hold, in `results` ({exercise: verdict}), every passed part whose code reaches a held definition, and
+    fail those reaching a graded name a string run as code may have defined: copied code earns nothing through
+    what it draws."""
+    held = {}  # name: its held match, for the held parts' graded names and the copies
+    for number, verdict in results.items():
+        for part, check in zip(registry.exercises[number].parts, verdict["checks"]):
+            if check.get("held") and check.get("passed"):
+                for name in (*part.scanned, check["held"].get("definition", "")):
+                    held.setdefault(name, check["held"])
+    try:
+        strung = {name: why for name, _, why in scan.run_strings(code, sorted(registry_graded(registry)))}
+    except scan.Unreadable:
+        strung = {}
+    if not held and not strung:
+        return results
+    for number, verdict in results.items():
+        parts = registry.exercises[number].parts
+        for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
+            if not check.get("passed") or check.get("held"):
+                continue
+            readable = [n for n in (*part.names(), *part.scanned) if n.isidentifier()]
+            try:
+                names = set(part.uses) | scan.drawn_with(code, readable)
+            except scan.Unreadable:
+                names = set(part.uses)
+            names -= set(part.scanned)
+            on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
+            if on_held:
+                verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
+            elif on_string:
+                verdict["checks"][index] = _refused_with(check, on_string[0], strung[on_string[0]])
+        _rescore(verdict, registry)
+    return results
+
+
+def _held_with(check, name, held):
+    detail = (
+        f"it is built on {name}, held for your instructor to look at: its code is mostly {held.get('source', '?')}'s"
+    )
+    hint = (
+        f"this part waits with {name}, which it is built on; write {name} in your own way to be paid without waiting."
+    )
+    return _with_step(check, _step(HELD_STEP, detail), hint, held={**held, "through": name})
+
+
+def _refused_with(check, name, why, step="is built on the student's own code"):
+    """The part's check, failed: it is built on `name`, which a string run as code may have defined (`why`)."""
+    hint = (
+        f"define {name} with def in a code cell, after any exec, eval or compile of a string, so that the grader "
+        "can read it; code run from a string is never graded."
+    )
+    return _with_step(check, _step(step, why, REFUSED), hint, passed=False)
 
 
 def registry_graded(registry):
@@ -419,8 +481,7 @@ def _grade_in(graded, numbers, variant):
     for number in numbers:
         mine = None if variant is None else variant.get(str(number), {})
         results[number] = _check_exercise(graded, number, mine, problems)
-    # copied code earns nothing through what it draws
-    holding.hold_dependents(results, graded.registry, code, registry_graded(graded.registry), _rescore)
+    hold_dependents(results, graded.registry, code)
     if notebook.stopped:
         text = f"{name}: {notebook.stopped} while its functions were being checked."
         problems.append(ProblemText.one(text, notebook.stopped_kind))
@@ -469,7 +530,8 @@ def _judge_code(verdict, exercise, code, profiles, registry, options):
         if findings:
             verdict["checks"][index] = _own_code(check, findings)
         elif strung:
-            verdict["checks"][index] = holding.run_from_a_string(check, strung)
+            name, _, why = strung[0]
+            verdict["checks"][index] = _refused_with(check, name, why, step="its code can be read")
         else:
             verdict["checks"][index] = judge_known(check, part, code, registry, options)
 
