@@ -12,13 +12,13 @@ import functools
 import hashlib
 import json
 import os
-import tempfile
 from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..store.record import replace_text
 from . import fingerprint
 from .fingerprint import canonical, normalise
 
@@ -83,10 +83,7 @@ def _cached(name, raw, compute):
     data = compute()
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        handle, partial = tempfile.mkstemp(dir=folder, suffix=".partial")
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            json.dump(data, stream)
-        os.replace(partial, path)
+        replace_text(path, json.dumps(data))
     except OSError:
         pass  # a cache that cannot be written only costs time
     return data, key

@@ -13,6 +13,7 @@ import re
 import sys
 import time
 
+from ..sandbox.guard import _within
 from ..store.text import MAX_SOURCE_CHARS
 
 MAX_CODE_BYTES = 512 * 1024  # a lab notebook's code is a few tens of kilobytes
@@ -287,10 +288,6 @@ def _getattr_call(node):
         and node.func.id == "getattr"
         and len(node.args) >= 2
     )
-
-
-def _within(dotted, prefixes):
-    return next((p for p in prefixes if dotted == p or dotted.startswith(p + ".")), None)
 
 
 class _Refused:

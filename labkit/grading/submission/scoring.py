@@ -30,6 +30,7 @@ from ..options import GradeOptions
 from ..sandbox import backends, remote, timings
 from ..store import rubric as rubrics
 from ..store.model import ExerciseResult
+from ..store.record import replace_text
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
 from . import known, refusals, scan
 
@@ -599,11 +600,8 @@ def main(argv=None):
     options = GradeOptions.from_dict(spec["options"])  # the run's options, read once at this process's edge
     timings.reset()
     grade = grade_submission(spec["submission"], options=options, profiles=profiles, name=spec["name"])
-    result = Path(spec["result"])
-    partial = result.with_suffix(".partial")
-    partial.write_text(json.dumps(grade.as_dict()), encoding="utf-8")
-    os.replace(partial, result)
-    timings.write_beside(result)  # where the time went, for the run's folder (never the student's feedback)
+    replace_text(Path(spec["result"]), json.dumps(grade.as_dict()))
+    timings.write_beside(spec["result"])  # where the time went, for the run's folder (never the student's feedback)
     return 0
 
 
