@@ -21,6 +21,7 @@ import numpy as np
 from ..store.record import replace_text
 from . import fingerprint
 from .fingerprint import canonical, normalise
+from .scan import python_source
 
 # measured on copies, independent solutions and honest variants (docs/grading-security.md):
 # honest work shares at most 46 fingerprints; the copies tried, 98 or more
@@ -68,8 +69,10 @@ def _definitions(text, prefix, source=None):
     return found
 
 
-def _cached(name, raw, compute):
-    """``(compute(), key)``: JSON data cached under `key`, the SHA-256 of `raw`, `name` and the versions."""
+def _cached(name, raw, definitions, with_text):
+    """``(data, key)``: the units of `definitions()` ([name, first line, last line, text] each; the text kept
+    `with_text`) and each one's distinct fingerprints, JSON data cached under `key`, the SHA-256 of `raw`, `name`
+    and the versions."""
     import pygments
 
     key = hashlib.sha256(f"{VERSION} pygments {pygments.__version__}\0{name}\0".encode() + raw).hexdigest()
@@ -80,7 +83,13 @@ def _cached(name, raw, compute):
         return json.loads(path.read_text(encoding="utf-8")), key
     except (OSError, ValueError):
         pass
-    data = compute()
+    found = definitions()
+    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(unit[3]))[0])[0]).tolist() for unit in found]
+    data = {
+        "units": found if with_text else [unit[:3] for unit in found],
+        "hashes": [h for each in hashes for h in each],
+        "unit_of": [index for index, each in enumerate(hashes) for _ in each],
+    }
     try:
         folder.mkdir(parents=True, exist_ok=True)
         replace_text(path, json.dumps(data))
@@ -89,34 +98,19 @@ def _cached(name, raw, compute):
     return data, key
 
 
-def _entry(units, texts):
-    """JSON data: the `units`, and the distinct fingerprints of each one's text (`texts`) with its index."""
-    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(text))[0])[0]).tolist() for text in texts]
-    unit_of = [index for index, found in enumerate(hashes) for _ in found]
-    return {"units": units, "hashes": [h for found in hashes for h in found], "unit_of": unit_of}
-
-
 def _module_entry(module, path):
     """The units (their text left out) and fingerprints of one Python source file, cached."""
     raw = Path(path).read_bytes()
-
-    def compute():
-        found = _definitions(raw.decode("utf-8", "replace"), f"{module}.", raw)
-        return _entry([unit[:3] for unit in found], [unit[3] for unit in found])
-
-    return _cached(module, raw, compute)
+    return _cached(module, raw, lambda: _definitions(raw.decode("utf-8", "replace"), f"{module}.", raw), False)
 
 
 def _notebook_entry(name, cells):
     """The units and fingerprints of one instructor notebook's code cells, as the grader reads them, cached."""
 
-    def compute():
-        from .scan import python_source
+    def definitions():
+        return [unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")]
 
-        units = [unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")]
-        return _entry(units, [unit[3] for unit in units])
-
-    return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), compute)
+    return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), definitions, True)
 
 
 @functools.lru_cache(maxsize=4)
