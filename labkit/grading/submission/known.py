@@ -69,10 +69,8 @@ def _definitions(text, prefix, source=None):
     return found
 
 
-def _cached(name, raw, definitions, with_text):
-    """``(data, key)``: the units of `definitions()` ([name, first line, last line, text] each; the text kept
-    `with_text`) and each one's distinct fingerprints, JSON data cached under `key`, the SHA-256 of `raw`, `name`
-    and the versions."""
+def _cached(name, raw, compute):
+    """``(compute(), key)``: JSON data cached under `key`, the SHA-256 of `raw`, `name` and the versions."""
     import pygments
 
     key = hashlib.sha256(f"{VERSION} pygments {pygments.__version__}\0{name}\0".encode() + raw).hexdigest()
@@ -83,13 +81,7 @@ def _cached(name, raw, definitions, with_text):
         return json.loads(path.read_text(encoding="utf-8")), key
     except (OSError, ValueError):
         pass
-    found = definitions()
-    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(unit[3]))[0])[0]).tolist() for unit in found]
-    data = {
-        "units": found if with_text else [unit[:3] for unit in found],
-        "hashes": [h for each in hashes for h in each],
-        "unit_of": [index for index, each in enumerate(hashes) for _ in each],
-    }
+    data = compute()
     try:
         folder.mkdir(parents=True, exist_ok=True)
         replace_text(path, json.dumps(data))
@@ -98,19 +90,28 @@ def _cached(name, raw, definitions, with_text):
     return data, key
 
 
+def _entry(found, with_text):
+    """JSON data: the units `found` ([name, first line, last line, text] each; the text kept `with_text`), and the
+    distinct fingerprints of each one's text with its index."""
+    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(unit[3]))[0])[0]).tolist() for unit in found]
+    unit_of = [index for index, each in enumerate(hashes) for _ in each]
+    units = found if with_text else [unit[:3] for unit in found]
+    return {"units": units, "hashes": [h for each in hashes for h in each], "unit_of": unit_of}
+
+
 def _module_entry(module, path):
     """The units (their text left out) and fingerprints of one Python source file, cached."""
     raw = Path(path).read_bytes()
-    return _cached(module, raw, lambda: _definitions(raw.decode("utf-8", "replace"), f"{module}.", raw), False)
+    return _cached(module, raw, lambda: _entry(_definitions(raw.decode("utf-8", "replace"), f"{module}.", raw), False))
 
 
 def _notebook_entry(name, cells):
     """The units and fingerprints of one instructor notebook's code cells, as the grader reads them, cached."""
 
-    def definitions():
-        return [unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")]
+    def compute():
+        return _entry([unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")], True)
 
-    return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), definitions, True)
+    return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), compute)
 
 
 @functools.lru_cache(maxsize=4)
