@@ -1,5 +1,2 @@
-"""One submission's grading process: reading its notebooks, the source scan, the refusals, scoring.
-
-Runs in one process per submission, started by :mod:`labkit.grading.run.processes`; student code runs in the
-sandbox it opens (:mod:`labkit.grading.sandbox`), never here.
-"""
+"""One submission's grading process (started by :mod:`labkit.grading.run.processes`): reading its notebooks, the
+source scan, the refusals, scoring; student code runs in the sandbox it opens, never here."""

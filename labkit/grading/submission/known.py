@@ -194,12 +194,8 @@ def _read(text, given):
 def _side_by_side(text, numbers, unit):
     """Up to :data:`SHOWN` pairs (student's line `numbers` of `text`, the next known line of the same shape)."""
     try:
-        if unit.text is None:
-            theirs = (
-                Path(unit.path).read_text(encoding="utf-8", errors="replace").split("\n")[unit.first - 1 : unit.last]
-            )
-        else:
-            theirs = unit.text.split("\n")
+        whole = Path(unit.path).read_text(encoding="utf-8", errors="replace") if unit.text is None else None
+        theirs = unit.text.split("\n") if whole is None else whole.split("\n")[unit.first - 1 : unit.last]
     except (OSError, IndexError, ValueError):
         theirs = [""]
     mine, their_normal = text.split("\n"), [normalise(line)[0] for line in theirs]

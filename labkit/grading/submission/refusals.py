@@ -26,21 +26,17 @@ def _module_files(prefix):
     try:
         spec = importlib.util.find_spec(prefix)
     except (ImportError, ValueError):
-        return []
-    if spec is None:
-        return []
-    if spec.submodule_search_locations:
+        spec = None
+    if spec is not None and spec.submodule_search_locations:
         found = []
         for location in spec.submodule_search_locations:
             for path in sorted(Path(location).rglob("*.py")):
                 parts = path.relative_to(location).with_suffix("").parts
-                if "tests" in parts:
-                    continue
-                if parts[-1] == "__init__":
-                    parts = parts[:-1]
-                found.append((".".join((prefix,) + parts), path))
+                if "tests" not in parts:
+                    module = parts[:-1] if parts[-1] == "__init__" else parts
+                    found.append((".".join((prefix,) + module), path))
         return found
-    if spec.origin and spec.origin.endswith(".py"):
+    if spec is not None and spec.origin and spec.origin.endswith(".py"):
         return [(prefix, Path(spec.origin))]
     return []  # a compiled module: its routines are refused by the module's name
 

@@ -1,14 +1,10 @@
-"""Grading one notebook and one submission, on the grader's (trusted) side.
-
-Each notebook is read here (JSON only, nothing run), its code cells run in a sandboxed worker, and every
-exercise's checks run here through proxies into it (:mod:`labkit.grading.sandbox.remote`), each part with its
-references switched off in the sandbox and named if the source reaches for them (:mod:`.scan`). A part whose code
-is mostly code the student has on disk (:mod:`.known`) is held for a person until the rubric's ``[held]`` table
-releases it. One time limit covers a submission's notebooks; an exercise counts from the first notebook (in name
-order) that defines its names.
+"""Grading one submission on the grader's (trusted) side: its notebooks read (JSON only, nothing run), their code
+cells run in a sandboxed worker, each exercise's checks run here through proxies into it
+(:mod:`labkit.grading.sandbox.remote`). A part reaching for a refused reference fails (:mod:`.scan`); one whose code
+is mostly code the student has on disk (:mod:`.known`), or is built on such code, is held for a person.
 
 ``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a process of its own
-(:mod:`labkit.grading.run.processes` starts one each) and writes its result file.
+(:mod:`labkit.grading.run.processes`) and writes its result file.
 """
 
 import functools
@@ -559,8 +555,8 @@ def submission_name(path):
 
 
 def grade_submission(path, options=None, *, profiles=None, name=None):
-    """Grade one submission (a notebook or a folder of them) with the options' rubric (else the lab's); `name` (its
-    folder's by default) picks its variant's data."""
+    """Grade one submission (a notebook or a folder of them) with the options' rubric (else the lab's) within one
+    time limit; `name` (its folder's by default) picks its variant's data."""
     options = _options(options)
     rubric = rubrics.load(options.rubric) if options.rubric is not None else None
     deadline = time.monotonic() + options.total_timeout
