@@ -254,23 +254,14 @@ def _dotted(node, aliases):
 
 def _constant_getattr(node):
     """Whether `node` is ``getattr(value, "name")`` (or with a default): an attribute written as a string."""
-    return (
-        _getattr_call(node)
-        and len(node.args) <= 3
-        and not node.keywords
-        and isinstance(node.args[1], ast.Constant)
-        and isinstance(node.args[1].value, str)
-        and node.args[1].value.isidentifier()
-    )
+    name = node.args[1] if _getattr_call(node) and len(node.args) <= 3 and not node.keywords else None
+    return isinstance(name, ast.Constant) and isinstance(name.value, str) and name.value.isidentifier()
 
 
 def _getattr_call(node):
-    return (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id == "getattr"
-        and len(node.args) >= 2
-    )
+    """Whether `node` calls ``getattr`` with an object and a name."""
+    function = node.func if isinstance(node, ast.Call) else None
+    return isinstance(function, ast.Name) and function.id == "getattr" and len(node.args) >= 2
 
 
 class _Refused:
