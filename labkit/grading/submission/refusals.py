@@ -51,12 +51,8 @@ def _compiled_codes(path):
     """Every code object of a source file compiled whole (as imported) and statement by statement as IPython
     compiles a cell (its flags, with and without the file's futures), whose bytecode differs (``np.diff(x)``)."""
     source = Path(path).read_bytes()
-    whole = compile(source, str(path), "exec", dont_inherit=True)
-    found = list(codes_in(whole))
-    try:
-        tree = ast.parse(source, str(path))
-    except (SyntaxError, ValueError):
-        return tuple(found)
+    found = list(codes_in(compile(source, str(path), "exec", dont_inherit=True)))
+    tree = ast.parse(source, str(path))  # it compiled: it parses
     futures = 0
     for node in tree.body:
         if isinstance(node, ast.ImportFrom) and node.module == "__future__":

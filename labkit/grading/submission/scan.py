@@ -331,9 +331,15 @@ def scan(sources, names, profile):
         for owner, definition, own_names in reader.reached(name):
             local = {k: v for k, v in reader.aliases.items() if k not in own_names}
             start = getattr(definition, "lineno", 1)
+            # the inner links of an attribute chain are judged with the whole chain (``pw`` in ``pw.bracket``)
+            inner = set()
             for node in ast.walk(definition):
                 reader._tick()
-                if isinstance(node, (ast.Import, ast.ImportFrom)):
+                if isinstance(node, ast.Attribute):
+                    inner.add(id(node.value))
+                elif _constant_getattr(node):
+                    inner.add(id(node.args[0]))
+                elif isinstance(node, (ast.Import, ast.ImportFrom)):
                     for alias_name, dotted in _imported(node):
                         local[alias_name] = dotted
                         # a refused module imported is judged by its uses (``pw.bracket`` is allowed)
@@ -343,13 +349,6 @@ def scan(sources, names, profile):
                         if why:
                             findings.add((owner, node.lineno - start + 1, why))
             outside = {k: v for k, v in local.items() if k not in reader.definitions}
-            # the inner links of an attribute chain are judged with the whole chain (``pw`` in ``pw.bracket``)
-            inner = set()
-            for node in ast.walk(definition):
-                if isinstance(node, ast.Attribute):
-                    inner.add(id(node.value))
-                elif _constant_getattr(node):
-                    inner.add(id(node.args[0]))
             for node in ast.walk(definition):
                 reader._tick()
                 what = None

@@ -506,31 +506,27 @@ def _check_exercise(graded, number, variant, problems):
         )
         problems.append(ProblemText.one(text, VARIANT))
     with timings.phase("recognition"):
-        _judge_code(verdict, exercise, graded.code, graded.profiles, registry, graded.options)
+        verdict["checks"] = [_judged(check, part, graded) for part, check in zip(exercise.parts, verdict["checks"])]
     return _rescore(verdict, registry)
 
 
-def _judge_code(verdict, exercise, code, profiles, registry, options):
-    """Each part's check in `verdict`, failed for a refused reference or a string run as code, held for known code."""
-    for index, part in enumerate(exercise.parts):
-        check = verdict["checks"][index]
-        if part.refused is None:
-            verdict["checks"][index] = judge_plain(check, part, code, registry, options)
-            continue
-        try:
-            findings = scan.scan(code, part.scanned, profiles[part.refused.name])
-            strung = scan.run_strings(code, part.scanned)
-        except scan.Unreadable as exc:
-            why = "keep the notebook's code to what the lab asks for."
-            verdict["checks"][index] = _failed_part(check, check["name"], "its source can be read", str(exc), why)
-            continue
-        if findings:
-            verdict["checks"][index] = _own_code(check, findings)
-        elif strung:
-            name, _, why = strung[0]
-            verdict["checks"][index] = _refused_with(check, name, why, step="its code can be read")
-        else:
-            verdict["checks"][index] = judge_known(check, part, code, registry, options)
+def _judged(check, part, graded):
+    """A part's check, failed for a refused reference or a string run as code, held for known code."""
+    code, registry, options = graded.code, graded.registry, graded.options
+    if part.refused is None:
+        return judge_plain(check, part, code, registry, options)
+    try:
+        findings = scan.scan(code, part.scanned, graded.profiles[part.refused.name])
+        strung = scan.run_strings(code, part.scanned)
+    except scan.Unreadable as exc:
+        why = "keep the notebook's code to what the lab asks for."
+        return _failed_part(check, check["name"], "its source can be read", str(exc), why)
+    if findings:
+        return _own_code(check, findings)
+    if strung:
+        name, _, why = strung[0]
+        return _refused_with(check, name, why, step="its code can be read")
+    return judge_known(check, part, code, registry, options)
 
 
 def _number(value):
