@@ -117,7 +117,7 @@ def _notebook_entry(name, cells):
 @functools.lru_cache(maxsize=4)
 def corpus(refusals=(), solutions=()):
     """The :class:`Corpus` of labkit's library (but its grader: no answer there), the modules `refusals` refuse,
-    and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.solutions` gives them."""
+    and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.known_sources` reads them."""
     from .refusals import _module_files
 
     modules = {}  # file: module

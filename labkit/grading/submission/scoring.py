@@ -251,15 +251,17 @@ def _run_problems(name, ran, code=()):
     return problems
 
 
+@functools.lru_cache(maxsize=1)
 def _profiles(registry):
     """The refusals of every exercise, computed once per grading process."""
-    if getattr(_profiles, "source", None) != registry.source:
-        _profiles.value, _profiles.source = refusals.wire(registry.refusals), registry.source
-    return _profiles.value
+    return refusals.wire(registry.refusals)
 
 
-def solutions(folder):
-    """`folder`'s instructor notebooks, ((name, code cells), ...) as :func:`.known.corpus` takes them, or ValueError."""
+def known_sources(registry, folder=None):
+    """The known code a part's is compared with: labkit's, the refused modules' and the instructor notebooks in
+    `folder`, if given (an InputError when it holds none)."""
+    if folder is None:
+        return known.corpus(tuple(registry.refusals), ())
     folder = Path(folder)
     notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
     if not notebooks:
@@ -268,18 +270,14 @@ def solutions(folder):
             "instructor notebooks (the course repository's notebooks/)."
         )
     stamps = tuple((str(p), p.stat().st_mtime_ns, p.stat().st_size) for p in notebooks)
-    return _solutions(stamps)
+    return known.corpus(tuple(registry.refusals), _solutions(stamps))
 
 
 @functools.lru_cache(maxsize=4)
 def _solutions(stamps):
-    """The notebooks named in `stamps` read once while none of them changes (their paths, times and sizes)."""
+    """The notebooks named in `stamps`, ((name, code cells), ...), read once while none of them changes (their
+    paths, times and sizes)."""
     return tuple((Path(path).name, tuple(read_cells(Path(path))[0])) for path, _, _ in stamps)
-
-
-def known_sources(registry, folder=None):
-    """The known code a part's is compared with: labkit's, the refused modules' and `folder`'s notebooks'."""
-    return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
 
 
 def judge_known(check, part, code, registry, options):
@@ -369,12 +367,10 @@ def _refused_with(check, name, why, step="is built on the student's own code"):
     return _with_step(check, _step(step, why, REFUSED), hint, passed=False)
 
 
+@functools.lru_cache(maxsize=1)
 def registry_graded(registry):
     """Every name a part of the registry scans: the functions judged for copied code each in their own part."""
-    if getattr(registry_graded, "source", None) != registry.source:
-        registry_graded.source = registry.source
-        registry_graded.value = {n for e in registry.exercises.values() for p in e.parts for n in p.scanned}
-    return registry_graded.value
+    return {n for e in registry.exercises.values() for p in e.parts for n in p.scanned}
 
 
 @functools.cache
