@@ -1,19 +1,17 @@
 """Code every student has on disk (labkit's, scipy's, the solutions' if they leak), recognised in a graded part.
 
-The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*,
-so that a part built on one is held for a person instead of paid (:func:`.scoring.judge_known`). The corpus,
-every known function and method fingerprinted (syntax trees normalised first), is cached per file."""
+The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*
+(fingerprinted, each file's cached), so that a part built on one is held for a person (:func:`.scoring.judge_known`)."""
 
 from __future__ import annotations
 
 import ast
-import dataclasses
 import functools
 import hashlib
 import json
 import os
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -150,7 +148,7 @@ class Match:
     public: bool = True
 
     def as_dict(self):
-        return dataclasses.asdict(self)
+        return asdict(self)
 
 
 class Given:
