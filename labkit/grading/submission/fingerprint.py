@@ -107,9 +107,8 @@ def _named(node, names):
 
 def _no_effect(statement):
     """A bare constant (a docstring), a bare name, ``pass``."""
-    return isinstance(statement, ast.Pass) or (
-        isinstance(statement, ast.Expr) and isinstance(statement.value, (ast.Constant, ast.Name))
-    )
+    expression = statement.value if isinstance(statement, ast.Expr) else None
+    return isinstance(statement, ast.Pass) or isinstance(expression, (ast.Constant, ast.Name))
 
 
 def _dead(statement, read):

@@ -230,14 +230,14 @@ def _locals(node):
 
 
 def _imported(node):
-    if isinstance(node, ast.Import):
-        for alias in node.names:
-            yield (alias.asname or alias.name.split(".")[0]), (alias.name if alias.asname else alias.name.split(".")[0])
-    elif node.module and not node.level:
-        for alias in node.names:
+    """(local name, dotted name) of each name an import binds."""
+    for alias in node.names:
+        if isinstance(node, ast.Import):
+            top = alias.name.split(".")[0]
+            yield (alias.asname or top), (alias.name if alias.asname else top)
+        elif node.module and not node.level:
             yield (alias.asname or alias.name), f"{node.module}.{alias.name}"
-    else:  # a relative import: a module the notebook wrote itself
-        for alias in node.names:
+        else:  # a relative import: a module the notebook wrote itself
             yield (alias.asname or alias.name), f".{node.module or ''}.{alias.name}"
 
 
