@@ -1,2 +1,4 @@
-"""One submission's grading process (started by :mod:`labkit.grading.run.processes`): reading its notebooks, the
-source scan, the refusals, scoring; student code runs in the sandbox it opens, never here."""
+"""One submission's grading process: reading its notebooks, the source scan, the refusals, scoring.
+
+One process per submission (:mod:`labkit.grading.run.processes`); student code runs in its sandbox, never here.
+"""
