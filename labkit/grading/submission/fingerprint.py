@@ -1,8 +1,6 @@
-"""The one fingerprinting engine, for known code in a graded part (:mod:`.known`) and classmates' similar code
-(:mod:`labkit.grading.reports.similarity`), each with its own corpus and threshold. Nothing is ever run:
-:func:`canonical` (known code only) writes code back without what does nothing, :func:`normalise` keeps what
-the tokens do, not their names, and :func:`fingerprints` winnows runs of :data:`NOISE` characters (Schleimer,
-Wilkerson and Aiken 2003). What the student release gives everyone (:func:`release_grams`) is never evidence."""
+"""The one fingerprinting engine (winnowing, Schleimer, Wilkerson and Aiken 2003; nothing is ever run), for known
+code in a graded part (:mod:`.known`) and classmates' similar code (:mod:`labkit.grading.reports.similarity`), each
+with its own corpus and threshold. What the student release gives everyone (:func:`release_grams`) is never evidence."""
 
 from __future__ import annotations
 
@@ -109,9 +107,8 @@ def _named(node, names):
 
 def _no_effect(statement):
     """A bare constant (a docstring), a bare name, ``pass``."""
-    return isinstance(statement, ast.Pass) or (
-        isinstance(statement, ast.Expr) and isinstance(statement.value, (ast.Constant, ast.Name))
-    )
+    expression = statement.value if isinstance(statement, ast.Expr) else None
+    return isinstance(statement, ast.Pass) or isinstance(expression, (ast.Constant, ast.Name))
 
 
 def _dead(statement, read):

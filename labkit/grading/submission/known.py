@@ -1,26 +1,25 @@
 """Code every student has on disk (labkit's, scipy's, the solutions' if they leak), recognised in a graded part.
 
-The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*,
-so that a part built on one is held for a person instead of paid (:func:`.scoring.judge_known`). The corpus,
-every known function and method fingerprinted (syntax trees normalised first), is cached per file."""
+The scan and the sandbox refuse *calls* of that code; this module recognises renamed or reordered *copies*
+(fingerprinted, each file's cached), so that a part built on one is held for a person (:func:`.scoring.judge_known`)."""
 
 from __future__ import annotations
 
 import ast
-import dataclasses
 import functools
 import hashlib
 import json
 import os
-import tempfile
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..store.record import replace_text
 from . import fingerprint
 from .fingerprint import canonical, normalise
+from .scan import python_source
 
 # measured on copies, independent solutions and honest variants (docs/grading-security.md):
 # honest work shares at most 46 fingerprints; the copies tried, 98 or more
@@ -83,41 +82,32 @@ def _cached(name, raw, compute):
     data = compute()
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        handle, partial = tempfile.mkstemp(dir=folder, suffix=".partial")
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            json.dump(data, stream)
-        os.replace(partial, path)
+        replace_text(path, json.dumps(data))
     except OSError:
         pass  # a cache that cannot be written only costs time
     return data, key
 
 
-def _entry(units, texts):
-    """JSON data: the `units`, and the distinct fingerprints of each one's text (`texts`) with its index."""
-    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(text))[0])[0]).tolist() for text in texts]
-    unit_of = [index for index, found in enumerate(hashes) for _ in found]
-    return {"units": units, "hashes": [h for found in hashes for h in found], "unit_of": unit_of}
+def _entry(found, with_text):
+    """JSON data: the units `found` ([name, first line, last line, text] each; the text kept `with_text`), and the
+    distinct fingerprints of each one's text with its index."""
+    hashes = [np.unique(fingerprint.fingerprints(normalise(canonical(unit[3]))[0])[0]).tolist() for unit in found]
+    unit_of = [index for index, each in enumerate(hashes) for _ in each]
+    units = found if with_text else [unit[:3] for unit in found]
+    return {"units": units, "hashes": [h for each in hashes for h in each], "unit_of": unit_of}
 
 
 def _module_entry(module, path):
     """The units (their text left out) and fingerprints of one Python source file, cached."""
     raw = Path(path).read_bytes()
-
-    def compute():
-        found = _definitions(raw.decode("utf-8", "replace"), f"{module}.", raw)
-        return _entry([unit[:3] for unit in found], [unit[3] for unit in found])
-
-    return _cached(module, raw, compute)
+    return _cached(module, raw, lambda: _entry(_definitions(raw.decode("utf-8", "replace"), f"{module}.", raw), False))
 
 
 def _notebook_entry(name, cells):
     """The units and fingerprints of one instructor notebook's code cells, as the grader reads them, cached."""
 
     def compute():
-        from .scan import python_source
-
-        units = [unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")]
-        return _entry(units, [unit[3] for unit in units])
+        return _entry([unit for cell in cells for unit in _definitions(python_source(cell) or "", f"{name}: ")], True)
 
     return _cached(name, json.dumps([name, list(cells)]).encode("utf-8"), compute)
 
@@ -125,7 +115,7 @@ def _notebook_entry(name, cells):
 @functools.lru_cache(maxsize=4)
 def corpus(refusals=(), solutions=()):
     """The :class:`Corpus` of labkit's library (but its grader: no answer there), the modules `refusals` refuse,
-    and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.solutions` gives them."""
+    and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.known_sources` reads them."""
     from .refusals import _module_files
 
     modules = {}  # file: module
@@ -158,7 +148,7 @@ class Match:
     public: bool = True
 
     def as_dict(self):
-        return dataclasses.asdict(self)
+        return asdict(self)
 
 
 class Given:
@@ -202,12 +192,8 @@ def _read(text, given):
 def _side_by_side(text, numbers, unit):
     """Up to :data:`SHOWN` pairs (student's line `numbers` of `text`, the next known line of the same shape)."""
     try:
-        if unit.text is None:
-            theirs = (
-                Path(unit.path).read_text(encoding="utf-8", errors="replace").split("\n")[unit.first - 1 : unit.last]
-            )
-        else:
-            theirs = unit.text.split("\n")
+        whole = Path(unit.path).read_text(encoding="utf-8", errors="replace") if unit.text is None else None
+        theirs = unit.text.split("\n") if whole is None else whole.split("\n")[unit.first - 1 : unit.last]
     except (OSError, IndexError, ValueError):
         theirs = [""]
     mine, their_normal = text.split("\n"), [normalise(line)[0] for line in theirs]

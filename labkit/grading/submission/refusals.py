@@ -26,21 +26,17 @@ def _module_files(prefix):
     try:
         spec = importlib.util.find_spec(prefix)
     except (ImportError, ValueError):
-        return []
-    if spec is None:
-        return []
-    if spec.submodule_search_locations:
+        spec = None
+    if spec is not None and spec.submodule_search_locations:
         found = []
         for location in spec.submodule_search_locations:
             for path in sorted(Path(location).rglob("*.py")):
                 parts = path.relative_to(location).with_suffix("").parts
-                if "tests" in parts:
-                    continue
-                if parts[-1] == "__init__":
-                    parts = parts[:-1]
-                found.append((".".join((prefix,) + parts), path))
+                if "tests" not in parts:
+                    module = parts[:-1] if parts[-1] == "__init__" else parts
+                    found.append((".".join((prefix,) + module), path))
         return found
-    if spec.origin and spec.origin.endswith(".py"):
+    if spec is not None and spec.origin and spec.origin.endswith(".py"):
         return [(prefix, Path(spec.origin))]
     return []  # a compiled module: its routines are refused by the module's name
 
@@ -55,12 +51,8 @@ def _compiled_codes(path):
     """Every code object of a source file compiled whole (as imported) and statement by statement as IPython
     compiles a cell (its flags, with and without the file's futures), whose bytecode differs (``np.diff(x)``)."""
     source = Path(path).read_bytes()
-    whole = compile(source, str(path), "exec", dont_inherit=True)
-    found = list(codes_in(whole))
-    try:
-        tree = ast.parse(source, str(path))
-    except (SyntaxError, ValueError):
-        return tuple(found)
+    found = list(codes_in(compile(source, str(path), "exec", dont_inherit=True)))
+    tree = ast.parse(source, str(path))  # it compiled: it parses
     futures = 0
     for node in tree.body:
         if isinstance(node, ast.ImportFrom) and node.module == "__future__":

@@ -1,10 +1,6 @@
-"""Reading a notebook's source for refused references, on the grader's side (``ast``; nothing is run).
-
-For a graded name, :func:`scan` follows what its last definition reaches in the notebook (through import aliases)
-and reports every reference into a refused module or to a refused function under any name it has, and every way of
-reaching code a reader cannot follow (``eval``, ``getattr`` with a computed name, ``sys.modules``, ...), within
-:data:`MAX_CODE_BYTES` and :data:`TIME_BUDGET`. Cell magics that run Python (``%%time``) are read as Python; cells
-IPython hands to another program are skipped. :func:`function_sources` reads the graded functions' text.
+"""Reading a notebook's source, on the grader's side (``ast``; nothing is run): what a graded name reaches, the
+refused references and unreadable ways of reaching code in it (:func:`scan`), and the graded functions' text
+(:func:`function_sources`). Cell magics that run Python (``%%time``) are read as Python; other cells are skipped.
 """
 
 import ast
@@ -13,6 +9,7 @@ import re
 import sys
 import time
 
+from ..sandbox.guard import _within
 from ..store.text import MAX_SOURCE_CHARS
 
 MAX_CODE_BYTES = 512 * 1024  # a lab notebook's code is a few tens of kilobytes
@@ -80,10 +77,7 @@ class _Reader:
             for node in _top_level(tree.body):
                 self.texts[id(node)] = text
             for node in tree.body:
-                before = {name: id(found) for name, found in self.definitions.items()}
-                self._record(node)
-                changed = [n for n, found in self.definitions.items() if before.get(n) != id(found)]
-                self.when.update({n: (cell, node.lineno) for n in changed})
+                self._record(node, (cell, node.lineno))
                 self.strings += [(cell, node.lineno, what) for what in _runs_strings(node, self.definitions)]
                 if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
                     self.statements.append(node)
@@ -92,8 +86,8 @@ class _Reader:
         if time.monotonic() > self.deadline:
             raise Unreadable(f"reading the notebook's code took more than {TIME_BUDGET:g} s")
 
-    def _record(self, node):
-        """Top-level names: the last definition wins, as when the cells run in order."""
+    def _record(self, node, where):
+        """Top-level names, bound at `where` (cell, line): the last definition wins, as when the cells run in order."""
         if isinstance(node, (ast.Import, ast.ImportFrom)):
             for local, dotted in _imported(node):
                 self.aliases[local] = dotted
@@ -101,10 +95,10 @@ class _Reader:
         elif isinstance(node, (ast.If, ast.For, ast.While, ast.With, ast.Try)):
             for child in ast.iter_child_nodes(node):
                 if isinstance(child, ast.stmt):
-                    self._record(child)
+                    self._record(child, where)
         else:
             for name in _bound_names(node):
-                self.definitions[name] = node
+                self.definitions[name], self.when[name] = node, where
                 self.aliases.pop(name, None)
 
     def reached(self, name, stop=frozenset()):
@@ -147,10 +141,10 @@ def _runs_strings(node, definitions=None):
     return found
 
 
-def run_strings(sources, names, deadline=None):
+def run_strings(sources, names):
     """Findings ``(name, line, reason)`` for each graded name that a top-level ``exec`` of a built string may have
     defined (no readable binding after it): code that arrives in a string cannot be read, so it is never graded."""
-    reader = _reader(sources, deadline)
+    reader = _reader(sources)
     findings = []
     for name in names:
         bound = reader.when.get(name, (-1, 0)) if name in reader.definitions else (-1, 0)  # (cell, line)
@@ -165,7 +159,7 @@ def run_strings(sources, names, deadline=None):
     return findings
 
 
-def reached_sources(sources, names, deadline=None, stop=frozenset()):
+def reached_sources(sources, names, stop=frozenset()):
     """``[(name, source text)]`` of every definition the graded `names` reach (themselves first) as :func:`scan`
     follows them, not through the names in `stop`; :class:`Unreadable` as :func:`scan` raises it.
 
@@ -175,8 +169,7 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
     >>> [name for name, _ in reached_sources(cells, ["f"])]
     ['f', 'h']
     """
-    _bounded(sources)
-    reader = _reader(sources, deadline)
+    reader = _reader(sources)
     found, seen = [], set()
     for name in names:
         for owner, node, _ in reader.reached(name, frozenset(stop)):
@@ -189,21 +182,12 @@ def reached_sources(sources, names, deadline=None, stop=frozenset()):
     return found
 
 
-def _bounded(sources):
-    """Raise :class:`Unreadable` when a notebook's code cells hold more than :data:`MAX_CODE_BYTES`."""
-    size = code_bytes(sources)
-    if size > MAX_CODE_BYTES:
-        raise Unreadable(
-            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
-        )
-
-
 def code_bytes(sources):
     """The bytes of a notebook's code cells (as UTF-8)."""
     return sum(len(str(s).encode("utf-8", "surrogatepass")) for s in sources)
 
 
-def drawn_with(sources, names, deadline=None):
+def drawn_with(sources, names):
     """The definitions `names` reach, and those the statements mentioning them reach (``ax.plot(my_eval(t))``).
 
     Examples
@@ -212,7 +196,7 @@ def drawn_with(sources, names, deadline=None):
     >>> sorted(drawn_with(cells, ["ax"]) & {"ax", "g", "h"})
     ['ax', 'h']
     """
-    reader = _reader(sources, deadline)
+    reader = _reader(sources)
     wanted, found, starts = set(names), set(), list(names)
     for node in reader.statements:
         loaded = {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
@@ -246,14 +230,14 @@ def _locals(node):
 
 
 def _imported(node):
-    if isinstance(node, ast.Import):
-        for alias in node.names:
-            yield (alias.asname or alias.name.split(".")[0]), (alias.name if alias.asname else alias.name.split(".")[0])
-    elif node.module and not node.level:
-        for alias in node.names:
+    """(local name, dotted name) of each name an import binds."""
+    for alias in node.names:
+        if isinstance(node, ast.Import):
+            top = alias.name.split(".")[0]
+            yield (alias.asname or top), (alias.name if alias.asname else top)
+        elif node.module and not node.level:
             yield (alias.asname or alias.name), f"{node.module}.{alias.name}"
-    else:  # a relative import: a module the notebook wrote itself
-        for alias in node.names:
+        else:  # a relative import: a module the notebook wrote itself
             yield (alias.asname or alias.name), f".{node.module or ''}.{alias.name}"
 
 
@@ -270,27 +254,14 @@ def _dotted(node, aliases):
 
 def _constant_getattr(node):
     """Whether `node` is ``getattr(value, "name")`` (or with a default): an attribute written as a string."""
-    return (
-        _getattr_call(node)
-        and len(node.args) <= 3
-        and not node.keywords
-        and isinstance(node.args[1], ast.Constant)
-        and isinstance(node.args[1].value, str)
-        and node.args[1].value.isidentifier()
-    )
+    name = node.args[1] if _getattr_call(node) and len(node.args) <= 3 and not node.keywords else None
+    return isinstance(name, ast.Constant) and isinstance(name.value, str) and name.value.isidentifier()
 
 
 def _getattr_call(node):
-    return (
-        isinstance(node, ast.Call)
-        and isinstance(node.func, ast.Name)
-        and node.func.id == "getattr"
-        and len(node.args) >= 2
-    )
-
-
-def _within(dotted, prefixes):
-    return next((p for p in prefixes if dotted == p or dotted.startswith(p + ".")), None)
+    """Whether `node` calls ``getattr`` with an object and a name."""
+    function = node.func if isinstance(node, ast.Call) else None
+    return isinstance(function, ast.Name) and function.id == "getattr" and len(node.args) >= 2
 
 
 class _Refused:
@@ -348,22 +319,27 @@ def _installed(top):
         return False
 
 
-def scan(sources, names, profile, deadline=None):
+def scan(sources, names, profile):
     """Findings ``(function, line, reference)``: where the graded `names`, or what they reach, name a reference
     that `profile` (one refusal, as :func:`.refusals.wire` gives it) switches off, or reach for code in a way the
     scan cannot follow. Raises :class:`Unreadable` past :data:`MAX_CODE_BYTES` or :data:`TIME_BUDGET`."""
     if profile is None:
         return []
-    _bounded(sources)
-    reader = _reader(sources, deadline)
+    reader = _reader(sources)
     refused, findings = _Refused(profile), set()
     for name in names:
         for owner, definition, own_names in reader.reached(name):
             local = {k: v for k, v in reader.aliases.items() if k not in own_names}
             start = getattr(definition, "lineno", 1)
+            # the inner links of an attribute chain are judged with the whole chain (``pw`` in ``pw.bracket``)
+            inner = set()
             for node in ast.walk(definition):
                 reader._tick()
-                if isinstance(node, (ast.Import, ast.ImportFrom)):
+                if isinstance(node, ast.Attribute):
+                    inner.add(id(node.value))
+                elif _constant_getattr(node):
+                    inner.add(id(node.args[0]))
+                elif isinstance(node, (ast.Import, ast.ImportFrom)):
                     for alias_name, dotted in _imported(node):
                         local[alias_name] = dotted
                         # a refused module imported is judged by its uses (``pw.bracket`` is allowed)
@@ -373,13 +349,6 @@ def scan(sources, names, profile, deadline=None):
                         if why:
                             findings.add((owner, node.lineno - start + 1, why))
             outside = {k: v for k, v in local.items() if k not in reader.definitions}
-            # the inner links of an attribute chain are judged with the whole chain (``pw`` in ``pw.bracket``)
-            inner = set()
-            for node in ast.walk(definition):
-                if isinstance(node, ast.Attribute):
-                    inner.add(id(node.value))
-                elif _constant_getattr(node):
-                    inner.add(id(node.args[0]))
             for node in ast.walk(definition):
                 reader._tick()
                 what = None
@@ -398,10 +367,15 @@ def scan(sources, names, profile, deadline=None):
 _READERS: dict = {}
 
 
-def _reader(sources, deadline=None):
-    """The notebook's :class:`_Reader` (the last one kept), reading until `deadline` (default: the budget)."""
-    sources = tuple(sources)
-    deadline = deadline if deadline is not None else time.monotonic() + TIME_BUDGET
+def _reader(sources):
+    """The notebook's :class:`_Reader` (the last one kept), reading for :data:`TIME_BUDGET` from now;
+    :class:`Unreadable` past :data:`MAX_CODE_BYTES`."""
+    sources, deadline = tuple(sources), time.monotonic() + TIME_BUDGET
+    size = code_bytes(sources)
+    if size > MAX_CODE_BYTES:
+        raise Unreadable(
+            f"the notebook's code cells hold {size:,} bytes, more than the {MAX_CODE_BYTES:,} a lab notebook needs"
+        )
     found = _READERS.get(sources)
     if found is None:
         _READERS.clear()

@@ -1,14 +1,10 @@
-"""Grading one notebook and one submission, on the grader's (trusted) side.
-
-Each notebook is read here (JSON only, nothing run), its code cells run in a sandboxed worker, and every
-exercise's checks run here through proxies into it (:mod:`labkit.grading.sandbox.remote`), each part with its
-references switched off in the sandbox and named if the source reaches for them (:mod:`.scan`). A part whose code
-is mostly code the student has on disk (:mod:`.known`) is held for a person until the rubric's ``[held]`` table
-releases it. One time limit covers a submission's notebooks; an exercise counts from the first notebook (in name
-order) that defines its names.
+"""Grading one submission on the grader's (trusted) side: its notebooks read (JSON only, nothing run), their code
+cells run in a sandboxed worker, each exercise's checks run here through proxies into it
+(:mod:`labkit.grading.sandbox.remote`). A part reaching for a refused reference fails (:mod:`.scan`); one whose code
+is mostly code the student has on disk (:mod:`.known`), or is built on such code, is held for a person.
 
 ``python -m labkit.grading.submission.scoring SPEC`` grades one submission in a process of its own
-(:mod:`labkit.grading.run.processes` starts one each) and writes its result file.
+(:mod:`labkit.grading.run.processes`) and writes its result file.
 """
 
 import functools
@@ -30,8 +26,9 @@ from ..options import GradeOptions
 from ..sandbox import backends, remote, timings
 from ..store import rubric as rubrics
 from ..store.model import ExerciseResult
+from ..store.record import replace_text
 from ..store.report import HELD_STEP, ProblemText, SubmissionGrade, one_line, printable
-from . import holding, known, refusals, scan
+from . import known, refusals, scan
 
 OUTPUT_LIMIT = 100_000  # characters a notebook may print before its feedback says so
 SHOWN_ERRORS = 12  # failing cells named in the feedback (a bare release has up to 10 per notebook)
@@ -254,15 +251,17 @@ def _run_problems(name, ran, code=()):
     return problems
 
 
+@functools.lru_cache(maxsize=1)
 def _profiles(registry):
     """The refusals of every exercise, computed once per grading process."""
-    if getattr(_profiles, "source", None) != registry.source:
-        _profiles.value, _profiles.source = refusals.wire(registry.refusals), registry.source
-    return _profiles.value
+    return refusals.wire(registry.refusals)
 
 
-def solutions(folder):
-    """`folder`'s instructor notebooks, ((name, code cells), ...) as :func:`.known.corpus` takes them, or ValueError."""
+def known_sources(registry, folder=None):
+    """The known code a part's is compared with: labkit's, the refused modules' and the instructor notebooks in
+    `folder`, if given (an InputError when it holds none)."""
+    if folder is None:
+        return known.corpus(tuple(registry.refusals), ())
     folder = Path(folder)
     notebooks = sorted(folder.glob("*.ipynb")) if folder.is_dir() else []
     if not notebooks:
@@ -271,51 +270,107 @@ def solutions(folder):
             "instructor notebooks (the course repository's notebooks/)."
         )
     stamps = tuple((str(p), p.stat().st_mtime_ns, p.stat().st_size) for p in notebooks)
-    return _solutions(stamps)
+    return known.corpus(tuple(registry.refusals), _solutions(stamps))
 
 
 @functools.lru_cache(maxsize=4)
 def _solutions(stamps):
-    """The notebooks named in `stamps` read once while none of them changes (their paths, times and sizes)."""
+    """The notebooks named in `stamps`, ((name, code cells), ...), read once while none of them changes (their
+    paths, times and sizes)."""
     return tuple((Path(path).name, tuple(read_cells(Path(path))[0])) for path, _, _ in stamps)
-
-
-def known_sources(registry, folder=None):
-    """The known code a part's is compared with: labkit's, the refused modules' and `folder`'s notebooks'."""
-    return known.corpus(tuple(registry.refusals), solutions(folder) if folder is not None else ())
 
 
 def judge_known(check, part, code, registry, options):
     """A part's check, held for a person when it passed and its code (`code`: the cells) is mostly known code."""
     if not check["passed"] or part.refused is None:
         return check
+    # a graded function another part judges (the driver's interpolant) is judged there, once
+    return _judge_reached(check, code, part.scanned, registry, options, own=part.scanned)
+
+
+def judge_plain(check, part, code, registry, options):
+    """A passed part without a refusal (a plot, a table), held when the code that draws it (graded functions
+    aside, each judged in its own part) is mostly known code."""
+    if not check["passed"]:
+        return check
     try:
-        reached = scan.reached_sources(code, part.scanned)
+        drawn = scan.drawn_with(code, [n for n in part.names() if n.isidentifier()])
+    except scan.Unreadable:
+        return check
+    return _judge_reached(check, code, sorted(drawn), registry, options)
+
+
+def _judge_reached(check, code, names, registry, options, own=()):
+    """`check`, held when the definitions `names` reach (graded names but `own` aside) are mostly known code."""
+    try:
+        reached = scan.reached_sources(code, names)
     except scan.Unreadable:
         return check  # the refusal scan read the same cells in time: not reached here
-    # a graded function another part judges (the driver's interpolant) is judged there, once
-    reached = [(n, t) for n, t in reached if n in part.scanned or n not in registry_graded(registry)]
-    return _judge_reached(check, reached, registry, options)
-
-
-def _judge_reached(check, reached, registry, options):
-    """`check`, held when the definitions `reached` ([(name, source)]) are mostly known code."""
+    graded = registry_graded(registry)
+    reached = [(n, t) for n, t in reached if n in own or n not in graded]
     found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
     return check if found is None else _held(check, found)
 
 
-def judge_plain(check, part, code, registry, options):
-    """A part without a refusal (a plot, a table), held when the code that draws it is mostly known code."""
-    judge = lambda check, reached: _judge_reached(check, reached, registry, options)
-    return holding.judge_plain(check, part, code, registry_graded(registry), judge)
+def hold_dependents(results, registry, code):
+    """Hold, in `results` ({exercise: verdict}), every passed part whose code reaches a held definition, and
+    fail those reaching a graded name a string run as code may have defined: copied code earns nothing through
+    what it draws."""
+    held = {}  # name: its held match, for the held parts' graded names and the copies
+    for number, verdict in results.items():
+        for part, check in zip(registry.exercises[number].parts, verdict["checks"]):
+            if check.get("held") and check.get("passed"):
+                for name in (*part.scanned, check["held"].get("definition", "")):
+                    held.setdefault(name, check["held"])
+    try:
+        strung = {name: why for name, _, why in scan.run_strings(code, sorted(registry_graded(registry)))}
+    except scan.Unreadable:
+        strung = {}
+    if not held and not strung:
+        return results
+    for number, verdict in results.items():
+        parts = registry.exercises[number].parts
+        for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
+            if not check.get("passed") or check.get("held"):
+                continue
+            readable = [n for n in (*part.names(), *part.scanned) if n.isidentifier()]
+            try:
+                names = set(part.uses) | scan.drawn_with(code, readable)
+            except scan.Unreadable:
+                names = set(part.uses)
+            names -= set(part.scanned)
+            on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
+            if on_held:
+                verdict["checks"][index] = _held_with(check, on_held[0], held[on_held[0]])
+            elif on_string:
+                verdict["checks"][index] = _refused_with(check, on_string[0], strung[on_string[0]])
+        _rescore(verdict, registry)
+    return results
 
 
+def _held_with(check, name, held):
+    detail = (
+        f"it is built on {name}, held for your instructor to look at: its code is mostly {held.get('source', '?')}'s"
+    )
+    hint = (
+        f"this part waits with {name}, which it is built on; write {name} in your own way to be paid without waiting."
+    )
+    return _with_step(check, _step(HELD_STEP, detail), hint, held={**held, "through": name})
+
+
+def _refused_with(check, name, why, step="is built on the student's own code"):
+    """The part's check, failed: it is built on `name`, which a string run as code may have defined (`why`)."""
+    hint = (
+        f"define {name} with def in a code cell, after any exec, eval or compile of a string, so that the grader "
+        "can read it; code run from a string is never graded."
+    )
+    return _with_step(check, _step(step, why, REFUSED), hint, passed=False)
+
+
+@functools.lru_cache(maxsize=1)
 def registry_graded(registry):
     """Every name a part of the registry scans: the functions judged for copied code each in their own part."""
-    if getattr(registry_graded, "source", None) != registry.source:
-        registry_graded.source = registry.source
-        registry_graded.value = {n for e in registry.exercises.values() for p in e.parts for n in p.scanned}
-    return registry_graded.value
+    return {n for e in registry.exercises.values() for p in e.parts for n in p.scanned}
 
 
 @functools.cache
@@ -419,8 +474,7 @@ def _grade_in(graded, numbers, variant):
     for number in numbers:
         mine = None if variant is None else variant.get(str(number), {})
         results[number] = _check_exercise(graded, number, mine, problems)
-    # copied code earns nothing through what it draws
-    holding.hold_dependents(results, graded.registry, code, registry_graded(graded.registry), _rescore)
+    hold_dependents(results, graded.registry, code)
     if notebook.stopped:
         text = f"{name}: {notebook.stopped} while its functions were being checked."
         problems.append(ProblemText.one(text, notebook.stopped_kind))
@@ -448,30 +502,27 @@ def _check_exercise(graded, number, variant, problems):
         )
         problems.append(ProblemText.one(text, VARIANT))
     with timings.phase("recognition"):
-        _judge_code(verdict, exercise, graded.code, graded.profiles, registry, graded.options)
+        verdict["checks"] = [_judged(check, part, graded) for part, check in zip(exercise.parts, verdict["checks"])]
     return _rescore(verdict, registry)
 
 
-def _judge_code(verdict, exercise, code, profiles, registry, options):
-    """Each part's check in `verdict`, failed for a refused reference or a string run as code, held for known code."""
-    for index, part in enumerate(exercise.parts):
-        check = verdict["checks"][index]
-        if part.refused is None:
-            verdict["checks"][index] = judge_plain(check, part, code, registry, options)
-            continue
-        try:
-            findings = scan.scan(code, part.scanned, profiles[part.refused.name])
-            strung = scan.run_strings(code, part.scanned)
-        except scan.Unreadable as exc:
-            why = "keep the notebook's code to what the lab asks for."
-            verdict["checks"][index] = _failed_part(check, check["name"], "its source can be read", str(exc), why)
-            continue
-        if findings:
-            verdict["checks"][index] = _own_code(check, findings)
-        elif strung:
-            verdict["checks"][index] = holding.run_from_a_string(check, strung)
-        else:
-            verdict["checks"][index] = judge_known(check, part, code, registry, options)
+def _judged(check, part, graded):
+    """A part's check, failed for a refused reference or a string run as code, held for known code."""
+    code, registry, options = graded.code, graded.registry, graded.options
+    if part.refused is None:
+        return judge_plain(check, part, code, registry, options)
+    try:
+        findings = scan.scan(code, part.scanned, graded.profiles[part.refused.name])
+        strung = scan.run_strings(code, part.scanned)
+    except scan.Unreadable as exc:
+        why = "keep the notebook's code to what the lab asks for."
+        return _failed_part(check, check["name"], "its source can be read", str(exc), why)
+    if findings:
+        return _own_code(check, findings)
+    if strung:
+        name, _, why = strung[0]
+        return _refused_with(check, name, why, step="its code can be read")
+    return judge_known(check, part, code, registry, options)
 
 
 def _number(value):
@@ -496,8 +547,8 @@ def submission_name(path):
 
 
 def grade_submission(path, options=None, *, profiles=None, name=None):
-    """Grade one submission (a notebook or a folder of them) with the options' rubric (else the lab's); `name` (its
-    folder's by default) picks its variant's data."""
+    """Grade one submission (a notebook or a folder of them) with the options' rubric (else the lab's) within one
+    time limit; `name` (its folder's by default) picks its variant's data."""
     options = _options(options)
     rubric = rubrics.load(options.rubric) if options.rubric is not None else None
     deadline = time.monotonic() + options.total_timeout
@@ -537,11 +588,8 @@ def main(argv=None):
     options = GradeOptions.from_dict(spec["options"])  # the run's options, read once at this process's edge
     timings.reset()
     grade = grade_submission(spec["submission"], options=options, profiles=profiles, name=spec["name"])
-    result = Path(spec["result"])
-    partial = result.with_suffix(".partial")
-    partial.write_text(json.dumps(grade.as_dict()), encoding="utf-8")
-    os.replace(partial, result)
-    timings.write_beside(result)  # where the time went, for the run's folder (never the student's feedback)
+    replace_text(Path(spec["result"]), json.dumps(grade.as_dict()))
+    timings.write_beside(spec["result"])  # where the time went, for the run's folder (never the student's feedback)
     return 0
 
 

@@ -29,6 +29,7 @@ from labkit.grading.submission import fingerprint, known, scan
 from labkit.grading.submission.scoring import (
     _rescore,
     exercises_in,
+    hold_dependents,
     judge_known,
     judge_plain,
     known_sources,
@@ -523,29 +524,25 @@ def test_a_plot_drawn_with_a_copy_is_held():
 
 
 def test_a_part_built_on_a_held_definition_is_held_with_it():
-    from labkit.grading.submission import holding
-
     cells = [module_source("labkit.piecewise"), "def test_pherm_interpolate(n, f):\n    return eval_pherm(n, f, f, n)"]
     held_check = judge_known(_passed(_part(2, "eval_pherm")), _part(2, "eval_pherm"), cells, LAB, GradeOptions())
     results = {
         2: {"exercise": 2, "checks": [held_check]},
         3: {"exercise": 3, "checks": [_passed(p) for p in LAB.exercises[3].parts]},
     }
-    holding.hold_dependents(results, LAB, cells, registry_graded(LAB), _rescore)
+    hold_dependents(results, LAB, cells)
     three = {c["name"]: c for c in results[3]["checks"]}
     assert "held" not in three["runge"] and three["test_pherm_interpolate"]["held"]["through"] == "eval_pherm"
     assert results[3]["points"] == _part(3, "runge").weight
 
 
 def test_a_part_built_on_code_run_from_a_string_earns_nothing():
-    from labkit.grading.submission import holding
-
     cells = [
         exec_compressed(module_source("labkit.piecewise")),
         "def test_pherm_interpolate(n):\n    return eval_pherm(n)",
     ]
     results = {3: {"exercise": 3, "checks": [_passed(p) for p in LAB.exercises[3].parts]}}
-    holding.hold_dependents(results, LAB, cells, registry_graded(LAB), _rescore)
+    hold_dependents(results, LAB, cells)
     driver = {c["name"]: c for c in results[3]["checks"]}["test_pherm_interpolate"]
     assert not driver["passed"] and "cannot be read" in driver["steps"][-1]["detail"]
 
