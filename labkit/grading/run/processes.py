@@ -1,13 +1,11 @@
 """Each submission's grading process, as the grader supervises it: its limits, its end, its outcome.
 
-A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` for one submission (or has the
-run's launcher fork it: :mod:`.launcher`) in an address-space limit and a memory cgroup of its own
-(:mod:`labkit.grading.sandbox.cgroup`), set to die with the thread that started it, and stops it when it
-overruns the submission's time limit plus a grace for the checks. One that breaks is started once more
-(:data:`ATTEMPTS`); its outcome is plain data (:meth:`Job.message`), which :func:`settled` scores under the
-run's rubric. No student code runs here.
+A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` (or has the run's launcher fork it,
+:mod:`.launcher`) in an address-space limit and a memory cgroup of its own, and stops it when it overruns the
+submission's time limit plus a grace for the checks. No student code runs here.
 """
 
+import contextlib
 import ctypes
 import json
 import os
@@ -24,7 +22,7 @@ from ...errors import InputError
 from ..sandbox import backends, cgroup, forkserver
 from ..store import record as records
 from ..store.late import read_small
-from ..store.report import FORMAT, SubmissionGrade, one_line, safe_name
+from ..store.report import FORMAT, one_line, safe_name
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
@@ -116,15 +114,6 @@ class Job:
     def limit(self):
         return self.options.total_timeout + self.options.grader_grace
 
-    def stop(self):
-        """Kill the grading process and everything it started (its sandboxes die with it)."""
-        try:
-            os.killpg(self.process.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
-        self.process.wait()
-        self.finish()
-
     def last_words(self):
         """The last line the grading process wrote to stderr (a Python error's summary), as one printable line."""
         try:
@@ -135,40 +124,27 @@ class Job:
             return ""
         return f": {one_line(lines[-1], 200)}" if lines else ""
 
-    def finish(self):
-        self.out_of_memory, self.peak = False, None
-        if self.cgroup is not None:
-            self.out_of_memory = self.cgroup.out_of_memory()
-            self.peak = self.cgroup.peak()
-            self.cgroup.remove()
-
     def poll(self):
-        """Whether this attempt is over (its process ended, or it overran its limit and was stopped)."""
+        """Whether this attempt is over: its process ended, or overran its limit and was killed with everything it
+        started (its sandboxes die with it)."""
         running = self.process.poll() is None
         if running and time.monotonic() - self.started <= self.limit:
             return False
         self.timed_out = running
         if running:
-            self.stop()
-        else:
-            self.finish()
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(self.process.pid, signal.SIGKILL)
+            self.process.wait()
+        self.out_of_memory, peak = False, None
+        if self.cgroup is not None:
+            self.out_of_memory, peak = self.cgroup.out_of_memory(), self.cgroup.peak()
+            self.cgroup.remove()
+        self.peaks.append(peak)
         return True
 
-    def wait(self):
-        """Wait until this attempt is over (its process ends, or it overruns its limit and is stopped)."""
-        try:
-            self.process.wait(timeout=max(0.0, self.limit - (time.monotonic() - self.started)))
-        except subprocess.TimeoutExpired:
-            self.stop()
-            self.timed_out = True
-        else:
-            self.finish()
-            self.timed_out = False
-
     def conclude(self):
-        """After an attempt: True when the submission is done (:meth:`message`), False when its grading
-        process is to be started once more."""
-        self.peaks.append(self.peak)
+        """After an attempt: True when the submission is done (:meth:`message`), False when its grading process is
+        to be started once more (:data:`ATTEMPTS`)."""
         self.data, self.why = self.read()
         return self.data is not None or self.attempt >= ATTEMPTS
 
@@ -228,17 +204,3 @@ def die_with(parent):
         _LIBC.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
         if os.getppid() != parent:  # the grader died before the line above
             os._exit(1)
-
-
-def settled(message, rubric, seed):
-    """The :class:`SubmissionGrade` of :func:`grade_one`'s outcome, scored with `rubric`; a result that cannot be
-    read (another labkit version's, say) makes a submission that could not be graded, saying why."""
-    name = message["name"]
-    if message.get("result") is not None:
-        try:
-            grade = SubmissionGrade.from_dict(message["result"], one_line(name, 80), rubric)
-        except ValueError as exc:
-            return SubmissionGrade(name, seed=seed, rubric=rubric, failure=f"its result could not be read ({exc})")
-        grade.name = name
-        return grade
-    return SubmissionGrade(name, seed=seed, rubric=rubric, failure=str(message.get("failure")))
