@@ -1,11 +1,6 @@
-"""Grading a class: :func:`grade` plans the run (:mod:`.plan`), runs it on an engine, and writes the run folder.
-
-The plan touches nothing. :func:`run` hands the submissions still to grade to an engine (:mod:`.engines`:
-a few grading processes at a time here, or on a Dask cluster), each in a grading process of its own, so
-a submission that makes its grading crash, run out of memory or hang costs only its own grade (it is
-reported as "could not be graded", saying why). :class:`RunFolder` does every write: each submission's
-result and feedback as soon as it is graded, entered in the run's record, then ``grades.csv`` with every
-submission once and ``run.json``, how the run went (its seed, counts, time, engine, peak memory).
+"""Grading a class: :func:`grade` plans the run (:mod:`.plan`), runs it on an engine (:mod:`.engines`), and
+:class:`RunFolder` writes the run folder: each submission's result and feedback as soon as it is graded, then
+``grades.csv`` and ``run.json``, how the run went (its seed, counts, time, engine, peak memory).
 """
 
 import contextlib
@@ -35,13 +30,12 @@ def grade(submissions, out_dir, options: GradeOptions | None = None, *, engine: 
     """Grade submissions; write grades.csv, feedback/, results/, seed.txt and the run's record into `out_dir`.
 
     `submissions` is a :class:`~labkit.grading.run.plan.Submissions`, or the paths alone. `options` (a
-    :class:`~labkit.grading.options.GradeOptions`, the defaults when None) bound the run: its limits, its
-    sandbox backend (``"none"``: student code runs unconfined, after a warning on stderr), its seed (drawn
-    and written to ``seed.txt`` when None), its rubric (a TOML file; else the one an earlier run recorded in
-    `out_dir`, else the lab's), its shard (``"I/N"``, :func:`~labkit.grading.run.resume.shard`), and the
-    student-written times that count (:func:`labkit.grading.run.times.submission_time`). `engine` grades:
-    by default a :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` processes here.
-    `progress` draws a bar with an ETA on a terminal.
+    :class:`~labkit.grading.options.GradeOptions`, the defaults when None) bound the run: a seed None is drawn, a
+    rubric None is the one an earlier run recorded in `out_dir`, else the lab's; with backend ``"none"`` student
+    code runs unconfined, after a warning on stderr. `engine` grades: by default a
+    :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` processes here. `progress` draws a bar
+    with an ETA on a terminal. Each submission is graded in a process of its own, so one that crashes, runs out of
+    memory or hangs costs only its own grade ("could not be graded", saying why).
 
     A run into a folder with a run's record resumes it (:func:`~labkit.grading.run.resume.resumed`). Returns the
     grades in the order given (a shard's in name order; the ungradable last), an earlier run's included; those

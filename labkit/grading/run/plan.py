@@ -1,13 +1,8 @@
 """A class run's plan: what it grades, with what, and what it takes over, worked out before anything runs.
 
-:func:`plan` turns a :class:`Submissions`, the output folder and the run's options into a frozen
-:class:`Plan`, reading and never writing: names and shard, the earlier run resumed (:mod:`.resume`), each
-student's data and time, the known sources, the options every grading process gets. Every refusal comes
-from here, before a file is touched. :class:`~labkit.grading.options.GradeOptions` holds the run's choices
-(plain data a flag sets, the same for every submission: limits, seed, rubric, ``jobs``, ``shard``,
-``fresh``, the student-written times allowed); :class:`Submissions` what this run grades (data about one
-class: paths, names, the ungradable, the times given, roster, variants). The engine and the progress bar,
-how this process carries the run out, are keywords of :func:`.classrun.grade`.
+:func:`plan` turns a :class:`Submissions` (what this run grades: data about one class), the output folder and the
+run's :class:`~labkit.grading.options.GradeOptions` (its choices, the same for every submission) into a frozen
+:class:`Plan`, reading and never writing: every refusal comes from here, before a file is touched.
 """
 
 import os
