@@ -25,12 +25,10 @@ from pathlib import Path
 
 from ...errors import InputError
 from ..options import GradeOptions
-from ..sandbox import backends
-from ..sandbox.backends.base import SandboxUnavailable
 from ..store.report import one_line, safe_name
 from ..submission import refusals
 from .engines import Batch, Engine, Outcome, start_warm, stop_warm
-from .processes import Job, low_space
+from .processes import Job, low_space, sandbox_problem
 
 LOCAL = "local"  # --dask local: a LocalCluster on this machine
 CONNECT_TIMEOUT = "30s"  # to reach a scheduler
@@ -48,16 +46,10 @@ def _dask():
     return distributed
 
 
-def _check_address(address):
-    if not isinstance(address, str) or not address.strip():
-        raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
-
-
 def connect(address, workers=2):
     """(client, close) of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker
     processes when it is ``"local"``; ``close()`` closes both. ValueError when it cannot be reached."""
     distributed = _dask()
-    _check_address(address)
     if address == LOCAL:
         if int(workers) < 1:
             raise InputError(f"--dask-workers must be at least 1; got {workers}.")
@@ -87,7 +79,8 @@ class DaskEngine(Engine):
     name = "dask"
 
     def __init__(self, address: str, workers: int = 2):
-        _check_address(address)
+        if not isinstance(address, str) or not address.strip():
+            raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
         self.address, self.workers = address, workers
         self._record: dict = {"engine": self.name}
 
@@ -172,14 +165,7 @@ def _profiles_text(exercises):
     return json.dumps(refusals.wire(load_registry(exercises).refusals))
 
 
-@functools.cache
-def _sandbox_problem(backend):
-    """Why the sandbox cannot run on this worker, or None."""
-    try:
-        backends.get_backend(backend).available()
-    except SandboxUnavailable as exc:
-        return str(exc)
-    return None
+_sandbox_problem = functools.cache(sandbox_problem)  # looked at once per worker process
 
 
 def _task(path, name, payload):

@@ -15,7 +15,6 @@ When its stdin closes (the run is over, or the grader died) it stops every child
 import contextlib
 import json
 import os
-import resource
 import secrets
 import select
 import signal
@@ -25,7 +24,7 @@ import threading
 import time
 
 from ..sandbox import protocol
-from .processes import die_with, one_thread
+from .processes import confine, die_with, one_thread
 
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
 LAUNCHER_READY = 120  # seconds for the launcher to import the grader
@@ -151,12 +150,7 @@ def _child(request):
     code = 1
     try:
         os.setsid()
-        die_with(request["launcher"])
-        for procs in request.get("cgroups", ()):
-            with open(procs, "w") as handle:
-                handle.write(str(os.getpid()))
-        memory = int(request["memory"])
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        confine(request["launcher"], int(request["memory"]), request.get("cgroups", ()))
         null = os.open(os.devnull, os.O_RDWR)
         log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         for fd, target in ((null, 0), (null, 1), (log, 2)):

@@ -16,12 +16,12 @@ from typing import TYPE_CHECKING
 from ...errors import InputError
 from ..options import GradeOptions
 from ..sandbox import backends
-from ..sandbox.backends.base import SandboxUnavailable
 from ..store import record as records
 from ..store.report import labkit_version, one_line
 from ..store.rubric import Rubric
 from ..store.rubric import load as load_rubric
 from ..submission.scoring import known_sources, submission_name
+from .processes import sandbox_problem
 from .resume import Resumed, content, notebooks, parse_shard, resumed, shard
 from .times import submission_time
 
@@ -135,12 +135,10 @@ def _named(request, part):
 
 def _check_backend(name):
     """ValueError when the sandbox backend `name` cannot run here; its warning (``none``'s) on stderr."""
-    backend = backends.get_backend(name)
-    try:
-        backend.available()
-    except SandboxUnavailable as exc:
-        raise InputError(f"cannot grade in a sandbox: {exc}") from None
-    warning = backend.warning()
+    problem = sandbox_problem(name)
+    if problem is not None:
+        raise InputError(f"cannot grade in a sandbox: {problem}")
+    warning = backends.get_backend(name).warning()
     if warning:
         sys.stderr.write(warning)
 

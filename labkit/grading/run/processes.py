@@ -7,6 +7,7 @@ submission's time limit plus a grace for the checks. No student code runs here.
 
 import contextlib
 import ctypes
+import functools
 import json
 import os
 import resource
@@ -20,6 +21,7 @@ from pathlib import Path
 
 from ...errors import InputError
 from ..sandbox import backends, cgroup, forkserver
+from ..sandbox.backends.base import SandboxUnavailable
 from ..store import record as records
 from ..store.late import read_small
 from ..store.report import FORMAT, one_line, safe_name
@@ -73,6 +75,8 @@ class Job:
         )
         memory = self.options.grader_memory
         group = self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
+        folders = [group.path, group.cpu_path] if group is not None else []
+        cgroups = [str(folder / "cgroup.procs") for folder in folders if folder is not None]
         environment = one_thread()
         if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
             environment.update(group.sibling_environment())
@@ -80,8 +84,6 @@ class Job:
         if self.server is not None:
             environment.update(self.server.environment())
         if self.launcher is not None:
-            folders = [group.path, group.cpu_path] if group is not None else []
-            cgroups = [str(folder / "cgroup.procs") for folder in folders if folder is not None]
             request = {"spec": str(spec), "log": str(self.log), "memory": memory, "cgroups": cgroups}
             try:
                 self.process = self.launcher.launch({**request, "environment": environment})
@@ -89,14 +91,6 @@ class Job:
                 return
             except OSError:  # the launcher is gone: this submission and the next start the plain way
                 self.launcher = None
-        parent = os.getpid()
-
-        def prepare():
-            if group is not None:
-                group.join()
-            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
-            die_with(parent)
-
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "labkit.grading.submission.scoring", str(spec)],
@@ -104,7 +98,7 @@ class Job:
                 stdout=subprocess.DEVNULL,
                 stderr=log,
                 start_new_session=True,
-                preexec_fn=prepare,
+                preexec_fn=functools.partial(confine, os.getpid(), memory, cgroups),
                 env=environment,
                 pass_fds=(self.server.fd,) if self.server is not None else (),
             )
@@ -195,6 +189,25 @@ def one_thread():
 
 
 _LIBC = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None
+
+
+def confine(parent, memory, cgroups):
+    """In a grading process before it runs (Popen's ``preexec_fn``, or forked by the launcher): join its `cgroups`
+    (their ``cgroup.procs`` files), limit its address space to `memory` bytes, and die with `parent`."""
+    for procs in cgroups:
+        with open(procs, "w") as handle:
+            handle.write(str(os.getpid()))
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    die_with(parent)
+
+
+def sandbox_problem(backend):
+    """Why the sandbox backend named `backend` cannot run here, or None."""
+    try:
+        backends.get_backend(backend).available()
+    except SandboxUnavailable as exc:
+        return str(exc)
+    return None
 
 
 def die_with(parent):
