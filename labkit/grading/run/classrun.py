@@ -18,7 +18,7 @@ from ..progress import Progress
 from ..sandbox import timings
 from ..store import record as records
 from ..store import report as store
-from ..store.report import SubmissionGrade, one_line, write_report
+from ..store.report import one_line, write_report
 from ..store.variants import write_variants
 from ..submission import refusals
 from .engines import Batch, Engine, LocalEngine
@@ -57,9 +57,24 @@ def run(planned: Plan, engine: Engine, progress=True):
     folder = RunFolder(planned)
     folder.begin()
     start = time.monotonic()
-    graded, peaks = _on(engine, planned, progress, folder.add)
+    graded, peaks = {}, []
+    work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
+    try:
+        profiles_file = work / "profiles.json"
+        profiles_file.write_text(json.dumps(refusals.wire(planned.rubric.registry.refusals)), encoding="utf-8")
+        batch = Batch(planned.todo, planned.options, planned.rubric, profiles_file, work, planned.out)
+        outcomes = contextlib.closing(engine.grade(batch))
+        with Progress(len(planned.todo), "grading", enabled=progress) as bar, outcomes as each:
+            for outcome in each:
+                graded[outcome.grade.name] = outcome.grade
+                peaks.append(outcome.peak)
+                folder.add(outcome.grade)
+                bar.advance()
+    finally:
+        store.write_timings(planned.out, timings.collect(work))  # where each submission's time went (not feedback)
+        shutil.rmtree(work, ignore_errors=True)
     for name, why in planned.ungradable.items():
-        graded[name] = SubmissionGrade(name, seed=planned.options.seed, rubric=planned.rubric, failure=why)
+        graded[name] = batch.not_graded(name, why)
     ordered = [graded[name] if name in graded else planned.earlier.done[name] for name in planned.order]
     for grade in ordered:
         grade.time = planned.when[grade.name]
@@ -78,27 +93,6 @@ def run(planned: Plan, engine: Engine, progress=True):
     }
     folder.end(ordered, summary)
     return Graded(ordered, planned.earlier)
-
-
-def _on(engine, planned, progress, arrived):
-    """({name: grade}, [peak bytes]) of the submissions `engine` graded, each handed to `arrived` as it came."""
-    work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
-    graded, peaks = {}, []
-    try:
-        profiles_file = work / "profiles.json"
-        profiles_file.write_text(json.dumps(refusals.wire(planned.rubric.registry.refusals)), encoding="utf-8")
-        batch = Batch(planned.todo, planned.options, planned.rubric, profiles_file, work, planned.out)
-        outcomes = contextlib.closing(engine.grade(batch))
-        with Progress(len(planned.todo), "grading", enabled=progress) as bar, outcomes as each:
-            for outcome in each:
-                graded[outcome.grade.name] = outcome.grade
-                peaks.append(outcome.peak)
-                arrived(outcome.grade)
-                bar.advance()
-    finally:
-        store.write_timings(planned.out, timings.collect(work))  # where each submission's time went (not feedback)
-        shutil.rmtree(work, ignore_errors=True)
-    return graded, peaks
 
 
 class RunFolder:

@@ -230,11 +230,10 @@ def _kept(options):
         )
         if found is None or died:  # none started yet (or none could be: then none is tried again), or one died
             stop_warm(server, launcher)
-            server, launcher = start_warm(options)
             if key not in _KEPT:
                 atexit.register(_stop_kept, key)
-            _KEPT[key] = (server, launcher)
-        return server, launcher
+            _KEPT[key] = start_warm(options)
+        return _KEPT[key]
 
 
 def _stop_kept(key):

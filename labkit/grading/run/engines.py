@@ -6,6 +6,7 @@ process of its own (:class:`.processes.Job`), and stop starting them when the te
 space (:func:`.processes.low_space`), reporting the rest as not graded, saying why: a resumed run grades them.
 """
 
+import contextlib
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Generator
@@ -128,14 +129,11 @@ def start_warm(options):
     a new Python for every grading process), slower and as safe."""
     if not options.fork_server:
         return None, None
-    try:
+    server = launcher = None
+    with contextlib.suppress(forkserver.ForkServerError):
         server = forkserver.ForkServer(backends.get_backend(options.backend), options.limits).start(wait=False)
-    except forkserver.ForkServerError:
-        server = None
-    try:
+    with contextlib.suppress(OSError, ValueError):
         launcher = Launcher(options, server, wait=False)
-    except (OSError, ValueError):
-        launcher = None
     if server is not None:
         try:
             server.wait_ready()
