@@ -1,19 +1,8 @@
-"""Releasing the lab to students and grading what comes back.
-
-One subpackage per process and job (CONTRIBUTING.md draws the process tree):
-
-* :mod:`~labkit.grading.authoring` - handing the lab out: the student release, nbgrader's markup;
-* :mod:`~labkit.grading.run` - the grader's own process: the class as the LMS gives it, the class run, its
-  engines (here or on Dask), each submission's grading process and the launcher, resume, shards, merge;
-* :mod:`~labkit.grading.submission` - one submission's grading process: its notebooks, the source scan,
-  the refusals, copied code, scoring;
-* :mod:`~labkit.grading.sandbox` - isolation: backends, cgroup, seccomp, the protocol, the grader's handle,
-  the fork server and, inside the sandbox, the zygote, the worker and its watch;
-* :mod:`~labkit.grading.store` - what a run writes and reads back: results, the record, the rubric, lateness;
-* :mod:`~labkit.grading.reports` - what a person reads afterwards: the class report, similarity, marking, LMS;
-* :mod:`~labkit.grading.options` - the limits of a run, built once at its edge and passed to every process.
-
-Student code never runs in the grading process: see docs/grading-security.md.
+"""Releasing the lab to students and grading what comes back, in the rooms CONTRIBUTING.md maps: ``lms`` (the class
+in, the grades out), ``run`` (the plan and its run), ``submission`` (one submission's grading process), ``sandbox``
+(isolation), ``store`` (a run's folder), ``reports`` (what a person reads afterwards) and ``authoring`` (the
+release); ``options`` holds the limits of a run. Student code never runs in the grading process: see
+docs/grading-security.md.
 """
 
 import importlib

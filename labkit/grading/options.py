@@ -1,17 +1,9 @@
 """How a grading run is bounded and run: one options object, its defaults defined once.
 
-:class:`GradeOptions` is built once, at the edge: by the command line (``labkit grade``, whose
-defaults are read from here) or by the caller of :func:`labkit.grading.grade`.
-Inside, it is frozen and passed on as it is (the class run settles its seed
-and rubric once, :mod:`labkit.grading.run.classrun`), as plain data to each
-submission's grading process (:mod:`labkit.grading.submission.scoring`) and into the
-sandbox (:class:`labkit.grading.sandbox.remote.NotebookHandle`). No other module spells out
-a default of its own: they take the options object, or values from it.
-
-The options are the run's choices, plain data that a flag of ``labkit grade`` sets: its limits, seed,
-sandbox and rubric, and how the class is run (``jobs``, ``shard``, ``fresh``, which student-written
-times count). What one run is asked to grade, this class's paths, names, times, roster and variants,
-is a :class:`labkit.grading.run.plan.Submissions` instead (:mod:`labkit.grading.run.plan` says why).
+:class:`GradeOptions`, the run's choices that a flag of ``labkit grade`` sets, is built once at the edge (the command
+line, whose defaults are read from here, or the caller of :func:`labkit.grading.grade`) and passed on frozen, down
+to each submission's grading process and into the sandbox; no other module spells out a default of its own. What a
+run grades (paths, names, times, roster, variants) is a :class:`labkit.grading.run.plan.Submissions` instead.
 """
 
 import os
@@ -39,9 +31,8 @@ class GradeOptions:
     grader_grace: int = 120  # seconds the grader's own work may take beyond the submission's time limit
     # the exercises' registry as module:attribute (the lab's when None; see labkit.exercises)
     exercises: str | None = None
-    fork_server: bool = (
-        True  # notebooks' workers forked from one warm server per run (labkit.grading.sandbox.forkserver)
-    )
+    # notebooks' workers forked from one warm server per run (labkit.grading.sandbox.forkserver)
+    fork_server: bool = True
     # the instructor notebooks' folder, a known source (labkit.grading.submission.known); None: left out
     solutions: str | None = None
     # each student's own data (labkit.exercises.variants), derived by the class run from the roster and the

@@ -25,14 +25,13 @@ def environment():
 
 
 def style(name: str) -> Markup:
-    """A stylesheet of ``templates/`` as text to inline in a ``<style>`` element (labkit's own file, no input)."""
+    """A stylesheet or script of ``templates/`` as text to inline in a ``<style>`` or ``<script>`` element (labkit's
+    own file, no input)."""
     text = files("labkit.grading").joinpath("templates", name).read_text(encoding="utf-8")
     return Markup(text.replace("</", "<\\/"))
 
 
-def script(name: str) -> Markup:
-    """A script of ``templates/`` as text to inline in a ``<script>`` element (labkit's own file, no input)."""
-    return style(name)
+script = style  # a script is inlined as a stylesheet is
 
 
 def render(template: str, **values) -> str:

@@ -1,11 +1,7 @@
 """A progress bar with counts and an ETA, for the instructor's long commands (``labkit grade``, ``labkit merge``).
 
-:class:`Progress` draws with `rich <https://rich.readthedocs.io>`_ on standard
-error, and only on a terminal: in a batch job's log, a pipe or a file it
-prints nothing at all (``--quiet`` turns it off on a terminal too). The ETA
-is the time per finished item so far, times the items left: grading's items
-take similar times but finish in bursts when several run at once, which
-this average evens out.
+:class:`Progress` draws with `rich <https://rich.readthedocs.io>`_ on standard error, only on a terminal: in a batch
+job's log, a pipe or a file it prints nothing at all (``--quiet`` turns it off on a terminal too).
 
 >>> with Progress(3, "grading") as bar:  # not a terminal here: nothing is drawn
 ...     bar.advance()
@@ -26,7 +22,8 @@ def _eta_column():
     from rich.text import Text
 
     class Eta(ProgressColumn):
-        """The time left: the time per finished item so far, times the items left."""
+        """The time left: the time per finished item so far, times the items left (grading's items take similar
+        times but finish in bursts when several run at once, which this average evens out)."""
 
         def render(self, task):
             if not task.completed or task.total is None or task.elapsed is None:
@@ -38,18 +35,13 @@ def _eta_column():
 
 
 class Progress:
-    """Counts done of a total, a bar, the time taken and an ETA, drawn on a terminal only.
+    """Counts of `total` items done, a bar, the time taken and an ETA, after what is being done (`what`, "grading");
+    drawn on a terminal only, and never with `enabled` False (``--quiet``).
 
     Parameters
     ----------
-    total : int
-        How many items there are.
-    what : str
-        What is being done, shown before the bar ("grading").
-    enabled : bool
-        False draws nothing (``--quiet``).
     console : rich.console.Console, optional
-        Where to draw; standard error when None. Nothing is drawn unless it is a terminal.
+        Where to draw; standard error when None.
     get_time : callable, optional
         The clock, in seconds (for tests); rich's own when None.
 

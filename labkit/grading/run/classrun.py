@@ -1,11 +1,6 @@
-"""Grading a class: :func:`grade` plans the run (:mod:`.plan`), runs it on an engine, and writes the run folder.
-
-The plan touches nothing. :func:`run` hands the submissions still to grade to an engine (:mod:`.engines`:
-a few grading processes at a time here, or on a Dask cluster), each in a grading process of its own, so
-a submission that makes its grading crash, run out of memory or hang costs only its own grade (it is
-reported as "could not be graded", saying why). :class:`RunFolder` does every write: each submission's
-result and feedback as soon as it is graded, entered in the run's record, then ``grades.csv`` with every
-submission once and ``run.json``, how the run went (its seed, counts, time, engine, peak memory).
+"""Grading a class: :func:`grade` plans the run (:mod:`.plan`), runs it on an engine (:mod:`.engines`), and
+:class:`RunFolder` writes the run folder: each submission's result and feedback as soon as it is graded, then
+``grades.csv`` and ``run.json``, how the run went (its seed, counts, time, engine, peak memory).
 """
 
 import contextlib
@@ -23,7 +18,7 @@ from ..progress import Progress
 from ..sandbox import timings
 from ..store import record as records
 from ..store import report as store
-from ..store.report import SubmissionGrade, one_line, write_report
+from ..store.report import one_line, write_report
 from ..store.variants import write_variants
 from ..submission import refusals
 from .engines import Batch, Engine, LocalEngine
@@ -35,13 +30,12 @@ def grade(submissions, out_dir, options: GradeOptions | None = None, *, engine: 
     """Grade submissions; write grades.csv, feedback/, results/, seed.txt and the run's record into `out_dir`.
 
     `submissions` is a :class:`~labkit.grading.run.plan.Submissions`, or the paths alone. `options` (a
-    :class:`~labkit.grading.options.GradeOptions`, the defaults when None) bound the run: its limits, its
-    sandbox backend (``"none"``: student code runs unconfined, after a warning on stderr), its seed (drawn
-    and written to ``seed.txt`` when None), its rubric (a TOML file; else the one an earlier run recorded in
-    `out_dir`, else the lab's), its shard (``"I/N"``, :func:`~labkit.grading.run.resume.shard`), and the
-    student-written times that count (:func:`labkit.grading.run.times.submission_time`). `engine` grades:
-    by default a :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` processes here.
-    `progress` draws a bar with an ETA on a terminal.
+    :class:`~labkit.grading.options.GradeOptions`, the defaults when None) bound the run: a seed None is drawn, a
+    rubric None is the one an earlier run recorded in `out_dir`, else the lab's; with backend ``"none"`` student
+    code runs unconfined, after a warning on stderr. `engine` grades: by default a
+    :class:`~labkit.grading.run.engines.LocalEngine` of ``options.jobs`` processes here. `progress` draws a bar
+    with an ETA on a terminal. Each submission is graded in a process of its own, so one that crashes, runs out of
+    memory or hangs costs only its own grade ("could not be graded", saying why).
 
     A run into a folder with a run's record resumes it (:func:`~labkit.grading.run.resume.resumed`). Returns the
     grades in the order given (a shard's in name order; the ungradable last), an earlier run's included; those
@@ -63,9 +57,24 @@ def run(planned: Plan, engine: Engine, progress=True):
     folder = RunFolder(planned)
     folder.begin()
     start = time.monotonic()
-    graded, peaks = _on(engine, planned, progress, folder.add)
+    graded, peaks = {}, []
+    work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
+    try:
+        profiles_file = work / "profiles.json"
+        profiles_file.write_text(json.dumps(refusals.wire(planned.rubric.registry.refusals)), encoding="utf-8")
+        batch = Batch(planned.todo, planned.options, planned.rubric, profiles_file, work, planned.out)
+        outcomes = contextlib.closing(engine.grade(batch))
+        with Progress(len(planned.todo), "grading", enabled=progress) as bar, outcomes as each:
+            for outcome in each:
+                graded[outcome.grade.name] = outcome.grade
+                peaks.append(outcome.peak)
+                folder.add(outcome.grade)
+                bar.advance()
+    finally:
+        store.write_timings(planned.out, timings.collect(work))  # where each submission's time went (not feedback)
+        shutil.rmtree(work, ignore_errors=True)
     for name, why in planned.ungradable.items():
-        graded[name] = SubmissionGrade(name, seed=planned.options.seed, rubric=planned.rubric, failure=why)
+        graded[name] = batch.not_graded(name, why)
     ordered = [graded[name] if name in graded else planned.earlier.done[name] for name in planned.order]
     for grade in ordered:
         grade.time = planned.when[grade.name]
@@ -84,27 +93,6 @@ def run(planned: Plan, engine: Engine, progress=True):
     }
     folder.end(ordered, summary)
     return Graded(ordered, planned.earlier)
-
-
-def _on(engine, planned, progress, arrived):
-    """({name: grade}, [peak bytes]) of the submissions `engine` graded, each handed to `arrived` as it came."""
-    work = Path(tempfile.mkdtemp(prefix="labkit-run-"))
-    graded, peaks = {}, []
-    try:
-        profiles_file = work / "profiles.json"
-        profiles_file.write_text(json.dumps(refusals.wire(planned.rubric.registry.refusals)), encoding="utf-8")
-        batch = Batch(planned.todo, planned.options, planned.rubric, profiles_file, work, planned.out)
-        outcomes = contextlib.closing(engine.grade(batch))
-        with Progress(len(planned.todo), "grading", enabled=progress) as bar, outcomes as each:
-            for outcome in each:
-                graded[outcome.grade.name] = outcome.grade
-                peaks.append(outcome.peak)
-                arrived(outcome.grade)
-                bar.advance()
-    finally:
-        store.write_timings(planned.out, timings.collect(work))  # where each submission's time went (not feedback)
-        shutil.rmtree(work, ignore_errors=True)
-    return graded, peaks
 
 
 class RunFolder:

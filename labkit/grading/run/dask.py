@@ -1,15 +1,14 @@
 """Grading a class on a Dask cluster: :class:`DaskEngine`, ``labkit grade --dask ADDRESS`` (or ``--dask local``).
 
-One task per submission, graded in a Dask worker as ``--jobs`` grades it here (:func:`.engines.grade_one`:
-a grading process of its own, started with :mod:`subprocess`, since a worker is a daemonic process that
-multiprocessing refuses children). The workers need the same labkit version, the course's exercises
-module, the sandbox's tool and the submissions at the client's path (a shared file system); the rubric
-is sent, the refusals computed once per worker. A task whose worker dies goes to another (the scheduler's
-``allowed-failures``), one that raises runs once more (``retries=1``), then it is "could not be graded",
-which a resumed run grades again. A second arrival for a name is ignored and counted in ``run.json``.
-Dask is imported here only, when a run asks for it (the ``labkit[dask]`` extra).
+One task per submission (:func:`_task`), graded in a Dask worker as ``--jobs`` grades it here. The workers need
+the same labkit version, the course's exercises module, the sandbox's tool and the submissions at the client's
+path (a shared file system); the rubric is sent, the refusals computed once per worker. A task whose worker dies
+goes to another (the scheduler's ``allowed-failures``), one that raises runs once more (``retries=1``), then it is
+"could not be graded", which a resumed run grades again. A second arrival for a name is ignored and counted in
+``run.json``. Dask is imported here only, when a run asks for it (the ``labkit[dask]`` extra).
 """
 
+import atexit
 import functools
 import json
 import logging
@@ -18,18 +17,18 @@ import resource
 import secrets
 import shutil
 import tempfile
+import threading
+import time
 from collections.abc import Generator
 from dataclasses import replace
 from pathlib import Path
 
 from ...errors import InputError
 from ..options import GradeOptions
-from ..sandbox import backends
-from ..sandbox.backends.base import SandboxUnavailable
 from ..store.report import one_line, safe_name
 from ..submission import refusals
-from .engines import Batch, Engine, Outcome, grade_one
-from .processes import low_space, settled
+from .engines import Batch, Engine, Outcome, start_warm, stop_warm
+from .processes import Job, low_space, sandbox_problem
 
 LOCAL = "local"  # --dask local: a LocalCluster on this machine
 CONNECT_TIMEOUT = "30s"  # to reach a scheduler
@@ -47,16 +46,10 @@ def _dask():
     return distributed
 
 
-def _check_address(address):
-    if not isinstance(address, str) or not address.strip():
-        raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
-
-
 def connect(address, workers=2):
     """(client, close) of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker
     processes when it is ``"local"``; ``close()`` closes both. ValueError when it cannot be reached."""
     distributed = _dask()
-    _check_address(address)
     if address == LOCAL:
         if int(workers) < 1:
             raise InputError(f"--dask-workers must be at least 1; got {workers}.")
@@ -86,7 +79,8 @@ class DaskEngine(Engine):
     name = "dask"
 
     def __init__(self, address: str, workers: int = 2):
-        _check_address(address)
+        if not isinstance(address, str) or not address.strip():
+            raise InputError(f"--dask takes a scheduler's address (tcp://host:8786) or 'local'; got {address!r}.")
         self.address, self.workers = address, workers
         self._record: dict = {"engine": self.name}
 
@@ -134,8 +128,8 @@ class DaskEngine(Engine):
                 worker = message.get("worker")
                 if worker:
                     by_worker[worker] = by_worker.get(worker, 0) + 1
-                yield Outcome(settled(message, batch.rubric, options.seed), message.get("peak"))
-                stopped = stopped or low_space(batch.out)
+                yield batch.outcome(message)
+                stopped = low_space(batch.out)
                 if stopped is not None:
                     break
             if stopped is not None:  # as the local engine does: the rest are reported, and a resumed run grades them
@@ -171,19 +165,13 @@ def _profiles_text(exercises):
     return json.dumps(refusals.wire(load_registry(exercises).refusals))
 
 
-@functools.cache
-def _sandbox_problem(backend):
-    """Why the sandbox cannot run on this worker, or None."""
-    try:
-        backends.get_backend(backend).available()
-    except SandboxUnavailable as exc:
-        return str(exc)
-    return None
+_sandbox_problem = functools.cache(sandbox_problem)  # looked at once per worker process
 
 
 def _task(path, name, payload):
-    """In a Dask worker: grade one submission (:func:`.engines.grade_one`); its outcome as plain
-    data, with the worker's address."""
+    """In a Dask worker: grade one submission in a grading process of its own (started once more if it breaks,
+    with :mod:`subprocess`: a worker is a daemonic process that multiprocessing refuses children); its
+    outcome as plain data (:meth:`.processes.Job.message`), with the worker's address."""
     from distributed import get_worker
 
     try:
@@ -209,7 +197,44 @@ def _task(path, name, payload):
         if payload.get("rubric") is not None:
             (work / "rubric.toml").write_text(payload["rubric"], encoding="utf-8")
             options = replace(options, rubric=str(work / "rubric.toml"))
-        outcome.update(grade_one(path, name, options, profiles_file, work))
+        job = Job(path, name, work, options, profiles_file, *_kept(options))
+        while True:
+            job.start()
+            while not job.poll():
+                time.sleep(0.05)
+            if job.conclude():
+                break
+        outcome.update(job.message())
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return outcome
+
+
+_KEPT: dict = {}  # (backend, limits, exercises, thread) -> (fork server, launcher) kept
+_KEPT_LOCK = threading.Lock()
+
+
+def _kept(options):
+    """The fork server and launcher this worker keeps (:func:`.engines.start_warm`), as it grades one submission per
+    task: started on first use, started again if they died, stopped when the process ends."""
+    if not options.fork_server:
+        return None, None
+    # one pair per thread: a worker's threads never stop each other's, and the pair dies with its thread
+    # (the sandbox and the launcher are set to die with the thread that started them)
+    key = (options.backend, options.limits, options.exercises, threading.get_ident())
+    with _KEPT_LOCK:
+        found = _KEPT.get(key)
+        server, launcher = found or (None, None)
+        died = (server is not None and server.box.process.poll() is not None) or (
+            launcher is not None and launcher.process.poll() is not None
+        )
+        if found is None or died:  # none started yet (or none could be: then none is tried again), or one died
+            stop_warm(server, launcher)
+            if key not in _KEPT:
+                atexit.register(_stop_kept, key)
+            _KEPT[key] = start_warm(options)
+        return _KEPT[key]
+
+
+def _stop_kept(key):
+    stop_warm(*_KEPT.pop(key, (None, None)))

@@ -1,22 +1,20 @@
 """The launcher: one warm Python that forks each submission's grading process; its client and its server.
 
-Started as ``python -m labkit.grading.submission.scoring SPEC``, each grading process (:mod:`.processes`)
-would import labkit's checks, numpy and scipy again. The client, :class:`Launcher`, starts
-``python -m labkit.grading.run.launcher`` once per run instead: the server (:func:`main`) imports all
-that, then forks one child per submission, which puts itself in a session, cgroup and address-space
-limit of its own (what ``Popen``'s ``preexec_fn`` does otherwise) and runs
+Started as ``python -m labkit.grading.submission.scoring SPEC``, each grading process (:mod:`.processes`) would
+import labkit's checks, numpy and scipy again. Instead :class:`Launcher` starts ``python -m
+labkit.grading.run.launcher`` once per run: its server (:func:`main`) imports all that, then forks one child per
+submission, which puts itself in a session, cgroup and address-space limit of its own and runs
 :func:`labkit.grading.submission.scoring.main`. No student code runs here: only in the child's sandboxes.
 
-The server reads one request per line on stdin (``{"spec", "log", "memory", "cgroups", "environment",
-"id"}``) and writes one line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id":
-i}`` and ``{"ended": pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid can be used again),
-``c`` as Popen's returncode. When its stdin closes (the run is over, or the grader died) it stops every
-child still running and ends.
+The server reads one request per line on stdin (``{"spec", "log", "memory", "cgroups", "environment", "id"}``) and
+writes one line per event on stdout: ``{"ready": true}`` once, then ``{"started": pid, "id": i}`` and ``{"ended":
+pid, "id": i, "code": c}``, `i` the request's own ``id`` (a pid can be used again), ``c`` as Popen's returncode.
+When its stdin closes (the run is over, or the grader died) it stops every child still running and ends.
 """
 
+import contextlib
 import json
 import os
-import resource
 import secrets
 import select
 import signal
@@ -26,7 +24,7 @@ import threading
 import time
 
 from ..sandbox import protocol
-from .processes import die_with, one_thread
+from .processes import confine, die_with, one_thread
 
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
 LAUNCHER_READY = 120  # seconds for the launcher to import the grader
@@ -46,17 +44,14 @@ class _Launched:
     def returncode(self):
         return self.launcher.ended.get(self.key)
 
-    def poll(self):
-        self.launcher.pump(0)
+    def poll(self, wait=0):
+        if not self.launcher.pump(wait) and self.launcher.process.poll() is not None:
+            self.launcher.ended.setdefault(self.key, -signal.SIGKILL)  # the launcher is gone, and its children
         return self.returncode
 
-    def wait(self, timeout=None):
-        until = None if timeout is None else time.monotonic() + timeout
-        while self.returncode is None:
-            if until is not None and time.monotonic() > until:
-                raise subprocess.TimeoutExpired("grading process", timeout)
-            if not self.launcher.pump(0.05) and self.launcher.process.poll() is not None:
-                self.launcher.ended.setdefault(self.key, -signal.SIGKILL)  # the launcher is gone, and its children
+    def wait(self):
+        while self.poll(0.05) is None:
+            pass
         return self.returncode
 
 
@@ -64,7 +59,7 @@ class Launcher:
     """One warm process that forks each submission's grading process (its server: :func:`main`)."""
 
     def __init__(self, options, server=None, wait=True):
-        self.ended, self._lines, self._lock = {}, None, threading.RLock()
+        self.ended, self._lock = {}, threading.RLock()
         parent = os.getpid()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "labkit.grading.run.launcher", options.exercises or ""],
@@ -76,6 +71,7 @@ class Launcher:
             pass_fds=(server.fd,) if server is not None else (),
             preexec_fn=lambda: die_with(parent),
         )
+        self._lines = protocol.Lines(self.process.stdout.fileno(), REQUEST_LIMIT)
         if wait:
             self.wait_ready()
 
@@ -87,12 +83,8 @@ class Launcher:
 
     def _next(self, until):
         """The launcher's next message, or None when `until` passes or it is gone."""
-        try:
-            fd = self.process.stdout.fileno()
-        except ValueError:  # stopped
+        if self.process.stdout.closed:  # stopped
             return None
-        if self._lines is None or self._lines.fd != fd:
-            self._lines = protocol.Lines(fd, REQUEST_LIMIT)
         try:
             line = self._lines.readline(until)
         except (TimeoutError, protocol.ProtocolError):  # nothing yet, or not the launcher's message
@@ -131,10 +123,8 @@ class Launcher:
                     return _Launched(self, int(message["started"]), key)
 
     def stop(self):
-        try:
+        with contextlib.suppress(OSError):
             self.process.stdin.close()  # it stops every grading process still running, then ends
-        except OSError:
-            pass
         try:
             self.process.wait(timeout=10)
         except subprocess.TimeoutExpired:
@@ -160,12 +150,7 @@ def _child(request):
     code = 1
     try:
         os.setsid()
-        die_with(request["launcher"])
-        for procs in request.get("cgroups", ()):
-            with open(procs, "w") as handle:
-                handle.write(str(os.getpid()))
-        memory = int(request["memory"])
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        confine(request["launcher"], int(request["memory"]), request.get("cgroups", ()))
         null = os.open(os.devnull, os.O_RDWR)
         log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         for fd, target in ((null, 0), (null, 1), (log, 2)):
@@ -185,11 +170,9 @@ def _child(request):
     except BaseException:  # noqa: BLE001 - written to the log, as an unforked process would have
         import traceback
 
-        try:
+        with contextlib.suppress(Exception):
             traceback.print_exc()
             sys.stderr.flush()
-        except Exception:  # noqa: BLE001
-            pass
     os._exit(code)
 
 
@@ -239,10 +222,8 @@ def main(argv=None):
                 _say({"started": pid, "id": request.get("id")})
     finally:
         for pid in children:
-            try:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
         deadline = time.monotonic() + 5
         while children and time.monotonic() < deadline:
             _reaped(children)

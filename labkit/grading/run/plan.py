@@ -1,13 +1,8 @@
 """A class run's plan: what it grades, with what, and what it takes over, worked out before anything runs.
 
-:func:`plan` turns a :class:`Submissions`, the output folder and the run's options into a frozen
-:class:`Plan`, reading and never writing: names and shard, the earlier run resumed (:mod:`.resume`), each
-student's data and time, the known sources, the options every grading process gets. Every refusal comes
-from here, before a file is touched. :class:`~labkit.grading.options.GradeOptions` holds the run's choices
-(plain data a flag sets, the same for every submission: limits, seed, rubric, ``jobs``, ``shard``,
-``fresh``, the student-written times allowed); :class:`Submissions` what this run grades (data about one
-class: paths, names, the ungradable, the times given, roster, variants). The engine and the progress bar,
-how this process carries the run out, are keywords of :func:`.classrun.grade`.
+:func:`plan` turns a :class:`Submissions` (what this run grades: data about one class), the output folder and the
+run's :class:`~labkit.grading.options.GradeOptions` (its choices, the same for every submission) into a frozen
+:class:`Plan`, reading and never writing: every refusal comes from here, before a file is touched.
 """
 
 import os
@@ -21,12 +16,12 @@ from typing import TYPE_CHECKING
 from ...errors import InputError
 from ..options import GradeOptions
 from ..sandbox import backends
-from ..sandbox.backends.base import SandboxUnavailable
 from ..store import record as records
 from ..store.report import labkit_version, one_line
 from ..store.rubric import Rubric
 from ..store.rubric import load as load_rubric
 from ..submission.scoring import known_sources, submission_name
+from .processes import sandbox_problem
 from .resume import Resumed, content, notebooks, parse_shard, resumed, shard
 from .times import submission_time
 
@@ -140,12 +135,10 @@ def _named(request, part):
 
 def _check_backend(name):
     """ValueError when the sandbox backend `name` cannot run here; its warning (``none``'s) on stderr."""
-    backend = backends.get_backend(name)
-    try:
-        backend.available()
-    except SandboxUnavailable as exc:
-        raise InputError(f"cannot grade in a sandbox: {exc}") from None
-    warning = backend.warning()
+    problem = sandbox_problem(name)
+    if problem is not None:
+        raise InputError(f"cannot grade in a sandbox: {problem}")
+    warning = backends.get_backend(name).warning()
     if warning:
         sys.stderr.write(warning)
 

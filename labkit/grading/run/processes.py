@@ -1,14 +1,13 @@
 """Each submission's grading process, as the grader supervises it: its limits, its end, its outcome.
 
-A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` for one submission (or has the
-run's launcher fork it: :mod:`.launcher`) in an address-space limit and a memory cgroup of its own
-(:mod:`labkit.grading.sandbox.cgroup`), set to die with the thread that started it, and stops it when it
-overruns the submission's time limit plus a grace for the checks. One that breaks is started once more
-(:data:`ATTEMPTS`); its outcome is plain data (:meth:`Job.message`), which :func:`settled` scores under the
-run's rubric. No student code runs here.
+A :class:`Job` starts ``python -m labkit.grading.submission.scoring SPEC`` (or has the run's launcher fork it,
+:mod:`.launcher`) in an address-space limit and a memory cgroup of its own, and stops it when it overruns the
+submission's time limit plus a grace for the checks. No student code runs here.
 """
 
+import contextlib
 import ctypes
+import functools
 import json
 import os
 import resource
@@ -22,9 +21,10 @@ from pathlib import Path
 
 from ...errors import InputError
 from ..sandbox import backends, cgroup, forkserver
+from ..sandbox.backends.base import SandboxUnavailable
 from ..store import record as records
 from ..store.late import read_small
-from ..store.report import FORMAT, SubmissionGrade, one_line, safe_name
+from ..store.report import FORMAT, one_line, safe_name
 
 MIN_FREE = 512 * 1024**2  # bytes free in the temporary and output folders before a submission starts
 ATTEMPTS = 2  # a grading process that breaks is started once more
@@ -75,6 +75,8 @@ class Job:
         )
         memory = self.options.grader_memory
         group = self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
+        folders = [group.path, group.cpu_path] if group is not None else []
+        cgroups = [str(folder / "cgroup.procs") for folder in folders if folder is not None]
         environment = one_thread()
         if group is not None:  # the sandboxes' cgroups go beside the grading process's, not inside its limit
             environment.update(group.sibling_environment())
@@ -82,8 +84,6 @@ class Job:
         if self.server is not None:
             environment.update(self.server.environment())
         if self.launcher is not None:
-            folders = [group.path, group.cpu_path] if group is not None else []
-            cgroups = [str(folder / "cgroup.procs") for folder in folders if folder is not None]
             request = {"spec": str(spec), "log": str(self.log), "memory": memory, "cgroups": cgroups}
             try:
                 self.process = self.launcher.launch({**request, "environment": environment})
@@ -91,14 +91,6 @@ class Job:
                 return
             except OSError:  # the launcher is gone: this submission and the next start the plain way
                 self.launcher = None
-        parent = os.getpid()
-
-        def prepare():
-            if group is not None:
-                group.join()
-            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
-            die_with(parent)
-
         with open(self.log, "wb") as log:
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "labkit.grading.submission.scoring", str(spec)],
@@ -106,7 +98,7 @@ class Job:
                 stdout=subprocess.DEVNULL,
                 stderr=log,
                 start_new_session=True,
-                preexec_fn=prepare,
+                preexec_fn=functools.partial(confine, os.getpid(), memory, cgroups),
                 env=environment,
                 pass_fds=(self.server.fd,) if self.server is not None else (),
             )
@@ -115,15 +107,6 @@ class Job:
     @property
     def limit(self):
         return self.options.total_timeout + self.options.grader_grace
-
-    def stop(self):
-        """Kill the grading process and everything it started (its sandboxes die with it)."""
-        try:
-            os.killpg(self.process.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
-        self.process.wait()
-        self.finish()
 
     def last_words(self):
         """The last line the grading process wrote to stderr (a Python error's summary), as one printable line."""
@@ -135,40 +118,27 @@ class Job:
             return ""
         return f": {one_line(lines[-1], 200)}" if lines else ""
 
-    def finish(self):
-        self.out_of_memory, self.peak = False, None
-        if self.cgroup is not None:
-            self.out_of_memory = self.cgroup.out_of_memory()
-            self.peak = self.cgroup.peak()
-            self.cgroup.remove()
-
     def poll(self):
-        """Whether this attempt is over (its process ended, or it overran its limit and was stopped)."""
+        """Whether this attempt is over: its process ended, or overran its limit and was killed with everything it
+        started (its sandboxes die with it)."""
         running = self.process.poll() is None
         if running and time.monotonic() - self.started <= self.limit:
             return False
         self.timed_out = running
         if running:
-            self.stop()
-        else:
-            self.finish()
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(self.process.pid, signal.SIGKILL)
+            self.process.wait()
+        self.out_of_memory, peak = False, None
+        if self.cgroup is not None:
+            self.out_of_memory, peak = self.cgroup.out_of_memory(), self.cgroup.peak()
+            self.cgroup.remove()
+        self.peaks.append(peak)
         return True
 
-    def wait(self):
-        """Wait until this attempt is over (its process ends, or it overruns its limit and is stopped)."""
-        try:
-            self.process.wait(timeout=max(0.0, self.limit - (time.monotonic() - self.started)))
-        except subprocess.TimeoutExpired:
-            self.stop()
-            self.timed_out = True
-        else:
-            self.finish()
-            self.timed_out = False
-
     def conclude(self):
-        """After an attempt: True when the submission is done (:meth:`message`), False when its grading
-        process is to be started once more."""
-        self.peaks.append(self.peak)
+        """After an attempt: True when the submission is done (:meth:`message`), False when its grading process is
+        to be started once more (:data:`ATTEMPTS`)."""
         self.data, self.why = self.read()
         return self.data is not None or self.attempt >= ATTEMPTS
 
@@ -221,6 +191,25 @@ def one_thread():
 _LIBC = ctypes.CDLL(None, use_errno=True) if sys.platform.startswith("linux") else None
 
 
+def confine(parent, memory, cgroups):
+    """In a grading process before it runs (Popen's ``preexec_fn``, or forked by the launcher): join its `cgroups`
+    (their ``cgroup.procs`` files), limit its address space to `memory` bytes, and die with `parent`."""
+    for procs in cgroups:
+        with open(procs, "w") as handle:
+            handle.write(str(os.getpid()))
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    die_with(parent)
+
+
+def sandbox_problem(backend):
+    """Why the sandbox backend named `backend` cannot run here, or None."""
+    try:
+        backends.get_backend(backend).available()
+    except SandboxUnavailable as exc:
+        return str(exc)
+    return None
+
+
 def die_with(parent):
     """In a grading process before it runs: be killed when the thread that started it dies (the grader, or
     a Dask worker killed mid-task), so no grading outlives its grader; Linux only."""
@@ -228,17 +217,3 @@ def die_with(parent):
         _LIBC.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
         if os.getppid() != parent:  # the grader died before the line above
             os._exit(1)
-
-
-def settled(message, rubric, seed):
-    """The :class:`SubmissionGrade` of :func:`grade_one`'s outcome, scored with `rubric`; a result that cannot be
-    read (another labkit version's, say) makes a submission that could not be graded, saying why."""
-    name = message["name"]
-    if message.get("result") is not None:
-        try:
-            grade = SubmissionGrade.from_dict(message["result"], one_line(name, 80), rubric)
-        except ValueError as exc:
-            return SubmissionGrade(name, seed=seed, rubric=rubric, failure=f"its result could not be read ({exc})")
-        grade.name = name
-        return grade
-    return SubmissionGrade(name, seed=seed, rubric=rubric, failure=str(message.get("failure")))

@@ -1,9 +1,5 @@
-"""What a run into an output folder takes over from the one before it there, and which part of a class it grades.
-
-:func:`resumed` reads the earlier run's record (:mod:`labkit.grading.store.record`) and keeps the
-submissions graded there whose notebooks did not change since; :func:`carried_marks` keeps a person's
-marks that still apply to one graded again. :func:`shard` picks the I-th of N parts of a class, for
-batch systems (``--shard I/N``); ``labkit merge`` combines the parts.
+"""What a run into an output folder takes over from the one before it there (:func:`resumed`, :func:`carried_marks`),
+and which part of a class it grades (:func:`shard`, for batch systems; ``labkit merge`` combines the parts).
 """
 
 from dataclasses import dataclass, field
@@ -50,11 +46,11 @@ class Resumed:
 def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     """What the earlier run in `out` leaves to this one: a :class:`Resumed`. Reads, never writes.
 
-    The submissions graded there are kept unless their notebooks' digest differs from the recorded one
-    (`contents`, {name: digest}) or they could not be graded; the others are graded with the earlier run's
-    seed and rubric, which `seed` and `rubric` (None: the recorded one) may repeat but not change. Another
-    labkit version's folder, a merge's, results without a record, or a result of a name not in `names` are
-    refused with a ValueError saying what to do. With `fresh` nothing is kept (:func:`clear` deletes it)."""
+    The submissions graded there are kept unless their notebooks' digest differs from `contents` ({name: digest})
+    or they could not be graded; the others are graded with the earlier run's seed and rubric, which `seed` and
+    `rubric` (None: the recorded one) may repeat but not change. Another labkit version's folder, a merge's, results
+    without a record, or a result of a name not in `names` are refused, saying what to do. With `fresh` nothing is
+    kept (:func:`clear` deletes it)."""
     out = Path(out)
     files = sorted((out / "results").glob("*.json")) if (out / "results").is_dir() else []
     if fresh or not (out / records.RECORD).exists():
@@ -164,14 +160,13 @@ def parse_shard(spec):
 
 
 def shard(names, index, count):
-    """The `index`-th (from 1) of `count` parts of `names`, in name order: every name is in exactly one part,
-    the parts' sizes differ by at most one, and with more parts than names some parts are empty.
+    """The `index`-th (from 1) of `count` parts of `names` (checked by :func:`parse_shard`), in name order: every
+    name is in exactly one part, the parts' sizes differ by at most one, and with more parts than names some are empty.
 
     >>> [shard(["d", "a", "c", "b", "e"], i, 2) for i in (1, 2)]
     [['a', 'b'], ['c', 'd', 'e']]
     >>> shard(["a"], 2, 3)
     []
     """
-    index, count = parse_shard((index, count))
     ordered = sorted(names)
     return ordered[(index - 1) * len(ordered) // count : index * len(ordered) // count]
