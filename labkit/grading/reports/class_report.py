@@ -1,11 +1,8 @@
 """The class report: one self-contained HTML page about a grading run (``labkit report OUT``).
 
-:func:`read` reads a run's results back (a merged run's too), :func:`summarise` counts what the class did,
-:func:`write` writes ``OUT/report.html`` from ``templates/class_report.*``: totals (after any late penalty),
-lateness, pass rates, slips, problems (by the kind codes the grader set, never by their words), the most
-failed parts, held parts, copies and similar code (which never changes a grade; without pygments, "not
-computed" and why). Figures are inline PNGs drawn on matplotlib's Agg canvas; every text a submission could
-have influenced is made printable and bounded (:func:`~labkit.grading.store.report.one_line`), then escaped.
+:func:`read` reads a run's results back (a merged run's too), :func:`summarise` counts what the class did and
+:func:`write` renders ``templates/class_report.*`` into ``OUT/report.html``. Figures are inline PNGs drawn on
+matplotlib's Agg canvas; every text a submission could have influenced is made printable and bounded, then escaped.
 """
 
 from __future__ import annotations
@@ -14,8 +11,7 @@ import base64
 import io
 import os
 import statistics
-import tempfile
-from collections import Counter, defaultdict
+from collections import Counter, defaultdict, namedtuple
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from datetime import timedelta
@@ -38,8 +34,8 @@ from ...exercises.result import (
 )
 from .. import pages
 from ..store import late as lateness
+from ..store import record as records
 from ..store.names import shown_name
-from ..store.record import rubric_for
 from ..store.report import SubmissionGrade, one_line, printable, read_results
 from ..store.report import problem_kinds as kinds_of
 from ..store.rubric import Rubric
@@ -107,32 +103,12 @@ class PartRate(_Rated):
         return self.passed + self.slipped + self.problem
 
 
-@dataclass(frozen=True)
-class Slip:
-    """One hint of one part, and the students whose work failed the part with it."""
-
-    exercise: int
-    part: str
-    hint: str
-    students: tuple
-
-
-@dataclass(frozen=True)
-class Problem:
-    """What went wrong for one student, of one kind (its texts as the grader worded them)."""
-
-    student: str
-    texts: tuple
-
-
-@dataclass(frozen=True)
-class Struggle:
-    """A student's failed parts: "exercise part" labels of those attempted and failed, and those not done."""
-
-    student: str
-    total: float
-    failed: tuple
-    not_done: int
+# one hint of one part, and the students whose work failed the part with it
+Slip = namedtuple("Slip", "exercise part hint students")
+# what went wrong for one student, of one kind (its texts as the grader worded them)
+Problem = namedtuple("Problem", "student texts")
+# a student's failed parts: "exercise part" labels of those attempted and failed, and how many not done
+Struggle = namedtuple("Struggle", "student total failed not_done")
 
 
 @dataclass(frozen=True)
@@ -248,7 +224,6 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
 
     Parameters
     ----------
-    folder : str or Path
     rubric : Rubric, optional
         The rubric the run was scored with (the recorded one when None; another one is refused).
 
@@ -272,17 +247,13 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
             f"{folder / 'results'} holds more than {MAX_SUBMISSIONS:,} result files, more than a class report "
             "shows: split the class and report on each part."
         )
-    return read_results([folder], rubric_for([folder], rubric, "the class report"))
+    return read_results([folder], records.rubric_for([folder], rubric, "the class report"))
 
 
 def check_outcome(check: dict) -> str:
-    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"``, ``"another
-    variant"`` or a problem's kind (:data:`OUTCOMES`; ``"other"``: a fault of the check itself).
-
-    Parameters
-    ----------
-    check : dict
-        One entry of an exercise's ``checks`` in a result.
+    """What became of one part in one submission (`check`, one entry of an exercise's ``checks`` in a result):
+    ``"passed"``, ``"slip"``, ``"not done"``, ``"another variant"`` or a problem's kind (:data:`OUTCOMES`;
+    ``"other"``: a fault of the check itself).
 
     Examples
     --------
@@ -584,7 +555,6 @@ def render(
 
     Parameters
     ----------
-    summary : ClassSummary
     pairs : list of Pair, optional
         Similar code to show side by side; None when the search was not made.
     threshold : float
@@ -644,10 +614,8 @@ def _check_pairs(pairs):
 
 def _variant_students(out):
     """Each student's variant data, as the run in `out` recorded them ({} without variants or a record)."""
-    from ..store.record import read as read_record
-
     try:
-        return read_record(out).variants.get("students", {})
+        return records.read(out).variants.get("students", {})
     except ValueError:
         return {}
 
@@ -660,17 +628,9 @@ def write(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> Path:
-    """Write ``report.html`` into a grading run's output folder, through a temporary file renamed over an
-    earlier report, and return its path; the folder's other files are neither read nor touched.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        The run's ``--out`` folder.
-    grades : list of SubmissionGrade
-        The class (:func:`read` reads them from `out_dir`).
-    pairs, threshold, similarity_note
-        As for :func:`render`; `threshold` is in (0, 1].
+    """Write ``report.html`` into a grading run's ``--out`` folder `out_dir`, through a temporary file renamed over
+    an earlier report, and return its path; the folder's other files are neither read nor touched. `grades` are the
+    class (:func:`read` reads them), `pairs`, `threshold` (in (0, 1]) and `similarity_note` as for :func:`render`.
 
     Raises
     ------
@@ -689,16 +649,5 @@ def write(
     grades = list(grades)
     summary = summarise(grades)
     summary.copies = find_copies(grades, _variant_students(out))
-    page = render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note)
-    handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
-        "w", encoding="utf-8", dir=out, prefix=".report-", suffix=".html.tmp", delete=False
-    )
-    try:
-        with handle:
-            handle.write(page)
-        os.chmod(handle.name, 0o644)
-        os.replace(handle.name, target)
-    except BaseException:
-        Path(handle.name).unlink(missing_ok=True)
-        raise
+    records.replace_text(target, render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note))
     return target
