@@ -120,54 +120,40 @@ class LateEntry(lateness.Lateness):
 
 @dataclass(frozen=True)
 class LateSummary:
-    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission, by name."""
+    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission, by name, and
+    the groups the page lists (see :meth:`of`)."""
 
     rule: lateness.Late
     entries: tuple
-
-    @property
-    def late(self):
-        """The late submissions, latest first."""
-        return sorted((e for e in self.entries if e.units > 0), key=lambda e: (-e.late_by, e.student))
-
-    @property
-    def on_time(self):
-        return [e for e in self.entries if e.known and e.units <= 0]
-
-    @property
-    def within_grace(self):
-        return [e for e in self.on_time if e.late_by > timedelta(0)]
-
-    @property
-    def unknown(self):
-        return [e for e in self.entries if not e.known]
-
-    @property
-    def extended(self):
-        return [e for e in self.entries if e.extended]
-
-    @property
-    def student_supplied(self):
-        """Submissions whose known time the student supplied (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)."""
-        return [e for e in self.entries if e.known and e.time.source in lateness.STUDENT_SUPPLIED]
-
-    @property
-    def penalty(self):
-        return round(sum(e.penalty for e in self.entries), 2)
-
-    @property
-    def unused_extensions(self):
-        """Names in ``[late.extensions]`` that no graded submission has (a typo in the rubric?)."""
-        names = {e.student for e in self.entries}
-        return [name for name, _ in self.rule.extensions if name not in names]
+    late: list  # latest first
+    on_time: list
+    within_grace: list
+    unknown: list
+    extended: list
+    student_supplied: list  # known times the student supplied (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)
+    penalty: float
+    unused_extensions: list  # names in ``[late.extensions]`` no graded submission has (a typo in the rubric?)
 
     @classmethod
     def of(cls, rubric, graded):
         """The late view of `graded`; None when the rubric has no ``[late]`` table."""
         if rubric.late is None:
             return None
-        entries = (LateEntry(**vars(g.lateness), student=g.name) for g in sorted(graded, key=lambda g: g.name))
-        return cls(rubric.late, tuple(entries))
+        entries = [LateEntry(**vars(g.lateness), student=g.name) for g in sorted(graded, key=lambda g: g.name)]
+        on_time = [e for e in entries if e.known and e.units <= 0]
+        names = {e.student for e in entries}
+        return cls(
+            rule=rubric.late,
+            entries=tuple(entries),
+            late=sorted((e for e in entries if e.units > 0), key=lambda e: (-e.late_by, e.student)),
+            on_time=on_time,
+            within_grace=[e for e in on_time if e.late_by > timedelta(0)],
+            unknown=[e for e in entries if not e.known],
+            extended=[e for e in entries if e.extended],
+            student_supplied=[e for e in entries if e.known and e.time.source in lateness.STUDENT_SUPPLIED],
+            penalty=round(sum(e.penalty for e in entries), 2),
+            unused_extensions=[name for name, _ in rubric.late.extensions if name not in names],
+        )
 
 
 @dataclass(frozen=True)
@@ -220,12 +206,8 @@ class ClassSummary:
 
 
 def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
-    """The grades, in name order, of a grading run's ``--out`` folder (``labkit grade`` or ``labkit merge``).
-
-    Parameters
-    ----------
-    rubric : Rubric, optional
-        The rubric the run was scored with (the recorded one when None; another one is refused).
+    """The grades, in name order, of a grading run's ``--out`` folder (``labkit grade`` or ``labkit merge``),
+    scored under `rubric`: the recorded one when None; another one is refused.
 
     Raises
     ------
@@ -408,12 +390,8 @@ def _checked(grades):
 
 
 def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
-    """Count what a class did: totals, pass rates, slips, problems and the most failed parts.
-
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        One per submission, all scored under one rubric (:func:`read` gives them).
+    """Count what a class did: totals, pass rates, slips, problems and the most failed parts, of `grades` (one
+    SubmissionGrade per submission, all scored under one rubric, as :func:`read` gives them).
 
     Raises
     ------
@@ -498,8 +476,9 @@ def _rate_text(rate, attempted):
     return "nobody attempted it" if rate is None else f"{rate:.0%} of {attempted}"
 
 
-def _bars(rated, labels):
+def _bars(rated):
     """Bars of the pass rates of `rated` (ExerciseRate or PartRate), each labelled, its rate written beside it."""
+    labels = [f"{r.exercise} {r.part}" if isinstance(r, PartRate) else f"exercise {r.exercise}" for r in rated]
     figure, axes = _figure(7.5, 0.9 + 0.26 * len(labels))
     positions = range(len(labels))
     axes.barh(positions, [100 * (r.rate or 0.0) for r in rated], color=BLUE, height=0.7)
@@ -511,14 +490,6 @@ def _bars(rated, labels):
     axes.set_xticks([0, 25, 50, 75, 100], ["0%", "25%", "50%", "75%", "100%"])
     axes.set_xlabel("passed, of the submissions that attempted it")
     return _png(figure)
-
-
-def _rate_figures(summary):
-    """Bar charts of the pass rates as base64 PNGs: the exercises', then the parts'."""
-    return [
-        _bars(summary.exercises, [f"exercise {e.exercise}" for e in summary.exercises]),
-        _bars(summary.parts, [f"{p.exercise} {p.part}" for p in summary.parts]),
-    ]
 
 
 def _text(value, limit=MAX_TEXT):
@@ -575,7 +546,7 @@ def render(
         late=summary.late,
         limits={name: value for name, value in globals().items() if name.startswith("MAX_")},
         totals=_totals(summary) if summary.totals else None,
-        rate_figures=_rate_figures(summary) if summary.totals else None,
+        rate_figures=[_bars(summary.exercises), _bars(summary.parts)] if summary.totals else None,
         rate_text=_rate_text,
         held_threshold=THRESHOLD,
         copy_lines=copies.holder_lines(),
