@@ -20,7 +20,7 @@ from pathlib import Path
 from ...errors import InputError
 from ...exercises.result import (
     CRASH,
-    HELD,
+    ERROR,
     NOT_DONE,
     OTHER,
     PASSED,
@@ -249,11 +249,9 @@ def check_outcome(check: dict) -> str:
     if not isinstance(check, dict):
         raise InputError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
     kind = part_kind(check)  # the one place a part's kind is decided: the feedback and labkit handin agree
-    if kind in (PASSED, HELD):
-        return PASSED
-    if kind in (NOT_DONE, VARIANT, SLIP):
+    if kind != ERROR:
         return kind
-    kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}
+    kinds = {s.get("kind") for s in check["steps"] if isinstance(s, dict) and not s.get("passed")}
     return next((kind for kind in OUTCOMES if kind in kinds), OTHER)
 
 
@@ -273,11 +271,6 @@ def problem_kinds(problem: str) -> list[tuple[str, str]]:
     return [(kind, one_line(description, MAX_TEXT)) for kind, description in kinds_of(problem)]
 
 
-def _steps(check):
-    steps = check.get("steps", [])
-    return [s for s in steps if isinstance(s, dict)] if isinstance(steps, list) else []
-
-
 def _checks(grade, number):
     """{part name: check} of exercise `number` in `grade`; None when the submission does not have it."""
     verdict = grade.results.get(number)
@@ -292,7 +285,7 @@ def _weights(rubric, exercise):
 def _failed_text(check, number):
     details = [
         f"{one_line(s.get('step', ''), 100)}: {one_line(s.get('detail', ''), MAX_TEXT)}"
-        for s in _steps(check)
+        for s in check["steps"]
         if not s.get("passed")
     ]
     return one_line(f"exercise {number}, {check.get('name', '?')}: " + ("; ".join(details) or "failed"), MAX_TEXT)
@@ -309,7 +302,7 @@ class _Tally:
 
     def part(self, grade, number, name, index, check):
         """What became of part `name` of exercise `number` in `grade`, noted where the page shows it."""
-        outcome = check_outcome(check) if check else NOT_DONE
+        outcome = check_outcome(check)
         if outcome == NOT_DONE:
             self.not_done[grade.name] += 1
         elif outcome != PASSED:
@@ -331,7 +324,7 @@ class _Tally:
         counts = {name: Counter(missing=len(graded) - len(found)) for name in names}
         attempted = passed = 0
         for grade, checks in found:
-            outcomes = [self.part(grade, number, n, i, checks.get(n) or {}) for i, n in enumerate(names)]
+            outcomes = [self.part(grade, number, n, i, checks.get(n, {})) for i, n in enumerate(names)]
             for name, outcome in zip(names, outcomes):
                 counts[name][outcome] += 1
             attempted += any(outcome != NOT_DONE for outcome in outcomes)
