@@ -1,12 +1,5 @@
-"""The student version of the instructor notebooks (nbgrader's markers and stubs).
-
-A ``### BEGIN SOLUTION`` / ``### END SOLUTION`` region becomes a stub raising ``NotImplementedError`` in code, and
-``YOUR ANSWER HERE`` in markdown (an answer in words). Hidden-test regions disappear, their cell left read-only and
-not deletable as nbgrader leaves it; outputs are cleared. :func:`tag_raising` tags ``raises-exception`` the cells
-that raise in the release, so Run All of an unwritten notebook goes on to its end. With a roster and a variants
-file, :func:`release` writes one folder per student, each notebook's ``variant-data`` cells holding that student's
-values (:func:`with_values`).
-"""
+"""The student version of the instructor notebooks, from nbgrader's markers (:func:`release_notebook`); with a
+roster and a variants file, one folder per student whose notebooks hold their own data (:func:`with_values`)."""
 
 import ast
 import json
@@ -48,12 +41,14 @@ def strip_solutions(source, where="cell", stub=STUB):
 
 
 def release_notebook(nb, name="notebook"):
-    """The student version of an instructor notebook (a new object)."""
+    """The student version of an instructor notebook (a new object): each solution region a stub (:data:`STUB` in
+    code, :data:`TEXT_STUB` in markdown), hidden-test regions gone (their cell read-only and not deletable, as
+    nbgrader leaves it), outputs cleared."""
     student = copy_notebook(nb)
     student.metadata.pop("widgets", None)
     for index, cell in enumerate(student.cells):
         if cell.cell_type == "code":
-            if BEGIN_HIDDEN in cell.source:  # the grader's cell: JupyterLab and Notebook 7 keep it read-only
+            if BEGIN_HIDDEN in cell.source:  # JupyterLab and Notebook 7 keep it read-only
                 cell.metadata.update(editable=False, deletable=False)
             cell.source = strip_solutions(cell.source, f"{name}, cell {index}")
             cell.outputs = []
@@ -65,7 +60,8 @@ def release_notebook(nb, name="notebook"):
 
 def tag_raising(nb, folder, name="notebook", timeout=300):
     """Tag ``raises-exception`` (in place) the cells of instructor notebook `nb` that raise in its release, run in
-    `folder` (for its data files), and untag the others; the indices of the tagged cells."""
+    `folder` (for its data files), so that Run All of an unwritten notebook goes on to its end; untag the others.
+    Returns the indices of the tagged cells."""
     raising = set(raising_cells(release_notebook(nb, name), folder, timeout))
     for index, cell in enumerate(nb.cells):
         if cell.cell_type == "code":

@@ -41,9 +41,7 @@ from ..store.report import problem_kinds as kinds_of
 from ..store.rubric import Rubric
 from ..store.text import points_text
 from ..submission.known import THRESHOLD
-from .copies import Copies, pair_rows
-from .copies import find as find_copies
-from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
+from .similarity import DEFAULT_THRESHOLD, Copies, Pair, find_copies, pair_rows, unavailable
 
 REPORT = "report.html"
 MAX_SUBMISSIONS = 20_000  # result files in one folder
@@ -202,7 +200,7 @@ class ClassSummary:
     seeds: list = field(default_factory=list)
     late: LateSummary | None = None  # when the rubric has a [late] table
     held: list = field(default_factory=list)  # Held
-    copies: Copies | None = None  # whose data, solution markers, each student's graded functions (copies.py)
+    copies: Copies | None = None  # whose data, solution markers, each student's graded functions
 
 
 def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
