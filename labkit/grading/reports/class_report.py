@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from datetime import timedelta
 from pathlib import Path
 
+import numpy as np
+
 from ...errors import InputError
 from ...exercises.result import (
     CRASH,
@@ -437,8 +439,6 @@ def _png(figure):
 
 def _bins(totals, maximum):
     """Bin edges of a round width, about twenty bins from 0 to the largest possible total."""
-    import numpy as np
-
     top = max([float(maximum), *map(float, totals), 1.0])
     width = next(w for w in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 10**9) if top / w <= 25)
     edges = np.arange(0.0, top + width, float(width))
@@ -513,17 +513,9 @@ def render(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> str:
-    """The class report as one HTML document, figures inline (``templates/class_report.html``).
-
-    Parameters
-    ----------
-    pairs : list of Pair, optional
-        Similar code to show side by side; None when the search was not made.
-    threshold : float
-        The similarity from which pairs were listed.
-    similarity_note : str, optional
-        Why `pairs` is None; by default, why the similarity search cannot run here, if it cannot.
-    """
+    """The class report as one HTML document, figures inline (``templates/class_report.html``): `pairs` are the
+    similar code to show side by side (None when the search was not made), listed from similarity `threshold`;
+    `similarity_note` says why `pairs` is None (by default, why the search cannot run here, if it cannot)."""
     if not isinstance(summary, ClassSummary):
         raise InputError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
     pairs = _check_pairs(pairs)
