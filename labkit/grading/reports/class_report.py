@@ -366,22 +366,6 @@ class _Tally:
         return sorted(struggles, key=lambda s: (-len(s.failed), s.total, s.student))[:MOST_FAILED]
 
 
-def _checked(grades):
-    """`grades` as a list, refused when empty, not SubmissionGrade objects or scored under several rubrics."""
-    grades = list(grades)
-    if not grades:
-        raise InputError("there are no submissions to report on: grade some first (`labkit grade`).")
-    for grade in grades:
-        if not isinstance(grade, SubmissionGrade):
-            raise InputError(
-                f"a class report is made of SubmissionGrade objects (labkit.grading.store.report); got "
-                f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
-            )
-    if any(grade.rubric != grades[0].rubric for grade in grades):
-        raise InputError("the grades are scored under different rubrics: read them all with one rubric.")
-    return grades
-
-
 def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     """Count what a class did: totals, pass rates, slips, problems and the most failed parts, of `grades` (one
     SubmissionGrade per submission, all scored under one rubric, as :func:`read` gives them).
@@ -398,8 +382,18 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     ...     {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}]}})]).totals
     {'ann': 10.0}
     """
-    submissions = _checked(grades)
+    submissions = list(grades)
+    if not submissions:
+        raise InputError("there are no submissions to report on: grade some first (`labkit grade`).")
+    for grade in submissions:
+        if not isinstance(grade, SubmissionGrade):
+            raise InputError(
+                f"a class report is made of SubmissionGrade objects (labkit.grading.store.report); got "
+                f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
+            )
     rubric = submissions[0].rubric
+    if any(grade.rubric != rubric for grade in submissions):
+        raise InputError("the grades are scored under different rubrics: read them all with one rubric.")
     graded = [g for g in submissions if g.graded]
     tally = _Tally({g.name: [] for g in graded})
     rates = [tally.exercise(rubric, number, graded) for number in rubric.graded]
@@ -566,14 +560,6 @@ def _check_pairs(pairs):
     return pairs
 
 
-def _variant_students(out):
-    """Each student's variant data, as the run in `out` recorded them ({} without variants or a record)."""
-    try:
-        return records.read(out).variants.get("students", {})
-    except ValueError:
-        return {}
-
-
 def write(
     out_dir: str | Path,
     grades: Iterable[SubmissionGrade],
@@ -602,6 +588,10 @@ def write(
         raise InputError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
     grades = list(grades)
     summary = summarise(grades)
-    summary.copies = find_copies(grades, _variant_students(out))
+    try:
+        students = records.read(out).variants.get("students", {})  # each student's variant data, for the copies
+    except ValueError:
+        students = {}  # no variants or no record
+    summary.copies = find_copies(grades, students)
     records.replace_text(target, render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note))
     return target
