@@ -60,8 +60,8 @@ MAX_LABEL = 64  # characters of a part's label in the list of a student's failed
 MAX_FAILED_SHOWN = 50  # failed parts listed per student
 
 NOT_GRADED = "not graded"  # a submission whose grading failed (its `failure`): no points, not zero
-# what a failed part's steps say became of it, the first kind found winning (no kind at all: a slip)
-OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER, NOT_DONE)
+# the problem a part that failed with an error met: the first of these among its failed steps' kinds
+OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER)
 # the kinds of problem, in the order the page lists them (its words for each are in the template)
 KINDS = (TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, VARIANT, NOT_GRADED, OTHER)
 BLUE = "#2b5797"

@@ -1,8 +1,6 @@
 """What only a person can mark, as a page: answers in words, held parts and excused exercises (``labkit mark``).
-
-The page writes ``marks.csv``; :mod:`labkit.grading.store.marks` says what a row holds and reads it into the
-run (``labkit mark OUT --import marks.csv``).
-"""
+The page writes ``marks.csv``; :mod:`labkit.grading.store.marks` says what a row holds and reads it into the run
+(``labkit mark OUT --import marks.csv``)."""
 
 import base64
 import functools
