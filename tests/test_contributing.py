@@ -61,7 +61,7 @@ def _labkit(*args, cwd):
 def test_the_toy_exercise_is_declared_once_and_everything_follows(course):
     import toy_lab
 
-    from labkit.grading.authoring.nbgrader import mark
+    from labkit.grading.authoring.release import mark
     from labkit.grading.store import rubric as rubrics
 
     registry = toy_lab.REGISTRY

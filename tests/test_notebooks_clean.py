@@ -80,7 +80,7 @@ def test_nbgrader_metadata_is_kept_and_valid(path):
     """`labkit execute` writes nbgrader's cell metadata (schema version 3); nbgrader's own validator accepts it."""
     import copy
 
-    from labkit.grading.authoring.nbgrader import mark
+    from labkit.grading.authoring.release import mark
 
     nb = nbformat.read(path, as_version=4)
     expected = mark(copy.deepcopy(nb), path.name)

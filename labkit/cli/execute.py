@@ -25,8 +25,7 @@ def handle(args):
     from nbclient.exceptions import CellExecutionError
 
     from ..execute import execute, notebook_paths
-    from ..grading.authoring.nbgrader import mark
-    from ..grading.authoring.release import tag_raising
+    from ..grading.authoring.release import mark, tag_raising
     from ..grading.store.rubric import load
 
     rubric = load(args.rubric)  # nbgrader's points are the rubric's in force

@@ -20,7 +20,7 @@ import labkit.check
 from labkit import convergence
 from labkit.exercises import model
 from labkit.exercises.registry import LAB, Registry, function_name, load
-from labkit.grading.authoring.nbgrader import CHECK_CALL
+from labkit.grading.authoring.release import CHECK_CALL
 from labkit.grading.sandbox import protocol
 from labkit.grading.store.rubric import default
 
@@ -136,7 +136,7 @@ def test_the_docs_exercise_table_is_the_declarations():
 
 
 def test_the_answers_in_words_are_the_notebooks_answer_cells():
-    from labkit.grading.authoring.nbgrader import answer_ids
+    from labkit.grading.authoring.release import answer_ids
 
     found = {grade_id for path in NOTEBOOKS.values() for grade_id in answer_ids(nbformat.read(path, as_version=4))}
     assert found == set(LAB.answers)

@@ -1,12 +1,6 @@
-"""The student version of the instructor notebooks (nbgrader's markers and stubs).
-
-A ``### BEGIN SOLUTION`` / ``### END SOLUTION`` region becomes a stub raising ``NotImplementedError`` in code, and
-``YOUR ANSWER HERE`` in markdown (an answer in words). Hidden-test regions disappear, their cell left read-only and
-not deletable as nbgrader leaves it; outputs are cleared. :func:`tag_raising` tags ``raises-exception`` the cells
-that raise in the release, so Run All of an unwritten notebook goes on to its end. With a roster and a variants
-file, :func:`release` writes one folder per student, each notebook's ``variant-data`` cells holding that student's
-values (:func:`with_values`).
-"""
+"""The student version of the instructor notebooks, from nbgrader's markers (:func:`release_notebook`); with a
+roster and a variants file, one folder per student whose notebooks hold their own data (:func:`with_values`).
+The instructor notebooks' nbgrader cell metadata comes from the same markers (:func:`mark`)."""
 
 import ast
 import json
@@ -16,12 +10,18 @@ from pathlib import Path
 from ...errors import InputError
 from ...execute import RAISES, notebook_paths, raising_cells, read_notebook, set_tag
 from ...exercises import variants as variant_data
+from ...exercises.model import sections
 from ...exercises.registry import LAB
+from ..store import rubric as rubrics
 
 BEGIN_SOLUTION, END_SOLUTION = "### BEGIN SOLUTION", "### END SOLUTION"
 BEGIN_HIDDEN, END_HIDDEN = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
 STUB = ["# YOUR CODE HERE", "raise NotImplementedError()"]
 TEXT_STUB = ["YOUR ANSWER HERE"]
+SCHEMA_VERSION = 3  # of nbgrader's cell metadata (nbgrader/nbgraderformat/v3.json)
+EXERCISE_OF_TESTS = re.compile(r"^# tests for exercise (\d+)\s*$", re.MULTILINE)
+# a self-check call, labkit.check.<name>(...) or a course's check_<name>(...); a quoted first argument is an experiment
+CHECK_CALL = re.compile(r"(?:\blabkit\.check\.|\bcheck_)(\w+)\(\s*(?:\"(\w+)\")?")
 
 
 def strip_solutions(source, where="cell", stub=STUB):
@@ -48,12 +48,14 @@ def strip_solutions(source, where="cell", stub=STUB):
 
 
 def release_notebook(nb, name="notebook"):
-    """The student version of an instructor notebook (a new object)."""
+    """The student version of an instructor notebook (a new object): each solution region a stub (:data:`STUB` in
+    code, :data:`TEXT_STUB` in markdown), hidden-test regions gone (their cell read-only and not deletable, as
+    nbgrader leaves it), outputs cleared."""
     student = copy_notebook(nb)
     student.metadata.pop("widgets", None)
     for index, cell in enumerate(student.cells):
         if cell.cell_type == "code":
-            if BEGIN_HIDDEN in cell.source:  # the grader's cell: JupyterLab and Notebook 7 keep it read-only
+            if BEGIN_HIDDEN in cell.source:  # JupyterLab and Notebook 7 keep it read-only
                 cell.metadata.update(editable=False, deletable=False)
             cell.source = strip_solutions(cell.source, f"{name}, cell {index}")
             cell.outputs = []
@@ -65,7 +67,8 @@ def release_notebook(nb, name="notebook"):
 
 def tag_raising(nb, folder, name="notebook", timeout=300):
     """Tag ``raises-exception`` (in place) the cells of instructor notebook `nb` that raise in its release, run in
-    `folder` (for its data files), and untag the others; the indices of the tagged cells."""
+    `folder` (for its data files), so that Run All of an unwritten notebook goes on to its end; untag the others.
+    Returns the indices of the tagged cells."""
     raising = set(raising_cells(release_notebook(nb, name), folder, timeout))
     for index, cell in enumerate(nb.cells):
         if cell.cell_type == "code":
@@ -189,3 +192,65 @@ def release(notebook_dir, out_dir, roster=None, variants=None, registry=LAB):
             nbformat.write(student, target)
             written.append(target)
     return written
+
+
+def test_points(source, where="a test cell", rubric=None):
+    """(exercise, points) of a hidden-test cell: the weights of the parts its ``labkit.check.f(...)`` (or
+    ``check_f(...)``) calls check (of the experiment the first argument names), scaled to `rubric`'s points."""
+    rubric = rubric or rubrics.default()
+    registry, found = rubric.registry, EXERCISE_OF_TESTS.search(source)
+    if not found or int(found.group(1)) not in registry.exercises:
+        raise InputError(f"{where} has hidden tests but no '# tests for exercise N' line naming a graded exercise.")
+    number = int(found.group(1))
+    exercise = registry.exercises[number]
+    checked = {
+        part.name
+        for function, key in CHECK_CALL.findall(source.split(BEGIN_HIDDEN, 1)[1].split(END_HIDDEN, 1)[0])
+        for part in registry.parts_checked(number, function, key or None)
+    }
+    weights = sum(part.weight for part in exercise.parts if part.name in checked)
+    if not weights:
+        parts = ", ".join(p.name for p in exercise.parts)
+        raise InputError(f"{where} tests exercise {number} but checks none of its parts ({parts}).")
+    points = weights * (rubric.points.get(number, exercise.points) / exercise.points if exercise.points else 0)
+    return number, int(points) if points == int(points) else round(points, 2)
+
+
+def answer_ids(nb):
+    """The grade ids of a notebook's answers in words, in order: ``exerciseN-answer-K``."""
+    ids, exercise, counters = [], None, {}
+    for cell in (cell for cell in nb.cells if cell.cell_type == "markdown"):
+        found = sections(cell.source)
+        if found:
+            exercise = found[-1]
+        if BEGIN_SOLUTION in cell.source:
+            counters[exercise] = counters.get(exercise, 0) + 1
+            ids.append(f"exercise{exercise}-answer-{counters[exercise]}")
+    return ids
+
+
+def mark(nb, name="notebook", rubric=None):
+    """Give every cell of an instructor notebook nbgrader's metadata (in place; ``labkit execute`` applies it);
+    returns `nb`. A code cell with a solution region is a *solution* cell; a markdown one a *manually graded answer*
+    worth 0 points (the instructor reads it), grade id ``exerciseN-answer-K``; a hidden-test cell an *autograded
+    test* worth the weights of the parts its asserts check (:func:`test_points`); every other cell is *locked*."""
+    counters, answers = {}, iter(answer_ids(nb))
+    stem = re.sub(r"[^a-zA-Z0-9_-]+", "-", name.rsplit(".", 1)[0])
+
+    def grade_id(kind):
+        counters[kind] = counters.get(kind, 0) + 1
+        return f"{kind}-{counters[kind]}"
+
+    for index, cell in enumerate(nb.cells):
+        meta = {"schema_version": SCHEMA_VERSION, "grade": False, "solution": False, "locked": True}
+        if cell.cell_type == "markdown" and BEGIN_SOLUTION in cell.source:
+            meta.update(solution=True, grade=True, locked=False, points=0, grade_id=next(answers))
+        elif cell.cell_type == "code" and BEGIN_SOLUTION in cell.source:
+            meta.update(solution=True, locked=False, grade_id=grade_id(f"{stem}-solution"))
+        elif cell.cell_type == "code" and BEGIN_HIDDEN in cell.source:
+            number, points = test_points(cell.source, f"{name}, cell {index}", rubric)
+            meta.update(grade=True, points=points, grade_id=grade_id(f"exercise{number}-tests"))
+        else:
+            meta["grade_id"] = grade_id(f"{stem}-locked")
+        cell.metadata["nbgrader"] = meta
+    return nb

@@ -1,4 +1,1 @@
-"""What a person reads after a run: the class report, code similarity, marking by hand, LMS exports.
-
-Run in the instructor's process (``labkit report``, ``labkit mark``, ``labkit export``).
-"""
+"""What a person reads after a run, in the instructor's process: the class report, copies, marking by hand, notes."""

@@ -1,11 +1,8 @@
 """The class report: one self-contained HTML page about a grading run (``labkit report OUT``).
 
-:func:`read` reads a run's results back (a merged run's too), :func:`summarise` counts what the class did,
-:func:`write` writes ``OUT/report.html`` from ``templates/class_report.*``: totals (after any late penalty),
-lateness, pass rates, slips, problems (by the kind codes the grader set, never by their words), the most
-failed parts, held parts, copies and similar code (which never changes a grade; without pygments, "not
-computed" and why). Figures are inline PNGs drawn on matplotlib's Agg canvas; every text a submission could
-have influenced is made printable and bounded (:func:`~labkit.grading.store.report.one_line`), then escaped.
+:func:`read` reads a run's results back (a merged run's too), :func:`summarise` counts what the class did and
+:func:`write` renders ``templates/class_report.*`` into ``OUT/report.html``. Figures are inline PNGs drawn on
+matplotlib's Agg canvas; every text a submission could have influenced is made printable and bounded, then escaped.
 """
 
 from __future__ import annotations
@@ -14,17 +11,18 @@ import base64
 import io
 import os
 import statistics
-import tempfile
-from collections import Counter, defaultdict
+from collections import Counter, defaultdict, namedtuple
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from datetime import timedelta
 from pathlib import Path
 
+import numpy as np
+
 from ...errors import InputError
 from ...exercises.result import (
     CRASH,
-    HELD,
+    ERROR,
     NOT_DONE,
     OTHER,
     PASSED,
@@ -38,16 +36,14 @@ from ...exercises.result import (
 )
 from .. import pages
 from ..store import late as lateness
+from ..store import record as records
 from ..store.names import shown_name
-from ..store.record import rubric_for
 from ..store.report import SubmissionGrade, one_line, printable, read_results
 from ..store.report import problem_kinds as kinds_of
 from ..store.rubric import Rubric
 from ..store.text import points_text
 from ..submission.known import THRESHOLD
-from .copies import Copies, pair_rows
-from .copies import find as find_copies
-from .similarity import DEFAULT_THRESHOLD, Pair, unavailable
+from .similarity import DEFAULT_THRESHOLD, Copies, Pair, find_copies, pair_rows, unavailable
 
 REPORT = "report.html"
 MAX_SUBMISSIONS = 20_000  # result files in one folder
@@ -64,8 +60,8 @@ MAX_LABEL = 64  # characters of a part's label in the list of a student's failed
 MAX_FAILED_SHOWN = 50  # failed parts listed per student
 
 NOT_GRADED = "not graded"  # a submission whose grading failed (its `failure`): no points, not zero
-# what a failed part's steps say became of it, the first kind found winning (no kind at all: a slip)
-OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER, NOT_DONE)
+# the problem a part that failed with an error met: the first of these among its failed steps' kinds
+OUTCOMES = (REFUSED, TAMPERED, TIMEOUT, CRASH, RAISED, OTHER)
 # the kinds of problem, in the order the page lists them (its words for each are in the template)
 KINDS = (TIMEOUT, CRASH, RAISED, REFUSED, TAMPERED, VARIANT, NOT_GRADED, OTHER)
 BLUE = "#2b5797"
@@ -107,32 +103,12 @@ class PartRate(_Rated):
         return self.passed + self.slipped + self.problem
 
 
-@dataclass(frozen=True)
-class Slip:
-    """One hint of one part, and the students whose work failed the part with it."""
-
-    exercise: int
-    part: str
-    hint: str
-    students: tuple
-
-
-@dataclass(frozen=True)
-class Problem:
-    """What went wrong for one student, of one kind (its texts as the grader worded them)."""
-
-    student: str
-    texts: tuple
-
-
-@dataclass(frozen=True)
-class Struggle:
-    """A student's failed parts: "exercise part" labels of those attempted and failed, and those not done."""
-
-    student: str
-    total: float
-    failed: tuple
-    not_done: int
+# one hint of one part, and the students whose work failed the part with it
+Slip = namedtuple("Slip", "exercise part hint students")
+# what went wrong for one student, of one kind (its texts as the grader worded them)
+Problem = namedtuple("Problem", "student texts")
+# a student's failed parts: "exercise part" labels of those attempted and failed, and how many not done
+Struggle = namedtuple("Struggle", "student total failed not_done")
 
 
 @dataclass(frozen=True)
@@ -144,54 +120,40 @@ class LateEntry(lateness.Lateness):
 
 @dataclass(frozen=True)
 class LateSummary:
-    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission, by name."""
+    """The class under the rubric's ``[late]`` table: one :class:`LateEntry` per graded submission, by name, and
+    the groups the page lists (see :meth:`of`)."""
 
     rule: lateness.Late
     entries: tuple
-
-    @property
-    def late(self):
-        """The late submissions, latest first."""
-        return sorted((e for e in self.entries if e.units > 0), key=lambda e: (-e.late_by, e.student))
-
-    @property
-    def on_time(self):
-        return [e for e in self.entries if e.known and e.units <= 0]
-
-    @property
-    def within_grace(self):
-        return [e for e in self.on_time if e.late_by > timedelta(0)]
-
-    @property
-    def unknown(self):
-        return [e for e in self.entries if not e.known]
-
-    @property
-    def extended(self):
-        return [e for e in self.entries if e.extended]
-
-    @property
-    def student_supplied(self):
-        """Submissions whose known time the student supplied (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)."""
-        return [e for e in self.entries if e.known and e.time.source in lateness.STUDENT_SUPPLIED]
-
-    @property
-    def penalty(self):
-        return round(sum(e.penalty for e in self.entries), 2)
-
-    @property
-    def unused_extensions(self):
-        """Names in ``[late.extensions]`` that no graded submission has (a typo in the rubric?)."""
-        names = {e.student for e in self.entries}
-        return [name for name, _ in self.rule.extensions if name not in names]
+    late: list  # latest first
+    on_time: list
+    within_grace: list
+    unknown: list
+    extended: list
+    student_supplied: list  # known times the student supplied (:data:`labkit.grading.store.late.STUDENT_SUPPLIED`)
+    penalty: float
+    unused_extensions: list  # names in ``[late.extensions]`` no graded submission has (a typo in the rubric?)
 
     @classmethod
     def of(cls, rubric, graded):
         """The late view of `graded`; None when the rubric has no ``[late]`` table."""
         if rubric.late is None:
             return None
-        entries = (LateEntry(**vars(g.lateness), student=g.name) for g in sorted(graded, key=lambda g: g.name))
-        return cls(rubric.late, tuple(entries))
+        entries = [LateEntry(**vars(g.lateness), student=g.name) for g in sorted(graded, key=lambda g: g.name)]
+        on_time = [e for e in entries if e.known and e.units <= 0]
+        names = {e.student for e in entries}
+        return cls(
+            rule=rubric.late,
+            entries=tuple(entries),
+            late=sorted((e for e in entries if e.units > 0), key=lambda e: (-e.late_by, e.student)),
+            on_time=on_time,
+            within_grace=[e for e in on_time if e.late_by > timedelta(0)],
+            unknown=[e for e in entries if not e.known],
+            extended=[e for e in entries if e.extended],
+            student_supplied=[e for e in entries if e.known and e.time.source in lateness.STUDENT_SUPPLIED],
+            penalty=round(sum(e.penalty for e in entries), 2),
+            unused_extensions=[name for name, _ in rubric.late.extensions if name not in names],
+        )
 
 
 @dataclass(frozen=True)
@@ -240,17 +202,12 @@ class ClassSummary:
     seeds: list = field(default_factory=list)
     late: LateSummary | None = None  # when the rubric has a [late] table
     held: list = field(default_factory=list)  # Held
-    copies: Copies | None = None  # whose data, solution markers, each student's graded functions (copies.py)
+    copies: Copies | None = None  # whose data, solution markers, each student's graded functions
 
 
 def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
-    """The grades, in name order, of a grading run's ``--out`` folder (``labkit grade`` or ``labkit merge``).
-
-    Parameters
-    ----------
-    folder : str or Path
-    rubric : Rubric, optional
-        The rubric the run was scored with (the recorded one when None; another one is refused).
+    """The grades, in name order, of a grading run's ``--out`` folder (``labkit grade`` or ``labkit merge``),
+    scored under `rubric`: the recorded one when None; another one is refused.
 
     Raises
     ------
@@ -272,17 +229,13 @@ def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGra
             f"{folder / 'results'} holds more than {MAX_SUBMISSIONS:,} result files, more than a class report "
             "shows: split the class and report on each part."
         )
-    return read_results([folder], rubric_for([folder], rubric, "the class report"))
+    return read_results([folder], records.rubric_for([folder], rubric, "the class report"))
 
 
 def check_outcome(check: dict) -> str:
-    """What became of one part in one submission: ``"passed"``, ``"slip"``, ``"not done"``, ``"another
-    variant"`` or a problem's kind (:data:`OUTCOMES`; ``"other"``: a fault of the check itself).
-
-    Parameters
-    ----------
-    check : dict
-        One entry of an exercise's ``checks`` in a result.
+    """What became of one part in one submission (`check`, one entry of an exercise's ``checks`` in a result):
+    ``"passed"``, ``"slip"``, ``"not done"``, ``"another variant"`` or a problem's kind (:data:`OUTCOMES`;
+    ``"other"``: a fault of the check itself).
 
     Examples
     --------
@@ -296,11 +249,9 @@ def check_outcome(check: dict) -> str:
     if not isinstance(check, dict):
         raise InputError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
     kind = part_kind(check)  # the one place a part's kind is decided: the feedback and labkit handin agree
-    if kind in (PASSED, HELD):
-        return PASSED
-    if kind in (NOT_DONE, VARIANT, SLIP):
+    if kind != ERROR:
         return kind
-    kinds = {s.get("kind") for s in _steps(check) if not s.get("passed")}
+    kinds = {s.get("kind") for s in check["steps"] if isinstance(s, dict) and not s.get("passed")}
     return next((kind for kind in OUTCOMES if kind in kinds), OTHER)
 
 
@@ -320,11 +271,6 @@ def problem_kinds(problem: str) -> list[tuple[str, str]]:
     return [(kind, one_line(description, MAX_TEXT)) for kind, description in kinds_of(problem)]
 
 
-def _steps(check):
-    steps = check.get("steps", [])
-    return [s for s in steps if isinstance(s, dict)] if isinstance(steps, list) else []
-
-
 def _checks(grade, number):
     """{part name: check} of exercise `number` in `grade`; None when the submission does not have it."""
     verdict = grade.results.get(number)
@@ -339,7 +285,7 @@ def _weights(rubric, exercise):
 def _failed_text(check, number):
     details = [
         f"{one_line(s.get('step', ''), 100)}: {one_line(s.get('detail', ''), MAX_TEXT)}"
-        for s in _steps(check)
+        for s in check["steps"]
         if not s.get("passed")
     ]
     return one_line(f"exercise {number}, {check.get('name', '?')}: " + ("; ".join(details) or "failed"), MAX_TEXT)
@@ -356,7 +302,7 @@ class _Tally:
 
     def part(self, grade, number, name, index, check):
         """What became of part `name` of exercise `number` in `grade`, noted where the page shows it."""
-        outcome = check_outcome(check) if check else NOT_DONE
+        outcome = check_outcome(check)
         if outcome == NOT_DONE:
             self.not_done[grade.name] += 1
         elif outcome != PASSED:
@@ -378,7 +324,7 @@ class _Tally:
         counts = {name: Counter(missing=len(graded) - len(found)) for name in names}
         attempted = passed = 0
         for grade, checks in found:
-            outcomes = [self.part(grade, number, n, i, checks.get(n) or {}) for i, n in enumerate(names)]
+            outcomes = [self.part(grade, number, n, i, checks.get(n, {})) for i, n in enumerate(names)]
             for name, outcome in zip(names, outcomes):
                 counts[name][outcome] += 1
             attempted += any(outcome != NOT_DONE for outcome in outcomes)
@@ -420,29 +366,9 @@ class _Tally:
         return sorted(struggles, key=lambda s: (-len(s.failed), s.total, s.student))[:MOST_FAILED]
 
 
-def _checked(grades):
-    """`grades` as a list, refused when empty, not SubmissionGrade objects or scored under several rubrics."""
-    grades = list(grades)
-    if not grades:
-        raise InputError("there are no submissions to report on: grade some first (`labkit grade`).")
-    for grade in grades:
-        if not isinstance(grade, SubmissionGrade):
-            raise InputError(
-                f"a class report is made of SubmissionGrade objects (labkit.grading.store.report); got "
-                f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
-            )
-    if any(grade.rubric != grades[0].rubric for grade in grades):
-        raise InputError("the grades are scored under different rubrics: read them all with one rubric.")
-    return grades
-
-
 def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
-    """Count what a class did: totals, pass rates, slips, problems and the most failed parts.
-
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        One per submission, all scored under one rubric (:func:`read` gives them).
+    """Count what a class did: totals, pass rates, slips, problems and the most failed parts, of `grades` (one
+    SubmissionGrade per submission, all scored under one rubric, as :func:`read` gives them).
 
     Raises
     ------
@@ -456,8 +382,18 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
     ...     {"name": "eval_pherm", "passed": True, "hint": "", "weight": 10, "steps": []}]}})]).totals
     {'ann': 10.0}
     """
-    submissions = _checked(grades)
+    submissions = list(grades)
+    if not submissions:
+        raise InputError("there are no submissions to report on: grade some first (`labkit grade`).")
+    for grade in submissions:
+        if not isinstance(grade, SubmissionGrade):
+            raise InputError(
+                f"a class report is made of SubmissionGrade objects (labkit.grading.store.report); got "
+                f"{type(grade).__name__}: read a run's results with labkit.grading.reports.class_report.read."
+            )
     rubric = submissions[0].rubric
+    if any(grade.rubric != rubric for grade in submissions):
+        raise InputError("the grades are scored under different rubrics: read them all with one rubric.")
     graded = [g for g in submissions if g.graded]
     tally = _Tally({g.name: [] for g in graded})
     rates = [tally.exercise(rubric, number, graded) for number in rubric.graded]
@@ -497,8 +433,6 @@ def _png(figure):
 
 def _bins(totals, maximum):
     """Bin edges of a round width, about twenty bins from 0 to the largest possible total."""
-    import numpy as np
-
     top = max([float(maximum), *map(float, totals), 1.0])
     width = next(w for w in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 10**9) if top / w <= 25)
     edges = np.arange(0.0, top + width, float(width))
@@ -527,8 +461,9 @@ def _rate_text(rate, attempted):
     return "nobody attempted it" if rate is None else f"{rate:.0%} of {attempted}"
 
 
-def _bars(rated, labels):
+def _bars(rated):
     """Bars of the pass rates of `rated` (ExerciseRate or PartRate), each labelled, its rate written beside it."""
+    labels = [f"{r.exercise} {r.part}" if isinstance(r, PartRate) else f"exercise {r.exercise}" for r in rated]
     figure, axes = _figure(7.5, 0.9 + 0.26 * len(labels))
     positions = range(len(labels))
     axes.barh(positions, [100 * (r.rate or 0.0) for r in rated], color=BLUE, height=0.7)
@@ -540,14 +475,6 @@ def _bars(rated, labels):
     axes.set_xticks([0, 25, 50, 75, 100], ["0%", "25%", "50%", "75%", "100%"])
     axes.set_xlabel("passed, of the submissions that attempted it")
     return _png(figure)
-
-
-def _rate_figures(summary):
-    """Bar charts of the pass rates as base64 PNGs: the exercises', then the parts'."""
-    return [
-        _bars(summary.exercises, [f"exercise {e.exercise}" for e in summary.exercises]),
-        _bars(summary.parts, [f"{p.exercise} {p.part}" for p in summary.parts]),
-    ]
 
 
 def _text(value, limit=MAX_TEXT):
@@ -580,18 +507,9 @@ def render(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> str:
-    """The class report as one HTML document, figures inline (``templates/class_report.html``).
-
-    Parameters
-    ----------
-    summary : ClassSummary
-    pairs : list of Pair, optional
-        Similar code to show side by side; None when the search was not made.
-    threshold : float
-        The similarity from which pairs were listed.
-    similarity_note : str, optional
-        Why `pairs` is None; by default, why the similarity search cannot run here, if it cannot.
-    """
+    """The class report as one HTML document, figures inline (``templates/class_report.html``): `pairs` are the
+    similar code to show side by side (None when the search was not made), listed from similarity `threshold`;
+    `similarity_note` says why `pairs` is None (by default, why the search cannot run here, if it cannot)."""
     if not isinstance(summary, ClassSummary):
         raise InputError(f"render takes the ClassSummary of summarise(grades); got {type(summary).__name__}.")
     pairs = _check_pairs(pairs)
@@ -605,7 +523,7 @@ def render(
         late=summary.late,
         limits={name: value for name, value in globals().items() if name.startswith("MAX_")},
         totals=_totals(summary) if summary.totals else None,
-        rate_figures=_rate_figures(summary) if summary.totals else None,
+        rate_figures=[_bars(summary.exercises), _bars(summary.parts)] if summary.totals else None,
         rate_text=_rate_text,
         held_threshold=THRESHOLD,
         copy_lines=copies.holder_lines(),
@@ -642,16 +560,6 @@ def _check_pairs(pairs):
     return pairs
 
 
-def _variant_students(out):
-    """Each student's variant data, as the run in `out` recorded them ({} without variants or a record)."""
-    from ..store.record import read as read_record
-
-    try:
-        return read_record(out).variants.get("students", {})
-    except ValueError:
-        return {}
-
-
 def write(
     out_dir: str | Path,
     grades: Iterable[SubmissionGrade],
@@ -660,17 +568,9 @@ def write(
     threshold: float = DEFAULT_THRESHOLD,
     similarity_note: str | None = None,
 ) -> Path:
-    """Write ``report.html`` into a grading run's output folder, through a temporary file renamed over an
-    earlier report, and return its path; the folder's other files are neither read nor touched.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        The run's ``--out`` folder.
-    grades : list of SubmissionGrade
-        The class (:func:`read` reads them from `out_dir`).
-    pairs, threshold, similarity_note
-        As for :func:`render`; `threshold` is in (0, 1].
+    """Write ``report.html`` into a grading run's ``--out`` folder `out_dir`, through a temporary file renamed over
+    an earlier report, and return its path; the folder's other files are neither read nor touched. `grades` are the
+    class (:func:`read` reads them), `pairs`, `threshold` (in (0, 1]) and `similarity_note` as for :func:`render`.
 
     Raises
     ------
@@ -688,17 +588,10 @@ def write(
         raise InputError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
     grades = list(grades)
     summary = summarise(grades)
-    summary.copies = find_copies(grades, _variant_students(out))
-    page = render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note)
-    handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
-        "w", encoding="utf-8", dir=out, prefix=".report-", suffix=".html.tmp", delete=False
-    )
     try:
-        with handle:
-            handle.write(page)
-        os.chmod(handle.name, 0o644)
-        os.replace(handle.name, target)
-    except BaseException:
-        Path(handle.name).unlink(missing_ok=True)
-        raise
+        students = records.read(out).variants.get("students", {})  # each student's variant data, for the copies
+    except ValueError:
+        students = {}  # no variants or no record
+    summary.copies = find_copies(grades, students)
+    records.replace_text(target, render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note))
     return target

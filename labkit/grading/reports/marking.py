@@ -1,12 +1,14 @@
 """What only a person can mark, as a page: answers in words, held parts and excused exercises (``labkit mark``).
+The page writes ``marks.csv``; :mod:`labkit.grading.store.marks` says what a row holds and reads it into the run
+(``labkit mark OUT --import marks.csv``)."""
 
-The page writes ``marks.csv``; :mod:`labkit.grading.store.marks` says what a row holds and reads it into the
-run (``labkit mark OUT --import marks.csv``).
-"""
-
+import base64
 import functools
+import hashlib
 import json
+import random
 import re
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from markupsafe import Markup
@@ -18,8 +20,6 @@ from ..store.feedback import blank
 from ..store.marks import import_marks, marks_csv  # noqa: F401 - labkit mark's import, with the marking page
 from ..store.names import shown_name
 from ..store.report import one_line, printable, read_results
-
-# -- the marking page ---------------------------------------------------------------------------------------------
 
 PAGE = "marking.html"
 SOLUTIONS = Path(__file__).resolve().parents[3] / "notebooks"  # the instructor notebooks, in a source tree
@@ -40,8 +40,7 @@ def model_answers(folder=SOLUTIONS):
     when there are none, as in an installed labkit without its source tree)."""
     import nbformat
 
-    from ..authoring.nbgrader import answer_ids
-    from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION
+    from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids
 
     found = {}
     for path in sorted(Path(folder).glob("*.ipynb")) if Path(folder).is_dir() else ():
@@ -66,8 +65,6 @@ def _parts():
 def math_html(tex, display=False):
     """TeX a student wrote as MathML the browser typesets (offline, no script), every element and attribute
     from a fixed list and every text escaped; the TeX itself, escaped, when it cannot be converted."""
-    import xml.etree.ElementTree as ET
-
     try:
         from latex2mathml.converter import convert
 
@@ -160,8 +157,6 @@ def _held_tasks(grades):
 def tasks(grades, marker="instructor"):
     """What the page marks, by item: [{"item", "title", "max", "kind", "answers": [...]}], each item's
     submissions in an order shuffled for `marker` (the same marker, the same order)."""
-    import random
-
     if not grades:
         return []
     rubric = grades[0].rubric
@@ -184,9 +179,6 @@ def _json_for_script(data):
 def write_page(out, marker="instructor", rubric=None):
     """OUT/marking.html: every item to mark, by keyboard, offline; the path written. Its one script is
     ``templates/marking.js`` with the tasks as data, and the page's policy runs that script alone."""
-    import base64
-    import hashlib
-
     out = Path(out)
     record = records.read(out)
     recorded = record.rubric_object(out)

@@ -1,8 +1,5 @@
-"""What a grading run or merge tells the instructor when it ends, as lines of text: submission times that cost
-nothing or match no submission, submissions whose time is unknown, late marks no time backs, how a resumed run went.
-
-Run in the instructor's process (``labkit grade``, ``labkit merge``); the command line prints the lines.
-"""
+"""What a grading run or merge tells the instructor when it ends, as lines of text the command line prints
+(``labkit grade``, ``labkit merge``)."""
 
 import json
 
@@ -16,22 +13,8 @@ def _names(found):
 
 
 def time_notes(grades, rubric, times):
-    """The notes on a run's submission times, and how many times could not be read.
-
-    Parameters
-    ----------
-    grades : list of SubmissionGrade
-        The run's grades.
-    rubric : Rubric
-        The rubric they were scored with (its ``late`` table, or None).
-    times : dict or None
-        The times given with ``--times``, by submission name.
-
-    Returns
-    -------
-    tuple of (list of str, int)
-        The lines for the instructor, and the number of times that could not be read.
-    """
+    """The lines on a run's submission times for the instructor, and how many times could not be read: of
+    `grades`, scored under `rubric`, with the `times` given with ``--times`` by submission name (or None)."""
     graded = {g.name for g in grades}
     lines = []
     if times and rubric.late is None:

@@ -15,8 +15,7 @@ from labkit.check import EXERCISES
 from labkit.exercises.registry import LAB
 
 ANSWERS = LAB.answers
-from labkit.grading.authoring.nbgrader import answer_ids, mark
-from labkit.grading.authoring.release import BEGIN_SOLUTION, END_SOLUTION, strip_solutions
+from labkit.grading.authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids, mark, strip_solutions
 
 ROOT = Path(__file__).resolve().parents[3]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))

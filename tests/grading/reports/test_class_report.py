@@ -851,7 +851,7 @@ def test_three_identical_submissions_are_three_rows_one_per_pair_with_their_func
 
 def test_copies_name_whose_data_a_notebook_holds_and_flag_the_solutions_markers():
     from labkit.exercises.registry import LAB
-    from labkit.grading.reports import copies
+    from labkit.grading.reports.similarity import find_copies
 
     exercise = next(e for e in LAB if e.params)
     param = exercise.params[0].name
@@ -860,6 +860,6 @@ def test_copies_name_whose_data_a_notebook_holds_and_flag_the_solutions_markers(
     holder = SubmissionGrade("fermat", {number: {"fraction": 0.0, "passed": False, "checks": [],
                                                 "other_variant": {param: [1.25, 1.75]}}})  # fmt: skip
     marked = SubmissionGrade("gauss", {}, sources={"runge": "def runge(x):\n    ### BEGIN SOLUTION\n    return x"})
-    found = copies.find([holder, marked], students)
+    found = find_copies([holder, marked], students)
     assert found.holder_lines() == [f"fermat holds ada's data for exercise {number}"]
     assert found.marked == [("gauss", ("runge",))]
