@@ -172,7 +172,12 @@ class Canvas(Lms):
         return [f"{prefix}_feedback.html"]
 
     def export(self, grades, roster, out, **options):
-        """:func:`to_canvas`, the gradebook given as ``gradebook=``."""
+        """:func:`to_canvas`, the gradebook given as ``gradebook=``; refused without one."""
+        if "gradebook" not in options:
+            raise InputError(
+                "a Canvas export fills in the course's gradebook: give it with `labkit export OUT --canvas "
+                "GRADEBOOK.csv` (Canvas: Grades > Export) instead of --lms canvas."
+            )
         return to_canvas(grades, options.pop("gradebook"), roster, out, **options)
 
 

@@ -147,7 +147,10 @@ def create(limit, label="labkit", cores=1):
                     (path / "memory.memsw.limit_in_bytes").write_text(str(int(limit)))  # no swapping past it
             else:
                 (path / "memory.max").write_text(str(int(limit)))
-                for setting, value in (("memory.swap.max", "0"), ("cpu.max", f"{int(100_000 * cores)} 100000")):
+                settings = {"memory.swap.max": "0"}  # no swapping past it
+                if cores:
+                    settings["cpu.max"] = f"{int(100_000 * cores)} 100000"
+                for setting, value in settings.items():
                     with contextlib.suppress(OSError):
                         (path / setting).write_text(value)
         except OSError:

@@ -90,8 +90,9 @@ def write(folder, record):
 
 def replace_text(path, text):
     """Write `text` into `path` as UTF-8, exactly (no newline translation), replacing it whole: a process killed
-    meanwhile leaves the earlier file or none. Every file of a run folder is written through it."""
-    partial = path.with_name(f".{path.name}.partial")
+    meanwhile leaves the earlier file or none, and two processes writing it at once never share a partial file.
+    Every file of a run folder is written through it."""
+    partial = path.with_name(f".{path.name}.{os.getpid()}.partial")
     partial.write_bytes(text.encode("utf-8"))
     os.replace(partial, path)
 

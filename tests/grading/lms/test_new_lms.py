@@ -161,6 +161,17 @@ def test_an_lms_no_module_names_is_refused_with_the_names(tmp_path, capsys):
     assert "canvas" in capsys.readouterr().err and not (out / "feedback-upload.zip").exists()
 
 
+def test_canvas_by_name_asks_for_its_gradebook(tmp_path, capsys):
+    """Canvas's export fills in a gradebook, so `--lms canvas` without one says how to give it (exit 2, no file),
+    instead of failing inside the export."""
+    out = tmp_path / "grades"
+    write_report(out, [SubmissionGrade("ada", {2: {"fraction": 1.0, "passed": True, "checks": []}})])
+    (tmp_path / "roster.csv").write_text("submission,id\nada,7\n", encoding="utf-8")
+    assert cli.main(["export", out, "--lms", "canvas", "--roster", tmp_path / "roster.csv"]) == 2
+    assert "--canvas GRADEBOOK.csv" in capsys.readouterr().err
+    assert not (tmp_path / "grades-canvas.csv").exists()
+
+
 def _toy_class(tmp_path):
     cls = tmp_path / "class"
     cls.mkdir()
