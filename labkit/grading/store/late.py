@@ -16,6 +16,7 @@ from ...errors import InputError
 from .text import points_text
 
 UNITS = {"day": 86400, "hour": 3600}
+MINUTE = int(timedelta(minutes=1).total_seconds())
 FORMAT = "ISO 8601 with a UTC offset, e.g. 2026-12-01T23:59:00+01:00 (or ...T22:59:00Z)"
 FROM_CSV = "the --times file"
 FROM_EXCHANGE = "nbgrader's exchange"
@@ -75,13 +76,13 @@ def duration_text(delta: timedelta) -> str:
     '42 s'
     """
     seconds = int(delta.total_seconds())
-    if seconds < 60:
+    if seconds < MINUTE:
         return f"{seconds} s"
     days, rest = divmod(seconds, UNITS["day"])
     hours, rest = divmod(rest, UNITS["hour"])
     parts = [f"{days} day{'s' if days != 1 else ''}"] if days else []
     parts += [f"{hours} h"] if hours else []
-    parts += [f"{rest // 60} min"] if rest >= 60 else []
+    parts += [f"{rest // MINUTE} min"] if rest >= MINUTE else []
     return " ".join(parts)
 
 
