@@ -593,5 +593,6 @@ def write(
     except ValueError:
         students = {}  # no variants or no record
     summary.copies = find_copies(grades, students)
-    records.replace_text(target, render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note))
+    page = render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note)
+    records.replace_text(target, page, mode=0o644)
     return target

@@ -160,13 +160,15 @@ def parse_shard(spec):
 
 
 def shard(names, index, count):
-    """The `index`-th (from 1) of `count` parts of `names` (checked by :func:`parse_shard`), in name order: every
-    name is in exactly one part, the parts' sizes differ by at most one, and with more parts than names some are empty.
+    """The `index`-th (from 1) of `count` parts of `names` (as :func:`parse_shard` checks them), in name order:
+    every name is in exactly one part, the parts' sizes differ by at most one, and with more parts than names some
+    are empty.
 
     >>> [shard(["d", "a", "c", "b", "e"], i, 2) for i in (1, 2)]
     [['a', 'b'], ['c', 'd', 'e']]
     >>> shard(["a"], 2, 3)
     []
     """
+    index, count = parse_shard((index, count))
     ordered = sorted(names)
     return ordered[(index - 1) * len(ordered) // count : index * len(ordered) // count]

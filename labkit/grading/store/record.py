@@ -88,13 +88,23 @@ def write(folder, record):
         replace_text(folder / RUBRIC_COPY, record.rubric_text)
 
 
-def replace_text(path, text):
+def replace_text(path, text, mode=None):
     """Write `text` into `path` as UTF-8, exactly (no newline translation), replacing it whole: a process killed
     meanwhile leaves the earlier file or none, and two processes writing it at once never share a partial file.
-    Every file of a run folder is written through it."""
+    The file gets `mode` (e.g. 0o600 for one only its owner may read), or the umask's when None. Every file of a
+    run folder is written through it."""
     partial = path.with_name(f".{path.name}.{os.getpid()}.partial")
-    partial.write_bytes(text.encode("utf-8"))
-    os.replace(partial, path)
+    try:
+        flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW
+        descriptor = os.open(partial, flags, 0o666 if mode is None else mode)
+        with open(descriptor, "wb") as handle:
+            if mode is not None:
+                os.fchmod(descriptor, mode)  # exactly `mode`, whatever the umask
+            handle.write(text.encode("utf-8"))
+        os.replace(partial, path)
+    except BaseException:
+        partial.unlink(missing_ok=True)
+        raise
 
 
 def note(record, name, path, text, content=None):

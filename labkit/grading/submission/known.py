@@ -82,7 +82,7 @@ def _cached(name, raw, compute):
     data = compute()
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        replace_text(path, json.dumps(data))
+        replace_text(path, json.dumps(data), mode=0o600)  # it may hold the solutions
     except OSError:
         pass  # a cache that cannot be written only costs time
     return data, key

@@ -35,6 +35,12 @@ def test_a_bad_shard_is_refused_saying_how_to_write_one(spec):
         parse_shard(spec)
 
 
+@pytest.mark.parametrize(("index", "count"), [(1, 0), (5, 4), (0, 4)])
+def test_shard_itself_refuses_a_part_that_does_not_exist(index, count):
+    with pytest.raises(ValueError, match=r"give --shard I/N with 1 <= I <= N"):
+        shard(["a", "b"], index, count)
+
+
 def test_the_cli_refuses_a_bad_shard_before_grading(tmp_path):
     (tmp_path / "class").mkdir()
     run = cli("grade", tmp_path / "class", "--out", tmp_path / "out", "--shard", "0/50")

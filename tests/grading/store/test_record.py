@@ -1,6 +1,7 @@
 """The run's record (labkit.grading.store.record): what it vouches for, and a record that is not one."""
 
 import json
+import os
 
 import pytest
 
@@ -58,3 +59,17 @@ def test_another_rubric_is_refused_with_a_command_that_runs(tmp_path):
         record.rubric_for([out], other, "labkit report")
     assert record.rubric_for([out], DEFAULT, "labkit report").same_as(default())  # the same rubric, named again
     assert record.rubric_for([out], None, "labkit report").text == DEFAULT.read_text()
+
+
+def test_a_replaced_file_gets_the_mode_asked_for_and_a_failed_write_leaves_the_earlier_file(tmp_path):
+    target = tmp_path / "report.html"
+    old = os.umask(0o077)
+    try:
+        record.replace_text(target, "first", mode=0o644)
+    finally:
+        os.umask(old)
+    assert target.stat().st_mode & 0o777 == 0o644  # readable as before, even under a strict umask
+    with pytest.raises(UnicodeEncodeError):
+        record.replace_text(target, "half \ud800 written", mode=0o644)
+    assert target.read_text() == "first"
+    assert [p.name for p in tmp_path.iterdir()] == ["report.html"]  # no partial file left beside it

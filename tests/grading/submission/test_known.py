@@ -8,6 +8,7 @@ the catalog's correct variations are planted into the instructor notebooks (test
 
 import csv
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -184,6 +185,19 @@ def test_the_cache_is_used_and_a_broken_cache_entry_is_computed_again(tmp_path, 
     again, _ = known._module_entry("labkit.bilinear", path)
     assert again == first
     assert known._module_entry("labkit.splines", path)[1] != known._module_entry("labkit.bilinear", path)[1]
+
+
+def test_a_cache_entry_is_readable_by_its_owner_only(tmp_path, monkeypatch):
+    """The cache keeps the solutions' code (an instructor notebook's units with their text): never world-readable,
+    whatever the umask."""
+    monkeypatch.setenv("LABKIT_CACHE", str(tmp_path))
+    old = os.umask(0o022)
+    try:
+        known._module_entry("labkit.bilinear", ROOT / "labkit" / "bilinear.py")
+    finally:
+        os.umask(old)
+    (entry,) = (tmp_path / "known").glob("*.json")
+    assert entry.stat().st_mode & 0o777 == 0o600
 
 
 # -- honest work is never held --------------------------------------------------------------------------------
