@@ -36,12 +36,13 @@ def headless() -> bool:
 NEEDED = ("numpy", "scipy", "matplotlib", "ipywidgets", "anywidget")
 
 
-def _installed_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version  # only when a notebook starts
+def installed_version() -> str:
+    """The installed labkit's version (a notebook's and the grader's), "0+unknown" in a tree never installed."""
+    from importlib.metadata import PackageNotFoundError, version  # only when asked, not on import
 
     try:
         return version("labkit")
-    except PackageNotFoundError:  # run from a source tree that was never installed
+    except PackageNotFoundError:
         return "0+unknown"
 
 
@@ -68,7 +69,7 @@ def ready(written_for: str) -> None:
         raise InputError(
             f'give the labkit version the notebook was written for as "major.minor", e.g. "0.1"; got {written_for!r}.'
         )
-    have = _installed_version()
+    have = installed_version()
     if have != "0+unknown" and have.split(".")[:2] != parts:
         warnings.warn(
             f"this notebook was written for labkit {wanted}, but the kernel has labkit {have}: if something "

@@ -257,15 +257,11 @@ def html(feedback: Feedback) -> str:
 def _render(template: str, feedback: Feedback) -> str:
     from ..pages import render
 
-    values = {"points": points_text, "kind_words": _kind_words, "box": FIGURE_BOX, "colours": FIGURE_COLOURS}
-    return render(template, feedback=feedback, **values)
+    values = {"points": points_text, "box": FIGURE_BOX, "colours": FIGURE_COLOURS}
+    return render(template, feedback=feedback, kind_words=lambda kind: KIND_WORDS.get(kind, kind), **values)
 
 
 KIND_WORDS = {ERROR: "an error", VARIANT: "another variant's data", HELD: "held for your instructor", PASSED: "passed"}
-
-
-def _kind_words(kind):
-    return KIND_WORDS.get(kind, kind)
 
 
 def problem_kinds(problem):

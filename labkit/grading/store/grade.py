@@ -7,10 +7,11 @@ one reader of a result file, reads back; everything else reads its typed fields 
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 from ...errors import InputError
 from ...exercises.result import KINDS
+from ...notebook import installed_version
 from . import feedback as feedbacks
 from . import rubric as rubrics
 from .late import Lateness, SubmissionTime
@@ -52,15 +53,7 @@ class ProblemText(str):
         return cls(text, [(kind, str(text).split("\n")[0])])
 
 
-@functools.cache
-def labkit_version() -> str:
-    """The installed labkit's version, recorded in every result file ("0+unknown" in a tree never installed)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("labkit")
-    except PackageNotFoundError:
-        return "0+unknown"
+labkit_version = functools.cache(installed_version)  # the version recorded in every result file
 
 
 @dataclass
@@ -196,7 +189,7 @@ class SubmissionGrade:
             "failure": self.failure,
             "answers": dict(self.answers),
             "sources": dict(self.sources),
-            "marks": {str(item): mark.as_dict() for item, mark in self.marks.items()},
+            "marks": {str(item): asdict(mark) for item, mark in self.marks.items()},
             "results": {str(n): v.as_dict() for n, v in self.results.items()},
             "rubric": self.rubric.title,
             "points": {str(n): v for n, v in score.points.items()},
@@ -239,13 +232,12 @@ class SubmissionGrade:
     def _read(cls, data: dict, rubric: rubrics.Rubric | None) -> SubmissionGrade:
         if data.get("format") != FORMAT:
             raise InputError(f"format is {data.get('format')!r}, not {FORMAT!r}")
-        results = {int(n): ExerciseResult.from_dict(v, int(n), str(data["name"])) for n, v in data["results"].items()}
         for verdict in data["results"].values():
             float(verdict["fraction"])
         failure = data.get("failure")
         return cls(
             str(data["name"]),
-            results,
+            data["results"],  # each read by __post_init__
             _problems(data["problems"], data["problem_kinds"]),
             data.get("seed"),
             rubric or rubrics.default(),

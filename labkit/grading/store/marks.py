@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import csv
 import io
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -37,15 +36,6 @@ MAX_COMMENT = 2000  # characters of a comment kept
 WORDS = {"held": ("release", "keep"), "exercise": ("excused", "counted")}  # the points of an item not paid in points
 
 
-@dataclass(frozen=True)
-class MarkRow:
-    """One validated row of marks.csv: the submission, the item, and its :class:`~.model.Mark` (no time yet)."""
-
-    submission: str
-    item: ItemKey
-    mark: Mark
-
-
 def items(grade: SubmissionGrade) -> dict[ItemKey, float | None]:
     """What can be marked for `grade`: each item, with the points an answer in words is worth (None for a
     held part or an exercise)."""
@@ -60,9 +50,9 @@ def items(grade: SubmissionGrade) -> dict[ItemKey, float | None]:
     return found
 
 
-def read_marks(text: str, grades: list[SubmissionGrade]) -> list[MarkRow]:
-    """The rows of marks.csv `text`, each checked against `grades` (by name); ValueError listing every bad
-    row (line number and why) when any is bad."""
+def read_marks(text: str, grades: list[SubmissionGrade]) -> list[tuple[str, ItemKey, Mark]]:
+    """The rows of marks.csv `text` as (submission, item, its mark with no time yet), each checked against
+    `grades` (by name); ValueError listing every bad row (line number and why) when any is bad."""
     by_name = {grade.name: grade for grade in grades}
     reader = csv.reader(io.StringIO(text))
     header = next(reader, None)
@@ -83,7 +73,7 @@ def read_marks(text: str, grades: list[SubmissionGrade]) -> list[MarkRow]:
     return rows
 
 
-def _row(row: list[str], by_name: dict[str, SubmissionGrade]) -> MarkRow | str:
+def _row(row: list[str], by_name: dict[str, SubmissionGrade]) -> tuple[str, ItemKey, Mark] | str:
     """One row of marks.csv as a mark, or why it is refused."""
     if len(row) not in (3, 4):
         return f"{len(row)} cells, not 4 ({','.join(HEADER)})"
@@ -107,7 +97,7 @@ def _row(row: list[str], by_name: dict[str, SubmissionGrade]) -> MarkRow | str:
         why = "the student wrote no answer (blank, or YOUR ANSWER HERE): it is marked 0, no answer"
     if why or value is None:
         return f"{item} of {one_line(name, 80)}: {why}"
-    return MarkRow(name, key, Mark(value, printable(comment).strip()[:MAX_COMMENT]))
+    return name, key, Mark(value, printable(comment).strip()[:MAX_COMMENT])
 
 
 def _points(kind: str, worth: float, text: str) -> tuple[float | str | None, str]:
@@ -156,12 +146,11 @@ def import_marks(out, path, rubric: Rubric | None = None, now: datetime | None =
     when = (now or datetime.now(UTC)).isoformat(timespec="seconds")
     by_name = {grade.name: grade for grade in grades}
     changed = set()
-    for row in read_marks(text, grades):  # a later row replaces an earlier one
-        grade = by_name[row.submission]
-        held = grade.marks.get(row.item)
-        if held is None or (held.points, held.comment) != (row.mark.points, row.mark.comment):
-            grade.marks[row.item] = Mark(row.mark.points, row.mark.comment, when)
-            changed.add((row.submission, row.item))
+    for name, item, mark in read_marks(text, grades):  # a later row replaces an earlier one
+        held = by_name[name].marks.get(item)
+        if held is None or (held.points, held.comment) != (mark.points, mark.comment):
+            by_name[name].marks[item] = Mark(mark.points, mark.comment, when)
+            changed.add((name, item))
     for name in sorted({name for name, _ in changed}):
         enter(out, record, by_name[name], record.submissions.get(name, {}).get("content"), save=False)
     if changed:

@@ -173,6 +173,3 @@ class Mark:
     points: float | str
     comment: str = ""
     time: str = ""
-
-    def as_dict(self) -> dict:
-        return {"points": self.points, "comment": self.comment, "time": self.time}

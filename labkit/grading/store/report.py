@@ -350,15 +350,12 @@ def merge(folders, out_dir, rubric=None, times=None, progress=False) -> Merged:
         )
     grades = read_results(folders, rubric)
     contents = {name: entry.get("content") for r in read for name, entry in r.submissions.items()}
-    for grade in grades:
-        if times and grade.name in times:
-            grade.time = SubmissionTime(times[grade.name], FROM_CSV)
-    out.mkdir(parents=True, exist_ok=True)
     record = _merged_record(read, grades)
     with Progress(len(grades), "merging", enabled=progress) as bar:
-        for grade in grades:
-            grade.rubric = grades.rubric
-            enter(out, record, grade, contents.get(grade.name), save=False)
+        for grade in grades:  # each scored with grades.rubric already (read_results)
+            if times and grade.name in times:
+                grade.time = SubmissionTime(times[grade.name], FROM_CSV)
+            enter(out, record, grade, contents.get(grade.name), save=False)  # makes `out`
             bar.advance()
     records.write(out, record)
     write_csv(out / "grades.csv", grades)
