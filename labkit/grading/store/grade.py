@@ -85,7 +85,7 @@ class SubmissionGrade:
             for n, v in self.results.items()
         }
         self.marks = {
-            k if isinstance(k, ItemKey) else ItemKey.of(k): m if isinstance(m, Mark) else Mark(**m)
+            k if isinstance(k, ItemKey) else ItemKey.of(k): m if isinstance(m, Mark) else _mark(k, m)
             for k, m in self.marks.items()
         }
 
@@ -245,20 +245,16 @@ class SubmissionGrade:
             {str(k): str(v)[:4000] for k, v in dict(data.get("answers") or {}).items()},
             SubmissionTime.from_dict(data.get("submitted")),
             _sources(data.get("sources") or {}),  # results written before sources were kept have none
-            _marks(data.get("marks") or {}),
+            dict(data.get("marks") or {}),  # each read by __post_init__
         )
 
 
-def _marks(value: dict) -> dict[ItemKey, Mark]:
-    """A result file's marks: {item: {"points", "comment", "time"}}; TypeError when they are not."""
-    marks = {}
-    for item, mark in dict(value).items():
-        points = mark["points"]
-        if isinstance(points, bool) or not isinstance(points, (int, float, str)):
-            raise TypeError(f"the mark of {item!r} has points {points!r}")
-        comment = printable(mark.get("comment", ""))[:2000]
-        marks[ItemKey.of(str(item))] = Mark(points, comment, str(mark.get("time", "")))
-    return marks
+def _mark(item, data: dict) -> Mark:
+    """A result file's mark of `item`, {"points", "comment", "time"}; TypeError when it is not one."""
+    points = data["points"]
+    if isinstance(points, bool) or not isinstance(points, (int, float, str)):
+        raise TypeError(f"the mark of {item!r} has points {points!r}")
+    return Mark(points, printable(data.get("comment", ""))[:2000], str(data.get("time", "")))
 
 
 def _sources(value: dict) -> dict[str, str]:
@@ -273,4 +269,4 @@ def _problems(texts: list, kinds: list) -> list[ProblemText]:
     """A result file's problems, each with its kinds (ValueError when the two lists do not pair up)."""
     if not isinstance(texts, list) or not isinstance(kinds, list) or len(texts) != len(kinds):
         raise InputError("its problems and their kinds do not pair up")
-    return [ProblemText(str(text), [(str(k), str(d)) for k, d in pairs]) for text, pairs in zip(texts, kinds)]
+    return [ProblemText(str(text), pairs) for text, pairs in zip(texts, kinds)]

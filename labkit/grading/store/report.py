@@ -140,9 +140,8 @@ def _csv_row(grade: SubmissionGrade, graded: list, width: int, held: bool, answe
 
 
 def write_csv(path: str | Path, grades: list[SubmissionGrade]) -> None:
-    """One row per submission: points per exercise, the branch that counted, extra credit, total, status.
-
-    A submission that could not be graded has empty points and says why in its status."""
+    """grades.csv (its columns in the module's docstring); a submission that could not be graded has empty
+    points and says why in its status."""
     rubric = grades[0].rubric if grades else None
     graded = rubric.graded if rubric is not None else []
     answers = rubric.registry.answers.items() if rubric is not None else ()
@@ -179,8 +178,7 @@ def enter(out_dir: str | Path, record: records.RunRecord, grade: SubmissionGrade
 
 def write_report(out_dir: str | Path, grades: list[SubmissionGrade], record: records.RunRecord | None = None):
     """Write grades.csv plus each submission's result and feedback files, each entered in the run's `record` (a new
-    one of the grades' rubric and seeds when None), which is written too; the record.
-    """
+    one of the grades' rubric and seeds when None), which is written too; the record."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if record is None:
