@@ -108,8 +108,7 @@ def _headline(grade):
 
 
 def _exercise(grade, number, other_branch):
-    rubric, points = grade.rubric, grade.points.get(number, 0.0)
-    worth = rubric.worth(number)
+    points, worth = grade.points.get(number, 0.0), grade.rubric.worth(number)
     if number in grade.excused:
         return Exercise(number, 0.0, 0.0, "excused")
     verdict = grade.results.get(number)
