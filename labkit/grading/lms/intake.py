@@ -54,10 +54,6 @@ class Intake:
     layout: str
     notes: list[str] = field(default_factory=list)
 
-    @property
-    def gradable(self) -> list[Student]:
-        return [s for s in self.students if s.path is not None]
-
 
 def entries(folder):
     """The entries of `folder` worth looking at, in name order; links never followed."""

@@ -69,7 +69,6 @@ class Nbgrader(Lms):
         return entry
 
     def feedback_names(self, name, entry):
-        """``{student}/feedback.html`` and ``feedback/{student}/{assignment}/{notebook}.html``."""
         names = FOLDERS.feedback_names(name, entry)
         assignment = str(entry.get("assignment") or "")
         if name == Path(name).name and assignment == Path(assignment).name and not name.startswith("."):
