@@ -309,8 +309,7 @@ def to_canvas(
     force: bool = False,
 ) -> Export:
     """Fill the assignment `column` of the Canvas `gradebook` with the grades' totals into `out` (and its summary),
-    matching students through `roster` on the `key` column; ValueError, and nothing written, for bad input. A
-    `column` it lacks is refused (a typo would be a new assignment in Canvas) unless `new_column`."""
+    matching students through `roster` on the `key` column; ValueError, and nothing written, for bad input."""
     if key not in KEYS:
         raise InputError(f"--key for Canvas is one of {', '.join(KEYS)} (a gradebook column); got {key!r}.")
     by_name, export = start(grades, out, "Canvas", column)

@@ -7,12 +7,11 @@ rule leaves its student ungraded, never the class.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import shutil
 import stat
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ...errors import InputError
@@ -53,6 +52,10 @@ class Intake:
     students: list[Student]
     layout: str
     notes: list[str] = field(default_factory=list)
+
+    @property
+    def gradable(self) -> list[Student]:
+        return [s for s in self.students if s.path is not None]
 
 
 def entries(folder):
@@ -129,7 +132,7 @@ class Builder:
     def refusal(self, student, key):
         """`student` as one who could not be graded when the class zip's members of theirs were refused, or None."""
         why = self.refused.get(key)
-        return None if why is None else dataclasses.replace(student, path=None, failure=why)
+        return None if why is None else replace(student, path=None, failure=why)
 
     def from_folder(self, name, folder, layout, lms_id=None, late=False, keep=(), key=None):
         """A student whose work is the folder `folder` (read only): graded in place unless it holds zips."""
@@ -139,13 +142,13 @@ class Builder:
         try:
             files = walk(folder, self.notes)
         except ValueError as exc:
-            return dataclasses.replace(who, failure=f"{exc} {FIX}")
+            return replace(who, failure=f"{exc} {FIX}")
         pieces = [(f.relative_to(folder), f) for f in files]
         if any(f.suffix.lower() == ".zip" for f in files):
             return self._assemble(who, key, pieces, [r.as_posix() for r, _ in pieces], keep)
         if not any(f.suffix == ".ipynb" for f in files):
-            return dataclasses.replace(who, failure=_no_notebook(as_text(r.as_posix()) for r, _ in pieces))
-        return dataclasses.replace(who, path=Path(folder))
+            return replace(who, failure=_no_notebook(as_text(r.as_posix()) for r, _ in pieces))
+        return replace(who, path=Path(folder))
 
     def from_files(self, name, pieces, layout, lms_id=None, late=False, key=None):
         """A student given as loose files: `pieces` pairs the name to give each with its path."""
@@ -158,7 +161,7 @@ class Builder:
         zips = [(relative, path) for relative, path in given if path.suffix.lower() == ".zip"]
         pieces = [(relative, path) for relative, path in given if path.suffix == ".ipynb" or path.name in keep]
         if not pieces and not zips:
-            return dataclasses.replace(who, failure=_no_notebook(shown))
+            return replace(who, failure=_no_notebook(shown))
         target = free(self.workspace / "students" / safe_name(who.name))
         target.mkdir(parents=True)
         try:
@@ -168,8 +171,8 @@ class Builder:
             failure = f"{one_line(as_text(str(exc)), 400)} {FIX}"
         if failure is not None:
             shutil.rmtree(target, ignore_errors=True)
-            return dataclasses.replace(who, failure=failure)
-        return dataclasses.replace(who, path=target)
+            return replace(who, failure=failure)
+        return replace(who, path=target)
 
     def _fill(self, name, target, pieces, zips, key):
         """Copy the student's notebooks into `target` and unpack their zips there, all on the student's budget."""
@@ -441,7 +444,7 @@ def _by_roster(students, roster, notes):
             name = student.name if student.name not in roster else f"{student.name}_{student.lms_id}"
             who = f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)})"
             notes.append(f"{who} is not on the roster: graded as {one_line(name, 80)}")
-        renamed.append(dataclasses.replace(student, name=name))
+        renamed.append(replace(student, name=name))
     return renamed
 
 
@@ -474,9 +477,6 @@ def find_students(paths, workspace, *, limits: UnpackLimits = LIMITS) -> Intake:
     students = []
     for path in map(Path, paths):
         name = as_text(path.stem if path.suffix == ".ipynb" else path.name)
-        try:
-            folder = stat.S_ISDIR(os.lstat(path).st_mode)
-        except OSError:
-            folder = False
+        folder = not os.path.islink(path) and os.path.isdir(path)
         students.append(builder.from_folder(name, path, "listed") if folder else Student(name, path, None, "listed"))
     return Intake(students, "listed", builder.notes)
