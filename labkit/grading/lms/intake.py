@@ -245,14 +245,10 @@ def is_class(path: str | os.PathLike) -> bool:
     """Whether `path` is a class (a zip, or a folder of an LMS's layout) rather than one student's notebooks;
     ValueError for a folder of both notebooks (not named as an LMS names them) and folders of notebooks."""
     path = Path(path)
-    try:
-        info = os.lstat(path)
-    except OSError:
+    if os.path.islink(path):
         return False
-    if stat.S_ISREG(info.st_mode):
-        return path.suffix.lower() == ".zip"
-    if not stat.S_ISDIR(info.st_mode):
-        return False
+    if not os.path.isdir(path):
+        return os.path.isfile(path) and path.suffix.lower() == ".zip"
     loose, folders = False, False
     for entry in entries(path):
         name = as_text(entry.name)
@@ -292,7 +288,8 @@ def _class_zip(path, root, builder):
             except ValueError as exc:
                 unzip.undo(written, made)  # a refused student's members are removed again
                 builder.refused[key] = f"{exc} {FIX}"
-            _placeholder(root, key, groups[key], lms.depth, builder)
+            if key in builder.refused:
+                _placeholder(root, groups[key], lms.depth, builder)
     return lms
 
 
@@ -367,10 +364,8 @@ def _check_space(lms, plans, root, label):
     )
 
 
-def _placeholder(root, key, items, depth, builder):
+def _placeholder(root, items, depth, builder):
     """For a refused student, empty stand-ins of what names them at the top, so that the layout finds them."""
-    if key not in builder.refused:
-        return
     folders = {tuple(p[:depth]) for info, p in items if len(p) > depth or (len(p) == depth and info.is_dir())}
     files = {tuple(p) for _, p in items if len(p) == 1 and depth == 1} - folders
     for parts in sorted(folders)[:SHOWN]:
