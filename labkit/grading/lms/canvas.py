@@ -133,8 +133,7 @@ class Canvas(Lms):
 
     def owners(self, tops, builder):
         chosen, said = resolve_canvas([name for name, kind in tops if kind == "file"], builder.roster_ids)
-        builder.notes += said
-        builder.noted = True  # the files filed to no one are never unpacked: their notes are said here
+        builder.notes += said  # the files filed to no one are never unpacked: their notes are said here
         owners = {name: None for name, _ in tops if canvas_readings(name)}
         return owners | {name: ("canvas", r.uid) for name, r in chosen.items() if r is not None}
 
@@ -191,7 +190,7 @@ def _files(root, builder):
         else:
             builder.notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
     chosen, said = resolve_canvas(files, builder.roster_ids)
-    builder.notes += [] if builder.noted else said
+    builder.notes += [] if builder.zip_depth else said  # a class zip's owners() said them already
     return {name: (reading, files[name]) for name, reading in chosen.items() if reading is not None}
 
 

@@ -115,7 +115,6 @@ class Builder:
         self.refused: dict = {}  # a student's key -> why the class zip's members of theirs were not extracted
         self.aliases: dict = {}  # a name written in the workspace -> the class zip's own (too long to write)
         self.roster_ids = roster_ids  # the roster's ids, which settle whose a file is when its name reads two ways
-        self.noted = False  # the class zip's owners() said already how each name was read
 
     def budget(self, key):
         """The budget of the student `key` (fresh for one seen first): every limit is per student, in total."""
