@@ -88,8 +88,8 @@ def walk(folder, notes=None):
 def safe_part(original):
     """An original file name from an LMS as one file name to create: its own, unless it could not be one."""
     text = original.replace("/", "_").replace("\\", "_").replace("\x00", "_")
-    if text in ("", ".", "..") or text.startswith(".") or len(text.encode("utf-8", "surrogateescape")) > 200:
-        stem, dot, ext = text.rpartition(".")
+    if not text or text.startswith(".") or len(text.encode("utf-8", "surrogateescape")) > 200:
+        _, dot, ext = text.rpartition(".")
         return safe_name(text) + (f".{ext}" if dot and ext.isalnum() and len(ext) <= 10 else "")
     return text
 
