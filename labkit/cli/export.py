@@ -129,7 +129,7 @@ def _to_moodle(args, grades):
 
 
 def _to_other(args, grades):
-    from ..grading.lms import exports
+    from ..grading.lms import exports, named
 
     out = args.out or exports.default_file(args.results, args.lms)
-    return exports.export(args.lms, grades, args.roster, out, force=args.force)
+    return named(args.lms).export(grades, args.roster, out, force=args.force)

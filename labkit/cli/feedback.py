@@ -27,10 +27,10 @@ def add(commands):
 
 def handle(args):
     """Write the upload zip and say how to hand it to the LMS; 1 when something is noted about it."""
-    from ..grading.lms import delivery
+    from ..grading.lms import delivery, named
 
     path, members, notes = delivery.write_upload(args.out, args.layout)
     for line in notes:
         print(f"labkit feedback: {line}", file=sys.stderr)
-    print(f"wrote {path}: {len(members)} file(s); {delivery.steps(delivery.layout_of(args.out, args.layout))}")
+    print(f"wrote {path}: {len(members)} file(s); {named(delivery.layout_of(args.out, args.layout)).steps}")
     return 1 if notes else 0

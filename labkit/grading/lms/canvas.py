@@ -133,8 +133,7 @@ class Canvas(Lms):
 
     def owners(self, tops, builder):
         chosen, said = resolve_canvas([name for name, kind in tops if kind == "file"], builder.roster_ids)
-        builder.notes += said
-        builder.noted = True  # the files filed to no one are never unpacked: their notes are said here
+        builder.notes += said  # the files filed to no one are never unpacked: their notes are said here
         owners = {name: None for name, _ in tops if canvas_readings(name)}
         return owners | {name: ("canvas", r.uid) for name, r in chosen.items() if r is not None}
 
@@ -191,7 +190,7 @@ def _files(root, builder):
         else:
             builder.notes.append(f"ignored {one_line(name)}: not named as Canvas names a submission's file")
     chosen, said = resolve_canvas(files, builder.roster_ids)
-    builder.notes += [] if builder.noted else said
+    builder.notes += [] if builder.zip_depth else said  # a class zip's owners() said them already
     return {name: (reading, files[name]) for name, reading in chosen.items() if reading is not None}
 
 
@@ -309,8 +308,7 @@ def to_canvas(
     force: bool = False,
 ) -> Export:
     """Fill the assignment `column` of the Canvas `gradebook` with the grades' totals into `out` (and its summary),
-    matching students through `roster` on the `key` column; ValueError, and nothing written, for bad input. A
-    `column` it lacks is refused (a typo would be a new assignment in Canvas) unless `new_column`."""
+    matching students through `roster` on the `key` column; ValueError, and nothing written, for bad input."""
     if key not in KEYS:
         raise InputError(f"--key for Canvas is one of {', '.join(KEYS)} (a gradebook column); got {key!r}.")
     by_name, export = start(grades, out, "Canvas", column)

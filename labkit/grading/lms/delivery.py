@@ -48,11 +48,6 @@ def write_upload(out, layout=None) -> tuple[Path, list[str], list[str]]:
     return path, members, notes
 
 
-def steps(layout: str) -> str:
-    """How the instructor hands the feedback zip of `layout` to the LMS."""
-    return named(layout).steps
-
-
 def layout_of(out, layout=None):
     """The layout `labkit feedback` names the files for: `layout`, else the run's recorded one, else folders."""
     return layout or records.read(out).delivery.get("layout") or "folders"

@@ -8,15 +8,15 @@ never replaces an input, nor an existing file unless ``force``.
 from __future__ import annotations
 
 import csv
+import io
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import InputError
+from ..store.record import replace_text
 from ..store.report import FORMULA_START, SubmissionGrade, csv_cell, one_line
 from ..store.text import points_text
-from . import named
 
 DEFAULT_COLUMN = "labkit"
 
@@ -28,7 +28,6 @@ class Export:
     result, or a gradebook row) [(submission, id)], `lms_only` (gradebook rows with no roster entry) [(name, id)]."""
 
     path: Path
-    summary_path: Path
     lms: str
     column: str
     exported: dict = field(default_factory=dict)
@@ -38,6 +37,11 @@ class Export:
     not_in_lms: list = field(default_factory=list)
     lms_only: list = field(default_factory=list)
     notes: list = field(default_factory=list)
+
+    @property
+    def summary_path(self) -> Path:
+        """The summary CSV beside the export file: ``grades-canvas.csv``'s is ``grades-canvas-summary.csv``."""
+        return self.path.with_name(f"{self.path.stem}-summary.csv")
 
     @property
     def listed(self) -> int:
@@ -75,21 +79,10 @@ class Export:
         return "\n".join(lines + self.notes)
 
 
-def export(layout: str, grades: list[SubmissionGrade], roster, out, **options) -> Export:
-    """Write `grades` for the grade import of the LMS named `layout` (its :meth:`~labkit.grading.lms.Lms.export`)."""
-    return named(layout).export(grades, roster, out, **options)
-
-
 def default_file(results_dir: str | os.PathLike, lms: str) -> Path:
     """Where ``labkit export`` writes when not told: ``<folder>-<lms>.csv`` beside the run's ``--out`` folder."""
     folder = Path(results_dir).resolve()
     return folder.with_name(f"{folder.name}-{lms}.csv")
-
-
-def summary_file(path: str | os.PathLike) -> Path:
-    """The summary CSV that goes with an export file: ``grades-canvas.csv``'s is ``grades-canvas-summary.csv``."""
-    path = Path(path)
-    return path.with_name(f"{path.stem}-summary.csv")
 
 
 def start(grades, out, lms, column):
@@ -107,7 +100,7 @@ def start(grades, out, lms, column):
         by_name[grade.name] = grade
     if not by_name:
         raise InputError("there are no grades to export: give the --out folder of a `labkit grade` run.")
-    return by_name, Export(Path(out), summary_file(out), lms, column)
+    return by_name, Export(Path(out), lms, column)
 
 
 def check_outputs(export, inputs, force):
@@ -142,20 +135,10 @@ def match(export, by_name, roster, rows=None):
 
 
 def write(rows, path, *, delimiter=",", newline="\r\n", bom=False):
-    """Write `rows` as CSV: to a temporary file beside `path`, renamed into place when complete."""
-    path = Path(path)
-    handle = tempfile.NamedTemporaryFile(  # noqa: SIM115 - closed below, then renamed into place
-        "w", encoding="utf-8", newline="", dir=path.parent, prefix=f".{path.name}.", suffix=".tmp", delete=False
-    )
-    try:
-        with handle:
-            if bom:
-                handle.write("\ufeff")
-            csv.writer(handle, delimiter=delimiter, lineterminator=newline).writerows(rows)
-        os.replace(handle.name, path)
-    except BaseException:
-        Path(handle.name).unlink(missing_ok=True)
-        raise
+    """Write `rows` as CSV into `path`, replaced whole; only its owner may read it (it holds ids and grades)."""
+    buffer = io.StringIO()
+    csv.writer(buffer, delimiter=delimiter, lineterminator=newline).writerows(rows)
+    replace_text(Path(path), ("\ufeff" if bom else "") + buffer.getvalue(), 0o600)
 
 
 def write_summary(export, roster, by_name):

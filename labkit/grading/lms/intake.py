@@ -7,12 +7,11 @@ rule leaves its student ungraded, never the class.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import shutil
 import stat
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ...errors import InputError
@@ -89,8 +88,8 @@ def walk(folder, notes=None):
 def safe_part(original):
     """An original file name from an LMS as one file name to create: its own, unless it could not be one."""
     text = original.replace("/", "_").replace("\\", "_").replace("\x00", "_")
-    if text in ("", ".", "..") or text.startswith(".") or len(text.encode("utf-8", "surrogateescape")) > 200:
-        stem, dot, ext = text.rpartition(".")
+    if not text or text.startswith(".") or len(text.encode("utf-8", "surrogateescape")) > 200:
+        _, dot, ext = text.rpartition(".")
         return safe_name(text) + (f".{ext}" if dot and ext.isalnum() and len(ext) <= 10 else "")
     return text
 
@@ -116,7 +115,6 @@ class Builder:
         self.refused: dict = {}  # a student's key -> why the class zip's members of theirs were not extracted
         self.aliases: dict = {}  # a name written in the workspace -> the class zip's own (too long to write)
         self.roster_ids = roster_ids  # the roster's ids, which settle whose a file is when its name reads two ways
-        self.noted = False  # the class zip's owners() said already how each name was read
 
     def budget(self, key):
         """The budget of the student `key` (fresh for one seen first): every limit is per student, in total."""
@@ -133,7 +131,7 @@ class Builder:
     def refusal(self, student, key):
         """`student` as one who could not be graded when the class zip's members of theirs were refused, or None."""
         why = self.refused.get(key)
-        return None if why is None else dataclasses.replace(student, path=None, failure=why)
+        return None if why is None else replace(student, path=None, failure=why)
 
     def from_folder(self, name, folder, layout, lms_id=None, late=False, keep=(), key=None):
         """A student whose work is the folder `folder` (read only): graded in place unless it holds zips."""
@@ -143,13 +141,13 @@ class Builder:
         try:
             files = walk(folder, self.notes)
         except ValueError as exc:
-            return dataclasses.replace(who, failure=f"{exc} {FIX}")
+            return replace(who, failure=f"{exc} {FIX}")
         pieces = [(f.relative_to(folder), f) for f in files]
         if any(f.suffix.lower() == ".zip" for f in files):
             return self._assemble(who, key, pieces, [r.as_posix() for r, _ in pieces], keep)
         if not any(f.suffix == ".ipynb" for f in files):
-            return dataclasses.replace(who, failure=_no_notebook(as_text(r.as_posix()) for r, _ in pieces))
-        return dataclasses.replace(who, path=Path(folder))
+            return replace(who, failure=_no_notebook(as_text(r.as_posix()) for r, _ in pieces))
+        return replace(who, path=Path(folder))
 
     def from_files(self, name, pieces, layout, lms_id=None, late=False, key=None):
         """A student given as loose files: `pieces` pairs the name to give each with its path."""
@@ -162,7 +160,7 @@ class Builder:
         zips = [(relative, path) for relative, path in given if path.suffix.lower() == ".zip"]
         pieces = [(relative, path) for relative, path in given if path.suffix == ".ipynb" or path.name in keep]
         if not pieces and not zips:
-            return dataclasses.replace(who, failure=_no_notebook(shown))
+            return replace(who, failure=_no_notebook(shown))
         target = free(self.workspace / "students" / safe_name(who.name))
         target.mkdir(parents=True)
         try:
@@ -172,8 +170,8 @@ class Builder:
             failure = f"{one_line(as_text(str(exc)), 400)} {FIX}"
         if failure is not None:
             shutil.rmtree(target, ignore_errors=True)
-            return dataclasses.replace(who, failure=failure)
-        return dataclasses.replace(who, path=target)
+            return replace(who, failure=failure)
+        return replace(who, path=target)
 
     def _fill(self, name, target, pieces, zips, key):
         """Copy the student's notebooks into `target` and unpack their zips there, all on the student's budget."""
@@ -246,14 +244,10 @@ def is_class(path: str | os.PathLike) -> bool:
     """Whether `path` is a class (a zip, or a folder of an LMS's layout) rather than one student's notebooks;
     ValueError for a folder of both notebooks (not named as an LMS names them) and folders of notebooks."""
     path = Path(path)
-    try:
-        info = os.lstat(path)
-    except OSError:
+    if os.path.islink(path):
         return False
-    if stat.S_ISREG(info.st_mode):
-        return path.suffix.lower() == ".zip"
-    if not stat.S_ISDIR(info.st_mode):
-        return False
+    if not os.path.isdir(path):
+        return os.path.isfile(path) and path.suffix.lower() == ".zip"
     loose, folders = False, False
     for entry in entries(path):
         name = as_text(entry.name)
@@ -293,7 +287,8 @@ def _class_zip(path, root, builder):
             except ValueError as exc:
                 unzip.undo(written, made)  # a refused student's members are removed again
                 builder.refused[key] = f"{exc} {FIX}"
-            _placeholder(root, key, groups[key], lms.depth, builder)
+            if key in builder.refused:
+                _placeholder(root, groups[key], lms.depth, builder)
     return lms
 
 
@@ -368,10 +363,8 @@ def _check_space(lms, plans, root, label):
     )
 
 
-def _placeholder(root, key, items, depth, builder):
+def _placeholder(root, items, depth, builder):
     """For a refused student, empty stand-ins of what names them at the top, so that the layout finds them."""
-    if key not in builder.refused:
-        return
     folders = {tuple(p[:depth]) for info, p in items if len(p) > depth or (len(p) == depth and info.is_dir())}
     files = {tuple(p) for _, p in items if len(p) == 1 and depth == 1} - folders
     for parts in sorted(folders)[:SHOWN]:
@@ -445,7 +438,7 @@ def _by_roster(students, roster, notes):
             name = student.name if student.name not in roster else f"{student.name}_{student.lms_id}"
             who = f"{one_line(student.name, 80)} (LMS id {one_line(student.lms_id, 40)})"
             notes.append(f"{who} is not on the roster: graded as {one_line(name, 80)}")
-        renamed.append(dataclasses.replace(student, name=name))
+        renamed.append(replace(student, name=name))
     return renamed
 
 
@@ -478,9 +471,6 @@ def find_students(paths, workspace, *, limits: UnpackLimits = LIMITS) -> Intake:
     students = []
     for path in map(Path, paths):
         name = as_text(path.stem if path.suffix == ".ipynb" else path.name)
-        try:
-            folder = stat.S_ISDIR(os.lstat(path).st_mode)
-        except OSError:
-            folder = False
+        folder = not os.path.islink(path) and os.path.isdir(path)
         students.append(builder.from_folder(name, path, "listed") if folder else Student(name, path, None, "listed"))
     return Intake(students, "listed", builder.notes)

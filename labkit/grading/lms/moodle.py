@@ -185,9 +185,7 @@ def points_in_words(grade):
 
 
 def _feedback_cell(grade):
-    """The points in words, then the student's feedback text, bounded and never read as a formula."""
-    if not grade.graded:
-        return csv_cell(points_in_words(grade))
+    """The points in words, then the graded student's feedback text, bounded and never read as a formula."""
     whole = f"{points_in_words(grade)}\n\n{text(build(grade))}"
     whole = whole if len(whole) <= MAX_FEEDBACK else whole[: MAX_FEEDBACK - 1] + "\u2026"
     return csv_cell(whole[:1]) + whole[1:]

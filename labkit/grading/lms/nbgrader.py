@@ -63,13 +63,11 @@ class Nbgrader(Lms):
         entry = super().remember(student)
         if student.path is not None:
             entry["assignment"] = student.path.name
-            entry["notebooks"] = sorted(p.stem for p in Path(student.path).glob("*.ipynb"))
-            for name in FILES:
-                entry[name] = _small(Path(student.path) / name)
+            entry["notebooks"] = sorted(p.stem for p in student.path.glob("*.ipynb"))
+            entry |= {name: _small(student.path / name) for name in FILES}
         return entry
 
     def feedback_names(self, name, entry):
-        """``{student}/feedback.html`` and ``feedback/{student}/{assignment}/{notebook}.html``."""
         names = FOLDERS.feedback_names(name, entry)
         assignment = str(entry.get("assignment") or "")
         if name == Path(name).name and assignment == Path(assignment).name and not name.startswith("."):

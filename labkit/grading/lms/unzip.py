@@ -103,10 +103,11 @@ def refused(label, shown, why):
     return InputError(f"{label}: member {shown!r} {why}")
 
 
-def member_parts(name, label, skip=0):
-    """The parts of a member's name; ValueError when it leaves the folder or a part past `skip` is too long."""
-    shown = one_line(name, 120)
-    text = name.replace("\\", "/")
+def _member(info, label, skip):
+    """(the parts of a member's name, whether it is a folder, its name shown); ValueError when the name leaves the
+    folder or a part past `skip` is too long, and for a link, a device, a pipe or an encrypted member."""
+    shown = one_line(info.filename, 120)
+    text = info.filename.replace("\\", "/")
     if text.startswith("/") or re.match(r"^[A-Za-z]:", text) or "\x00" in text:
         raise refused(label, shown, "has an absolute path; labkit never extracts it.")
     parts = [p for p in text.split("/") if p not in ("", ".")]
@@ -116,7 +117,15 @@ def member_parts(name, label, skip=0):
         raise refused(
             label, shown, f"has a name longer than {MAX_NAME} bytes, more than a file system takes; rename it."
         )
-    return parts
+    mode = info.external_attr >> 16
+    kind = stat.S_IFMT(mode)
+    if stat.S_ISLNK(mode):
+        raise refused(label, shown, "is a symbolic link; labkit never extracts links.")
+    if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
+        raise refused(label, shown, "is a device or a pipe; labkit never extracts those.")
+    if info.flag_bits & 0x1:
+        raise refused(label, shown, "is encrypted; labkit cannot read it.")
+    return parts, info.is_dir() or kind == stat.S_IFDIR, shown
 
 
 def _over_total(label, limits, when=""):
@@ -151,12 +160,11 @@ def checked(members, budget, label, skip=0):
         raise InputError(f"{label}: more than {most} members; labkit extracts at most {most} for one student.")
     plan, seen, declared = [], set(), 0
     for info, given in members:
-        parts = member_parts(info.filename, label, skip)  # refuses what leaves the folder, and too long a name
+        parts, is_dir, shown = _member(info, label, skip)  # refuses whatever could harm, before it is written
         parts = parts if given is None else given
-        is_dir = _member_kind(info, label)
         if not parts or parts[0] == "__MACOSX":
             continue
-        shown, key = one_line(info.filename, 120), "/".join(parts)
+        key = "/".join(parts)
         if key in seen:
             raise refused(label, shown, "appears twice; labkit extracts each name once.")
         seen.add(key)
@@ -167,20 +175,6 @@ def checked(members, budget, label, skip=0):
                 raise _over_total(label, budget.limits)
         plan.append((info, parts, is_dir, shown))
     return plan
-
-
-def _member_kind(info, label):
-    """Whether the member is a folder; ValueError for a link, a device, a pipe or an encrypted member."""
-    shown = one_line(info.filename, 120)
-    mode = info.external_attr >> 16
-    kind = stat.S_IFMT(mode)
-    if stat.S_ISLNK(mode):
-        raise refused(label, shown, "is a symbolic link; labkit never extracts links.")
-    if kind and kind not in (stat.S_IFREG, stat.S_IFDIR):
-        raise refused(label, shown, "is a device or a pipe; labkit never extracts those.")
-    if info.flag_bits & 0x1:
-        raise refused(label, shown, "is encrypted; labkit cannot read it.")
-    return info.is_dir() or kind == stat.S_IFDIR
 
 
 def _check_size(label, shown, size, compressed, limits, growing=False):

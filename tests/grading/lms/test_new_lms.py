@@ -12,7 +12,7 @@ import pytest
 
 import labkit.grading.lms as lms
 from labkit import cli
-from labkit.grading.lms import delivery, exports
+from labkit.grading.lms import delivery
 from labkit.grading.lms.intake import find_class
 from labkit.grading.store.report import SubmissionGrade, read_results, write_report
 
@@ -131,11 +131,11 @@ def test_intake_recognises_its_download_and_feedback_and_export_find_it(toy, tmp
     assert notes == [] and sorted(members) == ["ada_feedback.html", "bob_feedback.html"]
     with zipfile.ZipFile(path) as archive:
         assert b"Total: 10 / 100 points" in archive.read("ada_feedback.html")
-    assert delivery.steps(delivery.layout_of(out)) == "upload it in Toy's feedback page"
+    assert lms.named(delivery.layout_of(out)).steps == "upload it in Toy's feedback page"
 
     roster = tmp_path / "roster.csv"
     roster.write_text("submission,id\nada,ada\nbob,bob\n", encoding="utf-8")
-    export = exports.export("toy", read_results([out]), roster, tmp_path / "toy.csv")
+    export = lms.named("toy").export(read_results([out]), roster, tmp_path / "toy.csv")
     with open(tmp_path / "toy.csv", encoding="utf-8", newline="") as handle:
         assert list(csv.reader(handle)) == [["username", "points"], ["ada", "10.0"], ["bob", "10.0"]]
     assert export.listed == 0 and export.exported == {"ada": ("ada", 10.0), "bob": ("bob", 10.0)}
