@@ -53,9 +53,8 @@ class MemoryCgroup:
     """One sandbox's cgroup with a memory limit (and, with v1, a cpu cgroup beside it)."""
 
     def __init__(self, version, path, cpu_path=None):
-        self.version, self.path = version, Path(path)
-        self.cpu_path = Path(cpu_path) if cpu_path is not None else None
-        self.folders = [folder for folder in (self.path, self.cpu_path) if folder is not None]
+        self.version, self.path, self.cpu_path = version, path, cpu_path
+        self.folders = [folder for folder in (path, cpu_path) if folder is not None]
 
     def sibling_environment(self):
         """What to put in the environment of a process in this cgroup so its own cgroups are made beside it."""
@@ -140,23 +139,21 @@ def create(limit, label="labkit", cores=1):
             path.mkdir()
         except OSError:
             continue
+        if version == "v1":
+            limit_file, settings = "memory.limit_in_bytes", {"memory.memsw.limit_in_bytes": str(int(limit))}
+        else:
+            limit_file, settings = "memory.max", {"memory.swap.max": "0"}
+            if cores:
+                settings["cpu.max"] = f"{int(100_000 * cores)} 100000"
         try:
-            if version == "v1":
-                (path / "memory.limit_in_bytes").write_text(str(int(limit)))
-                with contextlib.suppress(OSError):
-                    (path / "memory.memsw.limit_in_bytes").write_text(str(int(limit)))  # no swapping past it
-            else:
-                (path / "memory.max").write_text(str(int(limit)))
-                settings = {"memory.swap.max": "0"}  # no swapping past it
-                if cores:
-                    settings["cpu.max"] = f"{int(100_000 * cores)} 100000"
-                for setting, value in settings.items():
-                    with contextlib.suppress(OSError):
-                        (path / setting).write_text(value)
+            (path / limit_file).write_text(str(int(limit)))
         except OSError:
             with contextlib.suppress(OSError):
                 path.rmdir()
             continue
+        for setting, value in settings.items():  # where the kernel has them: no swapping past the limit, cores
+            with contextlib.suppress(OSError):
+                (path / setting).write_text(value)
         cpu = _cpu_v1(name, cores) if version == "v1" and cores else None
         return MemoryCgroup(version, path, cpu)
     return None

@@ -9,8 +9,7 @@ import time
 from pathlib import Path
 
 SUFFIX = ".timings.json"  # beside a grading process's result file
-_seconds: dict[str, float] = {}
-_counts: dict[str, int] = {}
+_taken: dict[str, tuple[float, int]] = {}  # {phase: (seconds, count)}
 
 
 @contextlib.contextmanager
@@ -20,18 +19,17 @@ def phase(name):
     try:
         yield
     finally:
-        _seconds[name] = _seconds.get(name, 0.0) + time.perf_counter() - start
-        _counts[name] = _counts.get(name, 0) + 1
+        seconds, count = _taken.get(name, (0.0, 0))
+        _taken[name] = (seconds + time.perf_counter() - start, count + 1)
 
 
 def reset():
-    _seconds.clear()
-    _counts.clear()
+    _taken.clear()
 
 
 def taken():
     """{phase: {"seconds": s, "count": n}} of what this process measured since :func:`reset`."""
-    return {name: {"seconds": round(_seconds[name], 4), "count": _counts[name]} for name in _seconds}
+    return {name: {"seconds": round(seconds, 4), "count": count} for name, (seconds, count) in _taken.items()}
 
 
 def write_beside(result):

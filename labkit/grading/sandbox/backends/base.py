@@ -155,10 +155,6 @@ class Box:
         """Whether the sandbox's memory cgroup ran out of memory (False where there is none)."""
         return self.cgroup is not None and self.cgroup.out_of_memory()
 
-    def peak_memory(self):
-        """The sandbox's peak memory in bytes, or None where there is no cgroup to tell."""
-        return self.cgroup.peak() if self.cgroup is not None else None
-
     def close(self):
         """After :meth:`stop`: close the worker's pipes and undo what was set up for it (nothing is left behind)."""
         if self.closed:

@@ -73,9 +73,7 @@ def command(argv, limits=None, seccomp_fd=None, zygote=False):
         elif top.is_dir():
             args += ["--ro-bind", str(top), str(top)]
     made = {Path("/tmp")}
-    for path in environment_paths():
-        args += [*_parents(path, made), "--ro-bind", str(path), str(path)]
-    for origin, shown in course_mounts():
+    for origin, shown in [*((path, path) for path in environment_paths()), *course_mounts()]:
         args += [*_parents(shown, made), "--ro-bind", str(origin), str(shown)]
     args += [*_parents(HOME, made), "--perms", "1777", "--size", str(limits.home_size), "--tmpfs", HOME]
     args += ["--chdir", HOME]
@@ -108,7 +106,6 @@ class Bubblewrap(Backend):
     )
 
     def available(self):
-        """Raise SandboxUnavailable with what to do if bwrap cannot run a sandbox here; bwrap's path otherwise."""
         bwrap = shutil.which("bwrap")
         if bwrap is None:
             raise SandboxUnavailable(f"bwrap (bubblewrap) is not installed: {INSTALL_HINT}.")
@@ -118,7 +115,6 @@ class Bubblewrap(Backend):
             raise SandboxUnavailable(
                 f"bwrap cannot create a sandbox here ({probe.stderr.strip()[:300]}): {INSTALL_HINT}."
             )
-        return bwrap
 
     def box(self, argv, limits):
         uid = sandbox_uid()
