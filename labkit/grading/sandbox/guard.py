@@ -174,13 +174,11 @@ def _compiled_types():
 # x86-64 System V, CPython 3.11 (frame->f_frame->f_code; checked before use):
 #   endbr64; test edx, edx; jne done; mov rax, [rsi+24]; mov rax, [rax+32]; mov r8, rax; shr r8, 4;
 #   and r8d, SLOTS-1; movabs r9, TABLE; cmp [r9+r8*8], rax; je done; movabs rax, HOOK; jmp rax; done: xor eax, eax; ret
-_CALL_FILTER = {
-    "x86_64": (
-        "f30f1efa85d27532488b4618488b40204989c049c1e8044181e0ff0f000049b9",
-        "4b3904c1740c48b8",
-        "ffe031c0c3",
-    )
-}
+_CALL_FILTER = (
+    "f30f1efa85d27532488b4618488b40204989c049c1e8044181e0ff0f000049b9",
+    "4b3904c1740c48b8",
+    "ffe031c0c3",
+)
 SLOTS = 1 << 12  # the filter's table of code objects found clean: the slot of one is (its address >> 4) & (SLOTS - 1)
 
 
@@ -191,8 +189,7 @@ def _call_filter(hook_address):
     import mmap
     import platform
 
-    parts = _CALL_FILTER.get(platform.machine())
-    if parts is None or sys.implementation.name != "cpython" or sys.version_info[:2] != (3, 11):
+    if platform.machine() != "x86_64" or sys.implementation.name != "cpython" or sys.version_info[:2] != (3, 11):
         return hook_address, None, None
     frame = _getframe()  # does this Python lay frames out as the filter reads them (frame->f_frame->f_code)?
     inner = ctypes.c_void_p.from_address(id(frame) + 24).value
@@ -200,7 +197,8 @@ def _call_filter(hook_address):
         return hook_address, None, None
     table = (ctypes.c_uint64 * SLOTS)()
     table_at, hook_at = (address.to_bytes(8, "little") for address in (ctypes.addressof(table), hook_address))
-    code = bytes.fromhex(parts[0]) + table_at + bytes.fromhex(parts[1]) + hook_at + bytes.fromhex(parts[2])
+    head, middle, tail = (bytes.fromhex(part) for part in _CALL_FILTER)
+    code = head + table_at + middle + hook_at + tail
     try:
         page = mmap.mmap(-1, mmap.PAGESIZE, prot=mmap.PROT_READ | mmap.PROT_WRITE)
         page.write(code)
@@ -225,8 +223,6 @@ def install(secret, verdict_fd, profiles, passables, chain):
     """
     private = dict(globals())
     private["__builtins__"] = dict(vars(builtins))
-    # stand-ins, functions handed over and barriers get a namespace of their own: their ``__globals__`` never
-    # lead to the names the hooks look up
     exposed = {"__name__": __name__, "__builtins__": dict(vars(builtins))}
     for name, value in list(private.items()):
         if type(value) is _FunctionType and value.__globals__ is globals():
@@ -251,16 +247,14 @@ def _install(secret, verdict_fd, profiles, passables, chain):
     state.update(handed_code=_handed_over(lambda: None).__code__, cache={})  # cache: id(code) -> (code, key)
     # the request: mode is "idle" between requests, "reading" after begin, "graded" during a call, RUN during the cells
     state.update(mode="idle", rid=None, name=None, profile=None, passables=(), refused=None, tampered=None)
-    state.update(live=frozenset(), stubbed=[], busy=False, gc=True)
-    # the code objects in the filter's table, alive until it is emptied: no other code takes their address
-    state["held"] = []
+    # held: the code objects in the filter's table, alive until it is emptied: no other code takes their address
+    state.update(live=frozenset(), stubbed=[], busy=False, gc=True, held=[])
     hook_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.py_object, ctypes.c_int, ctypes.c_void_p)
     hook = hook_type(_profile_hook(state))
     set_profile = ctypes.pythonapi.PyEval_SetProfile
     set_profile.argtypes, set_profile.restype = (ctypes.c_void_p, ctypes.c_void_p), None
     hook_address, seen, page = _call_filter(ctypes.cast(hook, ctypes.c_void_p).value)
     state.update(set_profile=set_profile, hook_address=hook_address, seen=seen, memset=ctypes.memset)
-    state["seen_size"] = ctypes.sizeof(seen) if seen is not None else 0
     audit = _audit_hook(state)
     # the C callback and its filter live as long as the audit hook, which lives as long as the process
     audit.keep = (hook, page)
@@ -329,9 +323,8 @@ def _note_busy(state, what):
         state["busy"] = False
 
 
-def _genuine(state, frame):
+def _genuine(state, caller):
     """Whether the Python frame that raised a sentinel is the worker's own serving chain."""
-    caller = frame
     for expected in state["chain"]:
         if caller is None or caller.f_code is not expected:
             return False
@@ -347,11 +340,9 @@ def _stub(state, profile):
     targets = state["c_objects"].get(c_names, {})
     target_ids = frozenset(targets)
     for module_name, module in list(_modules.items()):
-        if type(module_name) is not str or type(module) is not _ModuleType:
+        if type(module_name) is not str or type(module) is not _ModuleType or type(module.__dict__) is not dict:
             continue
         namespace = module.__dict__
-        if type(namespace) is not dict:
-            continue
         whole = _within(module_name, mods)
         held = _holds_target(state, module_name, namespace, target_ids)
         if whole or held or any(m == module_name for m, _ in c_names):
@@ -393,11 +384,9 @@ def _unstub(state):
 
 
 def _key(state, code):
-    cache = state["cache"]
-    found = cache.get(id(code))
+    found = state["cache"].get(id(code))
     if found is None or found[0] is not code:
-        found = (code, code_key(code))
-        cache[id(code)] = found
+        found = state["cache"][id(code)] = (code, code_key(code))
     return found[1]
 
 
@@ -439,7 +428,7 @@ def _remember(state, code):
 def _forget(state):
     """Empty the filter's table (a new request, or its profile, starts)."""
     if state["seen"] is not None and state["held"]:
-        state["memset"](state["seen"], 0, state["seen_size"])
+        state["memset"](state["seen"], 0, 8 * SLOTS)  # SLOTS addresses of 8 bytes
         state["held"].clear()
 
 
@@ -521,9 +510,8 @@ def _audit_hook(state):
         if event in TAMPER_EVENTS or (event.startswith(TAMPER_PREFIXES) and event not in HARMLESS):
             _note_busy(state, event)
             return
-        if event == "object.__setattr__":
-            if len(args) == 3 and type(args[1]) is str and args[1] in GUARDED_ATTRIBUTES:
-                _note_busy(state, f"a function's {args[1]} replaced")
+        if event == "object.__setattr__" and len(args) == 3 and type(args[1]) is str and args[1] in GUARDED_ATTRIBUTES:
+            _note_busy(state, f"a function's {args[1]} replaced")
             return
         if event not in (BEGIN, CHOSEN, END):
             return

@@ -171,12 +171,10 @@ def passable(name):
 
 
 def loads(line):
-    """Parse one line; anything but a bounded JSON object is a ProtocolError. The bounds are checked before parsing:
-    a line of nested empty lists would otherwise cost the parser some thirty times its size."""
+    """Parse one line (bytes); anything but a bounded JSON object is a ProtocolError. The bounds are checked before
+    parsing: a line of nested empty lists would otherwise cost the parser some thirty times its size."""
     if len(line) > MAX_LINE:
         raise ProtocolError(f"a message of {len(line)} bytes is larger than {MAX_LINE}")
-    if isinstance(line, str):
-        line = line.encode("utf-8", "surrogatepass")
     containers = line.count(b"[") + line.count(b"{")
     if containers > MAX_CONTAINERS:
         raise ProtocolError(f"a message of {containers} lists and objects is more than {MAX_CONTAINERS}")

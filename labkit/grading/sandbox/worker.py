@@ -165,11 +165,6 @@ def _serve_one(notebook, reader, answers):
     return True
 
 
-def _serve(notebook, reader, answers):
-    while _serve_one(notebook, reader, answers):
-        pass
-
-
 def _notebook_main(shell, pipes, setup):
     """The notebook's process: its timer, seccomp, the watch, then requests until the pipe closes."""
     os.setpgrp()  # the supervisor stops it and everything it starts at once
@@ -180,10 +175,12 @@ def _notebook_main(shell, pipes, setup):
     seccomp.install_for_notebook()
     passables = {name: protocol.passable(name) for name in setup["passables"]}
     key = pipes["key"][0]
-    chain = (_serve_one.__code__, _serve.__code__, _notebook_main.__code__)
+    chain = (_serve_one.__code__, _notebook_main.__code__)
     guard.install(os.read(key, 32), pipes["verdict"][1], guard.unwire(setup["profiles"]), passables, chain=chain)
     os.close(key)
-    _serve(NotebookProcess(shell, output), protocol.Lines(pipes["requests"][0]), pipes["answers"][1])
+    notebook, reader = NotebookProcess(shell, output), protocol.Lines(pipes["requests"][0])
+    while _serve_one(notebook, reader, pipes["answers"][1]):
+        pass
 
 
 class Supervisor:
@@ -435,9 +432,8 @@ def supervise(requests, answers, shell):
     Supervisor(requests, answers, shell).serve()
 
 
-def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    drop_privileges(int(argv[0]) if argv else 0)
+def main():
+    drop_privileges(int(sys.argv[1]) if len(sys.argv) > 1 else 0)
     not_dumpable()
     supervise(0, 1, preload())
 
