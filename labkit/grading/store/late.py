@@ -210,12 +210,8 @@ class Late:
         if not lateness.known or lateness.time is None or lateness.time.when is None:
             return f"Late work: due {due}; this submission's time is not known, so no late penalty was applied."
         handed_in = f"handed in {time_text(lateness.time.when, zone)} ({lateness.time.source})"
-        if not lateness.units:
-            return f"Late work: due {due}; {handed_in}: {lateness.note}."
-        return (
-            f"Late work: due {due}; {handed_in}: {lateness.note}: "
-            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points."
-        )
+        off = f": {points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points" if lateness.units else ""
+        return f"Late work: due {due}; {handed_in}: {lateness.note}{off}."
 
 
 def _number(value):

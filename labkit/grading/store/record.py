@@ -249,16 +249,11 @@ def content_digest(notebooks, base=None):
         except OSError as exc:
             digest.update(f"unreadable {exc.errno}".encode())
             continue
-        try:
+        with os.fdopen(fd, "rb") as handle:
             digest.update(str(os.fstat(fd).st_size).encode() + b"\0")
-            while budget > 0:
-                chunk = os.read(fd, min(1 << 20, budget))
-                if not chunk:
-                    break
+            while chunk := handle.read(min(1 << 20, budget)):  # nothing once the budget is spent
                 digest.update(chunk)
                 budget -= len(chunk)
-        finally:
-            os.close(fd)
     return digest.hexdigest()
 
 
