@@ -126,10 +126,6 @@ class Rubric:
             found.append("the held parts its [held] table releases")
         return found
 
-    def releases(self, submission, number):
-        """Whether a person released the held parts of exercise `number` of `submission` ([held] release)."""
-        return number in self.released.get(submission, ())
-
     def score(self, fractions, marked=None, excused=()):
         """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1), with the points
         a person `marked` (exercise -> points of its answers in words) and the exercises `excused` (out of the
