@@ -74,10 +74,10 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
     recorded = record.rubric_object(out)
     if rubric is None:
         rubric = recorded
-    elif not recorded.same_as(rubric):
+    elif differ := recorded.differences(rubric):
         raise InputError(
             f"{out} was graded under the rubric recorded there ({recorded.title!r}), and {rubric.source} differs "
-            f"from it in {' and '.join(recorded.differences(rubric))}: leave --rubric out to resume that run. "
+            f"from it in {' and '.join(differ)}: leave --rubric out to resume that run. "
             f"To grade under {rubric.source}, {how}; to apply only another [late] or [held] table to these results, "
             f"`labkit merge {out} --rubric {_file_of(rubric)} --out NEW`."
         )

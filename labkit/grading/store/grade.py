@@ -99,7 +99,7 @@ class SubmissionGrade:
         mark = self.marks.get(ItemKey.held(number, part))
         if mark is not None:
             return mark.points == "release"
-        return self.rubric.releases(self.name, number)
+        return number in self.rubric.released.get(self.name, ())
 
     @property
     def excused(self) -> frozenset[int]:

@@ -180,8 +180,7 @@ class Late:
             note = f"{why or 'no submission time'}: not penalised"
             return Lateness(deadline, extended, time, None, 0, 0.0, raw_total, 0.0, note)
         late_by = time.when - deadline
-        grace = timedelta(minutes=self.grace)
-        if late_by <= timedelta(0) or late_by <= grace:
+        if late_by <= timedelta(minutes=self.grace):  # the grace is never negative (from_dict)
             note = "on time" if late_by <= timedelta(0) else f"on time (within the {_number(self.grace)}-minute grace)"
             return Lateness(deadline, extended, time, late_by, 0, 0.0, raw_total, 0.0, note)
         units = math.ceil(late_by.total_seconds() / UNITS[self.per])
@@ -211,24 +210,20 @@ class Late:
         if not lateness.known or lateness.time is None or lateness.time.when is None:
             return f"Late work: due {due}; this submission's time is not known, so no late penalty was applied."
         handed_in = f"handed in {time_text(lateness.time.when, zone)} ({lateness.time.source})"
-        if not lateness.units:
-            return f"Late work: due {due}; {handed_in}: {lateness.note}."
-        return (
-            f"Late work: due {due}; {handed_in}: {lateness.note}: "
-            f"{points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points."
-        )
+        off = f": {points_text(lateness.penalty)} of {points_text(lateness.raw_total)} points" if lateness.units else ""
+        return f"Late work: due {due}; {handed_in}: {lateness.note}{off}."
 
 
 def _number(value):
     return f"{int(value)}" if float(value) == int(value) else f"{value:g}"
 
 
-def _amount(table, key, source, low=0.0, high=None, unit=""):
+def _amount(table, key, source, high=None, unit=""):
     value = table[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise InputError(f"{source}: [late] {key} must be a number{unit}; got {value!r}.")
-    if value < low or (high is not None and value > high):
-        bound = f"between {_number(low)} and {_number(high)}" if high is not None else f"at least {_number(low)}"
+    if value < 0 or (high is not None and value > high):
+        bound = f"between 0 and {_number(high)}" if high is not None else "at least 0"
         raise InputError(f"{source}: [late] {key} must be {bound}{unit}; got {value!r}.")
     return float(value)
 
@@ -253,9 +248,9 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
     per = table["per"]
     if per not in UNITS:
         raise InputError(f'{section} per must be "day" or "hour" (what a started unit of lateness is); got {per!r}.')
-    percent = _amount(table, "percent", source, 0, 100, " (percent of the points per started unit)")
-    cap = _amount(table, "cap", source, 0, 100, " (the largest penalty, in percent)")
-    grace = _amount(table, "grace", source, 0, unit=" of minutes") if "grace" in table else 0.0
+    percent = _amount(table, "percent", source, 100, " (percent of the points per started unit)")
+    cap = _amount(table, "cap", source, 100, " (the largest penalty, in percent)")
+    grace = _amount(table, "grace", source, unit=" of minutes") if "grace" in table else 0.0
     extensions, listing = table.get("extensions", {}), f"{source}: [late.extensions]"
     if not isinstance(extensions, dict):
         raise InputError(f'{listing} must be a table of `name = "new deadline"` or `name = hours` lines.')

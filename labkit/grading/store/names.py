@@ -38,9 +38,8 @@ def name_from_cell(cell: str, names) -> str | None:
     if cell in names:
         return cell
     cells = {name_cell(name): name for name in names}
-    for candidate in (cell, cell.strip()):
+    stripped = cell.strip()
+    for candidate in (cell, stripped):
         if candidate in cells:
             return cells[candidate]
-        if candidate in names:
-            return candidate
-    return None
+    return stripped if stripped in names else None

@@ -71,7 +71,7 @@ class RunRecord:
 
 def new(kind, labkit, seed, rubric):
     """A record of `kind` for a run under `rubric` (a Rubric that knows its data), with no submission yet."""
-    if rubric.data is None or not rubrics.from_dict(rubric.data, rubric.source).same_as(rubric):
+    if rubric.data is None or rubrics.from_dict(rubric.data, rubric.source).differences(rubric):
         raise InputError(
             "the rubric was made or changed in code, not read from TOML, so a run cannot record it as it grades: "
             "read it with labkit.grading.store.rubric.load (or from_dict)."
@@ -249,16 +249,11 @@ def content_digest(notebooks, base=None):
         except OSError as exc:
             digest.update(f"unreadable {exc.errno}".encode())
             continue
-        try:
+        with os.fdopen(fd, "rb") as handle:
             digest.update(str(os.fstat(fd).st_size).encode() + b"\0")
-            while budget > 0:
-                chunk = os.read(fd, min(1 << 20, budget))
-                if not chunk:
-                    break
+            while chunk := handle.read(min(1 << 20, budget)):  # nothing once the budget is spent
                 digest.update(chunk)
                 budget -= len(chunk)
-        finally:
-            os.close(fd)
     return digest.hexdigest()
 
 
@@ -272,10 +267,10 @@ def rubric_for(folders, given, command):
     recorded = first.rubric_object(first_folder)
     for folder, record in records[1:]:
         other = record.rubric_object(folder)
-        if not recorded.same_as(other):
+        if differ := recorded.differences(other):
             raise InputError(
                 f"{folder} was graded under the rubric {other.title!r} and {first_folder} under {recorded.title!r} "
-                f"({' and '.join(recorded.differences(other))} differ): results of different rubrics are not read "
+                f"({' and '.join(differ)} differ): results of different rubrics are not read "
                 "together. Grade again under one rubric; when only the [late] or [held] tables differ, merge them "
                 "under one (labkit merge ... --rubric FILE --out NEW)."
             )

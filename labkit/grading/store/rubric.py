@@ -72,13 +72,10 @@ class Rubric:
     # answer grade id -> the rubric lines the marking page shows beside the model answer ([answers])
     answer_lines: dict = field(default_factory=dict, compare=False)
 
-    def answer_points(self, number):
-        """The points of exercise `number`'s answers in words ([answers]; 0 without them)."""
-        return sum(p for grade_id, p in self.answers.items() if self.registry.answers[grade_id][0] == number)
-
     def worth(self, number):
-        """Exercise `number`'s points: its parts' and its answers' in words."""
-        return self.points[number] + self.answer_points(number)
+        """Exercise `number`'s points: its parts' and its answers' in words ([answers])."""
+        answers = sum(p for grade_id, p in self.answers.items() if self.registry.answers[grade_id][0] == number)
+        return self.points[number] + answers
 
     @property
     def graded(self):
@@ -128,14 +125,6 @@ class Rubric:
         if self.released != other.released:
             found.append("the held parts its [held] table releases")
         return found
-
-    def releases(self, submission, number):
-        """Whether a person released the held parts of exercise `number` of `submission` ([held] release)."""
-        return number in self.released.get(submission, ())
-
-    def same_as(self, other):
-        """Whether `other` grades exactly as this rubric does (:meth:`differences` finds nothing)."""
-        return not self.differences(other)
 
     def score(self, fractions, marked=None, excused=()):
         """The grade for `fractions` (exercise -> share of its parts' weight that passed, 0..1), with the points
@@ -280,8 +269,9 @@ def from_dict(data, source="the rubric"):
     points = {number: points[number] for number in sorted(points)}
     late = lateness.from_dict(data["late"], source) if "late" in data else None
     released = _released(data.get("held"), source, registry, points)
+    plain = json.loads(json.dumps(data, default=methodcaller("isoformat")))  # date-times as ISO 8601 text
     return Rubric(
-        title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain(data),
+        title, points, required, branches, branch_extra, extra_credit, source, registry, late, data=plain,
         released=released, answers=answers, answer_lines=answer_lines,
     )  # fmt: skip
 
@@ -342,11 +332,6 @@ def _released(table, source, registry, points):
                 raise InputError(f"{source}: {where} names exercise {number}, which this rubric does not grade.")
         found[str(name)] = frozenset(numbers)
     return found
-
-
-def plain(value):
-    """Parsed TOML as JSON data: its date-times as ISO 8601 text (the [late] table reads both)."""
-    return json.loads(json.dumps(value, default=methodcaller("isoformat")))
 
 
 def _branches(table, source, registry):

@@ -1,9 +1,9 @@
 """``variants.csv`` of a run with variants (:mod:`labkit.exercises.variants`): who had which data."""
 
-import csv
 from pathlib import Path
 
-from .report import csv_cell
+from .record import replace_text
+from .report import csv_cell, csv_text
 
 VARIANTS_CSV = "variants.csv"
 
@@ -12,7 +12,7 @@ def write_variants(out, grades, students, roster, registry):
     """``variants.csv``, for the instructor only: each submission's roster id and data, and the classmates
     whose data its notebooks hold instead (``another variant`` when no one in the class has them)."""
     varied = [e for e in registry if e.params]
-    rows = []
+    rows = [["submission", "id", *(f"exercise {e.number}" for e in varied), "holds the data of"]]
     for grade in grades:
         mine = students.get(grade.name)
         if mine is None:
@@ -35,7 +35,4 @@ def write_variants(out, grades, students, roster, registry):
             holds.append(f"exercise {exercise.number}: " + (", ".join(whose) if whose else "another variant"))
         shown = [", ".join(f"{p} = {v}" for p, v in mine.get(str(e.number), {}).items()) for e in varied]
         rows.append([grade.name, roster.get(grade.name, ""), *shown, "; ".join(holds)])
-    with open(Path(out) / VARIANTS_CSV, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["submission", "id", *(f"exercise {e.number}" for e in varied), "holds the data of"])
-        writer.writerows([csv_cell(cell) for cell in row] for row in rows)
+    replace_text(Path(out) / VARIANTS_CSV, csv_text([csv_cell(cell) for cell in row] for row in rows))
