@@ -23,10 +23,9 @@ from ..sandbox.guard import _within, code_key, codes_in
 
 def _module_files(prefix):
     """(module name, file) of every Python source file of a module or package (tests left out)."""
-    try:
+    spec = None
+    with contextlib.suppress(ImportError, ValueError):
         spec = importlib.util.find_spec(prefix)
-    except (ImportError, ValueError):
-        spec = None
     if spec is not None and spec.submodule_search_locations:
         found = []
         for location in spec.submodule_search_locations:
@@ -57,8 +56,7 @@ def _compiled_codes(path):
     for node in tree.body:
         if isinstance(node, ast.ImportFrom) and node.module == "__future__":
             for alias in node.names:
-                feature = getattr(__future__, alias.name, None)
-                futures |= feature.compiler_flag if feature is not None else 0
+                futures |= getattr(__future__, alias.name).compiler_flag  # it compiled: each is a feature
     for flags in sorted({CELL_FLAGS, CELL_FLAGS | futures}):
         for node in tree.body:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.If, ast.Try, ast.With)):
