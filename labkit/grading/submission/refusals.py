@@ -115,14 +115,11 @@ def _resolve(dotted):
 def spellings(refusal):
     """({spelling: the refused object's own name}, [spellings of allowed objects]) in labkit, scipy and numpy."""
     for prefix in refusal.modules:
-        if prefix.split(".")[0] in LIBRARIES:
+        if _within(prefix, LIBRARIES):
             with contextlib.suppress(ImportError):
                 importlib.import_module(prefix)
-    libraries = [
-        (name, module)
-        for name, module in list(sys.modules.items())
-        if module is not None and name.split(".")[0] in LIBRARIES
-    ]
+    loaded = [(name, module) for name, module in list(sys.modules.items()) if module is not None]
+    libraries = [(name, module) for name, module in loaded if _within(name, LIBRARIES)]
     allowed = {id(value): value for value in map(_resolve, refusal.allowed) if value is not None}
     refused = {}
     for name, module in libraries:
@@ -155,7 +152,7 @@ def wire(refusals):
     for refusal in refusals:
         names, modules, c_names = recognised(refusal)
         spelled, allowed = spellings(refusal)  # imports the refused modules
-        loaded = list(sys.modules.items())
+        loaded = [name for name, module in list(sys.modules.items()) if module is not None]
         profiles[refusal.name] = {
             "names": {key.hex(): name for key, name in names.items()},
             "modules": list(modules),
@@ -163,8 +160,6 @@ def wire(refusals):
             "spellings": spelled,
             "allowed": allowed,
             # the refused modules themselves: the scan judges their uses, not their import
-            "submodules": sorted(
-                name for name, module in loaded if module is not None and _within(name, refusal.modules)
-            ),
+            "submodules": sorted(name for name in loaded if _within(name, refusal.modules)),
         }
     return profiles

@@ -358,9 +358,8 @@ def scan(sources, names, profile):
                 if what:
                     findings.add((owner, getattr(node, "lineno", start) - start + 1, what))
     # an attribute chain reports itself and its prefixes: keep the longest on each line
-    return sorted(
-        f for f in findings if not any(g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2]) for g in findings)
-    )
+    prefixes = {f for f in findings for g in findings if g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2])}
+    return sorted(findings - prefixes)
 
 
 _READERS: dict = {}
