@@ -287,7 +287,7 @@ def judge_known(check, part, code, registry, options):
         names = own if part.refused is not None else sorted(scan.drawn_with(code, part.names()))
         reached = scan.reached_sources(code, names)
     except scan.Unreadable:
-        return check  # the refusal scan read the same cells in time: not reached here
+        return check  # nothing held for cells that cannot be read (a refused part failed for them first)
     graded = registry_graded(registry)
     reached = [(n, t) for n, t in reached if n in own or n not in graded]
     found = known.match(known_sources(registry, options.solutions), reached, _own_reader())
