@@ -40,7 +40,7 @@ class Step:
 @dataclass(frozen=True)
 class PartResult:
     """One part of an exercise as it was graded: its weight, its steps and hint; ``held`` is what a part held
-    for a person matched (:meth:`labkit.grading.submission.known.Found.as_dict`), ``figure`` the student's
+    for a person matched (a :class:`labkit.grading.submission.known.Match` as a dict), ``figure`` the student's
     plot a failed part judged (:func:`labkit.plotdata.figure_data`)."""
 
     name: str

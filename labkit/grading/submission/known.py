@@ -6,12 +6,13 @@ The scan and the sandbox refuse *calls* of that code; this module recognises ren
 from __future__ import annotations
 
 import ast
+import contextlib
 import functools
 import hashlib
 import json
 import os
 from collections import namedtuple
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ import numpy as np
 from ..store.record import replace_text
 from . import fingerprint
 from .fingerprint import canonical, normalise
+from .refusals import _module_files
 from .scan import python_source
 
 # measured on copies, independent solutions and honest variants (docs/grading-security.md):
@@ -75,16 +77,12 @@ def _cached(name, raw, compute):
     cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     folder = Path(os.environ.get("LABKIT_CACHE") or os.path.join(cache, "labkit")) / "known"
     path = folder / f"{key}.json"
-    try:
+    with contextlib.suppress(OSError, ValueError):  # none yet, or one that cannot be read: computed again
         return json.loads(path.read_text(encoding="utf-8")), key
-    except (OSError, ValueError):
-        pass
     data = compute()
-    try:
+    with contextlib.suppress(OSError):  # a cache that cannot be written only costs time
         folder.mkdir(parents=True, exist_ok=True)
         replace_text(path, json.dumps(data), mode=0o600)  # it may hold the solutions
-    except OSError:
-        pass  # a cache that cannot be written only costs time
     return data, key
 
 
@@ -116,8 +114,6 @@ def _notebook_entry(name, cells):
 def corpus(refusals=(), solutions=()):
     """The :class:`Corpus` of labkit's library (but its grader: no answer there), the modules `refusals` refuse,
     and the instructor notebooks `solutions`, ((name, cells),) as :func:`.scoring.known_sources` reads them."""
-    from .refusals import _module_files
-
     modules = {}  # file: module
     for prefix in dict.fromkeys(["labkit"] + [p for r in refusals for p in r.modules if not p.startswith("labkit")]):
         for module, path in _module_files(prefix):
@@ -147,28 +143,23 @@ class Match:
     lines: tuple
     public: bool = True
 
-    def as_dict(self):
-        return asdict(self)
+
+def own_reader(cells):
+    """:func:`.fingerprint.own` of a text, never counting what the release's code `cells` give everyone
+    (:func:`.fingerprint.release_grams`); one per run, it reads each text once."""
+    given = fingerprint.release_grams(cells)
+    return functools.lru_cache(maxsize=256)(functools.partial(fingerprint.own, given=given))
 
 
-class Given:
-    """The release's code cells' hashes (:func:`.fingerprint.release_grams`), cached by identity, one per run."""
-
-    def __init__(self, cells):
-        self.array = fingerprint.release_grams(cells)
-
-
-release_grams = Given
-
-
-def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
+def match(known, definitions, own, threshold=THRESHOLD, minimum=MIN_SHARED):
     """The :class:`Match` of `definitions` ([(name, source)] of a graded function and what it reaches), or None.
     Each unit (:func:`.fingerprint.units`) is set against the unit of `known` that has most of its own
-    fingerprints (not `given`). It matches when those have `threshold` of its own fingerprints and at least
-    `minimum`: the lab's formulas make short code alike in everyone, so only a long shared stretch is evidence."""
+    fingerprints (as `own`, an :func:`own_reader`, reads them). It matches when those have `threshold` of its
+    own fingerprints and at least `minimum`: the lab's formulas make short code alike in everyone, so only a long
+    shared stretch is evidence."""
     total, judged = 0, []
     for name, text in fingerprint.units(definitions):
-        where, hashes, positions = _read(text, given)
+        where, hashes, positions = own(text)
         distinct = np.unique(hashes)
         total += distinct.size
         entries = known.holders(distinct) if distinct.size else distinct
@@ -184,18 +175,12 @@ def match(known, definitions, given, threshold=THRESHOLD, minimum=MIN_SHARED):
     return Match(name, unit.name, round(shared / total, 3), shared, _side_by_side(text, lines, unit), unit.text is None)
 
 
-@functools.lru_cache(maxsize=256)
-def _read(text, given):
-    return fingerprint.own(text, given.array)
-
-
 def _side_by_side(text, numbers, unit):
     """Up to :data:`SHOWN` pairs (student's line `numbers` of `text`, the next known line of the same shape)."""
-    try:
+    theirs = [""]
+    with contextlib.suppress(OSError, IndexError, ValueError):
         whole = Path(unit.path).read_text(encoding="utf-8", errors="replace") if unit.text is None else None
         theirs = unit.text.split("\n") if whole is None else whole.split("\n")[unit.first - 1 : unit.last]
-    except (OSError, IndexError, ValueError):
-        theirs = [""]
     mine, their_normal = text.split("\n"), [normalise(line)[0] for line in theirs]
     pairs, after = [], 0
     for number in numbers:

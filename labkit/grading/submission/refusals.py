@@ -23,10 +23,9 @@ from ..sandbox.guard import _within, code_key, codes_in
 
 def _module_files(prefix):
     """(module name, file) of every Python source file of a module or package (tests left out)."""
-    try:
+    spec = None
+    with contextlib.suppress(ImportError, ValueError):
         spec = importlib.util.find_spec(prefix)
-    except (ImportError, ValueError):
-        spec = None
     if spec is not None and spec.submodule_search_locations:
         found = []
         for location in spec.submodule_search_locations:
@@ -57,8 +56,7 @@ def _compiled_codes(path):
     for node in tree.body:
         if isinstance(node, ast.ImportFrom) and node.module == "__future__":
             for alias in node.names:
-                feature = getattr(__future__, alias.name, None)
-                futures |= feature.compiler_flag if feature is not None else 0
+                futures |= getattr(__future__, alias.name).compiler_flag  # it compiled: each is a feature
     for flags in sorted({CELL_FLAGS, CELL_FLAGS | futures}):
         for node in tree.body:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.If, ast.Try, ast.With)):
@@ -117,14 +115,11 @@ def _resolve(dotted):
 def spellings(refusal):
     """({spelling: the refused object's own name}, [spellings of allowed objects]) in labkit, scipy and numpy."""
     for prefix in refusal.modules:
-        if prefix.split(".")[0] in LIBRARIES:
+        if _within(prefix, LIBRARIES):
             with contextlib.suppress(ImportError):
                 importlib.import_module(prefix)
-    libraries = [
-        (name, module)
-        for name, module in list(sys.modules.items())
-        if module is not None and name.split(".")[0] in LIBRARIES
-    ]
+    loaded = [(name, module) for name, module in list(sys.modules.items()) if module is not None]
+    libraries = [(name, module) for name, module in loaded if _within(name, LIBRARIES)]
     allowed = {id(value): value for value in map(_resolve, refusal.allowed) if value is not None}
     refused = {}
     for name, module in libraries:
@@ -157,7 +152,7 @@ def wire(refusals):
     for refusal in refusals:
         names, modules, c_names = recognised(refusal)
         spelled, allowed = spellings(refusal)  # imports the refused modules
-        loaded = list(sys.modules.items())
+        loaded = [name for name, module in list(sys.modules.items()) if module is not None]
         profiles[refusal.name] = {
             "names": {key.hex(): name for key, name in names.items()},
             "modules": list(modules),
@@ -165,8 +160,6 @@ def wire(refusals):
             "spellings": spelled,
             "allowed": allowed,
             # the refused modules themselves: the scan judges their uses, not their import
-            "submodules": sorted(
-                name for name, module in loaded if module is not None and _within(name, refusal.modules)
-            ),
+            "submodules": sorted(name for name in loaded if _within(name, refusal.modules)),
         }
     return profiles

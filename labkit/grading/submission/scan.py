@@ -61,7 +61,7 @@ class _Reader:
     """The notebook's top-level definitions and import aliases, and the walk from a graded name."""
 
     def __init__(self, sources, deadline):
-        self.deadline, self.trees, self.texts, self.aliases, self.definitions = deadline, [], {}, {}, {}
+        self.deadline, self.texts, self.aliases, self.definitions = deadline, {}, {}, {}
         self.when, self.strings = {}, []  # where each name was last bound; where a string is run as code
         self.statements = []  # the top-level statements that are not definitions (plots are drawn there)
         for cell, source in enumerate(sources):
@@ -73,9 +73,8 @@ class _Reader:
                 tree = ast.parse(text)
             except (SyntaxError, ValueError, RecursionError, MemoryError):
                 continue  # IPython could not run it either: it defines nothing
-            self.trees.append(tree)  # kept alive: `texts` is keyed by its nodes' ids
             for node in _top_level(tree.body):
-                self.texts[id(node)] = text
+                self.texts[node] = text
             for node in tree.body:
                 self._record(node, (cell, node.lineno))
                 self.strings += [(cell, node.lineno, what) for what in _runs_strings(node, self.definitions)]
@@ -173,11 +172,11 @@ def reached_sources(sources, names, stop=frozenset()):
     found, seen = [], set()
     for name in names:
         for owner, node, _ in reader.reached(name, frozenset(stop)):
-            if id(node) in seen or id(node) not in reader.texts:
+            if node in seen or node not in reader.texts:
                 continue
-            seen.add(id(node))
+            seen.add(node)
             first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
-            lines = reader.texts[id(node)].split("\n")[first - 1 : node.end_lineno]
+            lines = reader.texts[node].split("\n")[first - 1 : node.end_lineno]
             found.append((owner, "\n".join(lines)))  # whole: a long comment must not push the code out
     return found
 
@@ -302,7 +301,7 @@ def _dynamic(node, aliases):
             top = dotted.split(".")[0]
             if dotted.startswith("."):
                 return f"a module of the notebook's own ({dotted.lstrip('.')})"
-            if top in DYNAMIC_MODULES or any(dotted == d or dotted.startswith(d) for d in DYNAMIC_DOTTED):
+            if top in DYNAMIC_MODULES or dotted.startswith(tuple(DYNAMIC_DOTTED)):
                 return dotted
             if top not in KNOWN and not _installed(top):
                 return f"{dotted} (a module the notebook wrote itself?)"
@@ -359,9 +358,8 @@ def scan(sources, names, profile):
                 if what:
                     findings.add((owner, getattr(node, "lineno", start) - start + 1, what))
     # an attribute chain reports itself and its prefixes: keep the longest on each line
-    return sorted(
-        f for f in findings if not any(g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2]) for g in findings)
-    )
+    prefixes = {f for f in findings for g in findings if g[:2] == f[:2] and g[2] != f[2] and g[2].startswith(f[2])}
+    return sorted(findings - prefixes)
 
 
 _READERS: dict = {}
@@ -384,8 +382,8 @@ def _reader(sources):
     return found
 
 
-def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
-    """``{name: source}``, from its first decorator to its last line (at most `limit` characters, whole lines),
+def function_sources(sources, names):
+    """``{name: source}``, from its first decorator to its last line (at most :data:`MAX_SOURCE_CHARS`, whole lines),
     of the last top-level ``def`` of each of `names` in a notebook's code cells (parsed, never run).
 
     A definition counts where the cells, run in order, leave it bound (a later assignment or import drops it; a
@@ -414,14 +412,14 @@ def function_sources(sources, names, limit=MAX_SOURCE_CHARS):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 if node.name in wanted:
                     first = min([node.lineno] + [d.lineno for d in node.decorator_list])
-                    found[node.name] = _clip("\n".join(lines[first - 1 : node.end_lineno]), limit)
+                    found[node.name] = _clip("\n".join(lines[first - 1 : node.end_lineno]))
             else:
                 for bound in _bound_names(node):
                     found.pop(bound, None)
     return found
 
 
-def reached_function_sources(sources, names, graded=(), limit=MAX_SOURCE_CHARS):
+def reached_function_sources(sources, names, graded=()):
     """:func:`function_sources` of `names`, each followed by the helpers it reaches (other `graded` names aside), so
     code moved into a helper is compared where the graded function uses it.
 
@@ -435,13 +433,13 @@ def reached_function_sources(sources, names, graded=(), limit=MAX_SOURCE_CHARS):
     def h(x):
         return x + 1
     """
-    found = function_sources(sources, names, limit)
+    found = function_sources(sources, names)
     for name, text in found.items():
         try:
             helpers = [t for n, t in reached_sources(sources, [name], stop=set(graded))[1:] if n != name]
         except Unreadable:
             continue
-        found[name] = _clip("\n\n".join([text, *helpers]), limit)
+        found[name] = _clip("\n\n".join([text, *helpers]))
     return found
 
 
@@ -468,9 +466,9 @@ def _bound_names(node):
     return []
 
 
-def _clip(text, limit):
-    """At most `limit` characters of `text`: whole lines while they fit."""
-    if len(text) <= limit:
+def _clip(text):
+    """At most :data:`MAX_SOURCE_CHARS` characters of `text`: whole lines while they fit."""
+    if len(text) <= MAX_SOURCE_CHARS:
         return text
-    cut = text[:limit]
+    cut = text[:MAX_SOURCE_CHARS]
     return cut[: cut.rindex("\n")] if "\n" in cut else cut

@@ -7,13 +7,14 @@ is mostly code the student has on disk (:mod:`.known`), or is built on such code
 (:mod:`labkit.grading.run.processes`) and writes its result file.
 """
 
+import contextlib
 import functools
 import json
 import os
 import stat
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ...errors import InputError
@@ -85,8 +86,6 @@ def read_cells(path, answers=None, registry=LAB):
 
 def exercises_in(markdown, registry=LAB):
     """Graded exercises whose section heading ('## Exercise N') the markdown has."""
-    if hasattr(markdown, "cells"):  # an nbformat notebook
-        markdown = [cell.source for cell in markdown.cells if cell.cell_type == "markdown"]
     found = {n for text in markdown for n in sections(text)}
     return sorted(found & set(registry.exercises))
 
@@ -131,26 +130,23 @@ def submission_notebooks(path):
     return sorted(found)[:MAX_NOTEBOOKS]
 
 
-def _failed_part(check, name, step, detail, hint, kind=None):
-    """The part's check, failed at one step."""
-    base = {"name": name, "passed": False, "hint": hint, "weight": check.get("weight", 0)}
-    return _with_step(base, _step(step, detail, kind), hint)
+def _failed_part(part, step, detail, hint, kind=None):
+    """The part's check, failed at one step (and no other)."""
+    base = {"name": part.name, "passed": False, "hint": hint, "weight": part.weight}
+    return _with_step(base, step, detail, hint, kind)
 
 
-def _step(step, detail, kind=None):
-    """A failed step of a check (of `kind`, :data:`labkit.exercises.result.KINDS`, unless a slip)."""
-    return {"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}
-
-
-def _with_step(check, step, hint, **more):
-    """`check` (updated with `more`) with one more `step` and `hint`."""
-    return {**check, **more, "steps": [*check.get("steps", []), step], "hint": hint}
+def _with_step(check, step, detail, hint, kind=None, **more):
+    """`check` (updated with `more`) with `hint` and one more `step`, failed with `detail` (of `kind`,
+    :data:`labkit.exercises.result.KINDS`, unless a slip)."""
+    failed = {"step": step, "passed": False, "detail": detail, **({"kind": kind} if kind else {})}
+    return {**check, **more, "steps": [*check.get("steps", []), failed], "hint": hint}
 
 
 def _voided(part, tampered):
     """The check of a part of a notebook that tampered with the grader's watch: none of its answers count."""
     step, hint = "the notebook's answers can be trusted", "remove what the message names and hand it in again."
-    return _failed_part({"weight": part.weight}, part.name, step, tampered, hint, TAMPERED)
+    return _failed_part(part, step, tampered, hint, TAMPERED)
 
 
 def _own_code(check, findings):
@@ -158,9 +154,8 @@ def _own_code(check, findings):
     details = "; ".join(
         f"{function} (line {line} of its definition) reaches for {name}" for function, line, name in findings[:8]
     )
-    step = _step("calls no reference implementation", details, REFUSED)
     hint = "the exercise asks you to write this yourself; labkit.bracket and the helpers the lab names stay available."
-    return _with_step(check, step, hint, passed=False)
+    return _with_step(check, "calls no reference implementation", details, hint, REFUSED, passed=False)
 
 
 def _held(check, found):
@@ -173,7 +168,7 @@ def _held(check, found):
         "this part's points wait until your instructor has compared your code with the one it resembles (shown "
         "below); write the exercise in your own way to be paid without waiting."
     )
-    return _with_step(check, _step(HELD_STEP, detail), hint, held=found.as_dict())
+    return _with_step(check, HELD_STEP, detail, hint, held=asdict(found))
 
 
 def _rescore(verdict, registry):
@@ -281,34 +276,21 @@ def _solutions(stamps):
 
 
 def judge_known(check, part, code, registry, options):
-    """A part's check, held for a person when it passed and its code (`code`: the cells) is mostly known code."""
-    if not check["passed"] or part.refused is None:
-        return check
-    # a graded function another part judges (the driver's interpolant) is judged there, once
-    return _judge_reached(check, code, part.scanned, registry, options, own=part.scanned)
-
-
-def judge_plain(check, part, code, registry, options):
-    """A passed part without a refusal (a plot, a table), held when the code that draws it (graded functions
-    aside, each judged in its own part) is mostly known code."""
+    """A part's check, held for a person when it passed and the code it judges (`code`: the cells) is mostly known
+    code: a refused part's graded functions and what they reach; any other part's (a plot, a table) the code that
+    draws it, graded functions aside, each judged in its own part."""
     if not check["passed"]:
         return check
+    # a graded function another part judges (the driver's interpolant) is judged there, once
+    own = part.scanned if part.refused is not None else ()
     try:
-        drawn = scan.drawn_with(code, [n for n in part.names() if n.isidentifier()])
-    except scan.Unreadable:
-        return check
-    return _judge_reached(check, code, sorted(drawn), registry, options)
-
-
-def _judge_reached(check, code, names, registry, options, own=()):
-    """`check`, held when the definitions `names` reach (graded names but `own` aside) are mostly known code."""
-    try:
+        names = own if part.refused is not None else sorted(scan.drawn_with(code, part.names()))
         reached = scan.reached_sources(code, names)
     except scan.Unreadable:
-        return check  # the refusal scan read the same cells in time: not reached here
+        return check  # nothing held for cells that cannot be read (a refused part failed for them first)
     graded = registry_graded(registry)
     reached = [(n, t) for n, t in reached if n in own or n not in graded]
-    found = known.match(known_sources(registry, options.solutions), reached, _release_grams())
+    found = known.match(known_sources(registry, options.solutions), reached, _own_reader())
     return check if found is None else _held(check, found)
 
 
@@ -322,22 +304,18 @@ def hold_dependents(results, registry, code):
             if check.get("held") and check.get("passed"):
                 for name in (*part.scanned, check["held"].get("definition", "")):
                     held.setdefault(name, check["held"])
-    try:
+    strung = {}
+    with contextlib.suppress(scan.Unreadable):
         strung = {name: why for name, _, why in scan.run_strings(code, sorted(registry_graded(registry)))}
-    except scan.Unreadable:
-        strung = {}
     if not held and not strung:
         return results
     for number, verdict in results.items():
-        parts = registry.exercises[number].parts
-        for index, (part, check) in enumerate(zip(parts, verdict["checks"])):
+        for index, (part, check) in enumerate(zip(registry.exercises[number].parts, verdict["checks"])):
             if not check.get("passed") or check.get("held"):
                 continue
-            readable = [n for n in (*part.names(), *part.scanned) if n.isidentifier()]
-            try:
-                names = set(part.uses) | scan.drawn_with(code, readable)
-            except scan.Unreadable:
-                names = set(part.uses)
+            names = set(part.uses)
+            with contextlib.suppress(scan.Unreadable):
+                names |= scan.drawn_with(code, [*part.names(), *part.scanned])
             names -= set(part.scanned)
             on_held, on_string = [n for n in held if n in names], sorted(names & strung.keys())  # graded names first
             if on_held:
@@ -355,7 +333,7 @@ def _held_with(check, name, held):
     hint = (
         f"this part waits with {name}, which it is built on; write {name} in your own way to be paid without waiting."
     )
-    return _with_step(check, _step(HELD_STEP, detail), hint, held={**held, "through": name})
+    return _with_step(check, HELD_STEP, detail, hint, held={**held, "through": name})
 
 
 def _refused_with(check, name, why, step="is built on the student's own code"):
@@ -364,7 +342,7 @@ def _refused_with(check, name, why, step="is built on the student's own code"):
         f"define {name} with def in a code cell, after any exec, eval or compile of a string, so that the grader "
         "can read it; code run from a string is never graded."
     )
-    return _with_step(check, _step(step, why, REFUSED), hint, passed=False)
+    return _with_step(check, step, why, hint, REFUSED, passed=False)
 
 
 @functools.lru_cache(maxsize=1)
@@ -374,8 +352,8 @@ def registry_graded(registry):
 
 
 @functools.cache
-def _release_grams():
-    return known.release_grams(_release_code())
+def _own_reader():
+    return known.own_reader(_release_code())
 
 
 def _for_sandbox(profiles):
@@ -510,13 +488,13 @@ def _judged(check, part, graded):
     """A part's check, failed for a refused reference or a string run as code, held for known code."""
     code, registry, options = graded.code, graded.registry, graded.options
     if part.refused is None:
-        return judge_plain(check, part, code, registry, options)
+        return judge_known(check, part, code, registry, options)
     try:
         findings = scan.scan(code, part.scanned, graded.profiles[part.refused.name])
         strung = scan.run_strings(code, part.scanned)
     except scan.Unreadable as exc:
         why = "keep the notebook's code to what the lab asks for."
-        return _failed_part(check, check["name"], "its source can be read", str(exc), why)
+        return _failed_part(part, "its source can be read", str(exc), why)
     if findings:
         return _own_code(check, findings)
     if strung:

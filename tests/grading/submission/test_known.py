@@ -32,7 +32,6 @@ from labkit.grading.submission.scoring import (
     exercises_in,
     hold_dependents,
     judge_known,
-    judge_plain,
     known_sources,
     read_cells,
     registry_graded,
@@ -51,7 +50,7 @@ SHARES = {}  # the largest share of each kind of honest work, shown in the test 
 
 @pytest.fixture(scope="module")
 def given():
-    return known.release_grams([c for p in paths() for c in read_cells(Path(str(p)))[0]])
+    return known.own_reader([c for p in paths() for c in read_cells(Path(str(p)))[0]])
 
 
 def _parts(cells, markdown):
@@ -531,10 +530,10 @@ def test_a_plot_drawn_with_a_copy_is_held():
     copy = module_source("labkit.piecewise")
     plot = "fig, ax4 = plt.subplots()\nt = np.linspace(0, 1, 5)\nax4.plot(t, eval_pherm(t, t, t, t))"
     part = _part(4, "ax4")
-    held = judge_plain(_passed(part), part, [copy, plot], LAB, GradeOptions())
+    held = judge_known(_passed(part), part, [copy, plot], LAB, GradeOptions())
     assert held["held"]["source"].startswith("labkit.piecewise.")
     honest = "fig, ax4 = plt.subplots()\nt = np.linspace(0, 1, 5)\nax4.plot(t, labkit.eval_pherm(t, t, t, t))"
-    assert "held" not in judge_plain(_passed(part), part, [honest], LAB, GradeOptions())
+    assert "held" not in judge_known(_passed(part), part, [honest], LAB, GradeOptions())
 
 
 def test_a_part_built_on_a_held_definition_is_held_with_it():
