@@ -7,7 +7,7 @@ run grades (paths, names, times, roster, variants) is a :class:`labkit.grading.r
 """
 
 import os
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass, field, fields
 
 from ..errors import InputError
 from .sandbox import backends
@@ -68,23 +68,17 @@ class GradeOptions:
         if not isinstance(self.limits, Limits):
             raise InputError(f"limits must be a labkit.grading.sandbox.backends.base.Limits; got {self.limits!r}.")
 
-    def as_dict(self):
-        """The options as plain data (JSON): how they travel to each submission's grading process."""
-        return asdict(self)
-
     @classmethod
     def from_dict(cls, data):
-        """The options :meth:`as_dict` wrote, read back once at the receiving process's edge; ValueError for
-        a field that is not an option."""
-        data = dict(data)
+        """The options as plain data (``dataclasses.asdict``, how they travel to each submission's grading process),
+        read back once at the receiving process's edge; ValueError for a field that is not an option."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:
             raise InputError(
                 f"unknown grading option(s) {', '.join(unknown)}; the options are {', '.join(sorted(known))}."
             )
-        data["limits"] = Limits(**data.get("limits", {}))
-        return cls(**data)
+        return cls(**{**data, "limits": Limits(**data.get("limits", {}))})
 
 
 DEFAULTS = GradeOptions()

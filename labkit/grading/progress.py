@@ -36,17 +36,9 @@ def _eta_column():
 
 class Progress:
     """Counts of `total` items done, a bar, the time taken and an ETA, after what is being done (`what`, "grading");
-    drawn on a terminal only, and never with `enabled` False (``--quiet``).
+    drawn on `console` (standard error when None) only when it is a terminal, and never with `enabled` False
+    (``--quiet``). `get_time` is the clock in seconds, for tests (rich's own when None).
 
-    Parameters
-    ----------
-    console : rich.console.Console, optional
-        Where to draw; standard error when None.
-    get_time : callable, optional
-        The clock, in seconds (for tests); rich's own when None.
-
-    Examples
-    --------
     >>> import io
     >>> from rich.console import Console
     >>> now = [0.0]
@@ -68,7 +60,7 @@ class Progress:
         console: "Console | None" = None,
         get_time: Callable[[], float] | None = None,
     ) -> None:
-        self.total, self.what, self.done = int(total), what, 0
+        self.total, self.done = int(total), 0
         self._bar = None
         if not enabled or self.total <= 0:
             return

@@ -2,7 +2,7 @@
 
 import io
 import tokenize
-from dataclasses import fields
+from dataclasses import asdict, fields
 from pathlib import Path
 
 import pytest
@@ -68,7 +68,7 @@ def test_every_grade_argument_lands_in_the_options():
         grader_memory=200 * MIB,
         limits=Limits(memory=100 * MIB, cpu_seconds=50 + CPU_GRACE),
     )
-    assert GradeOptions.from_dict(options.as_dict()) == options  # as each submission's grading process reads them
+    assert GradeOptions.from_dict(asdict(options)) == options  # as each submission's grading process reads them
     with pytest.raises(ValueError, match="--total-timeout must be at least 1; got 0"):
         grade_options(_args("--total-timeout", "0"))
 
@@ -82,7 +82,7 @@ def test_options_refuse_what_they_cannot_use():
     with pytest.raises(ValueError, match="limits must be a .*Limits"):
         GradeOptions(limits={"memory": 1})
     with pytest.raises(ValueError, match=r"grading option\(s\) timeout; the options are backend, cell_timeout"):
-        GradeOptions.from_dict({**GradeOptions().as_dict(), "timeout": 5})
+        GradeOptions.from_dict({**asdict(GradeOptions()), "timeout": 5})
     assert GradeOptions(rubric=Path("r.toml")).rubric == "r.toml"
     with pytest.raises(ValueError, match="options must be a GradeOptions"):
         grading.grade([], "out", {"cell_timeout": 5})  # type: ignore[arg-type]

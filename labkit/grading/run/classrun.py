@@ -5,7 +5,6 @@
 
 import contextlib
 import json
-import resource
 import shutil
 import sys
 import tempfile
@@ -23,6 +22,7 @@ from ..store.variants import write_variants
 from ..submission import refusals
 from .engines import Batch, Engine, LocalEngine
 from .plan import Plan, plan
+from .processes import peak_bytes
 from .resume import carried_marks, clear
 
 
@@ -130,7 +130,7 @@ class RunFolder:
                 f"labkit grade: {one_line(name, 80)}'s notebooks changed; {lost} of the marks given to it no longer "
                 "apply (an answer rewritten, a part no longer held): mark them again (labkit mark OUT).\n"
             )
-        summary["grader process peak bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+        summary["grader process peak bytes"] = peak_bytes()
         store.write_run(self.out, summary)
 
 
@@ -143,11 +143,9 @@ class Graded(list):
         self.earlier = earlier
 
 
-def report_failures(grades, stream=None):
-    """Name every submission that could not be graded (printable, one line each, on stderr by default); how many
-    there were."""
-    stream = sys.stderr if stream is None else stream
+def report_failures(grades):
+    """Name every submission that could not be graded (printable, one line each, on stderr); how many there were."""
     failed = [g for g in grades if not g.graded]
     for g in failed:
-        stream.write(f"could not grade {one_line(g.name, 80)}: {one_line(g.failure, 300)}\n")
+        sys.stderr.write(f"could not grade {one_line(g.name, 80)}: {one_line(g.failure, 300)}\n")
     return len(failed)

@@ -13,14 +13,13 @@ import functools
 import json
 import logging
 import os
-import resource
 import secrets
 import shutil
 import tempfile
 import threading
 import time
 from collections.abc import Generator
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 from ...errors import InputError
@@ -28,7 +27,7 @@ from ..options import GradeOptions
 from ..store.report import one_line, safe_name
 from ..submission import refusals
 from .engines import Batch, Engine, Outcome, start_warm, stop_warm
-from .processes import Job, low_space, sandbox_problem
+from .processes import Job, low_space, peak_bytes, sandbox_problem
 
 LOCAL = "local"  # --dask local: a LocalCluster on this machine
 CONNECT_TIMEOUT = "30s"  # to reach a scheduler
@@ -47,29 +46,26 @@ def _dask():
 
 
 def connect(address, workers=2):
-    """(client, close) of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker
-    processes when it is ``"local"``; ``close()`` closes both. ValueError when it cannot be reached."""
+    """A client of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker processes
+    when it is ``"local"`` (closing the client closes that cluster too). ValueError when it cannot be reached."""
     distributed = _dask()
     if address == LOCAL:
         if int(workers) < 1:
             raise InputError(f"--dask-workers must be at least 1; got {workers}.")
-        cluster = distributed.LocalCluster(
+        return distributed.Client(
             n_workers=int(workers),
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
             silence_logs=logging.ERROR,
         )
-        client = distributed.Client(cluster)
-        return client, lambda: (client.close(), cluster.close())
     try:
-        client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
+        return distributed.Client(address, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError) as exc:
         raise InputError(
             f"cannot reach the Dask scheduler at {one_line(address, 100)} ({one_line(exc, 200)}): start one "
             "(`dask scheduler`, and `dask worker ADDRESS --nthreads 1` on each machine), or give --dask local."
         ) from None
-    return client, client.close
 
 
 class DaskEngine(Engine):
@@ -89,14 +85,12 @@ class DaskEngine(Engine):
         return dict(self._record)
 
     def grade(self, batch: Batch) -> Generator[Outcome, None, None]:
-        # each worker computes the refusals itself, once (they are 250 kB: not sent per task)
         distributed = _dask()
         options = batch.options
-        client, close = connect(self.address, self.workers)
+        client = connect(self.address, self.workers)
         token = secrets.token_hex(4)
-        payload = {"options": options.as_dict(), "rubric": None}
-        if options.rubric is not None:
-            payload["rubric"] = Path(options.rubric).read_text(encoding="utf-8")
+        rubric = None if options.rubric is None else Path(options.rubric).read_text(encoding="utf-8")
+        payload = {"options": asdict(options), "rubric": rubric}
         seen: set[str] = set()
         by_worker: dict[str, int] = {}
         duplicates, stopped = 0, None
@@ -108,9 +102,9 @@ class DaskEngine(Engine):
                 future = client.submit(
                     _task, os.path.abspath(path), name, payload, key=key, pure=False, retries=1
                 )  # abspath, not resolve: a submission that is a link stays one (and is refused)
-                futures[future.key] = (future, name)
-            for future in distributed.as_completed([future for future, _ in futures.values()]):
-                name = futures[future.key][1]
+                futures[future] = name
+            for future in distributed.as_completed(list(futures)):
+                name = futures[future]
                 try:
                     message = future.result()
                 except Exception as exc:  # noqa: BLE001 - KilledWorker, or what the task raised twice
@@ -133,16 +127,16 @@ class DaskEngine(Engine):
                 if stopped is not None:
                     break
             if stopped is not None:  # as the local engine does: the rest are reported, and a resumed run grades them
-                left = [(future, name) for future, name in futures.values() if name not in seen]
-                client.cancel([future for future, _ in left])
-                for _, name in left:
-                    yield Outcome(batch.not_graded(name, stopped))
+                left = [future for future, name in futures.items() if name not in seen]
+                client.cancel(left)
+                for future in left:
+                    yield Outcome(batch.not_graded(futures[future], stopped))
             try:
-                worker_peaks = client.run(_peak_bytes)
+                worker_peaks = client.run(peak_bytes)
             except Exception:  # noqa: BLE001 - a worker that went away while asked
                 worker_peaks = {}
         finally:
-            close()
+            client.close()
         self._record.update(
             {
                 "dask workers": dict(sorted(by_worker.items())),
@@ -152,14 +146,9 @@ class DaskEngine(Engine):
         )
 
 
-def _peak_bytes():
-    """A Dask worker's peak resident memory (its own, not its grading processes')."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
-
 @functools.cache
 def _profiles_text(exercises):
-    """The refusals of the exercises' registry as JSON, computed once per worker process."""
+    """The refusals of the exercises' registry as JSON, computed once per worker (250 kB: not sent per task)."""
     from ...exercises.registry import load as load_registry
 
     return json.dumps(refusals.wire(load_registry(exercises).refusals))
@@ -174,10 +163,7 @@ def _task(path, name, payload):
     outcome as plain data (:meth:`.processes.Job.message`), with the worker's address."""
     from distributed import get_worker
 
-    try:
-        here = get_worker().address
-    except ValueError:
-        here = "a Dask worker"
+    here = get_worker().address
     options = GradeOptions.from_dict(payload["options"])
     outcome = {"name": name, "result": None, "attempts": 0, "peak": None, "worker": here}
     if not os.path.lexists(path):
@@ -231,10 +217,6 @@ def _kept(options):
         if found is None or died:  # none started yet (or none could be: then none is tried again), or one died
             stop_warm(server, launcher)
             if key not in _KEPT:
-                atexit.register(_stop_kept, key)
+                atexit.register(lambda: stop_warm(*_KEPT.pop(key, (None, None))))
             _KEPT[key] = start_warm(options)
         return _KEPT[key]
-
-
-def _stop_kept(key):
-    stop_warm(*_KEPT.pop(key, (None, None)))

@@ -133,7 +133,7 @@ def start_warm(options):
     with contextlib.suppress(forkserver.ForkServerError):
         server = forkserver.ForkServer(backends.get_backend(options.backend), options.limits).start(wait=False)
     with contextlib.suppress(OSError, ValueError):
-        launcher = Launcher(options, server, wait=False)
+        launcher = Launcher(options, server)
     if server is not None:
         try:
             server.wait_ready()

@@ -58,7 +58,7 @@ class _Launched:
 class Launcher:
     """One warm process that forks each submission's grading process (its server: :func:`main`)."""
 
-    def __init__(self, options, server=None, wait=True):
+    def __init__(self, options, server):
         self.ended, self._lock = {}, threading.RLock()
         parent = os.getpid()
         self.process = subprocess.Popen(
@@ -72,8 +72,6 @@ class Launcher:
             preexec_fn=lambda: die_with(parent),
         )
         self._lines = protocol.Lines(self.process.stdout.fileno(), REQUEST_LIMIT)
-        if wait:
-            self.wait_ready()
 
     def wait_ready(self):
         """Wait until the launcher has imported the grader; OSError (and the launcher stopped) when it does not."""
@@ -136,15 +134,6 @@ class Launcher:
 # The server: ``python -m labkit.grading.run.launcher [EXERCISES]``, a process of its own.
 
 
-def _import_grader(exercises):
-    """Import what grading a submission needs, once."""
-    from ..submission import scoring
-
-    scoring.load_registry(exercises)
-    import scipy.interpolate  # the checks compare with it
-    import scipy.linalg  # noqa: F401
-
-
 def _child(request):
     """The submission's grading process; never returns."""
     code = 1
@@ -193,9 +182,13 @@ def _reaped(children):
     return ended
 
 
-def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    _import_grader(argv[0] if argv and argv[0] else None)
+def main():
+    from ..submission import scoring  # what grading a submission needs, imported once
+
+    scoring.load_registry(sys.argv[1] if len(sys.argv) > 1 and sys.argv[1] else None)
+    import scipy.interpolate  # the checks compare with it
+    import scipy.linalg  # noqa: F401
+
     _say({"ready": True})
     children, buffer = {}, b""  # pid -> the request's id
     try:

@@ -17,6 +17,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import asdict
 from pathlib import Path
 
 from ...errors import InputError
@@ -60,19 +61,15 @@ class Job:
         stem = self.work / f"{safe_name(self.name)}-{self.attempt}"
         self.result, spec, self.log = Path(f"{stem}.json"), Path(f"{stem}.spec.json"), Path(f"{stem}.log")
         origin = None if self.options.backend in backends.BUILTIN else backends.origin(self.options.backend)
-        spec.write_text(
-            json.dumps(
-                {
-                    "submission": str(self.path),
-                    "name": self.name,
-                    "result": str(self.result),
-                    "profiles": str(self.profiles_file),
-                    "options": self.options.as_dict(),
-                    "backend_origin": origin,
-                }
-            ),
-            encoding="utf-8",
-        )
+        given = {
+            "submission": str(self.path),
+            "name": self.name,
+            "result": str(self.result),
+            "profiles": str(self.profiles_file),
+            "options": asdict(self.options),
+            "backend_origin": origin,
+        }
+        spec.write_text(json.dumps(given), encoding="utf-8")
         memory = self.options.grader_memory
         group = self.cgroup = cgroup.create(memory, label="labkit-grader", cores=None)
         folders = [group.path, group.cpu_path] if group is not None else []
@@ -181,6 +178,11 @@ class Job:
         except (OSError, ValueError) as exc:
             return None, f"its result could not be read ({str(exc)[:200]})"
         return data, None
+
+
+def peak_bytes():
+    """This process's peak resident memory in bytes (the grader's, or a Dask worker's; not its children's)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 def one_thread():

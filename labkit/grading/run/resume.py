@@ -16,8 +16,7 @@ from ..submission.scoring import submission_notebooks
 
 
 def content(path):
-    """The digest of a submission's notebooks (:func:`labkit.grading.store.record.content_digest`)."""
-    path = Path(path)
+    """The digest of a submission's notebooks (:func:`labkit.grading.store.record.content_digest`); `path` a Path."""
     return records.content_digest(notebooks(path), path if path.is_dir() else path.parent)
 
 
@@ -94,23 +93,21 @@ def resumed(out, names, seed, rubric=None, fresh=False, contents=None):
             "only these, or choose a new --out."
         )
     found, refused = records.results(out, record)
-    done, changed, before = {}, [], {}
+    done, before = {}, {}
     for name, (path, data) in found.items():
         grade = SubmissionGrade.from_dict(data, str(path), rubric)  # ValueError: another labkit version's
         if not grade.graded:
             continue
         if contents is not None and record.submissions[name].get("content") != contents.get(name):
-            changed.append(name)
             before[name] = grade
-            continue
-        done[name] = grade
+        else:
+            done[name] = grade
     seed = record.seed if record.seed is not None else seed
-    return Resumed(done, seed, rubric, record, sorted(changed), refused, earlier=before)
+    return Resumed(done, seed, rubric, record, sorted(before), refused, earlier=before)
 
 
 def clear(out):
-    """Delete the results, feedback and record of the run in `out` (``--fresh``)."""
-    out = Path(out)
+    """Delete the results, feedback and record of the run in the folder `out` (a Path; ``--fresh``)."""
     for folder, pattern in (("results", "*.json"), ("feedback", "*.txt"), ("feedback", "*.html")):
         for path in sorted((out / folder).glob(pattern)):
             path.unlink()

@@ -190,6 +190,5 @@ def read_exchange(course: str | os.PathLike, assignment: str) -> dict[str, datet
             if when is None:
                 continue
             student = entry.name.split(f"+{assignment}+")[0]
-            if student not in found or when > found[student]:
-                found[student] = when
+            found[student] = max(when, found.get(student, when))
     return found
