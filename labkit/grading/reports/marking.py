@@ -17,7 +17,6 @@ from ...errors import InputError
 from .. import pages
 from ..store import record as records
 from ..store.feedback import blank
-from ..store.marks import import_marks, marks_csv  # noqa: F401 - labkit mark's import, with the marking page
 from ..store.names import shown_name
 from ..store.report import one_line, printable, read_results
 
