@@ -343,14 +343,12 @@ class _Tally:
                         self.problems[(kind, grade.name)].append(line)
 
     def by_kind(self):
-        """Each kind's problems, by student."""
         found = {kind: [] for kind in KINDS}
         for (kind, student), texts in sorted(self.problems.items()):
             found[kind].append(Problem(student, tuple(dict.fromkeys(texts))))
         return {kind: rows for kind, rows in found.items() if rows}
 
     def slip_list(self):
-        """The slips, most frequent first."""
         ordered = sorted(self.slips.items(), key=lambda item: (-len(set(item[1])), item[0][0], item[0][1], item[0][3]))
         return [Slip(number, name, hint, tuple(sorted(set(who)))) for (number, _, name, hint), who in ordered]
 

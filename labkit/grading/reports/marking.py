@@ -15,6 +15,7 @@ from markupsafe import Markup
 
 from ...errors import InputError
 from .. import pages
+from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids
 from ..store import record as records
 from ..store.feedback import blank
 from ..store.names import shown_name
@@ -38,8 +39,6 @@ def model_answers(folder=SOLUTIONS):
     """{answer grade id: (the question, the model answer)} from the instructor notebooks in `folder` (empty
     when there are none, as in an installed labkit without its source tree)."""
     import nbformat
-
-    from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids
 
     found = {}
     for path in sorted(Path(folder).glob("*.ipynb")) if Path(folder).is_dir() else ():

@@ -43,6 +43,8 @@ class Pair:
 
 # what a release gives everyone: the hashes of its code, and its stripped lines (a stub's are never shared)
 Boilerplate = namedtuple("Boilerplate", "hashes lines")
+# two students, their graded functions that look alike (Pair, most similar first), and how many both define
+PairRow = namedtuple("PairRow", "first second alike both")
 # one student's version of a function, with its own fingerprints (fingerprint.own)
 _Version = namedtuple("_Version", "name text where hashes positions")
 
@@ -224,21 +226,6 @@ def _lines(version, other, given):
     return frozenset(
         n for n in fingerprint.shared_lines(version.text, version.where, positions) if lines[n].strip() not in given
     )
-
-
-@dataclass(frozen=True)
-class PairRow:
-    """Two students and the graded functions of theirs that look alike (each a similarity Pair)."""
-
-    first: str
-    second: str
-    alike: tuple  # Pair, most similar first
-    both: int  # graded functions both of them define
-
-    @property
-    def words(self):
-        alike = len(self.alike)
-        return f"{self.first} – {self.second}: {alike} of {max(self.both, alike)} graded functions alike"
 
 
 @dataclass
