@@ -269,12 +269,6 @@ def problem_kinds(problem: str) -> list[tuple[str, str]]:
     return [(kind, one_line(description, MAX_TEXT)) for kind, description in kinds_of(problem)]
 
 
-def _checks(grade, number):
-    """{part name: check} of exercise `number` in `grade`; None when the submission does not have it."""
-    verdict = grade.results.get(number)
-    return None if verdict is None else {one_line(part.name, MAX_TEXT): part.as_dict() for part in verdict.parts}
-
-
 def _failed_text(check, number):
     details = [
         f"{one_line(s.get('step', ''), 100)}: {one_line(s.get('detail', ''), MAX_TEXT)}"
@@ -311,7 +305,11 @@ class _Tally:
         """The class's rate of exercise `number` and of each of its parts (as declared, then any other the
         results hold)."""
         declared = getattr(rubric.registry.exercises.get(number), "parts", ())
-        found = [(g, checks) for g in graded if (checks := _checks(g, number)) is not None]
+        found = [
+            (g, {one_line(part.name, MAX_TEXT): part.as_dict() for part in g.results[number].parts})
+            for g in graded
+            if number in g.results
+        ]
         names = list(dict.fromkeys([*(part.name for part in declared),
                                     *(name for _, checks in found for name in checks)]))  # fmt: skip
         counts = {name: Counter(missing=len(graded) - len(found)) for name in names}
@@ -410,11 +408,9 @@ def summarise(grades: Iterable[SubmissionGrade], students: dict | None = None) -
 
 def _figure(width, height):
     """A matplotlib Figure and its one Axes, on no pyplot state (the figure is garbage once drawn)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(width, height), layout="constrained")
-    FigureCanvasAgg(figure)
     return figure, figure.subplots()
 
 
@@ -461,9 +457,8 @@ def _bars(rated):
         axes.text(100 * (r.rate or 0) + 1, y, _rate_text(r.rate, r.attempted), va="center", fontsize=8, color="black")
     axes.set_yticks(positions, [one_line(label, 40) for label in labels], fontsize=8)
     axes.invert_yaxis()
-    axes.set_xlim(0, 125)
     axes.set_xticks([0, 25, 50, 75, 100], ["0%", "25%", "50%", "75%", "100%"])
-    axes.set_xlabel("passed, of the submissions that attempted it")
+    axes.set(xlabel="passed, of the submissions that attempted it", xlim=(0, 125))
     return _png(figure)
 
 
@@ -547,11 +542,10 @@ def write(
     pairs: Iterable[Pair] | None = None,
     *,
     threshold: float = DEFAULT_THRESHOLD,
-    similarity_note: str | None = None,
 ) -> Path:
     """Write ``report.html`` into a grading run's ``--out`` folder `out_dir`, through a temporary file renamed over
     an earlier report, and return its path; the folder's other files are neither read nor touched. `grades` are the
-    class (:func:`read` reads them), `pairs`, `threshold` (in (0, 1]) and `similarity_note` as for :func:`render`.
+    class (:func:`read` reads them), `pairs` and `threshold` (in (0, 1]) as for :func:`render`.
 
     Raises
     ------
@@ -571,6 +565,6 @@ def write(
         students = records.read(out).variants.get("students", {})  # each student's variant data, for the copies
     except ValueError:
         students = {}  # no variants or no record
-    page = render(summarise(grades, students), pairs, threshold=float(threshold), similarity_note=similarity_note)
+    page = render(summarise(grades, students), pairs, threshold=float(threshold))
     records.replace_text(target, page, mode=0o644)
     return target

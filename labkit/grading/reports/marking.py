@@ -178,8 +178,7 @@ def write_page(out, marker="instructor", rubric=None):
     """OUT/marking.html: every item to mark, by keyboard, offline; the path written. Its one script is
     ``templates/marking.js`` with the tasks as data, and the page's policy runs that script alone."""
     out = Path(out)
-    record = records.read(out)
-    recorded = record.rubric_object(out)
+    recorded = records.read(out).rubric_object(out)
     if rubric is not None and recorded.digest != rubric.digest:
         raise InputError(f"{out} was graded under another rubric ({recorded.digest}); leave out --rubric.")
     grades = read_results([out], recorded)
