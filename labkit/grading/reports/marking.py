@@ -14,6 +14,7 @@ from pathlib import Path
 from markupsafe import Markup
 
 from ...errors import InputError
+from ...execute import read_notebook
 from .. import pages
 from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids
 from ..store import record as records
@@ -38,16 +39,12 @@ KEPT = re.compile(r"\x00(\d+)\x00")  # an atom's place in a line: printable() to
 def model_answers(folder=SOLUTIONS):
     """{answer grade id: (the question, the model answer)} from the instructor notebooks in `folder` (empty
     when there are none, as in an installed labkit without its source tree)."""
-    import nbformat
-
     found = {}
     for path in sorted(Path(folder).glob("*.ipynb")) if Path(folder).is_dir() else ():
-        nb = nbformat.read(path, as_version=4)
+        nb = read_notebook(path)
         ids = iter(answer_ids(nb))
         previous = ""
-        for cell in nb.cells:
-            if cell.cell_type != "markdown":
-                continue
+        for cell in (cell for cell in nb.cells if cell.cell_type == "markdown"):
             if BEGIN_SOLUTION in cell.source:
                 inside = cell.source.split(BEGIN_SOLUTION, 1)[1].split(END_SOLUTION, 1)[0].strip()
                 found[next(ids)] = (previous, inside)

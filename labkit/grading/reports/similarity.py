@@ -249,13 +249,12 @@ class Copies:
 def find_copies(grades, students=None) -> Copies:
     """The copies of a class; `students`: the run's variant data ({name: {exercise: {parameter: value}}}) or None."""
     graded = [g for g in grades if g.graded]
-    registry = graded[0].rubric.registry if graded else None
     found = defaultdict(list)  # (holder, whose data) -> exercises
     for grade in graded:
+        exercises = grade.rubric.registry.exercises
         for number, verdict in sorted(grade.results.items()):
-            other = verdict.other_variant
-            if other and registry is not None and number in registry.exercises:
-                whose = _whose(grade.name, registry.exercises[number], other, students or {})
+            if verdict.other_variant and number in exercises:
+                whose = _whose(grade.name, exercises[number], verdict.other_variant, students or {})
                 found[(grade.name, ", ".join(whose))].append(number)
     marked = [
         (g.name, sorted(f for f, s in g.sources.items() if any(m in str(s) for m in SOLUTION_MARKERS))) for g in graded
