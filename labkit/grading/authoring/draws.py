@@ -105,10 +105,8 @@ def run_cells(nb, names):
             # the cell's lines where a traceback looks for them (as in a kernel), so a hint can quote the line
             name = f"<labkit draws cell {index}>"
             linecache.cache[name] = (len(source), None, source.splitlines(True), name)
-            try:
+            with contextlib.suppress(Exception):  # a slip may raise; the checks say what it costs
                 exec(compile(source, name, "exec"), namespace)  # noqa: S102 - the instructor's own code
-            except Exception:  # noqa: BLE001 - a slip may raise; the checks say what it costs
-                pass
     return namespace
 
 
