@@ -29,6 +29,7 @@ def add(commands):
 def handle(args):
     """Write the marking page, or import the marks it gave."""
     from ..grading.reports import marking
+    from ..grading.store.marks import import_marks
     from ..grading.store.rubric import load
 
     rubric = None if args.rubric is None else load(args.rubric)
@@ -40,7 +41,7 @@ def handle(args):
                 "you download marks.csv and import it with --import)"
             )
         return 0
-    changed = marking.import_marks(args.out, args.import_, rubric)
+    changed = import_marks(args.out, args.import_, rubric)
     if not args.quiet:
         print(f"{changed} mark(s) changed in {args.out} (grades.csv, feedback/, results/ and record.json)")
     return 0

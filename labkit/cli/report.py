@@ -46,8 +46,8 @@ def handle(args):
     refused(grades, "labkit report")
     functions = {function for grade in grades for function in grade.sources}
     with Progress(len(functions), "comparing code", enabled=not args.quiet) as bar:
-        pairs, note = similarity.similar_pairs(grades, threshold, progress=bar), None
-    path = class_report.write(args.out, grades, pairs, threshold=threshold, similarity_note=note)
+        pairs = similarity.similar_pairs(grades, threshold, progress=bar)
+    path = class_report.write(args.out, grades, pairs, threshold=threshold)
     if not args.quiet:
         similar = "similar code not computed" if pairs is None else f"{len(pairs)} similar pair(s)"
         print(

@@ -16,7 +16,7 @@ import pytest
 from jupyterlab_session import CHROMIUM, CHROMIUM_FLAGS, skip_without_chromium
 
 from labkit.grading.reports import marking
-from labkit.grading.store import report, rubric
+from labkit.grading.store import marks, report, rubric
 
 playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (test extras)")
 axe_playwright = pytest.importorskip("axe_playwright_python.sync_playwright", reason="axe-playwright-python is missing")
@@ -88,7 +88,7 @@ def test_thirty_answers_marked_by_keyboard_survive_a_reload_and_reach_grades_csv
     with open(saved, newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == COUNT and {r["comment"] for r in rows} == {"", "Say why."}
-    assert marking.import_marks(out, saved) == COUNT
+    assert marks.import_marks(out, saved) == COUNT
     given = {name: k % 6 for k, name in enumerate(order)}
     with open(out / "grades.csv", newline="") as handle:
         totals = {row["submission"]: row["total"] for row in csv.DictReader(handle)}

@@ -14,6 +14,7 @@ import io
 import linecache
 import re
 import warnings
+from copy import deepcopy
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,7 +22,7 @@ from ...errors import InputError
 from ...execute import read_notebook
 from ...exercises import variants as variant_data
 from ...exercises.registry import LAB, Registry
-from .release import BEGIN_HIDDEN, END_HIDDEN, copy_notebook, with_values
+from .release import BEGIN_HIDDEN, END_HIDDEN, with_values
 
 
 @dataclass(frozen=True)
@@ -55,7 +56,7 @@ def load_catalog(path):
 
 def _planted(nb, replace, name):
     """Notebook `nb` with the (old, new) code replacements of a catalog entry (each old once in one code cell)."""
-    nb = copy_notebook(nb)
+    nb = deepcopy(nb)
     for old, new in replace:
         hits = [cell for cell in nb.cells if cell.cell_type == "code" and old in cell.source]
         if len(hits) != 1 or hits[0].source.count(old) != 1:
@@ -104,10 +105,8 @@ def run_cells(nb, names):
             # the cell's lines where a traceback looks for them (as in a kernel), so a hint can quote the line
             name = f"<labkit draws cell {index}>"
             linecache.cache[name] = (len(source), None, source.splitlines(True), name)
-            try:
+            with contextlib.suppress(Exception):  # a slip may raise; the checks say what it costs
                 exec(compile(source, name, "exec"), namespace)  # noqa: S102 - the instructor's own code
-            except Exception:  # noqa: BLE001 - a slip may raise; the checks say what it costs
-                pass
     return namespace
 
 

@@ -3,8 +3,8 @@ roster and a variants file, one folder per student whose notebooks hold their ow
 The instructor notebooks' nbgrader cell metadata comes from the same markers (:func:`mark`)."""
 
 import ast
-import json
 import re
+from copy import deepcopy
 from pathlib import Path
 
 from ...errors import InputError
@@ -51,7 +51,7 @@ def release_notebook(nb, name="notebook"):
     """The student version of an instructor notebook (a new object): each solution region a stub (:data:`STUB` in
     code, :data:`TEXT_STUB` in markdown), hidden-test regions gone (their cell read-only and not deletable, as
     nbgrader leaves it), outputs cleared."""
-    student = copy_notebook(nb)
+    student = deepcopy(nb)
     student.metadata.pop("widgets", None)
     for index, cell in enumerate(student.cells):
         if cell.cell_type == "code":
@@ -80,7 +80,7 @@ def with_values(nb, values, name="notebook", registry=LAB):
     """Notebook `nb` (a new object) whose ``variant-data`` cells' one-line assignments of its exercises' parameters
     (a plain number) and derived values hold `values` ({exercise: {parameter: value}}) as the notebook shows them;
     a missing assignment is refused (ValueError), so no student gets the lab's data by mistake."""
-    copy = copy_notebook(nb)
+    copy = deepcopy(nb)
     wanted, params = _assignments(values, name, registry)
     done = set()
     for index, cell in enumerate(copy.cells):
@@ -93,13 +93,6 @@ def with_values(nb, values, name="notebook", registry=LAB):
             f"{variant_data.DATA_TAG!r} with `{missing[0]} = <the lab's value>`."
         )
     return copy
-
-
-def copy_notebook(nb):
-    """A deep copy of notebook `nb`, as nbformat's own node."""
-    import nbformat  # the [grade] extra
-
-    return nbformat.from_dict(json.loads(json.dumps(nb)))
 
 
 def _assignments(values, name, registry):

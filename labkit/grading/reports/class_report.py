@@ -199,10 +199,10 @@ class ClassSummary:
     slips: list  # Slip, most frequent first
     problems: dict  # kind -> [Problem], by student
     most_failed: list  # Struggle, most failed parts first
-    seeds: list = field(default_factory=list)
-    late: LateSummary | None = None  # when the rubric has a [late] table
-    held: list = field(default_factory=list)  # Held
-    copies: Copies | None = None  # whose data, solution markers, each student's graded functions
+    seeds: list
+    late: LateSummary | None  # when the rubric has a [late] table
+    held: list  # Held
+    copies: Copies  # whose data, solution markers, each student's graded functions
 
 
 def read(folder: str | Path, rubric: Rubric | None = None) -> list[SubmissionGrade]:
@@ -246,8 +246,6 @@ def check_outcome(check: dict) -> str:
     ...     "detail": "ran past the time limit"}]})  # the words alone: no kind, so the check's slip
     'slip'
     """
-    if not isinstance(check, dict):
-        raise InputError(f"a part's result must be a dict with 'passed' and 'steps'; got {type(check).__name__}.")
     kind = part_kind(check)  # the one place a part's kind is decided: the feedback and labkit handin agree
     if kind != ERROR:
         return kind
@@ -269,17 +267,6 @@ def problem_kinds(problem: str) -> list[tuple[str, str]]:
     [('other', 'a.ipynb: it ran past the time limit')]
     """
     return [(kind, one_line(description, MAX_TEXT)) for kind, description in kinds_of(problem)]
-
-
-def _checks(grade, number):
-    """{part name: check} of exercise `number` in `grade`; None when the submission does not have it."""
-    verdict = grade.results.get(number)
-    return None if verdict is None else {one_line(part.name, MAX_TEXT): part.as_dict() for part in verdict.parts}
-
-
-def _weights(rubric, exercise):
-    total = sum(part.weight for part in exercise.parts) or 1
-    return {part.name: rubric.points.get(exercise.number, 0) * part.weight / total for part in exercise.parts}
 
 
 def _failed_text(check, number):
@@ -317,9 +304,13 @@ class _Tally:
     def exercise(self, rubric, number, graded):
         """The class's rate of exercise `number` and of each of its parts (as declared, then any other the
         results hold)."""
-        declared = rubric.registry.exercises.get(number)
-        found = [(g, checks) for g in graded if (checks := _checks(g, number)) is not None]
-        names = list(dict.fromkeys([*(part.name for part in getattr(declared, "parts", ())),
+        declared = getattr(rubric.registry.exercises.get(number), "parts", ())
+        found = [
+            (g, {one_line(part.name, MAX_TEXT): part.as_dict() for part in g.results[number].parts})
+            for g in graded
+            if number in g.results
+        ]
+        names = list(dict.fromkeys([*(part.name for part in declared),
                                     *(name for _, checks in found for name in checks)]))  # fmt: skip
         counts = {name: Counter(missing=len(graded) - len(found)) for name in names}
         attempted = passed = 0
@@ -329,7 +320,8 @@ class _Tally:
                 counts[name][outcome] += 1
             attempted += any(outcome != NOT_DONE for outcome in outcomes)
             passed += bool(outcomes) and all(outcome == PASSED for outcome in outcomes)
-        weights = _weights(rubric, declared) if declared is not None else {}
+        total = sum(part.weight for part in declared) or 1
+        weights = {part.name: rubric.points.get(number, 0) * part.weight / total for part in declared}
         parts = [
             PartRate(number, name, weights.get(name, 0.0), c[PASSED], c[SLIP], sum(c[kind] for kind in KINDS),
                      c[NOT_DONE], c["missing"])
@@ -349,14 +341,12 @@ class _Tally:
                         self.problems[(kind, grade.name)].append(line)
 
     def by_kind(self):
-        """Each kind's problems, by student."""
         found = {kind: [] for kind in KINDS}
         for (kind, student), texts in sorted(self.problems.items()):
             found[kind].append(Problem(student, tuple(dict.fromkeys(texts))))
         return {kind: rows for kind, rows in found.items() if rows}
 
     def slip_list(self):
-        """The slips, most frequent first."""
         ordered = sorted(self.slips.items(), key=lambda item: (-len(set(item[1])), item[0][0], item[0][1], item[0][3]))
         return [Slip(number, name, hint, tuple(sorted(set(who)))) for (number, _, name, hint), who in ordered]
 
@@ -366,9 +356,10 @@ class _Tally:
         return sorted(struggles, key=lambda s: (-len(s.failed), s.total, s.student))[:MOST_FAILED]
 
 
-def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
+def summarise(grades: Iterable[SubmissionGrade], students: dict | None = None) -> ClassSummary:
     """Count what a class did: totals, pass rates, slips, problems and the most failed parts, of `grades` (one
-    SubmissionGrade per submission, all scored under one rubric, as :func:`read` gives them).
+    SubmissionGrade per submission, all scored under one rubric, as :func:`read` gives them); `students` is the
+    run's variant data, for the copies (:func:`~labkit.grading.reports.similarity.find_copies`).
 
     Raises
     ------
@@ -410,18 +401,16 @@ def summarise(grades: Iterable[SubmissionGrade]) -> ClassSummary:
         most_failed=tally.most_failed(totals),
         seeds=sorted({g.seed for g in submissions if isinstance(g.seed, int)}),
         late=LateSummary.of(rubric, graded),
-        copies=find_copies(submissions),
+        copies=find_copies(submissions, students),
         held=[held for g in graded for held in Held.of(g)],
     )
 
 
 def _figure(width, height):
     """A matplotlib Figure and its one Axes, on no pyplot state (the figure is garbage once drawn)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(width, height), layout="constrained")
-    FigureCanvasAgg(figure)
     return figure, figure.subplots()
 
 
@@ -435,10 +424,7 @@ def _bins(totals, maximum):
     """Bin edges of a round width, about twenty bins from 0 to the largest possible total."""
     top = max([float(maximum), *map(float, totals), 1.0])
     width = next(w for w in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 10**9) if top / w <= 25)
-    edges = np.arange(0.0, top + width, float(width))
-    if edges[-1] < top:
-        edges = np.append(edges, edges[-1] + width)
-    return edges
+    return np.arange(int(np.ceil(top / width)) + 1) * float(width)
 
 
 def _histogram(summary):
@@ -471,14 +457,9 @@ def _bars(rated):
         axes.text(100 * (r.rate or 0) + 1, y, _rate_text(r.rate, r.attempted), va="center", fontsize=8, color="black")
     axes.set_yticks(positions, [one_line(label, 40) for label in labels], fontsize=8)
     axes.invert_yaxis()
-    axes.set_xlim(0, 125)
     axes.set_xticks([0, 25, 50, 75, 100], ["0%", "25%", "50%", "75%", "100%"])
-    axes.set_xlabel("passed, of the submissions that attempted it")
+    axes.set(xlabel="passed, of the submissions that attempted it", xlim=(0, 125))
     return _png(figure)
-
-
-def _text(value, limit=MAX_TEXT):
-    return one_line(value, limit)
 
 
 def _shared(indices, lines):
@@ -515,23 +496,18 @@ def render(
     pairs = _check_pairs(pairs)
     if pairs is None and similarity_note is None:
         similarity_note = unavailable()
-    copies = summary.copies or Copies()
     return pages.render(
         "class_report.html",
         s=summary,
-        rubric=summary.rubric,
-        late=summary.late,
         limits={name: value for name, value in globals().items() if name.startswith("MAX_")},
         totals=_totals(summary) if summary.totals else None,
         rate_figures=[_bars(summary.exercises), _bars(summary.parts)] if summary.totals else None,
         rate_text=_rate_text,
         held_threshold=THRESHOLD,
-        copy_lines=copies.holder_lines(),
-        copies_marked=copies.marked,
-        pair_rows=None if pairs is None else pair_rows(pairs, copies.functions),
+        pair_rows=None if pairs is None else pair_rows(pairs, summary.copies.functions),
         threshold=threshold,
         similarity_note=similarity_note,
-        text=_text,
+        text=lambda value, limit=MAX_TEXT: one_line(value, limit),
         who=lambda name: shown_name(name, MAX_NAME),
         points=points_text,
         time_text=lateness.time_text,
@@ -566,11 +542,10 @@ def write(
     pairs: Iterable[Pair] | None = None,
     *,
     threshold: float = DEFAULT_THRESHOLD,
-    similarity_note: str | None = None,
 ) -> Path:
     """Write ``report.html`` into a grading run's ``--out`` folder `out_dir`, through a temporary file renamed over
     an earlier report, and return its path; the folder's other files are neither read nor touched. `grades` are the
-    class (:func:`read` reads them), `pairs`, `threshold` (in (0, 1]) and `similarity_note` as for :func:`render`.
+    class (:func:`read` reads them), `pairs` and `threshold` (in (0, 1]) as for :func:`render`.
 
     Raises
     ------
@@ -586,13 +561,10 @@ def write(
     target = out / REPORT
     if target.is_symlink() or (target.exists() and not target.is_file()):
         raise InputError(f"{target} exists and is not a plain file: move it away, then run labkit report again.")
-    grades = list(grades)
-    summary = summarise(grades)
     try:
         students = records.read(out).variants.get("students", {})  # each student's variant data, for the copies
     except ValueError:
         students = {}  # no variants or no record
-    summary.copies = find_copies(grades, students)
-    page = render(summary, pairs, threshold=float(threshold), similarity_note=similarity_note)
+    page = render(summarise(grades, students), pairs, threshold=float(threshold))
     records.replace_text(target, page, mode=0o644)
     return target

@@ -14,10 +14,11 @@ from pathlib import Path
 from markupsafe import Markup
 
 from ...errors import InputError
+from ...execute import read_notebook
 from .. import pages
+from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids
 from ..store import record as records
 from ..store.feedback import blank
-from ..store.marks import import_marks, marks_csv  # noqa: F401 - labkit mark's import, with the marking page
 from ..store.names import shown_name
 from ..store.report import one_line, printable, read_results
 
@@ -38,18 +39,12 @@ KEPT = re.compile(r"\x00(\d+)\x00")  # an atom's place in a line: printable() to
 def model_answers(folder=SOLUTIONS):
     """{answer grade id: (the question, the model answer)} from the instructor notebooks in `folder` (empty
     when there are none, as in an installed labkit without its source tree)."""
-    import nbformat
-
-    from ..authoring.release import BEGIN_SOLUTION, END_SOLUTION, answer_ids
-
     found = {}
     for path in sorted(Path(folder).glob("*.ipynb")) if Path(folder).is_dir() else ():
-        nb = nbformat.read(path, as_version=4)
+        nb = read_notebook(path)
         ids = iter(answer_ids(nb))
         previous = ""
-        for cell in nb.cells:
-            if cell.cell_type != "markdown":
-                continue
+        for cell in (cell for cell in nb.cells if cell.cell_type == "markdown"):
             if BEGIN_SOLUTION in cell.source:
                 inside = cell.source.split(BEGIN_SOLUTION, 1)[1].split(END_SOLUTION, 1)[0].strip()
                 found[next(ids)] = (previous, inside)
@@ -180,8 +175,7 @@ def write_page(out, marker="instructor", rubric=None):
     """OUT/marking.html: every item to mark, by keyboard, offline; the path written. Its one script is
     ``templates/marking.js`` with the tasks as data, and the page's policy runs that script alone."""
     out = Path(out)
-    record = records.read(out)
-    recorded = record.rubric_object(out)
+    recorded = records.read(out).rubric_object(out)
     if rubric is not None and recorded.digest != rubric.digest:
         raise InputError(f"{out} was graded under another rubric ({recorded.digest}); leave out --rubric.")
     grades = read_results([out], recorded)

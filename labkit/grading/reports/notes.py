@@ -43,11 +43,11 @@ def time_notes(grades, rubric, times):
 
 def late_mark_notes(grades, marked):
     """A line per graded submission the LMS marked late whose time is unknown (so no penalty was applied)."""
-    unknown = [g.name for g in grades if g.name in marked and g.graded and (g.time is None or g.time.when is None)]
     return [
-        f"labkit grade: the LMS marked {one_line(name, 80)} late, but gave no time: give the LMS's submission "
+        f"labkit grade: the LMS marked {one_line(g.name, 80)} late, but gave no time: give the LMS's submission "
         "times in --times TIMES.csv for the late rule to apply."
-        for name in unknown
+        for g in grades
+        if g.name in marked and g.graded and (g.time is None or g.time.when is None)
     ]
 
 

@@ -43,6 +43,8 @@ class Pair:
 
 # what a release gives everyone: the hashes of its code, and its stripped lines (a stub's are never shared)
 Boilerplate = namedtuple("Boilerplate", "hashes lines")
+# two students, their graded functions that look alike (Pair, most similar first), and how many both define
+PairRow = namedtuple("PairRow", "first second alike both")
 # one student's version of a function, with its own fingerprints (fingerprint.own)
 _Version = namedtuple("_Version", "name text where hashes positions")
 
@@ -226,21 +228,6 @@ def _lines(version, other, given):
     )
 
 
-@dataclass(frozen=True)
-class PairRow:
-    """Two students and the graded functions of theirs that look alike (each a similarity Pair)."""
-
-    first: str
-    second: str
-    alike: tuple  # Pair, most similar first
-    both: int  # graded functions both of them define
-
-    @property
-    def words(self):
-        alike = len(self.alike)
-        return f"{self.first} – {self.second}: {alike} of {max(self.both, alike)} graded functions alike"
-
-
 @dataclass
 class Copies:
     """{submission: its graded functions}, (holder, whose data or "", exercises), (submission, marked functions)."""
@@ -262,13 +249,12 @@ class Copies:
 def find_copies(grades, students=None) -> Copies:
     """The copies of a class; `students`: the run's variant data ({name: {exercise: {parameter: value}}}) or None."""
     graded = [g for g in grades if g.graded]
-    registry = graded[0].rubric.registry if graded else None
     found = defaultdict(list)  # (holder, whose data) -> exercises
     for grade in graded:
+        exercises = grade.rubric.registry.exercises
         for number, verdict in sorted(grade.results.items()):
-            other = verdict.other_variant
-            if other and registry is not None and number in registry.exercises:
-                whose = _whose(grade.name, registry.exercises[number], other, students or {})
+            if verdict.other_variant and number in exercises:
+                whose = _whose(grade.name, exercises[number], verdict.other_variant, students or {})
                 found[(grade.name, ", ".join(whose))].append(number)
     marked = [
         (g.name, sorted(f for f, s in g.sources.items() if any(m in str(s) for m in SOLUTION_MARKERS))) for g in graded
