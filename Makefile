@@ -46,12 +46,13 @@ test: $(STAMP) chromium bwrap
 	$(PY) -m pytest tests labkit --nbval --nbval-current-env --nbval-sanitize-with tests/nbval_sanitize.cfg notebooks
 
 # The quick loop while changing code (under 3 minutes): lint, types, and every test that starts no sandbox, browser,
-# server or whole notebook (tests/conftest.py marks the others slow). `make test` runs everything before a commit.
+# server or whole notebook (tests/conftest.py marks the others slow), on both cores (pytest-xdist: its summary leaves
+# out the figures tests print). `make test` runs everything, in one process, before a commit.
 test-fast: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
 	$(PY) -m mypy
-	$(PY) -m pytest -q -m "not slow" tests labkit
+	$(PY) -m pytest -q -n 2 -m "not slow" tests labkit
 
 # Regrade the catalog class (tests/catalog.py) with the golden seed and write its grades.csv over the golden file
 # test_catalog compares with; `git diff tests/data/` then shows every row a change moved (keep only intended ones).
