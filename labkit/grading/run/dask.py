@@ -46,26 +46,29 @@ def _dask():
 
 
 def connect(address, workers=2):
-    """A client of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker processes
-    when it is ``"local"`` (closing the client closes that cluster too). ValueError when it cannot be reached."""
+    """(client, close) of the scheduler at `address`, or of a new LocalCluster of `workers` one-thread worker
+    processes when it is ``"local"``; ``close()`` closes both. ValueError when it cannot be reached."""
     distributed = _dask()
     if address == LOCAL:
         if int(workers) < 1:
             raise InputError(f"--dask-workers must be at least 1; got {workers}.")
-        return distributed.Client(
+        cluster = distributed.LocalCluster(
             n_workers=int(workers),
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
             silence_logs=logging.ERROR,
         )
+        client = distributed.Client(cluster)
+        return client, lambda: (client.close(), cluster.close())
     try:
-        return distributed.Client(address, timeout=CONNECT_TIMEOUT)
+        client = distributed.Client(address, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError) as exc:
         raise InputError(
             f"cannot reach the Dask scheduler at {one_line(address, 100)} ({one_line(exc, 200)}): start one "
             "(`dask scheduler`, and `dask worker ADDRESS --nthreads 1` on each machine), or give --dask local."
         ) from None
+    return client, client.close
 
 
 class DaskEngine(Engine):
@@ -87,7 +90,7 @@ class DaskEngine(Engine):
     def grade(self, batch: Batch) -> Generator[Outcome, None, None]:
         distributed = _dask()
         options = batch.options
-        client = connect(self.address, self.workers)
+        client, close = connect(self.address, self.workers)
         token = secrets.token_hex(4)
         rubric = None if options.rubric is None else Path(options.rubric).read_text(encoding="utf-8")
         payload = {"options": asdict(options), "rubric": rubric}
@@ -136,7 +139,7 @@ class DaskEngine(Engine):
             except Exception:  # noqa: BLE001 - a worker that went away while asked
                 worker_peaks = {}
         finally:
-            client.close()
+            close()
         self._record.update(
             {
                 "dask workers": dict(sorted(by_worker.items())),

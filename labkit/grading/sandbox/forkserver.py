@@ -157,10 +157,8 @@ class ForkedBox(Box):
         (requests_r, requests_w), (answers_r, answers_w), (control_r, control_w), (status_r, status_w) = (
             os.pipe() for _ in range(4)
         )
-        self.stdin, self.stdout = os.fdopen(requests_w, "wb"), os.fdopen(answers_r, "rb", buffering=0)
-        self.control, self.status = control_w, status_r
-        self.process = self  # our ends: closed by close(), whether the worker starts or not
         theirs = [requests_r, answers_w, control_r, status_w]  # closed here once sent, as the cgroup's files
+        ours = [requests_w, answers_r, control_w, status_r]
         try:
             for folder in self.cgroup.folders if self.cgroup is not None else ():
                 theirs.append(os.open(folder / "cgroup.procs", os.O_WRONLY))
@@ -175,9 +173,16 @@ class ForkedBox(Box):
             except OSError as exc:
                 _broken(self.server)
                 raise ForkServerError(f"the fork server is gone ({exc})") from None
+        except BaseException:
+            for fd in ours:
+                os.close(fd)
+            raise
         finally:
             for fd in theirs:
                 os.close(fd)
+        self.stdin, self.stdout = os.fdopen(requests_w, "wb"), os.fdopen(answers_r, "rb", buffering=0)
+        self.control, self.status = control_w, status_r
+        self.process = self  # closed by close(), whether the worker starts or not
         said = b""
         if _wait_readable(status_r, time.monotonic() + START_TIMEOUT):
             said = os.read(status_r, 1)

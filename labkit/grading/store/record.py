@@ -249,11 +249,16 @@ def content_digest(notebooks, base=None):
         except OSError as exc:
             digest.update(f"unreadable {exc.errno}".encode())
             continue
-        with os.fdopen(fd, "rb") as handle:
+        try:
             digest.update(str(os.fstat(fd).st_size).encode() + b"\0")
-            while chunk := handle.read(min(1 << 20, budget)):  # nothing once the budget is spent
+            while budget > 0:
+                chunk = os.read(fd, min(1 << 20, budget))
+                if not chunk:
+                    break
                 digest.update(chunk)
                 budget -= len(chunk)
+        finally:
+            os.close(fd)
     return digest.hexdigest()
 
 

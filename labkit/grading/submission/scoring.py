@@ -86,6 +86,8 @@ def read_cells(path, answers=None, registry=LAB):
 
 def exercises_in(markdown, registry=LAB):
     """Graded exercises whose section heading ('## Exercise N') the markdown has."""
+    if hasattr(markdown, "cells"):  # an nbformat notebook
+        markdown = [cell.source for cell in markdown.cells if cell.cell_type == "markdown"]
     found = {n for text in markdown for n in sections(text)}
     return sorted(found & set(registry.exercises))
 

@@ -417,3 +417,19 @@ def test_rewording_every_message_changes_nothing_the_report_says(graded_class):
     assert [(r.passed, r.slipped, r.problem, r.not_done) for r in before.parts] == [
         (r.passed, r.slipped, r.problem, r.not_done) for r in after.parts
     ]
+
+
+def test_exercises_in_takes_a_notebook_or_its_markdown_and_counts_only_markdown_headings():
+    import nbformat
+
+    from labkit.grading.submission.scoring import exercises_in
+
+    nb = nbformat.v4.new_notebook(
+        cells=[
+            nbformat.v4.new_markdown_cell("## Exercise 3\nA heading the grader counts."),
+            nbformat.v4.new_code_cell("## Exercise 5\n# a comment, not a section"),
+            nbformat.v4.new_markdown_cell("## Exercise 99\nno such exercise in the lab"),
+        ]
+    )
+    assert exercises_in(nb) == [3]
+    assert exercises_in([cell.source for cell in nb.cells if cell.cell_type == "markdown"]) == [3]
