@@ -13,7 +13,7 @@ from datetime import UTC, datetime, timedelta, tzinfo
 from pathlib import Path
 
 from ...errors import InputError
-from .text import points_text
+from .text import is_number, points_text
 
 UNITS = {"day": 86400, "hour": 3600}
 MINUTE = int(timedelta(minutes=1).total_seconds())
@@ -220,7 +220,7 @@ def _number(value):
 
 def _amount(table, key, source, high=None, unit=""):
     value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if not is_number(value):
         raise InputError(f"{source}: [late] {key} must be a number{unit}; got {value!r}.")
     if value < 0 or (high is not None and value > high):
         bound = f"between 0 and {_number(high)}" if high is not None else "at least 0"
@@ -261,7 +261,7 @@ def from_dict(table: dict, source: str = "the rubric") -> Late:
         where = f"{listing} {name[:SHOWN]!r}"
         if isinstance(value, (str, datetime)):
             new = parse_deadline(value, where)
-        elif isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+        elif is_number(value):
             if value <= 0:
                 raise InputError(f"{where} gives {value!r} hours; an extension adds more than 0 hours.")
             new = deadline + timedelta(hours=value)

@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass, field
 
 from ...errors import InputError
-from .text import one_line
+from .text import is_number, one_line
 
 _EXERCISE_ITEM = re.compile(r"exercise(?P<number>[0-9]+)(?:/(?P<part>.+))?", re.DOTALL)
 
@@ -59,7 +59,7 @@ class PartResult:
         held, weight = data.get("held"), data.get("weight", 0)
         if held is not None and not isinstance(held, dict):
             raise InputError(f"what part {str(data.get('name'))[:80]!r} was held for is not a table")
-        if isinstance(weight, bool) or not isinstance(weight, (int, float)):
+        if not is_number(weight):
             raise InputError(f"the weight of part {str(data.get('name'))[:80]!r} is not a number")
         return cls(
             str(data["name"]), bool(data["passed"]), weight, str(data.get("hint") or ""),

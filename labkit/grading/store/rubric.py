@@ -22,7 +22,7 @@ from ...errors import InputError
 from ...exercises.registry import LAB, Registry
 from ...exercises.registry import load as load_registry
 from . import late as lateness
-from .text import points_text
+from .text import is_number, points_text
 
 DEFAULT = Path(__file__).with_name("rubric.toml")
 
@@ -223,8 +223,8 @@ def from_dict(data, source="the rubric"):
     points = {}
     for key, value in raw_points.items():
         number = _exercise(key, "[points]", source, registry)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
-            raise InputError(f"{source}: [points] gives exercise {number} {value!r}; points must be a number.")
+        if not is_number(value):
+            raise InputError(f"{source}: [points] gives exercise {number} {value!r}; points must be a finite number.")
         if value < 0:
             raise InputError(
                 f"{source}: [points] gives exercise {number} negative points ({value}); "
@@ -304,8 +304,8 @@ def _answers(table, source, registry, points):
         number = registry.answers[grade_id][0]
         if number not in points:
             raise InputError(f"{source}: [answers] gives {grade_id} points, but exercise {number} is in no group.")
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or value < 0:
-            raise InputError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a number, at least 0.")
+        if not is_number(value) or value < 0:
+            raise InputError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a finite number, at least 0.")
         found[grade_id] = float(value)
     return {grade_id: found[grade_id] for grade_id in registry.answers if grade_id in found}, lines
 
@@ -345,8 +345,8 @@ def _branches(table, source, registry):
             f"{source}: unknown key(s) {', '.join(unknown)} in [branches]; it has extra_credit and choice."
         )
     extra = table.get("extra_credit", 0)
-    if isinstance(extra, bool) or not isinstance(extra, (int, float)) or extra < 0:
-        raise InputError(f"{source}: [branches] extra_credit must be a number of points, at least 0; got {extra!r}.")
+    if not is_number(extra) or extra < 0:
+        raise InputError(f"{source}: [branches] extra_credit must be a finite number of points, at least 0; got {extra!r}.")
     choices = table.get("choice", [])
     if not isinstance(choices, list) or len(choices) < 2:
         raise InputError(f"{source}: [branches] needs at least two [[branches.choice]] entries (alternatives).")

@@ -1,10 +1,16 @@
-"""Numbers as the grader writes them in feedback, reports and exports."""
+"""Numbers as the grader reads them from a rubric and writes them in feedback, reports and exports."""
 
 from __future__ import annotations
 
+import math
 import re
 
 MAX_SOURCE_CHARS = 20_000  # characters kept of one graded function's source (a lab function is a few hundred)
+
+
+def is_number(value) -> bool:
+    """Whether a rubric's `value` is a finite int or float (True, False, NaN and infinity are not)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def points_text(value) -> str:

@@ -98,7 +98,8 @@ def test_answer_points_add_to_their_exercise_full_credit_and_maximum(tmp_path):
     [
         ("[answers]\nexercise3-answer-9 = 2\n", "no answer in words"),
         ("[answers]\nexercise3-answer-1 = -1\n", "at least 0"),
-        ('[answers]\nexercise3-answer-1 = "two"\n', "must be a number"),
+        ('[answers]\nexercise3-answer-1 = "two"\n', "must be a finite number"),
+        ("[answers]\nexercise3-answer-1 = nan\n", "must be a finite number"),
         ("[answers]\nexercise7-answer-1 = 3\n", "branches must be worth the same"),
     ],
 )

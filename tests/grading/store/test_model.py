@@ -23,6 +23,8 @@ def test_a_result_without_its_checks_is_refused_naming_the_submission():
         SubmissionGrade("ada", {2: {"fraction": 1.0, "checks": [1, 2]}})
     with pytest.raises(ValueError, match="weight of part 'p' is not a number"):
         PartResult.from_dict({"name": "p", "passed": True, "weight": "ten"})
+    with pytest.raises(ValueError, match="weight of part 'p' is not a number"):
+        PartResult.from_dict({"name": "p", "passed": True, "weight": float("nan")})
 
 
 def test_item_keys_are_values_and_their_text_round_trips():

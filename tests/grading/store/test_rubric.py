@@ -150,7 +150,10 @@ required = [2, 3]
         ("[points]\n17 = 5\n", "names exercise '17', which labkit does not grade"),
         ("required = [1]\n[points]\n1 = 5\n", "exercise 1 is not graded"),
         ("required = [2]\n[points]\n2 = -5\n", "negative points"),
-        ("required = [2]\n[points]\n2 = 'ten'\n", "points must be a number"),
+        ("required = [2]\n[points]\n2 = 'ten'\n", "points must be a finite number"),
+        ("required = [2]\n[points]\n2 = inf\n", "gives exercise 2 inf; points must be a finite number"),
+        ("required = [2]\n[points]\n2 = nan\n", "gives exercise 2 nan; points must be a finite number"),
+        ("required = [12]\n[answers]\nexercise12-answer-1 = inf\n", "points must be a finite number, at least 0"),
         (
             "[points]\n2 = 5\n5 = 5\n10 = 5\n[branches]\nextra_credit = 1\n[[branches.choice]]\nname = 'a'\nexercises = [5, 2]\n"
             "[[branches.choice]]\nname = 'b'\nexercises = [10, 2]\n",
@@ -167,6 +170,14 @@ required = [2, 3]
             "must be worth the same points",
         ),
         ("[points]\n5 = 5\n[branches]\n[[branches.choice]]\nname = 'a'\nexercises = [5]\n", "at least two"),
+        *[
+            (
+                f"[points]\n5 = 5\n10 = 5\n[branches]\nextra_credit = {given}\n[[branches.choice]]\nname = 'a'\n"
+                "exercises = [5]\n[[branches.choice]]\nname = 'b'\nexercises = [10]\n",
+                f"extra_credit must be a finite number of points, at least 0; got {given}",
+            )
+            for given in ("nan", "inf", "-1")
+        ],
         ("title = 'x'\n", "grades nothing"),
         ("exercises = 'no_such_module:REGISTRY'\nrequired = [2]\n", "cannot load the exercises"),
         ("exercises = 'labkit.exercises.model:Part'\nrequired = [2]\n", "not a labkit Registry"),
