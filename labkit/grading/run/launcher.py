@@ -2,7 +2,8 @@
 
 Started as ``python -m labkit.grading.submission.scoring SPEC``, each grading process (:mod:`.processes`) would
 import labkit's checks, numpy and scipy again. Instead :class:`Launcher` starts ``python -m
-labkit.grading.run.launcher`` once per run: its server (:func:`main`) imports all that, then forks one child per
+labkit.grading.run.launcher EXERCISES SOLUTIONS`` once per run: its server (:func:`main`) imports all that and
+fingerprints the known code (:func:`~labkit.grading.submission.scoring.warm`), then forks one child per
 submission, which puts itself in a session, cgroup and address-space limit of its own and runs
 :func:`labkit.grading.submission.scoring.main`. No student code runs here: only in the child's sandboxes.
 
@@ -62,7 +63,7 @@ class Launcher:
         self.ended, self._lock = {}, threading.RLock()
         parent = os.getpid()
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "labkit.grading.run.launcher", options.exercises or ""],
+            [sys.executable, "-m", "labkit.grading.run.launcher", options.exercises or "", options.solutions or ""],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
@@ -185,7 +186,10 @@ def _reaped(children):
 def main():
     from ..submission import scoring  # what grading a submission needs, imported once
 
-    scoring.load_registry(sys.argv[1] if len(sys.argv) > 1 and sys.argv[1] else None)
+    exercises, solutions = (sys.argv[1:] + ["", ""])[:2]
+    registry = scoring.load_registry(exercises or None)
+    with contextlib.suppress(ValueError, OSError):  # then each grading process meets it and says what is wrong
+        scoring.warm(registry, solutions or None)  # once here, not once per submission
     import scipy.interpolate  # the checks compare with it
     import scipy.linalg  # noqa: F401
 

@@ -305,7 +305,9 @@ def _answers(table, source, registry, points):
         if number not in points:
             raise InputError(f"{source}: [answers] gives {grade_id} points, but exercise {number} is in no group.")
         if not is_number(value) or value < 0:
-            raise InputError(f"{source}: [answers] gives {grade_id} {value!r}; points must be a finite number, at least 0.")
+            raise InputError(
+                f"{source}: [answers] gives {grade_id} {value!r}; points must be a finite number, at least 0."
+            )
         found[grade_id] = float(value)
     return {grade_id: found[grade_id] for grade_id in registry.answers if grade_id in found}, lines
 
@@ -346,7 +348,9 @@ def _branches(table, source, registry):
         )
     extra = table.get("extra_credit", 0)
     if not is_number(extra) or extra < 0:
-        raise InputError(f"{source}: [branches] extra_credit must be a finite number of points, at least 0; got {extra!r}.")
+        raise InputError(
+            f"{source}: [branches] extra_credit must be a finite number of points, at least 0; got {extra!r}."
+        )
     choices = table.get("choice", [])
     if not isinstance(choices, list) or len(choices) < 2:
         raise InputError(f"{source}: [branches] needs at least two [[branches.choice]] entries (alternatives).")

@@ -270,6 +270,13 @@ def known_sources(registry, folder=None):
     return known.corpus(tuple(registry.refusals), _solutions(stamps))
 
 
+def warm(registry, solutions=None):
+    """Compute what grading every submission reads alike, the known code's fingerprints and the reader of a
+    text's own code, so that a process forked afterwards (:mod:`labkit.grading.run.launcher`) finds them made."""
+    known_sources(registry, solutions)
+    _own_reader()
+
+
 @functools.lru_cache(maxsize=4)
 def _solutions(stamps):
     """The notebooks named in `stamps`, ((name, code cells), ...), read once while none of them changes (their
