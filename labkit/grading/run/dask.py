@@ -210,7 +210,7 @@ def _kept(options):
         return None, None
     # one pair per thread: a worker's threads never stop each other's, and the pair dies with its thread
     # (the sandbox and the launcher are set to die with the thread that started them)
-    key = (options.backend, options.limits, options.exercises, threading.get_ident())
+    key = (options.backend, options.limits, options.exercises, options.solutions, threading.get_ident())
     with _KEPT_LOCK:
         found = _KEPT.get(key)
         server, launcher = found or (None, None)

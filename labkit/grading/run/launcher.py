@@ -28,7 +28,7 @@ from ..sandbox import protocol
 from .processes import confine, die_with, one_thread
 
 LAUNCH_TIMEOUT = 30  # seconds for the launcher to fork one grading process
-LAUNCHER_READY = 120  # seconds for the launcher to import the grader
+LAUNCHER_READY = 120  # seconds for the launcher to import the grader and fingerprint the known code
 REQUEST_LIMIT = 1 << 16  # bytes of one request line
 
 
@@ -132,7 +132,7 @@ class Launcher:
         self.process.stdout.close()
 
 
-# The server: ``python -m labkit.grading.run.launcher [EXERCISES]``, a process of its own.
+# The server: ``python -m labkit.grading.run.launcher [EXERCISES [SOLUTIONS]]``, a process of its own.
 
 
 def _child(request):

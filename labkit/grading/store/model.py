@@ -60,7 +60,7 @@ class PartResult:
         if held is not None and not isinstance(held, dict):
             raise InputError(f"what part {str(data.get('name'))[:80]!r} was held for is not a table")
         if not is_number(weight):
-            raise InputError(f"the weight of part {str(data.get('name'))[:80]!r} is not a number")
+            raise InputError(f"the weight of part {str(data.get('name'))[:80]!r} is not a finite number")
         return cls(
             str(data["name"]), bool(data["passed"]), weight, str(data.get("hint") or ""),
             tuple(Step.from_dict(step) for step in steps), held, data.get("figure"),

@@ -9,8 +9,12 @@ MAX_SOURCE_CHARS = 20_000  # characters kept of one graded function's source (a 
 
 
 def is_number(value) -> bool:
-    """Whether a rubric's `value` is a finite int or float (True, False, NaN and infinity are not)."""
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    """Whether a rubric's `value` is a finite int or float (True, False, NaN, infinity and an int no float can
+    hold are not)."""
+    try:
+        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 def points_text(value) -> str:

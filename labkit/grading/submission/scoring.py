@@ -273,8 +273,8 @@ def known_sources(registry, folder=None):
 def warm(registry, solutions=None):
     """Compute what grading every submission reads alike, the known code's fingerprints and the reader of a
     text's own code, so that a process forked afterwards (:mod:`labkit.grading.run.launcher`) finds them made."""
-    known_sources(registry, solutions)
     _own_reader()
+    known_sources(registry, solutions)  # last: an InputError here (no notebooks in `solutions`) leaves the rest made
 
 
 @functools.lru_cache(maxsize=4)

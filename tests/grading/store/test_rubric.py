@@ -153,6 +153,7 @@ required = [2, 3]
         ("required = [2]\n[points]\n2 = 'ten'\n", "points must be a finite number"),
         ("required = [2]\n[points]\n2 = inf\n", "gives exercise 2 inf; points must be a finite number"),
         ("required = [2]\n[points]\n2 = nan\n", "gives exercise 2 nan; points must be a finite number"),
+        ("required = [2]\n[points]\n2 = " + "9" * 400 + "\n", "points must be a finite number"),
         ("required = [12]\n[answers]\nexercise12-answer-1 = inf\n", "points must be a finite number, at least 0"),
         (
             "[points]\n2 = 5\n5 = 5\n10 = 5\n[branches]\nextra_credit = 1\n[[branches.choice]]\nname = 'a'\nexercises = [5, 2]\n"
